@@ -1,0 +1,62 @@
+#pragma once
+// The project document: a versioned JSON file holding a SceneDescription, validated against
+// LIGHTING.md's rules. Paths inside it are relative to the project file.
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/SceneDescription.h"
+
+namespace terralux {
+
+// Invalid project content or override: the message names the JSON path, the value and the rule.
+class ProjectError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+inline constexpr int kProjectVersion = 1;
+inline constexpr int kMaxTerrainGridProbes = 4096;   // LIGHTING.md, diffuse grid dims
+inline constexpr int kMaxBoxGridProbes = 65536;
+inline constexpr int kMaxReflectionProbes = 256;
+inline constexpr int kMaxBounces = 16;
+
+struct Project {
+    SceneDescription scene;
+    // Directory that relative paths in the document are resolved against.
+    std::filesystem::path baseDir = std::filesystem::current_path();
+    std::filesystem::path file;  // empty for an unsaved project
+
+    std::filesystem::path resolve(const std::string& relative) const;
+    std::filesystem::path demPath() const;    // empty: use the embedded sample
+    std::filesystem::path hdrPath() const;
+    std::filesystem::path outDir() const;
+};
+
+// Defaults, as JSON: every key the document may hold.
+nlohmann::json defaultProjectJson();
+nlohmann::json sceneToJson(const SceneDescription& scene);
+// Validates every value. `source` prefixes messages (a file name, or "--set").
+SceneDescription sceneFromJson(const nlohmann::json& doc, const std::string& source,
+                               std::vector<std::string>* warnings);
+
+// Merges `doc` over the defaults (probe volume entries over the default volume); keys the
+// defaults do not have are dropped with a warning naming their path.
+nlohmann::json mergeOverDefaults(const nlohmann::json& doc, const std::string& source,
+                                 std::vector<std::string>* warnings);
+
+// Applies one `key.path=value` override; the path must name an existing parameter
+// (`probe_volumes[0].grid_dims`, `sun.elevation_deg`). The value is JSON, or a bare string, or a
+// comma list for array parameters.
+void applyOverride(nlohmann::json& doc, const std::string& assignment);
+
+Project loadProject(const std::filesystem::path& file, std::vector<std::string>* warnings);
+// Writes atomically (temporary file in the same directory, then rename).
+void saveProject(const Project& project, const std::filesystem::path& file);
+nlohmann::json projectToJson(const Project& project);
+
+}  // namespace terralux

@@ -1,0 +1,485 @@
+#include "DemImport.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <atomic>
+#include <sstream>
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <cpl_string.h>
+#include <gdal_alg.h>
+#include <gdal_priv.h>
+#include <gdal_utils.h>
+#include <gdalwarper.h>
+#include <ogr_spatialref.h>
+
+namespace terralux {
+namespace {
+
+// Sentinel written by our own warps where the output has no source data; a float that no DEM
+// holds, so it cannot collide with a real height.
+constexpr double kWarpNodata = -3.0e38;
+
+void registerDriversOnce() {
+    static std::once_flag once;
+    std::call_once(once, [] { GDALAllRegister(); });
+}
+
+// GDAL reports through a global handler; keep its chatter off the user's terminal and fold its
+// last message into ours.
+class QuietGdalErrors {
+public:
+    QuietGdalErrors() {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        CPLErrorReset();
+    }
+    ~QuietGdalErrors() { CPLPopErrorHandler(); }
+    static std::string last() {
+        std::string msg = CPLGetLastErrorMsg();
+        std::replace(msg.begin(), msg.end(), '\n', ' ');
+        return msg;
+    }
+};
+
+struct DatasetCloser {
+    void operator()(GDALDatasetH ds) const {
+        if (ds) GDALClose(ds);
+    }
+};
+using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+    throw DemError(path + ": " + what);
+}
+
+std::string withGdalReason(const std::string& what) {
+    const std::string reason = QuietGdalErrors::last();
+    return reason.empty() ? what : what + " (" + reason + ")";
+}
+
+// Runs a GDAL command-line utility (gdalwarp / gdal_translate semantics) into memory.
+template <typename NewOptions, typename FreeOptions, typename Run>
+DatasetPtr runUtility(const std::string& path, const std::vector<std::string>& args,
+                      NewOptions newOptions, FreeOptions freeOptions, Run run, const char* what) {
+    CPLStringList argv;
+    for (const auto& a : args) argv.AddString(a.c_str());
+    auto* options = newOptions(argv.List(), nullptr);
+    if (!options) fail(path, withGdalReason(std::string("invalid ") + what + " options"));
+    int usageError = 0;
+    GDALDatasetH out = run(options, &usageError);
+    freeOptions(options);
+    if (!out || usageError) fail(path, withGdalReason(std::string(what) + " failed"));
+    return DatasetPtr(out);
+}
+
+DatasetPtr warpTo(const std::string& path, GDALDatasetH src, const std::vector<std::string>& args) {
+    return runUtility(
+        path, args, GDALWarpAppOptionsNew, GDALWarpAppOptionsFree,
+        [&](GDALWarpAppOptions* o, int* usage) {
+            GDALDatasetH srcs[1] = {src};
+            return GDALWarp("", nullptr, 1, srcs, o, usage);
+        },
+        "reprojection");
+}
+
+DatasetPtr translateTo(const std::string& path, GDALDatasetH src,
+                       const std::vector<std::string>& args) {
+    return runUtility(
+        path, args, GDALTranslateOptionsNew, GDALTranslateOptionsFree,
+        [&](GDALTranslateOptions* o, int* usage) { return GDALTranslate("", src, o, usage); },
+        "resampling");
+}
+
+std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+std::string srsName(const OGRSpatialReference& srs) {
+    const char* name = srs.GetName();
+    return name ? name : "";
+}
+
+int srsEpsg(const OGRSpatialReference& srs) {
+    OGRSpatialReference copy(srs);
+    const char* code = copy.GetAuthorityCode(nullptr);
+    const char* authority = copy.GetAuthorityName(nullptr);
+    if (!code || !authority || std::string(authority) != "EPSG") {
+        if (copy.AutoIdentifyEPSG() != OGRERR_NONE) return 0;
+        code = copy.GetAuthorityCode(nullptr);
+    }
+    return code ? std::atoi(code) : 0;
+}
+
+bool isWebMercator(const OGRSpatialReference& srs) {
+    const int epsg = srsEpsg(srs);
+    if (epsg == 3857 || epsg == 900913 || epsg == 3785) return true;
+    return srsName(srs).find("Pseudo-Mercator") != std::string::npos;
+}
+
+// Target size for a warp, as gdalwarp would choose it, so that maxResolution can be applied in
+// the same pass (area averaging) instead of warping at full size first.
+bool suggestedWarpSize(GDALDatasetH src, const std::string& dstWkt, int& w, int& h) {
+    void* transformer = GDALCreateGenImgProjTransformer(src, nullptr, nullptr, dstWkt.c_str(),
+                                                        FALSE, 0.0, 0);
+    if (!transformer) return false;
+    double gt[6];
+    const CPLErr err =
+        GDALSuggestedWarpOutput(src, GDALGenImgProjTransform, transformer, gt, &w, &h);
+    GDALDestroyGenImgProjTransformer(transformer);
+    return err == CE_None && w > 0 && h > 0;
+}
+
+// Largest axis-aligned window whose border rows and columns are all covered. The coverage of a
+// reprojected raster is a slightly rotated rectangle; trimming its ragged edges keeps only
+// measured terrain rather than extrapolating into the wedges outside the source.
+struct Window {
+    int x0, y0, x1, y1;  // inclusive
+};
+Window coveredWindow(const std::vector<uint8_t>& cov, int w, int h) {
+    Window win{0, 0, w - 1, h - 1};
+    auto rowGaps = [&](int y) {
+        int n = 0;
+        for (int x = win.x0; x <= win.x1; ++x) n += cov[size_t(y) * w + x] == 0;
+        return n;
+    };
+    auto colGaps = [&](int x) {
+        int n = 0;
+        for (int y = win.y0; y <= win.y1; ++y) n += cov[size_t(y) * w + x] == 0;
+        return n;
+    };
+    while (win.x0 <= win.x1 && win.y0 <= win.y1) {
+        const int gaps[4] = {rowGaps(win.y0), rowGaps(win.y1), colGaps(win.x0), colGaps(win.x1)};
+        const int worst = int(std::max_element(gaps, gaps + 4) - gaps);
+        if (gaps[worst] == 0) break;
+        switch (worst) {
+            case 0: ++win.y0; break;
+            case 1: --win.y1; break;
+            case 2: ++win.x0; break;
+            default: --win.x1; break;
+        }
+    }
+    return win;
+}
+
+}  // namespace
+
+int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
+    double lon = std::fmod(longitudeDeg + 180.0, 360.0);
+    if (lon < 0) lon += 360.0;
+    const int zone = std::clamp(int(std::floor(lon / 6.0)) + 1, 1, 60);
+    return (latitudeDeg >= 0.0 ? 32600 : 32700) + zone;
+}
+
+DemImportResult importDem(const std::string& path, const DemImportOptions& options) {
+    registerDriversOnce();
+    QuietGdalErrors quiet;
+
+    const bool isVirtual = path.rfind("/vsi", 0) == 0;
+    if (path.empty()) throw DemError("DEM path is empty");
+    if (!isVirtual) {
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
+        if (std::filesystem::is_directory(path, ec)) fail(path, "is a directory, not a raster");
+        if (std::filesystem::file_size(path, ec) == 0 && !ec) fail(path, "file is empty");
+    }
+    if (options.maxResolution < 0) fail(path, "maximum resolution must be >= 0");
+
+    DatasetPtr src(GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, nullptr, nullptr,
+                              nullptr));
+    if (!src) fail(path, withGdalReason("not a raster GDAL can read"));
+    auto* ds = static_cast<GDALDataset*>(src.get());
+
+    DemImportResult result;
+    DemSourceInfo& info = result.source;
+    info.path = path;
+    info.driver = ds->GetDriver() ? ds->GetDriver()->GetDescription() : "";
+    info.sourceWidth = ds->GetRasterXSize();
+    info.sourceHeight = ds->GetRasterYSize();
+    if (ds->GetRasterCount() < 1) fail(path, "has no raster band");
+    if (info.sourceWidth < 1 || info.sourceHeight < 1)
+        fail(path, "raster is empty (" + std::to_string(info.sourceWidth) + "x" +
+                       std::to_string(info.sourceHeight) + ")");
+
+    double gt[6] = {0, 1, 0, 0, 0, -1};
+    const bool hasGeoTransform = ds->GetGeoTransform(gt) == CE_None;
+    if (!hasGeoTransform)
+        info.warnings.push_back("no georeferencing: cells taken as 1 m, origin at 0");
+    info.sourcePixelX = gt[1];
+    info.sourcePixelY = gt[5];
+
+    const OGRSpatialReference* srcSrs = ds->GetSpatialRef();
+    const bool hasCrs = srcSrs && !srcSrs->IsEmpty();
+    if (hasCrs) {
+        info.sourceCrs = srsName(*srcSrs);
+        info.sourceEpsg = srsEpsg(*srcSrs);
+    } else if (hasGeoTransform) {
+        info.warnings.push_back("no CRS: coordinates and cell sizes taken as metres");
+    }
+
+    const bool rotated = gt[2] != 0.0 || gt[4] != 0.0 || gt[5] > 0.0;
+    const bool needsMetric = hasCrs && (srcSrs->IsGeographic() || isWebMercator(*srcSrs));
+    info.geographic = needsMetric;
+    if (rotated && !hasCrs)
+        fail(path, "rotated or south-up geotransform without a CRS cannot be resampled");
+    if (!(std::isfinite(gt[1]) && std::isfinite(gt[5])) || gt[1] == 0.0 || gt[5] == 0.0)
+        fail(path, "pixel size " + fmt(gt[1]) + " x " + fmt(gt[5]) + " must be finite and non-zero");
+
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    int hasNodata = 0;
+    const double srcNodata = band->GetNoDataValue(&hasNodata);
+
+    // Pick the output grid: metric CRS, north up, optionally reduced.
+    DatasetPtr work;        // the grid we finally read (may be src itself)
+    DatasetPtr coverage;    // 1 where the warped output lies inside the source footprint
+    GDALDatasetH readFrom = src.get();
+    const double maxCells = options.maxCells;
+
+    auto reducedSize = [&](int w, int h, int& rw, int& rh) {
+        rw = w;
+        rh = h;
+        if (options.maxResolution > 0 && std::max(w, h) > options.maxResolution) {
+            const double s = double(options.maxResolution) / std::max(w, h);
+            rw = std::max(1, int(std::lround(w * s)));
+            rh = std::max(1, int(std::lround(h * s)));
+        }
+    };
+
+    if (needsMetric || rotated) {
+        OGRSpatialReference dst;
+        if (needsMetric) {
+            // Centre of the footprint in longitude/latitude picks the UTM zone.
+            OGRSpatialReference wgs84;
+            wgs84.SetWellKnownGeogCS("WGS84");
+            wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+            OGRSpatialReference srcCopy(*srcSrs);
+            srcCopy.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+            std::unique_ptr<OGRCoordinateTransformation> toGeo(
+                OGRCreateCoordinateTransformation(&srcCopy, &wgs84));
+            double cx = gt[0] + gt[1] * info.sourceWidth * 0.5 + gt[2] * info.sourceHeight * 0.5;
+            double cy = gt[3] + gt[4] * info.sourceWidth * 0.5 + gt[5] * info.sourceHeight * 0.5;
+            if (!toGeo || !toGeo->Transform(1, &cx, &cy))
+                fail(path, withGdalReason("cannot locate the footprint centre in WGS 84"));
+            dst.importFromEPSG(utmEpsgFor(cx, cy));
+        } else {
+            dst = *srcSrs;
+        }
+        char* wktRaw = nullptr;
+        dst.exportToWkt(&wktRaw);
+        const std::string dstWkt = wktRaw ? wktRaw : "";
+        CPLFree(wktRaw);
+
+        int fullW = 0, fullH = 0;
+        if (!suggestedWarpSize(src.get(), dstWkt, fullW, fullH))
+            fail(path, withGdalReason("cannot compute the reprojected grid"));
+        int outW, outH;
+        reducedSize(fullW, fullH, outW, outH);
+        if (double(outW) * outH > maxCells)
+            fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
+                           " is too large to hold in memory; set terrain.max_resolution");
+
+        std::vector<std::string> args = {"-of", "MEM", "-t_srs", dstWkt, "-ot", "Float32",
+                                         "-dstnodata", fmt(kWarpNodata)};
+        if (outW != fullW || outH != fullH) {
+            args.insert(args.end(), {"-ts", std::to_string(outW), std::to_string(outH), "-r",
+                                     "average"});
+            info.resampled = true;
+        } else {
+            args.insert(args.end(), {"-r", "bilinear"});
+        }
+        if (hasNodata) args.insert(args.end(), {"-srcnodata", fmt(srcNodata)});
+        work = warpTo(path, src.get(), args);
+        info.reprojected = needsMetric;
+
+        // Same warp of an all-ones raster: where the output has no source at all.
+        GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+        DatasetPtr ones(mem->Create("", info.sourceWidth, info.sourceHeight, 1, GDT_Byte, nullptr));
+        auto* onesDs = static_cast<GDALDataset*>(ones.get());
+        onesDs->SetGeoTransform(gt);
+        onesDs->SetSpatialRef(srcSrs);
+        onesDs->GetRasterBand(1)->Fill(1.0);
+        coverage = warpTo(path, ones.get(),
+                          {"-of", "MEM", "-t_srs", dstWkt, "-ts", std::to_string(outW),
+                           std::to_string(outH), "-r", "near", "-dstnodata", "0"});
+        readFrom = work.get();
+    } else {
+        int outW, outH;
+        reducedSize(info.sourceWidth, info.sourceHeight, outW, outH);
+        if (double(outW) * outH > maxCells)
+            fail(path, "raster " + std::to_string(outW) + "x" + std::to_string(outH) +
+                           " is too large to hold in memory; set terrain.max_resolution");
+        if (outW != info.sourceWidth || outH != info.sourceHeight) {
+            work = translateTo(path, src.get(),
+                               {"-of", "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),
+                                std::to_string(outH), "-r", "average"});
+            readFrom = work.get();
+            info.resampled = true;
+        }
+    }
+
+    auto* rd = static_cast<GDALDataset*>(readFrom);
+    int w = rd->GetRasterXSize();
+    int h = rd->GetRasterYSize();
+    double rgt[6] = {0, 1, 0, 0, 0, -1};
+    if (hasGeoTransform || work) rd->GetGeoTransform(rgt);
+    GDALRasterBand* rband = rd->GetRasterBand(1);
+    int rHasNodata = 0;
+    const double rNodata = rband->GetNoDataValue(&rHasNodata);
+
+    std::vector<float> heights;
+    try {
+        heights.resize(size_t(w) * size_t(h));
+    } catch (const std::bad_alloc&) {
+        fail(path, "raster " + std::to_string(w) + "x" + std::to_string(h) +
+                       " is too large to hold in memory; set terrain.max_resolution");
+    }
+    if (rband->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
+        CE_None)
+        fail(path, withGdalReason("cannot read band 1"));
+
+    std::vector<uint8_t> nodata(heights.size(), 0);
+    const bool nodataIsNan = rHasNodata && std::isnan(rNodata);
+    const float nodataF = float(rNodata);
+    size_t nodataCount = 0;
+    for (size_t i = 0; i < heights.size(); ++i) {
+        const float v = heights[i];
+        if ((rHasNodata && (nodataIsNan ? std::isnan(v) : v == nodataF))) {
+            nodata[i] = 1;
+            ++nodataCount;
+        } else if (!std::isfinite(v)) {
+            fail(path, "non-finite height at column " + std::to_string(i % w) + ", row " +
+                           std::to_string(i / w) + "; heights must be finite numbers");
+        }
+    }
+
+    // Trim a reprojected grid to the window that lies wholly inside the source footprint.
+    int x0 = 0, y0 = 0;
+    if (coverage) {
+        std::vector<uint8_t> cov(size_t(w) * h);
+        if (static_cast<GDALDataset*>(coverage.get())
+                ->GetRasterBand(1)
+                ->RasterIO(GF_Read, 0, 0, w, h, cov.data(), w, h, GDT_Byte, 0, 0, nullptr) != CE_None)
+            fail(path, withGdalReason("cannot read the reprojected coverage"));
+        const Window win = coveredWindow(cov, w, h);
+        if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");
+        const int cw = win.x1 - win.x0 + 1, ch = win.y1 - win.y0 + 1;
+        std::vector<float> ch_h(size_t(cw) * ch);
+        std::vector<uint8_t> ch_n(size_t(cw) * ch);
+        nodataCount = 0;
+        for (int y = 0; y < ch; ++y)
+            for (int x = 0; x < cw; ++x) {
+                const size_t s = size_t(y + win.y0) * w + (x + win.x0), d = size_t(y) * cw + x;
+                ch_h[d] = heights[s];
+                ch_n[d] = nodata[s];
+                nodataCount += nodata[s];
+            }
+        heights.swap(ch_h);
+        nodata.swap(ch_n);
+        x0 = win.x0;
+        y0 = win.y0;
+        w = cw;
+        h = ch;
+    }
+
+    if (nodataCount == heights.size()) fail(path, "every cell is nodata; nothing to import");
+
+    // Fill holes from their valid neighbours: GDALFillNodata interpolates by inverse distance
+    // weighting over a search in four directions, then runs 3x3 smoothing passes over the filled
+    // cells only. The search reaches the whole grid, so every hole is filled.
+    if (nodataCount > 0) {
+        GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+        DatasetPtr fillDs(mem->Create("", w, h, 1, GDT_Float32, nullptr));
+        DatasetPtr maskDs(mem->Create("", w, h, 1, GDT_Byte, nullptr));
+        auto* fb = static_cast<GDALDataset*>(fillDs.get())->GetRasterBand(1);
+        auto* mb = static_cast<GDALDataset*>(maskDs.get())->GetRasterBand(1);
+        std::vector<uint8_t> valid(nodata.size());
+        for (size_t i = 0; i < nodata.size(); ++i) valid[i] = nodata[i] ? 0 : 1;
+        if (fb->RasterIO(GF_Write, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
+                CE_None ||
+            mb->RasterIO(GF_Write, 0, 0, w, h, valid.data(), w, h, GDT_Byte, 0, 0, nullptr) !=
+                CE_None ||
+            GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr,
+                           nullptr) != CE_None ||
+            fb->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
+                CE_None)
+            fail(path, withGdalReason("filling nodata cells failed"));
+    }
+
+    // Metric units and the geographic origin of the footprint centre.
+    double unit = 1.0;
+    std::string crsWkt, crsName;
+    int epsg = 0;
+    if (const OGRSpatialReference* outSrs = rd->GetSpatialRef(); outSrs && !outSrs->IsEmpty()) {
+        unit = outSrs->GetLinearUnits();
+        if (!(unit > 0.0)) unit = 1.0;
+        char* wkt = nullptr;
+        outSrs->exportToWkt(&wkt);
+        crsWkt = wkt ? wkt : "";
+        CPLFree(wkt);
+        crsName = srsName(*outSrs);
+        epsg = srsEpsg(*outSrs);
+    }
+    const double cellX = std::abs(rgt[1]) * unit;
+    const double cellZ = std::abs(rgt[5]) * unit;
+
+    const double scale = options.verticalScale;
+    if (!(scale > 0.0) || !std::isfinite(scale))
+        fail(path, "vertical scale " + fmt(scale) + " must be finite and > 0");
+    if (scale != 1.0)
+        for (float& v : heights) v = float(v * scale);
+
+    try {
+        result.heightfield = Heightfield(w, h, cellX, cellZ, std::move(heights));
+        result.heightfield.setNodataMask(nodataCount > 0 ? std::move(nodata)
+                                                         : std::vector<uint8_t>{});
+    } catch (const std::invalid_argument& e) {
+        fail(path, e.what());
+    }
+    GeoOrigin& geo = result.heightfield.geo;
+    geo.easting = (rgt[0] + rgt[1] * (x0 + w * 0.5)) * unit;
+    geo.northing = (rgt[3] + rgt[5] * (y0 + h * 0.5)) * unit;
+    geo.height = 0.0;
+    geo.crsWkt = crsWkt;
+    geo.crsName = crsName;
+    geo.epsg = epsg;
+    return result;
+}
+
+}  // namespace terralux
+
+namespace terralux {
+
+DemImportResult importDemFromMemory(const std::string& name, const unsigned char* bytes,
+                                    size_t size, const DemImportOptions& options) {
+    registerDriversOnce();
+    static std::atomic<unsigned> counter{0};
+    const std::string vsiPath =
+        "/vsimem/terralux-" + std::to_string(counter.fetch_add(1)) + "/" + name;
+    // GDAL only reads the buffer; it does not take ownership (last argument FALSE).
+    VSILFILE* f = VSIFileFromMemBuffer(vsiPath.c_str(), const_cast<GByte*>(bytes),
+                                       vsi_l_offset(size), FALSE);
+    if (!f) throw DemError(name + ": cannot map the embedded raster");
+    VSIFCloseL(f);
+    struct Unlink {
+        std::string p;
+        ~Unlink() { VSIUnlink(p.c_str()); }
+    } unlink{vsiPath};
+    try {
+        DemImportResult r = importDem(vsiPath, options);
+        r.source.path = name;
+        return r;
+    } catch (const DemError& e) {
+        std::string msg = e.what();
+        if (msg.rfind(vsiPath, 0) == 0) msg = name + msg.substr(vsiPath.size());
+        throw DemError(msg);
+    }
+}
+
+}  // namespace terralux

@@ -1,0 +1,63 @@
+#pragma once
+// DEM import: any raster GDAL opens, band 1, into an engine-space Heightfield.
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+// A user-facing failure: one line that names the file, the problem and, where it helps, the rule.
+class DemError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct DemImportOptions {
+    // 0 = keep the source resolution; otherwise the longer side is reduced to at most this many
+    // samples by area averaging.
+    int maxResolution = 0;
+    // Rasters with more cells than this (after maxResolution) are refused before any pixel is
+    // read: 4 bytes per cell for heights plus the working copies GDAL needs.
+    double maxCells = 256.0 * 1024 * 1024;
+    double verticalScale = 1.0;
+};
+
+// What the source was, before reprojection; what `terralux --info` prints.
+struct DemSourceInfo {
+    std::string path;
+    std::string driver;          // GDAL short name, e.g. "GTiff", "SRTMHGT", "AAIGrid"
+    int sourceWidth = 0;
+    int sourceHeight = 0;
+    std::string sourceCrs;       // name, or empty
+    int sourceEpsg = 0;
+    bool geographic = false;     // source CRS was geographic (or Web Mercator) and was reprojected
+    bool reprojected = false;
+    bool resampled = false;      // maxResolution reduced the grid
+    double sourcePixelX = 0.0;   // source units, as the geotransform says
+    double sourcePixelY = 0.0;
+    std::vector<std::string> warnings;  // e.g. no CRS: cells taken as metres
+};
+
+struct DemImportResult {
+    Heightfield heightfield;
+    DemSourceInfo source;
+};
+
+// Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.
+DemImportResult importDem(const std::string& path, const DemImportOptions& options = {});
+
+// The UTM zone EPSG code (WGS 84) for a geographic position: 326zz north, 327zz south.
+int utmEpsgFor(double longitudeDeg, double latitudeDeg);
+
+}  // namespace terralux
+
+namespace terralux {
+// Imports a raster held in memory (e.g. the sample compiled into the binary); `name` is the file
+// name GDAL sees (its extension helps pick the driver) and the name messages use.
+DemImportResult importDemFromMemory(const std::string& name, const unsigned char* bytes,
+                                    size_t size, const DemImportOptions& options = {});
+}  // namespace terralux

@@ -1,0 +1,95 @@
+#pragma once
+// Every lighting parameter of a Terralux scene, in one place (LIGHTING.md). The project JSON,
+// `--set`, the UI and the bake all read these fields; defaults here are the documented ones.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+namespace terralux {
+
+struct TerrainSettings {
+    std::string dem;                 // path; relative paths are relative to the project file
+    double verticalScale = 1.0;      // > 0
+    glm::vec3 albedo{0.3f, 0.3f, 0.3f};  // Lambertian, each in [0, 1]
+    int maxResolution = 0;           // 0 = source resolution; else longest side, area-averaged
+    bool skirt = true;               // ground continues beyond the footprint at the border height
+};
+
+struct SunSettings {
+    double azimuthDeg = 135.0;       // clockwise from north (−Z) toward east (+X)
+    double elevationDeg = 35.0;      // above the horizon, [−90, 90]
+    double illuminance = 3.0;        // E_sun on a surface facing the sun, scene-linear, >= 0
+    glm::vec3 color{1.0f, 0.96f, 0.9f};
+    double angularRadiusDeg = 0.27;  // [0, 45]
+};
+
+enum class SkyMode { Uniform, Hdr };
+
+struct SkySettings {
+    SkyMode mode = SkyMode::Uniform;
+    glm::vec3 color{0.6f, 0.75f, 1.0f};  // each >= 0
+    double intensity = 1.0;              // >= 0
+    std::string hdr;                     // equirectangular image, for mode hdr
+    double rotationDeg = 0.0;            // turns the HDR about +Y
+};
+
+enum class ProbePlacement { Terrain, Box };
+
+struct ProbeVolumeSettings {
+    std::string name = "probes";     // file stem of its .shprobe: [A-Za-z0-9_-]+
+    bool enabled = true;
+    ProbePlacement placement = ProbePlacement::Terrain;
+    // Terrain: (nx, nz) probes; Box: (nx, ny, nz) cells, one probe at each centre.
+    std::array<int, 3> gridDims{8, 1, 8};
+    // Terrain: (x, z) of the first probe; Box: (x, y, z) of the min corner. Unset = auto-span.
+    std::optional<glm::vec3> origin;
+    // Terrain: (sx, sz) between probes; Box: cube edge in .x. Unset = auto-span.
+    std::optional<glm::vec3> spacing;
+    double heightOffset = 5.0;       // terrain placement: metres above the bilinear terrain height
+    std::optional<int> rayCount;     // unset = the bake quality preset decides
+    std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
+};
+
+struct ReflectionProbeSettings {
+    bool enabled = false;
+    std::array<int, 2> gridDims{4, 4};
+    double heightOffset = 5.0;
+    int rayCount = 16;
+    glm::vec3 groundColor{0.22f, 0.18f, 0.14f};
+    double strength = 1.0;
+};
+
+enum class QualityPreset { Draft, Standard, High, Reference };
+enum class ShEncoding { Radiance, Irradiance };
+
+struct BakeSettings {
+    QualityPreset quality = QualityPreset::Standard;
+    std::optional<int> rays;          // per probe; unset = preset
+    std::optional<int> bounces;       // 0 = sky visibility only; unset = preset
+    ShEncoding encoding = ShEncoding::Radiance;
+    bool deringing = false;           // window SH so irradiance is never negative
+};
+
+struct ExportSettings {
+    std::string outDir = "bake";      // relative to the project file
+    bool gltf = true;
+    double defaultScale = 1.0;
+    double defaultAmbient = 0.1;
+};
+
+struct SceneDescription {
+    TerrainSettings terrain;
+    SunSettings sun;
+    SkySettings sky;
+    std::vector<ProbeVolumeSettings> probeVolumes{ProbeVolumeSettings{}};
+    ReflectionProbeSettings reflectionProbes;
+    BakeSettings bake;
+    ExportSettings exportSettings;
+};
+
+}  // namespace terralux

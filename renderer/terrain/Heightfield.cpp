@@ -1,0 +1,91 @@
+#include "terrain/Heightfield.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <glm/geometric.hpp>
+
+namespace terralux {
+
+Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSizeZ,
+                         std::vector<float> heights)
+    : width_(width), depth_(depth), cellSizeX_(cellSizeX), cellSizeZ_(cellSizeZ),
+      heights_(std::move(heights)) {
+    if (width < 1 || depth < 1)
+        throw std::invalid_argument("heightfield: size " + std::to_string(width) + "x" +
+                                    std::to_string(depth) + " must be at least 1x1");
+    if (!(cellSizeX > 0.0) || !(cellSizeZ > 0.0) || !std::isfinite(cellSizeX) ||
+        !std::isfinite(cellSizeZ))
+        throw std::invalid_argument("heightfield: cell size must be finite and > 0");
+    if (heights_.size() != size_t(width) * size_t(depth))
+        throw std::invalid_argument("heightfield: " + std::to_string(heights_.size()) +
+                                    " heights for a " + std::to_string(width) + "x" +
+                                    std::to_string(depth) + " grid");
+    minHeight_ = heights_[0];
+    maxHeight_ = heights_[0];
+    for (float h : heights_) {
+        if (!std::isfinite(h)) throw std::invalid_argument("heightfield: non-finite height");
+        minHeight_ = std::min(minHeight_, h);
+        maxHeight_ = std::max(maxHeight_, h);
+    }
+}
+
+float Heightfield::surfaceHeight(float x, float z) const {
+    const double gx = std::clamp(double(x) / cellSizeX_ + 0.5 * (width_ - 1), 0.0, double(width_ - 1));
+    const double gz = std::clamp(double(z) / cellSizeZ_ + 0.5 * (depth_ - 1), 0.0, double(depth_ - 1));
+    const int c = std::min(int(gx), std::max(width_ - 2, 0));
+    const int r = std::min(int(gz), std::max(depth_ - 2, 0));
+    if (width_ == 1 && depth_ == 1) return at(0, 0);
+    if (width_ == 1) {
+        const double fz = gz - r;
+        return float(at(0, r) + fz * (at(0, r + 1) - at(0, r)));
+    }
+    if (depth_ == 1) {
+        const double fx = gx - c;
+        return float(at(c, 0) + fx * (at(c + 1, 0) - at(c, 0)));
+    }
+    const double fx = gx - c, fz = gz - r;
+    const double h00 = at(c, r), h10 = at(c + 1, r), h01 = at(c, r + 1), h11 = at(c + 1, r + 1);
+    if (fx <= fz) return float(h00 + fz * (h01 - h00) + fx * (h11 - h01));
+    return float(h00 + fx * (h10 - h00) + fz * (h11 - h10));
+}
+
+glm::vec3 Heightfield::surfaceNormal(float x, float z) const {
+    if (!contains(x, z) || width_ < 2 || depth_ < 2) return {0.0f, 1.0f, 0.0f};
+    const double gx = double(x) / cellSizeX_ + 0.5 * (width_ - 1);
+    const double gz = double(z) / cellSizeZ_ + 0.5 * (depth_ - 1);
+    const int c = std::min(int(gx), width_ - 2);
+    const int r = std::min(int(gz), depth_ - 2);
+    const double fx = gx - c, fz = gz - r;
+    const double h00 = at(c, r), h10 = at(c + 1, r), h01 = at(c, r + 1), h11 = at(c + 1, r + 1);
+    double dhdx, dhdz;
+    if (fx <= fz) {
+        dhdx = (h11 - h01) / cellSizeX_;
+        dhdz = (h01 - h00) / cellSizeZ_;
+    } else {
+        dhdx = (h10 - h00) / cellSizeX_;
+        dhdz = (h11 - h10) / cellSizeZ_;
+    }
+    return glm::normalize(glm::vec3(float(-dhdx), 1.0f, float(-dhdz)));
+}
+
+glm::vec3 Heightfield::vertexNormal(int col, int row) const {
+    const int c0 = std::max(col - 1, 0), c1 = std::min(col + 1, width_ - 1);
+    const int r0 = std::max(row - 1, 0), r1 = std::min(row + 1, depth_ - 1);
+    const double dhdx = c1 > c0 ? (at(c1, row) - at(c0, row)) / ((c1 - c0) * cellSizeX_) : 0.0;
+    const double dhdz = r1 > r0 ? (at(col, r1) - at(col, r0)) / ((r1 - r0) * cellSizeZ_) : 0.0;
+    return glm::normalize(glm::vec3(float(-dhdx), 1.0f, float(-dhdz)));
+}
+
+void Heightfield::setNodataMask(std::vector<uint8_t> mask) {
+    if (!mask.empty() && mask.size() != heights_.size())
+        throw std::invalid_argument("heightfield: nodata mask size does not match the grid");
+    nodataMask_ = std::move(mask);
+}
+
+size_t Heightfield::nodataCount() const {
+    return size_t(std::count(nodataMask_.begin(), nodataMask_.end(), uint8_t(1)));
+}
+
+}  // namespace terralux

@@ -1,0 +1,88 @@
+#pragma once
+// The terrain surface every part of Terralux agrees on: bake, viewport and exports.
+//
+// Engine space (FORMATS.md): Y up, X east, Z south, metres, origin at the centre of the DEM
+// footprint at height 0. DEM sample (col, row) is mesh vertex (col, row); row 0 is the northern
+// edge, so it lies at the most negative Z. Each cell between four vertices is split into two
+// triangles along one fixed diagonal, from vertex (c, r) to (c + 1, r + 1):
+//   triangle A = (c, r), (c, r + 1), (c + 1, r + 1)   covers fx <= fz
+//   triangle B = (c, r), (c + 1, r + 1), (c + 1, r)   covers fx >  fz
+// where fx, fz in [0, 1] are the position inside the cell along +X and +Z.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace terralux {
+
+// Where the local origin sits on the Earth, kept in double precision (UTM-sized coordinates
+// do not fit a float).
+struct GeoOrigin {
+    double easting = 0.0;   // metres, in crsWkt, of the footprint centre
+    double northing = 0.0;  // metres
+    double height = 0.0;    // metres; engine y = elevation - height
+    std::string crsWkt;     // empty: the DEM carried no CRS
+    std::string crsName;    // short human-readable name, e.g. "WGS 84 / UTM zone 31N"
+    int epsg = 0;           // 0 when unknown
+};
+
+class Heightfield {
+public:
+    Heightfield() = default;
+    // heights: row-major, width * depth samples, metres. Throws std::invalid_argument on bad
+    // dimensions, non-positive cell sizes or non-finite heights.
+    Heightfield(int width, int depth, double cellSizeX, double cellSizeZ,
+                std::vector<float> heights);
+
+    int width() const { return width_; }   // vertices along X (DEM columns)
+    int depth() const { return depth_; }   // vertices along Z (DEM rows)
+    double cellSizeX() const { return cellSizeX_; }
+    double cellSizeZ() const { return cellSizeZ_; }
+    const std::vector<float>& heights() const { return heights_; }
+    float at(int col, int row) const { return heights_[size_t(row) * size_t(width_) + size_t(col)]; }
+
+    // Engine-space coordinate of a vertex column / row.
+    float xOf(double col) const { return float((col - 0.5 * (width_ - 1)) * cellSizeX_); }
+    float zOf(double row) const { return float((row - 0.5 * (depth_ - 1)) * cellSizeZ_); }
+    glm::vec3 vertex(int col, int row) const { return {xOf(col), at(col, row), zOf(row)}; }
+
+    // Footprint in engine space (the vertex grid's extent).
+    float minX() const { return xOf(0); }
+    float maxX() const { return xOf(width_ - 1); }
+    float minZ() const { return zOf(0); }
+    float maxZ() const { return zOf(depth_ - 1); }
+    float minHeight() const { return minHeight_; }
+    float maxHeight() const { return maxHeight_; }
+    bool contains(float x, float z) const {
+        return x >= minX() && x <= maxX() && z >= minZ() && z <= maxZ();
+    }
+
+    // Height of the triangle surface at (x, z); outside the footprint the surface continues
+    // at the nearest border point (the skirt of LIGHTING.md).
+    float surfaceHeight(float x, float z) const;
+    // Unit geometric normal of the triangle under (x, z) (the skirt is treated as level).
+    glm::vec3 surfaceNormal(float x, float z) const;
+    // Smooth per-vertex normal (central differences), what the mesh export and viewport shade.
+    glm::vec3 vertexNormal(int col, int row) const;
+
+    // Cells that were nodata in the source and were filled; empty when the source had none.
+    const std::vector<uint8_t>& nodataMask() const { return nodataMask_; }
+    void setNodataMask(std::vector<uint8_t> mask);
+    size_t nodataCount() const;
+
+    GeoOrigin geo;
+
+private:
+    int width_ = 0;
+    int depth_ = 0;
+    double cellSizeX_ = 1.0;
+    double cellSizeZ_ = 1.0;
+    std::vector<float> heights_;
+    std::vector<uint8_t> nodataMask_;
+    float minHeight_ = 0.0f;
+    float maxHeight_ = 0.0f;
+};
+
+}  // namespace terralux

@@ -1,0 +1,275 @@
+// DEM import against numbers computed independently with GDAL's own tools
+// (tests/data/dem/expected.json, tests/data/dem/SOURCES.md).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gdal_priv.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "DemImport.h"
+#include "SampleTerrain.h"
+
+using namespace terralux;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kData = fs::path(TERRALUX_TEST_DATA) / "dem";
+const fs::path kShared = fs::path(TERRALUX_SHARED_DATA) / "dem";
+
+const nlohmann::json& expected() {
+    static const nlohmann::json j = [] {
+        std::ifstream in(kData / "expected.json");
+        return nlohmann::json::parse(in);
+    }();
+    return j;
+}
+
+std::string importError(const std::string& path, DemImportOptions o = {}) {
+    try {
+        importDem(path, o);
+    } catch (const DemError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+double meanHeight(const Heightfield& hf) {
+    double s = 0;
+    for (float h : hf.heights()) s += h;
+    return s / double(hf.heights().size());
+}
+
+// Heights on filled cells must come from their neighbours: inside the valid range.
+void expectFilledWithinValidRange(const Heightfield& hf, double lo, double hi) {
+    ASSERT_EQ(hf.nodataMask().size(), hf.heights().size());
+    for (size_t i = 0; i < hf.heights().size(); ++i) {
+        if (!hf.nodataMask()[i]) continue;
+        EXPECT_GE(hf.heights()[i], lo - 1.0) << "cell " << i;
+        EXPECT_LE(hf.heights()[i], hi + 1.0) << "cell " << i;
+    }
+}
+
+}  // namespace
+
+TEST(DemImport, ProjectedGeoTiff) {
+    const auto& e = expected()["bigtujunga_utm11_crop.tif"];
+    const auto r = importDem((kData / "bigtujunga_utm11_crop.tif").string());
+    const Heightfield& hf = r.heightfield;
+    EXPECT_EQ(r.source.driver, "GTiff");
+    EXPECT_EQ(r.source.sourceEpsg, 32611);
+    EXPECT_FALSE(r.source.reprojected);
+    EXPECT_EQ(hf.width(), e["cols"].get<int>());
+    EXPECT_EQ(hf.depth(), e["rows"].get<int>());
+    EXPECT_DOUBLE_EQ(hf.cellSizeX(), 30.0);
+    EXPECT_DOUBLE_EQ(hf.cellSizeZ(), 30.0);
+    EXPECT_FLOAT_EQ(hf.minHeight(), e["min"].get<float>());
+    EXPECT_FLOAT_EQ(hf.maxHeight(), e["max"].get<float>());
+    EXPECT_NEAR(meanHeight(hf), e["mean"].get<double>(), 1e-3);
+    EXPECT_EQ(hf.nodataCount(), 0u);
+    // Vertices at pixel centres: the mesh spans (cols - 1) pixels, centred on the origin.
+    EXPECT_FLOAT_EQ(hf.maxX() - hf.minX(), e["footprint_centres_x_m"].get<float>());
+    EXPECT_FLOAT_EQ(hf.maxZ() - hf.minZ(), e["footprint_centres_y_m"].get<float>());
+    EXPECT_FLOAT_EQ(hf.minX(), -hf.maxX());
+    EXPECT_EQ(hf.geo.epsg, 32611);
+    EXPECT_NEAR(hf.geo.easting, e["origin_x"].get<double>() + 96 * 30.0 / 2, 1e-6);
+    EXPECT_NEAR(hf.geo.northing, e["origin_y"].get<double>() - 64 * 30.0 / 2, 1e-6);
+}
+
+TEST(DemImport, GeographicWithVoidsIsReprojectedToUtmAndFilled) {
+    const auto& e = expected()["n42e001_voids_crop.tif"];
+    const auto r = importDem((kData / "n42e001_voids_crop.tif").string());
+    const Heightfield& hf = r.heightfield;
+    EXPECT_TRUE(r.source.geographic);
+    EXPECT_TRUE(r.source.reprojected);
+    EXPECT_EQ(hf.geo.epsg, e["warped"]["utm_epsg"].get<int>());
+    // gdalwarp's own choice of pixel size for this raster.
+    EXPECT_NEAR(hf.cellSizeX(), e["warped"]["pixel_size_x"].get<double>(), 1e-3);
+    EXPECT_NEAR(hf.cellSizeZ(), std::abs(e["warped"]["pixel_size_y"].get<double>()), 1e-3);
+    // Trimmed to the part inside the source: never larger than gdalwarp's grid, rarely much smaller.
+    EXPECT_LE(hf.width(), e["warped"]["cols"].get<int>());
+    EXPECT_LE(hf.depth(), e["warped"]["rows"].get<int>());
+    EXPECT_GE(hf.width(), e["warped"]["cols"].get<int>() - 6);
+    EXPECT_GE(hf.depth(), e["warped"]["rows"].get<int>() - 6);
+    // 135 source voids (26 holes) stay flagged; the corner wedges are trimmed, not counted.
+    EXPECT_GT(hf.nodataCount(), 80u);
+    EXPECT_LT(hf.nodataCount(), e["warped"]["nodata_count"].get<size_t>());
+    EXPECT_GE(hf.minHeight(), e["min"].get<float>() - 1.0f);
+    EXPECT_LE(hf.maxHeight(), e["max"].get<float>() + 1.0f);
+    expectFilledWithinValidRange(hf, e["min"].get<double>(), e["max"].get<double>());
+}
+
+TEST(DemImport, GeographicSummitWithLargeHoles) {
+    const auto& e = expected()["rainier_crop.tif"];
+    const auto r = importDem((kData / "rainier_crop.tif").string());
+    const Heightfield& hf = r.heightfield;
+    EXPECT_EQ(hf.geo.epsg, 32610);
+    EXPECT_NEAR(hf.cellSizeX(), e["warped"]["pixel_size_x"].get<double>(), 1e-3);
+    // 23.6 % of the source is void; most of it survives the warp as flagged, filled cells.
+    const double share = double(hf.nodataCount()) / double(hf.heights().size());
+    EXPECT_GT(share, 0.15);
+    EXPECT_LT(share, 0.35);
+    expectFilledWithinValidRange(hf, e["min"].get<double>(), e["max"].get<double>());
+    EXPECT_LE(hf.maxHeight(), e["max"].get<float>() + 1.0f);
+}
+
+TEST(DemImport, AsciiGridWithoutCrsIsTakenAsMetresWithAWarning) {
+    const auto& e = expected()["orkhon_crop.asc"];
+    const auto r = importDem((kData / "orkhon_crop.asc").string());
+    const Heightfield& hf = r.heightfield;
+    EXPECT_EQ(r.source.driver, "AAIGrid");
+    EXPECT_EQ(hf.geo.epsg, 0);
+    ASSERT_EQ(r.source.warnings.size(), 1u);
+    EXPECT_NE(r.source.warnings[0].find("no CRS"), std::string::npos);
+    EXPECT_EQ(hf.width(), e["cols"].get<int>());
+    EXPECT_EQ(hf.depth(), e["rows"].get<int>());
+    EXPECT_NEAR(hf.cellSizeX(), e["pixel_size_x"].get<double>(), 1e-6);
+    EXPECT_NEAR(hf.minHeight(), e["min"].get<double>(), 1e-3);
+    EXPECT_NEAR(hf.maxHeight(), e["max"].get<double>(), 1e-3);
+    EXPECT_NEAR(meanHeight(hf), e["mean"].get<double>(), 1e-3);
+}
+
+TEST(DemImport, FrameMappingRowZeroIsNorthAtNegativeZ) {
+    // A synthetic north-up raster whose value encodes its pixel: 1000 * row + col.
+    GDALAllRegister();
+    const fs::path tmp = fs::temp_directory_path() / "terralux_frame_test.tif";
+    {
+        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+        GDALDataset* ds = gtiff->Create(tmp.c_str(), 5, 3, 1, GDT_Float32, nullptr);
+        double gt[6] = {500000.0, 10.0, 0.0, 4000000.0, 0.0, -20.0};
+        ds->SetGeoTransform(gt);
+        OGRSpatialReference srs;
+        srs.importFromEPSG(32633);
+        ds->SetSpatialRef(&srs);
+        std::vector<float> v(15);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 5; ++c) v[r * 5 + c] = float(1000 * r + c);
+        ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 5, 3, v.data(), 5, 3, GDT_Float32,
+                                                 0, 0, nullptr),
+                  CE_None);
+        GDALClose(ds);
+    }
+    const auto r = importDem(tmp.string());
+    fs::remove(tmp);
+    const Heightfield& hf = r.heightfield;
+    EXPECT_EQ(hf.at(0, 0), 0.0f);     // north-west
+    EXPECT_EQ(hf.at(4, 0), 4.0f);     // north-east: x grows east
+    EXPECT_EQ(hf.at(0, 2), 2000.0f);  // south-west: z grows south
+    EXPECT_FLOAT_EQ(hf.zOf(0), -20.0f);  // row 0 at the most negative z
+    EXPECT_FLOAT_EQ(hf.xOf(0), -20.0f);
+    EXPECT_DOUBLE_EQ(hf.cellSizeX(), 10.0);
+    EXPECT_DOUBLE_EQ(hf.cellSizeZ(), 20.0);
+    // The surface at the north-west corner is that vertex.
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(hf.xOf(0), hf.minZ()), 0.0f);
+    EXPECT_DOUBLE_EQ(hf.geo.easting, 500025.0);
+    EXPECT_DOUBLE_EQ(hf.geo.northing, 3999970.0);
+}
+
+TEST(DemImport, MaxResolutionAreaAverages) {
+    DemImportOptions o;
+    o.maxResolution = 48;
+    const auto r = importDem((kData / "bigtujunga_utm11_crop.tif").string(), o);
+    EXPECT_TRUE(r.source.resampled);
+    EXPECT_EQ(r.heightfield.width(), 48);
+    EXPECT_EQ(r.heightfield.depth(), 32);
+    EXPECT_DOUBLE_EQ(r.heightfield.cellSizeX(), 60.0);
+    // Area averaging keeps the mean (to 0.02 %) and narrows the range.
+    EXPECT_NEAR(meanHeight(r.heightfield), expected()["bigtujunga_utm11_crop.tif"]["mean"].get<double>(), 0.2);
+    EXPECT_GT(r.heightfield.minHeight(), 569.0f);
+    EXPECT_LT(r.heightfield.maxHeight(), 1589.0f);
+}
+
+TEST(DemImport, VerticalScaleMultipliesHeights) {
+    DemImportOptions o;
+    o.verticalScale = 2.0;
+    const auto r = importDem((kData / "bigtujunga_utm11_crop.tif").string(), o);
+    EXPECT_FLOAT_EQ(r.heightfield.maxHeight(), 2.0f * 1589.0f);
+}
+
+TEST(DemImport, EmbeddedSample) {
+    const auto r = importDemFromMemory(kSampleTerrainName, sampleTerrainBytes(), sampleTerrainSize());
+    EXPECT_EQ(r.heightfield.width(), 256);
+    EXPECT_EQ(r.heightfield.depth(), 256);
+    EXPECT_DOUBLE_EQ(r.heightfield.cellSizeX(), 30.0);
+    EXPECT_FLOAT_EQ(r.heightfield.minHeight(), 529.0f);
+    EXPECT_FLOAT_EQ(r.heightfield.maxHeight(), 1953.0f);
+    EXPECT_EQ(r.source.path, kSampleTerrainName);
+}
+
+TEST(DemImport, BadInputNamesTheFileAndTheProblem) {
+    const std::string missing = (kData / "does_not_exist.tif").string();
+    EXPECT_EQ(importError(missing), missing + ": no such file");
+
+    const std::string text = (kData / "not_a_raster.tif").string();
+    EXPECT_EQ(importError(text).rfind(text + ": not a raster GDAL can read", 0), 0u) << importError(text);
+
+    const std::string allNodata = (kData / "all_nodata.asc").string();
+    EXPECT_EQ(importError(allNodata), allNodata + ": every cell is nodata; nothing to import");
+
+    const std::string nan = (kData / "nan_values.asc").string();
+    EXPECT_NE(importError(nan).find(nan + ": non-finite height at column 1, row 1"), std::string::npos)
+        << importError(nan);
+
+    const fs::path empty = fs::temp_directory_path() / "terralux_empty.tif";
+    std::ofstream(empty).close();
+    EXPECT_EQ(importError(empty.string()), empty.string() + ": file is empty");
+    fs::remove(empty);
+
+    EXPECT_EQ(importError(kData.string()), kData.string() + ": is a directory, not a raster");
+
+    DemImportOptions tiny;
+    tiny.maxCells = 1000;
+    const std::string big = (kData / "bigtujunga_utm11_crop.tif").string();
+    EXPECT_NE(importError(big, tiny).find("too large to hold in memory; set terrain.max_resolution"),
+              std::string::npos);
+
+    // Messages are one line.
+    for (const auto& m : {importError(text), importError(nan), importError(allNodata)})
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+}
+
+TEST(DemImport, UtmZones) {
+    EXPECT_EQ(utmEpsgFor(1.5, 42.5), 32631);
+    EXPECT_EQ(utmEpsgFor(-121.5, 46.5), 32610);
+    EXPECT_EQ(utmEpsgFor(-179.9, -10.0), 32701);
+    EXPECT_EQ(utmEpsgFor(179.9, 10.0), 32660);
+    EXPECT_EQ(utmEpsgFor(180.0, 10.0), 32601);
+}
+
+// The full real DEMs, when the shared data folder is present.
+TEST(DemImportShared, RealDems) {
+    if (!fs::exists(kShared / "N42E001.hgt")) GTEST_SKIP() << "shared DEMs not present at " << kShared;
+    {
+        const auto r = importDem((kShared / "N42E001.hgt").string());
+        EXPECT_EQ(r.source.driver, "SRTMHGT");
+        EXPECT_EQ(r.heightfield.geo.epsg, 32631);
+        // 7,652 void pixels (0.53 %) in the source stay flagged after the warp.
+        const double share = double(r.heightfield.nodataCount()) / double(r.heightfield.heights().size());
+        EXPECT_GT(share, 0.003);
+        EXPECT_LT(share, 0.01);
+        EXPECT_GE(r.heightfield.minHeight(), 349.0f - 1.0f);
+        EXPECT_LE(r.heightfield.maxHeight(), 3100.0f + 1.0f);
+    }
+    {
+        const auto r = importDem((kShared / "srtm_bigtujunga30m_utm11.tif").string());
+        EXPECT_EQ(r.heightfield.width(), 1197);
+        EXPECT_EQ(r.heightfield.depth(), 643);
+        EXPECT_EQ(r.heightfield.nodataCount(), 0u);
+        EXPECT_FLOAT_EQ(r.heightfield.minHeight(), 315.0f);
+        EXPECT_FLOAT_EQ(r.heightfield.maxHeight(), 2295.0f);
+    }
+    {
+        DemImportOptions o;
+        o.maxResolution = 300;
+        const auto r = importDem((kShared / "mt_rainier_90m.tif").string(), o);
+        EXPECT_TRUE(r.source.resampled);
+        EXPECT_LE(std::max(r.heightfield.width(), r.heightfield.depth()), 300);
+        EXPECT_EQ(r.heightfield.geo.epsg, 32610);
+    }
+    {
+        const std::string zip = "/vsizip/" + (kShared / "..").string();  // not a zip: clean error
+        EXPECT_THROW(importDem(zip + "/nothing.zip/x.tif"), DemError);
+    }
+}

@@ -1,0 +1,55 @@
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "terrain/Heightfield.h"
+
+using namespace terralux;
+
+TEST(Heightfield, FixedDiagonalSplitsEachCell) {
+    // One cell: h00 = 0, h10 = 0, h01 = 0, h11 = 4. Along the diagonal (0,0)-(1,1) the surface
+    // rises linearly; off it, each triangle is planar.
+    Heightfield hf(2, 2, 1.0, 1.0, {0.f, 0.f, 0.f, 4.f});
+    const float x0 = hf.minX(), z0 = hf.minZ();
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(x0 + 0.5f, z0 + 0.5f), 2.0f);  // on the diagonal
+    // Triangle A (fx <= fz): h = fx * (h11 - h01) -> at (0.25, 0.75): 1
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(x0 + 0.25f, z0 + 0.75f), 1.0f);
+    // Triangle B (fx > fz): h = fz * (h11 - h10) -> at (0.75, 0.25): 1
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(x0 + 0.75f, z0 + 0.25f), 1.0f);
+    // Bilinear interpolation would give 0.75 there: the split is what the mesh draws.
+    const glm::vec3 nA = hf.surfaceNormal(x0 + 0.25f, z0 + 0.75f);
+    EXPECT_NEAR(nA.x, -4.0f / std::sqrt(17.0f), 1e-6);
+    EXPECT_NEAR(nA.z, 0.0f, 1e-6);
+}
+
+TEST(Heightfield, SkirtContinuesTheBorder) {
+    Heightfield hf(3, 2, 10.0, 10.0, {1.f, 2.f, 3.f, 4.f, 5.f, 6.f});
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(hf.maxX() + 1000.0f, hf.minZ()), 3.0f);  // north-east corner
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(hf.minX() - 50.0f, hf.maxZ() + 50.0f), 4.0f);
+    EXPECT_FLOAT_EQ(hf.surfaceHeight(0.0f, hf.minZ() - 1e6f), 2.0f);  // north edge, middle
+}
+
+TEST(Heightfield, FrameAndExtent) {
+    Heightfield hf(5, 3, 10.0, 20.0, std::vector<float>(15, 7.f));
+    EXPECT_FLOAT_EQ(hf.minX(), -20.f);
+    EXPECT_FLOAT_EQ(hf.maxX(), 20.f);
+    EXPECT_FLOAT_EQ(hf.minZ(), -20.f);
+    EXPECT_FLOAT_EQ(hf.maxZ(), 20.f);
+    EXPECT_EQ(hf.vertex(0, 0), glm::vec3(-20.f, 7.f, -20.f));
+}
+
+TEST(Heightfield, DegenerateGrids) {
+    Heightfield one(1, 1, 1.0, 1.0, {42.f});
+    EXPECT_FLOAT_EQ(one.surfaceHeight(5.f, -3.f), 42.f);
+    EXPECT_EQ(one.surfaceNormal(0.f, 0.f), glm::vec3(0, 1, 0));
+    Heightfield row(3, 1, 1.0, 1.0, {0.f, 2.f, 4.f});
+    EXPECT_FLOAT_EQ(row.surfaceHeight(0.5f, 0.f), 3.f);
+}
+
+TEST(Heightfield, RejectsBadInput) {
+    EXPECT_THROW(Heightfield(0, 1, 1.0, 1.0, {}), std::invalid_argument);
+    EXPECT_THROW(Heightfield(1, 1, 0.0, 1.0, {1.f}), std::invalid_argument);
+    EXPECT_THROW(Heightfield(2, 1, 1.0, 1.0, {1.f}), std::invalid_argument);
+    EXPECT_THROW(Heightfield(1, 1, 1.0, 1.0, {NAN}), std::invalid_argument);
+}

@@ -1,0 +1,219 @@
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "Project.h"
+#include "TerrainLoading.h"
+
+using namespace terralux;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string errorFor(const std::string& assignment) {
+    json doc = defaultProjectJson();
+    try {
+        applyOverride(doc, assignment);
+        sceneFromJson(doc, "p.json", nullptr);
+    } catch (const ProjectError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("terralux_project_" + name);
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+}  // namespace
+
+TEST(Project, DefaultsAreLightingMdDefaults) {
+    const SceneDescription s = sceneFromJson(defaultProjectJson(), "defaults", nullptr);
+    ASSERT_EQ(s.probeVolumes.size(), 1u);
+    EXPECT_EQ(s.probeVolumes[0].gridDims[0], 8);
+    EXPECT_EQ(s.probeVolumes[0].gridDims[2], 8);
+    EXPECT_DOUBLE_EQ(s.probeVolumes[0].heightOffset, 5.0);
+    EXPECT_FALSE(s.probeVolumes[0].spacing.has_value());  // auto-span
+    EXPECT_EQ(s.sky.color, glm::vec3(0.6f, 0.75f, 1.0f));
+    EXPECT_DOUBLE_EQ(s.sky.intensity, 1.0);
+    EXPECT_DOUBLE_EQ(s.sun.angularRadiusDeg, 0.27);
+    EXPECT_EQ(s.reflectionProbes.gridDims[0], 4);
+    EXPECT_EQ(s.reflectionProbes.rayCount, 16);
+    EXPECT_EQ(s.reflectionProbes.groundColor, glm::vec3(0.22f, 0.18f, 0.14f));
+    EXPECT_DOUBLE_EQ(s.exportSettings.defaultScale, 1.0);
+    EXPECT_DOUBLE_EQ(s.exportSettings.defaultAmbient, 0.1);
+    EXPECT_TRUE(s.terrain.skirt);
+}
+
+// Every rule: the message names the source, the JSON path, the value and the rule.
+struct Rule {
+    const char* assignment;
+    const char* message;
+};
+class ProjectRules : public ::testing::TestWithParam<Rule> {};
+TEST_P(ProjectRules, RejectsWithPathValueAndRule) {
+    EXPECT_EQ(errorFor(GetParam().assignment), GetParam().message);
+}
+INSTANTIATE_TEST_SUITE_P(
+    AllRules, ProjectRules,
+    ::testing::Values(
+        Rule{"probe_volumes[0].grid_dims=[0,8]", "p.json: probe_volumes[0].grid_dims[0] = 0: must be in [1, 4096]"},
+        Rule{"probe_volumes[0].grid_dims=[65,64]", "p.json: probe_volumes[0].grid_dims = [65,64]: must be >= 1 each with a product <= 4096 (is 4160)"},
+        Rule{"probe_volumes[0].grid_dims=[8]", "p.json: probe_volumes[0].grid_dims = [8]: must be an array of 2 numbers"},
+        Rule{"probe_volumes[0].grid_dims=[2.5,8]", "p.json: probe_volumes[0].grid_dims[0] = 2.5: must be an integer"},
+        Rule{"probe_volumes[0].height_offset=\"x\"", "p.json: probe_volumes[0].height_offset = \"x\": must be a number"},
+        Rule{"probe_volumes[0].ray_count=0", "p.json: probe_volumes[0].ray_count = 0: must be in [1, 1048576]"},
+        Rule{"probe_volumes[0].spacing=[0,10]", "p.json: probe_volumes[0].spacing[0] = 0: must be > 0"},
+        Rule{"probe_volumes[0].spacing=[10,-1]", "p.json: probe_volumes[0].spacing[1] = -1: must be > 0"},
+        Rule{"probe_volumes[0].fallback_blend_distance=-1", "p.json: probe_volumes[0].fallback_blend_distance = -1: must be >= 0"},
+        Rule{"probe_volumes[0].name=a/b", "p.json: probe_volumes[0].name = \"a/b\": must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)"},
+        Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box"},
+        Rule{"sky.color=[0.5,-1,1]", "p.json: sky.color[1] = -1: three components, each in [0, inf]"},
+        Rule{"sky.color=[1,1]", "p.json: sky.color = [1,1]: must be an array of 3 numbers"},
+        Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be >= 0"},
+        Rule{"sky.mode=hdr", "p.json: sky.hdr = \"\": must name an image when sky.mode is \"hdr\""},
+        Rule{"reflection_probes.grid_dims=[17,16]", "p.json: reflection_probes.grid_dims = [17,16]: must be >= 1 each with a product <= 256"},
+        Rule{"reflection_probes.grid_dims=[0,1]", "p.json: reflection_probes.grid_dims[0] = 0: must be in [1, 256]"},
+        Rule{"reflection_probes.ray_count=0", "p.json: reflection_probes.ray_count = 0: must be in [1, 1048576]"},
+        Rule{"reflection_probes.strength=1.5", "p.json: reflection_probes.strength = 1.5: must be in [0, 1]"},
+        Rule{"reflection_probes.ground_color=[1,1,-0.1]", "p.json: reflection_probes.ground_color[2] = -0.1: three components, each in [0, inf]"},
+        Rule{"sun.elevation_deg=91", "p.json: sun.elevation_deg = 91: must be in [-90, 90]"},
+        Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be >= 0"},
+        Rule{"sun.angular_radius_deg=50", "p.json: sun.angular_radius_deg = 50: must be in [0, 45]"},
+        Rule{"terrain.vertical_scale=0", "p.json: terrain.vertical_scale = 0: must be > 0"},
+        Rule{"terrain.albedo=[0.5,1.2,0.5]", "p.json: terrain.albedo[1] = 1.2: three components, each in [0, 1]"},
+        Rule{"terrain.max_resolution=1", "p.json: terrain.max_resolution = 1: must be 0 (off) or >= 2"},
+        Rule{"terrain.skirt=maybe", "p.json: terrain.skirt = \"maybe\": must be true or false"},
+        Rule{"bake.quality=ultra", "p.json: bake.quality = \"ultra\": must be one of draft | standard | high | reference"},
+        Rule{"bake.bounces=17", "p.json: bake.bounces = 17: must be in [0, 16]"},
+        Rule{"bake.rays=0", "p.json: bake.rays = 0: must be in [1, 1048576]"},
+        Rule{"bake.sh_encoding=rgb", "p.json: bake.sh_encoding = \"rgb\": must be one of radiance | irradiance"},
+        Rule{"export.out_dir=\"\"", "p.json: export.out_dir = \"\": must name a folder"},
+        Rule{"export.default_ambient=-0.1", "p.json: export.default_ambient = -0.1: must be >= 0"},
+        Rule{"version=2", "p.json: version = 2: is newer than this Terralux reads (1)"}));
+
+TEST(Project, BoxVolumesValidateThreeDims) {
+    EXPECT_EQ(errorFor("probe_volumes[0].placement=box"),
+              "p.json: probe_volumes[0].grid_dims = [8,8]: must be an array of 3 numbers");
+    json doc = defaultProjectJson();
+    applyOverride(doc, "probe_volumes[0].placement=box");
+    applyOverride(doc, "probe_volumes[0].grid_dims=4,2,4");
+    applyOverride(doc, "probe_volumes[0].spacing=25");
+    const SceneDescription s = sceneFromJson(doc, "p.json", nullptr);
+    EXPECT_EQ(s.probeVolumes[0].placement, ProbePlacement::Box);
+    EXPECT_EQ(s.probeVolumes[0].gridDims, (std::array<int, 3>{4, 2, 4}));
+    EXPECT_FLOAT_EQ(s.probeVolumes[0].spacing->x, 25.f);
+}
+
+TEST(Project, OverridesReachEveryParameterAndRejectUnknownPaths) {
+    json doc = defaultProjectJson();
+    applyOverride(doc, "sun.elevation_deg=12.5");
+    applyOverride(doc, "probe_volumes[0].grid_dims=16,16");
+    applyOverride(doc, "sky.hdr=skies/noon.hdr");
+    const SceneDescription s = sceneFromJson(doc, "--set", nullptr);
+    EXPECT_DOUBLE_EQ(s.sun.elevationDeg, 12.5);
+    EXPECT_EQ(s.probeVolumes[0].gridDims[0], 16);
+    EXPECT_EQ(s.sky.hdr, "skies/noon.hdr");
+
+    auto err = [&](const std::string& a) {
+        try {
+            applyOverride(doc, a);
+        } catch (const ProjectError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(err("sun.elevaton_deg=3"),
+              "--set sun.elevaton_deg: unknown parameter 'sun.elevaton_deg' (terralux --print-project lists them)");
+    EXPECT_EQ(err("probe_volumes[3].grid_dims=[2,2]"),
+              "--set probe_volumes[3].grid_dims: unknown parameter 'probe_volumes[3]' (there are 1)");
+    EXPECT_EQ(err("sun"), "--set sun: expected key.path=value");
+    EXPECT_EQ(err("=3"), "--set =3: expected key.path=value");
+}
+
+TEST(Project, UnknownKeysWarnAndAreDropped) {
+    std::vector<std::string> warnings;
+    json doc = {{"sun", {{"elevation_deg", 20}, {"colour", {1, 1, 1}}}}, {"extra", 1}};
+    const SceneDescription s = sceneFromJson(doc, "p.json", &warnings);
+    EXPECT_DOUBLE_EQ(s.sun.elevationDeg, 20.0);
+    ASSERT_EQ(warnings.size(), 2u);
+    EXPECT_EQ(warnings[0], "p.json: unknown key 'extra' ignored");
+    EXPECT_EQ(warnings[1], "p.json: unknown key 'sun.colour' ignored");
+}
+
+TEST(Project, PartialVolumesTakeTheDefaults) {
+    json doc = {{"probe_volumes", {{{"name", "valley"}}, {{"name", "ridge"}, {"grid_dims", {4, 4}}}}}};
+    const SceneDescription s = sceneFromJson(doc, "p.json", nullptr);
+    ASSERT_EQ(s.probeVolumes.size(), 2u);
+    EXPECT_EQ(s.probeVolumes[0].name, "valley");
+    EXPECT_EQ(s.probeVolumes[0].gridDims[0], 8);
+    EXPECT_EQ(s.probeVolumes[1].gridDims[0], 4);
+    json dup = {{"probe_volumes", {{{"name", "a"}}, {{"name", "a"}}}}};
+    EXPECT_THROW(sceneFromJson(dup, "p.json", nullptr), ProjectError);
+}
+
+TEST(Project, SaveLoadIsLosslessAndPathsStayRelative) {
+    const fs::path dir = tempDir("roundtrip");
+    fs::create_directories(dir / "dems");
+    Project p;
+    p.baseDir = dir;
+    p.scene.terrain.dem = "dems/a.tif";
+    p.scene.terrain.albedo = {0.1f, 0.2f, 0.3f};
+    p.scene.sun.elevationDeg = 7.25;
+    p.scene.probeVolumes[0].spacing = glm::vec3(40.f, 40.f, 55.f);
+    p.scene.probeVolumes[0].origin = glm::vec3(-100.f, 0.f, 250.f);
+    p.scene.probeVolumes[0].rayCount = 333;
+    ProbeVolumeSettings box;
+    box.name = "air";
+    box.placement = ProbePlacement::Box;
+    box.gridDims = {3, 2, 5};
+    box.origin = glm::vec3(1.f, 2.f, 3.f);
+    box.spacing = glm::vec3(12.5f);
+    p.scene.probeVolumes.push_back(box);
+    p.scene.bake.bounces = 3;
+
+    saveProject(p, dir / "a.terralux.json");
+    const Project q = loadProject(dir / "a.terralux.json", nullptr);
+    EXPECT_EQ(projectToJson(q), projectToJson(p));
+    EXPECT_EQ(q.demPath(), dir / "dems/a.tif");
+
+    saveProject(q, dir / "b.terralux.json");
+    const Project r = loadProject(dir / "b.terralux.json", nullptr);
+    EXPECT_EQ(projectToJson(r), projectToJson(p));
+    std::ifstream a(dir / "a.terralux.json"), b(dir / "b.terralux.json");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(a), {}),
+              std::string(std::istreambuf_iterator<char>(b), {}));
+    // Nothing temporary left beside it.
+    for (const auto& e : fs::directory_iterator(dir))
+        EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos);
+}
+
+TEST(Project, BadFilesAreOneLineErrors) {
+    const fs::path dir = tempDir("bad");
+    std::ofstream(dir / "broken.json") << "{ \"sun\": { \"elevation_deg\": 10, }";
+    try {
+        loadProject(dir / "broken.json", nullptr);
+        FAIL();
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("broken.json: not valid JSON (byte"), std::string::npos);
+    }
+    EXPECT_THROW(loadProject(dir / "missing.json", nullptr), ProjectError);
+    std::ofstream(dir / "array.json") << "[1,2]";
+    EXPECT_THROW(loadProject(dir / "array.json", nullptr), ProjectError);
+}
+
+TEST(Project, EffectiveProjectAppliesFileThenOverrides) {
+    const fs::path dir = tempDir("effective");
+    std::ofstream(dir / "p.json") << R"({"sun": {"elevation_deg": 20}, "terrain": {"dem": "x.tif"}})";
+    const Project p = loadEffectiveProject((dir / "p.json").string(), {"sun.azimuth_deg=90"}, "", nullptr);
+    EXPECT_DOUBLE_EQ(p.scene.sun.elevationDeg, 20.0);
+    EXPECT_DOUBLE_EQ(p.scene.sun.azimuthDeg, 90.0);
+    EXPECT_EQ(p.demPath(), dir / "x.tif");
+    EXPECT_THROW(loadEffectiveProject((dir / "p.json").string(), {"sun.elevation_deg=100"}, "", nullptr),
+                 ProjectError);
+}
