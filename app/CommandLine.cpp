@@ -8,7 +8,18 @@
 #include <QCommandLineParser>
 #include <QStringList>
 
+#include <atomic>
+#include <chrono>
+#include <csignal>
+
+#include <unistd.h>
+
+#include "BakeJob.h"
 #include "DemImport.h"
+#include "EnvironmentImage.h"
+#include "ShProbeFile.h"
+#include "bake/DiffuseBake.h"
+#include "bake/ProbePlacement.h"
 #include "Project.h"
 #include "SampleTerrain.h"
 #include "TerrainLoading.h"
@@ -25,6 +36,8 @@ const char* const kUsage = R"(Usage: terralux [COMMAND] [OPTIONS]
 Terrain-lighting authoring: import a DEM, bake spherical-harmonics probes, export .shprobe + glTF.
 
 Commands:
+  --bake [PROJECT]              Bake every enabled probe volume and export .shprobe files, a glTF
+                                scene and bake_report.json into the output folder.
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
@@ -33,6 +46,11 @@ Commands:
 
 Options:
   --dem FILE                    Use FILE as the terrain instead of the project's (or the sample).
+  --out DIR                     Output folder (default: export.out_dir, "bake" beside the project
+                                or in the current folder).
+  --quality PRESET              draft | standard | high | reference (bake.quality).
+  --compare-reference           Also run the brute-force reference and report the error of
+                                every probe against it (slow).
   --set KEY.PATH=VALUE          Override a project parameter by its JSON path; repeatable.
                                 Examples: --set sun.elevation_deg=12
                                           --set probe_volumes[0].grid_dims=16,16
@@ -57,10 +75,15 @@ struct Args {
     QCommandLineOption set{"set", "Override.", "KEY=VALUE"};
     QCommandLineOption threads{"threads", "Worker threads.", "N"};
     QCommandLineOption quiet{"quiet", "No progress."};
+    QCommandLineOption bake{"bake", "Bake."};
+    QCommandLineOption out{"out", "Output folder.", "DIR"};
+    QCommandLineOption quality{"quality", "Preset.", "PRESET"};
+    QCommandLineOption compareReference{"compare-reference", "Compare with the reference."};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
-        parser.addOptions({info, printProject, help, version, dem, set, threads, quiet});
+        parser.addOptions({info, printProject, help, version, dem, set, threads, quiet, bake, out,
+                           quality, compareReference});
     }
 };
 
@@ -122,6 +145,105 @@ int commandInfo(const Args& a) {
     return kExitOk;
 }
 
+std::atomic<bool> gInterrupted{false};
+extern "C" void onInterrupt(int) { gInterrupted.store(true); }
+
+// Percent, phase and ETA on stderr: redrawn in place on a terminal, a line per 10 % otherwise.
+class ProgressPrinter {
+public:
+    explicit ProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(2)) {}
+    void operator()(const std::string& phase, double f) {
+        if (quiet_) return;
+        const int percent = int(f * 100.0);
+        const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+        if (!tty_ && percent / 10 == last_ / 10 && phase == phase_ && percent != 100) return;
+        if (tty_ && percent == last_ && phase == phase_ &&
+            elapsed - lastDraw_ < 0.2)
+            return;
+        last_ = percent;
+        phase_ = phase;
+        lastDraw_ = elapsed;
+        std::string eta = "";
+        if (f > 0.02 && f < 1.0) eta = ", ETA " + fixed(elapsed * (1.0 - f) / f, 0) + " s";
+        char line[200];
+        std::snprintf(line, sizeof line, "[%3d%%] %s (%.1f s%s)", percent, phase.c_str(), elapsed,
+                      eta.c_str());
+        if (tty_) std::fprintf(stderr, "\r%-78s", line);
+        else std::fprintf(stderr, "%s\n", line);
+        if (tty_ && percent == 100) std::fprintf(stderr, "\n");
+        std::fflush(stderr);
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    bool quiet_, tty_;
+    Clock::time_point start_ = Clock::now();
+    int last_ = -1;
+    double lastDraw_ = 0;
+    std::string phase_;
+};
+
+int commandBake(const Args& a) {
+    const QStringList positional = a.parser.positionalArguments();
+    if (positional.size() > 1) throw UsageError("--bake takes one PROJECT");
+    std::vector<std::string> warnings;
+    std::vector<std::string> sets;
+    if (a.parser.isSet(a.quality)) sets.push_back("bake.quality=" + str(a.parser.value(a.quality)));
+    for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
+    BakeRequest request;
+    request.project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
+                                           a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "",
+                                           &warnings);
+    if (a.parser.isSet(a.out)) {
+        const std::string dir = str(a.parser.value(a.out));
+        if (dir.empty()) throw UsageError("--out: must name a folder");
+        request.project.scene.exportSettings.outDir =
+            std::filesystem::absolute(dir).lexically_normal().string();
+    }
+    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
+    request.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
+    request.compareReference = a.parser.isSet(a.compareReference);
+
+    const std::filesystem::path outDir = request.project.outDir();
+    std::error_code ec;
+    if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec))
+        throw UsageError("--out " + outDir.string() + ": exists and is not a folder");
+
+    std::signal(SIGINT, onInterrupt);
+    std::signal(SIGTERM, onInterrupt);
+    ProgressPrinter printer(a.parser.isSet(a.quiet));
+    BakeOutcome outcome;
+    try {
+        outcome = runBake(request, std::ref(printer), &gInterrupted);
+    } catch (const BakeCancelled&) {
+        std::cerr << "\nterralux: interrupted; earlier outputs in " << outDir.string()
+                  << " are untouched\n";
+        return kExitInterrupted;
+    }
+    const auto& r = outcome.report;
+    std::cout << "baked " << r["volumes"].size() << " volume(s) in " << fixed(r["time_s"].get<double>(), 2)
+              << " s (" << r["quality"]["preset"].get<std::string>() << ", "
+              << r["quality"]["rays"].get<int>() << " rays, " << r["quality"]["bounces"].get<int>()
+              << " bounces, " << r["threads"].get<int>() << " threads)\n";
+    for (const auto& v : r["volumes"]) {
+        std::cout << "  " << v["name"].get<std::string>() << ": " << v["probes"].get<size_t>()
+                  << " probes (" << v["invalid_probes"].get<size_t>() << " inside the terrain), "
+                  << v["bytes"].get<uint64_t>() << " bytes, standard error mean "
+                  << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " %";
+        if (v.contains("reference_error"))
+            std::cout << ", error vs reference mean "
+                      << fixed(100.0 * v["reference_error"]["mean"].get<double>(), 2) << " % / p95 "
+                      << fixed(100.0 * v["reference_error"]["p95"].get<double>(), 2) << " % / max "
+                      << fixed(100.0 * v["reference_error"]["max"].get<double>(), 2) << " %";
+        std::cout << "\n";
+    }
+    std::cout << "wrote " << outcome.outDir.string() << ":\n";
+    for (const auto& f : outcome.files)
+        std::cout << "  " << f.lexically_relative(outcome.outDir).generic_string() << " ("
+                  << std::filesystem::file_size(f) << " bytes)\n";
+    return kExitOk;
+}
+
 int commandPrintProject(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
     if (positional.size() > 1) throw UsageError("--print-project takes one PROJECT");
@@ -152,8 +274,9 @@ int runCommandLine(int argc, char** argv) {
             std::cout << "terralux " << TERRALUX_VERSION << "\n";
             return kExitOk;
         }
-        const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject));
-        if (commands > 1) throw UsageError("choose one command: --info or --print-project");
+        const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
+                             int(a.parser.isSet(a.bake));
+        if (commands > 1) throw UsageError("choose one command: --bake, --info or --print-project");
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
             const int n = a.parser.value(a.threads).toInt(&ok);
@@ -162,6 +285,7 @@ int runCommandLine(int argc, char** argv) {
                                  ": must be an integer in [1, 1024]");
         }
         if (a.parser.isSet(a.info)) return commandInfo(a);
+        if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);
         if (!a.parser.positionalArguments().isEmpty())
             throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) +
@@ -175,6 +299,12 @@ int runCommandLine(int argc, char** argv) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitUsage;
     } catch (const ProjectError& e) {
+        std::cerr << "terralux: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const ImageError& e) {
+        std::cerr << "terralux: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const PlacementError& e) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitUsage;
     } catch (const std::exception& e) {

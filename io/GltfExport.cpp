@@ -1,0 +1,543 @@
+#include "GltfExport.h"
+
+#include <algorithm>
+
+#include <glm/common.hpp>
+#include <atomic>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <span>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <tiny_gltf.h>
+
+namespace terralux {
+
+namespace {
+
+namespace fs = std::filesystem;
+using ojson = nlohmann::ordered_json;
+
+constexpr const char* kEngineExtension = "VULKAN_SCHNEE_engine_properties";
+constexpr const char* kGeoExtension = "TERRALUX_geo";
+constexpr const char* kBakeExtension = "TERRALUX_bake";
+constexpr const char* kGltfName = "scene.gltf";
+constexpr const char* kBinName = "scene.bin";
+constexpr const char* kProbeDir = "sh_coeffs";
+constexpr const char* kProbeExt = ".shprobe";
+constexpr size_t kMaxVolumeName = 64;
+
+// glTF enumerations (glTF 2.0 specification, section 5).
+constexpr int kFloat = 5126;
+constexpr int kUnsignedShort = 5123;
+constexpr int kUnsignedInt = 5125;
+constexpr int kArrayBuffer = 34962;
+constexpr int kElementArrayBuffer = 34963;
+constexpr int kTriangles = 4;
+
+// One file of the layout: where it goes below outDir and what it holds.
+struct PendingFile {
+    fs::path relative;
+    std::vector<uint8_t> bytes;
+};
+
+std::string errnoText(int err) {
+    return std::generic_category().message(err);
+}
+
+// Little-endian appends, independent of the host.
+void putU16(std::vector<uint8_t>& out, uint16_t v) {
+    out.push_back(static_cast<uint8_t>(v));
+    out.push_back(static_cast<uint8_t>(v >> 8));
+}
+void putU32(std::vector<uint8_t>& out, uint32_t v) {
+    for (int shift = 0; shift < 32; shift += 8)
+        out.push_back(static_cast<uint8_t>(v >> shift));
+}
+void putF32(std::vector<uint8_t>& out, float v) {
+    putU32(out, std::bit_cast<uint32_t>(v));
+}
+void padTo4(std::vector<uint8_t>& out) {
+    while (out.size() % 4 != 0)
+        out.push_back(0);
+}
+
+bool validVolumeName(const std::string& name) {
+    if (name.empty() || name.size() > kMaxVolumeName)
+        return false;
+    return std::all_of(name.begin(), name.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+               c == '_' || c == '-';
+    });
+}
+
+// Vertex rows or columns kept with stride k: 0, k, 2k, ... and always the last one.
+std::vector<int> sampledLines(int n, size_t k) {
+    std::vector<int> lines;
+    for (size_t i = 0; i + 1 < size_t(n); i += k)
+        lines.push_back(int(i));
+    lines.push_back(n - 1);
+    return lines;
+}
+
+size_t sampledCount(int n, size_t k) {
+    return n <= 1 ? 1 : (size_t(n - 1) + k - 1) / k + 1;
+}
+
+// The smallest stride whose mesh fits the vertex budget.
+size_t chooseStride(const Heightfield& hf, size_t budget, const fs::path& gltfPath) {
+    const size_t longest = size_t(std::max(hf.width(), hf.depth()));
+    size_t k = 1;
+    while (sampledCount(hf.width(), k) * sampledCount(hf.depth(), k) > budget) {
+        if (k + 1 >= longest) {
+            throw std::runtime_error(gltfPath.string() + ": meshMaxVertices = " +
+                                     std::to_string(budget) +
+                                     " is below the 4 vertices of the coarsest terrain mesh");
+        }
+        ++k;
+    }
+    return k;
+}
+
+ojson floats(std::initializer_list<float> values) {
+    ojson a = ojson::array();
+    for (float v : values)
+        a.push_back(double(v));
+    return a;
+}
+
+// Builds scene.bin and the mesh part of the glTF document.
+struct MeshBuild {
+    std::vector<uint8_t> bin;
+    size_t stride = 1;
+};
+
+MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::path& gltfPath,
+                    ojson& doc) {
+    MeshBuild mesh;
+    mesh.stride = chooseStride(hf, input.meshMaxVertices, gltfPath);
+    const std::vector<int> cols = sampledLines(hf.width(), mesh.stride);
+    const std::vector<int> rows = sampledLines(hf.depth(), mesh.stride);
+    const size_t nc = cols.size(), nr = rows.size();
+    const size_t vertexCount = nc * nr;
+    if (vertexCount > size_t(std::numeric_limits<uint32_t>::max())) {
+        throw std::runtime_error(gltfPath.string() + ": " + std::to_string(vertexCount) +
+                                 " mesh vertices do not fit 32-bit indices");
+    }
+    const size_t indexCount = 6 * (nc - 1) * (nr - 1);
+    // 65535 is the primitive-restart value of 16-bit indices, so it may not be used as an index.
+    const bool wideIndices = vertexCount > 65535;
+
+    std::vector<uint8_t>& bin = mesh.bin;
+    bin.reserve(vertexCount * 32 + indexCount * (wideIndices ? 4 : 2) + 4);
+
+    const size_t positionOffset = bin.size();
+    glm::vec3 lo(std::numeric_limits<float>::infinity());
+    glm::vec3 hi(-std::numeric_limits<float>::infinity());
+    for (int r : rows) {
+        for (int c : cols) {
+            const glm::vec3 p = hf.vertex(c, r);
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+            putF32(bin, p.x);
+            putF32(bin, p.y);
+            putF32(bin, p.z);
+        }
+    }
+    const size_t normalOffset = bin.size();
+    for (int r : rows) {
+        for (int c : cols) {
+            const glm::vec3 n = hf.vertexNormal(c, r);
+            putF32(bin, n.x);
+            putF32(bin, n.y);
+            putF32(bin, n.z);
+        }
+    }
+    const size_t uvOffset = bin.size();
+    const double uScale = 1.0 / double(hf.width() - 1), vScale = 1.0 / double(hf.depth() - 1);
+    for (int r : rows) {
+        for (int c : cols) {
+            putF32(bin, float(c * uScale));
+            putF32(bin, float(r * vScale));
+        }
+    }
+    const size_t indexOffset = bin.size();
+    auto putIndex = [&](size_t ci, size_t ri) {
+        const size_t v = ri * nc + ci;
+        if (wideIndices)
+            putU32(bin, uint32_t(v));
+        else
+            putU16(bin, uint16_t(v));
+    };
+    // Per cell, the bake's two triangles along the (c, r)-(c+1, r+1) diagonal. With X east and
+    // Z south, (c, r) -> (c, r+1) -> (c+1, r+1) turns counter-clockwise seen from +Y.
+    for (size_t ri = 0; ri + 1 < nr; ++ri) {
+        for (size_t ci = 0; ci + 1 < nc; ++ci) {
+            putIndex(ci, ri);
+            putIndex(ci, ri + 1);
+            putIndex(ci + 1, ri + 1);
+            putIndex(ci, ri);
+            putIndex(ci + 1, ri + 1);
+            putIndex(ci + 1, ri);
+        }
+    }
+    const size_t indexBytes = bin.size() - indexOffset;
+    padTo4(bin);
+
+    auto view = [](size_t offset, size_t length, int target) {
+        return ojson{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}, {"target", target}};
+    };
+    doc["scene"] = 0;
+    doc["scenes"] = ojson::array({ojson{{"name", "terrain"}, {"nodes", {0}}}});
+    doc["nodes"] = ojson::array({ojson{{"name", "terrain"}, {"mesh", 0}}});
+    doc["meshes"] = ojson::array({ojson{
+        {"name", "terrain"},
+        {"primitives",
+         ojson::array({ojson{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}},
+                             {"indices", 3},
+                             {"material", 0},
+                             {"mode", kTriangles}}})}}});
+    doc["materials"] = ojson::array({ojson{
+        {"name", "terrain"},
+        {"pbrMetallicRoughness",
+         {{"baseColorFactor", floats({input.albedo.r, input.albedo.g, input.albedo.b, 1.0f})},
+          {"metallicFactor", 0.0},
+          {"roughnessFactor", 1.0}}}}});
+    doc["accessors"] = ojson::array({
+        ojson{{"name", "POSITION"}, {"bufferView", 0}, {"componentType", kFloat},
+              {"count", vertexCount}, {"type", "VEC3"},
+              {"min", floats({lo.x, lo.y, lo.z})}, {"max", floats({hi.x, hi.y, hi.z})}},
+        ojson{{"name", "NORMAL"}, {"bufferView", 1}, {"componentType", kFloat},
+              {"count", vertexCount}, {"type", "VEC3"}},
+        ojson{{"name", "TEXCOORD_0"}, {"bufferView", 2}, {"componentType", kFloat},
+              {"count", vertexCount}, {"type", "VEC2"}},
+        ojson{{"name", "indices"}, {"bufferView", 3},
+              {"componentType", wideIndices ? kUnsignedInt : kUnsignedShort},
+              {"count", indexCount}, {"type", "SCALAR"}},
+    });
+    doc["bufferViews"] = ojson::array({
+        view(positionOffset, normalOffset - positionOffset, kArrayBuffer),
+        view(normalOffset, uvOffset - normalOffset, kArrayBuffer),
+        view(uvOffset, indexOffset - uvOffset, kArrayBuffer),
+        view(indexOffset, indexBytes, kElementArrayBuffer),
+    });
+    doc["buffers"] = ojson::array({ojson{{"uri", kBinName}, {"byteLength", bin.size()}}});
+    return mesh;
+}
+
+ojson probeGridEntry(const GltfProbeVolume& v) {
+    const ShProbeGrid& g = v.grid;
+    return ojson{
+        {"shProbePath", std::string(kProbeDir) + "/" + v.name + kProbeExt},
+        {"volumeName", v.name},
+        {"probeCount", uint64_t(g.probes.size())},
+        {"gridDimensions", {g.dims.x, g.dims.y, g.dims.z}},
+        {"gridOrigin", floats({g.origin.x, g.origin.y, g.origin.z})},
+        {"gridSpacing", double(g.spacing)},
+        {"defaultScale", double(g.defaultScale)},
+        {"defaultAmbient", double(g.defaultAmbient)},
+    };
+}
+
+// Encodes the grid; ShProbeError messages are re-prefixed with the file they were meant for.
+std::vector<uint8_t> encodeVolume(const GltfProbeVolume& v, const fs::path& target) {
+    try {
+        return encodeShProbe(v.grid);
+    } catch (const ShProbeError& e) {
+        static constexpr std::string_view kPrefix = "shprobe grid: ";
+        std::string_view what = e.what();
+        if (what.starts_with(kPrefix))
+            what.remove_prefix(kPrefix.size());
+        throw ShProbeError(target.string() + ": " + std::string(what));
+    }
+}
+
+void checkInput(const fs::path& outDir, const GltfSceneInput& input,
+                const std::vector<const GltfProbeVolume*>& sorted) {
+    const fs::path gltfPath = outDir / kGltfName;
+    const Heightfield* hf = input.heightfield;
+    if (!hf || hf->width() < 1 || hf->depth() < 1)
+        throw std::runtime_error(gltfPath.string() + ": no terrain to export (empty heightfield)");
+    for (int c = 0; c < 3; ++c) {
+        const float a = input.albedo[c];
+        if (!std::isfinite(a) || a < 0.0f || a > 1.0f) {
+            throw std::runtime_error(gltfPath.string() + ": albedo channel " + std::to_string(c) +
+                                     " = " + std::to_string(a) + " must be in [0, 1]");
+        }
+    }
+    if (!std::isfinite(input.verticalScale)) {
+        throw std::runtime_error(gltfPath.string() + ": vertical scale must be finite");
+    }
+    if (!input.bake.is_object()) {
+        throw std::runtime_error(gltfPath.string() + ": the " + kBakeExtension +
+                                 " metadata must be a JSON object, not " + input.bake.type_name());
+    }
+    for (size_t i = 0; i < sorted.size(); ++i) {
+        const std::string& name = sorted[i]->name;
+        if (!validVolumeName(name)) {
+            throw std::runtime_error((outDir / kProbeDir).string() + ": probe volume name '" +
+                                     name + "' must be 1 to 64 of A-Z a-z 0-9 _ -");
+        }
+        if (i > 0 && sorted[i - 1]->name == name) {
+            throw std::runtime_error((outDir / kProbeDir / (name + kProbeExt)).string() +
+                                     ": two probe volumes are named '" + name + "'");
+        }
+    }
+}
+
+std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput& input) {
+    const fs::path gltfPath = outDir / kGltfName;
+    std::vector<const GltfProbeVolume*> sorted;
+    for (const GltfProbeVolume& v : input.volumes)
+        sorted.push_back(&v);
+    // Sorted by file name, which is not always the order of the stems ("a-b.shprobe" < "a.shprobe").
+    std::sort(sorted.begin(), sorted.end(), [](const GltfProbeVolume* a, const GltfProbeVolume* b) {
+        return a->name + kProbeExt < b->name + kProbeExt;
+    });
+    checkInput(outDir, input, sorted);
+    const Heightfield& hf = *input.heightfield;
+
+    std::vector<PendingFile> files;
+    ojson grids = ojson::array();
+    for (const GltfProbeVolume* v : sorted) {
+        const fs::path relative = fs::path(kProbeDir) / (v->name + kProbeExt);
+        files.push_back({relative, encodeVolume(*v, outDir / relative)});
+        grids.push_back(probeGridEntry(*v));
+    }
+
+    try {
+        ojson doc;
+        doc["asset"] = {{"version", "2.0"},
+                        {"generator", input.generatorVersion.empty()
+                                          ? std::string("Terralux")
+                                          : "Terralux " + input.generatorVersion}};
+        doc["extensionsUsed"] = {kEngineExtension, kGeoExtension, kBakeExtension};
+        MeshBuild mesh;
+        const bool hasMesh = hf.width() >= 2 && hf.depth() >= 2;
+        if (hasMesh)
+            mesh = buildMesh(hf, input, gltfPath, doc);
+        doc["extensions"] = {
+            {kEngineExtension, {{"shProbeGrids", std::move(grids)}}},
+            {kGeoExtension,
+             {{"crs", hf.geo.crsWkt},
+              {"crsName", hf.geo.crsName},
+              {"epsg", hf.geo.epsg},
+              {"originEasting", hf.geo.easting},
+              {"originNorthing", hf.geo.northing},
+              {"originHeight", hf.geo.height},
+              {"verticalScale", input.verticalScale},
+              {"cellSize", {hf.cellSizeX(), hf.cellSizeZ()}},
+              {"gridSize", {hf.width(), hf.depth()}},
+              {"meshStride", mesh.stride}}},
+            {kBakeExtension, ojson(input.bake)},
+        };
+        if (hasMesh)
+            files.push_back({kBinName, std::move(mesh.bin)});
+        const std::string text = doc.dump(2) + "\n";
+        files.push_back({kGltfName, std::vector<uint8_t>(text.begin(), text.end())});
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(gltfPath.string() + ": cannot encode the glTF JSON (" +
+                                 e.what() + ")");
+    }
+    return files;
+}
+
+// Writes, flushes and syncs one staged file; errors name the final target.
+void writeStaged(const fs::path& staged, const fs::path& target, std::span<const uint8_t> bytes) {
+    std::FILE* f = std::fopen(staged.c_str(), "wb");
+    if (!f)
+        throw FileWriteError(target.string() + ": cannot write (" + errnoText(errno) + ")");
+    errno = 0;
+    const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const int writeErr = errno;
+    const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+    const int flushErr = errno;
+    const bool closed = std::fclose(f) == 0;
+    if (!written || !flushed || !closed) {
+        const int err = !written ? writeErr : !flushed ? flushErr : errno;
+        throw FileWriteError(target.string() + ": write failed (" + errnoText(err ? err : EIO) + ")");
+    }
+}
+
+void syncDirectory(const fs::path& dir) {
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        ::fsync(fd);
+        ::close(fd);
+    }
+}
+
+// A fresh ".staging-<unique>" directory inside outDir, removed with everything in it on scope exit.
+class StagingDirectory {
+public:
+    explicit StagingDirectory(const fs::path& outDir) {
+        static std::atomic<uint64_t> counter{0};
+        std::random_device rd;
+        for (int attempt = 0; attempt < 16; ++attempt) {
+            const uint64_t r = (uint64_t{rd()} << 32) ^ rd();
+            char suffix[17];
+            std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(r));
+            const fs::path candidate = outDir / (".staging-" + std::to_string(::getpid()) + "-" +
+                                                 std::to_string(counter.fetch_add(1)) + "-" + suffix);
+            std::error_code ec;
+            if (fs::create_directory(candidate, ec)) {
+                path_ = candidate;
+                return;
+            }
+            if (ec && ec != std::errc::file_exists) {
+                throw FileWriteError(outDir.string() + ": cannot create a staging directory (" +
+                                     ec.message() + ")");
+            }
+        }
+        throw FileWriteError(outDir.string() + ": cannot create a unique staging directory");
+    }
+    ~StagingDirectory() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    StagingDirectory(const StagingDirectory&) = delete;
+    StagingDirectory& operator=(const StagingDirectory&) = delete;
+    const fs::path& path() const { return path_; }
+
+private:
+    fs::path path_;
+};
+
+struct Replaced {
+    fs::path target;
+    fs::path backup;  // empty: there was no file before
+};
+
+// Moves every staged file into place. Before a target is replaced, its current file is hard-linked
+// (or copied) into the staging directory, so that a later failure can put every replaced file
+// back. Throws after the rollback.
+void commit(const fs::path& outDir, const fs::path& staging, const std::vector<PendingFile>& files) {
+    std::vector<Replaced> done;
+    const fs::path probeDir = outDir / kProbeDir;
+    bool createdProbeDir = false;
+    try {
+        const bool needProbeDir = std::any_of(files.begin(), files.end(), [](const PendingFile& f) {
+            return f.relative.has_parent_path();
+        });
+        if (needProbeDir && !fs::is_directory(probeDir)) {
+            std::error_code ec;
+            createdProbeDir = fs::create_directory(probeDir, ec);
+            if (!createdProbeDir) {
+                throw FileWriteError(probeDir.string() + ": cannot create directory (" +
+                                     (ec ? ec.message() : std::string("exists, not a directory")) + ")");
+            }
+        }
+        for (size_t i = 0; i < files.size(); ++i) {
+            const fs::path target = outDir / files[i].relative;
+            const fs::path staged = staging / files[i].relative;
+            Replaced step{target, {}};
+            std::error_code ec;
+            const fs::file_status st = fs::symlink_status(target, ec);
+            if (fs::exists(st)) {
+                if (fs::is_directory(st))
+                    throw FileWriteError(target.string() + ": cannot replace (is a directory)");
+                step.backup = staging / ("previous-" + std::to_string(i));
+                fs::create_hard_link(target, step.backup, ec);
+                if (ec) {
+                    ec.clear();
+                    fs::copy_file(target, step.backup, ec);
+                }
+                if (ec) {
+                    throw FileWriteError(target.string() + ": cannot keep the previous file (" +
+                                         ec.message() + ")");
+                }
+            }
+            fs::rename(staged, target, ec);
+            if (ec)
+                throw FileWriteError(target.string() + ": cannot replace (" + ec.message() + ")");
+            done.push_back(std::move(step));
+        }
+    } catch (...) {
+        for (auto it = done.rbegin(); it != done.rend(); ++it) {
+            std::error_code ec;
+            if (it->backup.empty())
+                fs::remove(it->target, ec);
+            else
+                fs::rename(it->backup, it->target, ec);
+        }
+        if (createdProbeDir) {
+            std::error_code ec;
+            fs::remove(probeDir, ec);
+        }
+        throw;
+    }
+    if (fs::is_directory(probeDir))
+        syncDirectory(probeDir);
+    syncDirectory(outDir);
+}
+
+}  // namespace
+
+GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input) {
+    // Everything is encoded before the filesystem is touched.
+    const std::vector<PendingFile> files = buildFiles(outDir, input);
+
+    std::error_code ec;
+    fs::create_directories(outDir, ec);
+    if (ec || !fs::is_directory(outDir)) {
+        throw FileWriteError(outDir.string() + ": cannot create the output directory (" +
+                             (ec ? ec.message() : std::string("exists, not a directory")) + ")");
+    }
+
+    const StagingDirectory staging(outDir);
+    if (std::any_of(files.begin(), files.end(),
+                    [](const PendingFile& f) { return f.relative.has_parent_path(); })) {
+        fs::create_directory(staging.path() / kProbeDir, ec);
+        if (ec) {
+            throw FileWriteError((outDir / kProbeDir).string() + ": cannot create a staging directory (" +
+                                 ec.message() + ")");
+        }
+    }
+    GltfExportResult result;
+    for (const PendingFile& f : files) {
+        writeStaged(staging.path() / f.relative, outDir / f.relative, f.bytes);
+        result.files.push_back(outDir / f.relative);
+        result.bytes += f.bytes.size();
+    }
+    commit(outDir, staging.path(), files);
+    return result;
+}
+
+nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile) {
+    const std::string name = gltfFile.string();
+    tinygltf::TinyGLTF loader;
+    loader.SetStoreOriginalJSONForExtrasAndExtensions(true);
+    tinygltf::Model model;
+    std::string err, warn;
+    const bool ok = loader.LoadASCIIFromFile(&model, &err, &warn, name);
+    if (!ok || !err.empty()) {
+        std::string reason = err.substr(0, err.find('\n'));
+        throw std::runtime_error(name + ": cannot load as glTF (" +
+                                 (reason.empty() ? std::string("unknown error") : reason) + ")");
+    }
+    nlohmann::json extensions;
+    try {
+        extensions = nlohmann::json::parse(model.extensions_json_string);
+    } catch (const nlohmann::json::exception&) {
+        extensions = nullptr;
+    }
+    if (!extensions.is_object() || !extensions.contains(kEngineExtension) ||
+        !extensions[kEngineExtension].is_object() ||
+        !extensions[kEngineExtension].contains("shProbeGrids") ||
+        !extensions[kEngineExtension]["shProbeGrids"].is_array()) {
+        throw std::runtime_error(name + ": no " + kEngineExtension + ".shProbeGrids array");
+    }
+    return extensions[kEngineExtension]["shProbeGrids"];
+}
+
+}  // namespace terralux

@@ -1,0 +1,73 @@
+#pragma once
+// glTF 2.0 scene export (FORMATS.md): the terrain mesh, its material, the baked SH probe volumes
+// and the geo/bake metadata, written as
+//
+//   <outDir>/scene.gltf
+//   <outDir>/scene.bin                    only when the terrain has triangles
+//   <outDir>/sh_coeffs/<volume>.shprobe   one file per probe volume
+//
+// Engine space is glTF space (Y up, right-handed: X east, Y up, Z south), so nothing is converted.
+// The mesh uses the bake's triangulation (Heightfield.h) wound counter-clockwise seen from +Y, so
+// glTF front faces point up. Three root-level extensions are listed in `extensionsUsed` and never
+// in `extensionsRequired`:
+//   VULKAN_SCHNEE_engine_properties  {"shProbeGrids": [...]} one entry per .shprobe file, sorted by
+//                                    file name; every number equals that file's header exactly
+//   TERRALUX_geo                     CRS, origin, vertical scale, cell size, grid size, mesh stride
+//   TERRALUX_bake                    the caller's JSON object, verbatim
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "AtomicFile.h"
+#include "ShProbeFile.h"
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+struct GltfProbeVolume {
+    std::string name;  // file stem: 1 to 64 of [A-Za-z0-9_-], unique within a scene
+    ShProbeGrid grid;
+};
+
+struct GltfSceneInput {
+    const Heightfield* heightfield = nullptr;
+    glm::vec3 albedo{0.3f};  // base colour factor, each channel in [0, 1]
+    double verticalScale = 1.0;  // recorded in TERRALUX_geo; the heights are exported as they are
+    std::vector<GltfProbeVolume> volumes;
+    nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object
+    std::string generatorVersion;                    // asset.generator = "Terralux <version>"
+    // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
+    // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride.
+    size_t meshMaxVertices = size_t(1) << 20;
+};
+
+struct GltfExportResult {
+    std::vector<std::filesystem::path> files;  // every file written, in outDir
+    uint64_t bytes = 0;                         // their total size
+};
+
+// Writes the whole layout into `outDir` (created if missing). Every file is first written into a
+// staging directory inside outDir (".staging-<unique>"); only when all were written is each renamed
+// into place (the .shprobe files, then scene.bin, then scene.gltf). If any step fails, the files
+// already replaced are restored, the staging directory is removed, and the files in outDir stay
+// byte-identical to what they were before the call.
+// Files of an earlier export that this one does not write are left alone: the .shprobe files of
+// volumes no longer present are NOT deleted, nor is an old scene.bin when the new scene has no mesh.
+// A heightfield with a single row or column has no triangles: the scene then has no mesh, no buffer
+// and no scene.bin, only the extensions.
+// Throws FileWriteError for filesystem failures, ShProbeError for a grid that cannot be encoded and
+// std::runtime_error for other invalid input, each with a one-line message naming the file.
+GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input);
+
+// Reads scene.gltf back with tinygltf and returns the VULKAN_SCHNEE_engine_properties.shProbeGrids
+// array as written (for tests and tools). Throws std::runtime_error naming the file if it does not
+// load or has no such array.
+nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile);
+
+}  // namespace terralux

@@ -1,0 +1,326 @@
+#include "bake/DiffuseBake.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "bake/SphereSampling.h"
+
+namespace terralux {
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+// Interleaved sub-lattices per probe whose spread gives the Monte Carlo standard error.
+constexpr int kErrorBatches = 4;
+
+// Lift off the surface by more than the tracer's self-hit distance, scaled with the coordinates.
+glm::vec3 liftOff(const glm::vec3& p, const glm::vec3& n) {
+    const float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    return p + n * (1e-5f * m + 1e-2f);
+}
+
+// Runs body(i) for i in [0, n) in chunks, reporting progress and honouring cancel. Results go
+// to per-index slots, so the chunking does not change any value.
+template <typename Body>
+void parallelIndices(size_t n, const BakeControl& control, Body body) {
+    std::atomic<size_t> done{0};
+    const size_t grain = 16;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), [&](const tbb::blocked_range<size_t>& r) {
+        if (control.cancelled()) return;
+        for (size_t i = r.begin(); i != r.end(); ++i) body(i);
+        const size_t d = done.fetch_add(r.size()) + r.size();
+        if (control.progress) control.progress(double(d) / double(n));
+    });
+    if (control.cancelled()) throw BakeCancelled();
+}
+
+glm::vec3 sunIrradiance(const BakeLighting& L, const glm::vec3& p, const glm::vec3& n, int samples,
+                        Rng& rng) {
+    const float cosine = glm::dot(n, L.sun.direction);
+    if (cosine <= 0.0f || samples <= 0 || L.sun.illuminance == glm::vec3(0.0f)) return glm::vec3(0.0f);
+    int visible = 0;
+    const glm::vec3 o = liftOff(p, n);
+    for (int s = 0; s < samples; ++s) {
+        // Stratified over the disk's cos-θ range.
+        const float u1 = (float(s) + rng.next()) / float(samples);
+        const glm::vec3 d = sampleCone(L.sun.direction, L.sun.angularRadius, u1, rng.next());
+        if (!L.tracer->occluded(o, d, INFINITY)) ++visible;
+    }
+    return L.sun.illuminance * cosine * (float(visible) / float(samples));
+}
+
+}  // namespace
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+const char* qualityName(QualityPreset preset) {
+    switch (preset) {
+        case QualityPreset::Draft: return "draft";
+        case QualityPreset::Standard: return "standard";
+        case QualityPreset::High: return "high";
+        case QualityPreset::Reference: return "reference";
+    }
+    return "standard";
+}
+
+BakeQuality qualityPreset(QualityPreset preset) {
+    switch (preset) {
+        case QualityPreset::Draft: return {64, 1, 64, 32, 2};
+        case QualityPreset::Standard: return {256, 2, 128, 64, 4};
+        case QualityPreset::High: return {1024, 3, 256, 128, 8};
+        case QualityPreset::Reference: return {4096, 16, 0, 0, 1};
+    }
+    return {};
+}
+
+IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays, int sunSamples,
+                                 int bounces, const BakeControl& control)
+    : lighting_(&L) {
+    const Heightfield& hf = L.tracer->heightfield();
+    skirt_ = L.sky.openIrradianceUp() + L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    const float span = std::max(spanX, spanZ);
+    resolution = std::max(resolution, 2);
+    // Never finer than the DEM itself.
+    nx_ = std::clamp(int(std::lround(resolution * (span > 0 ? spanX / span : 1.0f))) , 2,
+                     std::max(hf.width(), 2));
+    nz_ = std::clamp(int(std::lround(resolution * (span > 0 ? spanZ / span : 1.0f))), 2,
+                     std::max(hf.depth(), 2));
+    x0_ = hf.minX();
+    z0_ = hf.minZ();
+    dx_ = spanX > 0 ? spanX / float(nx_ - 1) : 1.0f;
+    dz_ = spanZ > 0 ? spanZ / float(nz_ - 1) : 1.0f;
+    const size_t points = size_t(nx_) * nz_;
+    rays = std::max(rays, 1);
+
+    std::vector<glm::vec3> direct(points);
+    // Hits per point: (x, z) of terrain hits; NaN x marks a skirt hit.
+    std::vector<float> hitXZ(points * size_t(rays) * 2);
+    BakeControl phase = control;
+    phase.progress = control.progress ? [&](double f) { control.progress(0.8 * f); }
+                                      : std::function<void(double)>();
+    parallelIndices(points, phase, [&](size_t i) {
+        const int ix = int(i % nx_), iz = int(i / nx_);
+        const float x = x0_ + dx_ * float(ix), z = z0_ + dz_ * float(iz);
+        const glm::vec3 p(x, hf.surfaceHeight(x, z), z);
+        // Cache-scale normal: central differences over one cache spacing.
+        const float hx = 0.5f * dx_, hz = 0.5f * dz_;
+        const glm::vec3 n = glm::normalize(glm::vec3(
+            -(hf.surfaceHeight(x + hx, z) - hf.surfaceHeight(x - hx, z)) / (2 * hx), 1.0f,
+            -(hf.surfaceHeight(x, z + hz) - hf.surfaceHeight(x, z - hz)) / (2 * hz)));
+        Rng rng(splitmix64(0x5EEDCACEull ^ uint64_t(i)));
+        const glm::vec3 o = liftOff(p, n);
+        glm::vec3 sky(0.0f);
+        const float offset = rng.next();
+        const float solidAngle = 2.0f * kPi / float(rays);
+        float* hits = &hitXZ[i * size_t(rays) * 2];
+        for (int r = 0; r < rays; ++r) {
+            const glm::vec3 d = cosineHemisphere(uint32_t(r), uint32_t(rays), offset, n);
+            RayHit hit;
+            if (L.tracer->intersect(o, d, INFINITY, hit)) {
+                hits[2 * r] = hit.onTerrain ? hit.position.x : NAN;
+                hits[2 * r + 1] = hit.position.z;
+            } else {
+                sky += L.sky.radiance(d, solidAngle);
+                hits[2 * r] = NAN;
+                hits[2 * r + 1] = INFINITY;  // escaped: contributes sky only
+            }
+        }
+        direct[i] = sky * (kPi / float(rays)) + sunIrradiance(L, p, n, sunSamples, rng);
+    });
+
+    // Gathers: E_b = E_0 + albedo / N × Σ E_{b-1}(hit) (cosine-weighted estimator of
+    // ∫ albedo/π E cos dω).
+    irradiance_ = direct;
+    std::vector<glm::vec3> next(points);
+    for (int b = 0; b < bounces; ++b) {
+        BakeControl gather = control;
+        gather.progress = control.progress
+                              ? [&](double f) { control.progress(0.8 + 0.2 * (b + f) / bounces); }
+                              : std::function<void(double)>();
+        parallelIndices(points, gather, [&](size_t i) {
+            const float* hits = &hitXZ[i * size_t(rays) * 2];
+            glm::vec3 sum(0.0f);
+            for (int r = 0; r < rays; ++r) {
+                if (!std::isnan(hits[2 * r])) sum += interpolate(irradiance_, hits[2 * r], hits[2 * r + 1]);
+                else if (std::isfinite(hits[2 * r + 1])) sum += skirt_;
+            }
+            next[i] = direct[i] + L.albedo * sum / float(rays);
+        });
+        irradiance_.swap(next);
+    }
+}
+
+glm::vec3 IrradianceCache::interpolate(const std::vector<glm::vec3>& e, float x, float z) const {
+    const float fx = std::clamp((x - x0_) / dx_, 0.0f, float(nx_ - 1));
+    const float fz = std::clamp((z - z0_) / dz_, 0.0f, float(nz_ - 1));
+    const int ix = std::min(int(fx), nx_ - 2), iz = std::min(int(fz), nz_ - 2);
+    const float tx = fx - float(ix), tz = fz - float(iz);
+    const size_t i00 = size_t(iz) * nx_ + ix;
+    return (1 - tz) * ((1 - tx) * e[i00] + tx * e[i00 + 1]) +
+           tz * ((1 - tx) * e[i00 + nx_] + tx * e[i00 + nx_ + 1]);
+}
+
+glm::vec3 IrradianceCache::at(const RayHit& hit) const {
+    return hit.onTerrain ? interpolate(irradiance_, hit.position.x, hit.position.z) : skirt_;
+}
+
+ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
+                     const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
+                     int rays, uint64_t seed, const BakeControl& control) {
+    ProbeBake out;
+    out.sh.assign(positions.size(), sh::ShRgb{});
+    out.standardError.assign(positions.size(), 0.0f);
+    rays = std::max(rays, 1);
+    const float weight = 4.0f * kPi / float(rays);
+    std::atomic<uint64_t> traced{0};
+    parallelIndices(positions.size(), control, [&](size_t i) {
+        if (!valid[i]) return;
+        Rng rng(splitmix64(seed ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull)));
+        const float offset = rng.next();
+        sh::ShRgb acc;
+        // Per interleaved batch: its share of E(up) luminance, for the standard error.
+        double batch[kErrorBatches] = {};
+        int batchCount[kErrorBatches] = {};
+        for (int r = 0; r < rays; ++r) {
+            const glm::vec3 d = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
+            RayHit hit;
+            glm::vec3 radiance(0.0f);
+            if (L.tracer->intersect(positions[i], d, INFINITY, hit)) {
+                if (bounces > 0 && cache) radiance = L.albedo / kPi * cache->at(hit);
+            } else {
+                radiance = L.sky.radiance(d, weight);
+            }
+            sh::accumulate(acc, d, radiance, weight);
+            const int b = r % kErrorBatches;
+            batch[b] += luminance(radiance) * std::max(0.0f, d.y);
+            ++batchCount[b];
+        }
+        out.sh[i] = acc;
+        // Standard error of the mean of the batch estimates, relative to their mean.
+        int k = 0;
+        double mean = 0, sq = 0;
+        for (int b = 0; b < kErrorBatches; ++b)
+            if (batchCount[b] > 0) {
+                const double e = batch[b] / batchCount[b];
+                mean += e;
+                sq += e * e;
+                ++k;
+            }
+        if (k > 1 && mean > 0) {
+            mean /= k;
+            const double var = std::max(0.0, sq / k - mean * mean) * k / (k - 1);
+            out.standardError[i] = float(std::sqrt(var / k) / mean);
+        }
+        traced.fetch_add(uint64_t(rays), std::memory_order_relaxed);
+    });
+    out.rays = traced.load();
+    return out;
+}
+
+int referencePathLength(const glm::vec3& albedo) {
+    const float a = std::max({albedo.x, albedo.y, albedo.z});
+    if (a <= 0.0f) return 1;
+    if (a >= 0.999f) return 64;
+    return std::clamp(int(std::ceil(std::log(1e-3f) / std::log(a))), 1, 64);
+}
+
+ProbeBake referenceProbes(const BakeLighting& L, int bounces, const std::vector<glm::vec3>& positions,
+                          const std::vector<uint8_t>& valid, int rays, uint64_t seed,
+                          const BakeControl& control) {
+    ProbeBake out;
+    out.sh.assign(positions.size(), sh::ShRgb{});
+    out.standardError.assign(positions.size(), 0.0f);
+    rays = std::max(rays, 1);
+    const int depth = bounces == 0 ? 0 : referencePathLength(L.albedo);
+    const float weight = 4.0f * kPi / float(rays);
+    const glm::vec3 skirt = L.sky.openIrradianceUp() + L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
+    std::atomic<uint64_t> traced{0};
+    parallelIndices(positions.size(), control, [&](size_t i) {
+        if (!valid[i]) return;
+        Rng rng(splitmix64(seed ^ 0xBADC0FFEEull ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull)));
+        const float offset = rng.next();
+        sh::ShRgb acc;
+        uint64_t count = 0;
+        for (int r = 0; r < rays; ++r) {
+            const glm::vec3 d0 = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
+            RayHit hit;
+            ++count;
+            glm::vec3 radiance(0.0f);
+            if (!L.tracer->intersect(positions[i], d0, INFINITY, hit)) {
+                radiance = L.sky.radiance(d0, weight);
+            } else if (depth > 0) {
+                // Path: at each terrain vertex, sun by a shadow ray plus one cosine-weighted
+                // continuation; throughput albedo per bounce.
+                glm::vec3 throughput = L.albedo / kPi;
+                for (int b = 0; b < depth; ++b) {
+                    if (!hit.onTerrain) {
+                        radiance += throughput * skirt;
+                        break;
+                    }
+                    const glm::vec3 n = hit.normal;
+                    radiance += throughput * sunIrradiance(L, hit.position, n, 1, rng);
+                    // Cosine-weighted direction from two fresh random numbers.
+                    const float u1 = rng.next(), u2 = rng.next();
+                    const float rr = std::sqrt(u1), phi = 2.0f * kPi * u2;
+                    glm::vec3 t, bt;
+                    basisAround(n, t, bt);
+                    const glm::vec3 dir = glm::normalize(rr * std::cos(phi) * t + rr * std::sin(phi) * bt +
+                                                         std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+                    const glm::vec3 o = liftOff(hit.position, n);
+                    ++count;
+                    RayHit next;
+                    // E = π × mean radiance under cosine sampling: the π cancels albedo's 1/π.
+                    if (!L.tracer->intersect(o, dir, INFINITY, next)) {
+                        radiance += throughput * kPi * L.sky.radiance(dir, 0.0f);
+                        break;
+                    }
+                    if (b + 1 == depth) break;
+                    throughput *= L.albedo;
+                    hit = next;
+                }
+            }
+            sh::accumulate(acc, d0, radiance, weight);
+        }
+        out.sh[i] = acc;
+        traced.fetch_add(count, std::memory_order_relaxed);
+    });
+    out.rays = traced.load();
+    return out;
+}
+
+ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
+                              const std::vector<sh::ShRgb>& reference,
+                              const std::vector<uint8_t>& valid) {
+    static const std::vector<glm::vec3> normals = [] {
+        std::vector<glm::vec3> n;
+        for (uint32_t i = 0; i < 256; ++i) n.push_back(fibonacciSphere(i, 256, 0.0f));
+        return n;
+    }();
+    ErrorStats s;
+    for (size_t i = 0; i < bake.size() && i < reference.size(); ++i) {
+        if (!valid[i]) continue;
+        double num = 0, den = 0;
+        for (const auto& n : normals) {
+            const double e = luminance(sh::evalIrradiance(bake[i], n));
+            const double r = luminance(sh::evalIrradiance(reference[i], n));
+            num += (e - r) * (e - r);
+            den += r * r;
+        }
+        s.perProbe.push_back(den > 0 ? float(std::sqrt(num / den)) : 0.0f);
+    }
+    if (s.perProbe.empty()) return s;
+    std::vector<float> sorted = s.perProbe;
+    std::sort(sorted.begin(), sorted.end());
+    double sum = 0;
+    for (float e : sorted) sum += e;
+    s.mean = sum / double(sorted.size());
+    s.p95 = sorted[std::min(sorted.size() - 1, size_t(std::ceil(0.95 * double(sorted.size()))) - 1)];
+    s.max = sorted.back();
+    return s;
+}
+
+}  // namespace terralux

@@ -1,0 +1,106 @@
+#pragma once
+// The CPU bake of diffuse SH probes over a heightfield (LIGHTING.md "Light transport for bakes").
+//
+// Probe radiance L(p, ω) is the sky where a ray escapes and, where it hits the terrain, the
+// light that point reflects: albedo/π × its irradiance from the sun (shadowed), the sky
+// (occluded) and, with more bounces, the terrain. The direct sun is not in the probes: engines
+// draw it as a light with shadows. Bounces go through a terrain irradiance cache (a regular grid
+// of surface points whose hemisphere rays are traced once and re-gathered per bounce), not
+// recursive rays per probe.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bake/HeightfieldTracer.h"
+#include "bake/SphericalHarmonics.h"
+#include "bake/Sky.h"
+#include "scene/SceneDescription.h"
+
+namespace terralux {
+
+struct BakeQuality {
+    int rays = 256;            // per probe, whole sphere
+    int bounces = 2;           // 0 = sky visibility only
+    int cacheResolution = 128; // irradiance-cache points along the longer footprint side
+    int cacheRays = 64;        // hemisphere rays per cache point
+    int sunSamples = 4;        // shadow rays per cache point across the sun's disk
+};
+BakeQuality qualityPreset(QualityPreset preset);
+const char* qualityName(QualityPreset preset);
+
+struct BakeLighting {
+    const HeightfieldTracer* tracer = nullptr;
+    Sky sky = Sky::uniform(glm::vec3(0.0f));
+    SunLight sun;
+    glm::vec3 albedo{0.3f};
+};
+
+// Progress in [0, 1] of the current phase, and a cancel flag polled between work chunks.
+struct BakeControl {
+    std::function<void(double)> progress;
+    const std::atomic<bool>* cancel = nullptr;
+    bool cancelled() const { return cancel && cancel->load(std::memory_order_relaxed); }
+};
+
+class BakeCancelled : public std::runtime_error {
+public:
+    BakeCancelled() : std::runtime_error("bake cancelled") {}
+};
+
+// Terrain irradiance after `bounces` gathers (0 = direct sun + occluded sky only).
+class IrradianceCache {
+public:
+    IrradianceCache(const BakeLighting& lighting, int resolution, int rays, int sunSamples,
+                    int bounces, const BakeControl& control);
+    // Irradiance arriving at a hit point: bilinear over the cache on the terrain; on the skirt,
+    // the open sky and the unshadowed sun (LIGHTING.md).
+    glm::vec3 at(const RayHit& hit) const;
+    int pointsX() const { return nx_; }
+    int pointsZ() const { return nz_; }
+
+private:
+    glm::vec3 interpolate(const std::vector<glm::vec3>& e, float x, float z) const;
+    const BakeLighting* lighting_;
+    int nx_ = 0, nz_ = 0;
+    float x0_ = 0, z0_ = 0, dx_ = 1, dz_ = 1;
+    glm::vec3 skirt_{0.0f};
+    std::vector<glm::vec3> irradiance_;
+};
+
+struct ProbeBake {
+    std::vector<sh::ShRgb> sh;          // radiance projections per probe (zero when invalid)
+    std::vector<float> standardError;   // relative Monte Carlo standard error of E(up) per probe
+    uint64_t rays = 0;                  // rays traced for the probes themselves
+};
+
+// Bakes the probes at `positions` (skipping those with valid[i] == 0). Deterministic: each probe's
+// directions depend only on its index and `seed`.
+ProbeBake bakeProbes(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
+                     const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
+                     int rays, uint64_t seed, const BakeControl& control);
+
+// Brute-force reference: path tracing from each probe, sun by shadow rays at every vertex, bounces
+// until the albedo-weighted energy a path can still add is below 0.1 % (0 bounces stays sky
+// visibility only, the same model as such a bake).
+ProbeBake referenceProbes(const BakeLighting& lighting, int bounces,
+                          const std::vector<glm::vec3>& positions,
+                          const std::vector<uint8_t>& valid, int rays, uint64_t seed,
+                          const BakeControl& control);
+int referencePathLength(const glm::vec3& albedo);
+
+// LIGHTING.md probe error: relative RMS of irradiance (luminance) over 256 fixed normals against
+// the reference, per valid probe; with mean, 95th percentile and max over probes.
+struct ErrorStats {
+    std::vector<float> perProbe;
+    double mean = 0, p95 = 0, max = 0;
+};
+ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
+                              const std::vector<sh::ShRgb>& reference,
+                              const std::vector<uint8_t>& valid);
+float luminance(const glm::vec3& c);
+
+}  // namespace terralux

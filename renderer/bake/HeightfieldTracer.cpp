@@ -1,0 +1,484 @@
+#include "bake/HeightfieldTracer.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+namespace terralux {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Adjacent planar pieces overlap by this much (in cells) in the point-in-piece tests, so a ray
+// through a shared edge or vertex cannot slip between them; rounding in those tests is ~1e-11
+// cells, and the brute force reference uses the same slack.
+constexpr double kEdgeSlack = 1e-7;
+constexpr float kMinDistanceRel = 1e-6f;
+
+// The ray in grid space: u = x / cellSizeX + (width - 1) / 2, v likewise; y and t in metres.
+struct GridRay {
+    double u0, v0, y0;
+    double du, dv, dy;
+};
+
+// Slopes (metres per cell along u and v) of the planar piece hit, to build its normal.
+struct Piece {
+    double gu = 0, gv = 0;
+    bool onTerrain = false;
+};
+
+struct Grid {
+    int cellsX, cellsZ;
+    bool skirt, triangles;
+};
+
+// Plane h(u, v) = h0 + (u - uc) * gu + (v - vc) * gv against the ray: t in (tLo, tHi] and the
+// hit's position relative to (uc, vc). The height difference ray - plane is linear in t, so
+// this is exact up to rounding. A parallel ray gives t = inf or NaN, which the range rejects.
+inline bool planeHit(const GridRay& r, double uc, double vc, double h0, double gu, double gv,
+                     double tLo, double tHi, double& t, double& fu, double& fv) {
+    const double a = r.u0 - uc, b = r.v0 - vc;
+    const double f0 = r.y0 - h0 - a * gu - b * gv;
+    const double f1 = r.dy - r.du * gu - r.dv * gv;
+    t = -f0 / f1;
+    if (!(t > tLo && t <= tHi)) return false;
+    fu = a + t * r.du;
+    fv = b + t * r.dv;
+    return true;
+}
+
+// Both triangles of cell (c, r) and, for border cells with the skirt on, the skirt pieces that
+// extend the cell outward. Updates tBest / piece with the nearest hit in (tLo, tBest].
+// c1 = min(c + 1, width - 1), r1 likewise; hRC = height of vertex (c or c1, r or r1).
+inline bool leafHit(const Grid& g, const GridRay& ray, int c, int r, int c1, int r1, double h00,
+                    double h10, double h01, double h11, double tLo, double& tBest, Piece& piece) {
+    constexpr double e = kEdgeSlack;
+    bool found = false;
+    double t, fu, fv;
+    auto take = [&](double gu, double gv, bool terrain) {
+        tBest = t;
+        piece = {gu, gv, terrain};
+        found = true;
+    };
+    if (g.triangles) {
+        // Triangle A: (c, r), (c, r+1), (c+1, r+1), where fu <= fv.
+        if (planeHit(ray, c, r, h00, h11 - h01, h01 - h00, tLo, tBest, t, fu, fv) && fu >= -e &&
+            fv <= 1 + e && fu <= fv + e)
+            take(h11 - h01, h01 - h00, true);
+        // Triangle B: (c, r), (c+1, r+1), (c+1, r), where fu > fv.
+        if (planeHit(ray, c, r, h00, h10 - h00, h11 - h10, tLo, tBest, t, fu, fv) && fv >= -e &&
+            fu <= 1 + e && fv <= fu + e)
+            take(h10 - h00, h11 - h10, true);
+    }
+    if (!g.skirt) return found;
+    const bool left = c == 0, right = c == g.cellsX - 1, top = r == 0, bottom = r == g.cellsZ - 1;
+    if (!(left || right || top || bottom)) return found;
+    // Edge strips: the border segment of this cell extruded outward, level across the edge.
+    if (r1 > r) {
+        if (left && planeHit(ray, c, r, h00, 0, h01 - h00, tLo, tBest, t, fu, fv) && fu <= e &&
+            fv >= -e && fv <= 1 + e)
+            take(0, h01 - h00, false);
+        if (right && planeHit(ray, c1, r, h10, 0, h11 - h10, tLo, tBest, t, fu, fv) && fu >= -e &&
+            fv >= -e && fv <= 1 + e)
+            take(0, h11 - h10, false);
+    }
+    if (c1 > c) {
+        if (top && planeHit(ray, c, r, h00, h10 - h00, 0, tLo, tBest, t, fu, fv) && fv <= e &&
+            fu >= -e && fu <= 1 + e)
+            take(h10 - h00, 0, false);
+        if (bottom && planeHit(ray, c, r1, h01, h11 - h01, 0, tLo, tBest, t, fu, fv) && fv >= -e &&
+            fu >= -e && fu <= 1 + e)
+            take(h11 - h01, 0, false);
+    }
+    // Corner quadrants: level at the corner vertex height.
+    if (left && top && planeHit(ray, c, r, h00, 0, 0, tLo, tBest, t, fu, fv) && fu <= e && fv <= e)
+        take(0, 0, false);
+    if (right && top && planeHit(ray, c1, r, h10, 0, 0, tLo, tBest, t, fu, fv) && fu >= -e &&
+        fv <= e)
+        take(0, 0, false);
+    if (left && bottom && planeHit(ray, c, r1, h01, 0, 0, tLo, tBest, t, fu, fv) && fu <= e &&
+        fv >= -e)
+        take(0, 0, false);
+    if (right && bottom && planeHit(ray, c1, r1, h11, 0, 0, tLo, tBest, t, fu, fv) && fu >= -e &&
+        fv >= -e)
+        take(0, 0, false);
+    return found;
+}
+
+// Cell index along one axis for grid coordinate p, clamped to the grid (border cells extend to
+// infinity outward).
+inline int startIndex(double p, int cells) {
+    return int(std::clamp(std::floor(p), 0.0, double(cells - 1)));
+}
+
+glm::vec3 pieceNormal(const Piece& p, double cellX, double cellZ) {
+    const double nx = -p.gu / cellX, nz = -p.gv / cellZ;
+    const double inv = 1.0 / std::sqrt(nx * nx + 1.0 + nz * nz);
+    return {float(nx * inv), float(inv), float(nz * inv)};
+}
+
+}  // namespace
+
+float HeightfieldTracer::minDistance(const glm::vec3& o) {
+    const float m = std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+    return kMinDistanceRel * (1.0f + m);
+}
+
+HeightfieldTracer::HeightfieldTracer(const Heightfield& hf) : HeightfieldTracer(hf, Options{}) {}
+
+HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&hf), opt_(opt) {
+    const int w = hf.width(), d = hf.depth();
+    cellsX_ = std::max(w - 1, 1);
+    cellsZ_ = std::max(d - 1, 1);
+    hasTriangles_ = w >= 2 && d >= 2;
+
+    // Level sizes: halve (rounding up) until a single root node remains.
+    int nx = cellsX_, nz = cellsZ_;
+    size_t total = 0;
+    levels_.push_back({nx, nz, 0});
+    while (nx > 1 || nz > 1) {
+        nx = (nx + 1) / 2;
+        nz = (nz + 1) / 2;
+        levels_.push_back({nx, nz, total});
+        total += size_t(nx) * size_t(nz);
+    }
+
+    // Culling compares double ray heights with these bounds; the margin dwarfs the rounding of
+    // either side, and only costs a little culling.
+    cullMargin_ = 1e-6 * (1.0 + std::max(std::fabs(hf.minHeight()), std::fabs(hf.maxHeight())));
+    qBase_ = hf.minHeight();
+    qStep_ = std::max(double(hf.maxHeight()) - double(hf.minHeight()), 1.0) / 60000.0;
+    auto quantize = [&](double m) {
+        const double q = std::ceil((m + cullMargin_ - qBase_) / qStep_) + 1.0;
+        return uint16_t(std::clamp(q, 0.0, 65535.0));
+    };
+    maxQ_.assign(total, 0);
+    if (levels_.size() < 2) return;
+
+    // Level 1 straight from the heights (each node: up to 3 x 3 vertices), then 2 x 2 reductions
+    // of the quantized values (monotonic, so still upper bounds).
+    const float* h = hf.heights().data();
+    const Level& l1 = levels_[1];
+    for (int z = 0; z < l1.nz; ++z) {
+        const int r0 = 2 * z, r1 = std::min(2 * z + 2, d - 1);
+        for (int x = 0; x < l1.nx; ++x) {
+            const int c0 = 2 * x, c1 = std::min(2 * x + 2, w - 1);
+            float m = h[size_t(r0) * size_t(w) + size_t(c0)];
+            for (int r = r0; r <= r1; ++r)
+                for (int c = c0; c <= c1; ++c) m = std::max(m, h[size_t(r) * size_t(w) + size_t(c)]);
+            maxQ_[l1.offset + size_t(z) * size_t(l1.nx) + size_t(x)] = quantize(m);
+        }
+    }
+    for (size_t l = 2; l < levels_.size(); ++l) {
+        const Level& fine = levels_[l - 1];
+        const Level& coarse = levels_[l];
+        const uint16_t* src = maxQ_.data() + fine.offset;
+        uint16_t* dst = maxQ_.data() + coarse.offset;
+        for (int z = 0; z < coarse.nz; ++z) {
+            const int z0 = 2 * z, z1 = std::min(2 * z + 1, fine.nz - 1);
+            for (int x = 0; x < coarse.nx; ++x) {
+                const int x0 = 2 * x, x1 = std::min(2 * x + 1, fine.nx - 1);
+                const uint16_t* a = src + size_t(z0) * size_t(fine.nx);
+                const uint16_t* b = src + size_t(z1) * size_t(fine.nx);
+                dst[size_t(z) * size_t(coarse.nx) + size_t(x)] =
+                    std::max(std::max(a[x0], a[x1]), std::max(b[x0], b[x1]));
+            }
+        }
+    }
+}
+
+// Stackless max-mipmap traversal (Tevs et al. 2008, sec. 4): keep the current node (level, ix,
+// iz) and the ray parameter t at which the ray is inside it. If the ray's lowest height over
+// the node's t interval is above the node max, step to the next node at the same level (and
+// one level up once the step leaves the parent); else descend into the child holding the ray
+// at t, or at a cell test its triangles. Node boundaries are integer cell indices and every
+// boundary's t is computed by one expression, so stepping, ascending and descending agree
+// exactly on which node holds the ray. Border nodes extend to infinity outward, which is where
+// the skirt lives; with the skirt off, t is clipped to the footprint instead.
+template <bool AnyHit>
+bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
+                              RayHit* hit) const {
+    const Heightfield& hf = *hf_;
+    const int w = hf.width(), d = hf.depth();
+    const double cellX = hf.cellSizeX(), cellZ = hf.cellSizeZ();
+    GridRay ray;
+    ray.u0 = double(o.x) / cellX + 0.5 * (w - 1);
+    ray.v0 = double(o.z) / cellZ + 0.5 * (d - 1);
+    ray.y0 = o.y;
+    ray.du = double(dir.x) / cellX;
+    ray.dv = double(dir.z) / cellZ;
+    ray.dy = dir.y;
+
+    const double tLo = minDistance(o);
+    double t = tLo;
+    // DBL_MAX rather than inf: a hit at t = inf (ray parallel to a level skirt) is no hit.
+    double tEnd = std::min(double(tMax), DBL_MAX);
+    if (!(t < tEnd)) return false;
+
+    if (!opt_.skirt) {
+        if (!hasTriangles_) return false;
+        auto clip = [&](double p0, double dp, double hi) {
+            if (dp == 0) {
+                if (p0 < 0 || p0 > hi) tEnd = -1;
+                return;
+            }
+            double ta = (0 - p0) / dp, tb = (hi - p0) / dp;
+            if (ta > tb) std::swap(ta, tb);
+            t = std::max(t, ta);
+            tEnd = std::min(tEnd, tb);
+        };
+        clip(ray.u0, ray.du, w - 1);
+        clip(ray.v0, ray.dv, d - 1);
+        if (!(t <= tEnd)) return false;
+    }
+
+    const Grid grid{cellsX_, cellsZ_, opt_.skirt, hasTriangles_};
+    const float* heights = hf.heights().data();
+    const int sx = ray.du > 0 ? 1 : (ray.du < 0 ? -1 : 0);
+    const int sz = ray.dv > 0 ? 1 : (ray.dv < 0 ? -1 : 0);
+    const double invDu = sx ? 1.0 / ray.du : 0.0;
+    const double invDv = sz ? 1.0 / ray.dv : 0.0;
+    const bool rising = ray.dy >= 0;
+    const int top = int(levels_.size()) - 1;
+    const Level* levels = levels_.data();
+    const uint16_t* maxQ = maxQ_.data();
+
+    // t at which the ray crosses grid line u = k (v = k); the single expression used everywhere.
+    auto crossU = [&](int k) { return (double(k) - ray.u0) * invDu; };
+    auto crossV = [&](int k) { return (double(k) - ray.v0) * invDv; };
+
+    // Start at the cell holding the ray at t (the first cells are where most rays cast from the
+    // surface end, and a walk down from the root would cost a dependent cache miss per level).
+    // The floor() guess is settled with the boundary crossings so it agrees with stepping.
+    int lvl = 0;
+    int ix = startIndex(ray.u0 + t * ray.du, cellsX_);
+    int iz = startIndex(ray.v0 + t * ray.dv, cellsZ_);
+    if (sx > 0) {
+        while (ix > 0 && crossU(ix) > t) --ix;
+        while (ix + 1 < cellsX_ && crossU(ix + 1) <= t) ++ix;
+    } else if (sx < 0) {
+        while (ix + 1 < cellsX_ && crossU(ix + 1) > t) ++ix;
+        while (ix > 0 && crossU(ix) <= t) --ix;
+    }
+    if (sz > 0) {
+        while (iz > 0 && crossV(iz) > t) --iz;
+        while (iz + 1 < cellsZ_ && crossV(iz + 1) <= t) ++iz;
+    } else if (sz < 0) {
+        while (iz + 1 < cellsZ_ && crossV(iz + 1) > t) ++iz;
+        while (iz > 0 && crossV(iz) <= t) --iz;
+    }
+    for (;;) {
+        const Level& L = levels[lvl];
+        double tx = kInf, tz = kInf;
+        if (sx > 0) {
+            if (ix + 1 < L.nx) tx = crossU((ix + 1) << lvl);
+        } else if (sx < 0) {
+            if (ix > 0) tx = crossU(ix << lvl);
+        }
+        if (sz > 0) {
+            if (iz + 1 < L.nz) tz = crossV((iz + 1) << lvl);
+        } else if (sz < 0) {
+            if (iz > 0) tz = crossV(iz << lvl);
+        }
+        const double tExit = std::min(std::min(tx, tz), tEnd);
+        const double yLow = rising ? ray.y0 + ray.dy * t : ray.y0 + ray.dy * tExit;
+        if (lvl == 0) {
+            // A cell: its own four heights bound it (and its skirt pieces), no stored level.
+            const int c1 = std::min(ix + 1, w - 1), r1 = std::min(iz + 1, d - 1);
+            const float* row0 = heights + size_t(iz) * size_t(w);
+            const float* row1 = heights + size_t(r1) * size_t(w);
+            const float f00 = row0[ix], f10 = row0[c1], f01 = row1[ix], f11 = row1[c1];
+            const double cellMax = std::max(std::max(f00, f10), std::max(f01, f11));
+            double tHit = tEnd;
+            Piece piece;
+            // The cell's pieces cannot be hit outside its box (up to kEdgeSlack), so the first
+            // cell with a hit holds the nearest one.
+            if (yLow <= cellMax + cullMargin_ &&
+                leafHit(grid, ray, ix, iz, c1, r1, f00, f10, f01, f11, tLo, tHit, piece)) {
+                if constexpr (!AnyHit) {
+                    hit->t = float(tHit);
+                    hit->position = o + hit->t * dir;
+                    hit->normal = pieceNormal(piece, cellX, cellZ);
+                    hit->onTerrain = piece.onTerrain;
+                }
+                return true;
+            }
+        } else if (yLow <= qBase_ + qStep_ * maxQ[L.offset + size_t(iz) * size_t(L.nx) + size_t(ix)]) {
+            --lvl;
+            ix <<= 1;
+            iz <<= 1;
+            const Level& C = levels[lvl];
+            if (ix + 1 < C.nx) {
+                const int k = (ix + 1) << lvl;
+                ix += sx > 0 ? t >= crossU(k) : (sx < 0 ? t < crossU(k) : ray.u0 >= k);
+            }
+            if (iz + 1 < C.nz) {
+                const int k = (iz + 1) << lvl;
+                iz += sz > 0 ? t >= crossV(k) : (sz < 0 ? t < crossV(k) : ray.v0 >= k);
+            }
+            continue;
+        }
+        if (tExit >= tEnd) return false;
+        t = tExit;
+        const int px = ix, pz = iz;
+        if (tx <= tExit) ix += sx;
+        if (tz <= tExit) iz += sz;
+        if (lvl < top && ((px >> 1) != (ix >> 1) || (pz >> 1) != (iz >> 1))) {
+            ++lvl;
+            ix >>= 1;
+            iz >>= 1;
+        }
+    }
+}
+
+bool HeightfieldTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax,
+                                  RayHit& hit) const {
+    return trace<false>(origin, dir, tMax, &hit);
+}
+
+bool HeightfieldTracer::occluded(const glm::vec3& origin, const glm::vec3& dir,
+                                 float tMax) const {
+    return trace<true>(origin, dir, tMax, nullptr);
+}
+
+bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& origin,
+                         const glm::vec3& dir, float tMax, RayHit& hit) {
+    using glm::dvec3;
+    const int w = hf.width(), d = hf.depth();
+    const double cellX = hf.cellSizeX(), cellZ = hf.cellSizeZ();
+    const double tLo = HeightfieldTracer::minDistance(origin);
+    double best = std::min(double(tMax), DBL_MAX);
+    if (!(tLo < best)) return false;
+    const dvec3 O(origin), D(dir);
+    auto X = [&](int c) { return (c - 0.5 * (w - 1)) * cellX; };
+    auto Z = [&](int r) { return (r - 0.5 * (d - 1)) * cellZ; };
+    auto V = [&](int c, int r) { return dvec3(X(c), double(hf.at(c, r)), Z(r)); };
+    constexpr double e = kEdgeSlack;
+
+    bool found = false;
+    dvec3 bestNormal(0, 1, 0);
+    bool bestTerrain = false;
+    auto take = [&](double t, dvec3 n, bool terrain) {
+        best = t;
+        bestNormal = n.y < 0 ? -n : n;
+        bestTerrain = terrain;
+        found = true;
+    };
+    // Moller & Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection" (JGT 1997), in
+    // double, no back-face culling.
+    auto triangle = [&](const dvec3& a, const dvec3& b, const dvec3& c) {
+        const dvec3 e1 = b - a, e2 = c - a;
+        const dvec3 p = glm::cross(D, e2);
+        const double det = glm::dot(e1, p);
+        if (det == 0) return;
+        const double inv = 1.0 / det;
+        const dvec3 s = O - a;
+        const double bu = glm::dot(s, p) * inv;
+        if (!(bu >= -e && bu <= 1 + e)) return;
+        const dvec3 q = glm::cross(s, e1);
+        const double bv = glm::dot(D, q) * inv;
+        if (!(bv >= -e && bu + bv <= 1 + e)) return;
+        const double t = glm::dot(e2, q) * inv;
+        if (t > tLo && t <= best) take(t, glm::cross(e1, e2), true);
+    };
+    for (int r = 0; r + 1 < d; ++r)
+        for (int c = 0; c + 1 < w; ++c) {
+            triangle(V(c, r), V(c, r + 1), V(c + 1, r + 1));
+            triangle(V(c, r), V(c + 1, r + 1), V(c + 1, r));
+        }
+
+    if (skirt) {
+        // Half-infinite strip: border segment p0-p1 swept along the horizontal unit vector out.
+        auto strip = [&](const dvec3& p0, const dvec3& p1, const dvec3& out, double cell) {
+            const dvec3 edge = p1 - p0;
+            const dvec3 n = glm::cross(edge, out);
+            const double den = glm::dot(D, n);
+            if (den == 0) return;
+            const double t = glm::dot(p0 - O, n) / den;
+            if (!(t > tLo && t <= best)) return;
+            const dvec3 rel = O + t * D - p0;
+            const double a = glm::dot(rel, edge) / glm::dot(edge, edge);
+            if (a >= -e && a <= 1 + e && glm::dot(rel, out) >= -e * cell) take(t, n, false);
+        };
+        if (d >= 2)
+            for (int r = 0; r + 1 < d; ++r) {
+                strip(V(0, r), V(0, r + 1), dvec3(-1, 0, 0), cellX);
+                strip(V(w - 1, r), V(w - 1, r + 1), dvec3(1, 0, 0), cellX);
+            }
+        if (w >= 2)
+            for (int c = 0; c + 1 < w; ++c) {
+                strip(V(c, 0), V(c + 1, 0), dvec3(0, 0, -1), cellZ);
+                strip(V(c, d - 1), V(c + 1, d - 1), dvec3(0, 0, 1), cellZ);
+            }
+        // Corner quadrants, level at the corner height; sx, sz = outward signs.
+        auto corner = [&](int c, int r, double sx, double sz) {
+            if (D.y == 0) return;
+            const dvec3 p = V(c, r);
+            const double t = (p.y - O.y) / D.y;
+            if (!(t > tLo && t <= best)) return;
+            const dvec3 q = O + t * D;
+            if ((q.x - p.x) * sx >= -e * cellX && (q.z - p.z) * sz >= -e * cellZ)
+                take(t, dvec3(0, 1, 0), false);
+        };
+        corner(0, 0, -1, -1);
+        corner(w - 1, 0, 1, -1);
+        corner(0, d - 1, -1, 1);
+        corner(w - 1, d - 1, 1, 1);
+    }
+    if (!found) return false;
+    hit.t = float(best);
+    hit.position = origin + hit.t * dir;
+    hit.normal = glm::vec3(glm::normalize(bestNormal));
+    hit.onTerrain = bestTerrain;
+    return true;
+}
+
+bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm::vec3& dir,
+                       float tMax, RayHit& hit) {
+    const double step = std::min(hf.cellSizeX(), hf.cellSizeZ());
+    const double lo = hf.minHeight(), hi = hf.maxHeight();
+    const glm::dvec3 O(origin), D(dir);
+    double t0 = HeightfieldTracer::minDistance(origin);
+    double tEnd = std::min(double(tMax), DBL_MAX);
+    // Only the slab lo <= y <= hi can hold a crossing: start at its top, stop at its bottom
+    // (below lo the ray is under the surface everywhere) or when rising out of it.
+    if (D.y > 0) {
+        tEnd = std::min(tEnd, (hi - O.y) / D.y);
+    } else if (D.y < 0) {
+        t0 = std::max(t0, (hi - O.y) / D.y);
+        tEnd = std::min(tEnd, (lo - O.y) / D.y);
+    } else {
+        if (O.y > hi) return false;
+        // Level ray inside the slab: march past the footprint by one footprint diagonal.
+        const double ex = hf.maxX() - hf.minX(), ez = hf.maxZ() - hf.minZ();
+        const double diag = std::sqrt(ex * ex + ez * ez);
+        tEnd = std::min(tEnd, std::hypot(O.x, O.z) + 2 * diag + step);
+    }
+    if (!(t0 <= tEnd)) return false;
+    auto below = [&](double t) {
+        const glm::dvec3 p = O + t * D;
+        return p.y <= double(hf.surfaceHeight(float(p.x), float(p.z)));
+    };
+    double ta = t0, tb = t0;
+    bool crossed = below(t0);
+    while (!crossed && tb < tEnd) {
+        ta = tb;
+        tb = std::min(tb + step, tEnd);
+        crossed = below(tb);
+    }
+    if (!crossed) return false;
+    while (tb - ta > 1e-4) {
+        const double tm = 0.5 * (ta + tb);
+        (below(tm) ? tb : ta) = tm;
+    }
+    hit.t = float(tb);
+    hit.position = origin + hit.t * dir;
+    hit.normal = hf.surfaceNormal(hit.position.x, hit.position.z);
+    hit.onTerrain = hf.contains(hit.position.x, hit.position.z);
+    return true;
+}
+
+}  // namespace terralux

@@ -1,0 +1,95 @@
+#pragma once
+// Exact ray casting against the Heightfield triangle surface (and its skirt), accelerated by a
+// maximum-height quadtree over the cells: the "maximum mipmap" of Tevs, Ihrke and Seidel,
+// "Maximum Mipmaps for Fast, Accurate, and Scalable Dynamic Height Field Rendering" (I3D 2008).
+//
+// Surface: inside the footprint, the two triangles per cell of Heightfield.h. With the skirt on,
+// outside it the height at (x, z) is the mesh height at the nearest border point (exactly
+// Heightfield::surfaceHeight): the border profile extruded outward along the four edges and a
+// level plane at the corner height in the four corner quadrants. That surface is infinite, so
+// with the skirt on every ray with dir.y < 0 hits something. With the skirt off, rays that leave
+// the footprint escape. Neither variant has vertical walls: every normal faces up (y > 0).
+//
+// All geometry is evaluated in double precision in grid space (u = x / cellSizeX + (width-1)/2,
+// the same mapping as Heightfield::surfaceHeight), so vertices sit on exact integers.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+struct RayHit {
+    float t = 0;             // distance along the unit direction
+    glm::vec3 position{};    // origin + t * dir
+    glm::vec3 normal{};      // unit geometric normal of the surface hit, facing up (y > 0)
+    bool onTerrain = false;  // true: a mesh triangle inside the footprint; false: the skirt
+};
+
+class HeightfieldTracer {
+public:
+    struct Options {
+        bool skirt = true;
+    };
+
+    // Keeps a reference to hf: it must outlive the tracer and not change while the tracer lives.
+    // (Two constructors rather than "Options opt = {}": GCC rejects a default argument of a
+    // nested type with member initializers inside the enclosing class.)
+    explicit HeightfieldTracer(const Heightfield& hf);
+    HeightfieldTracer(const Heightfield& hf, Options opt);
+
+    // First hit with minDistance(origin) < t <= tMax along a unit-length dir (tMax may be
+    // +infinity). false: the ray escapes (sky). Thread-safe: the tracer is immutable.
+    bool intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit& hit) const;
+    // Whether any hit exists in the same range; cheaper than intersect when only visibility matters.
+    bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const;
+
+    const Heightfield& heightfield() const { return *hf_; }
+    const Options& options() const { return opt_; }
+    // Number of quadtree levels (level 0 holds one node per cell).
+    int levelCount() const { return int(levels_.size()); }
+
+    // Hits at t <= minDistance(origin) are ignored so that a ray leaving a surface point does not
+    // hit that point again: 1e-6 relative to the origin's largest coordinate (about 16 float ulps),
+    // with a 1e-6 m floor. Callers should lift secondary-ray origins off the surface by more
+    // than that (e.g. 1e-4 * |position| + 1 mm along the normal).
+    static float minDistance(const glm::vec3& origin);
+
+private:
+    struct Level {
+        int nx = 0, nz = 0;  // nodes along X and Z
+        size_t offset = 0;   // first node in maxQ_ (unused for level 0)
+    };
+    template <bool AnyHit>
+    bool trace(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit* hit) const;
+
+    const Heightfield* hf_;
+    Options opt_;
+    int cellsX_ = 1, cellsZ_ = 1;  // at least 1: a one-vertex-wide grid has one zero-width cell
+    bool hasTriangles_ = false;    // width >= 2 and depth >= 2
+    std::vector<Level> levels_;    // levels_[0]: cells; levels_.back(): the single root node
+    // Max vertex height under each node of levels >= 1 (the skirt only repeats border heights),
+    // quantized upward: qBase_ + q * qStep_ >= true max + cullMargin_. 16 bits keep the
+    // levels of a 1201^2 DEM near 1 MB, cache-resident next to the float heights, which the
+    // cells (level 0) read directly.
+    std::vector<uint16_t> maxQ_;
+    double qBase_ = 0, qStep_ = 1;
+    double cullMargin_ = 0;  // absorbs rounding in the culling comparisons
+};
+
+// Reference: every triangle (and, when skirt is true, every skirt piece) tested one by one with
+// a double-precision Moller-Trumbore test in world space, nearest hit in (minDistance, tMax].
+bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& origin,
+                         const glm::vec3& dir, float tMax, RayHit& hit);
+
+// Baseline: fixed-step ray march (one step per min(cellSizeX, cellSizeZ) of t) over
+// Heightfield::surfaceHeight (so the skirt is always on), stopping at the first sample below the
+// surface and refining by bisection. Can step over thin ridges; kept for benchmarks.
+bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm::vec3& dir,
+                       float tMax, RayHit& hit);
+
+}  // namespace terralux

@@ -1,0 +1,157 @@
+#include "bake/ProbePlacement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace terralux {
+
+size_t ProbeLayout::validCount() const {
+    return size_t(std::count(valid.begin(), valid.end(), uint8_t(1)));
+}
+
+namespace {
+
+// Bilinear height over the DEM samples (seed 000's probe height rule). It can differ from the
+// drawn triangle surface, so validity is checked against that surface separately.
+float bilinearHeight(const Heightfield& hf, float x, float z) {
+    const double gx = std::clamp(double(x) / hf.cellSizeX() + 0.5 * (hf.width() - 1), 0.0, double(hf.width() - 1));
+    const double gz = std::clamp(double(z) / hf.cellSizeZ() + 0.5 * (hf.depth() - 1), 0.0, double(hf.depth() - 1));
+    const int c = std::min(int(gx), std::max(hf.width() - 2, 0));
+    const int r = std::min(int(gz), std::max(hf.depth() - 2, 0));
+    const int c1 = std::min(c + 1, hf.width() - 1), r1 = std::min(r + 1, hf.depth() - 1);
+    const double fx = gx - c, fz = gz - r;
+    return float((1 - fz) * ((1 - fx) * hf.at(c, r) + fx * hf.at(c1, r)) +
+                 fz * ((1 - fx) * hf.at(c, r1) + fx * hf.at(c1, r1)));
+}
+
+std::string num(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
+// Terrain-following grid (seed 000): nx × nz probes at the terrain height plus the
+// offset. Auto-span puts the end probes on the footprint edges; a 1-wide axis is centred.
+ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    const std::string where = "probe_volumes '" + v.name + "'";
+    ProbeLayout L;
+    const int nx = v.gridDims[0], nz = v.gridDims[2];
+    L.probeDims = {nx, 1, nz};
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    glm::vec3 spacing(0.0f);
+    glm::vec3 first(0.0f);
+    if (v.spacing) {
+        spacing = glm::vec3(v.spacing->x, 0.0f, v.spacing->z);
+    } else {
+        spacing.x = nx > 1 ? spanX / float(nx - 1) : 0.0f;
+        spacing.z = nz > 1 ? spanZ / float(nz - 1) : 0.0f;
+    }
+    if (v.origin) {
+        first = glm::vec3(v.origin->x, 0.0f, v.origin->z);
+    } else {
+        // Centred: auto-span reaches the edges exactly; explicit spacing is centred on the terrain.
+        first.x = -0.5f * spacing.x * float(nx - 1);
+        first.z = -0.5f * spacing.z * float(nz - 1);
+    }
+    L.spacing = spacing;
+    for (int k = 0; k < nz; ++k)
+        for (int i = 0; i < nx; ++i) {
+            const float x = first.x + spacing.x * float(i), z = first.z + spacing.z * float(k);
+            const glm::vec3 p(x, bilinearHeight(hf, x, z) + float(v.heightOffset), z);
+            L.positions.push_back(p);
+            L.valid.push_back(p.y > hf.surfaceHeight(x, z) ? 1 : 0);
+        }
+
+    // Occupancy: cubic cells of the smaller probe spacing (or, for a single probe, of the
+    // larger footprint side) spanning the probes' columns from the lowest ground to above the
+    // highest probe. A cell above the terrain maps to the nearest probe column; below, -1.
+    float cell = 0.0f;
+    if (spacing.x > 0.0f && spacing.z > 0.0f) cell = std::min(spacing.x, spacing.z);
+    else cell = std::max(spacing.x, spacing.z);
+    if (!(cell > 0.0f)) cell = std::max({spanX, spanZ, 1.0f});
+    const float halfX = nx > 1 ? 0.5f * spacing.x : 0.5f * cell;
+    const float halfZ = nz > 1 ? 0.5f * spacing.z : 0.5f * cell;
+    const float x0 = first.x - halfX, x1 = first.x + spacing.x * float(nx - 1) + halfX;
+    const float z0 = first.z - halfZ, z1 = first.z + spacing.z * float(nz - 1) + halfZ;
+    float yMin = hf.minHeight(), yMax = hf.maxHeight();
+    for (const auto& p : L.positions) yMax = std::max(yMax, p.y), yMin = std::min(yMin, p.y);
+    const double dimsD[3] = {std::ceil((x1 - x0) / cell - 1e-4),
+                             std::ceil((yMax - yMin) / cell - 1e-4) + 1.0,
+                             std::ceil((z1 - z0) / cell - 1e-4)};
+    const double cells = std::max(dimsD[0], 1.0) * std::max(dimsD[1], 1.0) * std::max(dimsD[2], 1.0);
+    if (cells > double(kMaxOccupancyCells))
+        throw PlacementError(where + ": occupancy grid of " + num(cells) +
+                             " cells exceeds " + std::to_string(kMaxOccupancyCells) +
+                             "; use fewer, wider-spaced probes");
+    L.cellSize = cell;
+    L.cellDims = {uint32_t(std::max(dimsD[0], 1.0)), uint32_t(std::max(dimsD[1], 1.0)),
+                  uint32_t(std::max(dimsD[2], 1.0))};
+    L.cellOrigin = glm::vec3(x0, yMin, z0);
+    L.cellProbe.assign(size_t(L.cellDims[0]) * L.cellDims[1] * L.cellDims[2], -1);
+    for (uint32_t cz = 0; cz < L.cellDims[2]; ++cz)
+        for (uint32_t cx = 0; cx < L.cellDims[0]; ++cx) {
+            const float x = x0 + (float(cx) + 0.5f) * cell, z = z0 + (float(cz) + 0.5f) * cell;
+            const int i = nx > 1 ? std::clamp(int(std::lround((x - first.x) / spacing.x)), 0, nx - 1) : 0;
+            const int k = nz > 1 ? std::clamp(int(std::lround((z - first.z) / spacing.z)), 0, nz - 1) : 0;
+            const int probe = k * nx + i;
+            if (!L.valid[size_t(probe)]) continue;
+            const float ground = hf.surfaceHeight(x, z);
+            for (uint32_t cy = 0; cy < L.cellDims[1]; ++cy) {
+                const float y = yMin + (float(cy) + 0.5f) * cell;
+                if (y > ground)
+                    L.cellProbe[cx + size_t(cy) * L.cellDims[0] +
+                                size_t(cz) * L.cellDims[0] * L.cellDims[1]] = probe;
+            }
+        }
+    return L;
+}
+
+// Uniform box grid: one probe at the centre of each cubic cell.
+ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    ProbeLayout L;
+    const int nx = v.gridDims[0], ny = v.gridDims[1], nz = v.gridDims[2];
+    L.probeDims = {nx, ny, nz};
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    float cell = v.spacing ? v.spacing->x
+                           : std::max({spanX / float(nx), spanZ / float(nz), 1e-3f});
+    glm::vec3 origin;
+    if (v.origin) {
+        origin = *v.origin;
+    } else {
+        // Centred on the footprint, from the lowest ground up.
+        origin = glm::vec3(-0.5f * cell * float(nx), hf.minHeight(), -0.5f * cell * float(nz));
+    }
+    L.spacing = glm::vec3(cell);
+    L.cellSize = cell;
+    L.cellOrigin = origin;
+    L.cellDims = {uint32_t(nx), uint32_t(ny), uint32_t(nz)};
+    L.cellProbe.assign(size_t(nx) * ny * nz, -1);
+    for (int z = 0; z < nz; ++z)
+        for (int y = 0; y < ny; ++y)
+            for (int x = 0; x < nx; ++x) {
+                const glm::vec3 p = origin + cell * glm::vec3(float(x) + 0.5f, float(y) + 0.5f,
+                                                              float(z) + 0.5f);
+                const bool above = p.y > hf.surfaceHeight(p.x, p.z);
+                const int index = int(L.positions.size());
+                L.positions.push_back(p);
+                L.valid.push_back(above ? 1 : 0);
+                if (above) L.cellProbe[x + size_t(y) * nx + size_t(z) * nx * ny] = index;
+            }
+    // Box placement order is x fastest, then y, then z, matching the occupancy layout.
+    return L;
+}
+
+}  // namespace
+
+ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    ProbeLayout L = v.placement == ProbePlacement::Box ? placeBoxGrid(v, hf) : placeTerrainGrid(v, hf);
+    float minSpacing = 0.0f;
+    for (int a = 0; a < 3; ++a)
+        if (L.spacing[a] > 0.0f) minSpacing = minSpacing > 0.0f ? std::min(minSpacing, L.spacing[a]) : L.spacing[a];
+    L.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
+                                                      : 2.0f * minSpacing;
+    return L;
+}
+
+}  // namespace terralux

@@ -1,0 +1,133 @@
+#include "bake/Sky.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <glm/common.hpp>
+
+namespace terralux {
+
+namespace {
+constexpr float kPi = std::numbers::pi_v<float>;
+}
+
+glm::vec3 sunDirection(double azimuthDeg, double elevationDeg) {
+    const double az = azimuthDeg * std::numbers::pi / 180.0;
+    const double el = elevationDeg * std::numbers::pi / 180.0;
+    return glm::vec3(float(std::sin(az) * std::cos(el)), float(std::sin(el)),
+                     float(-std::cos(az) * std::cos(el)));
+}
+
+Sky Sky::uniform(const glm::vec3& radiance) {
+    Sky s;
+    s.uniform_ = radiance;
+    s.sh_ = sh::projectConstant(radiance);
+    s.openUp_ = std::numbers::pi_v<float> * radiance;
+    return s;
+}
+
+Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity,
+                  float rotationDeg) {
+    if (width < 1 || height < 1 || rgb.size() != size_t(width) * size_t(height) * 3)
+        throw std::invalid_argument("sky image: " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " does not match its data");
+    if (!(intensity >= 0.0f) || !std::isfinite(intensity))
+        throw std::invalid_argument("sky intensity must be finite and >= 0");
+    Sky s;
+    Level base{width, height, std::vector<glm::vec3>(size_t(width) * height)};
+    for (size_t i = 0; i < base.texels.size(); ++i) {
+        const glm::vec3 t(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
+        if (!std::isfinite(t.x) || !std::isfinite(t.y) || !std::isfinite(t.z) || t.x < 0 ||
+            t.y < 0 || t.z < 0)
+            throw std::invalid_argument("sky image: texel " + std::to_string(i % width) + "," +
+                                        std::to_string(i / width) +
+                                        " is negative or not finite");
+        base.texels[i] = t * intensity;
+    }
+    s.levels_.push_back(std::move(base));
+    // Box-filtered pyramid, each texel weighted by its solid angle (∝ sin θ) so the poles do not
+    // dominate the average.
+    while (s.levels_.back().width > 1 || s.levels_.back().height > 1) {
+        const Level& f = s.levels_.back();
+        Level c{std::max(1, f.width / 2), std::max(1, f.height / 2), {}};
+        c.texels.assign(size_t(c.width) * c.height, glm::vec3(0.0f));
+        for (int y = 0; y < c.height; ++y)
+            for (int x = 0; x < c.width; ++x) {
+                glm::vec3 sum(0.0f);
+                float wsum = 0.0f;
+                for (int dy = 0; dy < 2; ++dy)
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const int fx = std::min(2 * x + dx, f.width - 1);
+                        const int fy = std::min(2 * y + dy, f.height - 1);
+                        const float w = std::sin(kPi * (fy + 0.5f) / f.height);
+                        sum += w * f.texels[size_t(fy) * f.width + fx];
+                        wsum += w;
+                    }
+                c.texels[size_t(y) * c.width + x] = wsum > 0 ? sum / wsum : glm::vec3(0.0f);
+            }
+        s.levels_.push_back(std::move(c));
+    }
+    s.rotation_ = float(rotationDeg / 360.0 - std::floor(rotationDeg / 360.0));
+    s.computeSh();
+    return s;
+}
+
+void Sky::computeSh() {
+    const Level& l = levels_.front();
+    sh_ = sh::ShRgb{};
+    openUp_ = glm::vec3(0.0f);
+    const double dphi = 2.0 * std::numbers::pi / l.width;
+    for (int y = 0; y < l.height; ++y) {
+        const double t0 = std::numbers::pi * y / l.height, t1 = std::numbers::pi * (y + 1) / l.height;
+        const float solidAngle = float(dphi * (std::cos(t0) - std::cos(t1)));
+        const float theta = float(0.5 * (t0 + t1));
+        for (int x = 0; x < l.width; ++x) {
+            const float u = (x + 0.5f) / l.width;
+            const float phi = (u - 0.5f + rotation_) * 2.0f * kPi;
+            const glm::vec3 dir(std::sin(theta) * std::sin(phi), std::cos(theta),
+                                -std::sin(theta) * std::cos(phi));
+            const glm::vec3& texel = l.texels[size_t(y) * l.width + x];
+            sh::accumulate(sh_, dir, texel, solidAngle);
+            if (dir.y > 0.0f) openUp_ += texel * (dir.y * solidAngle);
+        }
+    }
+}
+
+glm::vec3 Sky::sample(const Level& level, float u, float v) const {
+    // Bilinear, wrapping in u and clamping in v.
+    const float fx = u * level.width - 0.5f, fy = std::clamp(v * level.height - 0.5f, 0.0f,
+                                                              float(level.height - 1));
+    const int x0 = int(std::floor(fx)), y0 = int(fy);
+    const float tx = fx - std::floor(fx), ty = fy - y0;
+    const int y1 = std::min(y0 + 1, level.height - 1);
+    auto at = [&](int x, int y) {
+        x = ((x % level.width) + level.width) % level.width;
+        return level.texels[size_t(y) * level.width + x];
+    };
+    return (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x0 + 1, y0)) +
+           ty * ((1 - tx) * at(x0, y1) + tx * at(x0 + 1, y1));
+}
+
+glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
+    if (levels_.empty()) return uniform_;
+    const float phi = std::atan2(dir.x, -dir.z);
+    float u = 0.5f + phi / (2.0f * kPi) - rotation_;
+    u -= std::floor(u);
+    const float v = std::acos(std::clamp(dir.y, -1.0f, 1.0f)) / kPi;
+    const Level& base = levels_.front();
+    // Level whose texel (at the equator) covers about `solidAngle`; blend the two nearest.
+    const float texel0 = 2.0f * kPi * kPi / float(base.width * base.height);
+    float lod = solidAngle > texel0 ? 0.5f * std::log2(solidAngle / texel0) : 0.0f;
+    lod = std::min(lod, float(levels_.size() - 1));
+    const int l0 = int(lod);
+    const int l1 = std::min(l0 + 1, int(levels_.size()) - 1);
+    const float t = lod - l0;
+    const glm::vec3 a = sample(levels_[size_t(l0)], u, v);
+    if (t <= 0.0f || l1 == l0) return a;
+    return glm::mix(a, sample(levels_[size_t(l1)], u, v), t);
+}
+
+}  // namespace terralux

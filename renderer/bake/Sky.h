@@ -1,0 +1,59 @@
+#pragma once
+// The sky a bake sees: a uniform radiance, or an equirectangular HDR (× intensity, turned about
+// +Y), plus the sun as a separate directional light with an angular radius.
+//
+// Equirectangular mapping: v = acos(y) / π (v = 0 at the zenith); u = 0.5 + φ / 2π − rotation,
+// with φ = atan2(x, −z) the azimuth clockwise from north (−Z) toward east (+X). At rotation 0 the
+// image centre column faces north.
+
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bake/SphericalHarmonics.h"
+
+namespace terralux {
+
+struct SunLight {
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // unit, toward the sun
+    glm::vec3 illuminance{0.0f};            // E_sun × colour on a surface facing the sun
+    float angularRadius = 0.0f;             // radians
+};
+
+// Direction toward the sun from azimuth (clockwise from north) and elevation, in degrees.
+glm::vec3 sunDirection(double azimuthDeg, double elevationDeg);
+
+class Sky {
+public:
+    static Sky uniform(const glm::vec3& radiance);
+    // rgb: width × height × 3 floats, row 0 at the zenith. Throws std::invalid_argument on bad
+    // sizes or non-finite / negative texels.
+    static Sky equirect(std::vector<float> rgb, int width, int height, float intensity,
+                        float rotationDeg);
+
+    bool isUniform() const { return levels_.empty(); }
+    // Radiance toward `dir`, averaged over about `solidAngle` steradians around it (the share of
+    // the sphere one sample stands for). Prefiltering a peaky HDR this way removes most of the
+    // variance of a few hundred samples at the cost of blur below the SH's own resolution.
+    glm::vec3 radiance(const glm::vec3& dir, float solidAngle = 0.0f) const;
+    // Exact projection of the whole sky onto SH L2 (texel solid angles, no sampling).
+    const sh::ShRgb& sh() const { return sh_; }
+    // Irradiance on an unoccluded level surface (normal +Y), integrated exactly over the texels.
+    glm::vec3 openIrradianceUp() const { return openUp_; }
+
+private:
+    struct Level {
+        int width = 0, height = 0;
+        std::vector<glm::vec3> texels;
+    };
+    glm::vec3 sample(const Level& level, float u, float v) const;
+    void computeSh();
+
+    glm::vec3 uniform_{0.0f};
+    std::vector<Level> levels_;
+    float rotation_ = 0.0f;  // in u units [0, 1)
+    sh::ShRgb sh_;
+    glm::vec3 openUp_{0.0f};
+};
+
+}  // namespace terralux

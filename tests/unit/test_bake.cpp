@@ -1,0 +1,189 @@
+// The CPU bake against analytic answers (issue: constant sky over a flat plane, bounce limit,
+// valley vs ridge, determinism across thread counts, placement rules).
+#include <cmath>
+#include <cstring>
+#include <numbers>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "bake/DiffuseBake.h"
+#include "bake/ProbePlacement.h"
+#include "bake/SphereSampling.h"
+
+using namespace terralux;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+namespace {
+
+Heightfield flat(int n, double cell, float h = 100.0f) {
+    return Heightfield(n, n, cell, cell, std::vector<float>(size_t(n) * n, h));
+}
+
+BakeLighting lightingFor(const HeightfieldTracer& tracer, glm::vec3 sky, glm::vec3 albedo) {
+    BakeLighting L;
+    L.tracer = &tracer;
+    L.sky = Sky::uniform(sky);
+    L.albedo = albedo;
+    L.sun.direction = sunDirection(135.0, 35.0);
+    L.sun.illuminance = glm::vec3(0.0f);
+    return L;
+}
+
+const glm::vec3 kUp(0, 1, 0), kDown(0, -1, 0);
+
+}  // namespace
+
+TEST(Bake, ConstantSkyOverFlatGroundGivesPiLUpAndNothingDown) {
+    const Heightfield hf = flat(33, 10.0);
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f, 0.5f, 2.0f), glm::vec3(0.0f));
+    const BakeQuality q = qualityPreset(QualityPreset::Standard);
+    const std::vector<glm::vec3> probes = {{0, 105, 0}, {-150, 101, 120}, {150, 200, -150}};
+    const ProbeBake b = bakeProbes(L, nullptr, 0, probes, {1, 1, 1}, q.rays, 7, {});
+    for (const auto& sh : b.sh) {
+        const glm::vec3 up = sh::evalIrradiance(sh, kUp);
+        const glm::vec3 down = sh::evalIrradiance(sh, kDown);
+        EXPECT_NEAR(up.x, kPi * 1.0f, 0.005f * kPi);
+        EXPECT_NEAR(up.y, kPi * 0.5f, 0.005f * kPi * 0.5f);
+        EXPECT_NEAR(up.z, kPi * 2.0f, 0.005f * kPi * 2.0f);
+        EXPECT_NEAR(down.x, 0.0f, 0.005f * kPi);
+        EXPECT_NEAR(down.z, 0.0f, 0.005f * kPi * 2.0f);
+    }
+}
+
+TEST(Bake, BouncesOverFlatGroundTendToAlbedoPiL) {
+    const Heightfield hf = flat(33, 10.0);
+    const HeightfieldTracer tracer(hf);
+    const glm::vec3 albedo(0.2f, 0.5f, 0.8f);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), albedo);
+    const BakeQuality q = qualityPreset(QualityPreset::Standard);
+    const IrradianceCache cache(L, q.cacheResolution, q.cacheRays, q.sunSamples, 2, {});
+    const ProbeBake b = bakeProbes(L, &cache, 3, {{10, 110, -20}}, {1}, q.rays, 1, {});
+    const glm::vec3 down = sh::evalIrradiance(b.sh[0], kDown);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(down[c], albedo[c] * kPi, 0.01f * kPi) << c;
+    // Zero bounces: the ground is black whatever its albedo.
+    const ProbeBake b0 = bakeProbes(L, &cache, 0, {{10, 110, -20}}, {1}, q.rays, 1, {});
+    EXPECT_NEAR(sh::evalIrradiance(b0.sh[0], kDown).y, 0.0f, 0.005f * kPi);
+}
+
+TEST(Bake, SunLightsTheGroundThatBouncesIntoProbes) {
+    const Heightfield hf = flat(17, 10.0);
+    const HeightfieldTracer tracer(hf);
+    BakeLighting L = lightingFor(tracer, glm::vec3(0.0f), glm::vec3(0.5f));
+    L.sun.direction = sunDirection(0.0, 30.0);
+    L.sun.illuminance = glm::vec3(2.0f);
+    const IrradianceCache cache(L, 32, 16, 4, 0, {});
+    const ProbeBake b = bakeProbes(L, &cache, 1, {{0, 105, 0}}, {1}, 256, 3, {});
+    // Ground irradiance E_sun sin(30°) = 1; reflected radiance 0.5/π; down irradiance 0.5.
+    EXPECT_NEAR(sh::evalIrradiance(b.sh[0], kDown).x, 0.5f, 0.005f);
+    EXPECT_NEAR(sh::evalIrradiance(b.sh[0], kUp).x, 0.0f, 0.005f);
+}
+
+TEST(Bake, ValleyProbeSeesLessSkyThanRidgeProbe) {
+    // A V-shaped valley running north-south: height grows with |x|.
+    const int n = 65;
+    std::vector<float> h(size_t(n) * n);
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) h[size_t(r) * n + c] = 40.0f * std::abs(float(c - n / 2));
+    const Heightfield hf(n, n, 10.0, 10.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.0f));
+    // The ridge probe stands on the crest line (the east edge, where the skirt continues level).
+    const glm::vec3 valley(0, 5, 0), ridge(hf.maxX(), hf.maxHeight() + 5.0f, 0);
+    const ProbeBake b = bakeProbes(L, nullptr, 0, {valley, ridge}, {1, 1}, 256, 1, {});
+    const float eValley = sh::evalIrradiance(b.sh[0], kUp).x;
+    const float eRidge = sh::evalIrradiance(b.sh[1], kUp).x;
+    // Walls rising 4 m per metre leave a slot of half-angle atan(1/4) = 14° of open sky, and the
+    // black walls fill the rest; an infinite slot of half-angle α gives E(up) = π sin α (a
+    // cylinder-wedge of sky) = 0.24 π. The ridge sees almost the whole upper hemisphere.
+    EXPECT_NEAR(eValley, kPi * std::sin(std::atan(0.25f)), 0.05f * kPi);
+    EXPECT_GT(eRidge, 0.9f * kPi);
+    EXPECT_LT(eValley, 0.5f * eRidge);
+}
+
+TEST(Bake, SameBytesWithOneAndTwoThreads) {
+    std::vector<float> h(40 * 30);
+    Rng rng(5);
+    for (float& v : h) v = 200.0f * rng.next();
+    const Heightfield hf(40, 30, 15.0, 12.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    BakeLighting L = lightingFor(tracer, glm::vec3(0.6f, 0.75f, 1.0f), glm::vec3(0.3f));
+    L.sun.illuminance = glm::vec3(3.0f);
+    ProbeVolumeSettings v;
+    v.gridDims = {12, 1, 9};
+    const ProbeLayout layout = placeProbes(v, hf);
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        const IrradianceCache cache(L, 32, 16, 2, 2, {});
+        return bakeProbes(L, &cache, 3, layout.positions, layout.valid, 128, 99, {});
+    };
+    const ProbeBake a = run(1), b = run(2);
+    ASSERT_EQ(a.sh.size(), b.sh.size());
+    EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * sizeof(sh::ShRgb)), 0);
+    EXPECT_EQ(std::memcmp(a.standardError.data(), b.standardError.data(), a.standardError.size() * sizeof(float)), 0);
+}
+
+TEST(Bake, ReferenceAgreesWithAnalyticFlatPlane) {
+    const Heightfield hf = flat(17, 10.0);
+    const HeightfieldTracer tracer(hf);
+    const glm::vec3 albedo(0.5f);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), albedo);
+    const ProbeBake r = referenceProbes(L, 4, {{0, 105, 0}}, {1}, 4096, 3, {});
+    EXPECT_NEAR(sh::evalIrradiance(r.sh[0], kUp).x, kPi, 0.005f * kPi);
+    EXPECT_NEAR(sh::evalIrradiance(r.sh[0], kDown).x, 0.5f * kPi, 0.01f * kPi);
+    EXPECT_EQ(referencePathLength(glm::vec3(0.5f)), 10);  // 0.5^10 < 0.1 %
+}
+
+TEST(Bake, ErrorMetricIsRelativeRmsOfIrradiance) {
+    sh::ShRgb a = sh::projectConstant(glm::vec3(1.0f)), b = a;
+    b *= 1.1f;
+    const ErrorStats s = compareToReference({b}, {a}, {1});
+    EXPECT_NEAR(s.mean, 0.1, 1e-5);
+    EXPECT_NEAR(s.max, 0.1, 1e-5);
+}
+
+TEST(Placement, TerrainGridAutoSpanAndOneByOne) {
+    std::vector<float> h(11 * 6);
+    for (size_t i = 0; i < h.size(); ++i) h[i] = float(i % 11);
+    const Heightfield hf(11, 6, 10.0, 20.0, std::move(h));
+    ProbeVolumeSettings v;
+    v.gridDims = {3, 1, 2};
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.positions.size(), 6u);
+    EXPECT_FLOAT_EQ(L.positions[0].x, hf.minX());
+    EXPECT_FLOAT_EQ(L.positions[2].x, hf.maxX());
+    EXPECT_FLOAT_EQ(L.positions[3].z, hf.maxZ());
+    EXPECT_FLOAT_EQ(L.positions[2].y, 10.0f + 5.0f);  // east edge height 10 + offset
+    EXPECT_FLOAT_EQ(L.fallbackBlendDistance, 2.0f * 50.0f);
+    // Every cell above the ground maps to the nearest probe column; the cells below hold -1.
+    size_t above = 0;
+    for (int32_t c : L.cellProbe) above += c >= 0;
+    EXPECT_GT(above, 0u);
+
+    v.gridDims = {1, 1, 1};
+    const ProbeLayout one = placeProbes(v, hf);
+    ASSERT_EQ(one.positions.size(), 1u);
+    EXPECT_FLOAT_EQ(one.positions[0].x, 0.0f);
+    EXPECT_FLOAT_EQ(one.positions[0].z, 0.0f);
+    EXPECT_FLOAT_EQ(one.positions[0].y, 5.0f + 5.0f);
+}
+
+TEST(Placement, ProbesInsideTheTerrainAreInvalidWithNoCell) {
+    const Heightfield hf = flat(9, 10.0, 50.0f);
+    ProbeVolumeSettings v;
+    v.placement = ProbePlacement::Box;
+    v.gridDims = {2, 4, 2};
+    v.spacing = glm::vec3(20.0f);
+    v.origin = glm::vec3(-20.0f, 0.0f, -20.0f);  // cell centres at y = 10, 30, 50 (on), 70
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.positions.size(), 16u);
+    EXPECT_EQ(L.validCount(), 4u);  // only the y = 70 layer is above the ground
+    for (size_t i = 0; i < L.positions.size(); ++i) {
+        const size_t x = i % 2, y = (i / 2) % 4, z = i / 8;
+        EXPECT_EQ(L.cellProbe[x + y * 2 + z * 8], L.valid[i] ? int32_t(i) : -1);
+    }
+    ProbeVolumeSettings below;
+    below.heightOffset = -1.0;
+    EXPECT_EQ(placeProbes(below, hf).validCount(), 0u);
+}
