@@ -131,6 +131,8 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf) : HeightfieldTracer(
 
 HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&hf), opt_(opt) {
     const int w = hf.width(), d = hf.depth();
+    invCellX_ = 1.0 / hf.cellSizeX();
+    invCellZ_ = 1.0 / hf.cellSizeZ();
     cellsX_ = std::max(w - 1, 1);
     cellsZ_ = std::max(d - 1, 1);
     hasTriangles_ = w >= 2 && d >= 2;
@@ -203,13 +205,12 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
                               RayHit* hit) const {
     const Heightfield& hf = *hf_;
     const int w = hf.width(), d = hf.depth();
-    const double cellX = hf.cellSizeX(), cellZ = hf.cellSizeZ();
     GridRay ray;
-    ray.u0 = double(o.x) / cellX + 0.5 * (w - 1);
-    ray.v0 = double(o.z) / cellZ + 0.5 * (d - 1);
+    ray.u0 = double(o.x) * invCellX_ + 0.5 * (w - 1);
+    ray.v0 = double(o.z) * invCellZ_ + 0.5 * (d - 1);
     ray.y0 = o.y;
-    ray.du = double(dir.x) / cellX;
-    ray.dv = double(dir.z) / cellZ;
+    ray.du = double(dir.x) * invCellX_;
+    ray.dv = double(dir.z) * invCellZ_;
     ray.dy = dir.y;
 
     const double tLo = minDistance(o);
@@ -235,56 +236,46 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
         if (!(t <= tEnd)) return false;
     }
 
-    const Grid grid{cellsX_, cellsZ_, opt_.skirt, hasTriangles_};
-    const float* heights = hf.heights().data();
-    const int sx = ray.du > 0 ? 1 : (ray.du < 0 ? -1 : 0);
-    const int sz = ray.dv > 0 ? 1 : (ray.dv < 0 ? -1 : 0);
-    const double invDu = sx ? 1.0 / ray.du : 0.0;
-    const double invDv = sz ? 1.0 / ray.dv : 0.0;
+    // Per axis: negU when u decreases along the ray. A ray with du = 0 is walked as increasing
+    // u with 1 / du = DBL_MAX: its crossings then lie at +-huge t, behind or far ahead, so
+    // "which side of u = k" comes out as u0 >= k, with no separate case in the loop.
+    const bool negU = ray.du < 0, negV = ray.dv < 0;
+    const double invDu = ray.du != 0 ? 1.0 / ray.du : DBL_MAX;
+    const double invDv = ray.dv != 0 ? 1.0 / ray.dv : DBL_MAX;
+    const int stepU = negU ? -1 : 1, stepV = negV ? -1 : 1;
+    const int exitU = negU ? 0 : 1, exitV = negV ? 0 : 1;  // exit boundary = (index + exit) << lvl
     const bool rising = ray.dy >= 0;
     const int top = int(levels_.size()) - 1;
     const Level* levels = levels_.data();
     const uint16_t* maxQ = maxQ_.data();
+    const float* heights = hf.heights().data();
+    const Grid grid{cellsX_, cellsZ_, opt_.skirt, hasTriangles_};
 
-    // t at which the ray crosses grid line u = k (v = k); the single expression used everywhere.
+    // t at which the ray crosses grid line u = k (v = k): the single expression used everywhere.
     auto crossU = [&](int k) { return (double(k) - ray.u0) * invDu; };
     auto crossV = [&](int k) { return (double(k) - ray.v0) * invDv; };
+    // Whether the ray at t is on the high side of u = k (v = k), consistent with crossU.
+    auto highU = [&](int k) { return (t >= crossU(k)) != negU; };
+    auto highV = [&](int k) { return (t >= crossV(k)) != negV; };
 
-    // Start at the cell holding the ray at t (the first cells are where most rays cast from the
-    // surface end, and a walk down from the root would cost a dependent cache miss per level).
-    // The floor() guess is settled with the boundary crossings so it agrees with stepping.
+    // Start at the cell holding the ray at t (most rays cast from the surface end within a few
+    // cells, and a walk down from the root would cost a dependent cache miss per level). The
+    // floor() guess is settled against the crossings so that it agrees with stepping.
     int lvl = 0;
     int ix = startIndex(ray.u0 + t * ray.du, cellsX_);
     int iz = startIndex(ray.v0 + t * ray.dv, cellsZ_);
-    if (sx > 0) {
-        while (ix > 0 && crossU(ix) > t) --ix;
-        while (ix + 1 < cellsX_ && crossU(ix + 1) <= t) ++ix;
-    } else if (sx < 0) {
-        while (ix + 1 < cellsX_ && crossU(ix + 1) > t) ++ix;
-        while (ix > 0 && crossU(ix) <= t) --ix;
-    }
-    if (sz > 0) {
-        while (iz > 0 && crossV(iz) > t) --iz;
-        while (iz + 1 < cellsZ_ && crossV(iz + 1) <= t) ++iz;
-    } else if (sz < 0) {
-        while (iz + 1 < cellsZ_ && crossV(iz + 1) > t) ++iz;
-        while (iz > 0 && crossV(iz) <= t) --iz;
-    }
+    while (ix > 0 && !highU(ix)) --ix;
+    while (ix + 1 < cellsX_ && highU(ix + 1)) ++ix;
+    while (iz > 0 && !highV(iz)) --iz;
+    while (iz + 1 < cellsZ_ && highV(iz + 1)) ++iz;
+
     for (;;) {
-        const Level& L = levels[lvl];
-        double tx = kInf, tz = kInf;
-        if (sx > 0) {
-            if (ix + 1 < L.nx) tx = crossU((ix + 1) << lvl);
-        } else if (sx < 0) {
-            if (ix > 0) tx = crossU(ix << lvl);
-        }
-        if (sz > 0) {
-            if (iz + 1 < L.nz) tz = crossV((iz + 1) << lvl);
-        } else if (sz < 0) {
-            if (iz > 0) tz = crossV(iz << lvl);
-        }
+        // Where the ray leaves the node; the outermost nodes reach to infinity (the skirt).
+        const int ku = (ix + exitU) << lvl, kv = (iz + exitV) << lvl;
+        const double tx = ku > 0 && ku < cellsX_ ? crossU(ku) : kInf;
+        const double tz = kv > 0 && kv < cellsZ_ ? crossV(kv) : kInf;
         const double tExit = std::min(std::min(tx, tz), tEnd);
-        const double yLow = rising ? ray.y0 + ray.dy * t : ray.y0 + ray.dy * tExit;
+        const double yLow = ray.y0 + ray.dy * (rising ? t : tExit);
         if (lvl == 0) {
             // A cell: its own four heights bound it (and its skirt pieces), no stored level.
             const int c1 = std::min(ix + 1, w - 1), r1 = std::min(iz + 1, d - 1);
@@ -301,36 +292,37 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
                 if constexpr (!AnyHit) {
                     hit->t = float(tHit);
                     hit->position = o + hit->t * dir;
-                    hit->normal = pieceNormal(piece, cellX, cellZ);
+                    hit->normal = pieceNormal(piece, hf.cellSizeX(), hf.cellSizeZ());
                     hit->onTerrain = piece.onTerrain;
                 }
                 return true;
             }
-        } else if (yLow <= qBase_ + qStep_ * maxQ[L.offset + size_t(iz) * size_t(L.nx) + size_t(ix)]) {
-            --lvl;
-            ix <<= 1;
-            iz <<= 1;
-            const Level& C = levels[lvl];
-            if (ix + 1 < C.nx) {
-                const int k = (ix + 1) << lvl;
-                ix += sx > 0 ? t >= crossU(k) : (sx < 0 ? t < crossU(k) : ray.u0 >= k);
+        } else {
+            const Level& L = levels[lvl];
+            const double nodeMax =
+                qBase_ + qStep_ * maxQ[L.offset + size_t(iz) * size_t(L.nx) + size_t(ix)];
+            if (yLow <= nodeMax) {
+                // Descend into the child holding the ray at t.
+                --lvl;
+                ix <<= 1;
+                iz <<= 1;
+                const Level& C = levels[lvl];
+                if (ix + 1 < C.nx) ix += highU((ix + 1) << lvl);
+                if (iz + 1 < C.nz) iz += highV((iz + 1) << lvl);
+                continue;
             }
-            if (iz + 1 < C.nz) {
-                const int k = (iz + 1) << lvl;
-                iz += sz > 0 ? t >= crossV(k) : (sz < 0 ? t < crossV(k) : ray.v0 >= k);
-            }
-            continue;
         }
         if (tExit >= tEnd) return false;
+        // Step to the next node; go one level up when it lies in another parent or, for a
+        // rising ray (which only gets higher), always, as the parent may now be cleared too.
         t = tExit;
         const int px = ix, pz = iz;
-        if (tx <= tExit) ix += sx;
-        if (tz <= tExit) iz += sz;
-        if (lvl < top && ((px >> 1) != (ix >> 1) || (pz >> 1) != (iz >> 1))) {
-            ++lvl;
-            ix >>= 1;
-            iz >>= 1;
-        }
+        ix += tx <= tExit ? stepU : 0;
+        iz += tz <= tExit ? stepV : 0;
+        const int up = lvl < top && (rising || ((px ^ ix) | (pz ^ iz)) > 1);
+        lvl += up;
+        ix >>= up;
+        iz >>= up;
     }
 }
 

@@ -71,6 +71,7 @@ private:
     Options opt_;
     int cellsX_ = 1, cellsZ_ = 1;  // at least 1: a one-vertex-wide grid has one zero-width cell
     bool hasTriangles_ = false;    // width >= 2 and depth >= 2
+    double invCellX_ = 1, invCellZ_ = 1;
     std::vector<Level> levels_;    // levels_[0]: cells; levels_.back(): the single root node
     // Max vertex height under each node of levels >= 1 (the skirt only repeats border heights),
     // quantized upward: qBase_ + q * qStep_ >= true max + cullMargin_. 16 bits keep the
