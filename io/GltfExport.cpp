@@ -164,11 +164,10 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
         }
     }
     const size_t uvOffset = bin.size();
-    const double uScale = 1.0 / double(hf.width() - 1), vScale = 1.0 / double(hf.depth() - 1);
     for (int r : rows) {
         for (int c : cols) {
-            putF32(bin, float(c * uScale));
-            putF32(bin, float(r * vScale));
+            putF32(bin, float(double(c) / double(hf.width() - 1)));
+            putF32(bin, float(double(r) / double(hf.depth() - 1)));
         }
     }
     const size_t indexOffset = bin.size();
@@ -275,8 +274,11 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
                                      " = " + std::to_string(a) + " must be in [0, 1]");
         }
     }
-    if (!std::isfinite(input.verticalScale)) {
-        throw std::runtime_error(gltfPath.string() + ": vertical scale must be finite");
+    const GeoOrigin& geo = hf->geo;
+    if (!std::isfinite(input.verticalScale) || !std::isfinite(geo.easting) ||
+        !std::isfinite(geo.northing) || !std::isfinite(geo.height)) {
+        throw std::runtime_error(gltfPath.string() +
+                                 ": the vertical scale and the geo origin must be finite");
     }
     if (!input.bake.is_object()) {
         throw std::runtime_error(gltfPath.string() + ": the " + kBakeExtension +

@@ -60,7 +60,7 @@ struct GltfExportResult {
 // Files of an earlier export that this one does not write are left alone: the .shprobe files of
 // volumes no longer present are NOT deleted, nor is an old scene.bin when the new scene has no mesh.
 // A heightfield with a single row or column has no triangles: the scene then has no mesh, no buffer
-// and no scene.bin, only the extensions.
+// and no scene.bin, only the extensions (TERRALUX_geo.meshStride is 1).
 // Throws FileWriteError for filesystem failures, ShProbeError for a grid that cannot be encoded and
 // std::runtime_error for other invalid input, each with a one-line message naming the file.
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input);

@@ -1,6 +1,8 @@
 #include "bake/DiffuseBake.h"
 
 #include <algorithm>
+
+#include <glm/common.hpp>
 #include <cmath>
 #include <numbers>
 
@@ -97,6 +99,8 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
     rays = std::max(rays, 1);
 
     std::vector<glm::vec3> direct(points);
+    sunDirect_.assign(points, glm::vec3(0.0f));
+    skirtSun_ = L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
     // Hits per point: (x, z) of terrain hits; NaN x marks a skirt hit.
     std::vector<float> hitXZ(points * size_t(rays) * 2);
     BakeControl phase = control;
@@ -129,7 +133,8 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
                 hits[2 * r + 1] = INFINITY;  // escaped: contributes sky only
             }
         }
-        direct[i] = sky * (kPi / float(rays)) + sunIrradiance(L, p, n, sunSamples, rng);
+        sunDirect_[i] = sunIrradiance(L, p, n, sunSamples, rng);
+        direct[i] = sky * (kPi / float(rays)) + sunDirect_[i];
     });
 
     // Gathers: E_b = E_0 + albedo / N × Σ E_{b-1}(hit) (cosine-weighted estimator of
@@ -168,6 +173,13 @@ glm::vec3 IrradianceCache::at(const RayHit& hit) const {
     return hit.onTerrain ? interpolate(irradiance_, hit.position.x, hit.position.z) : skirt_;
 }
 
+glm::vec3 IrradianceCache::indirectAt(const RayHit& hit) const {
+    if (!hit.onTerrain) return skirt_ - skirtSun_;
+    return glm::max(interpolate(irradiance_, hit.position.x, hit.position.z) -
+                        interpolate(sunDirect_, hit.position.x, hit.position.z),
+                    glm::vec3(0.0f));
+}
+
 ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      int rays, uint64_t seed, const BakeControl& control) {
@@ -190,7 +202,14 @@ ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bo
             RayHit hit;
             glm::vec3 radiance(0.0f);
             if (L.tracer->intersect(positions[i], d, INFINITY, hit)) {
-                if (bounces > 0 && cache) radiance = L.albedo / kPi * cache->at(hit);
+                if (bounces > 0 && cache) {
+                    // Sun at the hit itself, one shadow ray across the disk; the cache for the
+                    // rest. The skirt is unshadowed by definition.
+                    const glm::vec3 sun = hit.onTerrain
+                                              ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
+                                              : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
+                    radiance = L.albedo / kPi * (cache->indirectAt(hit) + sun);
+                }
             } else {
                 radiance = L.sky.radiance(d, weight);
             }

@@ -59,6 +59,9 @@ public:
     // Irradiance arriving at a hit point: bilinear over the cache on the terrain; on the skirt,
     // the open sky and the unshadowed sun (LIGHTING.md).
     glm::vec3 at(const RayHit& hit) const;
+    // The same without the direct sun at the hit: callers that trace the sun themselves add it
+    // exactly (sun shadows are the sharpest part of terrain irradiance, too sharp for the cache).
+    glm::vec3 indirectAt(const RayHit& hit) const;
     int pointsX() const { return nx_; }
     int pointsZ() const { return nz_; }
 
@@ -69,6 +72,8 @@ private:
     float x0_ = 0, z0_ = 0, dx_ = 1, dz_ = 1;
     glm::vec3 skirt_{0.0f};
     std::vector<glm::vec3> irradiance_;
+    std::vector<glm::vec3> sunDirect_;
+    glm::vec3 skirtSun_{0.0f};
 };
 
 struct ProbeBake {

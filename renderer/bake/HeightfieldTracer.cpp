@@ -248,6 +248,7 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
     const int top = int(levels_.size()) - 1;
     const Level* levels = levels_.data();
     const uint16_t* maxQ = maxQ_.data();
+    const double rootMax = double(hf.maxHeight()) + cullMargin_;
     const float* heights = hf.heights().data();
     const Grid grid{cellsX_, cellsZ_, opt_.skirt, hasTriangles_};
 
@@ -312,7 +313,7 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
                 continue;
             }
         }
-        if (tExit >= tEnd) return false;
+        if (tExit >= tEnd || (rising && ray.y0 + ray.dy * tExit > rootMax)) return false;
         // Step to the next node; go one level up when it lies in another parent or, for a
         // rising ray (which only gets higher), always, as the parent may now be cleared too.
         t = tExit;

@@ -501,6 +501,9 @@ TEST_F(GltfExport, RejectsInvalidInputBeforeWritingAnything) {
     in.bake = json::array();
     expectRejected(in, "TERRALUX_bake metadata must be a JSON object");
     in = sampleInput(hf);
+    in.verticalScale = std::nan("");
+    expectRejected(in, "scene.gltf: the vertical scale and the geo origin must be finite");
+    in = sampleInput(hf);
     in.meshMaxVertices = 3;
     expectRejected(in, "meshMaxVertices = 3");
 }

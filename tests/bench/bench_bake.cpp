@@ -1,0 +1,89 @@
+// Bake time and error against the reference for each quality preset on a 64 x 64 terrain grid
+// (4096 probes) over a real DEM (the shared N42E001 SRTM tile, reprojected to UTM). Needs the
+// shared data beside the repository; exits 0 with a note when it is absent.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include <benchmark/benchmark.h>
+
+#include "DemImport.h"
+#include "bake/DiffuseBake.h"
+#include "bake/ProbePlacement.h"
+
+using namespace terralux;
+
+namespace {
+
+struct Fixture {
+    DemImportResult dem;
+    std::unique_ptr<HeightfieldTracer> tracer;
+    BakeLighting lighting;
+    ProbeLayout layout;
+    ProbeBake reference;
+    double referenceSeconds = 0;
+};
+
+Fixture* fixture() {
+    static std::unique_ptr<Fixture> f = [] {
+        const std::filesystem::path dem =
+            std::filesystem::path(TERRALUX_SHARED_DATA) / "dem" / "N42E001.hgt";
+        if (!std::filesystem::exists(dem)) return std::unique_ptr<Fixture>();
+        auto x = std::make_unique<Fixture>();
+        x->dem = importDem(dem.string());
+        x->tracer = std::make_unique<HeightfieldTracer>(x->dem.heightfield);
+        x->lighting.tracer = x->tracer.get();
+        x->lighting.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
+        x->lighting.sun.direction = sunDirection(135.0, 35.0);
+        x->lighting.sun.illuminance = glm::vec3(3.0f, 2.88f, 2.7f);
+        x->lighting.sun.angularRadius = 0.27f * 3.14159265f / 180.0f;
+        x->lighting.albedo = glm::vec3(0.3f);
+        ProbeVolumeSettings v;
+        v.gridDims = {64, 1, 64};
+        x->layout = placeProbes(v, x->dem.heightfield);
+        const auto t = std::chrono::steady_clock::now();
+        x->reference = referenceProbes(x->lighting, 16, x->layout.positions, x->layout.valid,
+                                       qualityPreset(QualityPreset::Reference).rays, 1234, {});
+        x->referenceSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+        std::fprintf(stderr, "reference: %zu probes, %llu rays, %.1f s\n", x->layout.positions.size(),
+                     (unsigned long long)x->reference.rays, x->referenceSeconds);
+        return x;
+    }();
+    return f.get();
+}
+
+void BM_BakePreset(benchmark::State& state) {
+    Fixture* f = fixture();
+    if (!f) {
+        state.SkipWithError("shared DEM N42E001.hgt not present");
+        return;
+    }
+    const auto preset = QualityPreset(state.range(0));
+    const BakeQuality q = qualityPreset(preset);
+    ProbeBake bake;
+    for (auto _ : state) {
+        const IrradianceCache cache(f->lighting, q.cacheResolution, q.cacheRays, q.sunSamples,
+                                    q.bounces - 1, {});
+        bake = bakeProbes(f->lighting, &cache, q.bounces, f->layout.positions, f->layout.valid,
+                          q.rays, 99, {});
+        benchmark::DoNotOptimize(bake.sh.data());
+    }
+    const ErrorStats e = compareToReference(bake.sh, f->reference.sh, f->layout.valid);
+    state.SetLabel(qualityName(preset));
+    state.counters["probes"] = double(f->layout.validCount());
+    state.counters["err_mean_pct"] = 100.0 * e.mean;
+    state.counters["err_p95_pct"] = 100.0 * e.p95;
+    state.counters["err_max_pct"] = 100.0 * e.max;
+    state.counters["ref_s"] = f->referenceSeconds;
+}
+BENCHMARK(BM_BakePreset)
+    ->Arg(int(QualityPreset::Draft))
+    ->Arg(int(QualityPreset::Standard))
+    ->Arg(int(QualityPreset::High))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
