@@ -272,6 +272,12 @@ json sceneToJson(const SceneDescription& s) {
           {"bounces", optionalInt(s.bake.bounces)},
           {"sh_encoding", s.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
           {"deringing", s.bake.deringing}}},
+        {"camera",
+         {{"target", s.camera.target ? vec(*s.camera.target, 3) : json(nullptr)},
+          {"radius", optionalNumber(s.camera.radius)},
+          {"azimuth_deg", s.camera.azimuthDeg},
+          {"elevation_deg", s.camera.elevationDeg},
+          {"fov_deg", s.camera.fovDeg}}},
         {"export",
          {{"out_dir", s.exportSettings.outDir},
           {"gltf", s.exportSettings.gltf},
@@ -369,6 +375,20 @@ SceneDescription sceneFromJson(const json& doc, const std::string& source,
                           ? ShEncoding::Irradiance
                           : ShEncoding::Radiance;
     s.bake.deringing = r.boolean(bake.at("deringing"), "bake.deringing");
+
+    const json& cam = d.at("camera");
+    if (!cam.at("target").is_null()) {
+        r.array(cam.at("target"), "camera.target", 3);
+        glm::vec3 t;
+        for (int i = 0; i < 3; ++i)
+            t[i] = float(r.number(cam.at("target")[size_t(i)], "camera.target[" + std::to_string(i) + "]"));
+        s.camera.target = t;
+    }
+    if (!cam.at("radius").is_null())
+        s.camera.radius = r.numberAtLeast(cam.at("radius"), "camera.radius", 0.0, true);
+    s.camera.azimuthDeg = r.number(cam.at("azimuth_deg"), "camera.azimuth_deg");
+    s.camera.elevationDeg = r.numberIn(cam.at("elevation_deg"), "camera.elevation_deg", -89.9, 89.9);
+    s.camera.fovDeg = r.numberIn(cam.at("fov_deg"), "camera.fov_deg", 1.0, 150.0);
 
     const json& ex = d.at("export");
     s.exportSettings.outDir = r.string(ex.at("out_dir"), "export.out_dir");

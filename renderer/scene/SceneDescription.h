@@ -82,6 +82,16 @@ struct ExportSettings {
     double defaultAmbient = 0.1;
 };
 
+// Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
+// the mean terrain height; unset radius = frames the whole footprint.
+struct CameraSettings {
+    std::optional<glm::vec3> target;
+    std::optional<double> radius;     // metres, > 0
+    double azimuthDeg = 210.0;        // clockwise from north, where the camera stands
+    double elevationDeg = 35.0;       // (-90, 90)
+    double fovDeg = 45.0;             // vertical, (1, 150)
+};
+
 struct SceneDescription {
     TerrainSettings terrain;
     SunSettings sun;
@@ -90,6 +100,7 @@ struct SceneDescription {
     ReflectionProbeSettings reflectionProbes;
     BakeSettings bake;
     ExportSettings exportSettings;
+    CameraSettings camera;
 };
 
 }  // namespace terralux

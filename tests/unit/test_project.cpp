@@ -95,6 +95,10 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"bake.sh_encoding=rgb", "p.json: bake.sh_encoding = \"rgb\": must be one of radiance | irradiance"},
         Rule{"export.out_dir=\"\"", "p.json: export.out_dir = \"\": must name a folder"},
         Rule{"export.default_ambient=-0.1", "p.json: export.default_ambient = -0.1: must be >= 0"},
+        Rule{"camera.elevation_deg=90", "p.json: camera.elevation_deg = 90: must be in [-89.9, 89.9]"},
+        Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
+        Rule{"camera.radius=0", "p.json: camera.radius = 0: must be > 0"},
+        Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers"},
         Rule{"version=2", "p.json: version = 2: is newer than this Terralux reads (1)"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -176,6 +180,9 @@ TEST(Project, SaveLoadIsLosslessAndPathsStayRelative) {
     box.spacing = glm::vec3(12.5f);
     p.scene.probeVolumes.push_back(box);
     p.scene.bake.bounces = 3;
+    p.scene.camera.target = glm::vec3(10.f, 500.f, -20.f);
+    p.scene.camera.radius = 2500.0;
+    p.scene.camera.fovDeg = 30.0;
 
     saveProject(p, dir / "a.terralux.json");
     const Project q = loadProject(dir / "a.terralux.json", nullptr);
