@@ -15,6 +15,9 @@
 #include <unistd.h>
 
 #include "BakeJob.h"
+#include "ImageFile.h"
+#include "RenderJob.h"
+#include "render/DebugViews.h"
 #include "DemImport.h"
 #include "EnvironmentImage.h"
 #include "ShProbeFile.h"
@@ -38,6 +41,9 @@ Terrain-lighting authoring: import a DEM, bake spherical-harmonics probes, expor
 Commands:
   --bake [PROJECT]              Bake every enabled probe volume and export .shprobe files, a glTF
                                 scene and bake_report.json into the output folder.
+  --render [PROJECT]            Render the terrain lit by the probes of the last bake in the
+                                output folder (baking first when there is none) into --out IMAGE
+                                (.png display-encoded, .exr scene-linear), on the Vulkan device.
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
@@ -51,6 +57,14 @@ Options:
   --quality PRESET              draft | standard | high | reference (bake.quality).
   --compare-reference           Also run the brute-force reference and report the error of
                                 every probe against it (slow).
+  --size WxH                    Render size (default 1280x720).
+  --debug-view N|NAME           What --render draws: 0 beauty, 1 albedo, 2 normal, 30 ndotl,
+                                32 linear, 50 probe-irradiance, 51 probe-weight.
+  --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
+                                degrees, radius in metres (default: the project's camera).
+  --no-probes                   Render without probe lighting.
+  --device NAME                 Vulkan device: cpu, gpu, or part of its name
+                                (default: discrete GPU, integrated, then CPU).
   --set KEY.PATH=VALUE          Override a project parameter by its JSON path; repeatable.
                                 Examples: --set sun.elevation_deg=12
                                           --set probe_volumes[0].grid_dims=16,16
@@ -79,11 +93,18 @@ struct Args {
     QCommandLineOption out{"out", "Output folder.", "DIR"};
     QCommandLineOption quality{"quality", "Preset.", "PRESET"};
     QCommandLineOption compareReference{"compare-reference", "Compare with the reference."};
+    QCommandLineOption render{"render", "Render."};
+    QCommandLineOption size{"size", "Size.", "WxH"};
+    QCommandLineOption debugView{"debug-view", "View.", "N"};
+    QCommandLineOption camera{"camera", "Camera.", "AZ,EL[,R]"};
+    QCommandLineOption noProbes{"no-probes", "No probes."};
+    QCommandLineOption device{"device", "Device.", "NAME"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, help, version, dem, set, threads, quiet, bake, out,
-                           quality, compareReference});
+                           quality, compareReference, render, size, debugView, camera, noProbes,
+                           device});
     }
 };
 
@@ -244,6 +265,77 @@ int commandBake(const Args& a) {
     return kExitOk;
 }
 
+int commandRender(const Args& a) {
+    const QStringList positional = a.parser.positionalArguments();
+    if (positional.size() > 1) throw UsageError("--render takes one PROJECT");
+    if (!a.parser.isSet(a.out)) throw UsageError("--render needs --out IMAGE (.png or .exr)");
+    const std::filesystem::path image = std::filesystem::absolute(str(a.parser.value(a.out)));
+    const std::string ext = image.extension().string();
+    if (ext != ".png" && ext != ".exr")
+        throw UsageError("--out " + image.string() + ": extension must be .png or .exr");
+    RenderRequest request;
+    request.width = 1280;
+    request.height = 720;
+    if (a.parser.isSet(a.size)) {
+        const std::string v = str(a.parser.value(a.size));
+        unsigned w = 0, h = 0;
+        char x = 0, extra = 0;
+        if (std::sscanf(v.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
+            h < 1 || w > 16384 || h > 16384)
+            throw UsageError("--size " + v + ": expected WxH, each in [1, 16384]");
+        request.width = w;
+        request.height = h;
+    }
+    if (a.parser.isSet(a.debugView)) {
+        const std::string v = str(a.parser.value(a.debugView));
+        const auto view = findDebugView(v);
+        if (!view) throw UsageError("--debug-view " + v + ": not one of " + debugViewList());
+        request.debugView = view->number;
+    }
+    request.probes = !a.parser.isSet(a.noProbes);
+    request.linearOutput = ext == ".exr";
+
+    std::vector<std::string> warnings, sets;
+    for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
+    if (a.parser.isSet(a.camera)) {
+        const QStringList parts = a.parser.value(a.camera).split(',');
+        bool ok = parts.size() == 2 || parts.size() == 3;
+        double v[3] = {0, 0, 0};
+        for (int i = 0; ok && i < parts.size(); ++i) v[i] = parts[i].toDouble(&ok);
+        if (!ok)
+            throw UsageError("--camera " + str(a.parser.value(a.camera)) +
+                             ": expected AZ,EL[,RADIUS] in degrees and metres");
+        sets.push_back("camera.azimuth_deg=" + std::to_string(v[0]));
+        sets.push_back("camera.elevation_deg=" + std::to_string(v[1]));
+        if (parts.size() == 3) sets.push_back("camera.radius=" + std::to_string(v[2]));
+    }
+    const Project project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
+                                                 a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "",
+                                                 &warnings);
+    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
+
+    vk::ContextOptions options;
+    if (a.parser.isSet(a.device)) options.device = str(a.parser.value(a.device));
+    std::unique_ptr<vk::VulkanContext> ctx;
+    try {
+        ctx = std::make_unique<vk::VulkanContext>(options);
+    } catch (const vk::VulkanUnavailable& e) {
+        std::cerr << "terralux: " << e.what() << "; --bake works without one\n";
+        return kExitRuntime;
+    }
+    ProjectRenderer renderer(*ctx, project);
+    std::string note;
+    const size_t volumes = request.probes ? renderer.loadProbes(true, &note) : 0;
+    if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
+    const RenderedImage img = renderer.render(request);
+    writeImage(image, img.width, img.height, img.rgba);
+    const auto view = findDebugView(std::to_string(request.debugView));
+    std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
+              << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
+              << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    return kExitOk;
+}
+
 int commandPrintProject(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
     if (positional.size() > 1) throw UsageError("--print-project takes one PROJECT");
@@ -275,8 +367,9 @@ int runCommandLine(int argc, char** argv) {
             return kExitOk;
         }
         const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
-                             int(a.parser.isSet(a.bake));
-        if (commands > 1) throw UsageError("choose one command: --bake, --info or --print-project");
+                             int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render));
+        if (commands > 1)
+            throw UsageError("choose one command: --bake, --render, --info or --print-project");
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
             const int n = a.parser.value(a.threads).toInt(&ok);
@@ -286,6 +379,7 @@ int runCommandLine(int argc, char** argv) {
         }
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
+        if (a.parser.isSet(a.render)) return commandRender(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);
         if (!a.parser.positionalArguments().isEmpty())
             throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) +
@@ -301,6 +395,9 @@ int runCommandLine(int argc, char** argv) {
     } catch (const ProjectError& e) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitUsage;
+    } catch (const vk::VulkanError& e) {
+        std::cerr << "terralux: " << e.what() << "\n";
+        return kExitRuntime;
     } catch (const ImageError& e) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitUsage;

@@ -1,0 +1,82 @@
+#include "RenderJob.h"
+
+#include <numbers>
+
+#include "BakeJob.h"
+#include "EnvironmentImage.h"
+#include "ShProbeFile.h"
+#include "TerrainLoading.h"
+#include "render/OrbitCamera.h"
+
+namespace terralux {
+
+namespace {
+Sky skyOf(const Project& p) {
+    const SkySettings& s = p.scene.sky;
+    if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
+    RgbImage img = readEquirectImage(p.hdrPath().string());
+    for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= s.color[int(i % 3)];
+    return Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
+                         float(s.rotationDeg));
+}
+}  // namespace
+
+ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
+    : project_(project), terrain_(loadProjectTerrain(project)) {
+    const SceneDescription& scene = project_.scene;
+    base_.albedo = scene.terrain.albedo;
+    base_.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
+    base_.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
+    base_.skySh = skyOf(project_).sh();
+    base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
+    renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
+}
+
+ProjectRenderer::~ProjectRenderer() = default;
+
+size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note) {
+    const SceneDescription& scene = project_.scene;
+    const std::filesystem::path dir = project_.outDir() / "sh_coeffs";
+    bool missing = false;
+    for (const auto& v : scene.probeVolumes)
+        if (v.enabled && !std::filesystem::exists(dir / (v.name + ".shprobe"))) missing = true;
+    if (missing && bakeIfMissing) {
+        BakeRequest request;
+        request.project = project_;
+        runBake(request, nullptr, nullptr);
+        if (note) *note = "baked " + project_.outDir().string() + " first (no earlier bake there)";
+    }
+    std::vector<GpuProbeVolume> volumes;
+    for (const auto& v : scene.probeVolumes) {
+        if (!v.enabled) continue;
+        const auto path = dir / (v.name + ".shprobe");
+        if (!std::filesystem::exists(path)) continue;
+        const ShProbeGrid g = readShProbeFile(path);
+        GpuProbeVolume gv;
+        gv.dims = g.dims;
+        gv.origin = g.origin;
+        gv.spacing = g.spacing;
+        gv.occupancy = g.occupancy;
+        gv.scale = g.defaultScale;
+        gv.irradianceEncoded = scene.bake.encoding == ShEncoding::Irradiance;
+        // LIGHTING.md default: twice the smallest probe spacing, which is the cell edge here.
+        gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
+                                                           : 2.0f * g.spacing;
+        for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);
+        volumes.push_back(std::move(gv));
+    }
+    renderer_->setProbeVolumes(volumes);
+    return volumes.size();
+}
+
+RenderedImage ProjectRenderer::render(const RenderRequest& r) {
+    RenderSettings s = base_;
+    s.width = r.width;
+    s.height = r.height;
+    s.debugView = r.debugView;
+    s.probes = r.probes;
+    s.linearOutput = r.linearOutput;
+    return renderer_->render(s);
+}
+
+}  // namespace terralux

@@ -1,0 +1,48 @@
+#pragma once
+// A render of the project's terrain, lit by the probes of the last bake in its output folder
+// (baking first when that folder has none for the enabled volumes). `terralux --render`, the
+// render tests and the UI viewport all come through here, so they draw the same image.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "DemImport.h"
+#include "Project.h"
+#include "render/TerrainRenderer.h"
+#include "vk/VulkanContext.h"
+
+namespace terralux {
+
+struct RenderRequest {
+    uint32_t width = 640, height = 360;
+    int debugView = 0;
+    bool probes = true;
+    bool linearOutput = false;
+    bool bakeIfMissing = true;
+};
+
+class ProjectRenderer {
+public:
+    // Loads the terrain and sky; the Vulkan context must outlive this object.
+    ProjectRenderer(vk::VulkanContext& ctx, const Project& project);
+    ~ProjectRenderer();
+
+    // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder; when any
+    // is missing and `bakeIfMissing`, bakes the project first (its own quality settings).
+    // Returns the number of volumes bound; `note` says what happened.
+    size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr);
+    RenderedImage render(const RenderRequest& request);
+
+    const Heightfield& heightfield() const { return terrain_.heightfield; }
+    TerrainRenderer& renderer() { return *renderer_; }
+
+private:
+    Project project_;
+    DemImportResult terrain_;
+    RenderSettings base_;
+    std::unique_ptr<TerrainRenderer> renderer_;
+};
+
+}  // namespace terralux

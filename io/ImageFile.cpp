@@ -1,0 +1,76 @@
+#include "ImageFile.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <OpenImageIO/imageio.h>
+
+#include "AtomicFile.h"
+#include "EnvironmentImage.h"
+
+namespace terralux {
+
+ImageEncoding encodingFor(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr" ? ImageEncoding::LinearFloat : ImageEncoding::Display8;
+}
+
+void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                const std::vector<float>& rgba) {
+    if (rgba.size() != size_t(width) * height * 4)
+        throw ImageError(path.string() + ": image data does not match " + std::to_string(width) +
+                         "x" + std::to_string(height));
+    // The temporary keeps the extension so OpenImageIO picks the format from it.
+    std::filesystem::path tmp = temporarySibling(path);
+    tmp += path.extension();
+    auto out = OIIO::ImageOutput::create(path.string());
+    if (!out)
+        throw ImageError(path.string() + ": no image writer for this extension (" +
+                         OIIO::geterror() + "); use .png or .exr");
+    const bool linear = encodingFor(path) == ImageEncoding::LinearFloat;
+    OIIO::ImageSpec spec(int(width), int(height), 4, linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    std::vector<uint8_t> bytes;
+    const void* data = rgba.data();
+    if (!linear) {
+        bytes.resize(rgba.size());
+        for (size_t i = 0; i < rgba.size(); ++i)
+            bytes[i] = uint8_t(std::lround(std::clamp(std::isfinite(rgba[i]) ? rgba[i] : 0.0f, 0.0f, 1.0f) * 255.0f));
+        data = bytes.data();
+    }
+    if (!out->open(tmp.string(), spec) ||
+        !out->write_image(linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8, data) ||
+        !out->close()) {
+        std::string why = out->geterror();
+        std::replace(why.begin(), why.end(), '\n', ' ');
+        std::error_code ec;
+        std::filesystem::remove(tmp, ec);
+        throw ImageError(path.string() + ": cannot write (" + why + ")");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        const std::string reason = ec.message();
+        std::filesystem::remove(tmp, ec);
+        throw ImageError(path.string() + ": cannot replace (" + reason + ")");
+    }
+}
+
+std::vector<float> readImageRgba(const std::filesystem::path& path, uint32_t& width,
+                                 uint32_t& height) {
+    auto in = OIIO::ImageInput::open(path.string());
+    if (!in) throw ImageError(path.string() + ": cannot open (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    width = uint32_t(spec.width);
+    height = uint32_t(spec.height);
+    const int ch = spec.nchannels;
+    std::vector<float> px(size_t(width) * height * size_t(ch));
+    if (!in->read_image(0, 0, 0, ch, OIIO::TypeDesc::FLOAT, px.data()))
+        throw ImageError(path.string() + ": cannot read (" + in->geterror() + ")");
+    std::vector<float> rgba(size_t(width) * height * 4, 1.0f);
+    for (size_t i = 0; i < size_t(width) * height; ++i)
+        for (int c = 0; c < std::min(ch, 4); ++c) rgba[i * 4 + size_t(c)] = px[i * size_t(ch) + size_t(c)];
+    return rgba;
+}
+
+}  // namespace terralux

@@ -1,0 +1,24 @@
+#pragma once
+// Rendered images out through OpenImageIO: 8-bit PNG of display-encoded values, or float EXR of
+// scene-linear ones. Written to a temporary sibling and renamed when whole.
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace terralux {
+
+enum class ImageEncoding { Display8, LinearFloat };
+
+// rgba: width * height * 4 floats, row 0 at the top. The encoding follows the extension:
+// .exr -> LinearFloat (half-free float32 RGBA), anything else (.png, .tif, ...) -> Display8.
+// Throws ImageError (EnvironmentImage.h) naming the file and the reason.
+void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                const std::vector<float>& rgba);
+ImageEncoding encodingFor(const std::filesystem::path& path);
+
+// Reads an image as RGBA float (8-bit files scaled to [0, 1]); for tests and tools.
+std::vector<float> readImageRgba(const std::filesystem::path& path, uint32_t& width,
+                                 uint32_t& height);
+
+}  // namespace terralux

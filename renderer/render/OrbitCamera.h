@@ -1,0 +1,28 @@
+#pragma once
+// The orbit camera of the viewport and `terralux --render`: it circles a target at a radius,
+// standing at an azimuth (clockwise from north) and an elevation.
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "scene/SceneDescription.h"
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+struct OrbitCamera {
+    glm::vec3 target{0.0f};
+    float radius = 1.0f;
+    float azimuthDeg = 210.0f;
+    float elevationDeg = 35.0f;
+    float fovDeg = 45.0f;
+
+    // Fills what the settings leave unset from the terrain: target at the footprint centre and
+    // mean height, radius framing the whole footprint.
+    static OrbitCamera fromSettings(const CameraSettings& s, const Heightfield& hf);
+    glm::vec3 position() const;
+    // Vulkan clip space (y down, depth 0..1), near/far fitted to the radius and `extent`.
+    glm::mat4 viewProjection(float aspect, float extent) const;
+};
+
+}  // namespace terralux

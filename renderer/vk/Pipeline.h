@@ -1,0 +1,32 @@
+#pragma once
+// The terrain graphics pipeline: SPIR-V modules, its descriptor-set layout (one uniform block
+// and three storage buffers), pipeline layout and pipeline state.
+
+#include <cstdint>
+#include <span>
+
+#include "vk/VulkanContext.h"
+
+namespace terralux::vk {
+
+class TerrainPipeline {
+public:
+    // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes).
+    TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass, std::span<const uint32_t> vertSpirv,
+                    std::span<const uint32_t> fragSpirv);
+    ~TerrainPipeline();
+    TerrainPipeline(const TerrainPipeline&) = delete;
+    TerrainPipeline& operator=(const TerrainPipeline&) = delete;
+
+    VkPipeline handle() const { return pipeline_; }
+    VkPipelineLayout layout() const { return layout_; }
+    VkDescriptorSetLayout setLayout() const { return setLayout_; }
+
+private:
+    VkDevice device_;
+    VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+    VkPipelineLayout layout_ = VK_NULL_HANDLE;
+    VkPipeline pipeline_ = VK_NULL_HANDLE;
+};
+
+}  // namespace terralux::vk

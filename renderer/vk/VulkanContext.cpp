@@ -1,0 +1,201 @@
+#include "vk/VulkanContext.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
+namespace terralux::vk {
+
+void check(VkResult result, const char* what) {
+    if (result != VK_SUCCESS)
+        throw VulkanError(std::string("Vulkan: ") + what + " failed (VkResult " +
+                          std::to_string(int(result)) + ")");
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                   void* user) {
+    if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
+        auto* self = static_cast<VulkanContext*>(user);
+        self->messages_.push_back(data && data->pMessage ? data->pMessage : "(no message)");
+    }
+    return VK_FALSE;
+}
+
+namespace {
+
+bool layerAvailable(const char* name) {
+    uint32_t n = 0;
+    vkEnumerateInstanceLayerProperties(&n, nullptr);
+    std::vector<VkLayerProperties> layers(n);
+    vkEnumerateInstanceLayerProperties(&n, layers.data());
+    return std::any_of(layers.begin(), layers.end(),
+                       [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+int typeRank(VkPhysicalDeviceType t) {
+    switch (t) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+        default: return 4;
+    }
+}
+
+}  // namespace
+
+VulkanContext::VulkanContext(const ContextOptions& options) {
+    std::string choice = options.device;
+    if (choice.empty())
+        if (const char* env = std::getenv("TERRALUX_VK_DEVICE")) choice = env;
+    bool validation = options.validation;
+    if (const char* env = std::getenv("TERRALUX_VK_VALIDATION"); env && std::string(env) == "1")
+        validation = true;
+    const char* kValidation = "VK_LAYER_KHRONOS_validation";
+    if (validation && !layerAvailable(kValidation))
+        throw VulkanUnavailable("Vulkan validation was requested but " + std::string(kValidation) +
+                                " is not installed (Debian: vulkan-validationlayers)");
+
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "Terralux";
+    app.apiVersion = VK_API_VERSION_1_1;
+    std::vector<const char*> layers, extensions;
+    if (validation) {
+        layers.push_back(kValidation);
+        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    }
+    VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ici.pApplicationInfo = &app;
+    ici.enabledLayerCount = uint32_t(layers.size());
+    ici.ppEnabledLayerNames = layers.data();
+    ici.enabledExtensionCount = uint32_t(extensions.size());
+    ici.ppEnabledExtensionNames = extensions.data();
+    if (VkResult r = vkCreateInstance(&ici, nullptr, &instance_); r != VK_SUCCESS)
+        throw VulkanUnavailable("no Vulkan instance (VkResult " + std::to_string(int(r)) +
+                                "); install a Vulkan driver (Debian: mesa-vulkan-drivers)");
+
+    if (validation) {
+        VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+        mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                              VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+        mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                          VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                          VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+        mci.pfnUserCallback = onValidationMessage;
+        mci.pUserData = this;
+        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+        if (create) check(create(instance_, &mci, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+    }
+
+    uint32_t count = 0;
+    vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+    std::vector<VkPhysicalDevice> devices(count);
+    vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+    int bestRank = 99;
+    std::string names;
+    for (VkPhysicalDevice d : devices) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(d, &p);
+        names += (names.empty() ? "" : ", ") + std::string(p.deviceName);
+        uint32_t qn = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(d, &qn, nullptr);
+        std::vector<VkQueueFamilyProperties> qf(qn);
+        vkGetPhysicalDeviceQueueFamilyProperties(d, &qn, qf.data());
+        int family = -1;
+        for (uint32_t i = 0; i < qn; ++i)
+            if (qf[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
+                family = int(i);
+                break;
+            }
+        if (family < 0) continue;
+        const bool isCpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+        if (choice == "cpu" && !isCpu) continue;
+        if (choice == "gpu" && isCpu) continue;
+        if (!choice.empty() && choice != "cpu" && choice != "gpu" &&
+            std::string(p.deviceName).find(choice) == std::string::npos)
+            continue;
+        const int rank = typeRank(p.deviceType);
+        if (rank < bestRank) {
+            bestRank = rank;
+            physical_ = d;
+            queueFamily_ = uint32_t(family);
+            deviceName_ = p.deviceName;
+            deviceType_ = p.deviceType;
+        }
+    }
+    if (physical_ == VK_NULL_HANDLE) {
+        const std::string found = names.empty() ? "none" : names;
+        vkDestroyInstance(instance_, nullptr);
+        if (messenger_) messenger_ = VK_NULL_HANDLE;
+        instance_ = VK_NULL_HANDLE;
+        throw VulkanUnavailable("no Vulkan device with graphics" +
+                                (choice.empty() ? std::string() : " matching '" + choice + "'") +
+                                " (devices: " + found + ")");
+    }
+    vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    qci.queueFamilyIndex = queueFamily_;
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &priority;
+    VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
+    vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pci.queueFamilyIndex = queueFamily_;
+    check(vkCreateCommandPool(device_, &pci, nullptr, &pool_), "vkCreateCommandPool");
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
+}
+
+VulkanContext::~VulkanContext() {
+    if (device_) {
+        vkDeviceWaitIdle(device_);
+        vkDestroyFence(device_, fence_, nullptr);
+        vkDestroyCommandPool(device_, pool_, nullptr);
+        vkDestroyDevice(device_, nullptr);
+    }
+    if (messenger_) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+        if (destroy) destroy(instance_, messenger_, nullptr);
+    }
+    if (instance_) vkDestroyInstance(instance_, nullptr);
+}
+
+uint32_t VulkanContext::memoryType(uint32_t typeBits, VkMemoryPropertyFlags required) const {
+    for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i)
+        if ((typeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & required) == required)
+            return i;
+    throw VulkanError("Vulkan: no memory type with the required properties");
+}
+
+void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer cb;
+    check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
+    record(cb);
+    check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cb;
+    check(vkResetFences(device_, 1, &fence_), "vkResetFences");
+    check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
+    check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    vkFreeCommandBuffers(device_, pool_, 1, &cb);
+}
+
+}  // namespace terralux::vk

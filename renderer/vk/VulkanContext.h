@@ -1,0 +1,84 @@
+#pragma once
+// Instance, physical device choice, logical device, one graphics queue and a command pool: the
+// one Vulkan device that serves offscreen rendering, tests and (later) the viewport.
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace terralux::vk {
+
+// No Vulkan loader, no instance or no usable device: the CPU bake still works, rendering does not.
+class VulkanUnavailable : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+class VulkanError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Throws VulkanError naming the call and the VkResult.
+void check(VkResult result, const char* what);
+
+struct ContextOptions {
+    // Device choice: "" = discrete GPU, then integrated, then virtual, then CPU (lavapipe);
+    // "cpu" / "gpu" restrict the kind; anything else picks the first device whose name contains it.
+    // The TERRALUX_VK_DEVICE environment variable supplies it when this is empty.
+    std::string device;
+    // Khronos validation layer with a messenger that counts (and records) every message;
+    // TERRALUX_VK_VALIDATION=1 turns it on too.
+    bool validation = false;
+};
+
+class VulkanContext {
+public:
+    explicit VulkanContext(const ContextOptions& options = {});
+    ~VulkanContext();
+    VulkanContext(const VulkanContext&) = delete;
+    VulkanContext& operator=(const VulkanContext&) = delete;
+
+    VkInstance instance() const { return instance_; }
+    VkPhysicalDevice physicalDevice() const { return physical_; }
+    VkDevice device() const { return device_; }
+    VkQueue queue() const { return queue_; }
+    uint32_t queueFamily() const { return queueFamily_; }
+    VkCommandPool commandPool() const { return pool_; }
+    const std::string& deviceName() const { return deviceName_; }
+    VkPhysicalDeviceType deviceType() const { return deviceType_; }
+    bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
+
+    // Validation messages seen so far (warnings and errors), for tests that must see none.
+    size_t validationMessageCount() const { return messages_.size(); }
+    const std::vector<std::string>& validationMessages() const { return messages_; }
+
+    uint32_t memoryType(uint32_t typeBits, VkMemoryPropertyFlags required) const;
+
+    // Records commands into a one-time command buffer, submits it and waits.
+    void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
+
+private:
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    uint32_t queueFamily_ = 0;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+    std::string deviceName_;
+    VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+    VkPhysicalDeviceMemoryProperties memory_{};
+    std::vector<std::string> messages_;
+
+    friend VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(
+        VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+        const VkDebugUtilsMessengerCallbackDataEXT*, void*);
+};
+
+}  // namespace terralux::vk

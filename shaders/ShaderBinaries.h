@@ -1,0 +1,10 @@
+#pragma once
+// SPIR-V compiled from the GLSL in this folder at build time and embedded in the binary.
+
+#include <cstdint>
+#include <span>
+
+namespace terralux::shaders {
+std::span<const uint32_t> terrainVert();
+std::span<const uint32_t> terrainFrag();
+}  // namespace terralux::shaders

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# render_checks.sh TERRALUX WORKDIR: renders the sample (baking first), a debug view as EXR, and
+# checks the files are the requested images. Skips (77) when no Vulkan device exists.
+set -u
+terralux=$1 work=$2
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+fail() { echo "FAIL: $*"; exit 1; }
+"$terralux" --render --out beauty.png --size 320x180 --quiet >stdout 2>stderr
+rc=$?
+if [ $rc -eq 3 ] && grep -q "no Vulkan" stderr; then echo "SKIP: $(cat stderr)"; exit 77; fi
+[ $rc -eq 0 ] || fail "render exited $rc: $(cat stderr)"
+grep -q "view 0 beauty, 1 probe volume" stdout || fail "unexpected report: $(cat stdout)"
+[ -f bake/sh_coeffs/probes.shprobe ] || fail "render did not bake first"
+head -c 8 beauty.png | od -An -tx1 | grep -q "89 50 4e 47" || fail "beauty.png is not a PNG"
+"$terralux" --render --out irr.exr --size 64x64 --debug-view 50 --quiet >stdout || fail "EXR render"
+head -c 4 irr.exr | od -An -tx1 | grep -q "76 2f 31 01" || fail "irr.exr is not OpenEXR"
+ls -a | grep -q "\.tmp-" && fail "temporary files left behind"
+echo "ok: rendered"
