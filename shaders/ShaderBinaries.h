@@ -7,4 +7,5 @@
 namespace terralux::shaders {
 std::span<const uint32_t> terrainVert();
 std::span<const uint32_t> terrainFrag();
+std::span<const uint32_t> probeVerticesComp();
 }  // namespace terralux::shaders

@@ -1,22 +1,19 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "frame.glsl"
-#include "probes.glsl"
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
+layout(location = 2) in vec4 inProbeLight;  // from probe_vertices.comp
 layout(location = 0) out vec3 worldPos;
 layout(location = 1) out vec3 worldNormal;
 // Probe irradiance is smooth at the scale of the mesh: evaluated per vertex (the mesh vertices are
-// the DEM samples, or every k-th under the vertex budget) and interpolated, it costs the
-// fragment stage nothing.
+// the DEM samples, or every k-th under the vertex budget) and interpolated.
 layout(location = 2) out vec4 probeIrradianceWeight;
 
 void main() {
     worldPos = inPosition;
     worldNormal = inNormal;
-    float weight = 0.0;
-    vec3 irradiance = frame.params.z == 1 ? probeIrradiance(inPosition, normalize(inNormal), weight) : vec3(0.0);
-    probeIrradianceWeight = vec4(irradiance, weight);
+    probeIrradianceWeight = frame.params.z == 1 ? inProbeLight : vec4(0.0);
     gl_Position = frame.viewProj * vec4(inPosition, 1.0);
 }

@@ -9,6 +9,7 @@
 
 #include "ShaderBinaries.h"
 #include "vk/Buffer.h"
+#include "vk/ComputePipeline.h"
 #include "vk/Descriptors.h"
 #include "vk/OffscreenTarget.h"
 #include "vk/Pipeline.h"
@@ -42,7 +43,8 @@ static_assert(sizeof(VolumeRecord) == 64);
 }  // namespace
 
 struct TerrainRenderer::Gpu {
-    vk::Buffer vertices, indices, uniforms, probes, cells, volumes;
+    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight;
+    std::unique_ptr<vk::ProbeVertexPass> probePass;
     std::unique_ptr<vk::OffscreenTarget> target;
     std::unique_ptr<vk::TerrainPipeline> pipeline;
     std::unique_ptr<vk::TerrainDescriptors> descriptors;
@@ -77,8 +79,13 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         }
     vertexCount_ = vertices.size() / 6;
     indexCount_ = indices.size();
+
     gpu_->vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
-                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    gpu_->probeLight = vk::Buffer(ctx_, std::max<size_t>(vertexCount(), 1) * 16,
+                                  VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    gpu_->probePass = std::make_unique<vk::ProbeVertexPass>(ctx_, shaders::probeVerticesComp());
     gpu_->indices = vk::Buffer::deviceLocal(ctx_, indices.data(), std::max<size_t>(indices.size(), 1) * 4,
                                             VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     gpu_->uniforms = vk::Buffer::hostVisible(ctx_, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -121,6 +128,16 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (gpu_->descriptors)
         gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
+
+    // Probe light per vertex, once per change of probes (the pass reads only the volume count
+    // from the frame uniforms).
+    FrameUniforms u{};
+    u.params[1] = volumeCount_;
+    gpu_->uniforms.write(&u, sizeof u);
+    ctx_.submitAndWait([&](VkCommandBuffer cb) {
+        gpu_->probePass->record(cb, gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes,
+                                gpu_->vertices, gpu_->probeLight, uint32_t(vertexCount_));
+    });
 }
 
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
@@ -187,9 +204,9 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
             VkDescriptorSet set = gpu_->descriptors->set();
             vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
                                     &set, 0, nullptr);
-            VkDeviceSize offset = 0;
-            VkBuffer vb = gpu_->vertices.handle();
-            vkCmdBindVertexBuffers(cb, 0, 1, &vb, &offset);
+            VkDeviceSize offsets[2] = {0, 0};
+            VkBuffer vb[2] = {gpu_->vertices.handle(), gpu_->probeLight.handle()};
+            vkCmdBindVertexBuffers(cb, 0, 2, vb, offsets);
             vkCmdBindIndexBuffer(cb, gpu_->indices.handle(), 0, VK_INDEX_TYPE_UINT32);
             vkCmdDrawIndexed(cb, uint32_t(indexCount_), 1, 0, 0, 0);
         }

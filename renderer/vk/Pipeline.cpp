@@ -43,13 +43,15 @@ TerrainPipeline::TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass,
     stages[1].module = frag;
     stages[1].pName = "main";
 
-    VkVertexInputBindingDescription vb{0, 24, VK_VERTEX_INPUT_RATE_VERTEX};
-    VkVertexInputAttributeDescription va[2] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
-                                               {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12}};
+    VkVertexInputBindingDescription vb[2] = {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX},
+                                             {1, 16, VK_VERTEX_INPUT_RATE_VERTEX}};
+    VkVertexInputAttributeDescription va[3] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                                               {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
+                                               {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
     VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    vi.vertexBindingDescriptionCount = 1;
-    vi.pVertexBindingDescriptions = &vb;
-    vi.vertexAttributeDescriptionCount = 2;
+    vi.vertexBindingDescriptionCount = 2;
+    vi.pVertexBindingDescriptions = vb;
+    vi.vertexAttributeDescriptionCount = 3;
     vi.pVertexAttributeDescriptions = va;
     VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;

@@ -11,7 +11,8 @@ namespace terralux::vk {
 
 class TerrainPipeline {
 public:
-    // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes).
+    // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes); binding 1,
+    // vec4 probe irradiance + weight per vertex (16 bytes).
     TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass, std::span<const uint32_t> vertSpirv,
                     std::span<const uint32_t> fragSpirv);
     ~TerrainPipeline();
