@@ -25,11 +25,11 @@ constexpr double constSqrt(double x) {
     return r;
 }
 
-constexpr double kC0 = 0.5 * constSqrt(1.0 / kPi);           // l = 0
-constexpr double kC1 = constSqrt(3.0 / (4.0 * kPi));         // l = 1
-constexpr double kC2 = 0.5 * constSqrt(15.0 / kPi);          // xy, yz, xz
-constexpr double kC3 = 0.25 * constSqrt(5.0 / kPi);          // 3z^2 - 1
-constexpr double kC4 = 0.25 * constSqrt(15.0 / kPi);         // x^2 - y^2
+constexpr double kC0 = 0.5 * constSqrt(1.0 / kPi);    // l = 0
+constexpr double kC1 = constSqrt(3.0 / (4.0 * kPi));  // l = 1
+constexpr double kC2 = 0.5 * constSqrt(15.0 / kPi);   // xy, yz, xz
+constexpr double kC3 = 0.25 * constSqrt(5.0 / kPi);   // 3z^2 - 1
+constexpr double kC4 = 0.25 * constSqrt(15.0 / kPi);  // x^2 - y^2
 constexpr double kLobe[kBandCount] = {kPi, 2.0 * kPi / 3.0, kPi / 4.0};
 
 constexpr float kC0f = static_cast<float>(kC0);
@@ -111,8 +111,8 @@ SymEigen jacobiEigen(Mat3d a) {
             }
             // Rotation angle that zeroes a[p][q]; t is the smaller root of t^2 + 2 theta t - 1.
             const double theta = (a[q][q] - a[p][p]) / (2.0 * apq);
-            const double t = (theta >= 0.0 ? 1.0 : -1.0) /
-                             (std::abs(theta) + std::hypot(theta, 1.0));
+            const double t =
+                (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::hypot(theta, 1.0));
             const double cs = 1.0 / std::sqrt(t * t + 1.0);
             const double sn = t * cs;
             for (int k = 0; k < 3; ++k) {  // A J

@@ -43,7 +43,9 @@ inline constexpr std::array<float, kBandCount> kCosineLobe = {
     static_cast<float>(std::numbers::pi / 4.0)};
 
 // Band l of coefficient k: 0, 1, 1, 1, 2, 2, 2, 2, 2.
-constexpr int bandOf(int k) { return k < 1 ? 0 : (k < 4 ? 1 : 2); }
+constexpr int bandOf(int k) {
+    return k < 1 ? 0 : (k < 4 ? 1 : 2);
+}
 
 // sum_k L_k Y_k(dir): the band-limited radiance.
 glm::vec3 evalRadiance(const ShRgb& sh, const glm::vec3& dir);
