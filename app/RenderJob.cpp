@@ -22,14 +22,23 @@ Sky skyOf(const Project& p) {
 }  // namespace
 
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
-    : project_(project), terrain_(loadProjectTerrain(project)) {
+    : ProjectRenderer(ctx, project, loadProjectTerrain(project)) {}
+
+ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
+                                 DemImportResult terrain)
+    : project_(project), terrain_(std::move(terrain)) {
+    setProject(project);
+    renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
+}
+
+void ProjectRenderer::setProject(const Project& project) {
+    project_ = project;
     const SceneDescription& scene = project_.scene;
     base_.albedo = scene.terrain.albedo;
     base_.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
     base_.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
     base_.skySh = skyOf(project_).sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
-    renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
 }
 
 ProjectRenderer::~ProjectRenderer() = default;
@@ -69,8 +78,11 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note) {
     return volumes.size();
 }
 
-RenderedImage ProjectRenderer::render(const RenderRequest& r) {
+RenderedImage ProjectRenderer::render(const RenderRequest& r) { return render(r, base_.camera); }
+
+RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera& camera) {
     RenderSettings s = base_;
+    s.camera = camera;
     s.width = r.width;
     s.height = r.height;
     s.debugView = r.debugView;

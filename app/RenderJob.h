@@ -27,13 +27,22 @@ class ProjectRenderer {
 public:
     // Loads the terrain and sky; the Vulkan context must outlive this object.
     ProjectRenderer(vk::VulkanContext& ctx, const Project& project);
+    // With a terrain already imported (the UI holds one).
+    ProjectRenderer(vk::VulkanContext& ctx, const Project& project, DemImportResult terrain);
     ~ProjectRenderer();
 
     // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder; when any
     // is missing and `bakeIfMissing`, bakes the project first (its own quality settings).
     // Returns the number of volumes bound; `note` says what happened.
     size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr);
+    // Binds probe volumes computed elsewhere (the UI's draft preview).
+    void setProbes(const std::vector<GpuProbeVolume>& volumes) { renderer_->setProbeVolumes(volumes); }
+    // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
+    void setProject(const Project& project);
     RenderedImage render(const RenderRequest& request);
+    // The same render with an explicit camera (the viewport's).
+    RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
+    const OrbitCamera& defaultCamera() const { return base_.camera; }
 
     const Heightfield& heightfield() const { return terrain_.heightfield; }
     TerrainRenderer& renderer() { return *renderer_; }

@@ -140,6 +140,10 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     });
 }
 
+VkImage TerrainRenderer::lastImage() const {
+    return gpu_->target ? gpu_->target->colorImage() : VK_NULL_HANDLE;
+}
+
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
     if (!gpu_->target || gpu_->target->width() != s.width || gpu_->target->height() != s.height) {

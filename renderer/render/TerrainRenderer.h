@@ -59,6 +59,8 @@ public:
 
     void setProbeVolumes(const std::vector<GpuProbeVolume>& volumes);
     RenderedImage render(const RenderSettings& settings);
+    // The colour image of the last render (TRANSFER_SRC_OPTIMAL), for a presenter.
+    VkImage lastImage() const;
 
     int meshStride() const { return stride_; }
     size_t vertexCount() const { return vertexCount_; }

@@ -20,6 +20,8 @@ public:
     uint32_t height() const { return height_; }
     VkRenderPass renderPass() const { return renderPass_; }
     VkFramebuffer framebuffer() const { return framebuffer_; }
+    // The colour image, in TRANSFER_SRC_OPTIMAL layout after a render (for presenting).
+    VkImage colorImage() const { return color_.image; }
 
     // Copies the colour image (after the render pass) into the readback buffer; call inside the
     // same command buffer as the draw.

@@ -62,6 +62,7 @@ VulkanContext::VulkanContext(const ContextOptions& options) {
     app.pApplicationName = "Terralux";
     app.apiVersion = VK_API_VERSION_1_1;
     std::vector<const char*> layers, extensions;
+    for (const auto& e : options.instanceExtensions) extensions.push_back(e.c_str());
     if (validation) {
         layers.push_back(kValidation);
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -145,6 +146,11 @@ VulkanContext::VulkanContext(const ContextOptions& options) {
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    const char* swapchainExtension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+    if (options.swapchain) {
+        dci.enabledExtensionCount = 1;
+        dci.ppEnabledExtensionNames = &swapchainExtension;
+    }
     check(vkCreateDevice(physical_, &dci, nullptr, &device_), "vkCreateDevice");
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
     VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};

@@ -34,6 +34,10 @@ struct ContextOptions {
     // Khronos validation layer with a messenger that counts (and records) every message;
     // TERRALUX_VK_VALIDATION=1 turns it on too.
     bool validation = false;
+    // Presentation (the UI viewport): extra instance extensions (the window system's surface
+    // extensions) and VK_KHR_swapchain on the device.
+    std::vector<std::string> instanceExtensions;
+    bool swapchain = false;
 };
 
 class VulkanContext {

@@ -1,0 +1,63 @@
+#include "PreviewBake.h"
+
+#include <numbers>
+
+#include "EnvironmentImage.h"
+#include "bake/DiffuseBake.h"
+#include "bake/HeightfieldTracer.h"
+#include "bake/ProbePlacement.h"
+#include "bake/SphereSampling.h"
+
+namespace terralux {
+
+std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
+                                          const std::atomic<bool>* cancel) {
+    const SceneDescription& scene = project.scene;
+    BakeLighting lighting;
+    if (scene.sky.mode == SkyMode::Uniform) {
+        lighting.sky = Sky::uniform(scene.sky.color * float(scene.sky.intensity));
+    } else {
+        RgbImage img = readEquirectImage(project.hdrPath().string());
+        for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= scene.sky.color[int(i % 3)];
+        lighting.sky = Sky::equirect(std::move(img.rgb), img.width, img.height,
+                                     float(scene.sky.intensity), float(scene.sky.rotationDeg));
+    }
+    lighting.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
+    lighting.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
+    lighting.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
+    lighting.albedo = scene.terrain.albedo;
+    const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
+    lighting.tracer = &tracer;
+    const BakeQuality q = qualityPreset(QualityPreset::Draft);
+    const BakeControl control{nullptr, cancel};
+    const IrradianceCache cache(lighting, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, control);
+
+    std::vector<GpuProbeVolume> out;
+    uint64_t index = 0;
+    for (const auto& v : scene.probeVolumes) {
+        if (!v.enabled) continue;
+        const ProbeLayout layout = placeProbes(v, hf);
+        const ProbeBake bake = bakeProbes(lighting, &cache, q.bounces, layout.positions, layout.valid,
+                                          q.rays, splitmix64(0x7E77A1ABull + index++), control);
+        GpuProbeVolume g;
+        g.dims = glm::uvec3(layout.cellDims[0], layout.cellDims[1], layout.cellDims[2]);
+        g.origin = layout.cellOrigin;
+        g.spacing = layout.cellSize;
+        g.fallbackBlendDistance = layout.fallbackBlendDistance;
+        g.scale = float(scene.exportSettings.defaultScale);
+        // Valid probes only, the occupancy pointing at their compacted indices (as in .shprobe).
+        std::vector<int32_t> compact(layout.positions.size(), -1);
+        for (size_t i = 0; i < layout.positions.size(); ++i)
+            if (layout.valid[i]) {
+                compact[i] = int32_t(g.coeffs.size());
+                g.coeffs.push_back(bake.sh[i].c);
+            }
+        g.occupancy.resize(layout.cellProbe.size());
+        for (size_t c = 0; c < layout.cellProbe.size(); ++c)
+            g.occupancy[c] = layout.cellProbe[c] < 0 ? -1 : compact[size_t(layout.cellProbe[c])];
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+}  // namespace terralux

@@ -1,0 +1,19 @@
+#pragma once
+// A draft bake held in memory for the viewport: what the probes of the current settings look
+// like, seconds after an edit, without touching the output folder.
+
+#include <atomic>
+#include <vector>
+
+#include "Project.h"
+#include "render/TerrainRenderer.h"
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+// Every enabled volume at draft quality (rays and bounces of the draft preset). Throws
+// BakeCancelled when `cancel` is set, PlacementError for bad volume settings.
+std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
+                                          const std::atomic<bool>* cancel);
+
+}  // namespace terralux

@@ -1,0 +1,618 @@
+#include "MainWindow.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDateTime>
+#include <QDir>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QPlainTextEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QScrollArea>
+#include <QSettings>
+#include <QStandardPaths>
+#include <QStatusBar>
+#include <QToolBar>
+#include <QVBoxLayout>
+
+#include "DemImport.h"
+#include "ParameterPanels.h"
+#include "PreviewBake.h"
+#include "ShProbeFile.h"
+#include "bake/DiffuseBake.h"
+#include "bake/ProbePlacement.h"
+#include "render/DebugViews.h"
+
+namespace terralux {
+
+namespace {
+
+std::vector<std::string> surfaceExtensions(QVulkanInstance& inst) {
+    std::vector<std::string> out;
+    for (const auto& e : inst.supportedExtensions()) {
+        const QByteArray name = e.name;
+        if (name == "VK_KHR_surface" || name.endsWith("_surface")) out.push_back(name.toStdString());
+    }
+    return out;
+}
+
+QWidget* scrolled(QWidget* w) {
+    auto* area = new QScrollArea;
+    area->setWidget(w);
+    area->setWidgetResizable(true);
+    area->setFrameShape(QFrame::NoFrame);
+    return area;
+}
+
+QString formatBytes(double bytes) {
+    if (bytes < 1024) return QString::number(bytes) + " B";
+    if (bytes < 1024 * 1024) return QString::number(bytes / 1024.0, 'f', 1) + " KiB";
+    return QString::number(bytes / (1024.0 * 1024.0), 'f', 1) + " MiB";
+}
+
+}  // namespace
+
+MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectDocument(this)) {
+    setObjectName("mainWindow");
+    // Our device, on an instance Qt can make surfaces for.
+    {
+        QVulkanInstance probe;
+        probe.create();
+        vk::ContextOptions options;
+        options.instanceExtensions = surfaceExtensions(probe);
+        options.swapchain = true;
+        ctx_ = std::make_unique<vk::VulkanContext>(options);
+    }
+    vulkan_.setVkInstance(ctx_->instance());
+    if (!vulkan_.create()) throw vk::VulkanUnavailable("Qt cannot use the Vulkan instance for windows");
+
+    bake_ = new BakeController(this);
+    viewport_ = new ViewportWindow(*ctx_, &vulkan_);
+    auto* container = QWidget::createWindowContainer(viewport_, this);
+    container->setObjectName("viewport");
+    container->setMinimumSize(480, 320);
+    container->setFocusPolicy(Qt::StrongFocus);
+    setCentralWidget(container);
+
+    buildDocks();
+    buildMenus();
+
+    previewTimer_.setSingleShot(true);
+    previewTimer_.setInterval(150);
+    connect(&previewTimer_, &QTimer::timeout, this, &MainWindow::startPreview);
+    autosaveTimer_.setInterval(qEnvironmentVariableIntValue("TERRALUX_AUTOSAVE_MS") > 0
+                                   ? qEnvironmentVariableIntValue("TERRALUX_AUTOSAVE_MS")
+                                   : 60000);
+    connect(&autosaveTimer_, &QTimer::timeout, this, &MainWindow::autosave);
+    autosaveTimer_.start();
+
+    connect(doc_, &ProjectDocument::terrainChanged, this, &MainWindow::rebuildRenderer);
+    connect(doc_, &ProjectDocument::parametersChanged, this, [this](const QString& path) {
+        refreshLighting();
+        updateEstimate();
+        if (path.isEmpty() || path.startsWith("probe_volumes") || path.startsWith("sun") ||
+            path.startsWith("sky") || path.startsWith("terrain") || path.startsWith("export.default"))
+            schedulePreview();
+    });
+    connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateTitle);
+    connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
+        frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
+    });
+    connect(viewport_, &ViewportWindow::cameraChanged, this, [this] {
+        const OrbitCamera& c = viewport_->camera();
+        doc_->setCameraQuietly({{"target", {c.target.x, c.target.y, c.target.z}},
+                                {"radius", c.radius},
+                                {"azimuth_deg", c.azimuthDeg},
+                                {"elevation_deg", c.elevationDeg},
+                                {"fov_deg", c.fovDeg}});
+    });
+    connect(bake_, &BakeController::progress, this, [this](double f, const QString& phase, double eta) {
+        progress_->setValue(int(f * 100.0));
+        eta_->setText(eta >= 0 ? QString("%1 — ETA %2 s").arg(phase).arg(eta, 0, 'f', 0) : phase);
+    });
+    connect(bake_, &BakeController::finished, this, [this](const nlohmann::json& report) {
+        progress_->setValue(100);
+        eta_->setText(QString("done in %1 s").arg(report["time_s"].get<double>(), 0, 'f', 2));
+        report_->setPlainText(QString::fromStdString(report.dump(2)));
+        bakeButton_->setEnabled(true);
+        cancelButton_->setEnabled(false);
+        if (renderer_) {
+            renderer_->setProject(doc_->project());
+            renderer_->loadProbes(false);
+            probeSource_ = "last bake";
+            viewport_->renderNow();
+            updateStatus();
+        }
+    });
+    connect(bake_, &BakeController::cancelled, this, [this] {
+        eta_->setText("cancelled: earlier outputs untouched");
+        progress_->setValue(0);
+        bakeButton_->setEnabled(true);
+        cancelButton_->setEnabled(false);
+    });
+    connect(bake_, &BakeController::failed, this, [this](const QString& m) {
+        eta_->setText("failed");
+        bakeButton_->setEnabled(true);
+        cancelButton_->setEnabled(false);
+        showError("Bake", m);
+    });
+
+    rebuildRenderer();
+    updateEstimate();
+    updateTitle();
+    resize(1400, 860);
+}
+
+MainWindow::~MainWindow() {
+    previewCancel_ = true;
+    if (previewWorker_.joinable()) previewWorker_.join();
+    bake_->cancel();
+    bake_->wait();
+    delete viewport_;  // before the device it presents with
+    viewport_ = nullptr;
+    renderer_.reset();
+}
+
+QString MainWindow::autosaveDir() {
+    const QString env = qEnvironmentVariable("TERRALUX_AUTOSAVE_DIR");
+    return env.isEmpty() ? QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) : env;
+}
+
+void MainWindow::buildDocks() {
+    auto dock = [this](const QString& title, const QString& name, QWidget* w) {
+        auto* d = new QDockWidget(title, this);
+        d->setObjectName(name);
+        d->setWidget(scrolled(w));
+        addDockWidget(Qt::RightDockWidgetArea, d);
+        return d;
+    };
+    auto connectRejected = [this](auto* w) {
+        connect(w, &std::remove_pointer_t<decltype(w)>::rejected, this,
+                [this](const QString& m) { statusBar()->showMessage(m, 8000); });
+    };
+
+    // Terrain.
+    auto* terrain = new QWidget;
+    auto* tv = new QVBoxLayout(terrain);
+    terrainSummary_ = new QLabel;
+    terrainSummary_->setObjectName("terrain.summary");
+    terrainSummary_->setWordWrap(true);
+    tv->addWidget(terrainSummary_);
+    auto* importDem = new QPushButton("Import DEM…");
+    importDem->setObjectName("terrain.import");
+    tv->addWidget(importDem);
+    auto* tf = new ParameterForm(doc_);
+    tf->addNumber("terrain.vertical_scale", "Vertical scale", 0.01, 100.0, 2, "×");
+    tf->addColor("terrain.albedo", "Albedo");
+    tf->addInteger("terrain.max_resolution", "Max resolution", 2, 65536, "source");
+    tf->addBool("terrain.skirt", "Ground beyond border");
+    tv->addWidget(tf);
+    tv->addStretch(1);
+    connectRejected(tf);
+    connect(importDem, &QPushButton::clicked, this, [this] {
+        const QString f = QFileDialog::getOpenFileName(this, "Import DEM", QString(),
+                                                       "Rasters (*.tif *.tiff *.hgt *.asc *.vrt *.zip *.img *.dem);;All files (*)");
+        if (f.isEmpty()) return;
+        QString error;
+        if (!doc_->importDem(f, &error)) showError("Import DEM", error);
+    });
+    auto* terrainDock = dock("Terrain", "dock.terrain", terrain);
+
+    // Sun & Sky.
+    auto* sky = new ParameterForm(doc_);
+    sky->addNumber("sun.azimuth_deg", "Sun azimuth", 0.0, 360.0, 1, "°", true);
+    sky->addNumber("sun.elevation_deg", "Sun elevation", -90.0, 90.0, 1, "°", true);
+    sky->addNumber("sun.illuminance", "Sun illuminance", 0.0, 1000.0, 2, "");
+    sky->addColor("sun.color", "Sun colour");
+    sky->addNumber("sun.angular_radius_deg", "Sun radius", 0.0, 45.0, 2, "°");
+    sky->addChoice("sky.mode", "Sky", {"uniform", "hdr"});
+    sky->addColor("sky.color", "Sky colour");
+    sky->addNumber("sky.intensity", "Sky intensity", 0.0, 1000.0, 2, "");
+    sky->addText("sky.hdr", "HDR image");
+    sky->addNumber("sky.rotation_deg", "HDR rotation", 0.0, 360.0, 1, "°", true);
+    auto* importHdr = new QPushButton("Import HDR…");
+    importHdr->setObjectName("sky.import");
+    sky->addWidget("", importHdr);
+    connect(importHdr, &QPushButton::clicked, this, [this] {
+        const QString f = QFileDialog::getOpenFileName(this, "Import HDR sky", QString(), "HDR images (*.hdr *.exr);;All files (*)");
+        if (f.isEmpty()) return;
+        QString error;
+        if (!doc_->importHdr(f, &error)) showError("Import HDR", error);
+    });
+    connectRejected(sky);
+    auto* skyDock = dock("Sun && Sky", "dock.sunSky", sky);
+
+    // Probe Volumes.
+    auto* volumes = new ProbeVolumesPanel(doc_);
+    connectRejected(volumes);
+    auto* volumesDock = dock("Probe Volumes", "dock.probeVolumes", volumes);
+
+    // Bake & Export.
+    auto* bakeWidget = new QWidget;
+    auto* bv = new QVBoxLayout(bakeWidget);
+    auto* bf = new ParameterForm(doc_);
+    bf->addChoice("bake.quality", "Quality", {"draft", "standard", "high", "reference"});
+    bf->addInteger("bake.rays", "Rays per probe", 1, 1 << 20, "preset");
+    bf->addInteger("bake.bounces", "Bounces", 0, 16, "preset");
+    bf->addChoice("bake.sh_encoding", "SH encoding", {"radiance", "irradiance"});
+    bf->addBool("bake.deringing", "Deringing");
+    bf->addText("export.out_dir", "Output folder");
+    bf->addBool("export.gltf", "glTF scene");
+    bf->addNumber("export.default_scale", "SH scale", -100.0, 100.0, 3, "");
+    bf->addNumber("export.default_ambient", "Ambient term", 0.0, 100.0, 3, "");
+    connectRejected(bf);
+    bv->addWidget(bf);
+    estimate_ = new QLabel;
+    estimate_->setObjectName("bake.estimate");
+    estimate_->setWordWrap(true);
+    bv->addWidget(estimate_);
+    auto* buttons = new QHBoxLayout;
+    bakeButton_ = new QPushButton("Bake");
+    bakeButton_->setObjectName("bake.start");
+    cancelButton_ = new QPushButton("Cancel");
+    cancelButton_->setObjectName("bake.cancel");
+    cancelButton_->setEnabled(false);
+    buttons->addWidget(bakeButton_);
+    buttons->addWidget(cancelButton_);
+    bv->addLayout(buttons);
+    progress_ = new QProgressBar;
+    progress_->setObjectName("bake.progress");
+    progress_->setRange(0, 100);
+    progress_->setValue(0);
+    bv->addWidget(progress_);
+    eta_ = new QLabel;
+    eta_->setObjectName("bake.eta");
+    bv->addWidget(eta_);
+    report_ = new QPlainTextEdit;
+    report_->setObjectName("bake.report");
+    report_->setReadOnly(true);
+    report_->setMinimumHeight(120);
+    bv->addWidget(report_, 1);
+    connect(bakeButton_, &QPushButton::clicked, this, [this] { startBake(); });
+    connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
+    auto* bakeDock = dock("Bake && Export", "dock.bakeExport", bakeWidget);
+
+    for (auto* f : {tf, sky, bf}) f->refresh();
+    tabifyDockWidget(terrainDock, skyDock);
+    tabifyDockWidget(volumesDock, bakeDock);
+    terrainDock->raise();
+    volumesDock->raise();
+
+    // Viewport toolbar: debug view and probe lighting.
+    auto* bar = addToolBar("Viewport");
+    bar->setObjectName("toolbar.viewport");
+    viewSelector_ = new QComboBox;
+    viewSelector_->setObjectName("viewport.debugView");
+    for (const auto& v : debugViews())
+        viewSelector_->addItem(QString("%1 %2").arg(v.number).arg(v.name), v.number);
+    bar->addWidget(new QLabel(" Debug view "));
+    bar->addWidget(viewSelector_);
+    probeToggle_ = new QCheckBox("Probe lighting");
+    probeToggle_->setObjectName("viewport.probes");
+    probeToggle_->setChecked(true);
+    bar->addWidget(probeToggle_);
+    connect(viewSelector_, &QComboBox::currentIndexChanged, this,
+            [this](int i) { viewport_->setDebugView(viewSelector_->itemData(i).toInt()); });
+    connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);
+
+    frameLabel_ = new QLabel;
+    frameLabel_->setObjectName("status.frame");
+    probeLabel_ = new QLabel;
+    probeLabel_->setObjectName("status.probes");
+    sourceLabel_ = new QLabel;
+    sourceLabel_->setObjectName("status.device");
+    statusBar()->addPermanentWidget(probeLabel_);
+    statusBar()->addPermanentWidget(frameLabel_);
+    statusBar()->addPermanentWidget(sourceLabel_);
+    sourceLabel_->setText(QString::fromStdString(ctx_->deviceName()));
+}
+
+void MainWindow::buildMenus() {
+    auto action = [this](QMenu* m, const QString& text, const QString& name, QKeySequence key,
+                         auto slot) {
+        auto* a = m->addAction(text);
+        a->setObjectName(name);
+        if (!key.isEmpty()) a->setShortcut(key);
+        connect(a, &QAction::triggered, this, slot);
+        return a;
+    };
+    QMenu* file = menuBar()->addMenu("&File");
+    file->setObjectName("menu.file");
+    action(file, "&New", "action.new", QKeySequence::New, [this] {
+        if (maybeSave()) doc_->newProject();
+    });
+    action(file, "&Open…", "action.open", QKeySequence::Open, [this] {
+        if (!maybeSave()) return;
+        const QString f = QFileDialog::getOpenFileName(this, "Open project", QString(), "Terralux projects (*.json);;All files (*)");
+        if (!f.isEmpty()) openProject(f);
+    });
+    action(file, "&Save", "action.save", QKeySequence::Save, [this] {
+        QString error;
+        if (doc_->fileName().isEmpty()) {
+            const QString f = QFileDialog::getSaveFileName(this, "Save project", "project.terralux.json", "Terralux projects (*.json)");
+            if (f.isEmpty()) return;
+            if (!doc_->saveAs(f, &error)) showError("Save", error);
+            else addRecent(f);
+        } else if (!doc_->save(&error)) {
+            showError("Save", error);
+        }
+    });
+    action(file, "Save &As…", "action.saveAs", QKeySequence::SaveAs, [this] {
+        const QString f = QFileDialog::getSaveFileName(this, "Save project as", "project.terralux.json", "Terralux projects (*.json)");
+        if (f.isEmpty()) return;
+        QString error;
+        if (!doc_->saveAs(f, &error)) showError("Save As", error);
+        else addRecent(f);
+    });
+    file->addSeparator();
+    action(file, "Import &DEM…", "action.importDem", QKeySequence("Ctrl+I"), [this] {
+        findChild<QPushButton*>("terrain.import")->click();
+    });
+    action(file, "Import &HDR…", "action.importHdr", QKeySequence("Ctrl+Shift+I"), [this] {
+        findChild<QPushButton*>("sky.import")->click();
+    });
+    action(file, "&Export to folder…", "action.export", QKeySequence("Ctrl+E"), [this] {
+        const QString dir = QFileDialog::getExistingDirectory(this, "Bake and export into");
+        if (!dir.isEmpty()) startBake(dir);
+    });
+    recentMenu_ = file->addMenu("&Recent files");
+    recentMenu_->setObjectName("menu.recent");
+    connect(recentMenu_, &QMenu::aboutToShow, this, [this] {
+        recentMenu_->clear();
+        const QStringList files = QSettings("Terralux", "Terralux").value("recent").toStringList();
+        for (const QString& f : files) {
+            auto* a = recentMenu_->addAction(f);
+            connect(a, &QAction::triggered, this, [this, f] {
+                if (maybeSave()) openProject(f);
+            });
+        }
+        if (files.isEmpty()) recentMenu_->addAction("(none)")->setEnabled(false);
+    });
+    file->addSeparator();
+    action(file, "&Quit", "action.quit", QKeySequence::Quit, [this] { close(); });
+
+    QMenu* edit = menuBar()->addMenu("&Edit");
+    edit->setObjectName("menu.edit");
+    QAction* undo = doc_->undoStack()->createUndoAction(this, "&Undo");
+    undo->setObjectName("action.undo");
+    undo->setShortcut(QKeySequence::Undo);
+    QAction* redo = doc_->undoStack()->createRedoAction(this, "&Redo");
+    redo->setObjectName("action.redo");
+    redo->setShortcut(QKeySequence::Redo);
+    edit->addAction(undo);
+    edit->addAction(redo);
+
+    QMenu* view = menuBar()->addMenu("&View");
+    view->setObjectName("menu.view");
+    QMenu* views = view->addMenu("&Debug view");
+    for (const auto& v : debugViews()) {
+        auto* a = views->addAction(QString("%1 %2").arg(v.number).arg(v.name));
+        a->setObjectName(QString("action.view.%1").arg(v.name));
+        const int index = views->actions().size() - 1;
+        connect(a, &QAction::triggered, this, [this, index] { viewSelector_->setCurrentIndex(index); });
+    }
+    QMenu* panels = view->addMenu("&Panels");
+    for (auto* d : findChildren<QDockWidget*>()) panels->addAction(d->toggleViewAction());
+
+    QMenu* bakeMenu = menuBar()->addMenu("&Bake");
+    bakeMenu->setObjectName("menu.bake");
+    action(bakeMenu, "&Bake", "action.bake", QKeySequence("Ctrl+B"), [this] { startBake(); });
+    action(bakeMenu, "&Cancel", "action.cancelBake", QKeySequence("Ctrl+."), [this] { bake_->cancel(); });
+}
+
+void MainWindow::showError(const QString& title, const QString& message) {
+    QMessageBox box(QMessageBox::Critical, title, message, QMessageBox::Ok, this);
+    box.setObjectName("errorDialog");
+    box.exec();
+}
+
+bool MainWindow::openProject(const QString& file) {
+    QString error;
+    if (!doc_->open(file, &error)) {
+        showError("Open project", error);
+        return false;
+    }
+    addRecent(file);
+    return true;
+}
+
+void MainWindow::addRecent(const QString& file) {
+    QSettings settings("Terralux", "Terralux");
+    QStringList files = settings.value("recent").toStringList();
+    const QString abs = QFileInfo(file).absoluteFilePath();
+    files.removeAll(abs);
+    files.prepend(abs);
+    while (files.size() > 8) files.removeLast();
+    settings.setValue("recent", files);
+}
+
+bool MainWindow::maybeSave() {
+    if (!doc_->isModified()) return true;
+    QMessageBox box(QMessageBox::Warning, "Unsaved changes", "The project has unsaved changes. Save them?",
+                    QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, this);
+    box.setObjectName("unsavedDialog");
+    const int answer = box.exec();
+    if (answer == QMessageBox::Cancel) return false;
+    if (answer == QMessageBox::Save) {
+        findChild<QAction*>("action.save")->trigger();
+        return !doc_->isModified();
+    }
+    return true;
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+    if (!maybeSave()) {
+        e->ignore();
+        return;
+    }
+    QFile::remove(QDir(autosaveDir()).filePath("autosave.terralux.json"));
+    e->accept();
+}
+
+void MainWindow::rebuildRenderer() {
+    previewCancel_ = true;
+    if (previewWorker_.joinable()) previewWorker_.join();
+    viewport_->setRenderer(nullptr);
+    renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain());
+    viewport_->setCamera(renderer_->defaultCamera());
+    const size_t baked = renderer_->loadProbes(false);
+    probeSource_ = baked ? "last bake" : "";
+    viewport_->setRenderer(renderer_.get());
+    const Heightfield& hf = doc_->terrain().heightfield;
+    const DemSourceInfo& s = doc_->terrain().source;
+    terrainSummary_->setText(QString("%1\n%2 × %3 vertices, %4 × %5 m cells\n%6 … %7 m, %8 nodata cells filled\n%9")
+                                 .arg(QString::fromStdString(s.path))
+                                 .arg(hf.width()).arg(hf.depth())
+                                 .arg(hf.cellSizeX(), 0, 'f', 2).arg(hf.cellSizeZ(), 0, 'f', 2)
+                                 .arg(hf.minHeight(), 0, 'f', 1).arg(hf.maxHeight(), 0, 'f', 1)
+                                 .arg(hf.nodataCount())
+                                 .arg(QString::fromStdString(hf.geo.crsName.empty() ? "no CRS" : hf.geo.crsName)));
+    if (!baked) schedulePreview();
+    updateStatus();
+}
+
+void MainWindow::refreshLighting() {
+    if (!renderer_) return;
+    renderer_->setProject(doc_->project());
+    viewport_->requestUpdate();
+}
+
+void MainWindow::schedulePreview() { previewTimer_.start(); }
+
+void MainWindow::startPreview() {
+    previewCancel_ = true;
+    if (previewWorker_.joinable()) previewWorker_.join();
+    previewCancel_ = false;
+    const unsigned generation = ++previewGeneration_;
+    const Project project = doc_->project();
+    auto terrain = doc_->terrainShared();
+    previewWorker_ = std::thread([this, project, terrain, generation] {
+        try {
+            auto volumes = std::make_shared<std::vector<GpuProbeVolume>>(
+                previewProbes(project, terrain->heightfield, &previewCancel_));
+            QMetaObject::invokeMethod(this, [this, volumes, generation] {
+                if (generation != previewGeneration_ || !renderer_) return;
+                renderer_->setProbes(*volumes);
+                probeSource_ = "draft preview";
+                viewport_->renderNow();
+                updateStatus();
+            }, Qt::QueuedConnection);
+        } catch (const std::exception&) {
+            // Cancelled by a newer edit, or settings the bake would refuse (the panel says why).
+        }
+    });
+}
+
+void MainWindow::updateEstimate() {
+    const Project& p = doc_->project();
+    size_t probes = 0, invalid = 0;
+    uint64_t bytes = 0;
+    double rays = 0;
+    BakeQuality q = qualityPreset(p.scene.bake.quality);
+    if (p.scene.bake.rays) q.rays = *p.scene.bake.rays;
+    try {
+        for (const auto& v : p.scene.probeVolumes) {
+            if (!v.enabled) continue;
+            const ProbeLayout l = placeProbes(v, doc_->terrain().heightfield);
+            probes += l.validCount();
+            invalid += l.positions.size() - l.validCount();
+            bytes += 48 + 160ull * l.validCount() + 4ull * l.cellProbe.size();
+            rays += double(l.validCount()) * (v.rayCount ? *v.rayCount : q.rays);
+        }
+    } catch (const std::exception& e) {
+        estimate_->setText(QString::fromStdString(e.what()));
+        return;
+    }
+    // Cache rays plus probe rays at the throughput measured by the bake benchmark on two cores.
+    const double cacheRays = double(q.cacheResolution) * q.cacheResolution * (q.cacheRays + q.sunSamples);
+    const double seconds = (rays * (p.scene.bake.quality == QualityPreset::Reference ? 8.0 : 1.5) + cacheRays) / 3.0e6;
+    estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, about %4 s")
+                           .arg(probes).arg(invalid).arg(formatBytes(double(bytes))).arg(seconds, 0, 'f', 1));
+}
+
+void MainWindow::updateTitle() {
+    const QString name = doc_->fileName().isEmpty() ? "untitled" : QFileInfo(doc_->fileName()).fileName();
+    setWindowTitle(QString("%1%2 — Terralux").arg(name, doc_->isModified() ? " *" : ""));
+}
+
+void MainWindow::updateStatus() {
+    if (!renderer_) return;
+    size_t probes = 0;
+    for (const auto& v : doc_->project().scene.probeVolumes)
+        if (v.enabled) probes += size_t(v.gridDims[0]) * size_t(v.gridDims[1]) * size_t(v.gridDims[2]);
+    probeLabel_->setText(QString("%1 probes (%2), %3 on the GPU")
+                             .arg(probes)
+                             .arg(probeSource_.isEmpty() ? "not baked" : probeSource_)
+                             .arg(formatBytes(double(renderer_->renderer().probeBytes()))));
+}
+
+void MainWindow::startBake(const QString& outDir) {
+    if (bake_->running()) return;
+    Project p = doc_->project();
+    if (!outDir.isEmpty()) p.scene.exportSettings.outDir = outDir.toStdString();
+    progress_->setValue(0);
+    eta_->setText("starting");
+    bakeButton_->setEnabled(false);
+    cancelButton_->setEnabled(true);
+    bake_->start(p);
+}
+
+void MainWindow::autosave() {
+    if (!doc_->isModified()) return;
+    QDir().mkpath(autosaveDir());
+    Project p = doc_->project();
+    try {
+        saveProject(p, QDir(autosaveDir()).filePath("autosave.terralux.json").toStdString());
+        QFile source(QDir(autosaveDir()).filePath("autosave.source"));
+        if (source.open(QIODevice::WriteOnly | QIODevice::Truncate)) source.write(doc_->fileName().toUtf8());
+    } catch (const std::exception& e) {
+        statusBar()->showMessage(QString("autosave failed: %1").arg(e.what()), 8000);
+    }
+}
+
+void MainWindow::offerRecovery() {
+    const QString file = QDir(autosaveDir()).filePath("autosave.terralux.json");
+    if (!QFileInfo::exists(file)) return;
+    QMessageBox box(QMessageBox::Question, "Recover unsaved changes",
+                    QString("Terralux did not close cleanly. Recover the changes autosaved at %1?")
+                        .arg(QFileInfo(file).lastModified().toString("yyyy-MM-dd hh:mm")),
+                    QMessageBox::Yes | QMessageBox::No, this);
+    box.setObjectName("recoveryDialog");
+    if (box.exec() == QMessageBox::Yes) {
+        QString error;
+        if (!doc_->open(file, &error)) showError("Recover", error);
+    }
+    QFile::remove(file);
+}
+
+int runGui(int argc, char** argv) {
+    QApplication app(argc, argv);
+    QApplication::setApplicationName("Terralux");
+    QApplication::setOrganizationName("Terralux");
+    std::unique_ptr<MainWindow> window;
+    try {
+        window = std::make_unique<MainWindow>();
+    } catch (const std::exception& e) {
+        QMessageBox::critical(nullptr, "Terralux", QString("The viewport needs a Vulkan device: %1\n"
+                                                           "Baking still works: terralux --bake --help.")
+                                                       .arg(e.what()));
+        return 3;
+    }
+    window->show();
+    QMetaObject::invokeMethod(window.get(), [w = window.get()] { w->findChild<QWidget*>("viewport")->setFocus(); }, Qt::QueuedConnection);
+    if (argc > 1) window->openProject(QString::fromLocal8Bit(argv[1]));
+    else QMetaObject::invokeMethod(window.get(), &MainWindow::offerRecovery, Qt::QueuedConnection);
+    return app.exec();
+}
+
+}  // namespace terralux

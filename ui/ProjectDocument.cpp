@@ -1,0 +1,167 @@
+#include "ProjectDocument.h"
+
+#include <QFileInfo>
+#include <QUndoCommand>
+
+#include "EnvironmentImage.h"
+#include "TerrainLoading.h"
+
+namespace terralux {
+
+namespace {
+
+// One parameter edit: the JSON value before and after, by path.
+class SetParameterCommand : public QUndoCommand {
+public:
+    SetParameterCommand(ProjectDocument* doc, std::string path, nlohmann::json before,
+                        nlohmann::json after)
+        : QUndoCommand(QString::fromStdString("Set " + path)), doc_(doc), path_(std::move(path)),
+          before_(std::move(before)), after_(std::move(after)) {}
+    void undo() override { doc_->apply(path_, before_); }
+    void redo() override { doc_->apply(path_, after_); }
+
+private:
+    ProjectDocument* doc_;
+    std::string path_;
+    nlohmann::json before_, after_;
+};
+
+bool touchesTerrain(const std::string& path) {
+    return path.rfind("terrain.dem", 0) == 0 || path.rfind("terrain.vertical_scale", 0) == 0 ||
+           path.rfind("terrain.max_resolution", 0) == 0 || path == "terrain" || path.empty();
+}
+
+// The JSON value at a `--set` path ("probe_volumes[0].grid_dims"), through its JSON pointer
+// ("/probe_volumes/0/grid_dims"); null when absent.
+nlohmann::json at(const nlohmann::json& doc, const std::string& path) {
+    std::string pointer;
+    for (char c : path) {
+        if (c == '.' || c == '[') pointer += '/';
+        else if (c != ']') pointer += c;
+    }
+    const nlohmann::json::json_pointer p(pointer.empty() || pointer[0] == '/' ? pointer : "/" + pointer);
+    return doc.contains(p) ? doc.at(p) : nlohmann::json();
+}
+
+}  // namespace
+
+ProjectDocument::ProjectDocument(QObject* parent) : QObject(parent) {
+    connect(&undo_, &QUndoStack::cleanChanged, this, [this] { emit fileChanged(); });
+    newProject();
+}
+
+QString ProjectDocument::fileName() const { return QString::fromStdString(project_.file.string()); }
+
+nlohmann::json ProjectDocument::value(const std::string& path) const { return at(json_, path); }
+
+void ProjectDocument::reset(const Project& project, std::shared_ptr<DemImportResult> terrain) {
+    project_ = project;
+    json_ = projectToJson(project_);
+    terrain_ = std::move(terrain);
+    undo_.clear();
+    undo_.setClean();
+    dirtyOutsideUndo_ = false;
+    emit terrainChanged();
+    emit parametersChanged(QString());
+    emit fileChanged();
+}
+
+void ProjectDocument::newProject() {
+    Project p;
+    reset(p, std::make_shared<DemImportResult>(loadProjectTerrain(p)));
+}
+
+bool ProjectDocument::open(const QString& file, QString* error) {
+    try {
+        Project p = loadProject(file.toStdString(), nullptr);
+        auto terrain = std::make_shared<DemImportResult>(loadProjectTerrain(p));
+        reset(p, terrain);
+        return true;
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+bool ProjectDocument::save(QString* error) {
+    if (project_.file.empty()) {
+        if (error) *error = "the project has no file name yet: use Save As";
+        return false;
+    }
+    return saveAs(fileName(), error);
+}
+
+bool ProjectDocument::saveAs(const QString& file, QString* error) {
+    try {
+        const std::filesystem::path target = std::filesystem::absolute(file.toStdString());
+        saveProject(project_, target);
+        // Relative paths now resolve against the new folder.
+        Project reloaded = loadProject(target, nullptr);
+        project_ = reloaded;
+        json_ = projectToJson(project_);
+        undo_.setClean();
+        dirtyOutsideUndo_ = false;
+        emit fileChanged();
+        emit parametersChanged(QString());
+        return true;
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json& value,
+                                   QString* error) {
+    try {
+        nlohmann::json next = json_;
+        applyOverride(next, path + "=" + value.dump());
+        Project candidate = project_;
+        candidate.scene = sceneFromJson(next, "project", nullptr);
+        if (touchesTerrain(path)) (void)loadProjectTerrain(candidate);  // fails before any change
+        const nlohmann::json before = at(json_, path);
+        if (before == at(next, path)) return true;
+        undo_.push(new SetParameterCommand(this, path, before, at(next, path)));
+        return true;
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+void ProjectDocument::apply(const std::string& path, const nlohmann::json& value) {
+    applyOverride(json_, path + "=" + value.dump());
+    project_.scene = sceneFromJson(json_, "project", nullptr);
+    if (touchesTerrain(path)) {
+        terrain_ = std::make_shared<DemImportResult>(loadProjectTerrain(project_));
+        emit terrainChanged();
+    }
+    emit parametersChanged(QString::fromStdString(path));
+}
+
+void ProjectDocument::setCameraQuietly(const nlohmann::json& camera) {
+    json_["camera"] = camera;
+    project_.scene = sceneFromJson(json_, "project", nullptr);
+    dirtyOutsideUndo_ = true;
+    emit fileChanged();
+}
+
+bool ProjectDocument::importDem(const QString& file, QString* error) {
+    const std::string abs = std::filesystem::absolute(file.toStdString()).lexically_normal().string();
+    return setParameter("terrain.dem", abs, error);
+}
+
+bool ProjectDocument::importHdr(const QString& file, QString* error) {
+    const std::string abs = std::filesystem::absolute(file.toStdString()).lexically_normal().string();
+    try {
+        (void)readEquirectImage(abs);
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+    undo_.beginMacro("Import HDR");
+    const bool ok = setParameter("sky.hdr", abs, error) && setParameter("sky.mode", "hdr", error);
+    undo_.endMacro();
+    return ok;
+}
+
+}  // namespace terralux

@@ -1,0 +1,64 @@
+#pragma once
+// The open project as the UI edits it: parameters by JSON path (the same paths as `--set`),
+// every edit an undoable command, the imported terrain kept in step with terrain.*.
+
+#include <memory>
+#include <string>
+
+#include <QObject>
+#include <QString>
+#include <QUndoStack>
+
+#include <nlohmann/json.hpp>
+
+#include "DemImport.h"
+#include "Project.h"
+
+namespace terralux {
+
+class ProjectDocument : public QObject {
+    Q_OBJECT
+public:
+    explicit ProjectDocument(QObject* parent = nullptr);
+
+    const Project& project() const { return project_; }
+    const nlohmann::json& json() const { return json_; }
+    nlohmann::json value(const std::string& path) const;
+    const DemImportResult& terrain() const { return *terrain_; }
+    std::shared_ptr<const DemImportResult> terrainShared() const { return terrain_; }
+    QUndoStack* undoStack() { return &undo_; }
+    bool isModified() const { return !undo_.isClean() || dirtyOutsideUndo_; }
+    QString fileName() const;  // empty for an unsaved project
+
+    // Validates `value` at `path` and pushes it as an undoable edit. On a rule violation nothing
+    // changes and `error` gets the one-line message.
+    bool setParameter(const std::string& path, const nlohmann::json& value, QString* error);
+    // Camera moves from the viewport: stored, marked as unsaved, not undoable (like a view).
+    void setCameraQuietly(const nlohmann::json& camera);
+
+    void newProject();
+    bool open(const QString& file, QString* error);
+    bool save(QString* error);
+    bool saveAs(const QString& file, QString* error);
+    // Imports a DEM (checked before anything changes) as an undoable edit of terrain.dem.
+    bool importDem(const QString& file, QString* error);
+    bool importHdr(const QString& file, QString* error);
+
+    // Used by the undo commands: applies an already validated value.
+    void apply(const std::string& path, const nlohmann::json& value);
+
+signals:
+    void parametersChanged(const QString& path);  // "" = everything
+    void terrainChanged();
+    void fileChanged();
+
+private:
+    void reset(const Project& project, std::shared_ptr<DemImportResult> terrain);
+    Project project_;
+    nlohmann::json json_;
+    std::shared_ptr<DemImportResult> terrain_;
+    QUndoStack undo_;
+    bool dirtyOutsideUndo_ = false;
+};
+
+}  // namespace terralux

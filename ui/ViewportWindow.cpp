@@ -1,0 +1,135 @@
+#include "ViewportWindow.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <QExposeEvent>
+#include <QKeyEvent>
+#include <QMouseEvent>
+#include <QVulkanInstance>
+#include <QWheelEvent>
+
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
+
+namespace terralux {
+
+ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance) : ctx_(ctx) {
+    setSurfaceType(QSurface::VulkanSurface);
+    setVulkanInstance(instance);
+}
+
+ViewportWindow::~ViewportWindow() { swapchain_.reset(); }
+
+void ViewportWindow::setRenderer(ProjectRenderer* renderer) {
+    renderer_ = renderer;
+    requestUpdate();
+}
+
+void ViewportWindow::setCamera(const OrbitCamera& camera) {
+    camera_ = camera;
+    requestUpdate();
+}
+
+void ViewportWindow::setDebugView(int view) {
+    request_.debugView = view;
+    requestUpdate();
+}
+
+void ViewportWindow::setProbeLighting(bool on) {
+    request_.probes = on;
+    requestUpdate();
+}
+
+void ViewportWindow::exposeEvent(QExposeEvent*) {
+    if (isExposed()) renderNow();
+}
+
+bool ViewportWindow::event(QEvent* e) {
+    if (e->type() == QEvent::UpdateRequest) {
+        renderNow();
+        return true;
+    }
+    return QWindow::event(e);
+}
+
+void ViewportWindow::renderNow() {
+    if (!renderer_) return;
+    const qreal dpr = devicePixelRatio();
+    request_.width = uint32_t(std::max(1, int(width() * dpr)));
+    request_.height = uint32_t(std::max(1, int(height() * dpr)));
+    last_ = renderer_->render(request_, camera_);
+    if (isExposed()) {
+        if (!swapchain_) {
+            VkSurfaceKHR surface = QVulkanInstance::surfaceForWindow(this);
+            if (surface) swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
+        }
+        if (swapchain_)
+            swapchain_->present(renderer_->renderer().lastImage(), request_.width, request_.height);
+    }
+    emit frameRendered(last_.milliseconds);
+}
+
+void ViewportWindow::orbit(float dAz, float dEl) {
+    camera_.azimuthDeg = std::fmod(camera_.azimuthDeg + dAz + 360.0f, 360.0f);
+    camera_.elevationDeg = std::clamp(camera_.elevationDeg + dEl, -89.0f, 89.0f);
+    emit cameraChanged();
+    requestUpdate();
+}
+
+void ViewportWindow::pan(float dx, float dy) {
+    // Move the target in the view plane, scaled so the terrain follows the cursor roughly.
+    const glm::vec3 forward = glm::normalize(camera_.target - camera_.position());
+    const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0.0f, 1.0f, 0.0f)));
+    const glm::vec3 up = glm::cross(right, forward);
+    const float scale = camera_.radius * std::tan(glm::radians(0.5f * camera_.fovDeg)) * 2.0f /
+                        float(std::max(1, height()));
+    camera_.target += (-dx * right + dy * up) * scale;
+    emit cameraChanged();
+    requestUpdate();
+}
+
+void ViewportWindow::zoom(float factor) {
+    camera_.radius = std::clamp(camera_.radius * factor, 1.0f, 1e8f);
+    emit cameraChanged();
+    requestUpdate();
+}
+
+void ViewportWindow::mousePressEvent(QMouseEvent* e) { lastMouse_ = e->position(); }
+
+void ViewportWindow::mouseMoveEvent(QMouseEvent* e) {
+    const QPointF d = e->position() - lastMouse_;
+    lastMouse_ = e->position();
+    const bool panning = (e->buttons() & Qt::MiddleButton) ||
+                         ((e->buttons() & Qt::LeftButton) && (e->modifiers() & Qt::ShiftModifier));
+    if (panning) pan(float(d.x()), float(d.y()));
+    else if (e->buttons() & Qt::LeftButton) orbit(float(d.x()) * 0.3f, float(d.y()) * 0.3f);
+}
+
+void ViewportWindow::wheelEvent(QWheelEvent* e) {
+    zoom(std::pow(0.999f, float(e->angleDelta().y())));
+}
+
+void ViewportWindow::keyPressEvent(QKeyEvent* e) {
+    switch (e->key()) {
+        case Qt::Key_Left: orbit(-5.0f, 0.0f); break;
+        case Qt::Key_Right: orbit(5.0f, 0.0f); break;
+        case Qt::Key_Up: orbit(0.0f, 5.0f); break;
+        case Qt::Key_Down: orbit(0.0f, -5.0f); break;
+        case Qt::Key_Plus:
+        case Qt::Key_Equal: zoom(0.9f); break;
+        case Qt::Key_Minus: zoom(1.0f / 0.9f); break;
+        case Qt::Key_W: pan(0.0f, 20.0f); break;
+        case Qt::Key_S: pan(0.0f, -20.0f); break;
+        case Qt::Key_A: pan(20.0f, 0.0f); break;
+        case Qt::Key_D: pan(-20.0f, 0.0f); break;
+        case Qt::Key_F:
+        case Qt::Key_Home:
+            if (renderer_) setCamera(renderer_->defaultCamera());
+            emit cameraChanged();
+            break;
+        default: QWindow::keyPressEvent(e);
+    }
+}
+
+}  // namespace terralux

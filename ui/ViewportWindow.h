@@ -1,0 +1,63 @@
+#pragma once
+// The live viewport: a Vulkan window that presents the renderer's offscreen image (the same
+// draw as `terralux --render`), with an orbit camera on the mouse and keys.
+//   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom
+//   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
+
+#include <memory>
+#include <optional>
+
+#include <QWindow>
+
+#include "RenderJob.h"
+#include "render/OrbitCamera.h"
+#include "vk/Swapchain.h"
+
+class QVulkanInstance;
+
+namespace terralux {
+
+class ViewportWindow : public QWindow {
+    Q_OBJECT
+public:
+    ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance);
+    ~ViewportWindow() override;
+
+    // The renderer to draw with (owned by the caller; may be replaced or cleared).
+    void setRenderer(ProjectRenderer* renderer);
+    void setCamera(const OrbitCamera& camera);
+    const OrbitCamera& camera() const { return camera_; }
+    void setDebugView(int view);
+    int debugView() const { return request_.debugView; }
+    void setProbeLighting(bool on);
+    // The last image drawn (row 0 at the top), for tests and screenshots.
+    const RenderedImage& lastImage() const { return last_; }
+    // Draws now (synchronously) instead of at the next update.
+    void renderNow();
+
+signals:
+    void frameRendered(double milliseconds);
+    void cameraChanged();
+
+protected:
+    void exposeEvent(QExposeEvent*) override;
+    bool event(QEvent* e) override;
+    void mousePressEvent(QMouseEvent* e) override;
+    void mouseMoveEvent(QMouseEvent* e) override;
+    void wheelEvent(QWheelEvent* e) override;
+    void keyPressEvent(QKeyEvent* e) override;
+
+private:
+    void orbit(float dAzimuth, float dElevation);
+    void pan(float dx, float dy);
+    void zoom(float factor);
+    vk::VulkanContext& ctx_;
+    ProjectRenderer* renderer_ = nullptr;
+    std::unique_ptr<vk::Swapchain> swapchain_;
+    OrbitCamera camera_;
+    RenderRequest request_;
+    RenderedImage last_;
+    QPointF lastMouse_;
+};
+
+}  // namespace terralux
