@@ -202,9 +202,7 @@ void MainWindow::buildDocks() {
     connect(importDem, &QPushButton::clicked, this, [this] {
         const QString f = QFileDialog::getOpenFileName(this, "Import DEM", QString(),
                                                        "Rasters (*.tif *.tiff *.hgt *.asc *.vrt *.zip *.img *.dem);;All files (*)");
-        if (f.isEmpty()) return;
-        QString error;
-        if (!doc_->importDem(f, &error)) showError("Import DEM", error);
+        if (!f.isEmpty()) importDemFile(f);
     });
     auto* terrainDock = dock("Terrain", "dock.terrain", terrain);
 
@@ -225,9 +223,7 @@ void MainWindow::buildDocks() {
     sky->addWidget("", importHdr);
     connect(importHdr, &QPushButton::clicked, this, [this] {
         const QString f = QFileDialog::getOpenFileName(this, "Import HDR sky", QString(), "HDR images (*.hdr *.exr);;All files (*)");
-        if (f.isEmpty()) return;
-        QString error;
-        if (!doc_->importHdr(f, &error)) showError("Import HDR", error);
+        if (!f.isEmpty()) importHdrFile(f);
     });
     connectRejected(sky);
     auto* skyDock = dock("Sun && Sky", "dock.sunSky", sky);
@@ -424,6 +420,20 @@ bool MainWindow::openProject(const QString& file) {
     }
     addRecent(file);
     return true;
+}
+
+bool MainWindow::importDemFile(const QString& file) {
+    QString error;
+    if (doc_->importDem(file, &error)) return true;
+    showError("Import DEM", error);
+    return false;
+}
+
+bool MainWindow::importHdrFile(const QString& file) {
+    QString error;
+    if (doc_->importHdr(file, &error)) return true;
+    showError("Import HDR", error);
+    return false;
 }
 
 void MainWindow::addRecent(const QString& file) {

@@ -36,10 +36,17 @@ public:
     BakeController* bakes() { return bake_; }
     // Opens a project or shows the error dialog; for the command line and tests.
     bool openProject(const QString& file);
+    // Imports a DEM or HDR as File > Import does after its file dialog: an error dialog on failure.
+    bool importDemFile(const QString& file);
+    bool importHdrFile(const QString& file);
+    // What the viewport's probes come from: "last bake", "draft preview" or "" (none yet).
+    const QString& probeSource() const { return probeSource_; }
     // Where autosaves go (TERRALUX_AUTOSAVE_DIR, else the user's data folder).
     static QString autosaveDir();
     // After an unclean exit: offers the autosaved project back.
     void offerRecovery();
+    // Writes the modified project where offerRecovery finds it (a timer calls it every minute).
+    void autosave();
 
 protected:
     void closeEvent(QCloseEvent* e) override;
@@ -57,8 +64,11 @@ private:
     void updateTitle();
     void updateStatus();
     void addRecent(const QString& file);
-    void autosave();
+
+public:
     void startBake(const QString& outDir = QString());
+
+private:
 
     ProjectDocument* doc_;
     QVulkanInstance vulkan_;

@@ -144,8 +144,11 @@ void ParameterForm::addIntegerArray(const std::string& path, const QString& labe
     }
     for (auto* spin : spins)
         connect(spin, &QSpinBox::valueChanged, this, [=, this] {
+            // As many values as the parameter holds now (2 for terrain grids, 3 for boxes).
+            const json current = doc_->value(full(path));
+            const size_t n = current.is_array() ? std::min(current.size(), spins.size()) : spins.size();
             json a = json::array();
-            for (auto* s : spins) a.push_back(s->value());
+            for (size_t i = 0; i < n; ++i) a.push_back(spins[i]->value());
             set(path, a);
         });
     refreshers_.push_back([=, this] {

@@ -1,0 +1,225 @@
+// The authoring window driven by Qt Test through objectNames, under Xvfb (ctest wraps it in
+// xvfb-run); skips, saying why, without a display or a Vulkan device.
+#include <filesystem>
+#include <fstream>
+
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
+#include <QLabel>
+#include <QMessageBox>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QScreen>
+#include <QSpinBox>
+#include <QTimer>
+#include <QtTest>
+
+#include "ImageCompare.h"
+#include "MainWindow.h"
+#include "RenderJob.h"
+#include "render/DebugViews.h"
+
+using namespace terralux;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kOut = fs::path(TERRALUX_BINARY_DIR) / "ui_out";
+
+std::string fileBytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Waits for the next draft preview or bake to reach the viewport.
+bool waitForProbes(MainWindow& w, const QString& source, int ms = 20000) {
+    return QTest::qWaitFor([&] { return w.probeSource() == source; }, ms);
+}
+
+}  // namespace
+
+class UiTest : public QObject {
+    Q_OBJECT
+    std::unique_ptr<MainWindow> w_;
+    QString skip_;
+
+private slots:
+    void initTestCase() {
+        if (QGuiApplication::platformName() == "offscreen" || QGuiApplication::platformName() == "minimal")
+            skip_ = "no display (platform " + QGuiApplication::platformName() + ")";
+        fs::remove_all(kOut);
+        fs::create_directories(kOut);
+        qputenv("TERRALUX_AUTOSAVE_DIR", QByteArray::fromStdString((kOut / "autosave").string()));
+    }
+    void init() {
+        if (!skip_.isEmpty()) QSKIP(qPrintable(skip_));
+        try {
+            w_ = std::make_unique<MainWindow>();
+        } catch (const vk::VulkanUnavailable& e) {
+            QSKIP(e.what());
+        }
+        w_->resize(1280, 800);
+        w_->show();
+        QVERIFY(QTest::qWaitForWindowExposed(w_.get()));
+        QVERIFY(waitForProbes(*w_, "draft preview"));
+        QString error;
+        QVERIFY(w_->document()->setParameter("export.out_dir", (kOut / "bake").string(), &error));
+    }
+    void cleanup() {
+        if (w_) w_->document()->undoStack()->setClean();
+        w_.reset();
+    }
+
+    void startsWithTheSampleAndEditsAreUndoable() {
+        QCOMPARE(w_->document()->terrain().heightfield.width(), 256);
+        // Probe irradiance (view 50) shows a grid change most directly.
+        auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
+        selector->setCurrentIndex(selector->findData(50));
+        w_->viewport()->renderNow();
+        const RenderedImage before = w_->viewport()->lastImage();
+        auto* nx = w_->findChild<QSpinBox*>("param.volume.grid_dims.0");
+        QVERIFY(nx);
+        QCOMPARE(nx->value(), 8);
+        nx->setValue(2);
+        QCOMPARE(w_->document()->project().scene.probeVolumes[0].gridDims[0], 2);
+        QVERIFY(QTest::qWaitFor([&] {
+            // A grid change moves probe light locally: a clear local change and a non-zero mean.
+            const auto d = test::compareImages(w_->viewport()->lastImage().rgba, before.rgba, before.width, before.height);
+            return d.maxAbs > 6.0 / 255.0 && d.meanAbs > 0.1 / 255.0;
+        }, 20000));
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(nx->value(), 8);
+        QCOMPARE(w_->document()->project().scene.probeVolumes[0].gridDims[0], 8);
+        QVERIFY(QTest::qWaitFor([&] {
+            return test::compareImages(w_->viewport()->lastImage().rgba, before.rgba, before.width, before.height).maxAbs <= 1.0 / 255.0;
+        }, 20000));
+    }
+
+    void rejectedValuesLeaveTheProject() {
+        auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
+        QVERIFY(elevation);
+        const double before = elevation->value();
+        QString error;
+        QVERIFY(!w_->document()->setParameter("probe_volumes[0].grid_dims", nlohmann::json{100, 100}, &error));
+        QVERIFY(error.contains("product <= 4096"));
+        QCOMPARE(elevation->value(), before);
+        QCOMPARE(w_->document()->project().scene.probeVolumes[0].gridDims[0], 8);
+    }
+
+    void bakeThroughTheUiThenCancelLeavesFilesUntouched() {
+        w_->findChild<QPushButton*>("bake.start")->click();
+        auto* progress = w_->findChild<QProgressBar*>("bake.progress");
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && progress->value() == 100; }, 60000));
+        const fs::path shprobe = kOut / "bake" / "sh_coeffs" / "probes.shprobe";
+        QVERIFY(fs::exists(shprobe));
+        QVERIFY(fs::exists(kOut / "bake" / "scene.gltf"));
+        QVERIFY(waitForProbes(*w_, "last bake"));
+        const std::string bytes = fileBytes(shprobe), gltf = fileBytes(kOut / "bake" / "scene.gltf");
+
+        QString error;
+        QVERIFY(w_->document()->setParameter("bake.quality", "reference", &error));
+        QVERIFY(w_->document()->setParameter("probe_volumes[0].grid_dims", nlohmann::json{64, 64}, &error));
+        w_->findChild<QPushButton*>("bake.start")->click();
+        QVERIFY(w_->bakes()->running());
+        QTest::qWait(300);
+        w_->findChild<QPushButton*>("bake.cancel")->click();
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running(); }, 60000));
+        QVERIFY(w_->findChild<QLabel*>("bake.eta")->text().contains("cancelled"));
+        QCOMPARE(fileBytes(shprobe), bytes);
+        QCOMPARE(fileBytes(kOut / "bake" / "scene.gltf"), gltf);
+    }
+
+    void everyDebugViewMatchesTheRenderCommand() {
+        w_->findChild<QPushButton*>("bake.start")->click();
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running(); }, 60000));
+        QVERIFY(waitForProbes(*w_, "last bake"));
+        // The command line's path: a fresh renderer of the same project, loading the same bake.
+        vk::VulkanContext ctx;
+        ProjectRenderer reference(ctx, w_->document()->project());
+        QCOMPARE(reference.loadProbes(false), size_t(1));
+        auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
+        QVERIFY(selector);
+        QCOMPARE(selector->count(), int(debugViews().size()));
+        for (int i = 0; i < selector->count(); ++i) {
+            selector->setCurrentIndex(i);
+            w_->viewport()->renderNow();
+            const RenderedImage& shown = w_->viewport()->lastImage();
+            RenderRequest q;
+            q.width = shown.width;
+            q.height = shown.height;
+            q.debugView = selector->itemData(i).toInt();
+            const RenderedImage cli = reference.render(q, w_->viewport()->camera());
+            const auto d = test::compareImages(shown.rgba, cli.rgba, shown.width, shown.height);
+            QVERIFY2(d.maxAbs <= 1.0 / 255.0, qPrintable(selector->itemText(i) + QString(": max diff %1").arg(d.maxAbs)));
+        }
+    }
+
+    void corruptDemGetsADialogAndKeepsTheTerrain() {
+        const int width = w_->document()->terrain().heightfield.width();
+        const nlohmann::json project = w_->document()->json();
+        const int undoSteps = w_->document()->undoStack()->count();
+        QString dialogText;
+        QTimer::singleShot(200, [&] {
+            if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget())) {
+                dialogText = box->objectName() + ": " + box->text();
+                box->accept();
+            }
+        });
+        const QString bad = QString::fromStdString((fs::path(TERRALUX_TEST_DATA) / "dem" / "not_a_raster.tif").string());
+        QVERIFY(!w_->importDemFile(bad));
+        QVERIFY2(dialogText.startsWith("errorDialog: ") && dialogText.contains("not_a_raster.tif"), qPrintable(dialogText));
+        QCOMPARE(w_->document()->terrain().heightfield.width(), width);
+        QVERIFY(w_->document()->json() == project);
+        QCOMPARE(w_->document()->undoStack()->count(), undoSteps);
+    }
+
+    void saveAndReopenKeepsEveryParameter() {
+        QString error;
+        QVERIFY(w_->document()->setParameter("sun.elevation_deg", 12.5, &error));
+        QVERIFY(w_->document()->setParameter("terrain.albedo", nlohmann::json{0.2, 0.25, 0.3}, &error));
+        const QString file = QString::fromStdString((kOut / "saved.terralux.json").string());
+        QVERIFY(w_->document()->saveAs(file, &error));
+        const nlohmann::json saved = projectToJson(w_->document()->project());
+        w_->document()->newProject();
+        QVERIFY(projectToJson(w_->document()->project()) != saved);
+        QVERIFY(w_->openProject(file));
+        QCOMPARE(QString::fromStdString(projectToJson(w_->document()->project()).dump()), QString::fromStdString(saved.dump()));
+        QCOMPARE(w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg")->value(), 12.5);
+    }
+
+    void autosaveIsOfferedBackAfterACrash() {
+        QString error;
+        QVERIFY(w_->document()->setParameter("sun.azimuth_deg", 77.0, &error));
+        w_->autosave();
+        const fs::path autosave = kOut / "autosave" / "autosave.terralux.json";
+        QVERIFY(fs::exists(autosave));
+        // A crash: the window goes away without closing, so the autosave stays behind.
+        w_.reset();
+        w_ = std::make_unique<MainWindow>();
+        w_->show();
+        QCOMPARE(w_->document()->project().scene.sun.azimuthDeg, 135.0);
+        QString asked;
+        QTimer::singleShot(200, [&] {
+            if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget())) {
+                asked = box->objectName();
+                box->button(QMessageBox::Yes)->click();
+            }
+        });
+        w_->offerRecovery();
+        QCOMPARE(asked, QString("recoveryDialog"));
+        QCOMPARE(w_->document()->project().scene.sun.azimuthDeg, 77.0);
+        QVERIFY(!fs::exists(autosave));
+    }
+
+    void screenshot() {
+        w_->viewport()->renderNow();
+        QTest::qWait(500);
+        const QPixmap shot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(shot.save(QString::fromStdString((kOut / "main_window.png").string())));
+    }
+};
+
+QTEST_MAIN(UiTest)
+#include "test_ui.moc"
