@@ -34,7 +34,8 @@
 namespace terralux {
 namespace {
 
-const char* const kUsage = R"(Usage: terralux [COMMAND] [OPTIONS]
+const char* const kUsage = R"(Usage: terralux [PROJECT]              open the authoring window
+       terralux COMMAND [OPTIONS]       work headless
 
 Terrain-lighting authoring: import a DEM, bake spherical-harmonics probes, export .shprobe + glTF.
 
@@ -52,8 +53,8 @@ Commands:
 
 Options:
   --dem FILE                    Use FILE as the terrain instead of the project's (or the sample).
-  --out DIR                     Output folder (default: export.out_dir, "bake" beside the project
-                                or in the current folder).
+  --out DIR | IMAGE             --bake: the output folder (default: export.out_dir, "bake" beside
+                                the project or in the current folder); --render: the image.
   --quality PRESET              draft | standard | high | reference (bake.quality).
   --compare-reference           Also run the brute-force reference and report the error of
                                 every probe against it (slow).
