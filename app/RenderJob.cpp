@@ -6,6 +6,7 @@
 #include "EnvironmentImage.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
+#include "bake/ProbePlacement.h"
 #include "render/OrbitCamera.h"
 
 namespace terralux {
@@ -27,8 +28,8 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
                                  DemImportResult terrain)
     : project_(project), terrain_(std::move(terrain)) {
-    setProject(project);
     renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
+    setProject(project);
 }
 
 void ProjectRenderer::setProject(const Project& project) {
@@ -39,6 +40,18 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
     base_.skySh = skyOf(project_).sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
+    std::vector<glm::vec4> positions;
+    for (const auto& v : scene.probeVolumes) {
+        if (!v.enabled) continue;
+        try {
+            const ProbeLayout layout = placeProbes(v, terrain_.heightfield);
+            for (size_t i = 0; i < layout.positions.size(); ++i)
+                positions.emplace_back(layout.positions[i], layout.valid[i] ? 1.0f : 0.0f);
+        } catch (const PlacementError&) {
+            // Settings the bake would refuse: no markers for that volume.
+        }
+    }
+    renderer_->setProbePositions(positions);
 }
 
 ProjectRenderer::~ProjectRenderer() = default;
@@ -88,6 +101,7 @@ RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera&
     s.debugView = r.debugView;
     s.probes = r.probes;
     s.linearOutput = r.linearOutput;
+    s.showProbePositions = r.probePositions;
     return renderer_->render(s);
 }
 

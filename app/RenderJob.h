@@ -21,6 +21,7 @@ struct RenderRequest {
     bool probes = true;
     bool linearOutput = false;
     bool bakeIfMissing = true;
+    bool probePositions = false;  // overlay of the enabled volumes' probe positions
 };
 
 class ProjectRenderer {
@@ -38,6 +39,7 @@ public:
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes) { renderer_->setProbeVolumes(volumes); }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
+    // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
     RenderedImage render(const RenderRequest& request);
     // The same render with an explicit camera (the viewport's).

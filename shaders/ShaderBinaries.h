@@ -8,4 +8,6 @@ namespace terralux::shaders {
 std::span<const uint32_t> terrainVert();
 std::span<const uint32_t> terrainFrag();
 std::span<const uint32_t> probeVerticesComp();
+std::span<const uint32_t> markersVert();
+std::span<const uint32_t> markersFrag();
 }  // namespace terralux::shaders

@@ -297,6 +297,10 @@ void MainWindow::buildDocks() {
     probeToggle_->setObjectName("viewport.probes");
     probeToggle_->setChecked(true);
     bar->addWidget(probeToggle_);
+    auto* positions = new QCheckBox("Probe positions");
+    positions->setObjectName("viewport.probePositions");
+    bar->addWidget(positions);
+    connect(positions, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbePositions);
     connect(viewSelector_, &QComboBox::currentIndexChanged, this,
             [this](int i) { viewport_->setDebugView(viewSelector_->itemData(i).toInt()); });
     connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);

@@ -41,6 +41,11 @@ void ViewportWindow::setProbeLighting(bool on) {
     requestUpdate();
 }
 
+void ViewportWindow::setProbePositions(bool on) {
+    request_.probePositions = on;
+    requestUpdate();
+}
+
 void ViewportWindow::exposeEvent(QExposeEvent*) {
     if (isExposed()) renderNow();
 }

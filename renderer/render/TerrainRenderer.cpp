@@ -43,7 +43,7 @@ static_assert(sizeof(VolumeRecord) == 64);
 }  // namespace
 
 struct TerrainRenderer::Gpu {
-    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight;
+    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight, markers;
     std::unique_ptr<vk::ProbeVertexPass> probePass;
     std::unique_ptr<vk::OffscreenTarget> target;
     std::unique_ptr<vk::TerrainPipeline> pipeline;
@@ -144,6 +144,17 @@ VkImage TerrainRenderer::lastImage() const {
     return gpu_->target ? gpu_->target->colorImage() : VK_NULL_HANDLE;
 }
 
+void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions) {
+    ctx_.submitAndWait([](VkCommandBuffer) {});  // no draw may still read the old buffer
+    markerCount_ = uint32_t(positions.size());
+    if (positions.empty()) {
+        gpu_->markers = vk::Buffer();
+        return;
+    }
+    gpu_->markers = vk::Buffer::deviceLocal(ctx_, positions.data(), positions.size() * sizeof(glm::vec4),
+                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+}
+
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
     if (!gpu_->target || gpu_->target->width() != s.width || gpu_->target->height() != s.height) {
@@ -152,7 +163,8 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
         // Render passes of the same formats are compatible: one pipeline serves every size.
         if (!gpu_->pipeline) {
             gpu_->pipeline = std::make_unique<vk::TerrainPipeline>(
-                ctx_, gpu_->target->renderPass(), shaders::terrainVert(), shaders::terrainFrag());
+                ctx_, gpu_->target->renderPass(), shaders::terrainVert(), shaders::terrainFrag(),
+                shaders::markersVert(), shaders::markersFrag());
             gpu_->descriptors = std::make_unique<vk::TerrainDescriptors>(ctx_, gpu_->pipeline->setLayout());
             gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
         }
@@ -170,7 +182,7 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     u.params[1] = volumeCount_;
     u.params[2] = s.probes ? 1 : 0;
     u.params[3] = s.linearOutput ? 1 : 0;
-    u.exposure = glm::vec4(s.exposure, s.roughness, 0.0f, 0.0f);
+    u.exposure = glm::vec4(s.exposure, s.roughness, float(s.width), float(s.height));
     gpu_->uniforms.write(&u, sizeof u);
 
     // Background: the sky toward the horizon, in the same encoding as the view.
@@ -213,6 +225,20 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
             vkCmdBindVertexBuffers(cb, 0, 2, vb, offsets);
             vkCmdBindIndexBuffer(cb, gpu_->indices.handle(), 0, VK_INDEX_TYPE_UINT32);
             vkCmdDrawIndexed(cb, uint32_t(indexCount_), 1, 0, 0, 0);
+        }
+        if (s.showProbePositions && markerCount_ > 0 && gpu_->pipeline) {
+            VkViewport vp{0, 0, float(s.width), float(s.height), 0.0f, 1.0f};
+            VkRect2D sc{{0, 0}, {s.width, s.height}};
+            vkCmdSetViewport(cb, 0, 1, &vp);
+            vkCmdSetScissor(cb, 0, 1, &sc);
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->markers());
+            VkDescriptorSet set = gpu_->descriptors->set();
+            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
+                                    &set, 0, nullptr);
+            VkDeviceSize offset = 0;
+            VkBuffer mb = gpu_->markers.handle();
+            vkCmdBindVertexBuffers(cb, 0, 1, &mb, &offset);
+            vkCmdDraw(cb, 6, markerCount_, 0, 0);
         }
         vkCmdEndRenderPass(cb);
         target.recordReadback(cb);

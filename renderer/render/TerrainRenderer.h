@@ -41,6 +41,7 @@ struct RenderSettings {
     sh::ShRgb skySh;
     float exposure = 1.0f;
     float roughness = 0.8f;
+    bool showProbePositions = false;  // the overlay of setProbePositions
 };
 
 struct RenderedImage {
@@ -58,6 +59,8 @@ public:
     ~TerrainRenderer();
 
     void setProbeVolumes(const std::vector<GpuProbeVolume>& volumes);
+    // Probe positions for the overlay: xyz, w = 1 valid, 0 inside the terrain.
+    void setProbePositions(const std::vector<glm::vec4>& positions);
     RenderedImage render(const RenderSettings& settings);
     // The colour image of the last render (TRANSFER_SRC_OPTIMAL), for a presenter.
     VkImage lastImage() const;
@@ -75,6 +78,7 @@ private:
     int stride_ = 1;
     size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0;
     int volumeCount_ = 0;
+    uint32_t markerCount_ = 0;
 };
 
 }  // namespace terralux

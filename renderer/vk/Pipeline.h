@@ -9,17 +9,27 @@
 
 namespace terralux::vk {
 
+// Graphics pipeline state shared by the terrain and the overlay: triangle lists, depth test,
+// dynamic viewport and scissor.
+VkPipeline createGraphicsPipeline(VkDevice device, VkRenderPass pass, VkPipelineLayout layout,
+                                  std::span<const uint32_t> vert, std::span<const uint32_t> frag,
+                                  const VkPipelineVertexInputStateCreateInfo& vertexInput,
+                                  bool depthWrite);
+
 class TerrainPipeline {
 public:
     // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes); binding 1,
     // vec4 probe irradiance + weight per vertex (16 bytes).
     TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass, std::span<const uint32_t> vertSpirv,
-                    std::span<const uint32_t> fragSpirv);
+                    std::span<const uint32_t> fragSpirv, std::span<const uint32_t> markerVert,
+                    std::span<const uint32_t> markerFrag);
     ~TerrainPipeline();
     TerrainPipeline(const TerrainPipeline&) = delete;
     TerrainPipeline& operator=(const TerrainPipeline&) = delete;
 
     VkPipeline handle() const { return pipeline_; }
+    // The probe-position overlay: per-instance vec4 (position, validity), same layout and set.
+    VkPipeline markers() const { return markers_; }
     VkPipelineLayout layout() const { return layout_; }
     VkDescriptorSetLayout setLayout() const { return setLayout_; }
 
@@ -28,6 +38,7 @@ private:
     VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
     VkPipelineLayout layout_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;
+    VkPipeline markers_ = VK_NULL_HANDLE;
 };
 
 }  // namespace terralux::vk

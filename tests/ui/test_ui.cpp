@@ -97,6 +97,31 @@ private slots:
         }, 20000));
     }
 
+    void probePositionOverlayFollowsTheGrid() {
+        auto* overlay = w_->findChild<QCheckBox*>("viewport.probePositions");
+        QVERIFY(overlay);
+        w_->viewport()->renderNow();
+        const RenderedImage plain = w_->viewport()->lastImage();
+        overlay->setChecked(true);
+        w_->viewport()->renderNow();
+        const RenderedImage marked = w_->viewport()->lastImage();
+        // Yellow markers: pixels whose blue channel falls far below red.
+        auto yellow = [](const RenderedImage& img) {
+            size_t n = 0;
+            for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+                n += img.rgba[i * 4] > 0.9f && img.rgba[i * 4 + 2] < 0.3f;
+            return n;
+        };
+        QCOMPARE(yellow(plain), size_t(0));
+        const size_t at64 = yellow(marked);
+        QVERIFY(at64 > 64 * 9);
+        QString error;
+        QVERIFY(w_->document()->setParameter("probe_volumes[0].grid_dims", nlohmann::json{2, 2}, &error));
+        w_->viewport()->renderNow();
+        const size_t at4 = yellow(w_->viewport()->lastImage());
+        QVERIFY2(at4 < at64 / 8 && at4 > 0, qPrintable(QString("%1 vs %2").arg(at4).arg(at64)));
+    }
+
     void rejectedValuesLeaveTheProject() {
         auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
         QVERIFY(elevation);
