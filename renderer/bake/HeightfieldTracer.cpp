@@ -16,7 +16,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // through a shared edge or vertex cannot slip between them; rounding in those tests is ~1e-11
 // cells, and the brute force reference uses the same slack.
 constexpr double kEdgeSlack = 1e-7;
-constexpr float kMinDistanceRel = 1e-6f;
 
 // The ray in grid space: u = x / cellSizeX + (width - 1) / 2, v likewise; y and t in metres.
 struct GridRay {
@@ -30,11 +29,6 @@ struct Piece {
     bool onTerrain = false;
 };
 
-struct Grid {
-    int cellsX, cellsZ;
-    bool skirt, triangles;
-};
-
 // Plane h(u, v) = h0 + (u - uc) * gu + (v - vc) * gv against the ray: t in (tLo, tHi] and the
 // hit's position relative to (uc, vc). The height difference ray - plane is linear in t, so
 // this is exact up to rounding. A parallel ray gives t = inf or NaN, which the range rejects.
@@ -44,67 +38,79 @@ inline bool planeHit(const GridRay& r, double uc, double vc, double h0, double g
     const double f0 = r.y0 - h0 - a * gu - b * gv;
     const double f1 = r.dy - r.du * gu - r.dv * gv;
     t = -f0 / f1;
-    if (!(t > tLo && t <= tHi)) return false;
+    if (!(t > tLo && t <= tHi))
+        return false;
     fu = a + t * r.du;
     fv = b + t * r.dv;
     return true;
 }
 
-// Both triangles of cell (c, r) and, for border cells with the skirt on, the skirt pieces that
-// extend the cell outward. Updates tBest / piece with the nearest hit in (tLo, tBest].
-// c1 = min(c + 1, width - 1), r1 likewise; hRC = height of vertex (c or c1, r or r1).
-inline bool leafHit(const Grid& g, const GridRay& ray, int c, int r, int c1, int r1, double h00,
-                    double h10, double h01, double h11, double tLo, double& tBest, Piece& piece) {
+// The two triangles of cell (c, r): updates tBest / piece with the nearest hit in
+// (tLo, tBest]. hRC = height of vertex (c or c + 1, r or r + 1).
+inline bool trianglesHit(const GridRay& ray, int c, int r, double h00, double h10, double h01,
+                         double h11, double tLo, double& tBest, Piece& piece) {
     constexpr double e = kEdgeSlack;
     bool found = false;
     double t, fu, fv;
-    auto take = [&](double gu, double gv, bool terrain) {
+    // Triangle A: (c, r), (c, r+1), (c+1, r+1), where fu <= fv.
+    if (planeHit(ray, c, r, h00, h11 - h01, h01 - h00, tLo, tBest, t, fu, fv) && fu >= -e &&
+        fv <= 1 + e && fu <= fv + e) {
         tBest = t;
-        piece = {gu, gv, terrain};
+        piece = {h11 - h01, h01 - h00, true};
+        found = true;
+    }
+    // Triangle B: (c, r), (c+1, r+1), (c+1, r), where fu > fv.
+    if (planeHit(ray, c, r, h00, h10 - h00, h11 - h10, tLo, tBest, t, fu, fv) && fv >= -e &&
+        fu <= 1 + e && fv <= fu + e) {
+        tBest = t;
+        piece = {h10 - h00, h11 - h10, true};
+        found = true;
+    }
+    return found;
+}
+
+// The skirt pieces that extend border cell (c, r) outward, as trianglesHit. c1 = min(c + 1,
+// width - 1), r1 likewise (a one-vertex-wide grid has zero-width cells).
+bool skirtHit(const GridRay& ray, int cellsX, int cellsZ, int c, int r, int c1, int r1, double h00,
+              double h10, double h01, double h11, double tLo, double& tBest, Piece& piece) {
+    constexpr double e = kEdgeSlack;
+    bool found = false;
+    double t, fu, fv;
+    auto take = [&](double gu, double gv) {
+        tBest = t;
+        piece = {gu, gv, false};
         found = true;
     };
-    if (g.triangles) {
-        // Triangle A: (c, r), (c, r+1), (c+1, r+1), where fu <= fv.
-        if (planeHit(ray, c, r, h00, h11 - h01, h01 - h00, tLo, tBest, t, fu, fv) && fu >= -e &&
-            fv <= 1 + e && fu <= fv + e)
-            take(h11 - h01, h01 - h00, true);
-        // Triangle B: (c, r), (c+1, r+1), (c+1, r), where fu > fv.
-        if (planeHit(ray, c, r, h00, h10 - h00, h11 - h10, tLo, tBest, t, fu, fv) && fv >= -e &&
-            fu <= 1 + e && fv <= fu + e)
-            take(h10 - h00, h11 - h10, true);
-    }
-    if (!g.skirt) return found;
-    const bool left = c == 0, right = c == g.cellsX - 1, top = r == 0, bottom = r == g.cellsZ - 1;
-    if (!(left || right || top || bottom)) return found;
+    const bool left = c == 0, right = c == cellsX - 1, top = r == 0, bottom = r == cellsZ - 1;
     // Edge strips: the border segment of this cell extruded outward, level across the edge.
     if (r1 > r) {
         if (left && planeHit(ray, c, r, h00, 0, h01 - h00, tLo, tBest, t, fu, fv) && fu <= e &&
             fv >= -e && fv <= 1 + e)
-            take(0, h01 - h00, false);
+            take(0, h01 - h00);
         if (right && planeHit(ray, c1, r, h10, 0, h11 - h10, tLo, tBest, t, fu, fv) && fu >= -e &&
             fv >= -e && fv <= 1 + e)
-            take(0, h11 - h10, false);
+            take(0, h11 - h10);
     }
     if (c1 > c) {
         if (top && planeHit(ray, c, r, h00, h10 - h00, 0, tLo, tBest, t, fu, fv) && fv <= e &&
             fu >= -e && fu <= 1 + e)
-            take(h10 - h00, 0, false);
+            take(h10 - h00, 0);
         if (bottom && planeHit(ray, c, r1, h01, h11 - h01, 0, tLo, tBest, t, fu, fv) && fv >= -e &&
             fu >= -e && fu <= 1 + e)
-            take(h11 - h01, 0, false);
+            take(h11 - h01, 0);
     }
     // Corner quadrants: level at the corner vertex height.
     if (left && top && planeHit(ray, c, r, h00, 0, 0, tLo, tBest, t, fu, fv) && fu <= e && fv <= e)
-        take(0, 0, false);
+        take(0, 0);
     if (right && top && planeHit(ray, c1, r, h10, 0, 0, tLo, tBest, t, fu, fv) && fu >= -e &&
         fv <= e)
-        take(0, 0, false);
+        take(0, 0);
     if (left && bottom && planeHit(ray, c, r1, h01, 0, 0, tLo, tBest, t, fu, fv) && fu <= e &&
         fv >= -e)
-        take(0, 0, false);
+        take(0, 0);
     if (right && bottom && planeHit(ray, c1, r1, h11, 0, 0, tLo, tBest, t, fu, fv) && fu >= -e &&
         fv >= -e)
-        take(0, 0, false);
+        take(0, 0);
     return found;
 }
 
@@ -121,11 +127,6 @@ glm::vec3 pieceNormal(const Piece& p, double cellX, double cellZ) {
 }
 
 }  // namespace
-
-float HeightfieldTracer::minDistance(const glm::vec3& o) {
-    const float m = std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
-    return kMinDistanceRel * (1.0f + m);
-}
 
 HeightfieldTracer::HeightfieldTracer(const Heightfield& hf) : HeightfieldTracer(hf, Options{}) {}
 
@@ -158,7 +159,8 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
         return uint16_t(std::clamp(q, 0.0, 65535.0));
     };
     maxQ_.assign(total, 0);
-    if (levels_.size() < 2) return;
+    if (levels_.size() < 2)
+        return;
 
     // Level 1 straight from the heights (each node: up to 3 x 3 vertices), then 2 x 2 reductions
     // of the quantized values (monotonic, so still upper bounds).
@@ -170,7 +172,8 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
             const int c0 = 2 * x, c1 = std::min(2 * x + 2, w - 1);
             float m = h[size_t(r0) * size_t(w) + size_t(c0)];
             for (int r = r0; r <= r1; ++r)
-                for (int c = c0; c <= c1; ++c) m = std::max(m, h[size_t(r) * size_t(w) + size_t(c)]);
+                for (int c = c0; c <= c1; ++c)
+                    m = std::max(m, h[size_t(r) * size_t(w) + size_t(c)]);
             maxQ_[l1.offset + size_t(z) * size_t(l1.nx) + size_t(x)] = quantize(m);
         }
     }
@@ -194,15 +197,19 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
 
 // Stackless max-mipmap traversal (Tevs et al. 2008, sec. 4): keep the current node (level, ix,
 // iz) and the ray parameter t at which the ray is inside it. If the ray's lowest height over
-// the node's t interval is above the node max, step to the next node at the same level (and
-// one level up once the step leaves the parent); else descend into the child holding the ray
-// at t, or at a cell test its triangles. Node boundaries are integer cell indices and every
-// boundary's t is computed by one expression, so stepping, ascending and descending agree
-// exactly on which node holds the ray. Border nodes extend to infinity outward, which is where
-// the skirt lives; with the skirt off, t is clipped to the footprint instead.
+// the node's t interval is above the node max, step to the next node at the same level and go
+// up a level (see the end of the loop); else descend into the child holding the ray at t, or
+// at a cell test its triangles. Node boundaries are integer cell indices and every boundary's
+// t is computed by one expression, so stepping, ascending and descending agree exactly on
+// which node holds the ray, and every step moves forward: the walk ends. Border nodes extend
+// to infinity outward, which is where the skirt lives; with the skirt off, t is clipped to the
+// footprint instead.
 template <bool AnyHit>
 bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
                               RayHit* hit) const {
+    // NaN or infinite input would make the cell index below undefined.
+    if (!std::isfinite(double(o.x) + o.y + o.z + dir.x + dir.y + dir.z))
+        return false;
     const Heightfield& hf = *hf_;
     const int w = hf.width(), d = hf.depth();
     GridRay ray;
@@ -215,30 +222,37 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
 
     const double tLo = minDistance(o);
     double t = tLo;
-    // DBL_MAX rather than inf: a hit at t = inf (ray parallel to a level skirt) is no hit.
-    double tEnd = std::min(double(tMax), DBL_MAX);
-    if (!(t < tEnd)) return false;
+    // At most FLT_MAX: hit.t must fit a float, and t = inf (a ray parallel to a level skirt
+    // piece) is no hit.
+    double tEnd = std::min(double(tMax), double(FLT_MAX));
+    if (!(t < tEnd))
+        return false;
 
     if (!opt_.skirt) {
-        if (!hasTriangles_) return false;
+        if (!hasTriangles_)
+            return false;
         auto clip = [&](double p0, double dp, double hi) {
             if (dp == 0) {
-                if (p0 < 0 || p0 > hi) tEnd = -1;
+                if (p0 < 0 || p0 > hi)
+                    tEnd = -1;
                 return;
             }
             double ta = (0 - p0) / dp, tb = (hi - p0) / dp;
-            if (ta > tb) std::swap(ta, tb);
+            if (ta > tb)
+                std::swap(ta, tb);
             t = std::max(t, ta);
             tEnd = std::min(tEnd, tb);
         };
         clip(ray.u0, ray.du, w - 1);
         clip(ray.v0, ray.dv, d - 1);
-        if (!(t <= tEnd)) return false;
+        if (!(t <= tEnd))
+            return false;
     }
 
     // Per axis: negU when u decreases along the ray. A ray with du = 0 is walked as increasing
-    // u with 1 / du = DBL_MAX: its crossings then lie at +-huge t, behind or far ahead, so
-    // "which side of u = k" comes out as u0 >= k, with no separate case in the loop.
+    // u with 1 / du = DBL_MAX: its crossings then lie at t = 0 (u0 on the line) or at |t| far
+    // beyond FLT_MAX >= tEnd, so "which side of u = k" comes out as u0 >= k with no separate
+    // case in the loop.
     const bool negU = ray.du < 0, negV = ray.dv < 0;
     const double invDu = ray.du != 0 ? 1.0 / ray.du : DBL_MAX;
     const double invDv = ray.dv != 0 ? 1.0 / ray.dv : DBL_MAX;
@@ -250,7 +264,6 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
     const uint16_t* maxQ = maxQ_.data();
     const double rootMax = double(hf.maxHeight()) + cullMargin_;
     const float* heights = hf.heights().data();
-    const Grid grid{cellsX_, cellsZ_, opt_.skirt, hasTriangles_};
 
     // t at which the ray crosses grid line u = k (v = k): the single expression used everywhere.
     auto crossU = [&](int k) { return (double(k) - ray.u0) * invDu; };
@@ -265,10 +278,14 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
     int lvl = 0;
     int ix = startIndex(ray.u0 + t * ray.du, cellsX_);
     int iz = startIndex(ray.v0 + t * ray.dv, cellsZ_);
-    while (ix > 0 && !highU(ix)) --ix;
-    while (ix + 1 < cellsX_ && highU(ix + 1)) ++ix;
-    while (iz > 0 && !highV(iz)) --iz;
-    while (iz + 1 < cellsZ_ && highV(iz + 1)) ++iz;
+    while (ix > 0 && !highU(ix))
+        --ix;
+    while (ix + 1 < cellsX_ && highU(ix + 1))
+        ++ix;
+    while (iz > 0 && !highV(iz))
+        --iz;
+    while (iz + 1 < cellsZ_ && highV(iz + 1))
+        ++iz;
 
     for (;;) {
         // Where the ray leaves the node; the outermost nodes reach to infinity (the skirt).
@@ -284,19 +301,25 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
             const float* row1 = heights + size_t(r1) * size_t(w);
             const float f00 = row0[ix], f10 = row0[c1], f01 = row1[ix], f11 = row1[c1];
             const double cellMax = std::max(std::max(f00, f10), std::max(f01, f11));
-            double tHit = tEnd;
-            Piece piece;
             // The cell's pieces cannot be hit outside its box (up to kEdgeSlack), so the first
             // cell with a hit holds the nearest one.
-            if (yLow <= cellMax + cullMargin_ &&
-                leafHit(grid, ray, ix, iz, c1, r1, f00, f10, f01, f11, tLo, tHit, piece)) {
-                if constexpr (!AnyHit) {
-                    hit->t = float(tHit);
-                    hit->position = o + hit->t * dir;
-                    hit->normal = pieceNormal(piece, hf.cellSizeX(), hf.cellSizeZ());
-                    hit->onTerrain = piece.onTerrain;
+            if (yLow <= cellMax + cullMargin_) {
+                double tHit = tEnd;
+                Piece piece;
+                bool found = hasTriangles_ &&
+                             trianglesHit(ray, ix, iz, f00, f10, f01, f11, tLo, tHit, piece);
+                if (opt_.skirt && (ix == 0 || iz == 0 || ix == cellsX_ - 1 || iz == cellsZ_ - 1))
+                    found |= skirtHit(ray, cellsX_, cellsZ_, ix, iz, c1, r1, f00, f10, f01, f11,
+                                      tLo, tHit, piece);
+                if (found) {
+                    if constexpr (!AnyHit) {
+                        hit->t = float(tHit);
+                        hit->position = o + hit->t * dir;
+                        hit->normal = pieceNormal(piece, hf.cellSizeX(), hf.cellSizeZ());
+                        hit->onTerrain = piece.onTerrain;
+                    }
+                    return true;
                 }
-                return true;
             }
         } else {
             const Level& L = levels[lvl];
@@ -308,12 +331,15 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
                 ix <<= 1;
                 iz <<= 1;
                 const Level& C = levels[lvl];
-                if (ix + 1 < C.nx) ix += highU((ix + 1) << lvl);
-                if (iz + 1 < C.nz) iz += highV((iz + 1) << lvl);
+                if (ix + 1 < C.nx)
+                    ix += highU((ix + 1) << lvl);
+                if (iz + 1 < C.nz)
+                    iz += highV((iz + 1) << lvl);
                 continue;
             }
         }
-        if (tExit >= tEnd || (rising && ray.y0 + ray.dy * tExit > rootMax)) return false;
+        if (tExit >= tEnd || (rising && ray.y0 + ray.dy * tExit > rootMax))
+            return false;
         // Step to the next node; go one level up when it lies in another parent or, for a
         // rising ray (which only gets higher), always, as the parent may now be cleared too.
         t = tExit;
@@ -332,8 +358,7 @@ bool HeightfieldTracer::intersect(const glm::vec3& origin, const glm::vec3& dir,
     return trace<false>(origin, dir, tMax, &hit);
 }
 
-bool HeightfieldTracer::occluded(const glm::vec3& origin, const glm::vec3& dir,
-                                 float tMax) const {
+bool HeightfieldTracer::occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const {
     return trace<true>(origin, dir, tMax, nullptr);
 }
 
@@ -343,8 +368,9 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
     const int w = hf.width(), d = hf.depth();
     const double cellX = hf.cellSizeX(), cellZ = hf.cellSizeZ();
     const double tLo = HeightfieldTracer::minDistance(origin);
-    double best = std::min(double(tMax), DBL_MAX);
-    if (!(tLo < best)) return false;
+    double best = std::min(double(tMax), double(FLT_MAX));
+    if (!(tLo < best))
+        return false;
     const dvec3 O(origin), D(dir);
     auto X = [&](int c) { return (c - 0.5 * (w - 1)) * cellX; };
     auto Z = [&](int r) { return (r - 0.5 * (d - 1)) * cellZ; };
@@ -366,16 +392,20 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
         const dvec3 e1 = b - a, e2 = c - a;
         const dvec3 p = glm::cross(D, e2);
         const double det = glm::dot(e1, p);
-        if (det == 0) return;
+        if (det == 0)
+            return;
         const double inv = 1.0 / det;
         const dvec3 s = O - a;
         const double bu = glm::dot(s, p) * inv;
-        if (!(bu >= -e && bu <= 1 + e)) return;
+        if (!(bu >= -e && bu <= 1 + e))
+            return;
         const dvec3 q = glm::cross(s, e1);
         const double bv = glm::dot(D, q) * inv;
-        if (!(bv >= -e && bu + bv <= 1 + e)) return;
+        if (!(bv >= -e && bu + bv <= 1 + e))
+            return;
         const double t = glm::dot(e2, q) * inv;
-        if (t > tLo && t <= best) take(t, glm::cross(e1, e2), true);
+        if (t > tLo && t <= best)
+            take(t, glm::cross(e1, e2), true);
     };
     for (int r = 0; r + 1 < d; ++r)
         for (int c = 0; c + 1 < w; ++c) {
@@ -389,12 +419,15 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
             const dvec3 edge = p1 - p0;
             const dvec3 n = glm::cross(edge, out);
             const double den = glm::dot(D, n);
-            if (den == 0) return;
+            if (den == 0)
+                return;
             const double t = glm::dot(p0 - O, n) / den;
-            if (!(t > tLo && t <= best)) return;
+            if (!(t > tLo && t <= best))
+                return;
             const dvec3 rel = O + t * D - p0;
             const double a = glm::dot(rel, edge) / glm::dot(edge, edge);
-            if (a >= -e && a <= 1 + e && glm::dot(rel, out) >= -e * cell) take(t, n, false);
+            if (a >= -e && a <= 1 + e && glm::dot(rel, out) >= -e * cell)
+                take(t, n, false);
         };
         if (d >= 2)
             for (int r = 0; r + 1 < d; ++r) {
@@ -408,10 +441,12 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
             }
         // Corner quadrants, level at the corner height; sx, sz = outward signs.
         auto corner = [&](int c, int r, double sx, double sz) {
-            if (D.y == 0) return;
+            if (D.y == 0)
+                return;
             const dvec3 p = V(c, r);
             const double t = (p.y - O.y) / D.y;
-            if (!(t > tLo && t <= best)) return;
+            if (!(t > tLo && t <= best))
+                return;
             const dvec3 q = O + t * D;
             if ((q.x - p.x) * sx >= -e * cellX && (q.z - p.z) * sz >= -e * cellZ)
                 take(t, dvec3(0, 1, 0), false);
@@ -421,7 +456,8 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
         corner(0, d - 1, -1, 1);
         corner(w - 1, d - 1, 1, 1);
     }
-    if (!found) return false;
+    if (!found)
+        return false;
     hit.t = float(best);
     hit.position = origin + hit.t * dir;
     hit.normal = glm::vec3(glm::normalize(bestNormal));
@@ -435,7 +471,7 @@ bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm
     const double lo = hf.minHeight(), hi = hf.maxHeight();
     const glm::dvec3 O(origin), D(dir);
     double t0 = HeightfieldTracer::minDistance(origin);
-    double tEnd = std::min(double(tMax), DBL_MAX);
+    double tEnd = std::min(double(tMax), double(FLT_MAX));
     // Only the slab lo <= y <= hi can hold a crossing: start at its top, stop at its bottom
     // (below lo the ray is under the surface everywhere) or when rising out of it.
     if (D.y > 0) {
@@ -444,13 +480,16 @@ bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm
         t0 = std::max(t0, (hi - O.y) / D.y);
         tEnd = std::min(tEnd, (lo - O.y) / D.y);
     } else {
-        if (O.y > hi) return false;
-        // Level ray inside the slab: march past the footprint by one footprint diagonal.
+        if (O.y > hi)
+            return false;
+        // Level ray inside the slab: march until well past the footprint.
         const double ex = hf.maxX() - hf.minX(), ez = hf.maxZ() - hf.minZ();
         const double diag = std::sqrt(ex * ex + ez * ez);
         tEnd = std::min(tEnd, std::hypot(O.x, O.z) + 2 * diag + step);
     }
-    if (!(t0 <= tEnd)) return false;
+    if (!(t0 <= tEnd))
+        return false;
+    tEnd = std::min(tEnd, t0 + 1e8 * step);  // near-level rays: give up after 1e8 steps
     auto below = [&](double t) {
         const glm::dvec3 p = O + t * D;
         return p.y <= double(hf.surfaceHeight(float(p.x), float(p.z)));
@@ -462,7 +501,8 @@ bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm
         tb = std::min(tb + step, tEnd);
         crossed = below(tb);
     }
-    if (!crossed) return false;
+    if (!crossed)
+        return false;
     while (tb - ta > 1e-4) {
         const double tm = 0.5 * (ta + tb);
         (below(tm) ? tb : ta) = tm;

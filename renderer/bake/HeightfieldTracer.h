@@ -13,6 +13,8 @@
 // All geometry is evaluated in double precision in grid space (u = x / cellSizeX + (width-1)/2,
 // the same mapping as Heightfield::surfaceHeight), so vertices sit on exact integers.
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -37,15 +39,16 @@ public:
     };
 
     // Keeps a reference to hf: it must outlive the tracer and not change while the tracer lives.
-    // (Two constructors rather than "Options opt = {}": GCC rejects a default argument of a
-    // nested type with member initializers inside the enclosing class.)
+    // (Two constructors rather than "Options opt = {}": a nested type's default member
+    // initializers cannot be used by a default argument inside the enclosing class, CWG 1397.)
     explicit HeightfieldTracer(const Heightfield& hf);
     HeightfieldTracer(const Heightfield& hf, Options opt);
 
     // First hit with minDistance(origin) < t <= tMax along a unit-length dir (tMax may be
     // +infinity). false: the ray escapes (sky). Thread-safe: the tracer is immutable.
     bool intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit& hit) const;
-    // Whether any hit exists in the same range; cheaper than intersect when only visibility matters.
+    // Whether any hit exists in the same range; cheaper than intersect when only visibility
+    // matters.
     bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const;
 
     const Heightfield& heightfield() const { return *hf_; }
@@ -53,11 +56,14 @@ public:
     // Number of quadtree levels (level 0 holds one node per cell).
     int levelCount() const { return int(levels_.size()); }
 
-    // Hits at t <= minDistance(origin) are ignored so that a ray leaving a surface point does not
-    // hit that point again: 1e-6 relative to the origin's largest coordinate (about 16 float ulps),
-    // with a 1e-6 m floor. Callers should lift secondary-ray origins off the surface by more
-    // than that (e.g. 1e-4 * |position| + 1 mm along the normal).
-    static float minDistance(const glm::vec3& origin);
+    // Hits at t <= minDistance(origin) are ignored, so that a ray leaving a surface point cannot
+    // hit that point again through rounding: 1e-6 of the origin's largest coordinate (8 to 16
+    // float ulps of it) plus 1e-6 m. Callers should lift secondary-ray origins off the surface
+    // by a few times that along the normal, e.g. 1e-5 * max|coordinate| + 1 mm.
+    static float minDistance(const glm::vec3& origin) {
+        const float m = std::max({std::fabs(origin.x), std::fabs(origin.y), std::fabs(origin.z)});
+        return 1e-6f * (1.0f + m);
+    }
 
 private:
     struct Level {
@@ -72,7 +78,7 @@ private:
     int cellsX_ = 1, cellsZ_ = 1;  // at least 1: a one-vertex-wide grid has one zero-width cell
     bool hasTriangles_ = false;    // width >= 2 and depth >= 2
     double invCellX_ = 1, invCellZ_ = 1;
-    std::vector<Level> levels_;    // levels_[0]: cells; levels_.back(): the single root node
+    std::vector<Level> levels_;  // levels_[0]: cells; levels_.back(): the single root node
     // Max vertex height under each node of levels >= 1 (the skirt only repeats border heights),
     // quantized upward: qBase_ + q * qStep_ >= true max + cullMargin_. 16 bits keep the
     // levels of a 1201^2 DEM near 1 MB, cache-resident next to the float heights, which the
@@ -89,7 +95,8 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
 
 // Baseline: fixed-step ray march (one step per min(cellSizeX, cellSizeZ) of t) over
 // Heightfield::surfaceHeight (so the skirt is always on), stopping at the first sample below the
-// surface and refining by bisection. Can step over thin ridges; kept for benchmarks.
+// surface and refining by bisection to 1e-4 m; gives up after 1e8 steps. Can step over thin
+// ridges and so miss hits or find later ones; kept as the benchmarks' baseline.
 bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm::vec3& dir,
                        float tMax, RayHit& hit);
 

@@ -42,7 +42,8 @@ struct BenchDem {
 
 bool envInt(const char* name, long& out) {
     const char* s = std::getenv(name);
-    if (!s || !*s) return false;
+    if (!s || !*s)
+        return false;
     char* end = nullptr;
     out = std::strtol(s, &end, 10);
     return end && *end == '\0';
@@ -50,7 +51,8 @@ bool envInt(const char* name, long& out) {
 
 bool envDouble(const char* name, double& out) {
     const char* s = std::getenv(name);
-    if (!s || !*s) return false;
+    if (!s || !*s)
+        return false;
     char* end = nullptr;
     out = std::strtod(s, &end);
     return end && *end == '\0';
@@ -61,23 +63,36 @@ void fillVoids(std::vector<float>& h, int w, int d) {
     auto invalid = [](float v) { return !std::isfinite(v) || v < -1e4f; };
     std::vector<uint8_t> bad(h.size());
     size_t left = 0;
-    for (size_t i = 0; i < h.size(); ++i) left += bad[i] = invalid(h[i]);
+    for (size_t i = 0; i < h.size(); ++i)
+        left += bad[i] = invalid(h[i]);
     while (left > 0) {
         std::vector<uint8_t> next = bad;
         size_t filled = 0;
         for (int r = 0; r < d; ++r)
             for (int c = 0; c < w; ++c) {
                 const size_t i = size_t(r) * size_t(w) + size_t(c);
-                if (!bad[i]) continue;
+                if (!bad[i])
+                    continue;
                 double sum = 0;
                 int n = 0;
                 auto take = [&](int cc, int rr) {
-                    if (cc < 0 || rr < 0 || cc >= w || rr >= d) return;
+                    if (cc < 0 || rr < 0 || cc >= w || rr >= d)
+                        return;
                     const size_t j = size_t(rr) * size_t(w) + size_t(cc);
-                    if (!bad[j]) sum += h[j], ++n;
+                    if (!bad[j]) {
+                        sum += h[j];
+                        ++n;
+                    }
                 };
-                take(c - 1, r), take(c + 1, r), take(c, r - 1), take(c, r + 1);
-                if (n) h[i] = float(sum / n), next[i] = 0, ++filled;
+                take(c - 1, r);
+                take(c + 1, r);
+                take(c, r - 1);
+                take(c, r + 1);
+                if (n) {
+                    h[i] = float(sum / n);
+                    next[i] = 0;
+                    ++filled;
+                }
             }
         if (filled == 0) {  // nothing valid at all
             std::fill(h.begin(), h.end(), 0.0f);
@@ -90,7 +105,8 @@ void fillVoids(std::vector<float>& h, int w, int d) {
 
 bool loadRawDem(BenchDem& out) {
     const char* path = std::getenv("TERRALUX_BENCH_DEM_RAW");
-    if (!path || !*path) return false;
+    if (!path || !*path)
+        return false;
     long w = 0, d = 0;
     double cx = 0, cz = 0;
     if (!envInt("TERRALUX_BENCH_DEM_W", w) || !envInt("TERRALUX_BENCH_DEM_H", d) ||
@@ -106,20 +122,23 @@ bool loadRawDem(BenchDem& out) {
         std::fprintf(stderr, "cannot read %ld x %ld float32 samples from %s\n", w, d, path);
         return false;
     }
-    if constexpr (std::endian::native == std::endian::big)
+    if constexpr (std::endian::native == std::endian::big) {
         for (float& v : h) {
             const uint32_t b = std::bit_cast<uint32_t>(v);
             v = std::bit_cast<float>((b >> 24) | ((b >> 8) & 0xff00u) | ((b << 8) & 0xff0000u) |
                                      (b << 24));
         }
+    }
     size_t voids = 0;
-    for (float v : h) voids += !std::isfinite(v) || v < -1e4f;
+    for (float v : h)
+        voids += !std::isfinite(v) || v < -1e4f;
     fillVoids(h, int(w), int(d));
-    const std::string name = std::string(path).substr(std::string(path).find_last_of('/') + 1);
+    const std::string file(path);
+    char desc[512];
+    std::snprintf(desc, sizeof desc, "real DEM %s %ldx%ld, %gx%g m cells, %zu voids filled",
+                  file.substr(file.find_last_of('/') + 1).c_str(), w, d, cx, cz, voids);
     out.hf = Heightfield(int(w), int(d), cx, cz, std::move(h));
-    out.source = "real DEM " + name + " " + std::to_string(w) + "x" + std::to_string(d) + ", " +
-                 std::to_string(int(cx)) + "x" + std::to_string(int(cz)) + " m cells, " +
-                 std::to_string(voids) + " voids filled";
+    out.source = desc;
     return true;
 }
 
@@ -133,12 +152,14 @@ BenchDem syntheticDem() {
     for (int period = 512; period >= 2; period /= 2, amp *= 0.5f) {
         const int g = n / period + 2;
         std::vector<float> lattice(size_t(g) * size_t(g));
-        for (float& v : lattice) v = u01(rng);
+        for (float& v : lattice)
+            v = u01(rng);
         auto L = [&](int i, int j) { return lattice[size_t(j) * size_t(g) + size_t(i)]; };
         for (int r = 0; r < n; ++r)
             for (int c = 0; c < n; ++c) {
                 const int i = c / period, j = r / period;
-                float fx = float(c % period) / float(period), fz = float(r % period) / float(period);
+                float fx = float(c % period) / float(period),
+                      fz = float(r % period) / float(period);
                 fx = fx * fx * (3 - 2 * fx);
                 fz = fz * fz * (3 - 2 * fz);
                 const float a = L(i, j) + fx * (L(i + 1, j) - L(i, j));
@@ -148,7 +169,8 @@ BenchDem syntheticDem() {
     }
     const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
     const float scale = 2000.0f / (*hi - *lo), base = *lo;
-    for (float& v : h) v = 300.0f + (v - base) * scale;
+    for (float& v : h)
+        v = 300.0f + (v - base) * scale;
     return {Heightfield(n, n, 30.0, 30.0, std::move(h)),
             "synthetic fractal DEM 1201x1201, 30x30 m cells, 2000 m relief"};
 }
@@ -156,7 +178,8 @@ BenchDem syntheticDem() {
 const BenchDem& dem() {
     static const BenchDem d = [] {
         BenchDem b;
-        if (!loadRawDem(b)) b = syntheticDem();
+        if (!loadRawDem(b))
+            b = syntheticDem();
         std::fprintf(stderr, "bench_tracer DEM: %s (heights %.1f .. %.1f m)\n", b.source.c_str(),
                      b.hf.minHeight(), b.hf.maxHeight());
         return b;
@@ -185,7 +208,8 @@ const Rays& rays() {
             const float z = hf.minZ() + u01(rng) * (hf.maxZ() - hf.minZ());
             out.origin.emplace_back(x, hf.surfaceHeight(x, z) + 2.0f, z);
             glm::vec3 d;
-            do d = glm::vec3(g(rng), g(rng), g(rng));
+            do
+                d = glm::vec3(g(rng), g(rng), g(rng));
             while (glm::dot(d, d) < 1e-8f);
             out.dir.push_back(glm::normalize(d));
         }

@@ -31,7 +31,8 @@ Heightfield makeRoughDem(int w, int d, double cellX, double cellZ, float relief,
     for (int period = 16; period >= 1; period /= 2, amp *= 0.5f) {
         const int gw = w / period + 2, gd = d / period + 2;
         std::vector<float> lattice(size_t(gw) * size_t(gd));
-        for (float& v : lattice) v = u01(rng);
+        for (float& v : lattice)
+            v = u01(rng);
         for (int r = 0; r < d; ++r)
             for (int c = 0; c < w; ++c) {
                 const int lc = c / period, lr = r / period;
@@ -44,7 +45,8 @@ Heightfield makeRoughDem(int w, int d, double cellX, double cellZ, float relief,
             }
     }
     std::uniform_int_distribution<size_t> pick(0, h.size() - 1);
-    for (size_t i = 0; i < h.size() / 20 + 1; ++i) h[pick(rng)] += relief * (2.0f * u01(rng) - 0.5f);
+    for (size_t i = 0; i < h.size() / 20 + 1; ++i)
+        h[pick(rng)] += relief * (2.0f * u01(rng) - 0.5f);
     return Heightfield(w, d, cellX, cellZ, std::move(h));
 }
 
@@ -53,7 +55,8 @@ glm::vec3 randomDir(std::mt19937& rng) {
     for (;;) {
         const glm::vec3 v(u(rng), u(rng), u(rng));
         const float l2 = glm::dot(v, v);
-        if (l2 > 1e-4f && l2 <= 1.0f) return v / std::sqrt(l2);
+        if (l2 > 1e-4f && l2 <= 1.0f)
+            return v / std::sqrt(l2);
     }
 }
 
@@ -83,7 +86,9 @@ std::ostream& operator<<(std::ostream& os, const Stats& s) {
               << s.badHitPoint;
 }
 
-bool tAgrees(float a, float b) { return std::fabs(a - b) <= std::max(1e-3f, 1e-4f * b); }
+bool tAgrees(float a, float b) {
+    return std::fabs(a - b) <= std::max(1e-3f, 1e-4f * b);
+}
 
 // One ray through the tracer and the reference. strict: also compare normal and onTerrain,
 // which are ambiguous for rays aimed exactly at an edge or a seam.
@@ -226,8 +231,8 @@ Stats specialRays(const HeightfieldTracer& tracer, uint32_t seed) {
         compareRay(tracer, above(gx, z, lift()), {0.0f, se, sy * ce}, kInf, false, s, "axis z");
         compareRay(tracer, above(x, gz, lift()), {sy * ce, se, 0.0f}, kInf, false, s, "axis x");
         // Grazing along a grid line.
-        compareRay(tracer, above(gx, z, lift()), {0.0f, -1e-4f, sy * 0.99999999f}, kInf, false,
-                   s, "grazing axis");
+        compareRay(tracer, above(gx, z, lift()), {0.0f, -1e-4f, sy * 0.99999999f}, kInf, false, s,
+                   "grazing axis");
         // Vertical, at random points, at vertices and at cell-edge midpoints.
         compareRay(tracer, above(x, z, lift()), {0.0f, -1.0f, 0.0f}, kInf, true, s, "vertical");
         compareRay(tracer, above(gx, gz, lift()), {0.0f, -1.0f, 0.0f}, kInf, false, s,
@@ -236,11 +241,11 @@ Stats specialRays(const HeightfieldTracer& tracer, uint32_t seed) {
                    {0.0f, -1.0f, 0.0f}, kInf, false, s, "vertical edge");
         compareRay(tracer, above(x, z, lift()), {0.0f, 1.0f, 0.0f}, kInf, true, s, "up");
         // Along the cell diagonal from a vertex, down and up.
-        const glm::vec3 diag = glm::normalize(glm::vec3(
-            sy * float(hf.cellSizeX()), 2.0f * (u01(rng) - 0.5f) * float(hf.cellSizeX()),
-            sy * float(hf.cellSizeZ())));
-        compareRay(tracer, above(hf.xOf(col(rng)), hf.zOf(row(rng)), lift()), diag, kInf, false,
-                   s, "diagonal");
+        const glm::vec3 diag = glm::normalize(
+            glm::vec3(sy * float(hf.cellSizeX()), 2.0f * (u01(rng) - 0.5f) * float(hf.cellSizeX()),
+                      sy * float(hf.cellSizeZ())));
+        compareRay(tracer, above(hf.xOf(col(rng)), hf.zOf(row(rng)), lift()), diag, kInf, false, s,
+                   "diagonal");
         // From outside the footprint, above the skirt, aimed at a point inside it.
         const float side = 1.5f + u01(rng);
         const glm::vec3 from(std::cos(phi) * side * ex, hf.maxHeight() + 200.0f * u01(rng),
@@ -254,7 +259,8 @@ Stats specialRays(const HeightfieldTracer& tracer, uint32_t seed) {
         const glm::vec3 n = hf.surfaceNormal(x, z);
         const glm::vec3 p = glm::vec3(x, hf.surfaceHeight(x, z), z) + 0.01f * n;
         glm::vec3 dir = randomDir(rng);
-        if (glm::dot(dir, n) < 0) dir = -dir;
+        if (glm::dot(dir, n) < 0)
+            dir = -dir;
         compareRay(tracer, p, dir, kInf, true, s, "leaving surface");
     }
     return s;
@@ -268,8 +274,8 @@ void runComparison(bool skirt, uint32_t seedBase) {
         const HeightfieldTracer tracer(hf, {skirt});
         const Stats r = randomRays(tracer, dc, ++seed);
         const Stats g = specialRays(tracer, ++seed);
-        std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] " << dc.name << ": random "
-                  << r << "\n                     special " << g << "\n";
+        std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] " << dc.name << ": random " << r
+                  << "\n                     special " << g << "\n";
         total.add(r);
         special.add(g);
     }
@@ -285,19 +291,23 @@ void runComparison(bool skirt, uint32_t seedBase) {
     }
 }
 
-TEST(HeightfieldTracer, MatchesBruteForceWithSkirt) { runComparison(true, 100); }
-TEST(HeightfieldTracer, MatchesBruteForceWithoutSkirt) { runComparison(false, 200); }
+TEST(HeightfieldTracer, MatchesBruteForceWithSkirt) {
+    runComparison(true, 100);
+}
+TEST(HeightfieldTracer, MatchesBruteForceWithoutSkirt) {
+    runComparison(false, 200);
+}
 
-// Large, non-power-of-two grid: a few thousand rays against the reference.
+// Larger non-power-of-two grid: 1000 rays per skirt setting against the reference.
 TEST(HeightfieldTracer, MatchesBruteForceOnLargeOddGrid) {
     const Heightfield hf = makeRoughDem(203, 131, 30.0, 45.0, 1500.0f, 7);
     for (bool skirt : {true, false}) {
         const HeightfieldTracer tracer(hf, {skirt});
-        const DemCase dc{"203x131", 203, 131, 30.0, 45.0, 1500.0f, 1500};
+        const DemCase dc{"203x131", 203, 131, 30.0, 45.0, 1500.0f, 1000};
         const Stats s = randomRays(tracer, dc, 8);
         std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] 203x131: " << s << "\n";
         EXPECT_EQ(s.disagreements(), 0);
-        EXPECT_GT(s.hits, 300);
+        EXPECT_GT(s.hits, 200);
     }
 }
 
@@ -316,12 +326,13 @@ TEST(HeightfieldTracer, FlatPlaneAnalytic) {
         const glm::vec3 o(90.0f * u(rng), h0 + 1.0f + 60.0f * (u(rng) + 1.0f), 90.0f * u(rng));
         glm::vec3 dir = randomDir(rng);
         dir.y = -std::fabs(dir.y);
-        if (dir.y > -1e-3f) continue;
+        if (dir.y > -1e-3f)
+            continue;
         const double t = (double(h0) - o.y) / dir.y;
         const glm::dvec3 p = glm::dvec3(o) + t * glm::dvec3(dir);
         const bool in = std::fabs(p.x) <= 100.0 && std::fabs(p.z) <= 100.0;
-        const bool onSeam = std::fabs(std::fabs(p.x) - 100.0) < 1e-3 ||
-                            std::fabs(std::fabs(p.z) - 100.0) < 1e-3;
+        const bool onSeam =
+            std::fabs(std::fabs(p.x) - 100.0) < 1e-3 || std::fabs(std::fabs(p.z) - 100.0) < 1e-3;
         RayHit hit;
         ASSERT_TRUE(withSkirt.intersect(o, dir, kInf, hit));
         EXPECT_NEAR(hit.t, t, 1e-4 * t + 1e-4);
@@ -375,7 +386,8 @@ TEST(HeightfieldTracer, TiltedPlaneSkirtAnalytic) {
     const double a = 0.3, b = -0.2;
     std::vector<float> h(n * n);
     for (int r = 0; r < n; ++r)
-        for (int c = 0; c < n; ++c) h[r * n + c] = float(a * (c - 5) * cell + b * (r - 5) * cell);
+        for (int c = 0; c < n; ++c)
+            h[r * n + c] = float(a * (c - 5) * cell + b * (r - 5) * cell);
     const Heightfield hf(n, n, cell, cell, h);
     const HeightfieldTracer tracer(hf, {true});
     // West strip: y = a * -50 + b * z; ray from (-40, 20, 10) heading west and down.
@@ -482,6 +494,41 @@ TEST(HeightfieldTracer, DegenerateGrids) {
     EXPECT_FALSE(hit.onTerrain);
 }
 
+// The baseline marcher samples the same surface: on smooth terrain it agrees with the tracer
+// except for the odd ray grazing a crest between two samples.
+TEST(HeightfieldTracer, RayMarchBaselineAgreesOnSmoothTerrain) {
+    std::vector<float> h(65 * 65);
+    for (int r = 0; r < 65; ++r)
+        for (int c = 0; c < 65; ++c)
+            h[size_t(r) * 65 + size_t(c)] =
+                float(200.0 * std::sin(c * 0.1) * std::cos(r * 0.07) + 1.5 * r);
+    const Heightfield hf(65, 65, 30.0, 45.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    int rays = 0, agree = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const float x = hf.minX() + u01(rng) * (hf.maxX() - hf.minX());
+        const float z = hf.minZ() + u01(rng) * (hf.maxZ() - hf.minZ());
+        const glm::vec3 o(x, hf.surfaceHeight(x, z) + 2.0f, z), dir = randomDir(rng);
+        RayHit a, b;
+        const bool ha = tracer.intersect(o, dir, kInf, a);
+        const bool hb = intersectRayMarch(hf, o, dir, kInf, b);
+        ++rays;
+        agree += ha == hb && (!ha || std::fabs(a.t - b.t) <= 0.01f + 1e-4f * a.t);
+    }
+    std::cout << "[ marcher ] " << agree << " of " << rays << " rays agree with the tracer\n";
+    EXPECT_GE(agree, rays * 99 / 100);
+    // Flat ground: analytic.
+    const Heightfield flat(5, 5, 10.0, 10.0, std::vector<float>(25, 3.0f));
+    RayHit hit;
+    const glm::vec3 dir = glm::normalize(glm::vec3(1.0f, -0.5f, 0.2f));
+    ASSERT_TRUE(intersectRayMarch(flat, {0.0f, 23.0f, 0.0f}, dir, kInf, hit));  // lands at x = 40
+    EXPECT_NEAR(hit.t, 20.0f / 0.5f * glm::length(glm::vec3(1.0f, -0.5f, 0.2f)), 1e-3f);
+    EXPECT_FALSE(hit.onTerrain);
+    EXPECT_FALSE(intersectRayMarch(flat, {0.0f, 23.0f, 0.0f}, -dir, kInf, hit));
+}
+
 TEST(HeightfieldTracer, RejectsBadInput) {
     const Heightfield hf = makeRoughDem(9, 9, 10.0, 10.0, 50.0f, 1);
     const HeightfieldTracer tracer(hf);
@@ -489,6 +536,8 @@ TEST(HeightfieldTracer, RejectsBadInput) {
     EXPECT_FALSE(tracer.intersect({0, 100, 0}, {0, -1, 0}, 0.0f, hit));
     EXPECT_FALSE(tracer.intersect({0, 100, 0}, {0, -1, 0}, -5.0f, hit));
     EXPECT_FALSE(tracer.intersect({0, 100, 0}, {0, -1, 0}, std::nanf(""), hit));
+    EXPECT_FALSE(tracer.intersect({std::nanf(""), 100, 0}, {0, -1, 0}, kInf, hit));
+    EXPECT_FALSE(tracer.occluded({0, 100, 0}, {0, -kInf, 0}, kInf));
     EXPECT_EQ(tracer.levelCount(), 4);  // 8x8 cells -> 4x4 -> 2x2 -> 1x1
 }
 
