@@ -124,6 +124,59 @@ TEST(Bake, SameBytesWithOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(a.standardError.data(), b.standardError.data(), a.standardError.size() * sizeof(float)), 0);
 }
 
+TEST(Bake, PerProbeSeedsGiveTheIndexSeededBytesAndFollowTheProbe) {
+    std::vector<float> h(20 * 20);
+    Rng rng(9);
+    for (float& v : h) v = 80.0f * rng.next();
+    const Heightfield hf(20, 20, 10.0, 10.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    const std::vector<glm::vec3> probes = {{0, 120, 0}, {30, 130, -20}, {-50, 150, 40}};
+    const std::vector<uint8_t> valid = {1, 1, 1};
+    std::vector<uint64_t> seeds;
+    for (uint64_t i = 0; i < probes.size(); ++i) seeds.push_back(42 ^ (i * 0x9E3779B97F4A7C15ull));
+    const ProbeBake a = bakeProbes(L, nullptr, 0, probes, valid, 64, 42, {});
+    const ProbeBake b = bakeProbesSeeded(L, nullptr, 0, probes, valid, 64, seeds, {});
+    EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * sizeof(sh::ShRgb)), 0);
+    // A probe keeps its bytes whatever else is baked with it, in any order.
+    const ProbeBake c = bakeProbesSeeded(L, nullptr, 0, {probes[2], probes[0]}, {1, 1}, 64,
+                                         {seeds[2], seeds[0]}, {});
+    EXPECT_EQ(std::memcmp(&c.sh[0], &a.sh[2], sizeof(sh::ShRgb)), 0);
+    EXPECT_EQ(std::memcmp(&c.sh[1], &a.sh[0], sizeof(sh::ShRgb)), 0);
+    const ProbeBake r1 = referenceProbes(L, 0, probes, valid, 64, 42, {});
+    const ProbeBake r2 = referenceProbesSeeded(L, 0, probes, valid, 64, seeds, {});
+    EXPECT_EQ(std::memcmp(r1.sh.data(), r2.sh.data(), r1.sh.size() * sizeof(sh::ShRgb)), 0);
+}
+
+TEST(Bake, ValidityIsTheShareOfRaysSeeingTheTerrainFromBelow) {
+    const Heightfield hf = flat(17, 10.0, 50.0f);
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    // Above the ground nothing is seen from below; under it every upward ray meets the underside
+    // (half of a lattice with as many directions above the horizon as below).
+    const std::vector<glm::vec3> probes = {{0, 55, 0}, {0, 45, 0}, {200, 20, -300}};
+    for (const ProbeBake& b : {bakeProbes(L, nullptr, 0, probes, {1, 1, 1}, 128, 3, {}),
+                               referenceProbes(L, 0, probes, {1, 1, 1}, 128, 3, {})}) {
+        ASSERT_EQ(b.fromBelowShare.size(), 3u);
+        EXPECT_EQ(b.fromBelowShare[0], 0.0f);
+        EXPECT_FLOAT_EQ(b.fromBelowShare[1], 0.5f);
+        EXPECT_FLOAT_EQ(b.fromBelowShare[2], 0.5f);  // under the skirt
+    }
+}
+
+TEST(Bake, CachePointCountIsKnownBeforeBuilding) {
+    std::vector<float> h(50 * 20, 1.0f);
+    const Heightfield hf(50, 20, 30.0, 30.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    for (int resolution : {2, 16, 40, 128}) {
+        const IrradianceCache cache(L, resolution, 4, 1, 0, {});
+        const std::array<int, 2> n = IrradianceCache::gridPoints(hf, resolution);
+        EXPECT_EQ(n[0], cache.pointsX());
+        EXPECT_EQ(n[1], cache.pointsZ());
+    }
+}
+
 TEST(Bake, ReferenceAgreesWithAnalyticFlatPlane) {
     const Heightfield hf = flat(17, 10.0);
     const HeightfieldTracer tracer(hf);
@@ -141,6 +194,9 @@ TEST(Bake, ErrorMetricIsRelativeRmsOfIrradiance) {
     const ErrorStats s = compareToReference({b}, {a}, {1});
     EXPECT_NEAR(s.mean, 0.1, 1e-5);
     EXPECT_NEAR(s.max, 0.1, 1e-5);
+    EXPECT_NEAR(relativeIrradianceError(b, a), 0.1f, 1e-5f);
+    EXPECT_NEAR(relativeIrradianceError(a, b), 0.1f / 1.1f, 1e-5f);
+    EXPECT_EQ(relativeIrradianceError(a, sh::ShRgb{}), 0.0f);
 }
 
 TEST(Placement, TerrainGridAutoSpanAndOneByOne) {
