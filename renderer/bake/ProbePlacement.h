@@ -1,6 +1,8 @@
 #pragma once
 // Where the probes of a volume go, which are valid, and the .shprobe grid they are written into.
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -35,6 +37,14 @@ struct ProbeLayout {
 
     size_t validCount() const;
 };
+
+// Exact lowest and highest point of the triangle surface (and its skirt) over the rectangle
+// [x0, x1] × [z0, z1]: a piecewise-linear surface takes its extremes at the mesh vertices inside
+// the rectangle and where the rectangle's edges cross grid lines and cell diagonals.
+struct SurfaceRange {
+    float lo = INFINITY, hi = -INFINITY;
+};
+SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0, double z1);
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;

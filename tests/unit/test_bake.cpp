@@ -1,5 +1,6 @@
 // The CPU bake against analytic answers (issue: constant sky over a flat plane, bounce limit,
 // valley vs ridge, determinism across thread counts, placement rules).
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -242,4 +243,94 @@ TEST(Placement, ProbesInsideTheTerrainAreInvalidWithNoCell) {
     ProbeVolumeSettings below;
     below.heightOffset = -1.0;
     EXPECT_EQ(placeProbes(below, hf).validCount(), 0u);
+}
+
+TEST(SurfaceRange, IsExactOverRandomRectangles) {
+    std::vector<float> h(23 * 17);
+    Rng rng(11);
+    for (float& x : h) x = 100.0f * rng.next();
+    const Heightfield hf(23, 17, 7.0, 5.0, std::move(h));
+    for (int trial = 0; trial < 200; ++trial) {
+        // Rectangles inside, across and beyond the footprint (the skirt).
+        const double x0 = -100.0 + 200.0 * rng.next(), z0 = -60.0 + 120.0 * rng.next();
+        const double x1 = x0 + 40.0 * rng.next(), z1 = z0 + 30.0 * rng.next();
+        const SurfaceRange r = surfaceRange(hf, x0, x1, z0, z1);
+        // No point inside leaves the range.
+        const int n = 200;
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) {
+                const float y = hf.surfaceHeight(float(x0 + (x1 - x0) * i / n), float(z0 + (z1 - z0) * j / n));
+                ASSERT_GE(y, r.lo - 1e-3f);
+                ASSERT_LE(y, r.hi + 1e-3f);
+            }
+        // And the range is attained: a piecewise-linear surface peaks at a mesh vertex inside the
+        // rectangle (clamped to the footprint, as the skirt repeats the border) or on its edges,
+        // here sampled every 0.4 mm.
+        float lo = INFINITY, hi = -INFINITY;
+        auto take = [&](float y) {
+            lo = std::min(lo, y);
+            hi = std::max(hi, y);
+        };
+        const double cx0 = std::clamp(x0, double(hf.minX()), double(hf.maxX()));
+        const double cx1 = std::clamp(x1, double(hf.minX()), double(hf.maxX()));
+        const double cz0 = std::clamp(z0, double(hf.minZ()), double(hf.maxZ()));
+        const double cz1 = std::clamp(z1, double(hf.minZ()), double(hf.maxZ()));
+        for (int row = 0; row < hf.depth(); ++row)
+            for (int col = 0; col < hf.width(); ++col)
+                if (hf.xOf(col) >= cx0 && hf.xOf(col) <= cx1 && hf.zOf(row) >= cz0 && hf.zOf(row) <= cz1)
+                    take(hf.at(col, row));
+        const int steps = 100000;
+        for (int k = 0; k <= steps; ++k) {
+            const double t = double(k) / steps;
+            take(hf.surfaceHeight(float(x0 + (x1 - x0) * t), float(z0)));
+            take(hf.surfaceHeight(float(x0 + (x1 - x0) * t), float(z1)));
+            take(hf.surfaceHeight(float(x0), float(z0 + (z1 - z0) * t)));
+            take(hf.surfaceHeight(float(x1), float(z0 + (z1 - z0) * t)));
+        }
+        EXPECT_NEAR(r.lo, lo, 0.02f);
+        EXPECT_NEAR(r.hi, hi, 0.02f);
+    }
+}
+
+TEST(Placement, TerrainGridCellsPartlyAboveTheGroundPointAtTheirColumn) {
+    // A rough slope under a 7 x 5 grid: an object standing anywhere on the ground lands in a
+    // cell that names the probe of the column nearest that cell's centre.
+    std::vector<float> h(31 * 21);
+    Rng rng(21);
+    for (size_t i = 0; i < h.size(); ++i) h[i] = 25.0f * float(i % 31) + 60.0f * rng.next();
+    const Heightfield hf(31, 21, 30.0, 30.0, std::move(h));
+    ProbeVolumeSettings v;
+    v.gridDims = {7, 1, 5};
+    v.heightOffset = 400.0;
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.validCount(), 35u);
+    const float sx = (hf.maxX() - hf.minX()) / 6.0f, sz = (hf.maxZ() - hf.minZ()) / 4.0f;
+    for (int i = 0; i < 5000; ++i) {
+        const float x = hf.minX() + (hf.maxX() - hf.minX()) * rng.next();
+        const float z = hf.minZ() + (hf.maxZ() - hf.minZ()) * rng.next();
+        const glm::vec3 p(x, hf.surfaceHeight(x, z) + 0.05f, z);
+        const glm::uvec3 c = glm::uvec3((p - L.cellOrigin) / L.cellSize);
+        ASSERT_TRUE(c.x < L.cellDims[0] && c.y < L.cellDims[1] && c.z < L.cellDims[2]);
+        const float cx = L.cellOrigin.x + L.cellSize * (float(c.x) + 0.5f);
+        const float cz = L.cellOrigin.z + L.cellSize * (float(c.z) + 0.5f);
+        const int column = std::clamp(int(std::lround((cz - hf.minZ()) / sz)), 0, 4) * 7 +
+                           std::clamp(int(std::lround((cx - hf.minX()) / sx)), 0, 6);
+        EXPECT_EQ(L.cellProbe[c.x + size_t(c.y) * L.cellDims[0] + size_t(c.z) * L.cellDims[0] * L.cellDims[1]],
+                  column);
+    }
+    // Only cells with no part above the ground hold -1.
+    size_t buried = 0;
+    for (uint32_t z = 0; z < L.cellDims[2]; ++z)
+        for (uint32_t y = 0; y < L.cellDims[1]; ++y)
+            for (uint32_t x = 0; x < L.cellDims[0]; ++x) {
+                if (L.cellProbe[x + size_t(y) * L.cellDims[0] + size_t(z) * L.cellDims[0] * L.cellDims[1]] >= 0)
+                    continue;
+                ++buried;
+                for (int s = 0; s < 64; ++s) {
+                    const glm::vec3 q = L.cellOrigin + L.cellSize * (glm::vec3(float(x), float(y), float(z)) +
+                                                                     glm::vec3(rng.next(), rng.next(), rng.next()));
+                    EXPECT_LE(q.y, hf.surfaceHeight(q.x, q.z));
+                }
+            }
+    EXPECT_GT(buried, 0u);
 }
