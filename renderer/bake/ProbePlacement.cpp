@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "bake/AdaptivePlacement.h"
+
 namespace terralux {
 
 size_t ProbeLayout::validCount() const {
@@ -53,6 +55,10 @@ SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0
     alongV(u0);
     alongV(u1);
     return r;
+}
+
+uint64_t ProbeLayout::fileBytes() const {
+    return 48 + 160 * uint64_t(validCount()) + 4 * uint64_t(cellProbe.size());
 }
 
 namespace {
@@ -193,7 +199,9 @@ ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
 }  // namespace
 
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {
-    ProbeLayout L = v.placement == ProbePlacement::Box ? placeBoxGrid(v, hf) : placeTerrainGrid(v, hf);
+    ProbeLayout L = v.placement == ProbePlacement::Box        ? placeBoxGrid(v, hf)
+                    : v.placement == ProbePlacement::Adaptive ? placeAdaptive(v, hf)
+                                                              : placeTerrainGrid(v, hf);
     float minSpacing = 0.0f;
     for (int a = 0; a < 3; ++a)
         if (L.spacing[a] > 0.0f) minSpacing = minSpacing > 0.0f ? std::min(minSpacing, L.spacing[a]) : L.spacing[a];
