@@ -493,4 +493,120 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     return out;
 }
 
+BakeEstimate estimateBake(const BakeRequest& request) {
+    const Project& project = request.project;
+    const SceneDescription& scene = project.scene;
+    const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    BakeSetup setup;
+    prepare(project, setup, [](const std::string&, double) {}, [] { return false; });
+    const Heightfield& hf = setup.terrain.heightfield;
+    const BakeQuality& q = setup.q;
+
+    BakeEstimate e;
+    e.threads = threads;
+    e.quality = qualityName(scene.bake.quality);
+    e.rays = q.rays;
+    e.bounces = q.bounces;
+
+    // The cache: a small one with the real ray counts, scaled by the point count.
+    std::unique_ptr<IrradianceCache> cache;
+    if (!setup.referenceMode && q.bounces > 0) {
+        constexpr int kCalibrationResolution = 16;
+        const auto t = Clock::now();
+        cache = std::make_unique<IrradianceCache>(setup.lighting, kCalibrationResolution,
+                                                  q.cacheRays, q.sunSamples, q.bounces - 1,
+                                                  BakeControl{});
+        const double seconds = secondsSince(t);
+        const std::array<int, 2> full = IrradianceCache::gridPoints(hf, q.cacheResolution);
+        e.cacheSeconds = seconds * double(full[0]) * double(full[1]) /
+                         double(cache->pointsX() * cache->pointsZ());
+    }
+
+    std::vector<ProbeLayout> layouts;
+    std::vector<glm::vec3> all;
+    for (const auto* v : setup.volumes) {
+        layouts.push_back(placeProbes(*v, hf));
+        for (size_t i = 0; i < layouts.back().positions.size(); ++i)
+            if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
+    }
+
+    // Probes: a few of the volumes' own, spread over them, baked as the bake would.
+    double secondsPerProbeRay = 0.0;
+    if (!all.empty()) {
+        const size_t n = std::min(all.size(), std::max<size_t>(64, 16 * size_t(threads)));
+        std::vector<glm::vec3> sample(n);
+        for (size_t i = 0; i < n; ++i) sample[i] = all[i * all.size() / n];
+        const std::vector<uint8_t> valid(n, 1);
+        const auto t = Clock::now();
+        if (setup.referenceMode)
+            referenceProbes(setup.lighting, q.bounces, sample, valid, q.rays, 1, BakeControl{});
+        else
+            bakeProbes(setup.lighting, cache.get(), q.bounces, sample, valid, q.rays, 1, BakeControl{});
+        secondsPerProbeRay = secondsSince(t) / (double(n) * double(q.rays));
+        e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
+    }
+
+    e.seconds = e.secondsMax = e.cacheSeconds;
+    for (size_t vi = 0; vi < setup.volumes.size(); ++vi) {
+        const ProbeVolumeSettings& v = *setup.volumes[vi];
+        const ProbeLayout& L = layouts[vi];
+        VolumeEstimate ve;
+        ve.name = v.name;
+        ve.placement = v.placement;
+        ve.grid = L.cellDims;
+        ve.cellSize = L.cellSize;
+        ve.probes = ve.probesMax = L.validCount();
+        ve.bytes = ve.bytesMax = L.fileBytes();
+        ve.raysPerProbe = v.rayCount ? *v.rayCount : q.rays;
+        const double perProbe = double(ve.raysPerProbe) * secondsPerProbeRay;
+        double probes = double(ve.probes), probesMax = probes;
+        if (L.octree) {
+            const AdaptiveOctree& t = *L.octree;
+            ve.minCell = t.minCell;
+            ve.maxCell = t.maxCell;
+            ve.moved = t.moved;
+            ve.borrowed = t.borrowed;
+            ve.uniformProbes = t.uniformProbes;
+            probes += kInterpolationPoints;
+            if (v.adaptive.tolerance) {
+                ve.refines = true;
+                ve.tolerance = *v.adaptive.tolerance;
+                // Every leaf larger than the minimum bakes its 8 octants at least once.
+                size_t coarse = 0;
+                for (const OctreeLeaf& l : t.leaves) coarse += l.level > 0;
+                probes += 8.0 * double(coarse);
+                // At most: every cell split down to the minimum, or the budget.
+                size_t cap = t.uniformProbes + t.moved;
+                ve.cap = "a uniform grid at the minimum cell size";
+                if (v.adaptive.maxProbes && size_t(*v.adaptive.maxProbes) < cap) {
+                    cap = size_t(*v.adaptive.maxProbes);
+                    ve.cap = "adaptive.max_probes";
+                }
+                if (v.adaptive.maxBytes) {
+                    const uint64_t fixed = 48 + 4 * uint64_t(L.cellProbe.size());
+                    const uint64_t byBytes =
+                        uint64_t(*v.adaptive.maxBytes) > fixed ? (uint64_t(*v.adaptive.maxBytes) - fixed) / 160 : 0;
+                    if (byBytes < cap) {
+                        cap = size_t(byBytes);
+                        ve.cap = "adaptive.max_bytes";
+                    }
+                }
+                ve.probesMax = std::max(ve.probes, cap);
+                ve.bytesMax = 48 + 160 * uint64_t(ve.probesMax) + 4 * uint64_t(L.cellProbe.size());
+                // Each split bakes 8 octants for 7 more probes.
+                probesMax = probes + double(ve.probesMax - ve.probes) * (1.0 + 8.0 / 7.0);
+            } else {
+                probesMax = probes;
+            }
+        }
+        ve.seconds = probes * perProbe;
+        ve.secondsMax = std::max(probesMax, probes) * perProbe;
+        e.seconds += ve.seconds;
+        e.secondsMax += ve.secondsMax;
+        e.volumes.push_back(std::move(ve));
+    }
+    return e;
+}
+
 }  // namespace terralux

@@ -680,3 +680,25 @@ TEST(AdaptiveBake, TerrainGridFileMapsEveryCellAboveTheGroundToItsColumn) {
             }
     fs::remove_all(dir);
 }
+
+TEST(AdaptiveBake, DryRunEstimatesWithoutWriting) {
+    const fs::path dir = tempDir("dry") / "out";
+    BakeRequest request{orkhonProject(dir), 0, false};
+    const BakeEstimate e = estimateBake(request);
+    EXPECT_FALSE(fs::exists(dir));
+    ASSERT_EQ(e.volumes.size(), 2u);
+    const VolumeEstimate& v = e.volumes[0];
+    const ProbeLayout L = placeProbes(request.project.scene.probeVolumes[0],
+                                      importDem(request.project.scene.terrain.dem).heightfield);
+    EXPECT_EQ(v.probes, L.validCount());
+    EXPECT_EQ(v.bytes, L.fileBytes());
+    EXPECT_TRUE(v.refines);
+    EXPECT_EQ(v.probesMax, L.octree->uniformProbes + L.octree->moved);
+    EXPECT_GT(v.seconds, 0.0);
+    EXPECT_GT(v.secondsMax, v.seconds);
+    EXPECT_EQ(e.volumes[1].probes,
+              placeProbes(request.project.scene.probeVolumes[1],
+                          importDem(request.project.scene.terrain.dem).heightfield).validCount());
+    EXPECT_GT(e.probeRaysPerSecond, 0.0);
+    EXPECT_GE(e.seconds, e.cacheSeconds + v.seconds);
+}
