@@ -4,9 +4,11 @@
 #include <chrono>
 #include <memory>
 #include <numbers>
+#include <sstream>
 #include <cmath>
 #include <thread>
 
+#include <glm/vector_relational.hpp>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
@@ -15,6 +17,7 @@
 #include "GltfExport.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
+#include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbePlacement.h"
@@ -78,6 +81,165 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
     return g;
 }
 
+const char* placementName(ProbePlacement p) {
+    switch (p) {
+        case ProbePlacement::Terrain: return "terrain";
+        case ProbePlacement::Box: return "box";
+        case ProbePlacement::Adaptive: return "adaptive";
+    }
+    return "terrain";
+}
+
+// What a bake needs before it places a probe: terrain, lighting, tracer, quality, volumes.
+struct BakeSetup {
+    DemImportResult terrain;
+    BakeLighting lighting;
+    std::unique_ptr<HeightfieldTracer> tracer;
+    BakeQuality q;
+    bool referenceMode = false;
+    std::vector<const ProbeVolumeSettings*> volumes;
+};
+
+void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
+             const std::function<bool()>& cancelled) {
+    const SceneDescription& scene = project.scene;
+    report("loading terrain", 0.0);
+    b.terrain = loadProjectTerrain(project);
+    if (cancelled()) throw BakeCancelled();
+    report("loading sky", 0.01);
+    b.lighting.sky = loadSky(project);
+    b.lighting.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
+    b.lighting.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
+    b.lighting.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
+    b.lighting.albedo = scene.terrain.albedo;
+    b.tracer = std::make_unique<HeightfieldTracer>(b.terrain.heightfield,
+                                                   HeightfieldTracer::Options{scene.terrain.skirt});
+    b.lighting.tracer = b.tracer.get();
+    b.q = qualityPreset(scene.bake.quality);
+    if (scene.bake.rays) b.q.rays = *scene.bake.rays;
+    if (scene.bake.bounces) b.q.bounces = *scene.bake.bounces;
+    b.referenceMode = scene.bake.quality == QualityPreset::Reference;
+    for (const auto& v : scene.probeVolumes)
+        if (v.enabled) b.volumes.push_back(&v);
+    if (b.volumes.empty())
+        throw ProjectError("probe_volumes: no enabled volume; enable one or add one to bake");
+}
+
+uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
+
+// Bakes probes seeded by key (adaptive leaves, interpolation-error points).
+ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed,
+                      const BakeControl& control) {
+    return [&b, cache, rays, seed, control](const std::vector<glm::vec3>& positions,
+                                            const std::vector<uint64_t>& keys) {
+        std::vector<uint64_t> seeds(keys.size());
+        for (size_t i = 0; i < keys.size(); ++i) seeds[i] = seed ^ keys[i];
+        const std::vector<uint8_t> valid(positions.size(), 1);
+        return b.referenceMode
+                   ? referenceProbesSeeded(b.lighting, b.q.bounces, positions, valid, rays, seeds,
+                                           control)
+                   : bakeProbesSeeded(b.lighting, cache, b.q.bounces, positions, valid, rays, seeds,
+                                      control);
+    };
+}
+
+// Where two volumes' grids overlap, the engine reads the one whose file name sorts first
+// (FORMATS.md); the other's probes go unused wherever the first has a probe.
+nlohmann::json overlapReport(const std::vector<GltfProbeVolume>& grids) {
+    nlohmann::json out = nlohmann::json::array();
+    for (size_t a = 0; a < grids.size(); ++a)
+        for (size_t b = a + 1; b < grids.size(); ++b) {
+            const bool aFirst = grids[a].name + ".shprobe" < grids[b].name + ".shprobe";
+            const ShProbeGrid& first = aFirst ? grids[a].grid : grids[b].grid;
+            const ShProbeGrid& second = aFirst ? grids[b].grid : grids[a].grid;
+            glm::vec3 lo, hi;
+            bool overlap = true;
+            for (int i = 0; i < 3; ++i) {
+                lo[i] = std::max(first.origin[i], second.origin[i]);
+                hi[i] = std::min(first.origin[i] + first.spacing * float(first.dims[i]),
+                                 second.origin[i] + second.spacing * float(second.dims[i]));
+                overlap = overlap && lo[i] < hi[i];
+            }
+            if (!overlap) continue;
+            // Cells of the second grid inside the overlap whose centre falls on a probe of the
+            // first: the engine never reads the second grid there.
+            size_t shadowed = 0, inside = 0;
+            for (uint32_t z = 0; z < second.dims.z; ++z)
+                for (uint32_t y = 0; y < second.dims.y; ++y)
+                    for (uint32_t x = 0; x < second.dims.x; ++x) {
+                        const glm::vec3 c = second.origin + second.spacing *
+                                            glm::vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f);
+                        if (second.occupancy[second.cellIndex(x, y, z)] < 0) continue;
+                        if (glm::any(glm::lessThan(c, lo)) || glm::any(glm::greaterThanEqual(c, hi)))
+                            continue;
+                        ++inside;
+                        const glm::vec3 g = (c - first.origin) / first.spacing;
+                        const glm::uvec3 cell = glm::min(glm::uvec3(glm::max(g, glm::vec3(0.0f))),
+                                                         first.dims - 1u);
+                        shadowed += first.occupancy[first.cellIndex(cell.x, cell.y, cell.z)] >= 0;
+                    }
+            const std::string firstName = aFirst ? grids[a].name : grids[b].name;
+            const std::string secondName = aFirst ? grids[b].name : grids[a].name;
+            out.push_back({{"volumes", {firstName, secondName}},
+                           {"engine_reads_first", firstName},
+                           {"box_min", {lo.x, lo.y, lo.z}},
+                           {"box_max", {hi.x, hi.y, hi.z}},
+                           {"cells_of_second_with_probe", inside},
+                           {"cells_of_second_shadowed_by_first", shadowed}});
+        }
+    return out;
+}
+
+nlohmann::json interpolationReport(const InterpolationError& e, std::optional<double> tolerance,
+                                   uint64_t rays) {
+    nlohmann::json j = {{"points", e.points},
+                        {"uncovered_points", e.uncovered},
+                        {"mean", e.mean},
+                        {"p95", e.p95},
+                        {"max", e.max},
+                        {"rays", rays},
+                        {"tolerance", tolerance ? nlohmann::json(*tolerance) : nlohmann::json(nullptr)}};
+    j["within_tolerance"] = e.withinTolerance ? nlohmann::json(*e.withinTolerance) : nlohmann::json(nullptr);
+    return j;
+}
+
+nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<AdaptiveRefinement>& r) {
+    nlohmann::json byEdge = nlohmann::json::object();
+    std::vector<size_t> counts(size_t(t.levels) + 1, 0);
+    for (const OctreeLeaf& l : t.leaves) ++counts[l.level];
+    for (size_t l = 0; l < counts.size(); ++l) {
+        std::ostringstream edge;
+        edge << t.minCell * double(1u << l);
+        byEdge[edge.str()] = counts[l];
+    }
+    nlohmann::json j = {{"min_cell_size", t.minCell},
+                        {"max_cell_size", t.maxCell},
+                        {"surface_band", t.surfaceBand},
+                        {"leaves", t.leaves.size()},
+                        {"leaves_by_edge_m", byEdge},
+                        {"uniform_grid_probes", t.uniformProbes},
+                        {"moved_probes", t.moved},
+                        {"borrowed_cells", t.borrowed},
+                        {"dropped_cells", t.dropped},
+                        {"split_for_inside", t.splitForInside}};
+    if (r)
+        j["refinement"] = {{"tolerance", r->tolerance},
+                           {"rounds", r->rounds},
+                           {"leaves_tested", r->leavesTested},
+                           {"leaves_split", r->leavesSplit},
+                           {"octant_probes_baked", r->octantProbes},
+                           {"octant_probes_kept", r->octantProbesKept},
+                           {"worst_kept_error", r->worstKeptError},
+                           {"budget_reached", r->budgetReached},
+                           {"leaves_over_tolerance", r->leavesOverTolerance}};
+    else
+        j["refinement"] = nullptr;
+    return j;
+}
+
+// Points at which every adaptive volume measures its interpolation error (LIGHTING.md).
+constexpr int kInterpolationPoints = 256;
+
 }  // namespace
 
 BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
@@ -93,31 +255,17 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     };
     auto cancelled = [&] { return cancel && cancel->load(); };
 
-    report("loading terrain", 0.0);
-    const DemImportResult terrain = loadProjectTerrain(project);
-    const Heightfield& hf = terrain.heightfield;
-    if (cancelled()) throw BakeCancelled();
-    report("loading sky", 0.01);
-    BakeLighting lighting;
-    lighting.sky = loadSky(project);
-    lighting.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
-    lighting.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
-    lighting.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
-    lighting.albedo = scene.terrain.albedo;
-    const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
-    lighting.tracer = &tracer;
+    BakeSetup setup;
+    prepare(project, setup, report, cancelled);
+    const Heightfield& hf = setup.terrain.heightfield;
+    const DemImportResult& terrain = setup.terrain;
+    const BakeLighting& lighting = setup.lighting;
+    const BakeQuality& q = setup.q;
+    const bool referenceMode = setup.referenceMode;
+    const auto& volumes = setup.volumes;
 
-    BakeQuality q = qualityPreset(scene.bake.quality);
-    if (scene.bake.rays) q.rays = *scene.bake.rays;
-    if (scene.bake.bounces) q.bounces = *scene.bake.bounces;
-    const bool referenceMode = scene.bake.quality == QualityPreset::Reference;
-
-    std::vector<const ProbeVolumeSettings*> volumes;
-    for (const auto& v : scene.probeVolumes)
-        if (v.enabled) volumes.push_back(&v);
-    if (volumes.empty())
-        throw ProjectError("probe_volumes: no enabled volume; enable one or add one to bake");
-
+    // Adaptive volumes are placed here geometrically (for the progress shares and early errors)
+    // and again, with their refinement, when they bake.
     std::vector<ProbeLayout> layouts;
     size_t totalProbes = 0;
     for (const auto* v : volumes) {
@@ -147,39 +295,78 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     size_t done = 0;
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *volumes[vi];
-        const ProbeLayout& layout = layouts[vi];
+        ProbeLayout& layout = layouts[vi];
         const auto volumeStart = Clock::now();
         const double share = totalProbes ? double(layout.positions.size()) / double(totalProbes) : 1.0;
-        const uint64_t seed = splitmix64(0x7E77A1ABull + vi);
+        const uint64_t seed = volumeSeed(vi);
         const int rays = v.rayCount ? *v.rayCount : q.rays;
+        std::string phase = "probes '" + v.name + "'";
         BakeControl c{[&](double f) {
-                          report("probes '" + v.name + "'",
+                          report(phase,
                                  base + probeShare * (double(done) / double(totalProbes) + share * f));
                       },
                       cancel};
-        ProbeBake bake = referenceMode
-                             ? referenceProbes(lighting, q.bounces, layout.positions, layout.valid,
-                                               rays, seed, c)
-                             : bakeProbes(lighting, cache.get(), q.bounces, layout.positions,
-                                          layout.valid, rays, seed, c);
-        totalRays += bake.rays;
+        ProbeBake bake;
+        std::optional<AdaptiveRefinement> refinement;
+        std::optional<InterpolationError> interpolation;
+        uint64_t interpolationRays = 0;
+        if (v.placement == ProbePlacement::Adaptive) {
+            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, c);
+            AdaptiveBake a = bakeAdaptive(v, hf, baker, [&](int round, size_t leaves) {
+                phase = "refining '" + v.name + "' (round " + std::to_string(round) + ", " +
+                        std::to_string(leaves) + " leaves)";
+            });
+            layout = std::move(a.layout);
+            bake = std::move(a.bake);
+            refinement = a.refinement;
+            phase = "interpolation error '" + v.name + "'";
+            const ProbeBaker truth = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+                ProbeBake t = baker(p, k);
+                interpolationRays += t.rays;
+                return t;
+            };
+            interpolation = measureInterpolationError(layout, bake.sh, hf, truth,
+                                                      kInterpolationPoints, seed,
+                                                      v.adaptive.tolerance);
+        } else {
+            bake = referenceMode ? referenceProbes(lighting, q.bounces, layout.positions,
+                                                   layout.valid, rays, seed, c)
+                                 : bakeProbes(lighting, cache.get(), q.bounces, layout.positions,
+                                              layout.valid, rays, seed, c);
+        }
+        totalRays += bake.rays + interpolationRays;
         const double volumeSeconds = secondsSince(volumeStart);
 
         nlohmann::json vr = {
             {"name", v.name},
-            {"placement", v.placement == ProbePlacement::Box ? "box" : "terrain"},
+            {"placement", placementName(v.placement)},
             {"probes", layout.validCount()},
             {"invalid_probes", layout.positions.size() - layout.validCount()},
-            {"probe_grid", {layout.probeDims[0], layout.probeDims[1], layout.probeDims[2]}},
             {"rays_per_probe", rays},
             {"rays", bake.rays},
             {"time_s", volumeSeconds},
             {"fallback_blend_distance", layout.fallbackBlendDistance},
+            {"moved_probes", layout.octree ? layout.octree->moved : size_t(0)},
+            {"split_for_inside", layout.octree ? layout.octree->splitForInside : size_t(0)},
         };
-        std::vector<float> se;
+        if (layout.octree) {
+            vr["adaptive"] = adaptiveReport(*layout.octree, refinement);
+            vr["interpolation_error"] =
+                interpolationReport(*interpolation, v.adaptive.tolerance, interpolationRays);
+        } else {
+            vr["probe_grid"] = {layout.probeDims[0], layout.probeDims[1], layout.probeDims[2]};
+        }
+        std::vector<float> se, below;
+        size_t fromBelow = 0;
         for (size_t i = 0; i < layout.valid.size(); ++i)
-            if (layout.valid[i]) se.push_back(bake.standardError[i]);
+            if (layout.valid[i]) {
+                se.push_back(bake.standardError[i]);
+                below.push_back(bake.fromBelowShare[i]);
+                fromBelow += bake.fromBelowShare[i] > 0.0f;
+            }
         vr["standard_error"] = stats(se);
+        vr["validity"] = {{"rays_from_below", stats(below)},
+                          {"probes_with_rays_from_below", fromBelow}};
 
         if (request.compareReference && !referenceMode) {
             BakeControl rc{[&](double f) {
@@ -227,7 +414,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
                       {"spacing", grid.spacing}};
         volumeReports.push_back(vr);
         grids.push_back({v.name, std::move(grid)});
-        done += layout.positions.size();
+        done += layouts[vi].positions.size();
     }
     if (cancelled()) throw BakeCancelled();
 
@@ -293,6 +480,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"rays", totalRays},
         {"time_s", secondsSince(start)},
         {"volumes", volumeReports},
+        {"overlaps", overlapReport(grids)},
     };
     nlohmann::json files = nlohmann::json::array();
     for (const auto& f : out.files) files.push_back(f.lexically_relative(out.outDir).generic_string());
@@ -303,6 +491,122 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     out.files.push_back(reportPath);
     report("done", 1.0);
     return out;
+}
+
+BakeEstimate estimateBake(const BakeRequest& request) {
+    const Project& project = request.project;
+    const SceneDescription& scene = project.scene;
+    const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    BakeSetup setup;
+    prepare(project, setup, [](const std::string&, double) {}, [] { return false; });
+    const Heightfield& hf = setup.terrain.heightfield;
+    const BakeQuality& q = setup.q;
+
+    BakeEstimate e;
+    e.threads = threads;
+    e.quality = qualityName(scene.bake.quality);
+    e.rays = q.rays;
+    e.bounces = q.bounces;
+
+    // The cache: a small one with the real ray counts, scaled by the point count.
+    std::unique_ptr<IrradianceCache> cache;
+    if (!setup.referenceMode && q.bounces > 0) {
+        constexpr int kCalibrationResolution = 16;
+        const auto t = Clock::now();
+        cache = std::make_unique<IrradianceCache>(setup.lighting, kCalibrationResolution,
+                                                  q.cacheRays, q.sunSamples, q.bounces - 1,
+                                                  BakeControl{});
+        const double seconds = secondsSince(t);
+        const std::array<int, 2> full = IrradianceCache::gridPoints(hf, q.cacheResolution);
+        e.cacheSeconds = seconds * double(full[0]) * double(full[1]) /
+                         double(cache->pointsX() * cache->pointsZ());
+    }
+
+    std::vector<ProbeLayout> layouts;
+    std::vector<glm::vec3> all;
+    for (const auto* v : setup.volumes) {
+        layouts.push_back(placeProbes(*v, hf));
+        for (size_t i = 0; i < layouts.back().positions.size(); ++i)
+            if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
+    }
+
+    // Probes: a few of the volumes' own, spread over them, baked as the bake would.
+    double secondsPerProbeRay = 0.0;
+    if (!all.empty()) {
+        const size_t n = std::min(all.size(), std::max<size_t>(64, 16 * size_t(threads)));
+        std::vector<glm::vec3> sample(n);
+        for (size_t i = 0; i < n; ++i) sample[i] = all[i * all.size() / n];
+        const std::vector<uint8_t> valid(n, 1);
+        const auto t = Clock::now();
+        if (setup.referenceMode)
+            referenceProbes(setup.lighting, q.bounces, sample, valid, q.rays, 1, BakeControl{});
+        else
+            bakeProbes(setup.lighting, cache.get(), q.bounces, sample, valid, q.rays, 1, BakeControl{});
+        secondsPerProbeRay = secondsSince(t) / (double(n) * double(q.rays));
+        e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
+    }
+
+    e.seconds = e.secondsMax = e.cacheSeconds;
+    for (size_t vi = 0; vi < setup.volumes.size(); ++vi) {
+        const ProbeVolumeSettings& v = *setup.volumes[vi];
+        const ProbeLayout& L = layouts[vi];
+        VolumeEstimate ve;
+        ve.name = v.name;
+        ve.placement = v.placement;
+        ve.grid = L.cellDims;
+        ve.cellSize = L.cellSize;
+        ve.probes = ve.probesMax = L.validCount();
+        ve.bytes = ve.bytesMax = L.fileBytes();
+        ve.raysPerProbe = v.rayCount ? *v.rayCount : q.rays;
+        const double perProbe = double(ve.raysPerProbe) * secondsPerProbeRay;
+        double probes = double(ve.probes), probesMax = probes;
+        if (L.octree) {
+            const AdaptiveOctree& t = *L.octree;
+            ve.minCell = t.minCell;
+            ve.maxCell = t.maxCell;
+            ve.moved = t.moved;
+            ve.borrowed = t.borrowed;
+            ve.uniformProbes = t.uniformProbes;
+            probes += kInterpolationPoints;
+            if (v.adaptive.tolerance) {
+                ve.refines = true;
+                ve.tolerance = *v.adaptive.tolerance;
+                // Every leaf larger than the minimum bakes its 8 octants at least once.
+                size_t coarse = 0;
+                for (const OctreeLeaf& l : t.leaves) coarse += l.level > 0;
+                probes += 8.0 * double(coarse);
+                // At most: every cell split down to the minimum, or the budget.
+                size_t cap = t.uniformProbes + t.moved;
+                ve.cap = "a uniform grid at the minimum cell size";
+                if (v.adaptive.maxProbes && size_t(*v.adaptive.maxProbes) < cap) {
+                    cap = size_t(*v.adaptive.maxProbes);
+                    ve.cap = "adaptive.max_probes";
+                }
+                if (v.adaptive.maxBytes) {
+                    const uint64_t fixed = 48 + 4 * uint64_t(L.cellProbe.size());
+                    const uint64_t byBytes =
+                        uint64_t(*v.adaptive.maxBytes) > fixed ? (uint64_t(*v.adaptive.maxBytes) - fixed) / 160 : 0;
+                    if (byBytes < cap) {
+                        cap = size_t(byBytes);
+                        ve.cap = "adaptive.max_bytes";
+                    }
+                }
+                ve.probesMax = std::max(ve.probes, cap);
+                ve.bytesMax = 48 + 160 * uint64_t(ve.probesMax) + 4 * uint64_t(L.cellProbe.size());
+                // Each split bakes 8 octants for 7 more probes.
+                probesMax = probes + double(ve.probesMax - ve.probes) * (1.0 + 8.0 / 7.0);
+            } else {
+                probesMax = probes;
+            }
+        }
+        ve.seconds = probes * perProbe;
+        ve.secondsMax = std::max(probesMax, probes) * perProbe;
+        e.seconds += ve.seconds;
+        e.secondsMax += ve.secondsMax;
+        e.volumes.push_back(std::move(ve));
+    }
+    return e;
 }
 
 }  // namespace terralux

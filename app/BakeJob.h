@@ -4,6 +4,7 @@
 // written until everything is computed, and files are staged and renamed, so a cancelled or
 // failed bake leaves earlier outputs untouched.
 
+#include <array>
 #include <atomic>
 #include <filesystem>
 #include <functional>
@@ -36,5 +37,44 @@ using BakeProgress = std::function<void(const std::string& phase, double fractio
 // when `cancel` was set, FileWriteError when the export fails.
 BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
                     const std::atomic<bool>* cancel);
+
+// What a bake would place and cost, without baking or writing anything (`terralux --bake
+// --dry-run`, the bake dialog). Times come from a calibration bake of a few of the volume's own
+// probes and a small irradiance cache on this terrain, scaled by ray and point counts.
+struct VolumeEstimate {
+    std::string name;
+    ProbePlacement placement = ProbePlacement::Terrain;
+    std::array<uint32_t, 3> grid{1, 1, 1};  // .shprobe cells
+    float cellSize = 0.0f;
+    size_t probes = 0;                      // placed (adaptive: the geometric octree)
+    uint64_t bytes = 0;                     // its .shprobe size
+    int raysPerProbe = 0;
+    double seconds = 0.0;
+    // Adaptive volumes.
+    double minCell = 0.0, maxCell = 0.0;
+    size_t moved = 0, borrowed = 0;
+    size_t uniformProbes = 0;               // a uniform grid at the minimum cell size
+    // Error-driven volumes: the refinement adds probes, at most up to `cap`.
+    bool refines = false;
+    double tolerance = 0.0;
+    size_t probesMax = 0;
+    uint64_t bytesMax = 0;
+    double secondsMax = 0.0;
+    std::string cap;
+};
+
+struct BakeEstimate {
+    std::vector<VolumeEstimate> volumes;
+    int threads = 0;
+    std::string quality;
+    int rays = 0, bounces = 0;
+    double cacheSeconds = 0.0;
+    double probeRaysPerSecond = 0.0;  // measured on this terrain, with this lighting
+    double seconds = 0.0;             // everything, with error-driven volumes at their minimum
+    double secondsMax = 0.0;          // with error-driven volumes at their cap
+};
+
+// Throws the same input errors as runBake.
+BakeEstimate estimateBake(const BakeRequest& request);
 
 }  // namespace terralux

@@ -66,6 +66,9 @@ Options:
   --no-probes                   Render without probe lighting.
   --device NAME                 Vulkan device: cpu, gpu, or part of its name
                                 (default: discrete GPU, integrated, then CPU).
+  --dry-run                     With --bake: place the probes and print, per volume, the probe
+                                count, the .shprobe bytes and the estimated bake time; bake and
+                                write nothing.
   --set KEY.PATH=VALUE          Override a project parameter by its JSON path; repeatable.
                                 Examples: --set sun.elevation_deg=12
                                           --set probe_volumes[0].grid_dims=16,16
@@ -100,12 +103,13 @@ struct Args {
     QCommandLineOption camera{"camera", "Camera.", "AZ,EL[,R]"};
     QCommandLineOption noProbes{"no-probes", "No probes."};
     QCommandLineOption device{"device", "Device.", "NAME"};
+    QCommandLineOption dryRun{"dry-run", "Estimate the bake only."};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, render, size, debugView, camera, noProbes,
-                           device});
+                           device, dryRun});
     }
 };
 
@@ -205,6 +209,41 @@ private:
     std::string phase_;
 };
 
+std::string duration(double seconds) {
+    if (seconds < 10.0) return fixed(seconds, 1) + " s";
+    if (seconds < 600.0) return fixed(seconds, 0) + " s";
+    return fixed(seconds / 60.0, 0) + " min";
+}
+
+int printEstimate(const BakeEstimate& e) {
+    std::cout << "dry run: nothing baked, nothing written (" << e.quality << ", " << e.rays
+              << " rays, " << e.bounces << " bounces, " << e.threads << " threads)\n";
+    for (const VolumeEstimate& v : e.volumes) {
+        std::cout << "  " << v.name << ": ";
+        if (v.placement == ProbePlacement::Adaptive)
+            std::cout << "adaptive, cells " << fixed(v.minCell, 2) << " to " << fixed(v.maxCell, 2)
+                      << " m, ";
+        else
+            std::cout << (v.placement == ProbePlacement::Box ? "box" : "terrain") << " grid, ";
+        std::cout << v.grid[0] << " x " << v.grid[1] << " x " << v.grid[2] << " cells of "
+                  << fixed(v.cellSize, 2) << " m: " << v.probes << " probes";
+        if (v.placement == ProbePlacement::Adaptive)
+            std::cout << " (" << v.moved << " moved up, " << v.borrowed
+                      << " cells borrow the probe above; a uniform grid would need "
+                      << v.uniformProbes << ")";
+        std::cout << ", " << v.bytes << " bytes, about " << duration(v.seconds) << "\n";
+        if (v.refines)
+            std::cout << "    error-driven refinement to " << fixed(100.0 * v.tolerance, 2)
+                      << " %: up to " << v.probesMax << " probes (" << v.cap << "), "
+                      << v.bytesMax << " bytes, up to " << duration(v.secondsMax) << "\n";
+    }
+    if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
+    std::cout << "estimated bake time: about " << duration(e.seconds);
+    if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
+    std::cout << " (" << fixed(e.probeRaysPerSecond / 1e6, 2) << " M probe rays/s measured here)\n";
+    return kExitOk;
+}
+
 int commandBake(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
     if (positional.size() > 1) throw UsageError("--bake takes one PROJECT");
@@ -230,6 +269,8 @@ int commandBake(const Args& a) {
     std::error_code ec;
     if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec))
         throw UsageError("--out " + outDir.string() + ": exists and is not a folder");
+
+    if (a.parser.isSet(a.dryRun)) return printEstimate(estimateBake(request));
 
     std::signal(SIGINT, onInterrupt);
     std::signal(SIGTERM, onInterrupt);
@@ -378,6 +419,8 @@ int runCommandLine(int argc, char** argv) {
                 throw UsageError("--threads " + str(a.parser.value(a.threads)) +
                                  ": must be an integer in [1, 1024]");
         }
+        if (a.parser.isSet(a.dryRun) && !a.parser.isSet(a.bake))
+            throw UsageError("--dry-run: only with --bake");
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.render)) return commandRender(a);

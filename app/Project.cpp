@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -56,6 +57,16 @@ public:
             reject(source_, path, v, "must be in [" + std::to_string(lo) + ", " +
                                          std::to_string(hi) + "]");
         return int(d);
+    }
+    long long count(const json& v, const std::string& path, long long lo, long long hi) const {
+        if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) ==
+                                                                  v.get<double>()))
+            reject(source_, path, v, "must be an integer");
+        const double d = v.get<double>();
+        if (d < double(lo) || d > double(hi))
+            reject(source_, path, v, "must be in [" + std::to_string(lo) + ", " +
+                                         std::to_string(hi) + "]");
+        return v.is_number_unsigned() ? (long long)v.get<unsigned long long>() : v.get<long long>();
     }
     bool boolean(const json& v, const std::string& path) const {
         if (!v.is_boolean()) reject(source_, path, v, "must be true or false");
@@ -123,22 +134,94 @@ json vec(const glm::vec3& v, int n) {
     return a;
 }
 
+const char* placementName(ProbePlacement p) {
+    switch (p) {
+        case ProbePlacement::Terrain: return "terrain";
+        case ProbePlacement::Box: return "box";
+        case ProbePlacement::Adaptive: return "adaptive";
+    }
+    return "terrain";
+}
+
+json adaptiveToJson(const AdaptiveVolumeSettings& a) {
+    return {{"min_cell_size", optionalNumber(a.minCellSize)},
+            {"max_cell_size", optionalNumber(a.maxCellSize)},
+            {"height_range", a.heightRange},
+            {"size", a.size ? vec(*a.size, 3) : json(nullptr)},
+            {"surface_band", optionalNumber(a.surfaceBand)},
+            {"tolerance", optionalNumber(a.tolerance)},
+            {"max_probes", optionalInt(a.maxProbes)},
+            {"max_bytes", a.maxBytes ? json(*a.maxBytes) : json(nullptr)},
+            {"max_move_share", a.maxMoveShare}};
+}
+
 json volumeToJson(const ProbeVolumeSettings& v) {
     const bool box = v.placement == ProbePlacement::Box;
-    json dims = box ? json{v.gridDims[0], v.gridDims[1], v.gridDims[2]}
-                    : json{v.gridDims[0], v.gridDims[2]};
+    const bool adaptive = v.placement == ProbePlacement::Adaptive;
+    // Adaptive volumes ignore grid_dims and spacing; they keep the terrain defaults so that a
+    // document reads back as it was written.
+    const ProbeVolumeSettings defaults;
+    const auto& gd = adaptive ? defaults.gridDims : v.gridDims;
+    json dims = box ? json{gd[0], gd[1], gd[2]} : json{gd[0], gd[2]};
     json origin = nullptr, spacing = nullptr;
-    if (v.origin) origin = box ? vec(*v.origin, 3) : json{v.origin->x, v.origin->z};
-    if (v.spacing) spacing = box ? json(double(v.spacing->x)) : json{v.spacing->x, v.spacing->z};
+    if (v.origin) origin = box || adaptive ? vec(*v.origin, 3) : json{v.origin->x, v.origin->z};
+    if (v.spacing && !adaptive)
+        spacing = box ? json(double(v.spacing->x)) : json{v.spacing->x, v.spacing->z};
     return {{"name", v.name},
             {"enabled", v.enabled},
-            {"placement", box ? "box" : "terrain"},
+            {"placement", placementName(v.placement)},
             {"grid_dims", dims},
             {"origin", origin},
             {"spacing", spacing},
             {"height_offset", v.heightOffset},
             {"ray_count", optionalInt(v.rayCount)},
-            {"fallback_blend_distance", optionalNumber(v.fallbackBlendDistance)}};
+            {"fallback_blend_distance", optionalNumber(v.fallbackBlendDistance)},
+            {"adaptive", adaptiveToJson(v.adaptive)}};
+}
+
+// Deepest octree: max_cell_size up to min_cell_size x 2^16 (seed 001's own defaults are 2^5),
+// as AdaptivePlacement.cpp checks again for sizes the terrain decides.
+constexpr int kMaxOctreeLevels = 16;
+
+AdaptiveVolumeSettings adaptiveFromJson(const json& o, const std::string& path, const Reader& r) {
+    if (!o.is_object()) reject(r.source(), path, o, "must be an object");
+    AdaptiveVolumeSettings a;
+    if (const json& v = o.at("min_cell_size"); !v.is_null())
+        a.minCellSize = r.numberAtLeast(v, path + ".min_cell_size", 0.0, true);
+    if (const json& v = o.at("max_cell_size"); !v.is_null()) {
+        const double max = r.numberAtLeast(v, path + ".max_cell_size", 0.0, true);
+        if (a.minCellSize) {
+            const double ratio = max / *a.minCellSize;
+            const double k = std::round(std::log2(ratio));
+            if (!(ratio >= 1.0) || k > kMaxOctreeLevels ||
+                std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
+                reject(r.source(), path + ".max_cell_size", v,
+                       "must be min_cell_size (" + show(o.at("min_cell_size")) +
+                           ") times 2^k, k in [0, " + std::to_string(kMaxOctreeLevels) + "]");
+        }
+        a.maxCellSize = max;
+    }
+    a.heightRange = r.numberAtLeast(o.at("height_range"), path + ".height_range", 0.0, false);
+    if (const json& v = o.at("size"); !v.is_null()) {
+        r.array(v, path + ".size", 3);
+        glm::vec3 s;
+        for (size_t i = 0; i < 3; ++i)
+            s[int(i)] = float(r.numberAtLeast(v[i], path + ".size[" + std::to_string(i) + "]", 0.0, true));
+        a.size = s;
+    }
+    if (const json& v = o.at("surface_band"); !v.is_null())
+        a.surfaceBand = r.numberAtLeast(v, path + ".surface_band", 0.0, false);
+    if (const json& v = o.at("tolerance"); !v.is_null()) {
+        const double t = r.number(v, path + ".tolerance");
+        if (!(t > 0.0) || t > 1.0) reject(r.source(), path + ".tolerance", v, "must be in (0, 1] or null");
+        a.tolerance = t;
+    }
+    if (const json& v = o.at("max_probes"); !v.is_null())
+        a.maxProbes = r.integer(v, path + ".max_probes", 1, std::numeric_limits<int>::max());
+    if (const json& v = o.at("max_bytes"); !v.is_null())
+        a.maxBytes = r.count(v, path + ".max_bytes", 1, 1ll << 53);
+    a.maxMoveShare = r.numberIn(o.at("max_move_share"), path + ".max_move_share", 0.0, 0.5);
+    return a;
 }
 
 ProbeVolumeSettings volumeFromJson(const json& o, const std::string& path, const Reader& r) {
@@ -149,9 +232,27 @@ ProbeVolumeSettings volumeFromJson(const json& o, const std::string& path, const
         reject(r.source(), path + ".name", o.at("name"),
                "must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)");
     v.enabled = r.boolean(o.at("enabled"), path + ".enabled");
-    v.placement = r.oneOf(o.at("placement"), path + ".placement", {"terrain", "box"}) == "box"
-                      ? ProbePlacement::Box
-                      : ProbePlacement::Terrain;
+    const std::string placement =
+        r.oneOf(o.at("placement"), path + ".placement", {"terrain", "box", "adaptive"});
+    v.placement = placement == "box"        ? ProbePlacement::Box
+                  : placement == "adaptive" ? ProbePlacement::Adaptive
+                                            : ProbePlacement::Terrain;
+    v.heightOffset = r.number(o.at("height_offset"), path + ".height_offset");
+    if (const json& rc = o.at("ray_count"); !rc.is_null())
+        v.rayCount = r.integer(rc, path + ".ray_count", 1, 1 << 20);
+    if (const json& fb = o.at("fallback_blend_distance"); !fb.is_null())
+        v.fallbackBlendDistance = r.numberAtLeast(fb, path + ".fallback_blend_distance", 0.0, false);
+    v.adaptive = adaptiveFromJson(o.at("adaptive"), path + ".adaptive", r);
+    if (v.placement == ProbePlacement::Adaptive) {
+        if (const json& origin = o.at("origin"); !origin.is_null()) {
+            r.array(origin, path + ".origin", 3);
+            glm::vec3 p;
+            for (size_t i = 0; i < 3; ++i)
+                p[int(i)] = float(r.number(origin[i], path + ".origin[" + std::to_string(i) + "]"));
+            v.origin = p;
+        }
+        return v;
+    }
     const bool box = v.placement == ProbePlacement::Box;
     const size_t n = box ? 3 : 2;
     const json& dims = o.at("grid_dims");
@@ -192,11 +293,6 @@ ProbeVolumeSettings volumeFromJson(const json& o, const std::string& path, const
         }
         v.spacing = s;
     }
-    v.heightOffset = r.number(o.at("height_offset"), path + ".height_offset");
-    if (const json& rc = o.at("ray_count"); !rc.is_null())
-        v.rayCount = r.integer(rc, path + ".ray_count", 1, 1 << 20);
-    if (const json& fb = o.at("fallback_blend_distance"); !fb.is_null())
-        v.fallbackBlendDistance = r.numberAtLeast(fb, path + ".fallback_blend_distance", 0.0, false);
     return v;
 }
 
@@ -445,7 +541,8 @@ void applyOverride(json& doc, const std::string& assignment) {
 
     json value = json::parse(text, nullptr, false);
     if (value.is_discarded()) {
-        if (node->is_array() && text.find(',') != std::string::npos) {
+        // A comma list sets an array parameter, or one that is unset (null) by default.
+        if ((node->is_array() || node->is_null()) && text.find(',') != std::string::npos) {
             value = json::array();
             std::stringstream ss(text);
             std::string item;

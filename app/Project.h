@@ -51,7 +51,7 @@ nlohmann::json mergeOverDefaults(const nlohmann::json& doc, const std::string& s
 
 // Applies one `key.path=value` override; the path must name an existing parameter
 // (`probe_volumes[0].grid_dims`, `sun.elevation_deg`). The value is JSON, or a bare string, or a
-// comma list for array parameters.
+// comma list for array parameters and unset ones (`probe_volumes[0].origin=-100,500,-200`).
 void applyOverride(nlohmann::json& doc, const std::string& assignment);
 
 Project loadProject(const std::filesystem::path& file, std::vector<std::string>* warnings);

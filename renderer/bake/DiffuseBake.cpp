@@ -78,19 +78,26 @@ BakeQuality qualityPreset(QualityPreset preset) {
     return {};
 }
 
+std::array<int, 2> IrradianceCache::gridPoints(const Heightfield& hf, int resolution) {
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    const float span = std::max(spanX, spanZ);
+    resolution = std::max(resolution, 2);
+    // Never finer than the DEM itself.
+    return {std::clamp(int(std::lround(resolution * (span > 0 ? spanX / span : 1.0f))), 2,
+                       std::max(hf.width(), 2)),
+            std::clamp(int(std::lround(resolution * (span > 0 ? spanZ / span : 1.0f))), 2,
+                       std::max(hf.depth(), 2))};
+}
+
 IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays, int sunSamples,
                                  int bounces, const BakeControl& control)
     : lighting_(&L) {
     const Heightfield& hf = L.tracer->heightfield();
     skirt_ = L.sky.openIrradianceUp() + L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
     const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
-    const float span = std::max(spanX, spanZ);
-    resolution = std::max(resolution, 2);
-    // Never finer than the DEM itself.
-    nx_ = std::clamp(int(std::lround(resolution * (span > 0 ? spanX / span : 1.0f))) , 2,
-                     std::max(hf.width(), 2));
-    nz_ = std::clamp(int(std::lround(resolution * (span > 0 ? spanZ / span : 1.0f))), 2,
-                     std::max(hf.depth(), 2));
+    const std::array<int, 2> n = gridPoints(hf, resolution);
+    nx_ = n[0];
+    nz_ = n[1];
     x0_ = hf.minX();
     z0_ = hf.minZ();
     dx_ = spanX > 0 ? spanX / float(nx_ - 1) : 1.0f;
@@ -180,28 +187,47 @@ glm::vec3 IrradianceCache::indirectAt(const RayHit& hit) const {
                     glm::vec3(0.0f));
 }
 
+namespace {
+std::vector<uint64_t> indexSeeds(size_t n, uint64_t seed) {
+    std::vector<uint64_t> seeds(n);
+    for (size_t i = 0; i < n; ++i) seeds[i] = seed ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull);
+    return seeds;
+}
+}  // namespace
+
 ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      int rays, uint64_t seed, const BakeControl& control) {
+    return bakeProbesSeeded(L, cache, bounces, positions, valid, rays,
+                            indexSeeds(positions.size(), seed), control);
+}
+
+ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, int bounces,
+                           const std::vector<glm::vec3>& positions,
+                           const std::vector<uint8_t>& valid, int rays,
+                           const std::vector<uint64_t>& seeds, const BakeControl& control) {
     ProbeBake out;
     out.sh.assign(positions.size(), sh::ShRgb{});
     out.standardError.assign(positions.size(), 0.0f);
+    out.fromBelowShare.assign(positions.size(), 0.0f);
     rays = std::max(rays, 1);
     const float weight = 4.0f * kPi / float(rays);
     std::atomic<uint64_t> traced{0};
     parallelIndices(positions.size(), control, [&](size_t i) {
         if (!valid[i]) return;
-        Rng rng(splitmix64(seed ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull)));
+        Rng rng(splitmix64(seeds[i]));
         const float offset = rng.next();
         sh::ShRgb acc;
         // Per interleaved batch: its share of E(up) luminance, for the standard error.
         double batch[kErrorBatches] = {};
         int batchCount[kErrorBatches] = {};
+        int fromBelow = 0;
         for (int r = 0; r < rays; ++r) {
             const glm::vec3 d = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
             RayHit hit;
             glm::vec3 radiance(0.0f);
             if (L.tracer->intersect(positions[i], d, INFINITY, hit)) {
+                fromBelow += glm::dot(d, hit.normal) > 0.0f;
                 if (bounces > 0 && cache) {
                     // Sun at the hit itself, one shadow ray across the disk; the cache for the
                     // rest. The skirt is unshadowed by definition.
@@ -219,6 +245,7 @@ ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bo
             ++batchCount[b];
         }
         out.sh[i] = acc;
+        out.fromBelowShare[i] = float(fromBelow) / float(rays);
         // Standard error of the mean of the batch estimates, relative to their mean.
         int k = 0;
         double mean = 0, sq = 0;
@@ -250,9 +277,18 @@ int referencePathLength(const glm::vec3& albedo) {
 ProbeBake referenceProbes(const BakeLighting& L, int bounces, const std::vector<glm::vec3>& positions,
                           const std::vector<uint8_t>& valid, int rays, uint64_t seed,
                           const BakeControl& control) {
+    return referenceProbesSeeded(L, bounces, positions, valid, rays,
+                                 indexSeeds(positions.size(), seed), control);
+}
+
+ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
+                                const std::vector<glm::vec3>& positions,
+                                const std::vector<uint8_t>& valid, int rays,
+                                const std::vector<uint64_t>& seeds, const BakeControl& control) {
     ProbeBake out;
     out.sh.assign(positions.size(), sh::ShRgb{});
     out.standardError.assign(positions.size(), 0.0f);
+    out.fromBelowShare.assign(positions.size(), 0.0f);
     rays = std::max(rays, 1);
     const int depth = bounces == 0 ? 0 : referencePathLength(L.albedo);
     const float weight = 4.0f * kPi / float(rays);
@@ -260,16 +296,19 @@ ProbeBake referenceProbes(const BakeLighting& L, int bounces, const std::vector<
     std::atomic<uint64_t> traced{0};
     parallelIndices(positions.size(), control, [&](size_t i) {
         if (!valid[i]) return;
-        Rng rng(splitmix64(seed ^ 0xBADC0FFEEull ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull)));
+        Rng rng(splitmix64(seeds[i] ^ 0xBADC0FFEEull));
         const float offset = rng.next();
         sh::ShRgb acc;
         uint64_t count = 0;
+        int fromBelow = 0;
         for (int r = 0; r < rays; ++r) {
             const glm::vec3 d0 = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
             RayHit hit;
             ++count;
             glm::vec3 radiance(0.0f);
-            if (!L.tracer->intersect(positions[i], d0, INFINITY, hit)) {
+            const bool hitSomething = L.tracer->intersect(positions[i], d0, INFINITY, hit);
+            if (hitSomething) fromBelow += glm::dot(d0, hit.normal) > 0.0f;
+            if (!hitSomething) {
                 radiance = L.sky.radiance(d0, weight);
             } else if (depth > 0) {
                 // Path: at each terrain vertex, sun by a shadow ray plus one cosine-weighted
@@ -305,31 +344,36 @@ ProbeBake referenceProbes(const BakeLighting& L, int bounces, const std::vector<
             sh::accumulate(acc, d0, radiance, weight);
         }
         out.sh[i] = acc;
+        out.fromBelowShare[i] = float(fromBelow) / float(rays);
         traced.fetch_add(count, std::memory_order_relaxed);
     });
     out.rays = traced.load();
     return out;
 }
 
-ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
-                              const std::vector<sh::ShRgb>& reference,
-                              const std::vector<uint8_t>& valid) {
+float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference) {
     static const std::vector<glm::vec3> normals = [] {
         std::vector<glm::vec3> n;
         for (uint32_t i = 0; i < 256; ++i) n.push_back(fibonacciSphere(i, 256, 0.0f));
         return n;
     }();
+    double num = 0, den = 0;
+    for (const auto& n : normals) {
+        const double e = luminance(sh::evalIrradiance(value, n));
+        const double r = luminance(sh::evalIrradiance(reference, n));
+        num += (e - r) * (e - r);
+        den += r * r;
+    }
+    return den > 0 ? float(std::sqrt(num / den)) : 0.0f;
+}
+
+ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
+                              const std::vector<sh::ShRgb>& reference,
+                              const std::vector<uint8_t>& valid) {
     ErrorStats s;
     for (size_t i = 0; i < bake.size() && i < reference.size(); ++i) {
         if (!valid[i]) continue;
-        double num = 0, den = 0;
-        for (const auto& n : normals) {
-            const double e = luminance(sh::evalIrradiance(bake[i], n));
-            const double r = luminance(sh::evalIrradiance(reference[i], n));
-            num += (e - r) * (e - r);
-            den += r * r;
-        }
-        s.perProbe.push_back(den > 0 ? float(std::sqrt(num / den)) : 0.0f);
+        s.perProbe.push_back(relativeIrradianceError(bake[i], reference[i]));
     }
     if (s.perProbe.empty()) return s;
     std::vector<float> sorted = s.perProbe;

@@ -8,6 +8,7 @@
 // of surface points whose hemisphere rays are traced once and re-gathered per bounce), not
 // recursive rays per probe.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -64,6 +65,8 @@ public:
     glm::vec3 indirectAt(const RayHit& hit) const;
     int pointsX() const { return nx_; }
     int pointsZ() const { return nz_; }
+    // The (x, z) point counts a cache of `resolution` gets over `hf`, without building it.
+    static std::array<int, 2> gridPoints(const Heightfield& hf, int resolution);
 
 private:
     glm::vec3 interpolate(const std::vector<glm::vec3>& e, float x, float z) const;
@@ -79,6 +82,10 @@ private:
 struct ProbeBake {
     std::vector<sh::ShRgb> sh;          // radiance projections per probe (zero when invalid)
     std::vector<float> standardError;   // relative Monte Carlo standard error of E(up) per probe
+    // LIGHTING.md probe validity: the share of a probe's rays whose first hit is the terrain seen
+    // from below (dot(dir, normal) > 0; the surface normals face up). A heightfield can only be
+    // reached from below by a probe inside it, so any valid probe has 0.
+    std::vector<float> fromBelowShare;
     uint64_t rays = 0;                  // rays traced for the probes themselves
 };
 
@@ -87,6 +94,12 @@ struct ProbeBake {
 ProbeBake bakeProbes(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      int rays, uint64_t seed, const BakeControl& control);
+// The same with one seed per probe (seeds[i]), for probes whose identity is not their index (an
+// octree leaf keeps its seed whatever order the leaves are baked in).
+ProbeBake bakeProbesSeeded(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
+                           const std::vector<glm::vec3>& positions,
+                           const std::vector<uint8_t>& valid, int rays,
+                           const std::vector<uint64_t>& seeds, const BakeControl& control);
 
 // Brute-force reference: path tracing from each probe, sun by shadow rays at every vertex, bounces
 // until the albedo-weighted energy a path can still add is below 0.1 % (0 bounces stays sky
@@ -95,6 +108,10 @@ ProbeBake referenceProbes(const BakeLighting& lighting, int bounces,
                           const std::vector<glm::vec3>& positions,
                           const std::vector<uint8_t>& valid, int rays, uint64_t seed,
                           const BakeControl& control);
+ProbeBake referenceProbesSeeded(const BakeLighting& lighting, int bounces,
+                                const std::vector<glm::vec3>& positions,
+                                const std::vector<uint8_t>& valid, int rays,
+                                const std::vector<uint64_t>& seeds, const BakeControl& control);
 int referencePathLength(const glm::vec3& albedo);
 
 // LIGHTING.md probe error: relative RMS of irradiance (luminance) over 256 fixed normals against
@@ -107,5 +124,8 @@ ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
                               const std::vector<sh::ShRgb>& reference,
                               const std::vector<uint8_t>& valid);
 float luminance(const glm::vec3& c);
+// The per-probe term of that metric: relative RMS of irradiance luminance over the 256 fixed
+// normals of `value` against `reference` (0 when the reference is black).
+float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference);
 
 }  // namespace terralux

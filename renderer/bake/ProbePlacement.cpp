@@ -4,10 +4,61 @@
 #include <cmath>
 #include <sstream>
 
+#include "bake/AdaptivePlacement.h"
+
 namespace terralux {
 
 size_t ProbeLayout::validCount() const {
     return size_t(std::count(valid.begin(), valid.end(), uint8_t(1)));
+}
+
+SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0, double z1) {
+    const int w = hf.width(), d = hf.depth();
+    auto gu = [&](double x) {
+        return std::clamp(x / hf.cellSizeX() + 0.5 * (w - 1), 0.0, double(w - 1));
+    };
+    auto gv = [&](double z) {
+        return std::clamp(z / hf.cellSizeZ() + 0.5 * (d - 1), 0.0, double(d - 1));
+    };
+    // Beyond the footprint the skirt repeats the border (Heightfield::surfaceHeight): clamp.
+    const double u0 = gu(x0), u1 = gu(x1), v0 = gv(z0), v1 = gv(z1);
+    auto heightAt = [&](double u, double v) { return hf.surfaceHeight(hf.xOf(u), hf.zOf(v)); };
+    SurfaceRange r;
+    auto add = [&](float h) {
+        r.lo = std::min(r.lo, h);
+        r.hi = std::max(r.hi, h);
+    };
+    for (int row = int(std::ceil(v0)); row <= int(std::floor(v1)); ++row)
+        for (int col = int(std::ceil(u0)); col <= int(std::floor(u1)); ++col) add(hf.at(col, row));
+    // Along an edge of constant v: its ends, the grid lines u = col and the diagonals of the
+    // cells it runs through (u - col = v - row, Heightfield.h).
+    auto alongU = [&](double v) {
+        add(heightAt(u0, v));
+        add(heightAt(u1, v));
+        for (int col = int(std::ceil(u0)); col <= int(std::floor(u1)); ++col) add(heightAt(col, v));
+        const int row = std::min(int(v), std::max(d - 2, 0));
+        const double f = v - row;
+        for (int col = std::max(int(std::floor(u0)) - 1, 0); col <= int(std::floor(u1)); ++col)
+            if (const double u = col + f; u > u0 && u < u1) add(heightAt(u, v));
+    };
+    auto alongV = [&](double u) {
+        add(heightAt(u, v0));
+        add(heightAt(u, v1));
+        for (int row = int(std::ceil(v0)); row <= int(std::floor(v1)); ++row) add(heightAt(u, row));
+        const int col = std::min(int(u), std::max(w - 2, 0));
+        const double f = u - col;
+        for (int row = std::max(int(std::floor(v0)) - 1, 0); row <= int(std::floor(v1)); ++row)
+            if (const double v = row + f; v > v0 && v < v1) add(heightAt(u, v));
+    };
+    alongU(v0);
+    alongU(v1);
+    alongV(u0);
+    alongV(u1);
+    return r;
+}
+
+uint64_t ProbeLayout::fileBytes() const {
+    return 48 + 160 * uint64_t(validCount()) + 4 * uint64_t(cellProbe.size());
 }
 
 namespace {
@@ -65,7 +116,9 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
 
     // Occupancy: cubic cells of the smaller probe spacing (or, for a single probe, of the
     // larger footprint side) spanning the probes' columns from the lowest ground to above the
-    // highest probe. A cell above the terrain maps to the nearest probe column; below, -1.
+    // highest probe. A cell with any part above the terrain maps to the nearest probe column (an
+    // object standing on the ground finds its probe whichever cell it lands in); a cell wholly
+    // inside the terrain holds -1.
     float cell = 0.0f;
     if (spacing.x > 0.0f && spacing.z > 0.0f) cell = std::min(spacing.x, spacing.z);
     else cell = std::max(spacing.x, spacing.z);
@@ -96,10 +149,11 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
             const int k = nz > 1 ? std::clamp(int(std::lround((z - first.z) / spacing.z)), 0, nz - 1) : 0;
             const int probe = k * nx + i;
             if (!L.valid[size_t(probe)]) continue;
-            const float ground = hf.surfaceHeight(x, z);
+            const float lowest = surfaceRange(hf, x - 0.5 * cell, x + 0.5 * cell, z - 0.5 * cell,
+                                              z + 0.5 * cell).lo;
             for (uint32_t cy = 0; cy < L.cellDims[1]; ++cy) {
-                const float y = yMin + (float(cy) + 0.5f) * cell;
-                if (y > ground)
+                const double top = double(yMin) + double(cy + 1) * cell;
+                if (top > lowest)
                     L.cellProbe[cx + size_t(cy) * L.cellDims[0] +
                                 size_t(cz) * L.cellDims[0] * L.cellDims[1]] = probe;
             }
@@ -145,7 +199,9 @@ ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
 }  // namespace
 
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {
-    ProbeLayout L = v.placement == ProbePlacement::Box ? placeBoxGrid(v, hf) : placeTerrainGrid(v, hf);
+    ProbeLayout L = v.placement == ProbePlacement::Box        ? placeBoxGrid(v, hf)
+                    : v.placement == ProbePlacement::Adaptive ? placeAdaptive(v, hf)
+                                                              : placeTerrainGrid(v, hf);
     float minSpacing = 0.0f;
     for (int a = 0; a < 3; ++a)
         if (L.spacing[a] > 0.0f) minSpacing = minSpacing > 0.0f ? std::min(minSpacing, L.spacing[a]) : L.spacing[a];

@@ -1,7 +1,10 @@
 #pragma once
 // Where the probes of a volume go, which are valid, and the .shprobe grid they are written into.
 
+#include <array>
+#include <cmath>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -16,6 +19,41 @@ namespace terralux {
 class PlacementError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
+};
+
+// One leaf of an adaptive octree, in units of the minimum cell: it covers the cells
+// [x, x + 2^level) × [y, y + 2^level) × [z, z + 2^level) of the .shprobe grid.
+struct OctreeLeaf {
+    uint32_t x = 0, y = 0, z = 0;
+    uint8_t level = 0;
+    uint32_t edge() const { return 1u << level; }
+    bool operator==(const OctreeLeaf&) const = default;
+};
+
+// What happened to the probe of a leaf (LIGHTING.md: never a probe inside the terrain).
+enum class LeafProbe : uint8_t {
+    Centre,    // at the leaf centre, above the terrain
+    Moved,     // a minimum-size leaf whose centre is inside: moved up, within max_move_share
+    // A minimum-size leaf whose centre is too deep inside to move: no probe of its own; its cell,
+    // partly above the terrain, points at the first probe above it in its column (as a
+    // terrain-following grid does), so objects on the ground there still find a probe.
+    Borrowed,
+    Dropped,   // the same with no probe above it in the box: its cell holds -1
+};
+
+// The adaptive octree behind a layout, with its resolved settings.
+struct AdaptiveOctree {
+    double minCell = 1.0, maxCell = 1.0, surfaceBand = 0.0;
+    int levels = 0;                    // maxCell = minCell * 2^levels
+    std::vector<OctreeLeaf> leaves;    // leaves[i] holds ProbeLayout::positions[i]
+    std::vector<LeafProbe> probe;      // per leaf
+    size_t moved = 0, borrowed = 0, dropped = 0;
+    // Cells that were split because their centre lay inside the terrain (they overlap the
+    // surface band too, so the band rule alone would have split them).
+    size_t splitForInside = 0;
+    // Probes a uniform grid at the minimum cell size over the same box would hold: every cell
+    // whose centre is above the terrain.
+    size_t uniformProbes = 0;
 };
 
 struct ProbeLayout {
@@ -33,13 +71,29 @@ struct ProbeLayout {
     // cell -> index into positions (not yet compacted to valid probes), -1 = none.
     std::vector<int32_t> cellProbe;
 
+    // Adaptive volumes: per probe, the key its bake seed derives from (the leaf's identity, so a
+    // leaf gets the same bytes however the refinement reached it). Empty: seeds follow the index.
+    std::vector<uint64_t> probeKeys;
+    std::optional<AdaptiveOctree> octree;
+
     size_t validCount() const;
+    // Bytes of the .shprobe this layout writes: 48 + 160 per valid probe + 4 per cell.
+    uint64_t fileBytes() const;
 };
+
+// Exact lowest and highest point of the triangle surface (and its skirt) over the rectangle
+// [x0, x1] × [z0, z1]: a piecewise-linear surface takes its extremes at the mesh vertices inside
+// the rectangle and where the rectangle's edges cross grid lines and cell diagonals.
+struct SurfaceRange {
+    float lo = INFINITY, hi = -INFINITY;
+};
+SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0, double z1);
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;
 
-// Throws PlacementError naming the volume setting, the value and the rule.
+// Throws PlacementError naming the volume setting, the value and the rule. Adaptive volumes get
+// their geometric octree here (AdaptivePlacement.h refines it by error).
 ProbeLayout placeProbes(const ProbeVolumeSettings& volume, const Heightfield& hf);
 
 }  // namespace terralux

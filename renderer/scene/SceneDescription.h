@@ -38,21 +38,51 @@ struct SkySettings {
     double rotationDeg = 0.0;            // turns the HDR about +Y
 };
 
-enum class ProbePlacement { Terrain, Box };
+enum class ProbePlacement { Terrain, Box, Adaptive };
+
+// Adaptive octree placement (seed 001): cubic cells from max_cell_size down to min_cell_size over
+// a box; cells that overlap the terrain surface band go down to the minimum, open air stays
+// coarse, one probe per leaf at its centre. The .shprobe grid is the box at the minimum cell size.
+struct AdaptiveVolumeSettings {
+    // Unset = the DEM's cell size (the larger axis). Probes closer than the terrain samples see
+    // no lighting detail the terrain can produce (LIGHTING.md's 0.5 m suits rooms, not DEMs).
+    std::optional<double> minCellSize;
+    // Unset = 16 x min_cell_size, the ratio of LIGHTING.md's terrain example (2 m / 32 m).
+    // Must be min_cell_size x 2^k: octree cells halve.
+    std::optional<double> maxCellSize;
+    // Auto box: the terrain footprint from the lowest terrain up to the highest + this, metres.
+    double heightRange = 100.0;
+    // Explicit box edge lengths (x, y, z), from the volume's origin; unset = the auto box. The
+    // box grows to whole min cells.
+    std::optional<glm::vec3> size;
+    // A cell overlaps the surface when it reaches within this height above it; unset = one
+    // min cell.
+    std::optional<double> surfaceBand;
+    // Relative interpolation error that splits a leaf (LIGHTING.md); unset = geometric only.
+    std::optional<double> tolerance;
+    std::optional<int> maxProbes;            // budget for the refinement; unset = none
+    std::optional<long long> maxBytes;       // .shprobe file size budget; unset = none
+    // A minimum-size leaf whose centre is inside the terrain moves its probe up by at most this
+    // share of the cell edge; beyond that it keeps no probe. [0, 0.5] keeps probes in their leaf.
+    double maxMoveShare = 0.25;
+};
 
 struct ProbeVolumeSettings {
     std::string name = "probes";     // file stem of its .shprobe: [A-Za-z0-9_-]+
     bool enabled = true;
     ProbePlacement placement = ProbePlacement::Terrain;
-    // Terrain: (nx, nz) probes; Box: (nx, ny, nz) cells, one probe at each centre.
+    // Terrain: (nx, nz) probes; Box: (nx, ny, nz) cells, one probe at each centre. Adaptive
+    // volumes ignore grid_dims, spacing and height_offset.
     std::array<int, 3> gridDims{8, 1, 8};
-    // Terrain: (x, z) of the first probe; Box: (x, y, z) of the min corner. Unset = auto-span.
+    // Terrain: (x, z) of the first probe; Box and Adaptive: (x, y, z) of the min corner.
+    // Unset = auto-span (Adaptive: the footprint's min corner at the lowest terrain).
     std::optional<glm::vec3> origin;
     // Terrain: (sx, sz) between probes; Box: cube edge in .x. Unset = auto-span.
     std::optional<glm::vec3> spacing;
     double heightOffset = 5.0;       // terrain placement: metres above the bilinear terrain height
     std::optional<int> rayCount;     // unset = the bake quality preset decides
     std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
+    AdaptiveVolumeSettings adaptive;
 };
 
 struct ReflectionProbeSettings {

@@ -1,5 +1,6 @@
 // The CPU bake against analytic answers (issue: constant sky over a flat plane, bounce limit,
 // valley vs ridge, determinism across thread counts, placement rules).
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -124,6 +125,59 @@ TEST(Bake, SameBytesWithOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(a.standardError.data(), b.standardError.data(), a.standardError.size() * sizeof(float)), 0);
 }
 
+TEST(Bake, PerProbeSeedsGiveTheIndexSeededBytesAndFollowTheProbe) {
+    std::vector<float> h(20 * 20);
+    Rng rng(9);
+    for (float& v : h) v = 80.0f * rng.next();
+    const Heightfield hf(20, 20, 10.0, 10.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    const std::vector<glm::vec3> probes = {{0, 120, 0}, {30, 130, -20}, {-50, 150, 40}};
+    const std::vector<uint8_t> valid = {1, 1, 1};
+    std::vector<uint64_t> seeds;
+    for (uint64_t i = 0; i < probes.size(); ++i) seeds.push_back(42 ^ (i * 0x9E3779B97F4A7C15ull));
+    const ProbeBake a = bakeProbes(L, nullptr, 0, probes, valid, 64, 42, {});
+    const ProbeBake b = bakeProbesSeeded(L, nullptr, 0, probes, valid, 64, seeds, {});
+    EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * sizeof(sh::ShRgb)), 0);
+    // A probe keeps its bytes whatever else is baked with it, in any order.
+    const ProbeBake c = bakeProbesSeeded(L, nullptr, 0, {probes[2], probes[0]}, {1, 1}, 64,
+                                         {seeds[2], seeds[0]}, {});
+    EXPECT_EQ(std::memcmp(&c.sh[0], &a.sh[2], sizeof(sh::ShRgb)), 0);
+    EXPECT_EQ(std::memcmp(&c.sh[1], &a.sh[0], sizeof(sh::ShRgb)), 0);
+    const ProbeBake r1 = referenceProbes(L, 0, probes, valid, 64, 42, {});
+    const ProbeBake r2 = referenceProbesSeeded(L, 0, probes, valid, 64, seeds, {});
+    EXPECT_EQ(std::memcmp(r1.sh.data(), r2.sh.data(), r1.sh.size() * sizeof(sh::ShRgb)), 0);
+}
+
+TEST(Bake, ValidityIsTheShareOfRaysSeeingTheTerrainFromBelow) {
+    const Heightfield hf = flat(17, 10.0, 50.0f);
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    // Above the ground nothing is seen from below; under it every upward ray meets the underside
+    // (half of a lattice with as many directions above the horizon as below).
+    const std::vector<glm::vec3> probes = {{0, 55, 0}, {0, 45, 0}, {200, 20, -300}};
+    for (const ProbeBake& b : {bakeProbes(L, nullptr, 0, probes, {1, 1, 1}, 128, 3, {}),
+                               referenceProbes(L, 0, probes, {1, 1, 1}, 128, 3, {})}) {
+        ASSERT_EQ(b.fromBelowShare.size(), 3u);
+        EXPECT_EQ(b.fromBelowShare[0], 0.0f);
+        EXPECT_FLOAT_EQ(b.fromBelowShare[1], 0.5f);
+        EXPECT_FLOAT_EQ(b.fromBelowShare[2], 0.5f);  // under the skirt
+    }
+}
+
+TEST(Bake, CachePointCountIsKnownBeforeBuilding) {
+    std::vector<float> h(50 * 20, 1.0f);
+    const Heightfield hf(50, 20, 30.0, 30.0, std::move(h));
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    for (int resolution : {2, 16, 40, 128}) {
+        const IrradianceCache cache(L, resolution, 4, 1, 0, {});
+        const std::array<int, 2> n = IrradianceCache::gridPoints(hf, resolution);
+        EXPECT_EQ(n[0], cache.pointsX());
+        EXPECT_EQ(n[1], cache.pointsZ());
+    }
+}
+
 TEST(Bake, ReferenceAgreesWithAnalyticFlatPlane) {
     const Heightfield hf = flat(17, 10.0);
     const HeightfieldTracer tracer(hf);
@@ -141,6 +195,9 @@ TEST(Bake, ErrorMetricIsRelativeRmsOfIrradiance) {
     const ErrorStats s = compareToReference({b}, {a}, {1});
     EXPECT_NEAR(s.mean, 0.1, 1e-5);
     EXPECT_NEAR(s.max, 0.1, 1e-5);
+    EXPECT_NEAR(relativeIrradianceError(b, a), 0.1f, 1e-5f);
+    EXPECT_NEAR(relativeIrradianceError(a, b), 0.1f / 1.1f, 1e-5f);
+    EXPECT_EQ(relativeIrradianceError(a, sh::ShRgb{}), 0.0f);
 }
 
 TEST(Placement, TerrainGridAutoSpanAndOneByOne) {
@@ -186,4 +243,94 @@ TEST(Placement, ProbesInsideTheTerrainAreInvalidWithNoCell) {
     ProbeVolumeSettings below;
     below.heightOffset = -1.0;
     EXPECT_EQ(placeProbes(below, hf).validCount(), 0u);
+}
+
+TEST(SurfaceRange, IsExactOverRandomRectangles) {
+    std::vector<float> h(23 * 17);
+    Rng rng(11);
+    for (float& x : h) x = 100.0f * rng.next();
+    const Heightfield hf(23, 17, 7.0, 5.0, std::move(h));
+    for (int trial = 0; trial < 200; ++trial) {
+        // Rectangles inside, across and beyond the footprint (the skirt).
+        const double x0 = -100.0 + 200.0 * rng.next(), z0 = -60.0 + 120.0 * rng.next();
+        const double x1 = x0 + 40.0 * rng.next(), z1 = z0 + 30.0 * rng.next();
+        const SurfaceRange r = surfaceRange(hf, x0, x1, z0, z1);
+        // No point inside leaves the range.
+        const int n = 200;
+        for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) {
+                const float y = hf.surfaceHeight(float(x0 + (x1 - x0) * i / n), float(z0 + (z1 - z0) * j / n));
+                ASSERT_GE(y, r.lo - 1e-3f);
+                ASSERT_LE(y, r.hi + 1e-3f);
+            }
+        // And the range is attained: a piecewise-linear surface peaks at a mesh vertex inside the
+        // rectangle (clamped to the footprint, as the skirt repeats the border) or on its edges,
+        // here sampled every 0.4 mm.
+        float lo = INFINITY, hi = -INFINITY;
+        auto take = [&](float y) {
+            lo = std::min(lo, y);
+            hi = std::max(hi, y);
+        };
+        const double cx0 = std::clamp(x0, double(hf.minX()), double(hf.maxX()));
+        const double cx1 = std::clamp(x1, double(hf.minX()), double(hf.maxX()));
+        const double cz0 = std::clamp(z0, double(hf.minZ()), double(hf.maxZ()));
+        const double cz1 = std::clamp(z1, double(hf.minZ()), double(hf.maxZ()));
+        for (int row = 0; row < hf.depth(); ++row)
+            for (int col = 0; col < hf.width(); ++col)
+                if (hf.xOf(col) >= cx0 && hf.xOf(col) <= cx1 && hf.zOf(row) >= cz0 && hf.zOf(row) <= cz1)
+                    take(hf.at(col, row));
+        const int steps = 100000;
+        for (int k = 0; k <= steps; ++k) {
+            const double t = double(k) / steps;
+            take(hf.surfaceHeight(float(x0 + (x1 - x0) * t), float(z0)));
+            take(hf.surfaceHeight(float(x0 + (x1 - x0) * t), float(z1)));
+            take(hf.surfaceHeight(float(x0), float(z0 + (z1 - z0) * t)));
+            take(hf.surfaceHeight(float(x1), float(z0 + (z1 - z0) * t)));
+        }
+        EXPECT_NEAR(r.lo, lo, 0.02f);
+        EXPECT_NEAR(r.hi, hi, 0.02f);
+    }
+}
+
+TEST(Placement, TerrainGridCellsPartlyAboveTheGroundPointAtTheirColumn) {
+    // A rough slope under a 7 x 5 grid: an object standing anywhere on the ground lands in a
+    // cell that names the probe of the column nearest that cell's centre.
+    std::vector<float> h(31 * 21);
+    Rng rng(21);
+    for (size_t i = 0; i < h.size(); ++i) h[i] = 25.0f * float(i % 31) + 60.0f * rng.next();
+    const Heightfield hf(31, 21, 30.0, 30.0, std::move(h));
+    ProbeVolumeSettings v;
+    v.gridDims = {7, 1, 5};
+    v.heightOffset = 400.0;
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.validCount(), 35u);
+    const float sx = (hf.maxX() - hf.minX()) / 6.0f, sz = (hf.maxZ() - hf.minZ()) / 4.0f;
+    for (int i = 0; i < 5000; ++i) {
+        const float x = hf.minX() + (hf.maxX() - hf.minX()) * rng.next();
+        const float z = hf.minZ() + (hf.maxZ() - hf.minZ()) * rng.next();
+        const glm::vec3 p(x, hf.surfaceHeight(x, z) + 0.05f, z);
+        const glm::uvec3 c = glm::uvec3((p - L.cellOrigin) / L.cellSize);
+        ASSERT_TRUE(c.x < L.cellDims[0] && c.y < L.cellDims[1] && c.z < L.cellDims[2]);
+        const float cx = L.cellOrigin.x + L.cellSize * (float(c.x) + 0.5f);
+        const float cz = L.cellOrigin.z + L.cellSize * (float(c.z) + 0.5f);
+        const int column = std::clamp(int(std::lround((cz - hf.minZ()) / sz)), 0, 4) * 7 +
+                           std::clamp(int(std::lround((cx - hf.minX()) / sx)), 0, 6);
+        EXPECT_EQ(L.cellProbe[c.x + size_t(c.y) * L.cellDims[0] + size_t(c.z) * L.cellDims[0] * L.cellDims[1]],
+                  column);
+    }
+    // Only cells with no part above the ground hold -1.
+    size_t buried = 0;
+    for (uint32_t z = 0; z < L.cellDims[2]; ++z)
+        for (uint32_t y = 0; y < L.cellDims[1]; ++y)
+            for (uint32_t x = 0; x < L.cellDims[0]; ++x) {
+                if (L.cellProbe[x + size_t(y) * L.cellDims[0] + size_t(z) * L.cellDims[0] * L.cellDims[1]] >= 0)
+                    continue;
+                ++buried;
+                for (int s = 0; s < 64; ++s) {
+                    const glm::vec3 q = L.cellOrigin + L.cellSize * (glm::vec3(float(x), float(y), float(z)) +
+                                                                     glm::vec3(rng.next(), rng.next(), rng.next()));
+                    EXPECT_LE(q.y, hf.surfaceHeight(q.x, q.z));
+                }
+            }
+    EXPECT_GT(buried, 0u);
 }

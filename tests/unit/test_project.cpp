@@ -72,7 +72,23 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"probe_volumes[0].spacing=[10,-1]", "p.json: probe_volumes[0].spacing[1] = -1: must be > 0"},
         Rule{"probe_volumes[0].fallback_blend_distance=-1", "p.json: probe_volumes[0].fallback_blend_distance = -1: must be >= 0"},
         Rule{"probe_volumes[0].name=a/b", "p.json: probe_volumes[0].name = \"a/b\": must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)"},
-        Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box"},
+        Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box | adaptive"},
+        Rule{"probe_volumes[0].adaptive.min_cell_size=0", "p.json: probe_volumes[0].adaptive.min_cell_size = 0: must be > 0"},
+        Rule{"probe_volumes[0].adaptive.max_cell_size=-4", "p.json: probe_volumes[0].adaptive.max_cell_size = -4: must be > 0"},
+        Rule{"probe_volumes[0].adaptive={\"min_cell_size\":30,\"max_cell_size\":100}", "p.json: probe_volumes[0].adaptive.max_cell_size = 100: must be min_cell_size (30) times 2^k, k in [0, 16]"},
+        Rule{"probe_volumes[0].adaptive={\"min_cell_size\":32,\"max_cell_size\":16}", "p.json: probe_volumes[0].adaptive.max_cell_size = 16: must be min_cell_size (32) times 2^k, k in [0, 16]"},
+        Rule{"probe_volumes[0].adaptive={\"min_cell_size\":1,\"max_cell_size\":131072}", "p.json: probe_volumes[0].adaptive.max_cell_size = 131072: must be min_cell_size (1) times 2^k, k in [0, 16]"},
+        Rule{"probe_volumes[0].adaptive.height_range=-1", "p.json: probe_volumes[0].adaptive.height_range = -1: must be >= 0"},
+        Rule{"probe_volumes[0].adaptive.size=[100,0,100]", "p.json: probe_volumes[0].adaptive.size[1] = 0: must be > 0"},
+        Rule{"probe_volumes[0].adaptive.size=[100,100]", "p.json: probe_volumes[0].adaptive.size = [100,100]: must be an array of 3 numbers"},
+        Rule{"probe_volumes[0].adaptive.surface_band=-2", "p.json: probe_volumes[0].adaptive.surface_band = -2: must be >= 0"},
+        Rule{"probe_volumes[0].adaptive.tolerance=0", "p.json: probe_volumes[0].adaptive.tolerance = 0: must be in (0, 1] or null"},
+        Rule{"probe_volumes[0].adaptive.tolerance=1.5", "p.json: probe_volumes[0].adaptive.tolerance = 1.5: must be in (0, 1] or null"},
+        Rule{"probe_volumes[0].adaptive.max_probes=0", "p.json: probe_volumes[0].adaptive.max_probes = 0: must be in [1, 2147483647]"},
+        Rule{"probe_volumes[0].adaptive.max_bytes=2.5", "p.json: probe_volumes[0].adaptive.max_bytes = 2.5: must be an integer"},
+        Rule{"probe_volumes[0].adaptive.max_bytes=0", "p.json: probe_volumes[0].adaptive.max_bytes = 0: must be in [1, 9007199254740992]"},
+        Rule{"probe_volumes[0].adaptive.max_move_share=0.6", "p.json: probe_volumes[0].adaptive.max_move_share = 0.6: must be in [0, 0.5]"},
+        Rule{"probe_volumes[0].adaptive=3", "p.json: probe_volumes[0].adaptive = 3: must be an object"},
         Rule{"sky.color=[0.5,-1,1]", "p.json: sky.color[1] = -1: three components, each in [0, inf]"},
         Rule{"sky.color=[1,1]", "p.json: sky.color = [1,1]: must be an array of 3 numbers"},
         Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be >= 0"},
@@ -112,6 +128,48 @@ TEST(Project, BoxVolumesValidateThreeDims) {
     EXPECT_EQ(s.probeVolumes[0].placement, ProbePlacement::Box);
     EXPECT_EQ(s.probeVolumes[0].gridDims, (std::array<int, 3>{4, 2, 4}));
     EXPECT_FLOAT_EQ(s.probeVolumes[0].spacing->x, 25.f);
+}
+
+TEST(Project, AdaptiveVolumesTakeTheirSettingsFromJsonAndSet) {
+    const SceneDescription d = sceneFromJson(defaultProjectJson(), "defaults", nullptr);
+    const AdaptiveVolumeSettings& a = d.probeVolumes[0].adaptive;
+    EXPECT_FALSE(a.minCellSize.has_value());   // the DEM cell size
+    EXPECT_FALSE(a.maxCellSize.has_value());   // 16 x min_cell_size
+    EXPECT_DOUBLE_EQ(a.heightRange, 100.0);
+    EXPECT_FALSE(a.surfaceBand.has_value());   // one min cell
+    EXPECT_FALSE(a.tolerance.has_value());     // geometric only
+    EXPECT_FALSE(a.maxProbes.has_value());
+    EXPECT_FALSE(a.maxBytes.has_value());
+    EXPECT_DOUBLE_EQ(a.maxMoveShare, 0.25);
+
+    json doc = defaultProjectJson();
+    for (const char* set :
+         {"probe_volumes[0].placement=adaptive", "probe_volumes[0].origin=-100,500,-200",
+          "probe_volumes[0].adaptive.min_cell_size=30", "probe_volumes[0].adaptive.max_cell_size=480",
+          "probe_volumes[0].adaptive.height_range=250", "probe_volumes[0].adaptive.size=3000,1200,2000",
+          "probe_volumes[0].adaptive.surface_band=45", "probe_volumes[0].adaptive.tolerance=0.03",
+          "probe_volumes[0].adaptive.max_probes=40000", "probe_volumes[0].adaptive.max_bytes=9000000000",
+          "probe_volumes[0].adaptive.max_move_share=0.5"})
+        applyOverride(doc, set);
+    const SceneDescription s = sceneFromJson(doc, "--set", nullptr);
+    const ProbeVolumeSettings& v = s.probeVolumes[0];
+    EXPECT_EQ(v.placement, ProbePlacement::Adaptive);
+    EXPECT_EQ(*v.origin, glm::vec3(-100.f, 500.f, -200.f));
+    EXPECT_DOUBLE_EQ(*v.adaptive.minCellSize, 30.0);
+    EXPECT_DOUBLE_EQ(*v.adaptive.maxCellSize, 480.0);
+    EXPECT_DOUBLE_EQ(v.adaptive.heightRange, 250.0);
+    EXPECT_EQ(*v.adaptive.size, glm::vec3(3000.f, 1200.f, 2000.f));
+    EXPECT_DOUBLE_EQ(*v.adaptive.surfaceBand, 45.0);
+    EXPECT_DOUBLE_EQ(*v.adaptive.tolerance, 0.03);
+    EXPECT_EQ(*v.adaptive.maxProbes, 40000);
+    EXPECT_EQ(*v.adaptive.maxBytes, 9000000000ll);
+    EXPECT_DOUBLE_EQ(v.adaptive.maxMoveShare, 0.5);
+    // Written back as read; grid_dims and spacing, which adaptive volumes ignore, are not
+    // validated against the adaptive placement.
+    EXPECT_EQ(sceneToJson(sceneFromJson(sceneToJson(s), "again", nullptr)), sceneToJson(s));
+    applyOverride(doc, "probe_volumes[0].grid_dims=4,2,4");
+    EXPECT_NO_THROW(sceneFromJson(doc, "--set", nullptr));
+    EXPECT_EQ(errorFor("probe_volumes[0].placement=adaptive").size(), 0u);
 }
 
 TEST(Project, OverridesReachEveryParameterAndRejectUnknownPaths) {
@@ -179,6 +237,16 @@ TEST(Project, SaveLoadIsLosslessAndPathsStayRelative) {
     box.origin = glm::vec3(1.f, 2.f, 3.f);
     box.spacing = glm::vec3(12.5f);
     p.scene.probeVolumes.push_back(box);
+    ProbeVolumeSettings octree;
+    octree.name = "octree";
+    octree.placement = ProbePlacement::Adaptive;
+    octree.origin = glm::vec3(-10.f, 20.f, -30.f);
+    octree.adaptive.minCellSize = 16.0;
+    octree.adaptive.maxCellSize = 256.0;
+    octree.adaptive.size = glm::vec3(320.f, 160.f, 480.f);
+    octree.adaptive.tolerance = 0.04;
+    octree.adaptive.maxBytes = 1ll << 40;
+    p.scene.probeVolumes.push_back(octree);
     p.scene.bake.bounces = 3;
     p.scene.camera.target = glm::vec3(10.f, 500.f, -20.f);
     p.scene.camera.radius = 2500.0;

@@ -1,0 +1,566 @@
+#include "bake/AdaptivePlacement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
+#include <tbb/parallel_for.h>
+
+#include "bake/SphereSampling.h"
+
+namespace terralux {
+namespace {
+
+std::string num(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+std::string whole(double v) {
+    std::ostringstream s;
+    s << std::fixed << std::setprecision(0) << v;
+    return s.str();
+}
+
+// Deepest octree: max_cell_size up to min_cell_size x 2^16 (the project validates the same).
+constexpr int kMaxLevels = 16;
+// Where a moved probe goes, and the least height of any probe above the surface: a share of the
+// cell edge.
+constexpr double kMoveClearance = 0.02;
+
+struct Range {
+    float lo = INFINITY, hi = -INFINITY;
+    void add(const Range& r) {
+        lo = std::min(lo, r.lo);
+        hi = std::max(hi, r.hi);
+    }
+};
+
+uint64_t flatIndex(const OctreeLeaf& l, const std::array<uint32_t, 3>& dims) {
+    return uint64_t(l.x) + uint64_t(l.y) * dims[0] + uint64_t(l.z) * dims[0] * dims[1];
+}
+
+// The octree of one volume: resolved settings, box and the surface ranges of its columns.
+class Octree {
+public:
+    Octree(const ProbeVolumeSettings& v, const Heightfield& hf) : hf_(hf), v_(v) {
+        const std::string where = "probe_volumes '" + v.name + "'";
+        const AdaptiveVolumeSettings& a = v.adaptive;
+        m_ = a.minCellSize ? *a.minCellSize : std::max(hf.cellSizeX(), hf.cellSizeZ());
+        const double maxCell = a.maxCellSize ? *a.maxCellSize : 16.0 * m_;
+        const double ratio = maxCell / m_;
+        const double k = std::round(std::log2(ratio));
+        if (!(ratio >= 1.0) || k > kMaxLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
+            throw PlacementError(where + ": adaptive.max_cell_size = " + num(maxCell) +
+                                 " must be min_cell_size (" + num(m_) +
+                                 (a.minCellSize ? "" : ", the DEM cell size") + ") times 2^k, k in [0, " +
+                                 std::to_string(kMaxLevels) + "]");
+        levels_ = int(k);
+        band_ = a.surfaceBand ? *a.surfaceBand : m_;
+        share_ = a.maxMoveShare;
+
+        glm::dvec3 size;
+        if (v.origin) {
+            origin_ = glm::dvec3(*v.origin);
+        } else {
+            origin_ = glm::dvec3(hf.minX(), hf.minHeight(), hf.minZ());
+        }
+        if (a.size) {
+            size = glm::dvec3(*a.size);
+        } else {
+            size = glm::dvec3(double(hf.maxX()) - hf.minX(),
+                              double(hf.maxHeight()) + a.heightRange - origin_.y,
+                              double(hf.maxZ()) - hf.minZ());
+        }
+        // Whole minimum cells; the box grows to the next one (1e-6 forgives rounding).
+        double cells = 1.0;
+        for (int i = 0; i < 3; ++i) {
+            const double n = std::max(1.0, std::ceil(size[i] / m_ - 1e-6));
+            dimsD_[i] = n;
+            cells *= n;
+        }
+        if (cells > double(kMaxOccupancyCells))
+            throw PlacementError(where + ": occupancy grid of " + whole(cells) + " cells (" +
+                                 whole(dimsD_[0]) + " x " + whole(dimsD_[1]) + " x " + whole(dimsD_[2]) +
+                                 " of " + num(m_) + " m) exceeds " +
+                                 std::to_string(kMaxOccupancyCells) +
+                                 "; raise adaptive.min_cell_size or shrink the box");
+        for (int i = 0; i < 3; ++i) dims_[size_t(i)] = uint32_t(dimsD_[i]);
+        buildColumnRanges();
+    }
+
+    double maxCell() const { return m_ * std::exp2(levels_); }
+
+    // In float, as a uniform box grid computes its cell centres, so both agree on which centres
+    // are above the terrain.
+    glm::vec3 centre(const OctreeLeaf& n) const {
+        const float h = 0.5f * float(n.edge());
+        return glm::vec3(origin_) +
+               float(m_) * glm::vec3(float(n.x) + h, float(n.y) + h, float(n.z) + h);
+    }
+    bool centreInside(const OctreeLeaf& n) const {
+        const glm::vec3 c = centre(n);
+        return !(c.y > hf_.surfaceHeight(c.x, c.z));
+    }
+    std::array<OctreeLeaf, 8> children(const OctreeLeaf& n) const {
+        std::array<OctreeLeaf, 8> c;
+        const uint32_t h = n.edge() / 2;
+        for (uint32_t i = 0; i < 8; ++i)
+            c[i] = {n.x + (i & 1) * h, n.y + ((i >> 1) & 1) * h, n.z + ((i >> 2) & 1) * h,
+                    uint8_t(n.level - 1)};
+        return c;
+    }
+
+    // Applies the geometric rules to one cell, appending the leaves it becomes.
+    void visit(const OctreeLeaf& n, std::vector<OctreeLeaf>& out, size_t& splitForInside) const {
+        if (n.x >= dims_[0] || n.y >= dims_[1] || n.z >= dims_[2]) return;
+        const uint32_t s = n.edge();
+        if (n.x + s > dims_[0] || n.y + s > dims_[1] || n.z + s > dims_[2]) {
+            // Sticks out of the box (never at the minimum size: the box is whole min cells).
+            for (const OctreeLeaf& c : children(n)) visit(c, out, splitForInside);
+            return;
+        }
+        const Range& r = range(n);
+        const double y0 = origin_.y + m_ * n.y, y1 = y0 + m_ * s;
+        if (y1 <= r.lo) return;  // wholly inside the terrain
+        if (n.level > 0) {
+            const bool inside = centreInside(n);
+            if (inside || y0 < double(r.hi) + band_) {
+                splitForInside += inside;
+                for (const OctreeLeaf& c : children(n)) visit(c, out, splitForInside);
+                return;
+            }
+        }
+        out.push_back(n);
+    }
+
+    std::vector<OctreeLeaf> build(size_t& splitForInside) const {
+        const uint32_t root = 1u << levels_;
+        const uint32_t rx = (dims_[0] + root - 1) / root, ry = (dims_[1] + root - 1) / root,
+                       rz = (dims_[2] + root - 1) / root;
+        const size_t roots = size_t(rx) * ry * rz;
+        std::vector<std::vector<OctreeLeaf>> perRoot(roots);
+        std::vector<size_t> split(roots, 0);
+        tbb::parallel_for(size_t(0), roots, [&](size_t i) {
+            const OctreeLeaf n{uint32_t(i % rx) * root, uint32_t((i / rx) % ry) * root,
+                               uint32_t(i / (size_t(rx) * ry)) * root, uint8_t(levels_)};
+            visit(n, perRoot[i], split[i]);
+        });
+        std::vector<OctreeLeaf> leaves;
+        for (size_t i = 0; i < roots; ++i) {
+            leaves.insert(leaves.end(), perRoot[i].begin(), perRoot[i].end());
+            splitForInside += split[i];
+        }
+        return leaves;
+    }
+
+    // The probe of a leaf: its centre, moved up, or none. A centre closer above the surface than
+    // the clearance moves up too: a probe on the surface itself sees the terrain from below
+    // through rounding (float surface, double tracer).
+    LeafProbe resolve(const OctreeLeaf& n, glm::vec3& p) const {
+        p = centre(n);
+        const float ground = hf_.surfaceHeight(p.x, p.z);
+        const double cellEdge = m_ * n.edge();
+        const float target = float(double(ground) + kMoveClearance * cellEdge);
+        if (p.y >= target) return LeafProbe::Centre;
+        if (n.level == 0 && target > ground && double(target) - double(p.y) <= share_ * cellEdge) {
+            p.y = target;
+            return LeafProbe::Moved;
+        }
+        // Above, but too close to move within the cap: it stays (max_move_share 0 asks for that).
+        if (p.y > ground) return LeafProbe::Centre;
+        return LeafProbe::Dropped;
+    }
+
+    ProbeLayout layout(std::vector<OctreeLeaf> leaves, size_t splitForInside) const {
+        std::sort(leaves.begin(), leaves.end(), [&](const OctreeLeaf& a, const OctreeLeaf& b) {
+            return flatIndex(a, dims_) < flatIndex(b, dims_);
+        });
+        ProbeLayout L;
+        L.probeDims = {int(dims_[0]), int(dims_[1]), int(dims_[2])};
+        L.spacing = glm::vec3(float(m_));
+        L.fallbackBlendDistance =
+            v_.fallbackBlendDistance ? float(*v_.fallbackBlendDistance) : 2.0f * float(m_);
+        L.cellSize = float(m_);
+        L.cellOrigin = glm::vec3(origin_);
+        L.cellDims = dims_;
+        L.cellProbe.assign(size_t(dims_[0]) * dims_[1] * dims_[2], -1);
+        AdaptiveOctree t;
+        t.minCell = m_;
+        t.maxCell = maxCell();
+        t.surfaceBand = band_;
+        t.levels = levels_;
+        t.splitForInside = splitForInside;
+        const size_t n = leaves.size();
+        L.positions.resize(n);
+        L.valid.resize(n);
+        L.probeKeys.resize(n);
+        t.probe.resize(n);
+        tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            t.probe[i] = resolve(leaves[i], L.positions[i]);
+            L.valid[i] = t.probe[i] != LeafProbe::Dropped;
+            L.probeKeys[i] = octreeLeafKey(leaves[i]);
+        });
+        const size_t layer = size_t(dims_[0]) * dims_[1];
+        for (size_t i = 0; i < n; ++i) {
+            if (!L.valid[i]) continue;
+            const OctreeLeaf& l = leaves[i];
+            const uint32_t e = l.edge();
+            for (uint32_t z = l.z; z < l.z + e; ++z)
+                for (uint32_t y = l.y; y < l.y + e; ++y) {
+                    int32_t* row = &L.cellProbe[l.x + size_t(y) * dims_[0] + size_t(z) * layer];
+                    std::fill(row, row + e, int32_t(i));
+                }
+        }
+        // Leaves without a probe (minimum size, so one cell each) borrow the first probe above
+        // them in their column; a cell between that already borrowed names the same probe.
+        for (size_t i = 0; i < n; ++i) {
+            if (L.valid[i]) continue;
+            const OctreeLeaf& l = leaves[i];
+            const size_t cell = l.x + size_t(l.y) * dims_[0] + size_t(l.z) * layer;
+            for (uint32_t y = l.y + 1; y < dims_[1]; ++y) {
+                const int32_t above = L.cellProbe[l.x + size_t(y) * dims_[0] + size_t(l.z) * layer];
+                if (above >= 0 && L.valid[size_t(above)]) {
+                    L.cellProbe[cell] = above;
+                    t.probe[i] = LeafProbe::Borrowed;
+                    break;
+                }
+            }
+        }
+        for (size_t i = 0; i < n; ++i) {
+            t.moved += t.probe[i] == LeafProbe::Moved;
+            t.borrowed += t.probe[i] == LeafProbe::Borrowed;
+            t.dropped += t.probe[i] == LeafProbe::Dropped;
+        }
+        t.uniformProbes = uniformProbes();
+        t.leaves = std::move(leaves);
+        L.octree = std::move(t);
+        return L;
+    }
+
+    // Cells whose centre is above the terrain: what a uniform grid at the minimum size keeps.
+    size_t uniformProbes() const {
+        size_t count = 0;
+        for (uint32_t z = 0; z < dims_[2]; ++z)
+            for (uint32_t x = 0; x < dims_[0]; ++x) {
+                const OctreeLeaf column{x, 0, z, 0};
+                const glm::vec3 c = centre(column);
+                const float ground = hf_.surfaceHeight(c.x, c.z);
+                for (uint32_t y = 0; y < dims_[1]; ++y)
+                    count += centre(OctreeLeaf{x, y, z, 0}).y > ground;
+            }
+        return count;
+    }
+
+    void checkBudget(const ProbeLayout& L, const char* what) const {
+        const std::string where = "probe_volumes '" + v_.name + "'";
+        const AdaptiveVolumeSettings& a = v_.adaptive;
+        if (a.maxProbes && L.validCount() > size_t(*a.maxProbes))
+            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.validCount()) +
+                                 " probes, more than adaptive.max_probes = " +
+                                 std::to_string(*a.maxProbes) +
+                                 "; raise it or adaptive.min_cell_size");
+        if (a.maxBytes && L.fileBytes() > uint64_t(*a.maxBytes))
+            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.fileBytes()) +
+                                 " bytes, more than adaptive.max_bytes = " +
+                                 std::to_string(*a.maxBytes) +
+                                 "; raise it or adaptive.min_cell_size");
+    }
+
+private:
+    const Range& range(const OctreeLeaf& n) const {
+        const auto& d = pyramidDims_[n.level];
+        return pyramid_[n.level][size_t(n.z >> n.level) * d[0] + (n.x >> n.level)];
+    }
+
+    // Level 0: the exact range over each minimum-cell column; level l: over 2^l x 2^l columns.
+    void buildColumnRanges() {
+        pyramid_.resize(size_t(levels_) + 1);
+        pyramidDims_.resize(size_t(levels_) + 1);
+        pyramidDims_[0] = {dims_[0], dims_[2]};
+        pyramid_[0].resize(size_t(dims_[0]) * dims_[2]);
+        tbb::parallel_for(uint32_t(0), dims_[2], [&](uint32_t z) {
+            for (uint32_t x = 0; x < dims_[0]; ++x) {
+                const double x0 = origin_.x + m_ * x, z0 = origin_.z + m_ * z;
+                const SurfaceRange r = surfaceRange(hf_, x0, x0 + m_, z0, z0 + m_);
+                pyramid_[0][size_t(z) * dims_[0] + x] = {r.lo, r.hi};
+            }
+        });
+        for (int l = 1; l <= levels_; ++l) {
+            const auto& fd = pyramidDims_[size_t(l) - 1];
+            const std::array<uint32_t, 2> cd{(fd[0] + 1) / 2, (fd[1] + 1) / 2};
+            pyramidDims_[size_t(l)] = cd;
+            std::vector<Range>& coarse = pyramid_[size_t(l)];
+            const std::vector<Range>& fine = pyramid_[size_t(l) - 1];
+            coarse.assign(size_t(cd[0]) * cd[1], Range{});
+            for (uint32_t z = 0; z < cd[1]; ++z)
+                for (uint32_t x = 0; x < cd[0]; ++x)
+                    for (uint32_t dz = 0; dz < 2; ++dz)
+                        for (uint32_t dx = 0; dx < 2; ++dx)
+                            if (2 * x + dx < fd[0] && 2 * z + dz < fd[1])
+                                coarse[size_t(z) * cd[0] + x].add(
+                                    fine[size_t(2 * z + dz) * fd[0] + 2 * x + dx]);
+        }
+    }
+
+    const Heightfield& hf_;
+    const ProbeVolumeSettings& v_;
+    double m_ = 1.0, band_ = 0.0, share_ = 0.25;
+    int levels_ = 0;
+    glm::dvec3 origin_{0.0};
+    double dimsD_[3] = {1, 1, 1};
+    std::array<uint32_t, 3> dims_{1, 1, 1};
+    std::vector<std::vector<Range>> pyramid_;
+    std::vector<std::array<uint32_t, 2>> pyramidDims_;
+};
+
+struct BakedProbe {
+    glm::vec3 position{0.0f};
+    sh::ShRgb sh;
+    float standardError = 0.0f;
+    float fromBelow = 0.0f;
+};
+
+// Bakes, through `baker`, every probe of `L` that `store` lacks at its position.
+uint64_t bakeMissing(const ProbeLayout& L, const ProbeBaker& baker,
+                     std::unordered_map<uint64_t, BakedProbe>& store) {
+    std::vector<glm::vec3> positions;
+    std::vector<uint64_t> keys;
+    for (size_t i = 0; i < L.positions.size(); ++i) {
+        if (!L.valid[i]) continue;
+        const auto it = store.find(L.probeKeys[i]);
+        if (it != store.end() && it->second.position == L.positions[i]) continue;
+        positions.push_back(L.positions[i]);
+        keys.push_back(L.probeKeys[i]);
+    }
+    if (positions.empty()) return 0;
+    const ProbeBake b = baker(positions, keys);
+    for (size_t i = 0; i < positions.size(); ++i)
+        store[keys[i]] = {positions[i], b.sh[i], b.standardError[i], b.fromBelowShare[i]};
+    return b.rays;
+}
+
+}  // namespace
+
+uint64_t octreeLeafKey(const OctreeLeaf& l) {
+    uint64_t k = splitmix64(0x0C7EE1EAFull ^ l.x);
+    k = splitmix64(k ^ l.y);
+    k = splitmix64(k ^ l.z);
+    return splitmix64(k ^ l.level);
+}
+
+ProbeLayout placeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    const Octree tree(v, hf);
+    size_t split = 0;
+    std::vector<OctreeLeaf> leaves = tree.build(split);
+    ProbeLayout L = tree.layout(std::move(leaves), split);
+    tree.checkBudget(L, "the surface band alone");
+    return L;
+}
+
+AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
+                          const ProbeBaker& baker,
+                          const std::function<void(int, size_t)>& onRound) {
+    const Octree tree(v, hf);
+    size_t split = 0;
+    std::vector<OctreeLeaf> leaves = tree.build(split);
+    AdaptiveBake out;
+    out.layout = tree.layout(leaves, split);
+    tree.checkBudget(out.layout, "the surface band alone");
+    std::unordered_map<uint64_t, BakedProbe> store;
+    uint64_t rays = bakeMissing(out.layout, baker, store);
+
+    if (v.adaptive.tolerance) {
+        AdaptiveRefinement ref;
+        ref.tolerance = *v.adaptive.tolerance;
+        const auto& budgetProbes = v.adaptive.maxProbes;
+        const auto& budgetBytes = v.adaptive.maxBytes;
+        std::unordered_set<uint64_t> kept;  // tested leaves that stay
+        for (int round = 1;; ++round) {
+            // The layout's leaves are sorted, so everything below follows a fixed order.
+            const std::vector<OctreeLeaf>& current = out.layout.octree->leaves;
+            std::vector<size_t> candidates;
+            for (size_t i = 0; i < current.size(); ++i)
+                if (current[i].level > 0 && !kept.count(out.layout.probeKeys[i]))
+                    candidates.push_back(i);
+            if (candidates.empty()) break;
+            ref.rounds = round;
+            ref.leavesTested += candidates.size();
+            if (onRound) onRound(round, candidates.size());
+
+            std::vector<glm::vec3> positions;
+            std::vector<uint64_t> keys;
+            for (size_t i : candidates)
+                for (const OctreeLeaf& c : tree.children(current[i])) {
+                    positions.push_back(tree.centre(c));
+                    keys.push_back(octreeLeafKey(c));
+                }
+            const ProbeBake octants = baker(positions, keys);
+            rays += octants.rays;
+            ref.octantProbes += positions.size();
+
+            struct Scored {
+                size_t leaf;
+                double error;
+            };
+            std::vector<Scored> failing;
+            for (size_t k = 0; k < candidates.size(); ++k) {
+                const size_t i = candidates[k];
+                const sh::ShRgb& own = store.at(out.layout.probeKeys[i]).sh;
+                double error = 0.0;
+                for (size_t o = 0; o < 8; ++o)
+                    error = std::max(error, double(relativeIrradianceError(own, octants.sh[8 * k + o])));
+                if (error > ref.tolerance) {
+                    failing.push_back({k, error});
+                } else {
+                    kept.insert(out.layout.probeKeys[i]);
+                    ref.worstKeptError = std::max(ref.worstKeptError, error);
+                }
+            }
+            std::stable_sort(failing.begin(), failing.end(),
+                             [](const Scored& a, const Scored& b) { return a.error > b.error; });
+
+            size_t probes = out.layout.validCount();
+            const uint64_t cells = out.layout.cellProbe.size();
+            std::vector<uint8_t> splitLeaf(current.size(), 0);
+            std::vector<OctreeLeaf> added;
+            for (size_t f = 0; f < failing.size(); ++f) {
+                const size_t k = failing[f].leaf, i = candidates[k];
+                std::vector<OctreeLeaf> children;
+                size_t unused = 0;
+                for (const OctreeLeaf& c : tree.children(current[i])) tree.visit(c, children, unused);
+                size_t childProbes = 0, octantsKept = 0;
+                for (const OctreeLeaf& c : children) {
+                    glm::vec3 p;
+                    const LeafProbe state = tree.resolve(c, p);
+                    childProbes += state != LeafProbe::Dropped;
+                    octantsKept += state == LeafProbe::Centre && c.level + 1 == current[i].level;
+                }
+                const size_t next = probes - 1 + childProbes;
+                if ((budgetProbes && next > size_t(*budgetProbes)) ||
+                    (budgetBytes && 48 + 160 * uint64_t(next) + 4 * cells > uint64_t(*budgetBytes))) {
+                    ref.budgetReached = true;
+                    ref.leavesOverTolerance = failing.size() - f;
+                    break;
+                }
+                probes = next;
+                splitLeaf[i] = 1;
+                ++ref.leavesSplit;
+                ref.octantProbesKept += octantsKept;
+                split += unused;
+                // The octant bakes become the children's probes.
+                for (size_t o = 0; o < 8; ++o)
+                    store[keys[8 * k + o]] = {positions[8 * k + o], octants.sh[8 * k + o],
+                                              octants.standardError[8 * k + o],
+                                              octants.fromBelowShare[8 * k + o]};
+                added.insert(added.end(), children.begin(), children.end());
+            }
+            if (!added.empty()) {
+                std::vector<OctreeLeaf> next;
+                for (size_t i = 0; i < current.size(); ++i)
+                    if (!splitLeaf[i]) next.push_back(current[i]);
+                next.insert(next.end(), added.begin(), added.end());
+                out.layout = tree.layout(std::move(next), split);
+                rays += bakeMissing(out.layout, baker, store);
+            }
+            if (ref.budgetReached || added.empty()) break;
+        }
+        out.refinement = ref;
+    }
+
+    const size_t n = out.layout.positions.size();
+    out.bake.sh.assign(n, sh::ShRgb{});
+    out.bake.standardError.assign(n, 0.0f);
+    out.bake.fromBelowShare.assign(n, 0.0f);
+    for (size_t i = 0; i < n; ++i) {
+        if (!out.layout.valid[i]) continue;
+        const BakedProbe& b = store.at(out.layout.probeKeys[i]);
+        out.bake.sh[i] = b.sh;
+        out.bake.standardError[i] = b.standardError;
+        out.bake.fromBelowShare[i] = b.fromBelow;
+    }
+    out.bake.rays = rays;
+    return out;
+}
+
+bool interpolateProbes(const ProbeLayout& L, const std::vector<sh::ShRgb>& shs, const glm::vec3& p,
+                       sh::ShRgb& out) {
+    // Lattice of cell centres: cell i's centre sits at lattice coordinate i.
+    const glm::dvec3 g = (glm::dvec3(p) - glm::dvec3(L.cellOrigin)) / double(L.cellSize) - 0.5;
+    const glm::dvec3 base = glm::floor(g);
+    const glm::dvec3 f = g - base;
+    sh::ShRgb acc;
+    double total = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = (corner >> 2) & 1;
+        const double cx = base.x + dx, cy = base.y + dy, cz = base.z + dz;
+        if (cx < 0 || cy < 0 || cz < 0 || cx >= L.cellDims[0] || cy >= L.cellDims[1] ||
+            cz >= L.cellDims[2])
+            continue;
+        const int32_t probe = L.cellProbe[size_t(cx) + size_t(cy) * L.cellDims[0] +
+                                          size_t(cz) * L.cellDims[0] * L.cellDims[1]];
+        if (probe < 0) continue;
+        const double w = (dx ? f.x : 1.0 - f.x) * (dy ? f.y : 1.0 - f.y) * (dz ? f.z : 1.0 - f.z);
+        if (w <= 0.0) continue;
+        sh::ShRgb term = shs[size_t(probe)];
+        term *= float(w);
+        acc += term;
+        total += w;
+    }
+    if (total <= 0.0) return false;
+    acc *= float(1.0 / total);
+    out = acc;
+    return true;
+}
+
+InterpolationError measureInterpolationError(const ProbeLayout& L, const std::vector<sh::ShRgb>& shs,
+                                             const Heightfield& hf, const ProbeBaker& baker,
+                                             int count, uint64_t seed,
+                                             std::optional<double> tolerance) {
+    InterpolationError e;
+    const glm::dvec3 lo(L.cellOrigin);
+    const glm::dvec3 extent = double(L.cellSize) *
+                              glm::dvec3(L.cellDims[0], L.cellDims[1], L.cellDims[2]);
+    Rng rng(seed ^ 0x1E7E5A4D5A3Dull);
+    std::vector<glm::vec3> points;
+    for (int attempt = 0; attempt < 64 * count && int(points.size()) < count; ++attempt) {
+        const glm::vec3 p(lo + extent * glm::dvec3(rng.next(), rng.next(), rng.next()));
+        if (p.y > hf.surfaceHeight(p.x, p.z)) points.push_back(p);
+    }
+    if (points.empty()) return e;
+    std::vector<uint64_t> keys(points.size());
+    for (size_t i = 0; i < points.size(); ++i)
+        keys[i] = splitmix64(seed ^ 0x5A3D1E7Eull ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull));
+    const ProbeBake truth = baker(points, keys);
+    for (size_t i = 0; i < points.size(); ++i) {
+        sh::ShRgb value;
+        if (!interpolateProbes(L, shs, points[i], value)) {
+            ++e.uncovered;
+            continue;
+        }
+        e.positions.push_back(points[i]);
+        e.errors.push_back(relativeIrradianceError(value, truth.sh[i]));
+    }
+    e.points = e.errors.size();
+    if (e.errors.empty()) return e;
+    std::vector<float> sorted = e.errors;
+    std::sort(sorted.begin(), sorted.end());
+    double sum = 0.0;
+    size_t within = 0;
+    for (float x : sorted) {
+        sum += x;
+        within += tolerance && double(x) <= *tolerance;
+    }
+    e.mean = sum / double(sorted.size());
+    e.p95 = sorted[std::min(sorted.size() - 1, size_t(std::ceil(0.95 * double(sorted.size()))) - 1)];
+    e.max = sorted.back();
+    if (tolerance) e.withinTolerance = double(within) / double(sorted.size());
+    return e;
+}
+
+}  // namespace terralux

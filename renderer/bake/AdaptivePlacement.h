@@ -1,0 +1,111 @@
+#pragma once
+// Adaptive octree placement of SH probes over a terrain (seed 001's adaptive octree, written as
+// FORMATS.md's .shprobe grid at the minimum cell size), its error-driven refinement, and the
+// interpolation model that the refinement and the reported interpolation error share.
+//
+// Geometry. The box (auto: the terrain footprint from the lowest terrain point up to the highest
+// + height_range) is made of whole minimum cells and tiled by root cells of max_cell_size. A cell
+//   - is dropped when it lies wholly inside the terrain (its top at or below the lowest surface
+//     point over its footprint): its grid cells hold -1;
+//   - splits when it is larger than the minimum and sticks out of the box, reaches into the
+//     surface band (its bottom below the highest surface point over its footprint plus
+//     surface_band), or has its centre inside the terrain;
+//   - otherwise is a leaf with one probe at its centre. A minimum-size leaf whose centre is inside
+//     the terrain, or above it by less than 2 % of the cell, moves its probe up to 2 % of the
+//     cell above the surface when that move is at most max_move_share of the cell; otherwise it
+//     keeps no probe and its cell, partly above the terrain, points at the first probe above it
+//     in its column (a cell with nothing above holds -1).
+// Surface ranges over a footprint are exact for the triangle surface (Heightfield.h): a
+// piecewise-linear surface takes its extremes over a rectangle at the mesh vertices inside it and
+// where the rectangle's edges cross grid lines and cell diagonals.
+//
+// Interpolation model ("interpolated from its neighbours", LIGHTING.md's interpolation error).
+// An engine reads the .shprobe occupancy grid. Filtered like a 3D texture, a point p gets the
+// trilinear blend of the probes named by the 8 grid cells whose centres surround p; cells
+// holding -1 (terrain, outside) are left out and the weights renormalised. Inside a leaf two or
+// more cells wide this is the leaf's own probe, which is also what seed 001's nearest-cell
+// lookup returns; near a leaf's faces it blends towards the neighbours.
+//
+// Error-driven refinement (tolerance set). Each leaf larger than the minimum bakes probes at the
+// centres of its 8 octants, where its children's probes would go. The model gives the leaf's own
+// probe there, so the leaf's error is the largest relative irradiance error (LIGHTING.md probe
+// error: RMS over 256 normals) of its probe against those 8 bakes; above the tolerance it splits
+// and its children keep the octant bakes (same position, same seed). Rounds go one level down at
+// a time; in each round the worst leaves split first, and a budget (max_probes, max_bytes) stops
+// the refinement at the first split that no longer fits.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "bake/DiffuseBake.h"
+#include "bake/ProbePlacement.h"
+
+namespace terralux {
+
+// Geometric adaptive placement (no refinement). Throws PlacementError for settings that only
+// the terrain can check (auto sizes), an occupancy grid over kMaxOccupancyCells, or a budget the
+// surface band alone already exceeds.
+ProbeLayout placeAdaptive(const ProbeVolumeSettings& volume, const Heightfield& hf);
+
+// The seed key of a leaf: a hash of its level and corner, independent of any ordering.
+uint64_t octreeLeafKey(const OctreeLeaf& leaf);
+
+// Bakes probes at `positions`, probe i seeded from keys[i] only (bakeProbesSeeded). The result's
+// vectors are aligned with `positions`.
+using ProbeBaker = std::function<ProbeBake(const std::vector<glm::vec3>& positions,
+                                           const std::vector<uint64_t>& keys)>;
+
+struct AdaptiveRefinement {
+    double tolerance = 0.0;
+    int rounds = 0;
+    size_t leavesTested = 0;       // leaves larger than the minimum whose octants were baked
+    size_t leavesSplit = 0;
+    size_t octantProbes = 0;       // probes baked at octant centres
+    size_t octantProbesKept = 0;   // of those, how many became probes of split leaves
+    double worstKeptError = 0.0;   // largest error of a tested leaf that was not split
+    bool budgetReached = false;
+    size_t leavesOverTolerance = 0;  // leaves the budget left unsplit above the tolerance
+};
+
+struct AdaptiveBake {
+    ProbeLayout layout;
+    ProbeBake bake;  // aligned with layout.positions; zero for positions without a probe
+    std::optional<AdaptiveRefinement> refinement;  // set when the volume has a tolerance
+};
+
+// Places the octree, bakes every probe with `baker` and, with a tolerance, refines by error.
+// `onRound` (optional) hears the round number and the leaves it tests. The baker's exceptions
+// (BakeCancelled) pass through.
+AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& volume, const Heightfield& hf,
+                          const ProbeBaker& baker,
+                          const std::function<void(int round, size_t leaves)>& onRound = {});
+
+// The interpolation model above, over any layout's occupancy grid (terrain and box grids too);
+// sh[i] belongs to layout.positions[i]. false: no occupied cell around p (the engine falls back).
+bool interpolateProbes(const ProbeLayout& layout, const std::vector<sh::ShRgb>& sh,
+                       const glm::vec3& p, sh::ShRgb& out);
+
+struct InterpolationError {
+    size_t points = 0;     // sampled points that had probes around them
+    size_t uncovered = 0;  // sampled points above the terrain with none (left out of the stats)
+    double mean = 0, p95 = 0, max = 0;
+    std::optional<double> withinTolerance;  // share of points with error <= tolerance
+    std::vector<glm::vec3> positions;       // the points counted, with their errors
+    std::vector<float> errors;
+};
+
+// LIGHTING.md interpolation error: at `count` points drawn uniformly (deterministically from
+// `seed`) from the part of the layout's grid box above the terrain, the relative irradiance error
+// of the interpolated probes against a probe baked at the point with `baker`.
+InterpolationError measureInterpolationError(const ProbeLayout& layout,
+                                             const std::vector<sh::ShRgb>& sh,
+                                             const Heightfield& hf, const ProbeBaker& baker,
+                                             int count, uint64_t seed,
+                                             std::optional<double> tolerance);
+
+}  // namespace terralux

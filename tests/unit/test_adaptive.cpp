@@ -1,0 +1,704 @@
+// Adaptive octree placement (issue: only the probes a scene needs, never one inside the terrain):
+// the geometric rules on real DEMs, the occupancy grid per FORMATS.md, the interpolation model,
+// the error-driven refinement and its budget, the acceptance numbers against a uniform grid, and
+// the whole bake's determinism and report.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numbers>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include "BakeJob.h"
+#include "DemImport.h"
+#include "ShProbeFile.h"
+#include "bake/AdaptivePlacement.h"
+#include "bake/DiffuseBake.h"
+#include "bake/SphereSampling.h"
+
+using namespace terralux;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kDems = fs::path(TERRALUX_TEST_DATA) / "dem";
+
+Heightfield flat(int n, double cell, float h) {
+    return Heightfield(n, n, cell, cell, std::vector<float>(size_t(n) * n, h));
+}
+
+ProbeVolumeSettings adaptive(std::optional<double> minCell = std::nullopt,
+                             std::optional<double> maxCell = std::nullopt) {
+    ProbeVolumeSettings v;
+    v.placement = ProbePlacement::Adaptive;
+    v.adaptive.minCellSize = minCell;
+    v.adaptive.maxCellSize = maxCell;
+    return v;
+}
+
+size_t cellIndex(const ProbeLayout& L, uint32_t x, uint32_t y, uint32_t z) {
+    return x + size_t(y) * L.cellDims[0] + size_t(z) * L.cellDims[0] * L.cellDims[1];
+}
+
+glm::vec3 cellCentre(const ProbeLayout& L, uint32_t x, uint32_t y, uint32_t z) {
+    return L.cellOrigin + L.cellSize * glm::vec3(float(x) + 0.5f, float(y) + 0.5f, float(z) + 0.5f);
+}
+
+bool leafContains(const OctreeLeaf& l, uint32_t x, uint32_t y, uint32_t z) {
+    return x >= l.x && x < l.x + l.edge() && y >= l.y && y < l.y + l.edge() && z >= l.z &&
+           z < l.z + l.edge();
+}
+
+// Every rule of the issue that the geometry alone decides, checked cell by cell.
+void expectPlacementRules(const ProbeLayout& L, const Heightfield& hf, double maxMoveShare) {
+    ASSERT_TRUE(L.octree.has_value());
+    const AdaptiveOctree& t = *L.octree;
+    ASSERT_EQ(t.leaves.size(), L.positions.size());
+    const uint32_t X = L.cellDims[0], Y = L.cellDims[1], Z = L.cellDims[2];
+    ASSERT_EQ(L.cellProbe.size(), size_t(X) * Y * Z);
+
+    // No probe with its centre below the terrain; moved probes stay in their leaf, within the cap.
+    size_t moved = 0;
+    for (size_t i = 0; i < L.positions.size(); ++i) {
+        if (!L.valid[i]) continue;
+        const glm::vec3& p = L.positions[i];
+        EXPECT_GT(p.y, hf.surfaceHeight(p.x, p.z)) << "probe " << i;
+        const OctreeLeaf& l = t.leaves[i];
+        const float edge = L.cellSize * float(l.edge());
+        const glm::vec3 centre = L.cellOrigin + L.cellSize * (glm::vec3(float(l.x), float(l.y), float(l.z)) +
+                                                              0.5f * float(l.edge()));
+        if (t.probe[i] == LeafProbe::Moved) {
+            ++moved;
+            EXPECT_EQ(l.level, 0);
+            EXPECT_GT(p.y, centre.y);
+            EXPECT_LE(p.y - centre.y, float(maxMoveShare) * edge * 1.0001f);
+        } else {
+            EXPECT_EQ(t.probe[i], LeafProbe::Centre);
+            EXPECT_NEAR(p.y, centre.y, 1e-3f * edge);
+        }
+        EXPECT_NEAR(p.x, centre.x, 1e-3f * edge);
+        EXPECT_NEAR(p.z, centre.z, 1e-3f * edge);
+    }
+    EXPECT_EQ(moved, t.moved);
+
+    // Leaves never overlap and stay inside the box.
+    std::vector<uint8_t> covered(L.cellProbe.size(), 0);
+    for (const OctreeLeaf& l : t.leaves) {
+        ASSERT_LE(l.x + l.edge(), X);
+        ASSERT_LE(l.y + l.edge(), Y);
+        ASSERT_LE(l.z + l.edge(), Z);
+        for (uint32_t z = l.z; z < l.z + l.edge(); ++z)
+            for (uint32_t y = l.y; y < l.y + l.edge(); ++y)
+                for (uint32_t x = l.x; x < l.x + l.edge(); ++x) {
+                    ASSERT_EQ(covered[cellIndex(L, x, y, z)], 0) << "cell " << x << "," << y << "," << z;
+                    covered[cellIndex(L, x, y, z)] = 1;
+                }
+    }
+
+    // Every cell whose centre is above the terrain maps to a probe whose leaf contains it; cells
+    // wholly inside the terrain hold -1; cells partly above (a ground object can stand in them)
+    // hold a probe, their own or the first one above in their column.
+    size_t above = 0, borrowed = 0;
+    for (uint32_t z = 0; z < Z; ++z)
+        for (uint32_t x = 0; x < X; ++x) {
+            const glm::vec3 c0 = cellCentre(L, x, 0, z);
+            const float ground = hf.surfaceHeight(c0.x, c0.z);
+            const SurfaceRange range = surfaceRange(hf, c0.x - 0.5 * L.cellSize, c0.x + 0.5 * L.cellSize,
+                                                    c0.z - 0.5 * L.cellSize, c0.z + 0.5 * L.cellSize);
+            for (uint32_t y = 0; y < Y; ++y) {
+                const int32_t probe = L.cellProbe[cellIndex(L, x, y, z)];
+                const glm::vec3 c = cellCentre(L, x, y, z);
+                const float top = c.y + 0.5f * L.cellSize;
+                if (c.y > ground) {
+                    ++above;
+                    ASSERT_GE(probe, 0) << "above-terrain cell " << x << "," << y << "," << z;
+                    ASSERT_TRUE(L.valid[size_t(probe)]);
+                    EXPECT_TRUE(leafContains(t.leaves[size_t(probe)], x, y, z));
+                } else if (top <= range.lo) {
+                    EXPECT_EQ(probe, -1) << "buried cell " << x << "," << y << "," << z;
+                } else if (probe >= 0 && !leafContains(t.leaves[size_t(probe)], x, y, z)) {
+                    ++borrowed;
+                    // The first probe above, in the same column.
+                    const OctreeLeaf& l = t.leaves[size_t(probe)];
+                    EXPECT_TRUE(x >= l.x && x < l.x + l.edge() && z >= l.z && z < l.z + l.edge());
+                    EXPECT_GT(l.y, y);
+                }
+            }
+        }
+    EXPECT_EQ(above, t.uniformProbes);
+    EXPECT_EQ(borrowed, t.borrowed);
+}
+
+// The .shprobe of a layout, with a distinct SH per probe, as the bake compacts it.
+ShProbeGrid gridOf(const ProbeLayout& L) {
+    ShProbeGrid g;
+    g.dims = glm::uvec3(L.cellDims[0], L.cellDims[1], L.cellDims[2]);
+    g.origin = L.cellOrigin;
+    g.spacing = L.cellSize;
+    std::vector<int32_t> compact(L.positions.size(), -1);
+    for (size_t i = 0; i < L.positions.size(); ++i) {
+        if (!L.valid[i]) continue;
+        compact[i] = int32_t(g.probes.size());
+        ShProbeRecord r;
+        r.coeffs[0] = L.positions[i];
+        g.probes.push_back(r);
+    }
+    for (int32_t c : L.cellProbe) g.occupancy.push_back(c < 0 ? -1 : compact[size_t(c)]);
+    return g;
+}
+
+class RealDem : public ::testing::TestWithParam<const char*> {};
+
+}  // namespace
+
+TEST_P(RealDem, NoProbeInsideEveryCellMappedLeavesDisjointFileReadsBack) {
+    const DemImportResult dem = importDem((kDems / GetParam()).string());
+    const Heightfield& hf = dem.heightfield;
+    const ProbeVolumeSettings v = adaptive();
+    const ProbeLayout L = placeProbes(v, hf);
+    // Defaults: the DEM cell, 16 times that, a band of one cell.
+    const double cell = std::max(hf.cellSizeX(), hf.cellSizeZ());
+    EXPECT_DOUBLE_EQ(L.octree->minCell, cell);
+    EXPECT_DOUBLE_EQ(L.octree->maxCell, 16.0 * cell);
+    EXPECT_DOUBLE_EQ(L.octree->surfaceBand, cell);
+    EXPECT_FLOAT_EQ(L.cellSize, float(cell));
+    EXPECT_FLOAT_EQ(L.fallbackBlendDistance, float(2.0 * cell));
+    // The auto box: the footprint from the lowest terrain to 100 m above the highest, whole cells.
+    EXPECT_FLOAT_EQ(L.cellOrigin.x, hf.minX());
+    EXPECT_FLOAT_EQ(L.cellOrigin.y, hf.minHeight());
+    EXPECT_FLOAT_EQ(L.cellOrigin.z, hf.minZ());
+    EXPECT_EQ(L.cellDims[1], uint32_t(std::ceil((hf.maxHeight() + 100.0 - hf.minHeight()) / cell - 1e-6)));
+    EXPECT_GE(L.cellOrigin.x + L.cellSize * float(L.cellDims[0]), hf.maxX() - 1e-3f);
+    expectPlacementRules(L, hf, v.adaptive.maxMoveShare);
+    EXPECT_LT(L.validCount(), L.octree->uniformProbes);
+    // The uniform count is what a box grid at the minimum cell size over the same box keeps.
+    ProbeVolumeSettings box;
+    box.placement = ProbePlacement::Box;
+    box.gridDims = {int(L.cellDims[0]), int(L.cellDims[1]), int(L.cellDims[2])};
+    box.spacing = glm::vec3(L.cellSize);
+    box.origin = L.cellOrigin;
+    EXPECT_EQ(placeProbes(box, hf).validCount(), L.octree->uniformProbes);
+
+    const fs::path file = fs::temp_directory_path() / (std::string("terralux_adaptive_") + GetParam() + ".shprobe");
+    const ShProbeGrid grid = gridOf(L);
+    writeShProbeFile(file, grid);
+    EXPECT_EQ(fs::file_size(file), L.fileBytes());
+    const ShProbeGrid back = readShProbeFile(file);
+    EXPECT_EQ(back, grid);
+    fs::remove(file);
+    std::cout << GetParam() << ": " << L.validCount() << " probes (" << L.octree->moved << " moved, "
+              << L.octree->borrowed << " borrowing cells) vs " << L.octree->uniformProbes
+              << " for a uniform grid of " << cell << " m\n";
+}
+INSTANTIATE_TEST_SUITE_P(Fixtures, RealDem,
+                         ::testing::Values("bigtujunga_utm11_crop.tif", "n42e001_voids_crop.tif",
+                                           "rainier_crop.tif", "orkhon_crop.asc"),
+                         [](const auto& info) {
+                             std::string n = info.param;
+                             return n.substr(0, n.find('_'));
+                         });
+
+TEST(AdaptivePlacement, FullSharedDemFollowsTheRules) {
+    const fs::path dem = fs::path(TERRALUX_SHARED_DATA) / "dem" / "srtm_bigtujunga30m_utm11.tif";
+    if (!fs::exists(dem)) GTEST_SKIP() << "shared DEM not present: " << dem;
+    DemImportOptions options;
+    options.maxResolution = 400;
+    const DemImportResult d = importDem(dem.string(), options);
+    ProbeVolumeSettings v = adaptive();
+    v.adaptive.maxMoveShare = 0.5;
+    const ProbeLayout L = placeProbes(v, d.heightfield);
+    expectPlacementRules(L, d.heightfield, 0.5);
+}
+
+TEST(AdaptivePlacement, SurfaceBandGoesToTheMinimumAndOpenAirStaysCoarse) {
+    // Flat ground at 100 m; cells of 10 m to 80 m from y = 0 to 400: the band reaches 110 m.
+    const Heightfield hf = flat(41, 10.0, 100.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 80.0);
+    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
+    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.cellDims, (std::array<uint32_t, 3>{40, 40, 40}));
+    for (const OctreeLeaf& l : L.octree->leaves) {
+        const double y0 = 10.0 * l.y, y1 = y0 + 10.0 * l.edge();
+        EXPECT_GT(y1, 100.0);  // nothing wholly below the ground
+        if (l.level > 0) {
+            EXPECT_GE(y0, 110.0);  // coarse cells only above the band
+        } else {
+            EXPECT_LT(y0, 120.0);  // minimum cells only where a parent reached into it
+        }
+    }
+    // Per 80 m column: the root [80, 160) reaches the band; its 40 m child [80, 120) too, whose
+    // 20 m child [80, 100) is buried and [100, 120) splits into 10 m cells (8 x 8 x 2); the 40 m
+    // cells [120, 160) stay (2 x 2); 80 m roots above 160 m (3).
+    EXPECT_EQ(L.validCount(), 25u * (128 + 4 + 3));
+    std::map<int, size_t> byLevel;
+    for (const OctreeLeaf& l : L.octree->leaves) ++byLevel[l.level];
+    EXPECT_EQ(byLevel[3], 25u * 3);
+    EXPECT_EQ(byLevel[2], 25u * 4);
+    EXPECT_EQ(byLevel[1], 0u);
+    EXPECT_EQ(byLevel[0], 25u * 128);
+}
+
+TEST(AdaptivePlacement, CentreInsideIsMovedUpOrBorrowsTheProbeAbove) {
+    ProbeVolumeSettings v = adaptive(10.0, 10.0);
+    v.origin = glm::vec3(-20.0f, 0.0f, -20.0f);
+    v.adaptive.size = glm::vec3(40.0f, 30.0f, 40.0f);
+    // Ground at 5.5 m: the first layer's centres (5 m) are 0.5 m inside; moved to 5.5 + 0.2.
+    {
+        const Heightfield hf = flat(9, 10.0, 5.5f);
+        const ProbeLayout L = placeProbes(v, hf);
+        EXPECT_EQ(L.octree->moved, 16u);
+        EXPECT_EQ(L.octree->borrowed, 0u);
+        for (size_t i = 0; i < L.positions.size(); ++i)
+            if (L.octree->leaves[i].y == 0) {
+                EXPECT_EQ(L.octree->probe[i], LeafProbe::Moved);
+                EXPECT_FLOAT_EQ(L.positions[i].y, 5.7f);
+            }
+        expectPlacementRules(L, hf, v.adaptive.maxMoveShare);
+    }
+    // Ground at 8 m: a 3.2 m move is over the 2.5 m cap, so the cell points at the probe above.
+    {
+        const Heightfield hf = flat(9, 10.0, 8.0f);
+        const ProbeLayout L = placeProbes(v, hf);
+        EXPECT_EQ(L.octree->moved, 0u);
+        EXPECT_EQ(L.octree->borrowed, 16u);
+        EXPECT_EQ(L.validCount(), 32u);
+        EXPECT_EQ(L.positions.size() - L.validCount(), 16u);
+        const int32_t bottom = L.cellProbe[cellIndex(L, 1, 0, 2)];
+        const int32_t above = L.cellProbe[cellIndex(L, 1, 1, 2)];
+        EXPECT_EQ(bottom, above);
+        EXPECT_FLOAT_EQ(L.positions[size_t(above)].y, 15.0f);
+        expectPlacementRules(L, hf, v.adaptive.maxMoveShare);
+        // With a cap of half the cell, the same probes move instead.
+        ProbeVolumeSettings half = v;
+        half.adaptive.maxMoveShare = 0.5;
+        const ProbeLayout M = placeProbes(half, hf);
+        EXPECT_EQ(M.octree->moved, 16u);
+        EXPECT_EQ(M.octree->borrowed, 0u);
+        // A box one cell high has nothing above to borrow: the cells hold -1.
+        ProbeVolumeSettings low = v;
+        low.adaptive.size = glm::vec3(40.0f, 10.0f, 40.0f);
+        const ProbeLayout N = placeProbes(low, hf);
+        EXPECT_EQ(N.octree->dropped, 16u);
+        EXPECT_EQ(N.validCount(), 0u);
+        EXPECT_TRUE(std::all_of(N.cellProbe.begin(), N.cellProbe.end(), [](int32_t c) { return c < 0; }));
+    }
+    // Ground at 25 m under 40 m roots: the root's centre (20 m) is inside, so it splits; of its
+    // children the lower ones are buried and the upper ones' centres (30 m) are above; their
+    // 10 m children at [20, 30) have their centres inside and move up.
+    {
+        const Heightfield hf = flat(9, 10.0, 25.0f);
+        ProbeVolumeSettings big = adaptive(10.0, 40.0);
+        big.origin = glm::vec3(-20.0f, 0.0f, -20.0f);
+        big.adaptive.size = glm::vec3(40.0f, 80.0f, 40.0f);
+        big.adaptive.surfaceBand = 0.0;
+        const ProbeLayout L = placeProbes(big, hf);
+        EXPECT_EQ(L.octree->splitForInside, 1u);
+        EXPECT_EQ(L.octree->moved, 16u);
+        expectPlacementRules(L, hf, big.adaptive.maxMoveShare);
+    }
+}
+
+TEST(AdaptivePlacement, SettingsTheTerrainDecidesAreChecked) {
+    const Heightfield hf = flat(11, 30.0, 0.0f);
+    auto message = [&](const ProbeVolumeSettings& v) {
+        try {
+            placeProbes(v, hf);
+        } catch (const PlacementError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    ProbeVolumeSettings v = adaptive(std::nullopt, 100.0);
+    v.name = "valley";
+    EXPECT_EQ(message(v), "probe_volumes 'valley': adaptive.max_cell_size = 100 must be "
+                          "min_cell_size (30, the DEM cell size) times 2^k, k in [0, 16]");
+    v = adaptive(0.25);
+    v.name = "fine";
+    EXPECT_EQ(message(v), "probe_volumes 'fine': occupancy grid of 576000000 cells (1200 x 400 x "
+                          "1200 of 0.25 m) exceeds 67108864; raise adaptive.min_cell_size or "
+                          "shrink the box");
+    v = adaptive(30.0, 120.0);
+    v.name = "tight";
+    const ProbeLayout unlimited = placeProbes(v, hf);
+    v.adaptive.maxProbes = 10;
+    EXPECT_EQ(message(v), "probe_volumes 'tight': the surface band alone needs " +
+                              std::to_string(unlimited.validCount()) +
+                              " probes, more than adaptive.max_probes = 10; raise it or "
+                              "adaptive.min_cell_size");
+    v.adaptive.maxProbes = int(unlimited.validCount());
+    EXPECT_EQ(message(v), "");
+    v.adaptive.maxProbes.reset();
+    v.adaptive.maxBytes = 1000;
+    EXPECT_EQ(message(v), "probe_volumes 'tight': the surface band alone needs " +
+                              std::to_string(unlimited.fileBytes()) +
+                              " bytes, more than adaptive.max_bytes = 1000; raise it or "
+                              "adaptive.min_cell_size");
+    // An explicit box grows to whole minimum cells.
+    v = adaptive(30.0, 120.0);
+    v.origin = glm::vec3(-100.0f, -50.0f, -100.0f);
+    v.adaptive.size = glm::vec3(95.0f, 30.0f, 60.0f);
+    const ProbeLayout L = placeProbes(v, hf);
+    EXPECT_EQ(L.cellDims, (std::array<uint32_t, 3>{4, 1, 2}));
+    EXPECT_EQ(L.cellOrigin, glm::vec3(-100.0f, -50.0f, -100.0f));
+}
+
+TEST(Interpolation, TrilinearOverCellCentresLeavesOutEmptyCells) {
+    ProbeLayout L;
+    L.cellDims = {3, 1, 1};
+    L.cellSize = 2.0f;
+    L.cellOrigin = glm::vec3(0.0f);
+    L.cellProbe = {0, 1, -1};
+    L.positions = {{1, 1, 1}, {3, 1, 1}};
+    L.valid = {1, 1};
+    const std::vector<sh::ShRgb> probes = {sh::projectConstant(glm::vec3(1.0f)),
+                                           sh::projectConstant(glm::vec3(3.0f))};
+    auto radiance = [&](const glm::vec3& p) {
+        sh::ShRgb out;
+        EXPECT_TRUE(interpolateProbes(L, probes, p, out));
+        return sh::evalRadiance(out, glm::vec3(0, 1, 0)).x;
+    };
+    EXPECT_NEAR(radiance({1.0f, 1.0f, 1.0f}), 1.0f, 1e-5f);   // a cell centre: its own probe
+    EXPECT_NEAR(radiance({2.5f, 0.3f, 1.9f}), 2.5f, 1e-5f);   // 3/4 of the way to the next
+    EXPECT_NEAR(radiance({0.2f, 1.0f, 1.0f}), 1.0f, 1e-5f);   // beyond the first centre: clamped
+    EXPECT_NEAR(radiance({4.5f, 1.0f, 1.0f}), 3.0f, 1e-5f);   // the empty cell is left out
+    sh::ShRgb none;
+    L.cellProbe = {-1, -1, -1};
+    EXPECT_FALSE(interpolateProbes(L, probes, {3.0f, 1.0f, 1.0f}, none));
+}
+
+namespace {
+
+// A baker whose irradiance follows an analytic field: a constant sky of radiance f(p).
+ProbeBaker fieldBaker(std::function<float(const glm::vec3&)> f, size_t* baked = nullptr) {
+    return [f, baked](const std::vector<glm::vec3>& p, const std::vector<uint64_t>&) {
+        ProbeBake b;
+        for (const glm::vec3& x : p) b.sh.push_back(sh::projectConstant(glm::vec3(f(x))));
+        b.standardError.assign(p.size(), 0.0f);
+        b.fromBelowShare.assign(p.size(), 0.0f);
+        b.rays = p.size();
+        if (baked) *baked += p.size();
+        return b;
+    };
+}
+
+float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
+    const glm::vec3 d = (p - c) / radius;
+    return std::exp(-glm::dot(d, d));
+}
+
+}  // namespace
+
+TEST(Refinement, SplitsWhereLightingVariesAndReusesTheOctantBakes) {
+    const Heightfield hf = flat(41, 10.0, 0.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 160.0);
+    v.origin = glm::vec3(-240.0f, 0.0f, -240.0f);
+    v.adaptive.size = glm::vec3(480.0f, 480.0f, 480.0f);
+    v.adaptive.tolerance = 0.05;
+    const glm::vec3 hot(-100.0f, 300.0f, 100.0f);
+    auto field = [&](const glm::vec3& p) { return 1.0f + 2.0f * bump(p, hot, 60.0f); };
+    size_t baked = 0;
+    const AdaptiveBake a = bakeAdaptive(v, hf, fieldBaker(field, &baked));
+    const ProbeLayout geometric = placeProbes(v, hf);
+    ASSERT_TRUE(a.refinement.has_value());
+    const AdaptiveRefinement& r = *a.refinement;
+    EXPECT_GT(r.leavesSplit, 0u);
+    EXPECT_FALSE(r.budgetReached);
+    EXPECT_LE(r.worstKeptError, 0.05);
+    // Each split adds its 8 children, all baked already as octants: nothing else was baked.
+    EXPECT_EQ(a.layout.validCount(), geometric.validCount() + 7 * r.leavesSplit);
+    EXPECT_EQ(r.octantProbesKept, 8 * r.leavesSplit);
+    EXPECT_EQ(baked, geometric.validCount() + r.octantProbes);
+    expectPlacementRules(a.layout, hf, v.adaptive.maxMoveShare);
+    // Splits happen near the bump only; far from it the air keeps the largest cells: every
+    // 160 m root above the ground band whose centre is over 350 m away is still one leaf.
+    size_t farRoots = 0;
+    for (int rz = 0; rz < 3; ++rz)
+        for (int ry = 1; ry < 3; ++ry)
+            for (int rx = 0; rx < 3; ++rx) {
+                const OctreeLeaf root{uint32_t(16 * rx), uint32_t(16 * ry), uint32_t(16 * rz), 4};
+                const glm::vec3 centre = v.origin.value() + 160.0f * (glm::vec3(float(rx), float(ry), float(rz)) + 0.5f);
+                if (glm::length(centre - hot) <= 350.0f) continue;
+                ++farRoots;
+                const auto& leaves = a.layout.octree->leaves;
+                EXPECT_NE(std::find(leaves.begin(), leaves.end(), root), leaves.end())
+                    << centre.x << "," << centre.y << "," << centre.z;
+            }
+    EXPECT_GE(farRoots, 2u);
+    // Every leaf larger than the minimum is within the tolerance at its octant centres now.
+    for (size_t i = 0; i < a.layout.positions.size(); ++i) {
+        const OctreeLeaf& l = a.layout.octree->leaves[i];
+        if (l.level == 0) continue;
+        const float own = field(a.layout.positions[i]);
+        const float quarter = 0.25f * a.layout.cellSize * float(l.edge());
+        for (int o = 0; o < 8; ++o) {
+            const glm::vec3 q = a.layout.positions[i] +
+                                quarter * glm::vec3(o & 1 ? 1 : -1, o & 2 ? 1 : -1, o & 4 ? 1 : -1);
+            EXPECT_LE(std::abs(own - field(q)) / field(q), 0.05f + 1e-4f);
+        }
+    }
+    // The SH handed back belongs to each probe's own position.
+    for (size_t i = 0; i < a.layout.positions.size(); ++i) {
+        if (!a.layout.valid[i]) continue;
+        EXPECT_NEAR(sh::evalRadiance(a.bake.sh[i], glm::vec3(0, 1, 0)).x,
+                    field(a.layout.positions[i]), 1e-4f);
+    }
+}
+
+TEST(Refinement, BudgetStopsItWorstLeavesFirst) {
+    const Heightfield hf = flat(33, 10.0, 0.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 80.0);
+    v.origin = glm::vec3(-160.0f, 0.0f, -160.0f);
+    v.adaptive.size = glm::vec3(320.0f, 320.0f, 320.0f);
+    v.adaptive.tolerance = 0.01;
+    // Two bumps in the air, the stronger in the leaf [0, 80)^2 x [240, 320).
+    const glm::vec3 strong(40.0f, 280.0f, 40.0f), weak(-120.0f, 280.0f, -120.0f);
+    auto field = [&](const glm::vec3& p) {
+        return 1.0f + 1.0f * bump(p, strong, 30.0f) + 0.2f * bump(p, weak, 30.0f);
+    };
+    const size_t before = placeProbes(v, hf).validCount();
+    v.adaptive.maxProbes = int(before + 7);  // room for exactly one split
+    const AdaptiveBake a = bakeAdaptive(v, hf, fieldBaker(field));
+    ASSERT_TRUE(a.refinement.has_value());
+    EXPECT_TRUE(a.refinement->budgetReached);
+    EXPECT_EQ(a.refinement->leavesSplit, 1u);
+    EXPECT_GT(a.refinement->leavesOverTolerance, 0u);
+    EXPECT_EQ(a.layout.validCount(), before + 7);
+    // The split leaf is the one around the strong bump.
+    bool strongSplit = false, weakSplit = false;
+    for (const OctreeLeaf& l : a.layout.octree->leaves) {
+        if (l.level != 2) continue;
+        const glm::vec3 lo = a.layout.cellOrigin + 10.0f * glm::vec3(float(l.x), float(l.y), float(l.z));
+        auto inside = [&](const glm::vec3& p) {
+            return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, lo + 40.0f));
+        };
+        strongSplit = strongSplit || inside(strong);
+        weakSplit = weakSplit || inside(weak);
+    }
+    EXPECT_TRUE(strongSplit);
+    EXPECT_FALSE(weakSplit);
+    // A byte budget stops it the same way.
+    v.adaptive.maxProbes.reset();
+    v.adaptive.maxBytes = (long long)(48 + 160 * (before + 7) + 4 * 32 * 32 * 32);
+    const AdaptiveBake b = bakeAdaptive(v, hf, fieldBaker(field));
+    EXPECT_EQ(b.layout.validCount(), before + 7);
+    EXPECT_EQ(b.layout.fileBytes(), uint64_t(*v.adaptive.maxBytes));
+}
+
+TEST(Refinement, SameResultWithOneAndTwoThreads) {
+    const DemImportResult dem = importDem((kDems / "orkhon_crop.asc").string());
+    const Heightfield& hf = dem.heightfield;
+    const HeightfieldTracer tracer(hf);
+    BakeLighting L;
+    L.tracer = &tracer;
+    L.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
+    L.sun.direction = sunDirection(135.0, 35.0);
+    L.sun.illuminance = glm::vec3(3.0f);
+    L.albedo = glm::vec3(0.3f);
+    ProbeVolumeSettings v = adaptive();
+    v.adaptive.tolerance = 0.01;
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        const IrradianceCache cache(L, 32, 16, 2, 0, {});
+        const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+            std::vector<uint64_t> seeds(k.size());
+            for (size_t i = 0; i < k.size(); ++i) seeds[i] = 77 ^ k[i];
+            return bakeProbesSeeded(L, &cache, 1, p, std::vector<uint8_t>(p.size(), 1), 32, seeds, {});
+        };
+        return bakeAdaptive(v, hf, baker);
+    };
+    const AdaptiveBake a = run(1), b = run(2);
+    EXPECT_GT(a.refinement->leavesSplit, 0u);
+    EXPECT_EQ(a.layout.octree->leaves, b.layout.octree->leaves);
+    EXPECT_EQ(a.layout.positions, b.layout.positions);
+    EXPECT_EQ(a.layout.cellProbe, b.layout.cellProbe);
+    ASSERT_EQ(a.bake.sh.size(), b.bake.sh.size());
+    EXPECT_EQ(std::memcmp(a.bake.sh.data(), b.bake.sh.data(), a.bake.sh.size() * sizeof(sh::ShRgb)), 0);
+}
+
+// The issue's acceptance numbers: over the steepest committed DEM crop (Big Tujunga, 1020 m of
+// relief over 2.9 km, 30 m cells), an error-driven adaptive volume at 2 % holds at most a quarter
+// of the probes of a uniform grid at its minimum cell size, and its interpolation error is within
+// the tolerance at 95 % of sampled points; the geometric octree alone is not.
+TEST(AdaptiveBake, QuarterOfTheUniformProbesWithinToleranceOnARealDem) {
+    const DemImportResult dem = importDem((kDems / "bigtujunga_utm11_crop.tif").string());
+    const Heightfield& hf = dem.heightfield;
+    const HeightfieldTracer tracer(hf);
+    BakeLighting L;
+    L.tracer = &tracer;
+    L.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
+    L.sun.direction = sunDirection(135.0, 35.0);
+    L.sun.illuminance = glm::vec3(3.0f, 2.88f, 2.7f);
+    L.sun.angularRadius = 0.27f * std::numbers::pi_v<float> / 180.0f;
+    L.albedo = glm::vec3(0.3f);
+    const IrradianceCache cache(L, 64, 32, 2, 0, {});
+    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+        std::vector<uint64_t> seeds(k.size());
+        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 99 ^ k[i];
+        return bakeProbesSeeded(L, &cache, 1, p, std::vector<uint8_t>(p.size(), 1), 256, seeds, {});
+    };
+    const double tolerance = 0.02;
+    ProbeVolumeSettings v = adaptive();  // 30 m to 480 m cells
+    const AdaptiveBake geometric = bakeAdaptive(v, hf, baker);
+    v.adaptive.tolerance = tolerance;
+    const AdaptiveBake refined = bakeAdaptive(v, hf, baker);
+    const size_t uniform = refined.layout.octree->uniformProbes;
+    const InterpolationError eg =
+        measureInterpolationError(geometric.layout, geometric.bake.sh, hf, baker, 512, 7, tolerance);
+    const InterpolationError er =
+        measureInterpolationError(refined.layout, refined.bake.sh, hf, baker, 512, 7, tolerance);
+    std::cout << "uniform grid at 30 m: " << uniform << " probes\n"
+              << "geometric octree: " << geometric.layout.validCount() << " probes, interpolation error p95 "
+              << 100 * eg.p95 << " %, within " << 100 * tolerance << " % at " << 100 * *eg.withinTolerance
+              << " % of " << eg.points << " points\n"
+              << "error-driven at 2 %: " << refined.layout.validCount() << " probes ("
+              << 100.0 * double(refined.layout.validCount()) / double(uniform)
+              << " % of uniform), p95 " << 100 * er.p95 << " %, within tolerance at "
+              << 100 * *er.withinTolerance << " % of " << er.points << " points\n";
+    RecordProperty("uniform_probes", std::to_string(uniform));
+    RecordProperty("adaptive_probes", std::to_string(refined.layout.validCount()));
+    RecordProperty("within_tolerance_share", std::to_string(*er.withinTolerance));
+    EXPECT_EQ(er.uncovered, 0u);
+    EXPECT_LE(4 * refined.layout.validCount(), uniform);
+    EXPECT_GE(*er.withinTolerance, 0.95);
+    EXPECT_LE(er.p95, tolerance);
+    EXPECT_GT(eg.p95, tolerance);  // the refinement is what brings it under
+    EXPECT_GT(refined.refinement->leavesSplit, 0u);
+}
+
+namespace {
+
+fs::path tempDir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("terralux_adaptive_" + name);
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+std::string bytesOf(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+Project orkhonProject(const fs::path& out) {
+    Project p;
+    p.scene.terrain.dem = (kDems / "orkhon_crop.asc").string();
+    p.scene.bake.quality = QualityPreset::Draft;
+    p.scene.exportSettings.outDir = out.string();
+    ProbeVolumeSettings& v = p.scene.probeVolumes[0];
+    v.name = "valley";
+    v.placement = ProbePlacement::Adaptive;
+    v.adaptive.tolerance = 0.05;
+    ProbeVolumeSettings grid;
+    grid.name = "grid";
+    grid.gridDims = {6, 1, 5};
+    p.scene.probeVolumes.push_back(grid);
+    return p;
+}
+
+}  // namespace
+
+TEST(AdaptiveBake, SameBytesWithOneAndTwoThreadsAndAReportThatSaysWhatHappened) {
+    const fs::path dir = tempDir("threads");
+    BakeRequest one{orkhonProject(dir / "one"), 1, false};
+    BakeRequest two{orkhonProject(dir / "two"), 2, false};
+    const BakeOutcome a = runBake(one, {}, nullptr);
+    runBake(two, {}, nullptr);
+    for (const char* f : {"sh_coeffs/valley.shprobe", "sh_coeffs/grid.shprobe"})
+        EXPECT_EQ(bytesOf(dir / "one" / f), bytesOf(dir / "two" / f)) << f;
+
+    const nlohmann::json& r = a.report;
+    ASSERT_EQ(r["volumes"].size(), 2u);
+    const nlohmann::json& v = r["volumes"][0];
+    EXPECT_EQ(v["placement"], "adaptive");
+    EXPECT_EQ(v["validity"]["probes_with_rays_from_below"], 0);
+    EXPECT_EQ(v["moved_probes"], v["adaptive"]["moved_probes"]);
+    EXPECT_TRUE(v["split_for_inside"].is_number_unsigned());
+    EXPECT_EQ(v["adaptive"]["refinement"]["tolerance"], 0.05);
+    EXPECT_EQ(v["interpolation_error"]["points"], 256);
+    EXPECT_EQ(v["interpolation_error"]["uncovered_points"], 0);
+    EXPECT_TRUE(v["interpolation_error"]["within_tolerance"].is_number());
+    EXPECT_GT(v["interpolation_error"]["rays"].get<uint64_t>(), 0u);
+    const ShProbeGrid g = readShProbeFile(dir / "one" / "sh_coeffs/valley.shprobe");
+    EXPECT_EQ(v["probes"], g.probes.size());
+    EXPECT_EQ(g.dims.x, v["grid"]["dims"][0].get<uint32_t>());
+    // The two volumes overlap; the engine reads "grid.shprobe" first (file-name order).
+    ASSERT_EQ(r["overlaps"].size(), 1u);
+    EXPECT_EQ(r["overlaps"][0]["engine_reads_first"], "grid");
+    EXPECT_EQ(r["overlaps"][0]["volumes"], (nlohmann::json{"grid", "valley"}));
+    EXPECT_GT(r["overlaps"][0]["cells_of_second_shadowed_by_first"].get<size_t>(), 0u);
+    fs::remove_all(dir);
+}
+
+TEST(AdaptiveBake, TerrainGridFileMapsEveryCellAboveTheGroundToItsColumn) {
+    const fs::path dir = tempDir("terrain");
+    Project p;
+    p.scene.terrain.dem = (kDems / "bigtujunga_utm11_crop.tif").string();
+    p.scene.bake.quality = QualityPreset::Draft;
+    p.scene.exportSettings.outDir = dir.string();
+    p.scene.probeVolumes[0].gridDims = {12, 1, 9};
+    p.scene.probeVolumes[0].heightOffset = 50.0;  // clear of the triangle surface everywhere
+    runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const ShProbeGrid g = readShProbeFile(dir / "sh_coeffs/probes.shprobe");
+    const DemImportResult dem = importDem(p.scene.terrain.dem);
+    const Heightfield& hf = dem.heightfield;
+    const float sx = (hf.maxX() - hf.minX()) / 11.0f, sz = (hf.maxZ() - hf.minZ()) / 8.0f;
+    // Points just above the ground anywhere (an object standing there) and high in the air find
+    // the probe of their nearest column; every probe is above the ground here, so indices match.
+    ASSERT_EQ(g.probes.size(), 12u * 9u);
+    Rng rng(4);
+    for (int i = 0; i < 4000; ++i) {
+        const float x = hf.minX() + (hf.maxX() - hf.minX()) * rng.next();
+        const float z = hf.minZ() + (hf.maxZ() - hf.minZ()) * rng.next();
+        const float ground = hf.surfaceHeight(x, z);
+        const float top = g.origin.y + g.spacing * float(g.dims.y);
+        const float y = i % 2 ? ground + 0.1f : ground + (top - ground) * rng.next();
+        const glm::uvec3 c = glm::uvec3((glm::vec3(x, y, z) - g.origin) / g.spacing);
+        ASSERT_TRUE(c.x < g.dims.x && c.y < g.dims.y && c.z < g.dims.z);
+        // A cell belongs to the column nearest its centre.
+        const float cx = g.origin.x + g.spacing * (float(c.x) + 0.5f);
+        const float cz = g.origin.z + g.spacing * (float(c.z) + 0.5f);
+        const int column = std::clamp(int(std::lround((cz - hf.minZ()) / sz)), 0, 8) * 12 +
+                           std::clamp(int(std::lround((cx - hf.minX()) / sx)), 0, 11);
+        EXPECT_EQ(g.occupancy[g.cellIndex(c.x, c.y, c.z)], column) << x << " " << y << " " << z;
+    }
+    // A cell holds -1 only if no part of it is above the ground.
+    for (uint32_t cz = 0; cz < g.dims.z; ++cz)
+        for (uint32_t cy = 0; cy < g.dims.y; ++cy)
+            for (uint32_t cx = 0; cx < g.dims.x; ++cx) {
+                if (g.occupancy[g.cellIndex(cx, cy, cz)] >= 0) continue;
+                for (int s = 0; s < 64; ++s) {
+                    const glm::vec3 q = g.origin + g.spacing * (glm::vec3(float(cx), float(cy), float(cz)) +
+                                                                glm::vec3(rng.next(), rng.next(), rng.next()));
+                    EXPECT_LE(q.y, hf.surfaceHeight(q.x, q.z));
+                }
+            }
+    fs::remove_all(dir);
+}
+
+TEST(AdaptiveBake, DryRunEstimatesWithoutWriting) {
+    const fs::path dir = tempDir("dry") / "out";
+    BakeRequest request{orkhonProject(dir), 0, false};
+    const BakeEstimate e = estimateBake(request);
+    EXPECT_FALSE(fs::exists(dir));
+    ASSERT_EQ(e.volumes.size(), 2u);
+    const VolumeEstimate& v = e.volumes[0];
+    const ProbeLayout L = placeProbes(request.project.scene.probeVolumes[0],
+                                      importDem(request.project.scene.terrain.dem).heightfield);
+    EXPECT_EQ(v.probes, L.validCount());
+    EXPECT_EQ(v.bytes, L.fileBytes());
+    EXPECT_TRUE(v.refines);
+    EXPECT_EQ(v.probesMax, L.octree->uniformProbes + L.octree->moved);
+    EXPECT_GT(v.seconds, 0.0);
+    EXPECT_GT(v.secondsMax, v.seconds);
+    EXPECT_EQ(e.volumes[1].probes,
+              placeProbes(request.project.scene.probeVolumes[1],
+                          importDem(request.project.scene.terrain.dem).heightfield).validCount());
+    EXPECT_GT(e.probeRaysPerSecond, 0.0);
+    EXPECT_GE(e.seconds, e.cacheSeconds + v.seconds);
+}
