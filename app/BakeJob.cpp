@@ -15,6 +15,7 @@
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
+#include "SceneLighting.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
@@ -43,17 +44,6 @@ nlohmann::json stats(const std::vector<float>& v) {
     for (float x : s) sum += x;
     const size_t p95 = std::min(s.size() - 1, size_t(std::ceil(0.95 * double(s.size()))) - 1);
     return {{"mean", sum / double(s.size())}, {"p95", s[p95]}, {"max", s.back()}};
-}
-
-Sky loadSky(const Project& p) {
-    const SkySettings& s = p.scene.sky;
-    if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
-    const std::string path = p.hdrPath().string();
-    RgbImage img = readEquirectImage(path);
-    // The image's colour is the sky; sky.color tints it (white leaves it as it is).
-    for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= s.color[int(i % 3)];
-    return Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
-                         float(s.rotationDeg));
 }
 
 // The .shprobe of a volume: valid probes only, occupancy pointing at their compacted indices.
@@ -107,11 +97,7 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     b.terrain = loadProjectTerrain(project);
     if (cancelled()) throw BakeCancelled();
     report("loading sky", 0.01);
-    b.lighting.sky = loadSky(project);
-    b.lighting.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
-    b.lighting.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
-    b.lighting.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
-    b.lighting.albedo = scene.terrain.albedo;
+    b.lighting = lightingOf(project);
     b.tracer = std::make_unique<HeightfieldTracer>(b.terrain.heightfield,
                                                    HeightfieldTracer::Options{scene.terrain.skirt});
     b.lighting.tracer = b.tracer.get();

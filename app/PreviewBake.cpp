@@ -1,8 +1,7 @@
 #include "PreviewBake.h"
 
-#include <numbers>
 
-#include "EnvironmentImage.h"
+#include "SceneLighting.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbePlacement.h"
@@ -13,19 +12,7 @@ namespace terralux {
 std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
                                           const std::atomic<bool>* cancel) {
     const SceneDescription& scene = project.scene;
-    BakeLighting lighting;
-    if (scene.sky.mode == SkyMode::Uniform) {
-        lighting.sky = Sky::uniform(scene.sky.color * float(scene.sky.intensity));
-    } else {
-        RgbImage img = readEquirectImage(project.hdrPath().string());
-        for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= scene.sky.color[int(i % 3)];
-        lighting.sky = Sky::equirect(std::move(img.rgb), img.width, img.height,
-                                     float(scene.sky.intensity), float(scene.sky.rotationDeg));
-    }
-    lighting.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
-    lighting.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
-    lighting.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
-    lighting.albedo = scene.terrain.albedo;
+    BakeLighting lighting = lightingOf(project);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
     lighting.tracer = &tracer;
     const BakeQuality q = qualityPreset(QualityPreset::Draft);

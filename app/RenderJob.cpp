@@ -3,7 +3,7 @@
 #include <numbers>
 
 #include "BakeJob.h"
-#include "EnvironmentImage.h"
+#include "SceneLighting.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
@@ -11,16 +11,6 @@
 
 namespace terralux {
 
-namespace {
-Sky skyOf(const Project& p) {
-    const SkySettings& s = p.scene.sky;
-    if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
-    RgbImage img = readEquirectImage(p.hdrPath().string());
-    for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= s.color[int(i % 3)];
-    return Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
-                         float(s.rotationDeg));
-}
-}  // namespace
 
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
     : ProjectRenderer(ctx, project, loadProjectTerrain(project)) {}
@@ -35,10 +25,10 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
 void ProjectRenderer::setProject(const Project& project) {
     project_ = project;
     const SceneDescription& scene = project_.scene;
-    base_.albedo = scene.terrain.albedo;
-    base_.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
-    base_.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
-    base_.skySh = skyOf(project_).sh();
+    const BakeLighting lighting = lightingOf(project_);
+    base_.albedo = lighting.albedo;
+    base_.sun = lighting.sun;
+    base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
     std::vector<glm::vec4> positions;
     for (const auto& v : scene.probeVolumes) {
