@@ -1,6 +1,7 @@
 #include "ParameterPanels.h"
 
 #include <cmath>
+#include <limits>
 
 #include <QCheckBox>
 #include <QColorDialog>
@@ -247,11 +248,20 @@ ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
     form_ = new ParameterForm(doc_, this);
     form_->setNamePrefix("volume.");
     form_->addBool("enabled", "Enabled");
-    form_->addChoice("placement", "Placement", {"terrain", "box"});
+    form_->addChoice("placement", "Placement", {"terrain", "box", "adaptive"});
     form_->addIntegerArray("grid_dims", "Grid (probes)", 3, 1, 4096);
     form_->addNumber("height_offset", "Height offset", -1000.0, 10000.0, 2, "m");
     form_->addInteger("ray_count", "Rays per probe", 1, 1 << 20, "preset");
     form_->addOptionalNumber("fallback_blend_distance", "Fallback blend", 1e7, 1, "m", "2 × spacing");
+    // Adaptive placement (seed 001's octree): cell sizes, the surface band, error-driven
+    // refinement and its budgets.
+    form_->addOptionalNumber("adaptive.min_cell_size", "Adaptive: min cell", 1e6, 2, "m", "DEM cell");
+    form_->addOptionalNumber("adaptive.max_cell_size", "Adaptive: max cell", 1e7, 2, "m", "16 × min");
+    form_->addNumber("adaptive.height_range", "Adaptive: above terrain", 0.0, 1e5, 1, "m");
+    form_->addOptionalNumber("adaptive.surface_band", "Adaptive: surface band", 1e6, 2, "m", "1 min cell");
+    form_->addOptionalNumber("adaptive.tolerance", "Adaptive: error tolerance", 1.0, 3, "", "geometric only");
+    form_->addInteger("adaptive.max_probes", "Adaptive: max probes", 1, std::numeric_limits<int>::max(), "no limit");
+    form_->addNumber("adaptive.max_move_share", "Adaptive: max move", 0.0, 0.5, 2, "of a cell");
     v->addWidget(form_);
     v->addStretch(1);
     connect(form_, &ParameterForm::rejected, this, &ProbeVolumesPanel::rejected);

@@ -122,6 +122,21 @@ private slots:
         QVERIFY2(at4 < at64 / 8 && at4 > 0, qPrintable(QString("%1 vs %2").arg(at4).arg(at64)));
     }
 
+    void adaptivePlacementThroughThePanel() {
+        auto* placement = w_->findChild<QComboBox*>("param.volume.placement");
+        QVERIFY(placement);
+        placement->setCurrentText("adaptive");
+        QCOMPARE(w_->document()->project().scene.probeVolumes[0].placement, ProbePlacement::Adaptive);
+        auto* tolerance = w_->findChild<QDoubleSpinBox*>("param.volume.adaptive.tolerance");
+        QVERIFY(tolerance);
+        tolerance->setValue(0.05);
+        QCOMPARE(w_->document()->value("probe_volumes[0].adaptive.tolerance").get<double>(), 0.05);
+        QVERIFY(w_->findChild<QLabel*>("bake.estimate")->text().contains("probes"));
+        w_->findChild<QAction*>("action.undo")->trigger();
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(placement->currentText(), QString("terrain"));
+    }
+
     void rejectedValuesLeaveTheProject() {
         auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
         QVERIFY(elevation);
