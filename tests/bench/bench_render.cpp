@@ -39,6 +39,11 @@ Fixture& fixture() {
         p.scene.exportSettings.outDir = (std::filesystem::temp_directory_path() / "terralux_bench_render").string();
         x.renderer = std::make_unique<ProjectRenderer>(*x.ctx, p);
         x.renderer->loadProbes(true);
+        // The first frame builds the pipelines (lavapipe compiles them then): not a frame time.
+        RenderRequest warm;
+        warm.width = 1280;
+        warm.height = 720;
+        x.renderer->render(warm);
         return x;
     }();
     return f;
