@@ -19,7 +19,7 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
-  xvfb xauth
+  xvfb xauth fonts-dejavu-core
   # the glTF validator is an npm package, installed by the test set-up
   nodejs
 )
