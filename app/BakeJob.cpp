@@ -55,29 +55,16 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
     g.spacing = layout.cellSize;
     g.defaultScale = float(ex.defaultScale);
     g.defaultAmbient = float(ex.defaultAmbient);
-    std::vector<int32_t> compact(layout.positions.size(), -1);
     for (size_t i = 0; i < layout.positions.size(); ++i) {
         if (!layout.valid[i]) continue;
-        compact[i] = int32_t(g.probes.size());
         ShProbeRecord r;
         r.coeffs = coeffs[i].c;
         r.scale = g.defaultScale;
         r.ambient = g.defaultAmbient;
         g.probes.push_back(r);
     }
-    g.occupancy.resize(layout.cellProbe.size());
-    for (size_t c = 0; c < layout.cellProbe.size(); ++c)
-        g.occupancy[c] = layout.cellProbe[c] < 0 ? -1 : compact[size_t(layout.cellProbe[c])];
+    g.occupancy = layout.compactedOccupancy();
     return g;
-}
-
-const char* placementName(ProbePlacement p) {
-    switch (p) {
-        case ProbePlacement::Terrain: return "terrain";
-        case ProbePlacement::Box: return "box";
-        case ProbePlacement::Adaptive: return "adaptive";
-    }
-    return "terrain";
 }
 
 // What a bake needs before it places a probe: terrain, lighting, tracer, quality, volumes.

@@ -32,16 +32,10 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
         g.spacing = layout.cellSize;
         g.fallbackBlendDistance = layout.fallbackBlendDistance;
         g.scale = float(scene.exportSettings.defaultScale);
-        // Valid probes only, the occupancy pointing at their compacted indices (as in .shprobe).
-        std::vector<int32_t> compact(layout.positions.size(), -1);
+        // Valid probes only, as in .shprobe.
         for (size_t i = 0; i < layout.positions.size(); ++i)
-            if (layout.valid[i]) {
-                compact[i] = int32_t(g.coeffs.size());
-                g.coeffs.push_back(bake.sh[i].c);
-            }
-        g.occupancy.resize(layout.cellProbe.size());
-        for (size_t c = 0; c < layout.cellProbe.size(); ++c)
-            g.occupancy[c] = layout.cellProbe[c] < 0 ? -1 : compact[size_t(layout.cellProbe[c])];
+            if (layout.valid[i]) g.coeffs.push_back(bake.sh[i].c);
+        g.occupancy = layout.compactedOccupancy();
         out.push_back(std::move(g));
     }
     return out;

@@ -134,15 +134,6 @@ json vec(const glm::vec3& v, int n) {
     return a;
 }
 
-const char* placementName(ProbePlacement p) {
-    switch (p) {
-        case ProbePlacement::Terrain: return "terrain";
-        case ProbePlacement::Box: return "box";
-        case ProbePlacement::Adaptive: return "adaptive";
-    }
-    return "terrain";
-}
-
 json adaptiveToJson(const AdaptiveVolumeSettings& a) {
     return {{"min_cell_size", optionalNumber(a.minCellSize)},
             {"max_cell_size", optionalNumber(a.maxCellSize)},

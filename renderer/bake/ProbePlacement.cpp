@@ -8,6 +8,17 @@
 
 namespace terralux {
 
+std::vector<int32_t> ProbeLayout::compactedOccupancy() const {
+    std::vector<int32_t> compact(positions.size(), -1);
+    int32_t next = 0;
+    for (size_t i = 0; i < positions.size(); ++i)
+        if (valid[i]) compact[i] = next++;
+    std::vector<int32_t> out(cellProbe.size());
+    for (size_t c = 0; c < cellProbe.size(); ++c)
+        out[c] = cellProbe[c] < 0 ? -1 : compact[size_t(cellProbe[c])];
+    return out;
+}
+
 size_t ProbeLayout::validCount() const {
     return size_t(std::count(valid.begin(), valid.end(), uint8_t(1)));
 }

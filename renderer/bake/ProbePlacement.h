@@ -77,6 +77,9 @@ struct ProbeLayout {
     std::optional<AdaptiveOctree> octree;
 
     size_t validCount() const;
+    // The occupancy as written to .shprobe: indices into the valid probes only, in placement
+    // order (invalid probes are left out of the file), -1 where no probe.
+    std::vector<int32_t> compactedOccupancy() const;
     // Bytes of the .shprobe this layout writes: 48 + 160 per valid probe + 4 per cell.
     uint64_t fileBytes() const;
 };

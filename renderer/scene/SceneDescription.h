@@ -40,6 +40,16 @@ struct SkySettings {
 
 enum class ProbePlacement { Terrain, Box, Adaptive };
 
+// The project-file spelling of a placement.
+inline const char* placementName(ProbePlacement p) {
+    switch (p) {
+        case ProbePlacement::Terrain: return "terrain";
+        case ProbePlacement::Box: return "box";
+        case ProbePlacement::Adaptive: return "adaptive";
+    }
+    return "terrain";
+}
+
 // Adaptive octree placement (seed 001): cubic cells from max_cell_size down to min_cell_size over
 // a box; cells that overlap the terrain surface band go down to the minimum, open air stays
 // coarse, one probe per leaf at its centre. The .shprobe grid is the box at the minimum cell size.
