@@ -15,12 +15,14 @@
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
+#include "ProbeDiagnosticsFile.h"
 #include "SceneLighting.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
 #include "bake/SphereSampling.h"
 
@@ -358,23 +360,52 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
                                      {"reference_time_s", secondsSince(refStart)}};
         }
 
-        // Encoding: radiance projections, optionally windowed so irradiance is never negative,
-        // or pre-convolved irradiance (Â_l L_k).
+        // Radiance projections, optionally windowed so irradiance is never negative.
         int windowed = 0;
         float strongest = INFINITY;
         for (size_t i = 0; i < bake.sh.size(); ++i) {
-            if (!layout.valid[i]) continue;
-            if (scene.bake.deringing) {
-                const sh::DeringResult d = sh::deringIrradiance(bake.sh[i]);
-                if (d.windowed) {
-                    ++windowed;
-                    strongest = std::min(strongest, d.width);
-                }
+            if (!layout.valid[i] || !scene.bake.deringing) continue;
+            const sh::DeringResult d = sh::deringIrradiance(bake.sh[i]);
+            if (d.windowed) {
+                ++windowed;
+                strongest = std::min(strongest, d.width);
             }
-            if (scene.bake.encoding == ShEncoding::Irradiance)
+        }
+
+        // The interpolation-error map of the probes as the engine will read them (view 56).
+        ProbeDiagnostics diagnostics = describeProbes(layout);
+        if (scene.bake.errorMapResolution > 0) {
+            phase = "error map '" + v.name + "'";
+            const auto mapStart = Clock::now();
+            uint64_t mapRays = 0;
+            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, c);
+            const ProbeBaker counted = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+                ProbeBake t = baker(p, k);
+                mapRays += t.rays;
+                return t;
+            };
+            diagnostics.errorMap = measureErrorMap(layout, bake.sh, hf, counted,
+                                                   scene.bake.errorMapResolution,
+                                                   errorMapHeight(v, layout), seed);
+            const ErrorMapStats ms = errorMapStats(diagnostics.errorMap);
+            totalRays += mapRays;
+            vr["error_map"] = {{"size", {diagnostics.errorMap.nx, diagnostics.errorMap.nz}},
+                               {"step_m", diagnostics.errorMap.step},
+                               {"height_m", diagnostics.errorMap.height},
+                               {"points", ms.points},
+                               {"uncovered", ms.uncovered},
+                               {"mean", ms.mean},
+                               {"p95", ms.p95},
+                               {"max", ms.max},
+                               {"rays", mapRays},
+                               {"time_s", secondsSince(mapStart)}};
+        }
+
+        // Pre-convolved irradiance (Â_l L_k) when asked for.
+        if (scene.bake.encoding == ShEncoding::Irradiance)
+            for (size_t i = 0; i < bake.sh.size(); ++i)
                 for (int k = 0; k < sh::kCoeffCount; ++k)
                     bake.sh[i].c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
-        }
         if (scene.bake.deringing)
             vr["deringing"] = {{"window", "lanczos-sigma"},
                                {"probes_windowed", windowed},
@@ -385,8 +416,9 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         vr["grid"] = {{"dims", {grid.dims.x, grid.dims.y, grid.dims.z}},
                       {"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
                       {"spacing", grid.spacing}};
+        const glm::uvec3 gridDims = grid.dims;
         volumeReports.push_back(vr);
-        grids.push_back({v.name, std::move(grid)});
+        grids.push_back({v.name, std::move(grid), encodeProbeDiagnostics(diagnostics, v.name, gridDims)});
         done += layouts[vi].positions.size();
     }
     if (cancelled()) throw BakeCancelled();
@@ -428,6 +460,9 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             const auto path = out.outDir / "sh_coeffs" / (g.name + ".shprobe");
             writeShProbeFile(path, g.grid);
             out.files.push_back(path);
+            const auto sidecar = out.outDir / "sh_coeffs" / probeDiagnosticsFileName(g.name);
+            writeFileAtomically(sidecar, g.diagnostics);
+            out.files.push_back(sidecar);
         }
     }
 
@@ -573,6 +608,10 @@ BakeEstimate estimateBake(const BakeRequest& request) {
                 probesMax = probes;
             }
         }
+        const ErrorMap map = errorMapGrid(L, hf, scene.bake.errorMapResolution, errorMapHeight(v, L));
+        ve.errorMapPoints = map.error.size();
+        probes += double(ve.errorMapPoints);
+        probesMax += double(ve.errorMapPoints);
         ve.seconds = probes * perProbe;
         ve.secondsMax = std::max(probesMax, probes) * perProbe;
         e.seconds += ve.seconds;

@@ -49,6 +49,7 @@ struct VolumeEstimate {
     size_t probes = 0;                      // placed (adaptive: the geometric octree)
     uint64_t bytes = 0;                     // its .shprobe size
     int raysPerProbe = 0;
+    size_t errorMapPoints = 0;              // probes baked for the interpolation-error map (at most)
     double seconds = 0.0;
     // Adaptive volumes.
     double minCell = 0.0, maxCell = 0.0;

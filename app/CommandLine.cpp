@@ -60,7 +60,11 @@ Options:
                                 every probe against it (slow).
   --size WxH                    Render size (default 1280x720).
   --debug-view N|NAME           What --render draws: 0 beauty, 1 albedo, 2 normal, 30 ndotl,
-                                32 linear, 50 probe-irradiance, 51 probe-weight.
+                                32 linear, 50 probe-irradiance, 51 probe-weight,
+                                54 probe-validity, 56 interpolation-error.
+  --overlay LIST                --render: draw over the image, comma-separated: probes (probe
+                                positions: gold valid, cyan moved up, red rejected), leaves
+                                (adaptive octree leaves).
   --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
                                 degrees, radius in metres (default: the project's camera).
   --no-probes                   Render without probe lighting.
@@ -104,12 +108,13 @@ struct Args {
     QCommandLineOption noProbes{"no-probes", "No probes."};
     QCommandLineOption device{"device", "Device.", "NAME"};
     QCommandLineOption dryRun{"dry-run", "Estimate the bake only."};
+    QCommandLineOption overlay{"overlay", "Overlays.", "LIST"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, render, size, debugView, camera, noProbes,
-                           device, dryRun});
+                           device, dryRun, overlay});
     }
 };
 
@@ -231,7 +236,9 @@ int printEstimate(const BakeEstimate& e) {
             std::cout << " (" << v.moved << " moved up, " << v.borrowed
                       << " cells borrow the probe above; a uniform grid would need "
                       << v.uniformProbes << ")";
-        std::cout << ", " << v.bytes << " bytes, about " << duration(v.seconds) << "\n";
+        std::cout << ", " << v.bytes << " bytes";
+        if (v.errorMapPoints) std::cout << ", " << v.errorMapPoints << " error-map points";
+        std::cout << ", about " << duration(v.seconds) << "\n";
         if (v.refines)
             std::cout << "    error-driven refinement to " << fixed(100.0 * v.tolerance, 2)
                       << " %: up to " << v.probesMax << " probes (" << v.cap << "), "
@@ -299,6 +306,14 @@ int commandBake(const Args& a) {
                       << fixed(100.0 * v["reference_error"]["p95"].get<double>(), 2) << " % / max "
                       << fixed(100.0 * v["reference_error"]["max"].get<double>(), 2) << " %";
         std::cout << "\n";
+        if (v.contains("error_map")) {
+            const auto& m = v["error_map"];
+            std::cout << "    interpolation error over the ground (" << m["size"][0].get<int>() << " x "
+                      << m["size"][1].get<int>() << " points, " << fixed(m["height_m"].get<double>(), 2)
+                      << " m up): mean " << fixed(100.0 * m["mean"].get<double>(), 2) << " % / p95 "
+                      << fixed(100.0 * m["p95"].get<double>(), 2) << " % / max "
+                      << fixed(100.0 * m["max"].get<double>(), 2) << " % (debug view 56)\n";
+        }
     }
     std::cout << "wrote " << outcome.outDir.string() << ":\n";
     for (const auto& f : outcome.files)
@@ -336,6 +351,16 @@ int commandRender(const Args& a) {
     }
     request.probes = !a.parser.isSet(a.noProbes);
     request.linearOutput = ext == ".exr";
+    for (const QString& o : a.parser.values(a.overlay))
+        for (const QString& part : o.split(',')) {
+            if (part == "probes")
+                request.probePositions = true;
+            else if (part == "leaves")
+                request.leaves = true;
+            else
+                throw UsageError("--overlay " + str(o) + ": '" + str(part) +
+                                 "' is not one of probes, leaves");
+        }
 
     std::vector<std::string> warnings, sets;
     for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
@@ -367,8 +392,12 @@ int commandRender(const Args& a) {
     }
     ProjectRenderer renderer(*ctx, project);
     std::string note;
-    const size_t volumes = request.probes ? renderer.loadProbes(true, &note) : 0;
+    std::vector<std::string> probeWarnings;
+    const size_t volumes = request.probes ? renderer.loadProbes(true, &note, &probeWarnings) : 0;
     if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
+    // Only the views that need the diagnostics complain about their absence.
+    if (request.debugView == 54 || request.debugView == 56)
+        for (const auto& w : probeWarnings) std::cerr << "terralux: warning: " << w << "\n";
     const RenderedImage img = renderer.render(request);
     writeImage(image, img.width, img.height, img.rgba);
     const auto view = findDebugView(std::to_string(request.debugView));
@@ -421,6 +450,8 @@ int runCommandLine(int argc, char** argv) {
         }
         if (a.parser.isSet(a.dryRun) && !a.parser.isSet(a.bake))
             throw UsageError("--dry-run: only with --bake");
+        if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
+            throw UsageError("--overlay: only with --render");
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.render)) return commandRender(a);

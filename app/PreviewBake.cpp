@@ -4,10 +4,16 @@
 #include "SceneLighting.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
 #include "bake/SphereSampling.h"
 
 namespace terralux {
+
+namespace {
+// The draft's error map: enough to see where interpolation fails, at a quarter of the points.
+constexpr int kPreviewErrorMapResolution = 32;
+}  // namespace
 
 std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
                                           const std::atomic<bool>* cancel) {
@@ -24,8 +30,20 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
         const ProbeLayout layout = placeProbes(v, hf);
+        const uint64_t seed = splitmix64(0x7E77A1ABull + index++);
         const ProbeBake bake = bakeProbes(lighting, &cache, q.bounces, layout.positions, layout.valid,
-                                          q.rays, splitmix64(0x7E77A1ABull + index++), control);
+                                          q.rays, seed, control);
+        // Diagnostics as the bake writes them, with a coarser error map.
+        ProbeDiagnostics d = describeProbes(layout);
+        const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& keys) {
+            std::vector<uint64_t> seeds(keys.size());
+            for (size_t i = 0; i < keys.size(); ++i) seeds[i] = seed ^ keys[i];
+            return bakeProbesSeeded(lighting, &cache, q.bounces, p, std::vector<uint8_t>(p.size(), 1),
+                                    q.rays, seeds, control);
+        };
+        d.errorMap = measureErrorMap(layout, bake.sh, hf, baker,
+                                     std::min(scene.bake.errorMapResolution, kPreviewErrorMapResolution),
+                                     errorMapHeight(v, layout), seed);
         GpuProbeVolume g;
         g.dims = glm::uvec3(layout.cellDims[0], layout.cellDims[1], layout.cellDims[2]);
         g.origin = layout.cellOrigin;
@@ -36,6 +54,7 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
         for (size_t i = 0; i < layout.positions.size(); ++i)
             if (layout.valid[i]) g.coeffs.push_back(bake.sh[i].c);
         g.occupancy = layout.compactedOccupancy();
+        g.diagnostics = std::move(d);
         out.push_back(std::move(g));
     }
     return out;

@@ -11,7 +11,8 @@
 
 namespace terralux {
 
-// Every enabled volume at draft quality (rays and bounces of the draft preset). Throws
+// Every enabled volume at draft quality (rays and bounces of the draft preset), with the
+// diagnostics the bake writes (an error map of at most 32 points a side). Throws
 // BakeCancelled when `cancel` is set, PlacementError for bad volume settings.
 std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
                                           const std::atomic<bool>* cancel);

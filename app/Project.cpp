@@ -358,7 +358,8 @@ json sceneToJson(const SceneDescription& s) {
           {"rays", optionalInt(s.bake.rays)},
           {"bounces", optionalInt(s.bake.bounces)},
           {"sh_encoding", s.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
-          {"deringing", s.bake.deringing}}},
+          {"deringing", s.bake.deringing},
+          {"error_map_resolution", s.bake.errorMapResolution}}},
         {"camera",
          {{"target", s.camera.target ? vec(*s.camera.target, 3) : json(nullptr)},
           {"radius", optionalNumber(s.camera.radius)},
@@ -462,6 +463,8 @@ SceneDescription sceneFromJson(const json& doc, const std::string& source,
                           ? ShEncoding::Irradiance
                           : ShEncoding::Radiance;
     s.bake.deringing = r.boolean(bake.at("deringing"), "bake.deringing");
+    s.bake.errorMapResolution = r.integer(bake.at("error_map_resolution"), "bake.error_map_resolution",
+                                          0, kMaxErrorMapResolution);
 
     const json& cam = d.at("camera");
     if (!cam.at("target").is_null()) {

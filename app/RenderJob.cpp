@@ -4,6 +4,7 @@
 
 #include "BakeJob.h"
 #include "SceneLighting.h"
+#include "ProbeDiagnosticsFile.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
@@ -11,6 +12,16 @@
 
 namespace terralux {
 
+namespace {
+
+// Overlay markers: w 1 = valid, 2 = moved up, 0 = rejected (inside the terrain).
+void appendMarkers(const ProbeDiagnostics& d, std::vector<glm::vec4>& out) {
+    for (size_t i = 0; i < d.positions.size(); ++i)
+        out.emplace_back(d.positions[i], i < d.moved.size() && d.moved[i] ? 2.0f : 1.0f);
+    for (const auto& p : d.rejected) out.emplace_back(p, 0.0f);
+}
+
+}  // namespace
 
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
     : ProjectRenderer(ctx, project, loadProjectTerrain(project)) {}
@@ -30,23 +41,47 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
-    std::vector<glm::vec4> positions;
+    placedMarkers_.clear();
+    placedLeaves_.clear();
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
         try {
-            const ProbeLayout layout = placeProbes(v, terrain_.heightfield);
-            for (size_t i = 0; i < layout.positions.size(); ++i)
-                positions.emplace_back(layout.positions[i], layout.valid[i] ? 1.0f : 0.0f);
+            const ProbeDiagnostics d = describeProbes(placeProbes(v, terrain_.heightfield));
+            appendMarkers(d, placedMarkers_);
+            placedLeaves_.insert(placedLeaves_.end(), d.leaves.begin(), d.leaves.end());
         } catch (const PlacementError&) {
             // Settings the bake would refuse: no markers for that volume.
         }
     }
-    renderer_->setProbePositions(positions);
+    updateOverlays();
+}
+
+void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
+    renderer_->setProbeVolumes(volumes);
+    boundMarkers_.clear();
+    boundLeaves_.clear();
+    boundDiagnostics_ = false;
+    boundVolumes_ = sceneToJson(project_.scene).at("probe_volumes").dump();
+    for (const auto& v : volumes) {
+        if (!v.diagnostics) continue;
+        boundDiagnostics_ = true;
+        appendMarkers(*v.diagnostics, boundMarkers_);
+        boundLeaves_.insert(boundLeaves_.end(), v.diagnostics->leaves.begin(), v.diagnostics->leaves.end());
+    }
+    updateOverlays();
+}
+
+void ProjectRenderer::updateOverlays() {
+    const bool bound = boundDiagnostics_ &&
+                       boundVolumes_ == sceneToJson(project_.scene).at("probe_volumes").dump();
+    renderer_->setProbePositions(bound ? boundMarkers_ : placedMarkers_);
+    renderer_->setProbeLeaves(bound ? boundLeaves_ : placedLeaves_);
 }
 
 ProjectRenderer::~ProjectRenderer() = default;
 
-size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note) {
+size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
+                                   std::vector<std::string>* warnings) {
     const SceneDescription& scene = project_.scene;
     const std::filesystem::path dir = project_.outDir() / "sh_coeffs";
     bool missing = false;
@@ -75,9 +110,18 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note) {
         gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
                                                            : 2.0f * g.spacing;
         for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);
+        const auto sidecar = dir / probeDiagnosticsFileName(v.name);
+        try {
+            if (std::filesystem::exists(sidecar))
+                gv.diagnostics = readProbeDiagnosticsFile(sidecar, g.probes.size(), g.dims);
+            else if (warnings)
+                warnings->push_back(sidecar.string() + ": missing (bake again for views 54 and 56)");
+        } catch (const ProbeDiagnosticsError& e) {
+            if (warnings) warnings->push_back(e.what());
+        }
         volumes.push_back(std::move(gv));
     }
-    renderer_->setProbeVolumes(volumes);
+    setProbes(volumes);
     return volumes.size();
 }
 
@@ -92,6 +136,7 @@ RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera&
     s.probes = r.probes;
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
+    s.showLeaves = r.leaves;
     return renderer_->render(s);
 }
 

@@ -22,6 +22,7 @@ struct RenderRequest {
     bool linearOutput = false;
     bool bakeIfMissing = true;
     bool probePositions = false;  // overlay of the enabled volumes' probe positions
+    bool leaves = false;          // overlay of the adaptive volumes' octree leaves
 };
 
 class ProjectRenderer {
@@ -32,12 +33,15 @@ public:
     ProjectRenderer(vk::VulkanContext& ctx, const Project& project, DemImportResult terrain);
     ~ProjectRenderer();
 
-    // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder; when any
-    // is missing and `bakeIfMissing`, bakes the project first (its own quality settings).
-    // Returns the number of volumes bound; `note` says what happened.
-    size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr);
+    // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder, with its
+    // <volume>.probes.json diagnostics when present and matching; when any .shprobe is missing
+    // and `bakeIfMissing`, bakes the project first (its own quality settings). Returns the number
+    // of volumes bound; `note` says what happened, `warnings` gets one line per unreadable or
+    // stale diagnostics file (views 54 and 56 then show no data for that volume).
+    size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr,
+                      std::vector<std::string>* warnings = nullptr);
     // Binds probe volumes computed elsewhere (the UI's draft preview).
-    void setProbes(const std::vector<GpuProbeVolume>& volumes) { renderer_->setProbeVolumes(volumes); }
+    void setProbes(const std::vector<GpuProbeVolume>& volumes);
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
@@ -50,7 +54,15 @@ public:
     TerrainRenderer& renderer() { return *renderer_; }
 
 private:
+    // The overlays follow the bound probes where they carry diagnostics and were baked from the
+    // current probe-volume settings; otherwise the placement of the current settings.
+    void updateOverlays();
+
     Project project_;
+    std::vector<glm::vec4> placedMarkers_, placedLeaves_;
+    std::vector<glm::vec4> boundMarkers_, boundLeaves_;
+    bool boundDiagnostics_ = false;
+    std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     DemImportResult terrain_;
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;

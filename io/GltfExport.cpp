@@ -1,4 +1,5 @@
 #include "GltfExport.h"
+#include "ProbeDiagnosticsFile.h"
 
 #include <algorithm>
 
@@ -314,6 +315,9 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
     for (const GltfProbeVolume* v : sorted) {
         const fs::path relative = fs::path(kProbeDir) / (v->name + kProbeExt);
         files.push_back({relative, encodeVolume(*v, outDir / relative)});
+        if (!v->diagnostics.empty())
+            files.push_back({fs::path(kProbeDir) / probeDiagnosticsFileName(v->name),
+                             std::vector<uint8_t>(v->diagnostics.begin(), v->diagnostics.end())});
         grids.push_back(probeGridEntry(*v));
     }
 

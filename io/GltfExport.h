@@ -33,6 +33,8 @@ namespace terralux {
 struct GltfProbeVolume {
     std::string name;  // file stem: 1 to 64 of [A-Za-z0-9_-], unique within a scene
     ShProbeGrid grid;
+    // When set, written as sh_coeffs/<name>.probes.json in the same commit (ProbeDiagnosticsFile.h).
+    std::string diagnostics;
 };
 
 struct GltfSceneInput {

@@ -10,4 +10,5 @@ std::span<const uint32_t> terrainFrag();
 std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();
+std::span<const uint32_t> leavesVert();
 }  // namespace terralux::shaders

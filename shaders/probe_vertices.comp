@@ -7,15 +7,47 @@ layout(local_size_x = 64) in;
 #include "probes.glsl"
 
 layout(set = 0, binding = 4, std430) readonly buffer Vertices { float v[]; } vertices;  // pos, normal
+// Per vertex: (probe irradiance, blend weight), then (moved share, interpolation error, 1 = the
+// error is known, 1 = inside a volume with no probe to light it).
 layout(set = 0, binding = 5, std430) writeonly buffer ProbeLight { vec4 v[]; } probeLight;
+// Every volume's interpolation-error map (Volume.errorMap), -1 where no probe covered the point.
+layout(set = 0, binding = 6, std430) readonly buffer Errors { float e[]; } errors;
 layout(push_constant) uniform Count { uint vertexCount; } pc;
+
+// Bilinear over the map points around (x, z); uncovered points drop out. known = 0: no value.
+float mapError(Volume vol, vec2 xz, out float known) {
+    known = 0.0;
+    ivec2 size = vol.errorMap.yz;
+    if (size.x <= 0 || size.y <= 0) return 0.0;
+    vec2 g = clamp((xz - vol.errorGrid.xy) / vol.errorGrid.z, vec2(0.0), vec2(size - 1));
+    ivec2 c0 = min(ivec2(floor(g)), size - 1);
+    vec2 f = g - vec2(c0);
+    float sum = 0.0, wsum = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        ivec2 c = min(c0 + o, size - 1);
+        float e = errors.e[vol.errorMap.x + c.x + c.y * size.x];
+        vec2 wv = mix(vec2(1.0) - f, f, vec2(o));
+        float w = wv.x * wv.y;
+        if (e < 0.0 || w <= 0.0) continue;
+        sum += w * e;
+        wsum += w;
+    }
+    if (wsum <= 0.0) return 0.0;
+    known = 1.0;
+    return sum / wsum;
+}
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.vertexCount) return;
     vec3 p = vec3(vertices.v[6 * i], vertices.v[6 * i + 1], vertices.v[6 * i + 2]);
     vec3 n = normalize(vec3(vertices.v[6 * i + 3], vertices.v[6 * i + 4], vertices.v[6 * i + 5]));
-    float weight = 0.0;
-    vec3 irradiance = probeIrradiance(p, n, weight);
-    probeLight.v[i] = vec4(irradiance, weight);
+    float weight = 0.0, moved = 0.0, known = 0.0, error = 0.0;
+    int volume = -1;
+    bool unlit = false;
+    vec3 irradiance = probeIrradiance(p, n, weight, moved, volume, unlit);
+    if (volume >= 0) error = mapError(volumes.v[volume], p.xz, known);
+    probeLight.v[2 * i] = vec4(irradiance, weight);
+    probeLight.v[2 * i + 1] = vec4(moved, error, known, unlit ? 1.0 : 0.0);
 }

@@ -38,8 +38,14 @@ int cellIndex(Volume vol, ivec3 c) {
 // terrain surface point, the lookup climbs to the first layer that has probes. The returned
 // weight fades from 1 at the grid box to 0 at the fallback blend distance outside it; the first
 // volume with any weight wins, as engines take the first grid that contains a point.
-vec3 probeIrradiance(vec3 p, vec3 n, out float weight) {
+// Also: the blended share of moved probes, the volume that lit p (-1: none), and whether p lies
+// inside some volume's box with no probe to light it.
+vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out int volume,
+                     out bool unlit) {
     weight = 0.0;
+    movedShare = 0.0;
+    volume = -1;
+    unlit = false;
     for (int vi = 0; vi < frame.params.y; ++vi) {
         Volume vol = volumes.v[vi];
         vec3 lo = vol.originSpacing.xyz;
@@ -59,7 +65,7 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight) {
             // the coefficients, and one evaluation costs what eight would not.
             vec3 blended[9];
             for (int j = 0; j < 9; ++j) blended[j] = vec3(0.0);
-            float wsum = 0.0;
+            float wsum = 0.0, moved = 0.0;
             for (int k = 0; k < 8; ++k) {
                 ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
                 ivec3 c = clamp(c0 + o + ivec3(0, climb, 0), ivec3(0), dims - 1);
@@ -69,15 +75,18 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight) {
                 float w = max(wv.x * wv.y * wv.z, 1e-6);  // a corner on a cell centre still counts
                 int base = (vol.dimsProbe.w + probe) * 9;
                 for (int j = 0; j < 9; ++j) blended[j] += w * probes.coeffs[base + j].rgb;
+                moved += w * probes.coeffs[base].w;
                 wsum += w;
             }
             if (wsum > 0.0) {
                 weight = fade;
+                movedShare = moved / wsum;
+                volume = vi;
                 for (int j = 0; j < 9; ++j) blended[j] /= wsum;
                 return max(shIrradiance(blended, n, vol.occupancy.y == 1) * vol.blend.y, vec3(0.0));
             }
         }
+        if (dist <= 0.0) unlit = true;
     }
     return vec3(0.0);
 }
-

@@ -7,6 +7,9 @@
 layout(location = 0) in vec3 worldPos;
 layout(location = 1) in vec3 worldNormal;
 layout(location = 2) in vec4 probeIrradianceWeight;  // rgb irradiance, a blend weight
+// x share of moved probes in the blend, y interpolation error, z 1 = error known, w 1 = inside a
+// volume with no probe to light it.
+layout(location = 3) in vec4 probeInfo;
 layout(location = 0) out vec4 outColor;
 
 #include "probes.glsl"
@@ -21,6 +24,15 @@ vec3 srgb(vec3 c) {
 }
 vec3 display(vec3 linear) {
     return frame.params.w == 1 ? linear : srgb(aces(linear * frame.exposure.x));
+}
+
+// Heat ramp for view 56: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red.
+vec3 heat(float e) {
+    const vec3 stops[5] = vec3[](vec3(0.05, 0.10, 0.55), vec3(0.0, 0.65, 0.90), vec3(0.15, 0.80, 0.20),
+                                 vec3(1.0, 0.85, 0.10), vec3(0.90, 0.10, 0.05));
+    float t = clamp(e / 0.10, 0.0, 1.0) * 4.0;
+    int i = min(int(t), 3);
+    return mix(stops[i], stops[i + 1], t - float(i));
 }
 
 void main() {
@@ -57,6 +69,19 @@ void main() {
     else if (view == 32) c = frame.params.w == 1 ? linear : clamp(linear, 0.0, 1.0);
     else if (view == 50) c = display(probe * weight / PI);
     else if (view == 51) c = vec3(weight);
+    else if (view == 54) {
+        // Probe validity: grey where probes at their placement light the ground, cyan as moved
+        // probes take part, red inside a volume where no valid probe is left, dark outside.
+        float relief = 0.55 + 0.45 * max(n.y, 0.0);
+        vec3 base = probeInfo.w > 0.5 ? vec3(0.85, 0.12, 0.10)
+                  : weight > 0.0      ? mix(vec3(0.72), vec3(0.10, 0.80, 1.0), clamp(probeInfo.x, 0.0, 1.0))
+                                      : vec3(0.18);
+        c = base * relief;
+    } else if (view == 56) {
+        // Interpolation error: EXR holds the error in red and 1 where it is known in green.
+        if (frame.params.w == 1) c = vec3(probeInfo.y * probeInfo.z, probeInfo.z, 0.0);
+        else c = (probeInfo.z > 0.5 ? heat(probeInfo.y) : vec3(0.25)) * (0.75 + 0.25 * max(n.y, 0.0));
+    }
     else c = display(linear);
     outColor = vec4(c, 1.0);
 }

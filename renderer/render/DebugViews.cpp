@@ -11,6 +11,14 @@ const std::vector<DebugView>& debugViews() {
         {32, "linear", "pre-tonemap colour", true},
         {50, "probe-irradiance", "probe irradiance × weight", true},
         {51, "probe-weight", "probe blend weight", false},
+        {54, "probe-validity",
+         "invalid / relocated probes: grey lit by probes at their placement, cyan by moved probes, "
+         "red inside a volume with no valid probe; markers gold valid, cyan moved, red rejected",
+         false},
+        {56, "interpolation-error",
+         "interpolation error heat map: blue 0 %, cyan 2.5 %, green 5 %, yellow 7.5 %, red 10 % and "
+         "above, grey unmeasured (EXR: error in red, 1 in green where measured)",
+         true},
     };
     return views;
 }

@@ -28,8 +28,9 @@ struct FrameUniforms {
     glm::vec4 skySh[9];
     int32_t params[4];
     glm::vec4 exposure;
+    glm::vec4 overlay;
 };
-static_assert(sizeof(FrameUniforms) == 304);
+static_assert(sizeof(FrameUniforms) == 320);
 
 // std430 mirror of `Volume`.
 struct VolumeRecord {
@@ -37,13 +38,15 @@ struct VolumeRecord {
     int32_t dimsProbe[4];
     int32_t occupancy[4];
     glm::vec4 blend;
+    int32_t errorMap[4];
+    glm::vec4 errorGrid;
 };
-static_assert(sizeof(VolumeRecord) == 64);
+static_assert(sizeof(VolumeRecord) == 96);
 
 }  // namespace
 
 struct TerrainRenderer::Gpu {
-    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight, markers;
+    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight, errors, markers, leaves;
     std::unique_ptr<vk::ProbeVertexPass> probePass;
     std::unique_ptr<vk::OffscreenTarget> target;
     std::unique_ptr<vk::TerrainPipeline> pipeline;
@@ -82,7 +85,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
 
     gpu_->vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
                                              VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    gpu_->probeLight = vk::Buffer(ctx_, std::max<size_t>(vertexCount(), 1) * 16,
+    gpu_->probeLight = vk::Buffer(ctx_, std::max<size_t>(vertexCount(), 1) * 32,
                                   VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     gpu_->probePass = std::make_unique<vk::ProbeVertexPass>(ctx_, shaders::probeVerticesComp());
@@ -98,6 +101,7 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     std::vector<glm::vec4> coeffs;
     std::vector<int32_t> cells;
     std::vector<VolumeRecord> records;
+    std::vector<float> errors;
     for (const auto& v : volumes) {
         VolumeRecord rec{};
         rec.originSpacing = glm::vec4(v.origin, v.spacing);
@@ -108,13 +112,24 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
         rec.occupancy[0] = int32_t(cells.size());
         rec.occupancy[1] = v.irradianceEncoded ? 1 : 0;
         rec.blend = glm::vec4(v.fallbackBlendDistance, v.scale, 0.0f, 0.0f);
-        for (const auto& p : v.coeffs)
-            for (const auto& c : p) coeffs.push_back(glm::vec4(c, 0.0f));
+        static const ProbeDiagnostics none;
+        const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
+        rec.errorMap[0] = int32_t(errors.size());
+        rec.errorMap[1] = int32_t(d.errorMap.nx);
+        rec.errorMap[2] = int32_t(d.errorMap.nz);
+        rec.errorGrid = glm::vec4(d.errorMap.x0, d.errorMap.z0, d.errorMap.step, 0.0f);
+        for (float e : d.errorMap.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
+        for (size_t i = 0; i < v.coeffs.size(); ++i) {
+            const float moved = i < d.moved.size() && d.moved[i] ? 1.0f : 0.0f;
+            coeffs.push_back(glm::vec4(v.coeffs[i][0], moved));
+            for (size_t k = 1; k < 9; ++k) coeffs.push_back(glm::vec4(v.coeffs[i][k], 0.0f));
+        }
         cells.insert(cells.end(), v.occupancy.begin(), v.occupancy.end());
         records.push_back(rec);
     }
     volumeCount_ = int(records.size());
     probeBytes_ = coeffs.size() * sizeof(glm::vec4) + cells.size() * 4;
+    if (errors.empty()) errors.push_back(-1.0f);
     // Storage buffers may not be empty: a placeholder element when there is nothing to bind.
     if (coeffs.empty()) coeffs.push_back(glm::vec4(0.0f));
     if (cells.empty()) cells.push_back(-1);
@@ -126,6 +141,8 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     gpu_->volumes = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(VolumeRecord),
                                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    gpu_->errors = vk::Buffer::deviceLocal(ctx_, errors.data(), errors.size() * 4,
+                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     if (gpu_->descriptors)
         gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
 
@@ -136,7 +153,7 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     gpu_->uniforms.write(&u, sizeof u);
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         gpu_->probePass->record(cb, gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes,
-                                gpu_->vertices, gpu_->probeLight, uint32_t(vertexCount_));
+                                gpu_->vertices, gpu_->probeLight, gpu_->errors, uint32_t(vertexCount_));
     });
 }
 
@@ -155,6 +172,20 @@ void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions)
                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
 }
 
+void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
+    ctx_.submitAndWait([](VkCommandBuffer) {});  // no draw may still read the old buffer
+    leafCount_ = uint32_t(leaves.size());
+    smallestLeaf_ = 1.0f;
+    if (leaves.empty()) {
+        gpu_->leaves = vk::Buffer();
+        return;
+    }
+    smallestLeaf_ = leaves.front().w;
+    for (const auto& l : leaves) smallestLeaf_ = std::min(smallestLeaf_, l.w);
+    gpu_->leaves = vk::Buffer::deviceLocal(ctx_, leaves.data(), leaves.size() * sizeof(glm::vec4),
+                                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+}
+
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
     if (!gpu_->target || gpu_->target->width() != s.width || gpu_->target->height() != s.height) {
@@ -164,7 +195,7 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
         if (!gpu_->pipeline) {
             gpu_->pipeline = std::make_unique<vk::TerrainPipeline>(
                 ctx_, gpu_->target->renderPass(), shaders::terrainVert(), shaders::terrainFrag(),
-                shaders::markersVert(), shaders::markersFrag());
+                shaders::markersVert(), shaders::markersFrag(), shaders::leavesVert());
             gpu_->descriptors = std::make_unique<vk::TerrainDescriptors>(ctx_, gpu_->pipeline->setLayout());
             gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
         }
@@ -183,6 +214,7 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     u.params[2] = s.probes ? 1 : 0;
     u.params[3] = s.linearOutput ? 1 : 0;
     u.exposure = glm::vec4(s.exposure, s.roughness, float(s.width), float(s.height));
+    u.overlay = glm::vec4(smallestLeaf_, s.showProbePositions ? 1.0f : 0.0f, 0.0f, 0.0f);
     gpu_->uniforms.write(&u, sizeof u);
 
     // Background: the sky toward the horizon, in the same encoding as the view.
@@ -226,20 +258,26 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
             vkCmdBindIndexBuffer(cb, gpu_->indices.handle(), 0, VK_INDEX_TYPE_UINT32);
             vkCmdDrawIndexed(cb, uint32_t(indexCount_), 1, 0, 0, 0);
         }
-        if (s.showProbePositions && markerCount_ > 0 && gpu_->pipeline) {
+        // Overlays: per-instance vec4 records, same layout and descriptor set as the terrain.
+        auto overlay = [&](VkPipeline pipeline, const vk::Buffer& instances, uint32_t vertices,
+                           uint32_t count) {
             VkViewport vp{0, 0, float(s.width), float(s.height), 0.0f, 1.0f};
             VkRect2D sc{{0, 0}, {s.width, s.height}};
             vkCmdSetViewport(cb, 0, 1, &vp);
             vkCmdSetScissor(cb, 0, 1, &sc);
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->markers());
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
             VkDescriptorSet set = gpu_->descriptors->set();
             vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
                                     &set, 0, nullptr);
             VkDeviceSize offset = 0;
-            VkBuffer mb = gpu_->markers.handle();
-            vkCmdBindVertexBuffers(cb, 0, 1, &mb, &offset);
-            vkCmdDraw(cb, 6, markerCount_, 0, 0);
-        }
+            VkBuffer b = instances.handle();
+            vkCmdBindVertexBuffers(cb, 0, 1, &b, &offset);
+            vkCmdDraw(cb, vertices, count, 0, 0);
+        };
+        if (s.showLeaves && leafCount_ > 0) overlay(gpu_->pipeline->leaves(), gpu_->leaves, 24, leafCount_);
+        // View 54 is about the probes themselves: their markers are part of it.
+        if ((s.showProbePositions || s.debugView == 54) && markerCount_ > 0)
+            overlay(gpu_->pipeline->markers(), gpu_->markers, 6, markerCount_);
         vkCmdEndRenderPass(cb);
         target.recordReadback(cb);
     });

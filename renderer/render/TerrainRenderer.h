@@ -6,10 +6,12 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "bake/ProbeDiagnostics.h"
 #include "bake/Sky.h"
 #include "bake/SphericalHarmonics.h"
 #include "render/OrbitCamera.h"
@@ -28,6 +30,9 @@ struct GpuProbeVolume {
     float fallbackBlendDistance = 0.0f;
     bool irradianceEncoded = false;                // coefficients hold Â_l L_k
     float scale = 1.0f;                            // the file's default SH scale
+    // What the bake wrote beside the file (moved probes for view 54, the error map for view 56);
+    // unset for bakes without it.
+    std::optional<ProbeDiagnostics> diagnostics;
 };
 
 struct RenderSettings {
@@ -41,7 +46,9 @@ struct RenderSettings {
     sh::ShRgb skySh;
     float exposure = 1.0f;
     float roughness = 0.8f;
-    bool showProbePositions = false;  // the overlay of setProbePositions
+    bool showProbePositions = false;  // the overlay of setProbePositions (view 54 always marks
+                                      // moved and rejected probes)
+    bool showLeaves = false;          // the overlay of setProbeLeaves
 };
 
 struct RenderedImage {
@@ -59,8 +66,10 @@ public:
     ~TerrainRenderer();
 
     void setProbeVolumes(const std::vector<GpuProbeVolume>& volumes);
-    // Probe positions for the overlay: xyz, w = 1 valid, 0 inside the terrain.
+    // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.
     void setProbePositions(const std::vector<glm::vec4>& positions);
+    // Octree leaves for the leaf overlay: min corner xyz, w edge (metres).
+    void setProbeLeaves(const std::vector<glm::vec4>& leaves);
     RenderedImage render(const RenderSettings& settings);
     // The colour image of the last render (TRANSFER_SRC_OPTIMAL), for a presenter.
     VkImage lastImage() const;
@@ -78,7 +87,8 @@ private:
     int stride_ = 1;
     size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0;
     int volumeCount_ = 0;
-    uint32_t markerCount_ = 0;
+    uint32_t markerCount_ = 0, leafCount_ = 0;
+    float smallestLeaf_ = 1.0f;
 };
 
 }  // namespace terralux

@@ -107,12 +107,18 @@ struct ReflectionProbeSettings {
 enum class QualityPreset { Draft, Standard, High, Reference };
 enum class ShEncoding { Radiance, Irradiance };
 
+// Largest interpolation-error map side (BakeSettings::errorMapResolution).
+inline constexpr int kMaxErrorMapResolution = 512;
+
 struct BakeSettings {
     QualityPreset quality = QualityPreset::Standard;
     std::optional<int> rays;          // per probe; unset = preset
     std::optional<int> bounces;       // 0 = sky visibility only; unset = preset
     ShEncoding encoding = ShEncoding::Radiance;
     bool deringing = false;           // window SH so irradiance is never negative
+    // Points along the longer side of each volume's interpolation-error map (debug view 56);
+    // 0 = no map. Each point costs one probe bake.
+    int errorMapResolution = 64;
 };
 
 struct ExportSettings {

@@ -4,15 +4,15 @@ namespace terralux::vk {
 
 ProbeVertexPass::ProbeVertexPass(const VulkanContext& ctx, std::span<const uint32_t> spirv)
     : device_(ctx.device()) {
-    VkDescriptorSetLayoutBinding b[6]{};
-    for (uint32_t i = 0; i < 6; ++i) {
+    VkDescriptorSetLayoutBinding b[7]{};
+    for (uint32_t i = 0; i < 7; ++i) {
         b[i].binding = i;
         b[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         b[i].descriptorCount = 1;
         b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
     VkDescriptorSetLayoutCreateInfo sli{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    sli.bindingCount = 6;
+    sli.bindingCount = 7;
     sli.pBindings = b;
     check(vkCreateDescriptorSetLayout(device_, &sli, nullptr, &setLayout_), "vkCreateDescriptorSetLayout (compute)");
     VkPushConstantRange pc{VK_SHADER_STAGE_COMPUTE_BIT, 0, 4};
@@ -39,7 +39,7 @@ ProbeVertexPass::ProbeVertexPass(const VulkanContext& ctx, std::span<const uint3
     check(r, "vkCreateComputePipelines");
 
     VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5}};
+                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 6}};
     VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     dpi.maxSets = 1;
     dpi.poolSizeCount = 2;
@@ -61,11 +61,11 @@ ProbeVertexPass::~ProbeVertexPass() {
 
 void ProbeVertexPass::record(VkCommandBuffer cb, const Buffer& uniforms, const Buffer& probes,
                              const Buffer& cells, const Buffer& volumes, const Buffer& vertices,
-                             const Buffer& out, uint32_t vertexCount) {
-    const Buffer* buffers[6] = {&uniforms, &probes, &cells, &volumes, &vertices, &out};
-    VkDescriptorBufferInfo info[6];
-    VkWriteDescriptorSet w[6]{};
-    for (uint32_t i = 0; i < 6; ++i) {
+                             const Buffer& out, const Buffer& errors, uint32_t vertexCount) {
+    const Buffer* buffers[7] = {&uniforms, &probes, &cells, &volumes, &vertices, &out, &errors};
+    VkDescriptorBufferInfo info[7];
+    VkWriteDescriptorSet w[7]{};
+    for (uint32_t i = 0; i < 7; ++i) {
         info[i] = {buffers[i]->handle(), 0, VK_WHOLE_SIZE};
         w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
         w[i].dstSet = set_;
@@ -74,7 +74,7 @@ void ProbeVertexPass::record(VkCommandBuffer cb, const Buffer& uniforms, const B
         w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         w[i].pBufferInfo = &info[i];
     }
-    vkUpdateDescriptorSets(device_, 6, w, 0, nullptr);
+    vkUpdateDescriptorSets(device_, 7, w, 0, nullptr);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
     vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, 4, &vertexCount);

@@ -1,7 +1,7 @@
 #pragma once
 // The per-vertex probe-lighting compute pass: its descriptor-set layout (frame uniforms, the
-// three probe buffers, vertices in, probe light out), a push constant for the count, the pipeline,
-// and its one descriptor set.
+// three probe buffers, vertices in, probe light out, the error maps), a push constant for the
+// count, the pipeline, and its one descriptor set.
 
 #include <cstdint>
 #include <span>
@@ -21,7 +21,8 @@ public:
     // Binds the buffers and records the dispatch over `vertexCount` vertices, with a barrier
     // that makes the output visible to vertex input.
     void record(VkCommandBuffer cb, const Buffer& uniforms, const Buffer& probes, const Buffer& cells,
-                const Buffer& volumes, const Buffer& vertices, const Buffer& out, uint32_t vertexCount);
+                const Buffer& volumes, const Buffer& vertices, const Buffer& out,
+                const Buffer& errors, uint32_t vertexCount);
 
 private:
     VkDevice device_;

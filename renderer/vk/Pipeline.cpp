@@ -15,7 +15,8 @@ VkShaderModule makeModule(VkDevice device, std::span<const uint32_t> code) {
 
 VkPipeline createGraphicsPipeline(VkDevice device, VkRenderPass pass, VkPipelineLayout layout,
                                   std::span<const uint32_t> vertSpirv, std::span<const uint32_t> fragSpirv,
-                                  const VkPipelineVertexInputStateCreateInfo& vi, bool depthWrite) {
+                                  const VkPipelineVertexInputStateCreateInfo& vi, bool depthWrite,
+                                  VkPrimitiveTopology topology) {
     VkShaderModule vert = makeModule(device, vertSpirv), frag = makeModule(device, fragSpirv);
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -26,7 +27,7 @@ VkPipeline createGraphicsPipeline(VkDevice device, VkRenderPass pass, VkPipeline
     stages[1].module = frag;
     stages[1].pName = "main";
     VkPipelineInputAssemblyStateCreateInfo ia{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    ia.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    ia.topology = topology;
     VkPipelineViewportStateCreateInfo vp{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
     vp.viewportCount = 1;
     vp.scissorCount = 1;
@@ -76,7 +77,8 @@ TerrainPipeline::TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass,
                                  std::span<const uint32_t> vertSpirv,
                                  std::span<const uint32_t> fragSpirv,
                                  std::span<const uint32_t> markerVert,
-                                 std::span<const uint32_t> markerFrag)
+                                 std::span<const uint32_t> markerFrag,
+                                 std::span<const uint32_t> leafVert)
     : device_(ctx.device()) {
     VkDescriptorSetLayoutBinding b[4]{};
     for (uint32_t i = 0; i < 4; ++i) {
@@ -95,14 +97,15 @@ TerrainPipeline::TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass,
     check(vkCreatePipelineLayout(device_, &pli, nullptr, &layout_), "vkCreatePipelineLayout");
 
     VkVertexInputBindingDescription vb[2] = {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX},
-                                             {1, 16, VK_VERTEX_INPUT_RATE_VERTEX}};
-    VkVertexInputAttributeDescription va[3] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                                             {1, 32, VK_VERTEX_INPUT_RATE_VERTEX}};
+    VkVertexInputAttributeDescription va[4] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                                                {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
-                                               {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
+                                               {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+                                               {3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 16}};
     VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     vi.vertexBindingDescriptionCount = 2;
     vi.pVertexBindingDescriptions = vb;
-    vi.vertexAttributeDescriptionCount = 3;
+    vi.vertexAttributeDescriptionCount = 4;
     vi.pVertexAttributeDescriptions = va;
     pipeline_ = createGraphicsPipeline(device_, pass, layout_, vertSpirv, fragSpirv, vi, true);
 
@@ -114,9 +117,13 @@ TerrainPipeline::TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass,
     mi.vertexAttributeDescriptionCount = 1;
     mi.pVertexAttributeDescriptions = &ma;
     markers_ = createGraphicsPipeline(device_, pass, layout_, markerVert, markerFrag, mi, false);
+    // Leaves: the same per-instance vec4 (min corner, edge), 12 edges as a line list.
+    leaves_ = createGraphicsPipeline(device_, pass, layout_, leafVert, markerFrag, mi, false,
+                                     VK_PRIMITIVE_TOPOLOGY_LINE_LIST);
 }
 
 TerrainPipeline::~TerrainPipeline() {
+    vkDestroyPipeline(device_, leaves_, nullptr);
     vkDestroyPipeline(device_, markers_, nullptr);
     vkDestroyPipeline(device_, pipeline_, nullptr);
     vkDestroyPipelineLayout(device_, layout_, nullptr);

@@ -12,7 +12,7 @@ case "$case_" in
     "$terralux" --bake --dry-run --dem "$dem" --out "$work/out" "${adaptive[@]}" \
       --set 'probe_volumes[0].adaptive.tolerance=0.03' >"$work/stdout" 2>"$work/stderr" || fail "dry run exited $?"
     grep -q "^dry run: nothing baked, nothing written" "$work/stdout" || fail "no dry-run header"
-    grep -Eq "^  valley: adaptive, cells 30.00 to 480.00 m, 95 x 38 x 63 cells of 30.00 m: [0-9]+ probes .*, [0-9]+ bytes, about" "$work/stdout" || fail "no volume estimate"
+    grep -Eq "^  valley: adaptive, cells 30.00 to 480.00 m, 95 x 38 x 63 cells of 30.00 m: [0-9]+ probes .*, [0-9]+ bytes, [0-9]+ error-map points, about" "$work/stdout" || fail "no volume estimate"
     grep -Eq "error-driven refinement to 3.00 %: up to [0-9]+ probes" "$work/stdout" || fail "no refinement estimate"
     grep -Eq "^estimated bake time: about" "$work/stdout" || fail "no total"
     [ -e "$work/out" ] && fail "the dry run created $work/out"

@@ -56,8 +56,8 @@ int main(int argc, char** argv) {
         GltfSceneInput in;
         in.heightfield = &hf;
         in.albedo = {0.32f, 0.3f, 0.26f};
-        in.volumes.push_back({"valley", syntheticGrid({8, 2, 4}, {-480.f, -50.f, -240.f}, 60.f, 20)});
-        in.volumes.push_back({"probes", syntheticGrid({4, 2, 4}, {-10.f, 0.f, -10.f}, 0.5f, 7)});
+        in.volumes.push_back({"valley", syntheticGrid({8, 2, 4}, {-480.f, -50.f, -240.f}, 60.f, 20), {}});
+        in.volumes.push_back({"probes", syntheticGrid({4, 2, 4}, {-10.f, 0.f, -10.f}, 0.5f, 7), {}});
         in.bake = {{"shEncoding", "L2"}, {"quality", "draft"}, {"rays", 64}, {"bounces", 1}};
         in.generatorVersion = "test";
         if (argc == 5)

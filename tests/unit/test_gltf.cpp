@@ -150,8 +150,8 @@ protected:
         in.heightfield = &hf;
         in.albedo = {0.25f, 0.5f, 0.7f};
         in.verticalScale = 1.5;
-        in.volumes.push_back({"zeta", makeGrid(1)});
-        in.volumes.push_back({"alpha", makeGrid(0)});
+        in.volumes.push_back({"zeta", makeGrid(1), {}});
+        in.volumes.push_back({"alpha", makeGrid(0), {}});
         in.bake = {{"shEncoding", "L2 RGB"}, {"quality", "standard"}, {"rays", 256},
                    {"bounces", 2}, {"bakeSeconds", 12.625}, {"errorEstimate", 0.0123}};
         in.generatorVersion = "1.2.3";
@@ -296,7 +296,7 @@ TEST_F(GltfExport, GridsAreSortedByFileNameNotByStem) {
     GltfSceneInput in;
     in.heightfield = &hf;
     for (const char* name : {"a", "a-b", "B"})
-        in.volumes.push_back({name, makeGrid(0)});
+        in.volumes.push_back({name, makeGrid(0), {}});
     exportGltfScene(dir, in);
     const json entries = readShProbeGridEntries(dir / "scene.gltf");
     ASSERT_EQ(entries.size(), 3u);
@@ -378,7 +378,7 @@ TEST_F(GltfExport, FailedEncodingLeavesThePreviousExportUntouched) {
     in.volumes[1].grid = makeGrid(3);  // would change alpha.shprobe
     ShProbeGrid bad = makeGrid(0);
     bad.occupancy.pop_back();
-    in.volumes.push_back({"bad", bad});
+    in.volumes.push_back({"bad", bad, {}});
     in.albedo = glm::vec3(0.9f);
     try {
         exportGltfScene(dir, in);
@@ -403,7 +403,7 @@ TEST_F(GltfExport, FailedReplaceRestoresTheFilesAlreadyMoved) {
 
     in.volumes[0].grid = makeGrid(2);
     in.volumes[1].grid = makeGrid(3);
-    in.volumes.push_back({"zz", makeGrid(1)});
+    in.volumes.push_back({"zz", makeGrid(1), {}});
     try {
         exportGltfScene(dir, in);
         FAIL() << "replacing a directory must fail the export";
@@ -434,7 +434,7 @@ TEST_F(GltfExport, StaleProbeFilesAreKept) {
     exportGltfScene(dir, in);
     const auto zetaBytes = readBytes(dir / "sh_coeffs/zeta.shprobe");
 
-    in.volumes = {{"alpha", makeGrid(4)}};
+    in.volumes = {{"alpha", makeGrid(4), {}}};
     const GltfExportResult res = exportGltfScene(dir, in);
     EXPECT_EQ(res.files.size(), 3u);
     const json entries = readShProbeGridEntries(dir / "scene.gltf");

@@ -1,0 +1,186 @@
+#include "ProbeDiagnosticsFile.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace terralux {
+
+namespace {
+
+using json = nlohmann::json;
+constexpr const char* kFormat = "terralux-probe-diagnostics";
+constexpr int kVersion = 1;
+
+// Millimetres for positions and sizes, 1e-6 for errors: shortest decimal output stays short.
+double rounded(double v, double unit) { return std::round(v / unit) * unit; }
+
+json flat(const std::vector<glm::vec3>& v) {
+    json a = json::array();
+    for (const auto& p : v)
+        for (int k = 0; k < 3; ++k) a.push_back(rounded(p[k], 1e-3));
+    return a;
+}
+
+[[noreturn]] void fail(const std::string& name, const std::string& what) {
+    throw ProbeDiagnosticsError(name + ": " + what);
+}
+
+const json& member(const json& j, const char* key, const std::string& name) {
+    if (!j.is_object() || !j.contains(key)) fail(name, std::string("missing '") + key + "'");
+    return j.at(key);
+}
+
+std::vector<float> numbers(const json& j, const char* key, const std::string& name, size_t multiple,
+                           bool nulls = false) {
+    const json& a = member(j, key, name);
+    if (!a.is_array()) fail(name, std::string("'") + key + "' must be an array");
+    if (a.size() % multiple != 0)
+        fail(name, std::string("'") + key + "' must hold a multiple of " + std::to_string(multiple) +
+                       " numbers (holds " + std::to_string(a.size()) + ")");
+    std::vector<float> out;
+    out.reserve(a.size());
+    for (const json& x : a) {
+        if (nulls && x.is_null()) {
+            out.push_back(NAN);
+            continue;
+        }
+        if (!x.is_number() || !std::isfinite(x.get<double>()))
+            fail(name, std::string("'") + key + "' holds " + x.dump() + ", not a finite number");
+        out.push_back(x.get<float>());
+    }
+    return out;
+}
+
+std::vector<glm::vec3> points(const std::vector<float>& f) {
+    std::vector<glm::vec3> out;
+    for (size_t i = 0; i + 2 < f.size(); i += 3) out.emplace_back(f[i], f[i + 1], f[i + 2]);
+    return out;
+}
+
+}  // namespace
+
+std::string probeDiagnosticsFileName(const std::string& volumeName) {
+    return volumeName + ".probes.json";
+}
+
+std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string& volumeName,
+                                   const glm::uvec3& gridDims) {
+    json moved = json::array();
+    for (size_t i = 0; i < d.moved.size(); ++i)
+        if (d.moved[i]) moved.push_back(i);
+    json leaves = json::array();
+    for (const auto& l : d.leaves)
+        for (int k = 0; k < 4; ++k) leaves.push_back(rounded(l[k], 1e-3));
+    json error = json::array();
+    for (float e : d.errorMap.error)
+        error.push_back(std::isfinite(e) ? json(rounded(e, 1e-6)) : json(nullptr));
+    const ErrorMap& m = d.errorMap;
+    json doc = {
+        {"format", kFormat},
+        {"version", kVersion},
+        {"volume", volumeName},
+        {"probe_count", d.positions.size()},
+        {"grid_dims", {gridDims.x, gridDims.y, gridDims.z}},
+        {"positions", flat(d.positions)},
+        {"moved", moved},
+        {"rejected", flat(d.rejected)},
+        {"leaves", leaves},
+        {"error_map",
+         {{"size", {m.nx, m.nz}},
+          {"origin", {rounded(m.x0, 1e-3), rounded(m.z0, 1e-3)}},
+          {"step", m.step},
+          {"height", m.height},
+          {"error", error}}},
+    };
+    return doc.dump() + "\n";
+}
+
+ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::string& name,
+                                        size_t probeCount, const glm::uvec3& gridDims) {
+    json j;
+    try {
+        j = json::parse(text);
+    } catch (const json::exception& e) {
+        fail(name, std::string("not JSON (") + e.what() + ")");
+    }
+    if (member(j, "format", name) != kFormat)
+        fail(name, "format is " + j.at("format").dump() + ", expected \"" + kFormat + "\"");
+    if (member(j, "version", name) != kVersion)
+        fail(name, "version " + j.at("version").dump() + " is not supported (this build reads " +
+                       std::to_string(kVersion) + ")");
+    const json& count = member(j, "probe_count", name);
+    if (!count.is_number_unsigned() || count.get<size_t>() != probeCount)
+        fail(name, "probe_count " + count.dump() + " does not match the .shprobe's " +
+                       std::to_string(probeCount) + " probes (a sidecar of another bake)");
+    const json& dims = member(j, "grid_dims", name);
+    if (dims != json{gridDims.x, gridDims.y, gridDims.z})
+        fail(name, "grid_dims " + dims.dump() + " do not match the .shprobe's [" +
+                       std::to_string(gridDims.x) + "," + std::to_string(gridDims.y) + "," +
+                       std::to_string(gridDims.z) + "] (a sidecar of another bake)");
+
+    ProbeDiagnostics d;
+    d.positions = points(numbers(j, "positions", name, 3));
+    if (d.positions.size() != probeCount)
+        fail(name, "positions hold " + std::to_string(d.positions.size()) + " probes, expected " +
+                       std::to_string(probeCount));
+    d.moved.assign(probeCount, 0);
+    const json& moved = member(j, "moved", name);
+    if (!moved.is_array()) fail(name, "'moved' must be an array");
+    for (const json& i : moved) {
+        if (!i.is_number_unsigned() || i.get<size_t>() >= probeCount)
+            fail(name, "'moved' holds " + i.dump() + ", not a probe index below " +
+                           std::to_string(probeCount));
+        d.moved[i.get<size_t>()] = 1;
+    }
+    d.rejected = points(numbers(j, "rejected", name, 3));
+    const std::vector<float> leaves = numbers(j, "leaves", name, 4);
+    for (size_t i = 0; i < leaves.size(); i += 4) {
+        if (!(leaves[i + 3] > 0.0f))
+            fail(name, "leaf " + std::to_string(i / 4) + " has edge " + std::to_string(leaves[i + 3]) +
+                           ", must be > 0");
+        d.leaves.emplace_back(leaves[i], leaves[i + 1], leaves[i + 2], leaves[i + 3]);
+    }
+
+    const json& em = member(j, "error_map", name);
+    const std::vector<float> size = numbers(em, "size", name + ": error_map", 2);
+    const std::vector<float> origin = numbers(em, "origin", name + ": error_map", 2);
+    if (size.size() != 2 || origin.size() != 2) fail(name, "error_map: size and origin take 2 numbers");
+    if (size[0] < 0 || size[1] < 0 || size[0] > kMaxErrorMapResolution ||
+        size[1] > kMaxErrorMapResolution || size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]))
+        fail(name, "error_map: size " + em.at("size").dump() + " must be whole numbers in [0, " +
+                       std::to_string(kMaxErrorMapResolution) + "]");
+    ErrorMap& m = d.errorMap;
+    m.nx = uint32_t(size[0]);
+    m.nz = uint32_t(size[1]);
+    m.x0 = origin[0];
+    m.z0 = origin[1];
+    const json& step = member(em, "step", name);
+    const json& height = member(em, "height", name);
+    if (!step.is_number() || !(step.get<double>() > 0.0) || !std::isfinite(step.get<double>()))
+        fail(name, "error_map: step " + step.dump() + " must be a number > 0");
+    if (!height.is_number() || !std::isfinite(height.get<double>()))
+        fail(name, "error_map: height " + height.dump() + " must be a finite number");
+    m.step = step.get<float>();
+    m.height = height.get<float>();
+    m.error = numbers(em, "error", name + ": error_map", 1, true);
+    if (m.error.size() != size_t(m.nx) * m.nz)
+        fail(name, "error_map: error holds " + std::to_string(m.error.size()) + " values, size " +
+                       em.at("size").dump() + " needs " + std::to_string(size_t(m.nx) * m.nz));
+    for (float e : m.error)
+        if (e < 0.0f) fail(name, "error_map: error holds " + std::to_string(e) + ", must be >= 0");
+    return d;
+}
+
+ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, size_t probeCount,
+                                          const glm::uvec3& gridDims) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ProbeDiagnosticsError(path.string() + ": cannot open");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return decodeProbeDiagnostics(ss.str(), path.string(), probeCount, gridDims);
+}
+
+}  // namespace terralux

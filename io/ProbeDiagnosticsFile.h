@@ -1,0 +1,48 @@
+#pragma once
+// `<volume>.probes.json`, written by the bake beside `<volume>.shprobe`: the probe diagnostics
+// that the file format has no room for (bake/ProbeDiagnostics.h), read back by `--render` and the
+// viewport for the validity and interpolation-error views and the leaf overlay.
+//
+//   {
+//     "format": "terralux-probe-diagnostics", "version": 1,
+//     "volume": "<name>",                      the .shprobe stem
+//     "probe_count": N, "grid_dims": [X, Y, Z] as in the .shprobe (a mismatch: stale sidecar)
+//     "positions": [x, y, z, ...]              3N numbers, metres, engine space (mm precision)
+//     "moved": [i, ...]                        probe indices moved up out of the terrain
+//     "rejected": [x, y, z, ...]               probes placed inside the terrain (not in the file)
+//     "leaves": [x, y, z, edge, ...]           adaptive octree leaves, min corner and edge
+//     "error_map": {"size": [nx, nz], "origin": [x0, z0], "step": s, "height": h,
+//                   "error": [...]}            nx·nz relative errors, x fastest, null = uncovered
+//   }
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "bake/ProbeDiagnostics.h"
+
+namespace terralux {
+
+class ProbeDiagnosticsError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// The sidecar's file name for a volume: "<name>.probes.json".
+std::string probeDiagnosticsFileName(const std::string& volumeName);
+
+std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string& volumeName,
+                                   const glm::uvec3& gridDims);
+
+// Parses and validates against the .shprobe it belongs to (probe count and grid dims). Every
+// error message starts with `name`.
+ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::string& name,
+                                        size_t probeCount, const glm::uvec3& gridDims);
+
+ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, size_t probeCount,
+                                          const glm::uvec3& gridDims);
+
+}  // namespace terralux

@@ -1,0 +1,101 @@
+#include "bake/ProbeDiagnostics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "bake/SphereSampling.h"
+
+namespace terralux {
+
+ErrorMapStats errorMapStats(const ErrorMap& map) {
+    ErrorMapStats s;
+    std::vector<float> e;
+    for (float x : map.error)
+        if (std::isfinite(x)) e.push_back(x);
+    s.points = e.size();
+    s.uncovered = map.error.size() - e.size();
+    if (e.empty()) return s;
+    std::sort(e.begin(), e.end());
+    double sum = 0.0;
+    for (float x : e) sum += x;
+    s.mean = sum / double(e.size());
+    s.p95 = e[std::min(e.size() - 1, size_t(std::ceil(0.95 * double(e.size()))) - 1)];
+    s.max = e.back();
+    return s;
+}
+
+ProbeDiagnostics describeProbes(const ProbeLayout& L) {
+    ProbeDiagnostics d;
+    for (size_t i = 0; i < L.positions.size(); ++i) {
+        if (!L.valid[i]) {
+            // Adaptive leaves without a probe of their own are not rejected probes: their cells
+            // borrow the probe above or hold -1 (the report counts them).
+            if (!L.octree) d.rejected.push_back(L.positions[i]);
+            continue;
+        }
+        d.positions.push_back(L.positions[i]);
+        d.moved.push_back(L.octree && L.octree->probe[i] == LeafProbe::Moved ? 1 : 0);
+    }
+    if (L.octree)
+        for (const OctreeLeaf& leaf : L.octree->leaves)
+            d.leaves.emplace_back(L.cellOrigin.x + L.cellSize * float(leaf.x),
+                                  L.cellOrigin.y + L.cellSize * float(leaf.y),
+                                  L.cellOrigin.z + L.cellSize * float(leaf.z),
+                                  L.cellSize * float(leaf.edge()));
+    return d;
+}
+
+float errorMapHeight(const ProbeVolumeSettings& v, const ProbeLayout& L) {
+    if (v.placement == ProbePlacement::Terrain && v.heightOffset > 0.0) return float(v.heightOffset);
+    return 0.02f * L.cellSize;
+}
+
+ErrorMap errorMapGrid(const ProbeLayout& L, const Heightfield& hf, int resolution, float height) {
+    ErrorMap m;
+    if (resolution <= 0) return m;
+    const double x0 = std::max<double>(L.cellOrigin.x, hf.minX());
+    const double z0 = std::max<double>(L.cellOrigin.z, hf.minZ());
+    const double x1 = std::min<double>(L.cellOrigin.x + double(L.cellSize) * L.cellDims[0], hf.maxX());
+    const double z1 = std::min<double>(L.cellOrigin.z + double(L.cellSize) * L.cellDims[2], hf.maxZ());
+    if (!(x1 > x0) || !(z1 > z0)) return m;
+    const double step = std::max(x1 - x0, z1 - z0) / double(resolution);
+    m.nx = uint32_t(std::clamp(std::lround((x1 - x0) / step), 1l, long(resolution)));
+    m.nz = uint32_t(std::clamp(std::lround((z1 - z0) / step), 1l, long(resolution)));
+    // Points at the centres of the map's cells, so the map spans the footprint symmetrically.
+    m.step = float(step);
+    m.x0 = float(x0 + 0.5 * ((x1 - x0) - step * double(m.nx - 1)));
+    m.z0 = float(z0 + 0.5 * ((z1 - z0) - step * double(m.nz - 1)));
+    m.height = height;
+    m.error.assign(size_t(m.nx) * m.nz, NAN);
+    return m;
+}
+
+ErrorMap measureErrorMap(const ProbeLayout& L, const std::vector<sh::ShRgb>& sh,
+                         const Heightfield& hf, const ProbeBaker& baker, int resolution,
+                         float height, uint64_t seed) {
+    ErrorMap m = errorMapGrid(L, hf, resolution, height);
+    std::vector<glm::vec3> points;
+    std::vector<uint64_t> keys;
+    std::vector<size_t> slot;
+    for (uint32_t j = 0; j < m.nz; ++j)
+        for (uint32_t i = 0; i < m.nx; ++i) {
+            const float x = m.x0 + m.step * float(i), z = m.z0 + m.step * float(j);
+            const glm::vec3 p(x, hf.surfaceHeight(x, z) + m.height, z);
+            sh::ShRgb unused;
+            if (!interpolateProbes(L, sh, p, unused)) continue;
+            const size_t k = size_t(j) * m.nx + i;
+            points.push_back(p);
+            keys.push_back(splitmix64(seed ^ 0xE7707A9ull ^ (uint64_t(k) * 0x9E3779B97F4A7C15ull)));
+            slot.push_back(k);
+        }
+    if (points.empty()) return m;
+    const ProbeBake truth = baker(points, keys);
+    for (size_t n = 0; n < points.size(); ++n) {
+        sh::ShRgb value;
+        interpolateProbes(L, sh, points[n], value);
+        m.error[slot[n]] = relativeIrradianceError(value, truth.sh[n]);
+    }
+    return m;
+}
+
+}  // namespace terralux

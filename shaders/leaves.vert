@@ -1,0 +1,20 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Octree-leaf overlay: the 12 edges of each leaf box as a line list (24 vertices per instance),
+// bright for the smallest leaves and darker for each doubling of the edge.
+#include "frame.glsl"
+
+layout(location = 0) in vec4 inLeaf;  // xyz min corner, w edge
+layout(location = 0) out vec3 color;
+
+void main() {
+    // Edge k runs from corner a to corner b; corners are bit patterns (x, y, z).
+    const int ends[24] = int[](0, 1, 2, 3, 4, 5, 6, 7,   // along x
+                               0, 2, 1, 3, 4, 6, 5, 7,   // along y
+                               0, 4, 1, 5, 2, 6, 3, 7);  // along z
+    int corner = ends[gl_VertexIndex % 24];
+    vec3 offset = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    gl_Position = frame.viewProj * vec4(inLeaf.xyz + inLeaf.w * offset, 1.0);
+    float level = log2(max(inLeaf.w / max(frame.overlay.x, 1e-6), 1.0));
+    color = mix(vec3(1.0, 0.95, 0.6), vec3(0.35, 0.25, 0.9), clamp(level / 5.0, 0.0, 1.0));
+}
