@@ -30,6 +30,7 @@
 #include "PreviewBake.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
 #include "render/DebugViews.h"
 
@@ -242,6 +243,7 @@ void MainWindow::buildDocks() {
     bf->addInteger("bake.bounces", "Bounces", 0, 16, "preset");
     bf->addChoice("bake.sh_encoding", "SH encoding", {"radiance", "irradiance"});
     bf->addBool("bake.deringing", "Deringing");
+    bf->addInteger("bake.error_map_resolution", "Error map points", 0, kMaxErrorMapResolution);
     bf->addText("export.out_dir", "Output folder");
     bf->addBool("export.gltf", "glTF scene");
     bf->addNumber("export.default_scale", "SH scale", -100.0, 100.0, 3, "");
@@ -289,8 +291,10 @@ void MainWindow::buildDocks() {
     bar->setObjectName("toolbar.viewport");
     viewSelector_ = new QComboBox;
     viewSelector_->setObjectName("viewport.debugView");
-    for (const auto& v : debugViews())
+    for (const auto& v : debugViews()) {
         viewSelector_->addItem(QString("%1 %2").arg(v.number).arg(v.name), v.number);
+        viewSelector_->setItemData(viewSelector_->count() - 1, QString::fromUtf8(v.shows), Qt::ToolTipRole);
+    }
     bar->addWidget(new QLabel(" Debug view "));
     bar->addWidget(viewSelector_);
     probeToggle_ = new QCheckBox("Probe lighting");
@@ -301,6 +305,11 @@ void MainWindow::buildDocks() {
     positions->setObjectName("viewport.probePositions");
     bar->addWidget(positions);
     connect(positions, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbePositions);
+    auto* leaves = new QCheckBox("Octree leaves");
+    leaves->setObjectName("viewport.leaves");
+    leaves->setToolTip("The leaves of adaptive volumes, bright at the minimum cell size");
+    bar->addWidget(leaves);
+    connect(leaves, &QCheckBox::toggled, viewport_, &ViewportWindow::setLeaves);
     connect(viewSelector_, &QComboBox::currentIndexChanged, this,
             [this](int i) { viewport_->setDebugView(viewSelector_->itemData(i).toInt()); });
     connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);
@@ -529,7 +538,7 @@ void MainWindow::startPreview() {
 
 void MainWindow::updateEstimate() {
     const Project& p = doc_->project();
-    size_t probes = 0, invalid = 0;
+    size_t probes = 0, invalid = 0, mapPoints = 0;
     uint64_t bytes = 0;
     double rays = 0;
     BakeQuality q = qualityPreset(p.scene.bake.quality);
@@ -542,6 +551,10 @@ void MainWindow::updateEstimate() {
             invalid += l.positions.size() - l.validCount();
             bytes += 48 + 160ull * l.validCount() + 4ull * l.cellProbe.size();
             rays += double(l.validCount()) * (v.rayCount ? *v.rayCount : q.rays);
+            const size_t points = errorMapGrid(l, doc_->terrain().heightfield, p.scene.bake.errorMapResolution,
+                                               errorMapHeight(v, l)).error.size();
+            mapPoints += points;
+            rays += double(points) * (v.rayCount ? *v.rayCount : q.rays);
         }
     } catch (const std::exception& e) {
         estimate_->setText(QString::fromStdString(e.what()));
@@ -550,8 +563,9 @@ void MainWindow::updateEstimate() {
     // Cache rays plus probe rays at the throughput measured by the bake benchmark on two cores.
     const double cacheRays = double(q.cacheResolution) * q.cacheResolution * (q.cacheRays + q.sunSamples);
     const double seconds = (rays * (p.scene.bake.quality == QualityPreset::Reference ? 8.0 : 1.5) + cacheRays) / 3.0e6;
-    estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, about %4 s")
-                           .arg(probes).arg(invalid).arg(formatBytes(double(bytes))).arg(seconds, 0, 'f', 1));
+    estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, %4 error-map points, about %5 s")
+                           .arg(probes).arg(invalid).arg(formatBytes(double(bytes))).arg(mapPoints)
+                           .arg(seconds, 0, 'f', 1));
 }
 
 void MainWindow::updateTitle() {

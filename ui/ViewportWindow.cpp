@@ -46,6 +46,11 @@ void ViewportWindow::setProbePositions(bool on) {
     requestUpdate();
 }
 
+void ViewportWindow::setLeaves(bool on) {
+    request_.leaves = on;
+    requestUpdate();
+}
+
 void ViewportWindow::exposeEvent(QExposeEvent*) {
     if (isExposed()) renderNow();
 }

@@ -31,6 +31,7 @@ public:
     int debugView() const { return request_.debugView; }
     void setProbeLighting(bool on);
     void setProbePositions(bool on);
+    void setLeaves(bool on);
     // The last image drawn (row 0 at the top), for tests and screenshots.
     const RenderedImage& lastImage() const { return last_; }
     // Draws now (synchronously) instead of at the next update.

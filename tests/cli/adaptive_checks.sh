@@ -27,6 +27,7 @@ case "$case_" in
         --set 'probe_volumes[0].adaptive.max_cell_size=960' >/dev/null || fail "bake with $t thread(s) exited $?"
     done
     cmp "$work/t1/sh_coeffs/valley.shprobe" "$work/t2/sh_coeffs/valley.shprobe" || fail ".shprobe differs"
+    cmp "$work/t1/sh_coeffs/valley.probes.json" "$work/t2/sh_coeffs/valley.probes.json" || fail "probes.json differs"
     "$checker" "$work/t1" || fail "glTF entries disagree with the .shprobe headers"
     for key in '"moved_probes"' '"split_for_inside"' '"borrowed_cells"' '"interpolation_error"' \
                '"probes_with_rays_from_below": 0' '"overlaps": \[\]' '"tolerance": 0.04'; do

@@ -232,3 +232,153 @@ TEST_F(RenderTest, EveryViewDiffersFromBeauty) {
         EXPECT_GT(meanAbsDiff(draw(r, v.number), beauty), 2.0 / 255.0) << v.number << " " << v.name;
     }
 }
+
+namespace {
+
+// One volume over the whole terrain: 4 x ? x 4 cubic cells, the west half pointing at probe 0,
+// the east half at probe 1 (both a constant sky), with diagnostics to fill in.
+GpuProbeVolume halves(const Heightfield& hf) {
+    GpuProbeVolume v;
+    const float cell = std::max(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ()) / 4.0f;
+    v.spacing = cell;
+    v.origin = glm::vec3(hf.minX(), hf.minHeight() - 1.0f, hf.minZ());
+    v.dims = glm::uvec3(4, uint32_t(std::ceil((hf.maxHeight() - hf.minHeight() + 2.0f) / cell)) + 1, 4);
+    for (int p = 0; p < 2; ++p) v.coeffs.push_back(sh::projectConstant(glm::vec3(0.5f)).c);
+    for (uint32_t z = 0; z < v.dims.z; ++z)
+        for (uint32_t y = 0; y < v.dims.y; ++y)
+            for (uint32_t x = 0; x < v.dims.x; ++x) v.occupancy.push_back(x < 2 ? 0 : 1);
+    v.fallbackBlendDistance = cell;
+    ProbeDiagnostics d;
+    d.positions = {v.origin + glm::vec3(cell, 2 * cell, 2 * cell), v.origin + glm::vec3(3 * cell, 2 * cell, 2 * cell)};
+    d.moved = {0, 0};
+    v.diagnostics = d;
+    return v;
+}
+
+// Pixels the albedo view paints (the background is cleared to black).
+std::vector<size_t> terrainPixels(ProjectRenderer& r) {
+    const RenderedImage albedo = draw(r, 1);
+    std::vector<size_t> out;
+    for (size_t i = 0; i < size_t(kW) * kH; ++i)
+        if (albedo.rgba[i * 4] > 0.0f) out.push_back(i);
+    return out;
+}
+
+RenderedImage drawLinear(ProjectRenderer& r, int view) {
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.debugView = view;
+    q.linearOutput = true;
+    return r.render(q);
+}
+
+}  // namespace
+
+TEST_F(RenderTest, ValidityViewShowsWhereMovedProbesLightAndWhereNoProbeIsLeft) {
+    ProjectRenderer r(*ctx_, sampleProject("validity", 8, 8));
+    const std::vector<size_t> terrain = terrainPixels(r);
+    ASSERT_GT(terrain.size(), size_t(kW) * kH / 4);
+    auto count = [&](const RenderedImage& img, auto predicate) {
+        size_t n = 0;
+        for (size_t i : terrain) n += predicate(&img.rgba[i * 4]);
+        return n;
+    };
+    auto cyan = [](const float* c) { return c[2] > c[0] + 0.3f; };
+    auto grey = [](const float* c) { return std::abs(c[0] - c[2]) < 0.02f && c[0] > 0.2f; };
+    auto red = [](const float* c) { return c[0] > 0.3f && c[1] < 0.2f * c[0] + 0.05f && c[2] < 0.2f * c[0] + 0.05f; };
+
+    GpuProbeVolume v = halves(r.heightfield());
+    r.setProbes({v});
+    const RenderedImage placed = draw(r, 54);
+    EXPECT_EQ(count(placed, cyan), 0u);
+    EXPECT_GT(count(placed, grey), terrain.size() * 9 / 10);
+
+    v.diagnostics->moved = {0, 1};
+    r.setProbes({v});
+    const RenderedImage moved = draw(r, 54);
+    EXPECT_GT(count(moved, cyan), terrain.size() / 4) << "the east half is lit by a moved probe";
+    EXPECT_GT(count(moved, grey), terrain.size() / 4) << "the west half is not";
+
+    std::fill(v.occupancy.begin(), v.occupancy.end(), -1);  // every probe rejected
+    r.setProbes({v});
+    EXPECT_GT(count(draw(r, 54), red), terrain.size() * 9 / 10);
+}
+
+TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
+    ProjectRenderer r(*ctx_, sampleProject("errormap", 8, 8));
+    const Heightfield& hf = r.heightfield();
+    const std::vector<size_t> terrain = terrainPixels(r);
+    GpuProbeVolume v = halves(hf);
+    ErrorMap& m = v.diagnostics->errorMap;
+    m.nx = m.nz = 2;
+    m.step = hf.maxX() - hf.minX();
+    m.x0 = hf.minX();
+    m.z0 = hf.minZ();
+    m.error = {0.05f, 0.05f, 0.05f, 0.05f};
+    r.setProbes({v});
+    // EXR: the error itself in red, 1 in green where measured.
+    RenderedImage img = drawLinear(r, 56);
+    for (size_t i : terrain) {
+        ASSERT_NEAR(img.rgba[i * 4], 0.05f, 1e-4f) << "pixel " << i;
+        ASSERT_NEAR(img.rgba[i * 4 + 1], 1.0f, 1e-3f) << "pixel " << i;  // half-float target
+    }
+
+    // West column 0, east column 20 %: every value in between, both ends on the heat ramp.
+    m.error = {0.0f, 0.2f, 0.0f, 0.2f};
+    r.setProbes({v});
+    img = drawLinear(r, 56);
+    float lo = 1.0f, hi = 0.0f;
+    for (size_t i : terrain) {
+        lo = std::min(lo, img.rgba[i * 4]);
+        hi = std::max(hi, img.rgba[i * 4]);
+    }
+    EXPECT_LT(lo, 0.01f);
+    EXPECT_GT(hi, 0.19f);
+    EXPECT_LE(hi, 0.2f + 1e-4f);
+    const RenderedImage shown = draw(r, 56);
+    size_t blue = 0, redPixels = 0;
+    for (size_t i : terrain) {
+        const float* c = &shown.rgba[i * 4];
+        const float e = img.rgba[i * 4];
+        if (e < 0.005f) blue += c[2] > c[0] + 0.2f && c[2] > c[1];
+        if (e > 0.15f) redPixels += c[0] > 0.6f && c[1] < 0.3f && c[2] < 0.3f;
+    }
+    EXPECT_GT(blue, 0u);
+    EXPECT_GT(redPixels, 0u);
+
+    // Unmeasured points (no probe around them at bake time): no value, grey.
+    m.error.assign(4, NAN);
+    r.setProbes({v});
+    img = drawLinear(r, 56);
+    const RenderedImage grey = draw(r, 56);
+    for (size_t i : terrain) {
+        ASSERT_NEAR(img.rgba[i * 4 + 1], 0.0f, 1e-3f) << "pixel " << i;
+        ASSERT_NEAR(grey.rgba[i * 4], grey.rgba[i * 4 + 2], 1e-3f) << "pixel " << i;
+    }
+}
+
+TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
+    ProjectRenderer r(*ctx_, sampleProject("leaves", 8, 8));
+    GpuProbeVolume v = halves(r.heightfield());
+    const float cell = v.spacing;
+    for (int x = 0; x < 4; ++x)
+        v.diagnostics->leaves.push_back(glm::vec4(v.origin + glm::vec3(float(x) * cell, 0.0f, 0.0f), cell));
+    r.setProbes({v});
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.debugView = 1;
+    const RenderedImage plain = r.render(q);
+    q.leaves = true;
+    const RenderedImage lines = r.render(q);
+    // Lines are pale yellow at the smallest edge; count the pixels that changed.
+    size_t changed = 0;
+    for (size_t i = 0; i < size_t(kW) * kH; ++i)
+        changed += std::abs(lines.rgba[i * 4 + 2] - plain.rgba[i * 4 + 2]) > 0.1f;
+    EXPECT_GT(changed, size_t(kW));
+    // Without leaves bound, the overlay draws nothing.
+    v.diagnostics->leaves.clear();
+    r.setProbes({v});
+    EXPECT_EQ(test::compareImages(r.render(q).rgba, plain.rgba, kW, kH).maxAbs, 0.0);
+}

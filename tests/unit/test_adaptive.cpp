@@ -609,7 +609,8 @@ TEST(AdaptiveBake, SameBytesWithOneAndTwoThreadsAndAReportThatSaysWhatHappened) 
     BakeRequest two{orkhonProject(dir / "two"), 2, false};
     const BakeOutcome a = runBake(one, {}, nullptr);
     runBake(two, {}, nullptr);
-    for (const char* f : {"sh_coeffs/valley.shprobe", "sh_coeffs/grid.shprobe"})
+    for (const char* f : {"sh_coeffs/valley.shprobe", "sh_coeffs/grid.shprobe",
+                          "sh_coeffs/valley.probes.json", "sh_coeffs/grid.probes.json"})
         EXPECT_EQ(bytesOf(dir / "one" / f), bytesOf(dir / "two" / f)) << f;
 
     const nlohmann::json& r = a.report;
@@ -624,6 +625,11 @@ TEST(AdaptiveBake, SameBytesWithOneAndTwoThreadsAndAReportThatSaysWhatHappened) 
     EXPECT_EQ(v["interpolation_error"]["uncovered_points"], 0);
     EXPECT_TRUE(v["interpolation_error"]["within_tolerance"].is_number());
     EXPECT_GT(v["interpolation_error"]["rays"].get<uint64_t>(), 0u);
+    // The ground error map of view 56, its points all covered by probes.
+    EXPECT_EQ(v["error_map"]["size"][0].get<int>(), 64);
+    EXPECT_EQ(v["error_map"]["uncovered"], 0);
+    EXPECT_GT(v["error_map"]["mean"].get<double>(), 0.0);
+    EXPECT_GE(v["error_map"]["p95"].get<double>(), v["error_map"]["mean"].get<double>());
     const ShProbeGrid g = readShProbeFile(dir / "one" / "sh_coeffs/valley.shprobe");
     EXPECT_EQ(v["probes"], g.probes.size());
     EXPECT_EQ(g.dims.x, v["grid"]["dims"][0].get<uint32_t>());
