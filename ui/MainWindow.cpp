@@ -307,7 +307,8 @@ void MainWindow::buildDocks() {
     connect(positions, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbePositions);
     auto* leaves = new QCheckBox("Octree leaves");
     leaves->setObjectName("viewport.leaves");
-    leaves->setToolTip("The leaves of adaptive volumes, bright at the minimum cell size");
+    leaves->setToolTip("The leaves of adaptive volumes, bright at the minimum cell size; leaves under "
+                       "6 pixels wide are left out, so zoom in to see the finest");
     bar->addWidget(leaves);
     connect(leaves, &QCheckBox::toggled, viewport_, &ViewportWindow::setLeaves);
     connect(viewSelector_, &QComboBox::currentIndexChanged, this,

@@ -14,5 +14,21 @@ grep -q "view 0 beauty, 1 probe volume" stdout || fail "unexpected report: $(cat
 head -c 8 beauty.png | od -An -tx1 | grep -q "89 50 4e 47" || fail "beauty.png is not a PNG"
 "$terralux" --render --out irr.exr --size 64x64 --debug-view 50 --quiet >stdout || fail "EXR render"
 head -c 4 irr.exr | od -An -tx1 | grep -q "76 2f 31 01" || fail "irr.exr is not OpenEXR"
+# Views 54 and 56 read the diagnostics the bake wrote beside the .shprobe.
+[ -s bake/sh_coeffs/probes.probes.json ] || fail "no probes.probes.json beside the .shprobe"
+"$terralux" --render --out err.png --size 64x64 --debug-view interpolation-error --overlay probes,leaves \
+  --quiet >stdout 2>stderr || fail "view 56 render exited $?"
+grep -q "view 56 interpolation-error" stdout || fail "unexpected report: $(cat stdout)"
+[ -s stderr ] && fail "view 56 warned: $(cat stderr)"
+# A sidecar of another bake: the render still works and says which file and why.
+printf '{"format": "terralux-probe-diagnostics", "version": 1, "probe_count": 3}' >bake/sh_coeffs/probes.probes.json
+"$terralux" --render --out err.png --size 64x64 --debug-view 56 --quiet >stdout 2>stderr || fail "stale sidecar render exited $?"
+grep -q "^terralux: warning: .*probes.probes.json: probe_count 3 does not match the .shprobe's 64 probes" stderr \
+  || fail "no warning for a stale sidecar: $(cat stderr)"
+"$terralux" --render --out beauty.png --size 64x64 --quiet >stdout 2>stderr || fail "beauty with a stale sidecar"
+[ -s stderr ] && fail "beauty warned about the sidecar: $(cat stderr)"
+"$terralux" --render --out x.png --overlay probes,grid --quiet >stdout 2>stderr
+[ $? -eq 2 ] || fail "--overlay grid accepted"
+grep -q "^terralux: --overlay probes,grid: 'grid' is not one of probes, leaves$" stderr || fail "overlay message: $(cat stderr)"
 ls -a | grep -q "\.tmp-" && fail "temporary files left behind"
 echo "ok: rendered"

@@ -137,6 +137,35 @@ private slots:
         QCOMPARE(placement->currentText(), QString("terrain"));
     }
 
+    void leafOverlayAndErrorMapSetting() {
+        auto* leaves = w_->findChild<QCheckBox*>("viewport.leaves");
+        QVERIFY(leaves);
+        auto* placement = w_->findChild<QComboBox*>("param.volume.placement");
+        placement->setCurrentText("adaptive");
+        w_->viewport()->renderNow();
+        const RenderedImage plain = w_->viewport()->lastImage();
+        leaves->setChecked(true);
+        w_->viewport()->renderNow();
+        const RenderedImage lines = w_->viewport()->lastImage();
+        const auto d = test::compareImages(plain.rgba, lines.rgba, plain.width, plain.height);
+        QVERIFY2(d.maxAbs > 0.2, qPrintable(QString("leaf overlay changed the image by %1").arg(d.maxAbs)));
+        leaves->setChecked(false);
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(placement->currentText(), QString("terrain"));
+
+        // The error map's size is a bake setting with its own row, and the estimate counts it.
+        auto* points = w_->findChild<QSpinBox*>("param.bake.error_map_resolution");
+        QVERIFY(points);
+        QCOMPARE(points->value(), 64);
+        auto* estimate = w_->findChild<QLabel*>("bake.estimate");
+        QVERIFY2(estimate->text().contains("4096 error-map points"), qPrintable(estimate->text()));
+        points->setValue(0);
+        QCOMPARE(w_->document()->project().scene.bake.errorMapResolution, 0);
+        QVERIFY2(estimate->text().contains(" 0 error-map points"), qPrintable(estimate->text()));
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(points->value(), 64);
+    }
+
     void rejectedValuesLeaveTheProject() {
         auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
         QVERIFY(elevation);
