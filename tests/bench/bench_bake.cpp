@@ -9,6 +9,7 @@
 
 #include "DemImport.h"
 #include "bake/DiffuseBake.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
 
 using namespace terralux;
@@ -83,6 +84,41 @@ BENCHMARK(BM_BakePreset)
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->UseRealTime();
+
+// The ground interpolation-error map of debug view 56 (bake.error_map_resolution points a side)
+// over the same grid: what it costs on top of the bake, and what it finds.
+void BM_ErrorMap(benchmark::State& state) {
+    Fixture* f = fixture();
+    if (!f) {
+        state.SkipWithError("shared DEM N42E001.hgt not present");
+        return;
+    }
+    const QualityPreset preset = QualityPreset::Standard;
+    const BakeQuality q = qualityPreset(preset);
+    const int resolution = int(state.range(0));
+    const IrradianceCache cache(f->lighting, q.cacheResolution, q.cacheRays, q.sunSamples,
+                                q.bounces - 1, {});
+    const ProbeBake bake = bakeProbes(f->lighting, &cache, q.bounces, f->layout.positions,
+                                      f->layout.valid, q.rays, 99, {});
+    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+        std::vector<uint64_t> seeds(k.size());
+        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 99 ^ k[i];
+        return bakeProbesSeeded(f->lighting, &cache, q.bounces, p, std::vector<uint8_t>(p.size(), 1),
+                                q.rays, seeds, {});
+    };
+    ErrorMap map;
+    for (auto _ : state) {
+        map = measureErrorMap(f->layout, bake.sh, f->dem.heightfield, baker, resolution, 5.0f, 99);
+        benchmark::DoNotOptimize(map.error.data());
+    }
+    const ErrorMapStats s = errorMapStats(map);
+    state.SetLabel(qualityName(preset));
+    state.counters["points"] = double(s.points);
+    state.counters["map_mean_pct"] = 100.0 * s.mean;
+    state.counters["map_p95_pct"] = 100.0 * s.p95;
+    state.counters["map_max_pct"] = 100.0 * s.max;
+}
+BENCHMARK(BM_ErrorMap)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
 
