@@ -322,6 +322,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             {"time_s", volumeSeconds},
             {"fallback_blend_distance", layout.fallbackBlendDistance},
             {"moved_probes", layout.octree ? layout.octree->moved : size_t(0)},
+            {"borrowed_cells", layout.octree ? layout.octree->borrowed : layout.borrowedCells},
             {"split_for_inside", layout.octree ? layout.octree->splitForInside : size_t(0)},
         };
         if (layout.octree) {

@@ -203,6 +203,26 @@ ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
                 L.valid.push_back(above ? 1 : 0);
                 if (above) L.cellProbe[x + size_t(y) * nx + size_t(z) * nx * ny] = index;
             }
+    // A cell partly above the ground whose centre probe is inside the terrain points at the first
+    // valid probe above it in its column (as terrain grids and adaptive minimum cells do), so an
+    // object standing on the ground there still finds a probe. Cells wholly inside keep -1.
+    for (int z = 0; z < nz; ++z)
+        for (int x = 0; x < nx; ++x) {
+            const double x0 = origin.x + cell * x, z0 = origin.z + cell * z;
+            const float lowest = surfaceRange(hf, x0, x0 + cell, z0, z0 + cell).lo;
+            for (int y = 0; y < ny; ++y) {
+                const size_t c = x + size_t(y) * nx + size_t(z) * nx * ny;
+                if (L.cellProbe[c] >= 0 || !(origin.y + cell * float(y + 1) > lowest)) continue;
+                for (int above = y + 1; above < ny; ++above) {
+                    const int32_t probe = L.cellProbe[x + size_t(above) * nx + size_t(z) * nx * ny];
+                    if (probe >= 0 && L.valid[size_t(probe)]) {
+                        L.cellProbe[c] = probe;
+                        ++L.borrowedCells;
+                        break;
+                    }
+                }
+            }
+        }
     // Box placement order is x fastest, then y, then z, matching the occupancy layout.
     return L;
 }

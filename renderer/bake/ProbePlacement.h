@@ -70,6 +70,9 @@ struct ProbeLayout {
     float cellSize = 1.0f;
     // cell -> index into positions (not yet compacted to valid probes), -1 = none.
     std::vector<int32_t> cellProbe;
+    // Box grids: cells partly above the ground whose own probe is inside the terrain, pointing
+    // at the first valid probe above them (adaptive volumes count theirs in octree->borrowed).
+    size_t borrowedCells = 0;
 
     // Adaptive volumes: per probe, the key its bake seed derives from (the leaf's identity, so a
     // leaf gets the same bytes however the refinement reached it). Empty: seeds follow the index.

@@ -708,3 +708,45 @@ TEST(AdaptiveBake, DryRunEstimatesWithoutWriting) {
     EXPECT_GT(e.probeRaysPerSecond, 0.0);
     EXPECT_GE(e.seconds, e.cacheSeconds + v.seconds);
 }
+
+TEST(BoxGrid, EveryCellPartlyAboveTheGroundNamesAProbe) {
+    const DemImportResult dem = importDem((kDems / "bigtujunga_utm11_crop.tif").string());
+    const Heightfield& hf = dem.heightfield;
+    ProbeVolumeSettings v;
+    v.placement = ProbePlacement::Box;
+    v.gridDims = {24, 10, 16};
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_GT(L.borrowedCells, 0u) << "cells straddling the ground with their centre inside";
+    size_t straddling = 0;
+    Rng rng(11);
+    for (uint32_t z = 0; z < L.cellDims[2]; ++z)
+        for (uint32_t y = 0; y < L.cellDims[1]; ++y)
+            for (uint32_t x = 0; x < L.cellDims[0]; ++x) {
+                const size_t c = cellIndex(L, x, y, z);
+                const int32_t probe = L.cellProbe[c];
+                if (probe >= 0) {
+                    // Its own probe, or the first valid one above in its column.
+                    ASSERT_TRUE(L.valid[size_t(probe)]);
+                    const glm::vec3 p = L.positions[size_t(probe)];
+                    const glm::vec3 centre = cellCentre(L, x, y, z);
+                    EXPECT_FLOAT_EQ(p.x, centre.x);
+                    EXPECT_FLOAT_EQ(p.z, centre.z);
+                    EXPECT_GE(p.y, centre.y);
+                    straddling += p.y > centre.y;
+                    continue;
+                }
+                // -1: no part above the ground, or nothing valid above it in the box.
+                bool validAbove = false;
+                for (uint32_t a = y + 1; a < L.cellDims[1]; ++a) {
+                    const int32_t q = L.cellProbe[cellIndex(L, x, a, z)];
+                    validAbove = validAbove || (q >= 0 && L.valid[size_t(q)]);
+                }
+                if (!validAbove) continue;
+                for (int s = 0; s < 32; ++s) {
+                    const glm::vec3 q = L.cellOrigin + L.cellSize * (glm::vec3(float(x), float(y), float(z)) +
+                                                                    glm::vec3(rng.next(), rng.next(), rng.next()));
+                    EXPECT_LE(q.y, hf.surfaceHeight(q.x, q.z) + 1e-3f) << x << " " << y << " " << z;
+                }
+            }
+    EXPECT_EQ(straddling, L.borrowedCells);
+}

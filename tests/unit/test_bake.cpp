@@ -226,7 +226,7 @@ TEST(Placement, TerrainGridAutoSpanAndOneByOne) {
     EXPECT_FLOAT_EQ(one.positions[0].y, 5.0f + 5.0f);
 }
 
-TEST(Placement, ProbesInsideTheTerrainAreInvalidWithNoCell) {
+TEST(Placement, ProbesInsideTheTerrainAreInvalidAndOnlyStraddlingCellsBorrow) {
     const Heightfield hf = flat(9, 10.0, 50.0f);
     ProbeVolumeSettings v;
     v.placement = ProbePlacement::Box;
@@ -236,10 +236,14 @@ TEST(Placement, ProbesInsideTheTerrainAreInvalidWithNoCell) {
     const ProbeLayout L = placeProbes(v, hf);
     ASSERT_EQ(L.positions.size(), 16u);
     EXPECT_EQ(L.validCount(), 4u);  // only the y = 70 layer is above the ground
+    // Cells wholly inside hold -1; the y = 50 cell straddles the ground, and with its own probe
+    // on the surface it points at the probe above.
     for (size_t i = 0; i < L.positions.size(); ++i) {
         const size_t x = i % 2, y = (i / 2) % 4, z = i / 8;
-        EXPECT_EQ(L.cellProbe[x + y * 2 + z * 8], L.valid[i] ? int32_t(i) : -1);
+        const int32_t expected = L.valid[i] ? int32_t(i) : y == 2 ? int32_t(i + 2) : -1;
+        EXPECT_EQ(L.cellProbe[x + y * 2 + z * 8], expected) << "cell " << x << " " << y << " " << z;
     }
+    EXPECT_EQ(L.borrowedCells, 4u);
     ProbeVolumeSettings below;
     below.heightOffset = -1.0;
     EXPECT_EQ(placeProbes(below, hf).validCount(), 0u);
