@@ -39,13 +39,8 @@ double secondsSince(Clock::time_point t) {
 }
 
 nlohmann::json stats(const std::vector<float>& v) {
-    if (v.empty()) return {{"mean", 0.0}, {"p95", 0.0}, {"max", 0.0}};
-    std::vector<float> s = v;
-    std::sort(s.begin(), s.end());
-    double sum = 0;
-    for (float x : s) sum += x;
-    const size_t p95 = std::min(s.size() - 1, size_t(std::ceil(0.95 * double(s.size()))) - 1);
-    return {{"mean", sum / double(s.size())}, {"p95", s[p95]}, {"max", s.back()}};
+    const Spread s = spreadOf(v);
+    return {{"mean", s.mean}, {"p95", s.p95}, {"max", s.max}};
 }
 
 // The .shprobe of a volume: valid probes only, occupancy pointing at their compacted indices.

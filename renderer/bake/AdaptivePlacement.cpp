@@ -548,18 +548,13 @@ InterpolationError measureInterpolationError(const ProbeLayout& L, const std::ve
     }
     e.points = e.errors.size();
     if (e.errors.empty()) return e;
-    std::vector<float> sorted = e.errors;
-    std::sort(sorted.begin(), sorted.end());
-    double sum = 0.0;
+    const Spread s = spreadOf(e.errors);
+    e.mean = s.mean;
+    e.p95 = s.p95;
+    e.max = s.max;
     size_t within = 0;
-    for (float x : sorted) {
-        sum += x;
-        within += tolerance && double(x) <= *tolerance;
-    }
-    e.mean = sum / double(sorted.size());
-    e.p95 = sorted[std::min(sorted.size() - 1, size_t(std::ceil(0.95 * double(sorted.size()))) - 1)];
-    e.max = sorted.back();
-    if (tolerance) e.withinTolerance = double(within) / double(sorted.size());
+    for (float x : e.errors) within += tolerance && double(x) <= *tolerance;
+    if (tolerance) e.withinTolerance = double(within) / double(e.errors.size());
     return e;
 }
 

@@ -375,14 +375,22 @@ ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
         if (!valid[i]) continue;
         s.perProbe.push_back(relativeIrradianceError(bake[i], reference[i]));
     }
-    if (s.perProbe.empty()) return s;
-    std::vector<float> sorted = s.perProbe;
-    std::sort(sorted.begin(), sorted.end());
+    const Spread d = spreadOf(s.perProbe);
+    s.mean = d.mean;
+    s.p95 = d.p95;
+    s.max = d.max;
+    return s;
+}
+
+Spread spreadOf(std::vector<float> values) {
+    Spread s;
+    if (values.empty()) return s;
+    std::sort(values.begin(), values.end());
     double sum = 0;
-    for (float e : sorted) sum += e;
-    s.mean = sum / double(sorted.size());
-    s.p95 = sorted[std::min(sorted.size() - 1, size_t(std::ceil(0.95 * double(sorted.size()))) - 1)];
-    s.max = sorted.back();
+    for (float e : values) sum += e;
+    s.mean = sum / double(values.size());
+    s.p95 = values[std::min(values.size() - 1, size_t(std::ceil(0.95 * double(values.size()))) - 1)];
+    s.max = values.back();
     return s;
 }
 

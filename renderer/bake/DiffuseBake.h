@@ -114,6 +114,12 @@ ProbeBake referenceProbesSeeded(const BakeLighting& lighting, int bounces,
                                 const std::vector<uint64_t>& seeds, const BakeControl& control);
 int referencePathLength(const glm::vec3& albedo);
 
+// Mean, 95th percentile (nearest rank) and max of a set of errors; zeros when it is empty.
+struct Spread {
+    double mean = 0, p95 = 0, max = 0;
+};
+Spread spreadOf(std::vector<float> values);
+
 // LIGHTING.md probe error: relative RMS of irradiance (luminance) over 256 fixed normals against
 // the reference, per valid probe; with mean, 95th percentile and max over probes.
 struct ErrorStats {

@@ -14,13 +14,10 @@ ErrorMapStats errorMapStats(const ErrorMap& map) {
         if (std::isfinite(x)) e.push_back(x);
     s.points = e.size();
     s.uncovered = map.error.size() - e.size();
-    if (e.empty()) return s;
-    std::sort(e.begin(), e.end());
-    double sum = 0.0;
-    for (float x : e) sum += x;
-    s.mean = sum / double(e.size());
-    s.p95 = e[std::min(e.size() - 1, size_t(std::ceil(0.95 * double(e.size()))) - 1)];
-    s.max = e.back();
+    const Spread d = spreadOf(std::move(e));
+    s.mean = d.mean;
+    s.p95 = d.p95;
+    s.max = d.max;
     return s;
 }
 

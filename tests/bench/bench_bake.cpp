@@ -8,6 +8,7 @@
 #include <benchmark/benchmark.h>
 
 #include "DemImport.h"
+#include "TestLighting.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
@@ -33,12 +34,7 @@ Fixture* fixture() {
         auto x = std::make_unique<Fixture>();
         x->dem = importDem(dem.string());
         x->tracer = std::make_unique<HeightfieldTracer>(x->dem.heightfield);
-        x->lighting.tracer = x->tracer.get();
-        x->lighting.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
-        x->lighting.sun.direction = sunDirection(135.0, 35.0);
-        x->lighting.sun.illuminance = glm::vec3(3.0f, 2.88f, 2.7f);
-        x->lighting.sun.angularRadius = 0.27f * 3.14159265f / 180.0f;
-        x->lighting.albedo = glm::vec3(0.3f);
+        x->lighting = test::skyAndSun(*x->tracer);
         ProbeVolumeSettings v;
         v.gridDims = {64, 1, 64};
         x->layout = placeProbes(v, x->dem.heightfield);

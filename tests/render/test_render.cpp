@@ -62,12 +62,13 @@ protected:
 std::unique_ptr<vk::VulkanContext> RenderTest::ctx_;
 std::string RenderTest::skipReason_;
 
-RenderedImage draw(ProjectRenderer& r, int view, bool probes = true) {
+RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear = false) {
     RenderRequest q;
     q.width = kW;
     q.height = kH;
     q.debugView = view;
     q.probes = probes;
+    q.linearOutput = linear;
     return r.render(q);
 }
 
@@ -193,14 +194,7 @@ TEST_F(RenderTest, PlateauIsBrighterThanValleyFloorInProbeIrradiance) {
 }
 
 TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
-    auto linear50 = [&](ProjectRenderer& r) {
-        RenderRequest q;
-        q.width = kW;
-        q.height = kH;
-        q.debugView = 50;
-        q.linearOutput = true;
-        return r.render(q);
-    };
+    auto linear50 = [&](ProjectRenderer& r) { return draw(r, 50, true, true); };
     auto relDiff = [](const RenderedImage& a, const RenderedImage& b) {
         double num = 0, den = 0;
         for (size_t i = 0; i < a.rgba.size(); ++i) {
@@ -264,15 +258,6 @@ std::vector<size_t> terrainPixels(ProjectRenderer& r) {
     return out;
 }
 
-RenderedImage drawLinear(ProjectRenderer& r, int view) {
-    RenderRequest q;
-    q.width = kW;
-    q.height = kH;
-    q.debugView = view;
-    q.linearOutput = true;
-    return r.render(q);
-}
-
 }  // namespace
 
 TEST_F(RenderTest, ValidityViewShowsWhereMovedProbesLightAndWhereNoProbeIsLeft) {
@@ -318,7 +303,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     m.error = {0.05f, 0.05f, 0.05f, 0.05f};
     r.setProbes({v});
     // EXR: the error itself in red, 1 in green where measured.
-    RenderedImage img = drawLinear(r, 56);
+    RenderedImage img = draw(r, 56, true, true);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4], 0.05f, 1e-4f) << "pixel " << i;
         ASSERT_NEAR(img.rgba[i * 4 + 1], 1.0f, 1e-3f) << "pixel " << i;  // half-float target
@@ -327,7 +312,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // West column 0, east column 20 %: every value in between, both ends on the heat ramp.
     m.error = {0.0f, 0.2f, 0.0f, 0.2f};
     r.setProbes({v});
-    img = drawLinear(r, 56);
+    img = draw(r, 56, true, true);
     float lo = 1.0f, hi = 0.0f;
     for (size_t i : terrain) {
         lo = std::min(lo, img.rgba[i * 4]);
@@ -350,7 +335,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // Unmeasured points (no probe around them at bake time): no value, grey.
     m.error.assign(4, NAN);
     r.setProbes({v});
-    img = drawLinear(r, 56);
+    img = draw(r, 56, true, true);
     const RenderedImage grey = draw(r, 56);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4 + 1], 0.0f, 1e-3f) << "pixel " << i;

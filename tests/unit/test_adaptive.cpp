@@ -17,6 +17,7 @@
 #include "BakeJob.h"
 #include "DemImport.h"
 #include "ShProbeFile.h"
+#include "TestLighting.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/SphereSampling.h"
@@ -494,12 +495,7 @@ TEST(Refinement, SameResultWithOneAndTwoThreads) {
     const DemImportResult dem = importDem((kDems / "orkhon_crop.asc").string());
     const Heightfield& hf = dem.heightfield;
     const HeightfieldTracer tracer(hf);
-    BakeLighting L;
-    L.tracer = &tracer;
-    L.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
-    L.sun.direction = sunDirection(135.0, 35.0);
-    L.sun.illuminance = glm::vec3(3.0f);
-    L.albedo = glm::vec3(0.3f);
+    const BakeLighting L = test::skyAndSun(tracer);
     ProbeVolumeSettings v = adaptive();
     v.adaptive.tolerance = 0.01;
     auto run = [&](int threads) {
@@ -529,13 +525,7 @@ TEST(AdaptiveBake, QuarterOfTheUniformProbesWithinToleranceOnARealDem) {
     const DemImportResult dem = importDem((kDems / "bigtujunga_utm11_crop.tif").string());
     const Heightfield& hf = dem.heightfield;
     const HeightfieldTracer tracer(hf);
-    BakeLighting L;
-    L.tracer = &tracer;
-    L.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
-    L.sun.direction = sunDirection(135.0, 35.0);
-    L.sun.illuminance = glm::vec3(3.0f, 2.88f, 2.7f);
-    L.sun.angularRadius = 0.27f * std::numbers::pi_v<float> / 180.0f;
-    L.albedo = glm::vec3(0.3f);
+    const BakeLighting L = test::skyAndSun(tracer);
     const IrradianceCache cache(L, 64, 32, 2, 0, {});
     const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
         std::vector<uint64_t> seeds(k.size());

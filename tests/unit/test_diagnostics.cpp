@@ -12,6 +12,7 @@
 
 #include "DemImport.h"
 #include "ProbeDiagnosticsFile.h"
+#include "TestLighting.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
@@ -170,12 +171,7 @@ TEST(ErrorMap, FinerTerrainGridsInterpolateBetterOnARealDem) {
     const DemImportResult dem = importDem((kDems / "bigtujunga_utm11_crop.tif").string());
     const Heightfield& hf = dem.heightfield;
     const HeightfieldTracer tracer(hf);
-    BakeLighting lighting;
-    lighting.tracer = &tracer;
-    lighting.sky = Sky::uniform(glm::vec3(0.6f, 0.75f, 1.0f));
-    lighting.sun.direction = sunDirection(135.0, 35.0);
-    lighting.sun.illuminance = glm::vec3(3.0f);
-    lighting.albedo = glm::vec3(0.3f);
+    const BakeLighting lighting = test::skyAndSun(tracer);
     const IrradianceCache cache(lighting, 48, 32, 2, 0, {});
     const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
         std::vector<uint64_t> seeds(k.size());
