@@ -100,17 +100,7 @@ uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
 // Bakes probes seeded by key (adaptive leaves, interpolation-error points).
 ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed,
                       const BakeControl& control) {
-    return [&b, cache, rays, seed, control](const std::vector<glm::vec3>& positions,
-                                            const std::vector<uint64_t>& keys) {
-        std::vector<uint64_t> seeds(keys.size());
-        for (size_t i = 0; i < keys.size(); ++i) seeds[i] = seed ^ keys[i];
-        const std::vector<uint8_t> valid(positions.size(), 1);
-        return b.referenceMode
-                   ? referenceProbesSeeded(b.lighting, b.q.bounces, positions, valid, rays, seeds,
-                                           control)
-                   : bakeProbesSeeded(b.lighting, cache, b.q.bounces, positions, valid, rays, seeds,
-                                      control);
-    };
+    return seededBaker(b.lighting, cache, b.q.bounces, rays, seed, control, b.referenceMode);
 }
 
 // Where two volumes' grids overlap, the engine reads the one whose file name sorts first

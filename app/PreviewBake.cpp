@@ -2,6 +2,7 @@
 
 
 #include "SceneLighting.h"
+#include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbeDiagnostics.h"
@@ -35,12 +36,7 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
                                           q.rays, seed, control);
         // Diagnostics as the bake writes them, with a coarser error map.
         ProbeDiagnostics d = describeProbes(layout);
-        const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& keys) {
-            std::vector<uint64_t> seeds(keys.size());
-            for (size_t i = 0; i < keys.size(); ++i) seeds[i] = seed ^ keys[i];
-            return bakeProbesSeeded(lighting, &cache, q.bounces, p, std::vector<uint8_t>(p.size(), 1),
-                                    q.rays, seeds, control);
-        };
+        const ProbeBaker baker = seededBaker(lighting, &cache, q.bounces, q.rays, seed, control);
         d.errorMap = measureErrorMap(layout, bake.sh, hf, baker,
                                      std::min(scene.bake.errorMapResolution, kPreviewErrorMapResolution),
                                      errorMapHeight(v, layout), seed);

@@ -347,6 +347,18 @@ uint64_t bakeMissing(const ProbeLayout& L, const ProbeBaker& baker,
 
 }  // namespace
 
+ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
+                       int rays, uint64_t seed, const BakeControl& control, bool reference) {
+    return [&lighting, cache, bounces, rays, seed, control, reference](
+               const std::vector<glm::vec3>& positions, const std::vector<uint64_t>& keys) {
+        std::vector<uint64_t> seeds(keys.size());
+        for (size_t i = 0; i < keys.size(); ++i) seeds[i] = seed ^ keys[i];
+        const std::vector<uint8_t> valid(positions.size(), 1);
+        return reference ? referenceProbesSeeded(lighting, bounces, positions, valid, rays, seeds, control)
+                         : bakeProbesSeeded(lighting, cache, bounces, positions, valid, rays, seeds, control);
+    };
+}
+
 uint64_t octreeLeafKey(const OctreeLeaf& l) {
     uint64_t k = splitmix64(0x0C7EE1EAFull ^ l.x);
     k = splitmix64(k ^ l.y);

@@ -60,6 +60,12 @@ uint64_t octreeLeafKey(const OctreeLeaf& leaf);
 using ProbeBaker = std::function<ProbeBake(const std::vector<glm::vec3>& positions,
                                            const std::vector<uint64_t>& keys)>;
 
+// The baker of a real bake: probe i seeded from seed ^ keys[i], with the irradiance cache
+// (bakeProbesSeeded) or, for `reference`, the path-traced reference (referenceProbesSeeded).
+// `lighting` and `cache` must outlive the baker.
+ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
+                       int rays, uint64_t seed, const BakeControl& control, bool reference = false);
+
 struct AdaptiveRefinement {
     double tolerance = 0.0;
     int rounds = 0;

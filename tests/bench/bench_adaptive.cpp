@@ -49,12 +49,7 @@ void benchDem(const char* label, const std::filesystem::path& file) {
     const auto cacheStart = Clock::now();
     const IrradianceCache cache(L, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, {});
     const double cacheSeconds = since(cacheStart);
-    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        std::vector<uint64_t> seeds(k.size());
-        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 0x7E77A1ABull ^ k[i];
-        return bakeProbesSeeded(L, &cache, q.bounces, p, std::vector<uint8_t>(p.size(), 1), q.rays,
-                                seeds, {});
-    };
+    const ProbeBaker baker = seededBaker(L, &cache, q.bounces, q.rays, 0x7E77A1ABull, {});
 
     ProbeVolumeSettings adaptive;
     adaptive.placement = ProbePlacement::Adaptive;

@@ -9,6 +9,7 @@
 
 #include "DemImport.h"
 #include "TestLighting.h"
+#include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
@@ -96,12 +97,7 @@ void BM_ErrorMap(benchmark::State& state) {
                                 q.bounces - 1, {});
     const ProbeBake bake = bakeProbes(f->lighting, &cache, q.bounces, f->layout.positions,
                                       f->layout.valid, q.rays, 99, {});
-    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        std::vector<uint64_t> seeds(k.size());
-        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 99 ^ k[i];
-        return bakeProbesSeeded(f->lighting, &cache, q.bounces, p, std::vector<uint8_t>(p.size(), 1),
-                                q.rays, seeds, {});
-    };
+    const ProbeBaker baker = seededBaker(f->lighting, &cache, q.bounces, q.rays, 99, {});
     ErrorMap map;
     for (auto _ : state) {
         map = measureErrorMap(f->layout, bake.sh, f->dem.heightfield, baker, resolution, 5.0f, 99);

@@ -501,12 +501,7 @@ TEST(Refinement, SameResultWithOneAndTwoThreads) {
     auto run = [&](int threads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
         const IrradianceCache cache(L, 32, 16, 2, 0, {});
-        const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-            std::vector<uint64_t> seeds(k.size());
-            for (size_t i = 0; i < k.size(); ++i) seeds[i] = 77 ^ k[i];
-            return bakeProbesSeeded(L, &cache, 1, p, std::vector<uint8_t>(p.size(), 1), 32, seeds, {});
-        };
-        return bakeAdaptive(v, hf, baker);
+        return bakeAdaptive(v, hf, seededBaker(L, &cache, 1, 32, 77, {}));
     };
     const AdaptiveBake a = run(1), b = run(2);
     EXPECT_GT(a.refinement->leavesSplit, 0u);
@@ -527,11 +522,7 @@ TEST(AdaptiveBake, QuarterOfTheUniformProbesWithinToleranceOnARealDem) {
     const HeightfieldTracer tracer(hf);
     const BakeLighting L = test::skyAndSun(tracer);
     const IrradianceCache cache(L, 64, 32, 2, 0, {});
-    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        std::vector<uint64_t> seeds(k.size());
-        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 99 ^ k[i];
-        return bakeProbesSeeded(L, &cache, 1, p, std::vector<uint8_t>(p.size(), 1), 256, seeds, {});
-    };
+    const ProbeBaker baker = seededBaker(L, &cache, 1, 256, 99, {});
     const double tolerance = 0.02;
     ProbeVolumeSettings v = adaptive();  // 30 m to 480 m cells
     const AdaptiveBake geometric = bakeAdaptive(v, hf, baker);

@@ -173,11 +173,7 @@ TEST(ErrorMap, FinerTerrainGridsInterpolateBetterOnARealDem) {
     const HeightfieldTracer tracer(hf);
     const BakeLighting lighting = test::skyAndSun(tracer);
     const IrradianceCache cache(lighting, 48, 32, 2, 0, {});
-    const ProbeBaker baker = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        std::vector<uint64_t> seeds(k.size());
-        for (size_t i = 0; i < k.size(); ++i) seeds[i] = 5 ^ k[i];
-        return bakeProbesSeeded(lighting, &cache, 1, p, std::vector<uint8_t>(p.size(), 1), 256, seeds, {});
-    };
+    const ProbeBaker baker = seededBaker(lighting, &cache, 1, 256, 5, {});
     double previous = INFINITY;
     for (int n : {4, 16, 48}) {
         const ProbeLayout L = placeProbes(terrainGrid(n), hf);
