@@ -227,10 +227,15 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     // Adaptive volumes are placed here geometrically (for the progress shares and early errors)
     // and again, with their refinement, when they bake.
     std::vector<ProbeLayout> layouts;
-    size_t totalProbes = 0;
+    // Progress counts probe bakes: the probes, then each volume's error-map points.
+    size_t totalProbes = 0, totalWork = 0;
+    std::vector<size_t> mapPoints;
     for (const auto* v : volumes) {
         layouts.push_back(placeProbes(*v, hf));
         totalProbes += layouts.back().positions.size();
+        mapPoints.push_back(errorMapGrid(layouts.back(), hf, scene.bake.errorMapResolution,
+                                         errorMapHeight(*v, layouts.back())).error.size());
+        totalWork += layouts.back().positions.size() + mapPoints.back();
     }
 
     // Phase weights for one progress bar: cache, probes, reference.
@@ -252,7 +257,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     nlohmann::json volumeReports = nlohmann::json::array();
     std::vector<GltfProbeVolume> grids;
     uint64_t totalRays = 0;
-    size_t done = 0;
+    size_t done = 0, doneWork = 0;
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *volumes[vi];
         ProbeLayout& layout = layouts[vi];
@@ -261,9 +266,10 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         const uint64_t seed = volumeSeed(vi);
         const int rays = v.rayCount ? *v.rayCount : q.rays;
         std::string phase = "probes '" + v.name + "'";
+        const double probeWork = double(layout.positions.size()), mapWork = double(mapPoints[vi]);
         BakeControl c{[&](double f) {
-                          report(phase,
-                                 base + probeShare * (double(done) / double(totalProbes) + share * f));
+                          report(phase, base + probeShare * (double(doneWork) + f * probeWork) /
+                                                   double(std::max<size_t>(totalWork, 1)));
                       },
                       cancel};
         ProbeBake bake;
@@ -364,10 +370,18 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             phase = "error map '" + v.name + "'";
             const auto mapStart = Clock::now();
             uint64_t mapRays = 0;
-            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, c);
+            const BakeControl mc{[&](double f) {
+                                     report(phase, base + probeShare * (double(doneWork) + probeWork + f * mapWork) /
+                                                              double(std::max<size_t>(totalWork, 1)));
+                                 },
+                                 cancel};
+            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, mc);
+            // The truth gets the same window as the probes, so the map shows interpolation alone.
             const ProbeBaker counted = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
                 ProbeBake t = baker(p, k);
                 mapRays += t.rays;
+                if (scene.bake.deringing)
+                    for (auto& s : t.sh) sh::deringIrradiance(s);
                 return t;
             };
             diagnostics.errorMap = measureErrorMap(layout, bake.sh, hf, counted,
@@ -402,10 +416,11 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         vr["grid"] = {{"dims", {grid.dims.x, grid.dims.y, grid.dims.z}},
                       {"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
                       {"spacing", grid.spacing}};
-        const glm::uvec3 gridDims = grid.dims;
         volumeReports.push_back(vr);
-        grids.push_back({v.name, std::move(grid), encodeProbeDiagnostics(diagnostics, v.name, gridDims)});
+        std::string sidecar = encodeProbeDiagnostics(diagnostics, v.name, grid);
+        grids.push_back({v.name, std::move(grid), std::move(sidecar)});
         done += layouts[vi].positions.size();
+        doneWork += layouts[vi].positions.size() + mapPoints[vi];
     }
     if (cancelled()) throw BakeCancelled();
 
@@ -553,6 +568,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
         ve.probes = ve.probesMax = L.validCount();
         ve.bytes = ve.bytesMax = L.fileBytes();
         ve.raysPerProbe = v.rayCount ? *v.rayCount : q.rays;
+        ve.borrowed = L.borrowedCells;
         const double perProbe = double(ve.raysPerProbe) * secondsPerProbeRay;
         double probes = double(ve.probes), probesMax = probes;
         if (L.octree) {

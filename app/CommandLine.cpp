@@ -236,6 +236,8 @@ int printEstimate(const BakeEstimate& e) {
             std::cout << " (" << v.moved << " moved up, " << v.borrowed
                       << " cells borrow the probe above; a uniform grid would need "
                       << v.uniformProbes << ")";
+        else if (v.borrowed)
+            std::cout << " (" << v.borrowed << " cells borrow the probe above)";
         std::cout << ", " << v.bytes << " bytes";
         if (v.errorMapPoints) std::cout << ", " << v.errorMapPoints << " error-map points";
         std::cout << ", about " << duration(v.seconds) << "\n";
@@ -306,7 +308,9 @@ int commandBake(const Args& a) {
                       << fixed(100.0 * v["reference_error"]["p95"].get<double>(), 2) << " % / max "
                       << fixed(100.0 * v["reference_error"]["max"].get<double>(), 2) << " %";
         std::cout << "\n";
-        if (v.contains("error_map")) {
+        if (v.contains("error_map") && v["error_map"]["size"][0].get<int>() == 0) {
+            std::cout << "    no interpolation-error map: the volume's grid is not over the terrain\n";
+        } else if (v.contains("error_map")) {
             const auto& m = v["error_map"];
             std::cout << "    interpolation error over the ground (" << m["size"][0].get<int>() << " x "
                       << m["size"][1].get<int>() << " points, " << fixed(m["height_m"].get<double>(), 2)

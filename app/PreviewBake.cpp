@@ -41,6 +41,7 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
                                      std::min(scene.bake.errorMapResolution, kPreviewErrorMapResolution),
                                      errorMapHeight(v, layout), seed);
         GpuProbeVolume g;
+        g.name = v.name;
         g.dims = glm::uvec3(layout.cellDims[0], layout.cellDims[1], layout.cellDims[2]);
         g.origin = layout.cellOrigin;
         g.spacing = layout.cellSize;

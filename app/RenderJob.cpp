@@ -14,11 +14,14 @@ namespace terralux {
 
 namespace {
 
-// Overlay markers: w 1 = valid, 2 = moved up, 0 = rejected (inside the terrain).
-void appendMarkers(const ProbeDiagnostics& d, std::vector<glm::vec4>& out) {
+// Overlay markers (w 1 = valid, 2 = moved up, 0 = rejected inside the terrain) and leaves.
+ProjectRenderer::Overlay overlayOf(const ProbeDiagnostics& d) {
+    ProjectRenderer::Overlay o;
     for (size_t i = 0; i < d.positions.size(); ++i)
-        out.emplace_back(d.positions[i], i < d.moved.size() && d.moved[i] ? 2.0f : 1.0f);
-    for (const auto& p : d.rejected) out.emplace_back(p, 0.0f);
+        o.markers.emplace_back(d.positions[i], i < d.moved.size() && d.moved[i] ? 2.0f : 1.0f);
+    for (const auto& p : d.rejected) o.markers.emplace_back(p, 0.0f);
+    o.leaves = d.leaves;
+    return o;
 }
 
 }  // namespace
@@ -41,14 +44,11 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
-    placedMarkers_.clear();
-    placedLeaves_.clear();
+    placed_.clear();
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
         try {
-            const ProbeDiagnostics d = describeProbes(placeProbes(v, terrain_.heightfield));
-            appendMarkers(d, placedMarkers_);
-            placedLeaves_.insert(placedLeaves_.end(), d.leaves.begin(), d.leaves.end());
+            placed_[v.name] = overlayOf(describeProbes(placeProbes(v, terrain_.heightfield)));
         } catch (const PlacementError&) {
             // Settings the bake would refuse: no markers for that volume.
         }
@@ -58,24 +58,29 @@ void ProjectRenderer::setProject(const Project& project) {
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
-    boundMarkers_.clear();
-    boundLeaves_.clear();
-    boundDiagnostics_ = false;
+    bound_.clear();
     boundVolumes_ = sceneToJson(project_.scene).at("probe_volumes").dump();
-    for (const auto& v : volumes) {
-        if (!v.diagnostics) continue;
-        boundDiagnostics_ = true;
-        appendMarkers(*v.diagnostics, boundMarkers_);
-        boundLeaves_.insert(boundLeaves_.end(), v.diagnostics->leaves.begin(), v.diagnostics->leaves.end());
-    }
+    for (const auto& v : volumes)
+        if (v.diagnostics) bound_[v.name] = overlayOf(*v.diagnostics);
     updateOverlays();
 }
 
 void ProjectRenderer::updateOverlays() {
-    const bool bound = boundDiagnostics_ &&
-                       boundVolumes_ == sceneToJson(project_.scene).at("probe_volumes").dump();
-    renderer_->setProbePositions(bound ? boundMarkers_ : placedMarkers_);
-    renderer_->setProbeLeaves(bound ? boundLeaves_ : placedLeaves_);
+    const bool current = boundVolumes_ == sceneToJson(project_.scene).at("probe_volumes").dump();
+    std::vector<glm::vec4> markers, leaves;
+    for (const auto& v : project_.scene.probeVolumes) {
+        if (!v.enabled) continue;
+        const auto b = bound_.find(v.name);
+        const auto p = placed_.find(v.name);
+        const Overlay* o = current && b != bound_.end() ? &b->second
+                           : p != placed_.end()          ? &p->second
+                                                         : nullptr;
+        if (!o) continue;
+        markers.insert(markers.end(), o->markers.begin(), o->markers.end());
+        leaves.insert(leaves.end(), o->leaves.begin(), o->leaves.end());
+    }
+    renderer_->setProbePositions(markers);
+    renderer_->setProbeLeaves(leaves);
 }
 
 ProjectRenderer::~ProjectRenderer() = default;
@@ -98,8 +103,10 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
         if (!v.enabled) continue;
         const auto path = dir / (v.name + ".shprobe");
         if (!std::filesystem::exists(path)) continue;
-        const ShProbeGrid g = readShProbeFile(path);
+        std::vector<uint8_t> bytes;
+        const ShProbeGrid g = readShProbeFile(path, &bytes);
         GpuProbeVolume gv;
+        gv.name = v.name;
         gv.dims = g.dims;
         gv.origin = g.origin;
         gv.spacing = g.spacing;
@@ -113,7 +120,7 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
         const auto sidecar = dir / probeDiagnosticsFileName(v.name);
         try {
             if (std::filesystem::exists(sidecar))
-                gv.diagnostics = readProbeDiagnosticsFile(sidecar, g.probes.size(), g.dims);
+                gv.diagnostics = readProbeDiagnosticsFile(sidecar, g, shProbeDigest(bytes));
             else if (warnings)
                 warnings->push_back(sidecar.string() + ": missing (bake again for views 54 and 56)");
         } catch (const ProbeDiagnosticsError& e) {

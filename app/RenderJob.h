@@ -4,6 +4,7 @@
 // render tests and the UI viewport all come through here, so they draw the same image.
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -53,15 +54,18 @@ public:
     const Heightfield& heightfield() const { return terrain_.heightfield; }
     TerrainRenderer& renderer() { return *renderer_; }
 
+    // One volume's overlay records: probe markers and octree leaves.
+    struct Overlay {
+        std::vector<glm::vec4> markers, leaves;
+    };
+
 private:
-    // The overlays follow the bound probes where they carry diagnostics and were baked from the
-    // current probe-volume settings; otherwise the placement of the current settings.
+    // Per volume, the overlays follow the bound probes where they carry diagnostics and were
+    // baked from the current probe-volume settings; otherwise the placement of those settings.
     void updateOverlays();
 
     Project project_;
-    std::vector<glm::vec4> placedMarkers_, placedLeaves_;
-    std::vector<glm::vec4> boundMarkers_, boundLeaves_;
-    bool boundDiagnostics_ = false;
+    std::map<std::string, Overlay> placed_, bound_;  // by volume name
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     DemImportResult terrain_;
     RenderSettings base_;

@@ -1,6 +1,8 @@
 #include "ProbeDiagnosticsFile.h"
 
+#include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -14,8 +16,15 @@ using json = nlohmann::json;
 constexpr const char* kFormat = "terralux-probe-diagnostics";
 constexpr int kVersion = 1;
 
-// Millimetres for positions and sizes, 1e-6 for errors: shortest decimal output stays short.
-double rounded(double v, double unit) { return std::round(v / unit) * unit; }
+// Millimetres for positions and sizes, 1e-6 for errors; dividing by the whole reciprocal keeps the
+// shortest decimal form short (0.012345, not 0.012345000000000001).
+double rounded(double v, double unit) { return std::round(v / unit) / std::round(1.0 / unit); }
+
+std::string hex64(uint64_t v) {
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+    return buf;
+}
 
 json flat(const std::vector<glm::vec3>& v) {
     json a = json::array();
@@ -47,7 +56,8 @@ std::vector<float> numbers(const json& j, const char* key, const std::string& na
             out.push_back(NAN);
             continue;
         }
-        if (!x.is_number() || !std::isfinite(x.get<double>()))
+        // Finite as the float it becomes, not only as the double it was written as.
+        if (!x.is_number() || !std::isfinite(x.get<double>()) || std::abs(x.get<double>()) > FLT_MAX)
             fail(name, std::string("'") + key + "' holds " + x.dump() + ", not a finite number");
         out.push_back(x.get<float>());
     }
@@ -66,8 +76,19 @@ std::string probeDiagnosticsFileName(const std::string& volumeName) {
     return volumeName + ".probes.json";
 }
 
+uint64_t shProbeDigest(std::span<const uint8_t> bytes) {
+    // FNV-1a, 64-bit (Fowler, Noll, Vo): offset basis and prime from the published parameters.
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (uint8_t b : bytes) {
+        h ^= b;
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
 std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string& volumeName,
-                                   const glm::uvec3& gridDims) {
+                                   const ShProbeGrid& grid) {
+    const glm::uvec3 gridDims = grid.dims;
     json moved = json::array();
     for (size_t i = 0; i < d.moved.size(); ++i)
         if (d.moved[i]) moved.push_back(i);
@@ -84,6 +105,7 @@ std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string&
         {"volume", volumeName},
         {"probe_count", d.positions.size()},
         {"grid_dims", {gridDims.x, gridDims.y, gridDims.z}},
+        {"shprobe_fnv1a64", hex64(shProbeDigest(encodeShProbe(grid)))},
         {"positions", flat(d.positions)},
         {"moved", moved},
         {"rejected", flat(d.rejected)},
@@ -99,7 +121,9 @@ std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string&
 }
 
 ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::string& name,
-                                        size_t probeCount, const glm::uvec3& gridDims) {
+                                        const ShProbeGrid& grid, uint64_t shprobeDigest) {
+    const size_t probeCount = grid.probes.size();
+    const glm::uvec3 gridDims = grid.dims;
     json j;
     try {
         j = json::parse(text);
@@ -120,6 +144,10 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
         fail(name, "grid_dims " + dims.dump() + " do not match the .shprobe's [" +
                        std::to_string(gridDims.x) + "," + std::to_string(gridDims.y) + "," +
                        std::to_string(gridDims.z) + "] (a sidecar of another bake)");
+    const json& digest = member(j, "shprobe_fnv1a64", name);
+    if (digest != hex64(shprobeDigest))
+        fail(name, "shprobe_fnv1a64 " + digest.dump() + " does not match the .shprobe's \"" +
+                       hex64(shprobeDigest) + "\" (a sidecar of another bake)");
 
     ProbeDiagnostics d;
     d.positions = points(numbers(j, "positions", name, 3));
@@ -159,9 +187,10 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
     m.z0 = origin[1];
     const json& step = member(em, "step", name);
     const json& height = member(em, "height", name);
-    if (!step.is_number() || !(step.get<double>() > 0.0) || !std::isfinite(step.get<double>()))
-        fail(name, "error_map: step " + step.dump() + " must be a number > 0");
-    if (!height.is_number() || !std::isfinite(height.get<double>()))
+    // The file holds millimetres: a step below that cannot come from a bake.
+    if (!step.is_number() || !(step.get<double>() >= 1e-3) || !(step.get<double>() <= FLT_MAX))
+        fail(name, "error_map: step " + step.dump() + " must be a number >= 0.001 (m)");
+    if (!height.is_number() || !std::isfinite(height.get<double>()) || std::abs(height.get<double>()) > FLT_MAX)
         fail(name, "error_map: height " + height.dump() + " must be a finite number");
     m.step = step.get<float>();
     m.height = height.get<float>();
@@ -174,13 +203,13 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
     return d;
 }
 
-ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, size_t probeCount,
-                                          const glm::uvec3& gridDims) {
+ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, const ShProbeGrid& grid,
+                                          uint64_t shprobeDigest) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ProbeDiagnosticsError(path.string() + ": cannot open");
     std::stringstream ss;
     ss << in.rdbuf();
-    return decodeProbeDiagnostics(ss.str(), path.string(), probeCount, gridDims);
+    return decodeProbeDiagnostics(ss.str(), path.string(), grid, shprobeDigest);
 }
 
 }  // namespace terralux

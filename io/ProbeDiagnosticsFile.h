@@ -7,6 +7,7 @@
 //     "format": "terralux-probe-diagnostics", "version": 1,
 //     "volume": "<name>",                      the .shprobe stem
 //     "probe_count": N, "grid_dims": [X, Y, Z] as in the .shprobe (a mismatch: stale sidecar)
+//     "shprobe_fnv1a64": "<16 hex digits>"     FNV-1a 64 of the .shprobe's bytes (the same check)
 //     "positions": [x, y, z, ...]              3N numbers, metres, engine space (mm precision)
 //     "moved": [i, ...]                        probe indices moved up out of the terrain
 //     "rejected": [x, y, z, ...]               probes placed inside the terrain (not in the file)
@@ -18,10 +19,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
+#include <span>
 #include <string>
 
 #include <glm/vec3.hpp>
 
+#include "ShProbeFile.h"
 #include "bake/ProbeDiagnostics.h"
 
 namespace terralux {
@@ -34,15 +37,18 @@ public:
 // The sidecar's file name for a volume: "<name>.probes.json".
 std::string probeDiagnosticsFileName(const std::string& volumeName);
 
+// What ties a sidecar to its .shprobe: FNV-1a 64 of the file's bytes.
+uint64_t shProbeDigest(std::span<const uint8_t> shprobeBytes);
+
 std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string& volumeName,
-                                   const glm::uvec3& gridDims);
+                                   const ShProbeGrid& grid);
 
-// Parses and validates against the .shprobe it belongs to (probe count and grid dims). Every
-// error message starts with `name`.
+// Parses and validates against the .shprobe it belongs to (probe count, grid dims and digest of
+// its bytes). Every error message starts with `name`.
 ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::string& name,
-                                        size_t probeCount, const glm::uvec3& gridDims);
+                                        const ShProbeGrid& grid, uint64_t shprobeDigest);
 
-ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, size_t probeCount,
-                                          const glm::uvec3& gridDims);
+ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, const ShProbeGrid& grid,
+                                          uint64_t shprobeDigest);
 
 }  // namespace terralux

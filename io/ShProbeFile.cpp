@@ -369,7 +369,7 @@ void writeShProbeFile(const std::filesystem::path& path, const ShProbeGrid& grid
     guard.armed = false;
 }
 
-ShProbeGrid readShProbeFile(const std::filesystem::path& path) {
+ShProbeGrid readShProbeFile(const std::filesystem::path& path, std::vector<uint8_t>* bytesOut) {
     const std::string name = path.string();
     std::error_code ec;
     if (fs::is_directory(path, ec))
@@ -402,7 +402,9 @@ ShProbeGrid readShProbeFile(const std::filesystem::path& path) {
         fail(name, "read " + num(static_cast<uint64_t>(in.gcount())) + " of " + num(fileBytes) +
                        " bytes");
     }
-    return decodeShProbe(bytes, name);
+    ShProbeGrid grid = decodeShProbe(bytes, name);
+    if (bytesOut) *bytesOut = std::move(bytes);
+    return grid;
 }
 
 }  // namespace terralux

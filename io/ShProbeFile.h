@@ -69,7 +69,7 @@ ShProbeGrid decodeShProbe(std::span<const uint8_t> bytes, const std::string& nam
 // any failure the temporary is removed, an existing target is left untouched, and it throws.
 void writeShProbeFile(const std::filesystem::path& path, const ShProbeGrid& grid);
 
-// Error messages start with the file path.
-ShProbeGrid readShProbeFile(const std::filesystem::path& path);
+// Error messages start with the file path. `bytes`, when given, receives the file as read.
+ShProbeGrid readShProbeFile(const std::filesystem::path& path, std::vector<uint8_t>* bytes = nullptr);
 
 }  // namespace terralux

@@ -7,8 +7,10 @@ layout(local_size_x = 64) in;
 #include "probes.glsl"
 
 layout(set = 0, binding = 4, std430) readonly buffer Vertices { float v[]; } vertices;  // pos, normal
-// Per vertex: (probe irradiance, blend weight), then (moved share, interpolation error, 1 = the
-// error is known, 1 = inside a volume with no probe to light it).
+// Per vertex: (probe irradiance, blend weight), then (moved share, interpolation error × known,
+// known: 1 where the error was measured, 1 = inside a volume with no probe to light it). The
+// error is premultiplied so that the rasteriser's blend, divided by the blended `known`, stays the
+// error near unmeasured vertices instead of fading towards 0.
 layout(set = 0, binding = 5, std430) writeonly buffer ProbeLight { vec4 v[]; } probeLight;
 // Every volume's interpolation-error map (Volume.errorMap), -1 where no probe covered the point.
 layout(set = 0, binding = 6, std430) readonly buffer Errors { float e[]; } errors;
@@ -19,7 +21,11 @@ float mapError(Volume vol, vec2 xz, out float known) {
     known = 0.0;
     ivec2 size = vol.errorMap.yz;
     if (size.x <= 0 || size.y <= 0) return 0.0;
-    vec2 g = clamp((xz - vol.errorGrid.xy) / vol.errorGrid.z, vec2(0.0), vec2(size - 1));
+    if (!(vol.errorGrid.z > 0.0)) return 0.0;
+    vec2 u = (xz - vol.errorGrid.xy) / vol.errorGrid.z;
+    // Beyond half a step outside the outermost points nothing was measured.
+    if (any(lessThan(u, vec2(-0.5))) || any(greaterThan(u, vec2(size) - 0.5))) return 0.0;
+    vec2 g = clamp(u, vec2(0.0), vec2(size - 1));
     ivec2 c0 = min(ivec2(floor(g)), size - 1);
     vec2 f = g - vec2(c0);
     float sum = 0.0, wsum = 0.0;
@@ -49,5 +55,5 @@ void main() {
     vec3 irradiance = probeIrradiance(p, n, weight, moved, volume, unlit);
     if (volume >= 0) error = mapError(volumes.v[volume], p.xz, known);
     probeLight.v[2 * i] = vec4(irradiance, weight);
-    probeLight.v[2 * i + 1] = vec4(moved, error, known, unlit ? 1.0 : 0.0);
+    probeLight.v[2 * i + 1] = vec4(moved, error * known, known, unlit ? 1.0 : 0.0);
 }

@@ -46,6 +46,7 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
     movedShare = 0.0;
     volume = -1;
     unlit = false;
+    bool inBox = false;
     for (int vi = 0; vi < frame.params.y; ++vi) {
         Volume vol = volumes.v[vi];
         vec3 lo = vol.originSpacing.xyz;
@@ -86,7 +87,8 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
                 return max(shIrradiance(blended, n, vol.occupancy.y == 1) * vol.blend.y, vec3(0.0));
             }
         }
-        if (dist <= 0.0) unlit = true;
+        inBox = inBox || dist <= 0.0;
     }
+    unlit = inBox;  // no volume lit p, and one of them contains it
     return vec3(0.0);
 }

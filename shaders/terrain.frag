@@ -7,8 +7,8 @@
 layout(location = 0) in vec3 worldPos;
 layout(location = 1) in vec3 worldNormal;
 layout(location = 2) in vec4 probeIrradianceWeight;  // rgb irradiance, a blend weight
-// x share of moved probes in the blend, y interpolation error, z 1 = error known, w 1 = inside a
-// volume with no probe to light it.
+// x share of moved probes in the blend, y interpolation error × known, z known (1 = measured),
+// w 1 = inside a volume with no probe to light it.
 layout(location = 3) in vec4 probeInfo;
 layout(location = 0) out vec4 outColor;
 
@@ -79,8 +79,10 @@ void main() {
         c = base * relief;
     } else if (view == 56) {
         // Interpolation error: EXR holds the error in red and 1 where it is known in green.
-        if (frame.params.w == 1) c = vec3(probeInfo.y * probeInfo.z, probeInfo.z, 0.0);
-        else c = (probeInfo.z > 0.5 ? heat(probeInfo.y) : vec3(0.25)) * (0.75 + 0.25 * max(n.y, 0.0));
+        float known = probeInfo.z;
+        float error = known > 0.0 ? probeInfo.y / known : 0.0;
+        if (frame.params.w == 1) c = vec3(known > 0.5 ? error : 0.0, known > 0.5 ? 1.0 : 0.0, 0.0);
+        else c = (known > 0.5 ? heat(error) : vec3(0.25)) * (0.75 + 0.25 * max(n.y, 0.0));
     }
     else c = display(linear);
     outColor = vec4(c, 1.0);

@@ -17,6 +17,6 @@ void main() {
     worldPos = inPosition;
     worldNormal = inNormal;
     probeIrradianceWeight = frame.params.z == 1 ? inProbeLight : vec4(0.0);
-    probeInfo = inProbeInfo;
+    probeInfo = frame.params.z == 1 ? inProbeInfo : vec4(0.0);
     gl_Position = frame.viewProj * vec4(inPosition, 1.0);
 }

@@ -243,7 +243,7 @@ void MainWindow::buildDocks() {
     bf->addInteger("bake.bounces", "Bounces", 0, 16, "preset");
     bf->addChoice("bake.sh_encoding", "SH encoding", {"radiance", "irradiance"});
     bf->addBool("bake.deringing", "Deringing");
-    bf->addInteger("bake.error_map_resolution", "Error map points", 0, kMaxErrorMapResolution);
+    bf->addInteger("bake.error_map_resolution", "Error map points a side", 0, kMaxErrorMapResolution);
     bf->addText("export.out_dir", "Output folder");
     bf->addBool("export.gltf", "glTF scene");
     bf->addNumber("export.default_scale", "SH scale", -100.0, 100.0, 3, "");

@@ -13,7 +13,8 @@ const std::vector<DebugView>& debugViews() {
         {51, "probe-weight", "probe blend weight", false},
         {54, "probe-validity",
          "invalid / relocated probes: grey lit by probes at their placement, cyan by moved probes, "
-         "red inside a volume with no valid probe; markers gold valid, cyan moved, red rejected",
+         "red inside a volume with no valid probe; markers cyan moved, red rejected (with the probe "
+         "overlay also gold valid)",
          false},
         {56, "interpolation-error",
          "interpolation error heat map: blue 0 %, cyan 2.5 %, green 5 %, yellow 7.5 %, red 10 % and "

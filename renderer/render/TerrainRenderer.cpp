@@ -114,11 +114,15 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
         rec.blend = glm::vec4(v.fallbackBlendDistance, v.scale, 0.0f, 0.0f);
         static const ProbeDiagnostics none;
         const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
-        rec.errorMap[0] = int32_t(errors.size());
-        rec.errorMap[1] = int32_t(d.errorMap.nx);
-        rec.errorMap[2] = int32_t(d.errorMap.nz);
-        rec.errorGrid = glm::vec4(d.errorMap.x0, d.errorMap.z0, d.errorMap.step, 0.0f);
-        for (float e : d.errorMap.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
+        const ErrorMap& m = d.errorMap;
+        // A map that does not hold nx·nz values (or has no step) is no map.
+        if (m.error.size() == size_t(m.nx) * m.nz && m.step > 0.0f && !m.error.empty()) {
+            rec.errorMap[0] = int32_t(errors.size());
+            rec.errorMap[1] = int32_t(m.nx);
+            rec.errorMap[2] = int32_t(m.nz);
+            rec.errorGrid = glm::vec4(m.x0, m.z0, m.step, 0.0f);
+            for (float e : m.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
+        }
         for (size_t i = 0; i < v.coeffs.size(); ++i) {
             const float moved = i < d.moved.size() && d.moved[i] ? 1.0f : 0.0f;
             coeffs.push_back(glm::vec4(v.coeffs[i][0], moved));

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -22,6 +23,7 @@ namespace terralux {
 
 // One baked volume as the GPU reads it: the .shprobe grid (occupancy + coefficients).
 struct GpuProbeVolume {
+    std::string name;  // the volume's, for overlays and messages
     glm::uvec3 dims{1};
     glm::vec3 origin{0.0f};
     float spacing = 1.0f;

@@ -233,6 +233,7 @@ namespace {
 // the east half at probe 1 (both a constant sky), with diagnostics to fill in.
 GpuProbeVolume halves(const Heightfield& hf) {
     GpuProbeVolume v;
+    v.name = "probes";  // the sample project's volume, whose overlays this replaces
     const float cell = std::max(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ()) / 4.0f;
     v.spacing = cell;
     v.origin = glm::vec3(hf.minX(), hf.minHeight() - 1.0f, hf.minZ());
@@ -285,9 +286,13 @@ TEST_F(RenderTest, ValidityViewShowsWhereMovedProbesLightAndWhereNoProbeIsLeft) 
     EXPECT_GT(count(moved, cyan), terrain.size() / 4) << "the east half is lit by a moved probe";
     EXPECT_GT(count(moved, grey), terrain.size() / 4) << "the west half is not";
 
-    std::fill(v.occupancy.begin(), v.occupancy.end(), -1);  // every probe rejected
-    r.setProbes({v});
+    GpuProbeVolume empty = v;
+    std::fill(empty.occupancy.begin(), empty.occupancy.end(), -1);  // every probe rejected
+    r.setProbes({empty});
     EXPECT_GT(count(draw(r, 54), red), terrain.size() * 9 / 10);
+    // A second volume that lights the same ground: nothing is left unlit.
+    r.setProbes({empty, v});
+    EXPECT_EQ(count(draw(r, 54), red), 0u);
 }
 
 TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
@@ -331,6 +336,25 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     }
     EXPECT_GT(blue, 0u);
     EXPECT_GT(redPixels, 0u);
+    // The map lands where the bake measured it: its east column (x > 0) is the east half, which
+    // view 54 shows through the probe that lights it.
+    v.diagnostics->moved = {0, 1};
+    r.setProbes({v});
+    const RenderedImage validity = draw(r, 54);
+    size_t agree = 0, high = 0;
+    for (size_t i : terrain) {
+        const float* c = &validity.rgba[i * 4];
+        const bool east = c[2] > c[0] + 0.3f;
+        if (img.rgba[i * 4] > 0.15f) {
+            ++high;
+            agree += east;
+        } else if (img.rgba[i * 4] < 0.05f) {
+            ++high;
+            agree += !east;
+        }
+    }
+    EXPECT_GT(high, terrain.size() / 3);
+    EXPECT_GT(agree, high * 95 / 100);
 
     // Unmeasured points (no probe around them at bake time): no value, grey.
     m.error.assign(4, NAN);

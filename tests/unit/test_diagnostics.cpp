@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -22,6 +23,18 @@ using namespace terralux;
 namespace fs = std::filesystem;
 
 namespace {
+
+// A .shprobe grid of `count` probes over `dims` cells (the sidecar is checked against it).
+ShProbeGrid gridOf(size_t count, glm::uvec3 dims) {
+    ShProbeGrid g;
+    g.dims = dims;
+    g.probes.resize(count);
+    for (size_t i = 0; i < count; ++i) g.probes[i].coeffs[0] = glm::vec3(float(i));
+    g.occupancy.assign(size_t(dims.x) * dims.y * dims.z, count ? 0 : -1);
+    return g;
+}
+
+uint64_t digestOf(const ShProbeGrid& g) { return shProbeDigest(encodeShProbe(g)); }
 
 const fs::path kDems = fs::path(TERRALUX_TEST_DATA) / "dem";
 
@@ -200,9 +213,9 @@ TEST(ProbeDiagnosticsFile, ReadsBackWhatItWrites) {
     d.errorMap.step = 2.5f;
     d.errorMap.height = 5.0f;
     d.errorMap.error = {0.0f, 0.125f, NAN, 0.5f, 2.0f, 0.03125f};
-    const glm::uvec3 dims(4, 2, 3);
-    const std::string text = encodeProbeDiagnostics(d, "valley", dims);
-    const ProbeDiagnostics back = decodeProbeDiagnostics(text, "valley.probes.json", 3, dims);
+    const ShProbeGrid grid = gridOf(3, {4, 2, 3});
+    const std::string text = encodeProbeDiagnostics(d, "valley", grid);
+    const ProbeDiagnostics back = decodeProbeDiagnostics(text, "valley.probes.json", grid, digestOf(grid));
     EXPECT_EQ(back.positions, d.positions);
     EXPECT_EQ(back.moved, d.moved);
     EXPECT_EQ(back.rejected, d.rejected);
@@ -221,7 +234,9 @@ TEST(ProbeDiagnosticsFile, ReadsBackWhatItWrites) {
     const fs::path file = fs::temp_directory_path() / probeDiagnosticsFileName("terralux_diag_test");
     EXPECT_EQ(file.filename(), "terralux_diag_test.probes.json");
     std::ofstream(file) << text;
-    EXPECT_EQ(readProbeDiagnosticsFile(file, 3, dims).moved, d.moved);
+    EXPECT_EQ(readProbeDiagnosticsFile(file, grid, digestOf(grid)).moved, d.moved);
+    // Short decimals: millimetres and millionths, not binary noise.
+    EXPECT_NE(text.find("[1.0,2.0,3.0,-4.5,6.25,1000.125,0.0,0.0,0.0]"), std::string::npos) << text;
     fs::remove(file);
 }
 
@@ -232,11 +247,13 @@ TEST(ProbeDiagnosticsFile, RejectsWhatDoesNotBelongToTheShProbe) {
     d.errorMap.nx = 2;
     d.errorMap.nz = 1;
     d.errorMap.error = {0.1f, 0.2f};
-    const glm::uvec3 dims(2, 1, 1);
-    const std::string good = encodeProbeDiagnostics(d, "v", dims);
-    auto error = [&](const std::string& text, size_t count = 2, glm::uvec3 gd = glm::uvec3(2, 1, 1)) {
+    const ShProbeGrid grid = gridOf(2, {2, 1, 1});
+    const std::string good = encodeProbeDiagnostics(d, "v", grid);
+    auto error = [&](const std::string& text, size_t count = 2, glm::uvec3 gd = glm::uvec3(2, 1, 1),
+                     std::optional<uint64_t> digest = std::nullopt) {
         try {
-            decodeProbeDiagnostics(text, "v.probes.json", count, gd);
+            const ShProbeGrid g = gridOf(count, gd);
+            decodeProbeDiagnostics(text, "v.probes.json", g, digest ? *digest : digestOf(grid));
         } catch (const ProbeDiagnosticsError& e) {
             return std::string(e.what());
         }
@@ -254,6 +271,12 @@ TEST(ProbeDiagnosticsFile, RejectsWhatDoesNotBelongToTheShProbe) {
     EXPECT_EQ(error("{").rfind("v.probes.json: not JSON", 0), 0u) << error("{");
     EXPECT_EQ(error(good, 3), "v.probes.json: probe_count 2 does not match the .shprobe's 3 probes (a sidecar of another bake)");
     EXPECT_EQ(error(good, 2, {2, 2, 1}), "v.probes.json: grid_dims [2,1,1] do not match the .shprobe's [2,2,1] (a sidecar of another bake)");
+    // Same layout, other coefficients (another bake of the same grid): the digest tells.
+    ShProbeGrid other = grid;
+    other.probes[1].coeffs[4] = glm::vec3(0.5f);
+    const std::string otherDigest = error(good, 2, {2, 1, 1}, digestOf(other));
+    EXPECT_EQ(otherDigest.rfind("v.probes.json: shprobe_fnv1a64 \"", 0), 0u) << otherDigest;
+    EXPECT_NE(otherDigest.find("does not match the .shprobe's"), std::string::npos) << otherDigest;
     EXPECT_EQ(error(edited("format", "other")), "v.probes.json: format is \"other\", expected \"terralux-probe-diagnostics\"");
     EXPECT_EQ(error(edited("version", 2)), "v.probes.json: version 2 is not supported (this build reads 1)");
     EXPECT_EQ(error(edited("positions", {1, 2})), "v.probes.json: 'positions' must hold a multiple of 3 numbers (holds 2)");
@@ -261,10 +284,15 @@ TEST(ProbeDiagnosticsFile, RejectsWhatDoesNotBelongToTheShProbe) {
     EXPECT_EQ(error(edited("leaves", {0, 0, 0, 0})), "v.probes.json: leaf 0 has edge 0.000000, must be > 0");
     EXPECT_EQ(error(edited("error_map.error", {0.1})), "v.probes.json: error_map: error holds 1 values, size [2,1] needs 2");
     EXPECT_EQ(error(edited("error_map.error", {0.1, -0.5})), "v.probes.json: error_map: error holds -0.500000, must be >= 0");
-    EXPECT_EQ(error(edited("error_map.step", 0)), "v.probes.json: error_map: step 0 must be a number > 0");
+    EXPECT_EQ(error(edited("error_map.step", 0)), "v.probes.json: error_map: step 0 must be a number >= 0.001 (m)");
+    EXPECT_EQ(error(edited("error_map.step", 1e-50)), "v.probes.json: error_map: step 1e-50 must be a number >= 0.001 (m)");
+    EXPECT_EQ(error(edited("positions", {1, 2, 1e300, 4, 5, 6})), "v.probes.json: 'positions' holds 1e+300, not a finite number");
     EXPECT_EQ(error(edited("error_map.error", {0.1, "x"})), "v.probes.json: error_map: 'error' holds \"x\", not a finite number");
     nlohmann::json missing = nlohmann::json::parse(good);
     missing.erase("leaves");
     EXPECT_EQ(error(missing.dump()), "v.probes.json: missing 'leaves'");
-    EXPECT_THROW(readProbeDiagnosticsFile("/nonexistent/v.probes.json", 2, dims), ProbeDiagnosticsError);
+    EXPECT_THROW(readProbeDiagnosticsFile("/nonexistent/v.probes.json", grid, digestOf(grid)), ProbeDiagnosticsError);
+    // FNV-1a 64 of "a" (the published test vector).
+    const uint8_t a = 'a';
+    EXPECT_EQ(shProbeDigest(std::span<const uint8_t>(&a, 1)), 0xaf63dc4c8601ec8cull);
 }
