@@ -7,10 +7,11 @@ layout(local_size_x = 64) in;
 #include "probes.glsl"
 
 layout(set = 0, binding = 4, std430) readonly buffer Vertices { float v[]; } vertices;  // pos, normal
-// Per vertex: (probe irradiance, blend weight), then (moved share, interpolation error × known,
-// known: 1 where the error was measured, 1 = inside a volume with no probe to light it). The
-// error is premultiplied so that the rasteriser's blend, divided by the blended `known`, stays the
-// error near unmeasured vertices instead of fading towards 0.
+// Per vertex: (probe irradiance, blend weight), then the diagnostics of views 54 and 56: (moved
+// share, or -1 where no probe lights the vertex; interpolation error × known; known: 1 where the
+// error was measured; 1 = inside a volume with no probe to light it). The error is premultiplied
+// so that the rasteriser's blend, divided by the blended `known`, stays the error near
+// unmeasured vertices instead of fading towards 0.
 layout(set = 0, binding = 5, std430) writeonly buffer ProbeLight { vec4 v[]; } probeLight;
 // Every volume's interpolation-error map (Volume.errorMap), -1 where no probe covered the point.
 layout(set = 0, binding = 6, std430) readonly buffer Errors { float e[]; } errors;
@@ -55,5 +56,5 @@ void main() {
     vec3 irradiance = probeIrradiance(p, n, weight, moved, volume, unlit);
     if (volume >= 0) error = mapError(volumes.v[volume], p.xz, known);
     probeLight.v[2 * i] = vec4(irradiance, weight);
-    probeLight.v[2 * i + 1] = vec4(moved, error * known, known, unlit ? 1.0 : 0.0);
+    probeLight.v[2 * i + 1] = vec4(volume >= 0 ? moved : -1.0, error * known, known, unlit ? 1.0 : 0.0);
 }

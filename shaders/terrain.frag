@@ -6,10 +6,10 @@
 
 layout(location = 0) in vec3 worldPos;
 layout(location = 1) in vec3 worldNormal;
-layout(location = 2) in vec4 probeIrradianceWeight;  // rgb irradiance, a blend weight
-// x share of moved probes in the blend, y interpolation error × known, z known (1 = measured),
-// w 1 = inside a volume with no probe to light it.
-layout(location = 3) in vec4 probeInfo;
+// rgb irradiance, a blend weight; in views 54 and 56 the diagnostics instead: x share of moved
+// probes in the blend (-1 where no probe lights the point), y interpolation error × known,
+// z known (1 = measured), w 1 = inside a volume with no probe to light it.
+layout(location = 2) in vec4 probeIrradianceWeight;
 layout(location = 0) out vec4 outColor;
 
 #include "probes.glsl"
@@ -28,11 +28,13 @@ vec3 display(vec3 linear) {
 
 // Heat ramp for view 56: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red.
 vec3 heat(float e) {
-    const vec3 stops[5] = vec3[](vec3(0.05, 0.10, 0.55), vec3(0.0, 0.65, 0.90), vec3(0.15, 0.80, 0.20),
-                                 vec3(1.0, 0.85, 0.10), vec3(0.90, 0.10, 0.05));
+    // Piecewise linear over the stops, without an indexed array (which a CPU driver may build for
+    // every fragment of every view).
     float t = clamp(e / 0.10, 0.0, 1.0) * 4.0;
-    int i = min(int(t), 3);
-    return mix(stops[i], stops[i + 1], t - float(i));
+    if (t < 1.0) return mix(vec3(0.05, 0.10, 0.55), vec3(0.0, 0.65, 0.90), t);
+    if (t < 2.0) return mix(vec3(0.0, 0.65, 0.90), vec3(0.15, 0.80, 0.20), t - 1.0);
+    if (t < 3.0) return mix(vec3(0.15, 0.80, 0.20), vec3(1.0, 0.85, 0.10), t - 2.0);
+    return mix(vec3(1.0, 0.85, 0.10), vec3(0.90, 0.10, 0.05), t - 3.0);
 }
 
 void main() {
@@ -72,15 +74,16 @@ void main() {
     else if (view == 54) {
         // Probe validity: grey where probes at their placement light the ground, cyan as moved
         // probes take part, red inside a volume where no valid probe is left, dark outside.
+        vec4 d = probeIrradianceWeight;
         float relief = 0.55 + 0.45 * max(n.y, 0.0);
-        vec3 base = probeInfo.w > 0.5 ? vec3(0.85, 0.12, 0.10)
-                  : weight > 0.0      ? mix(vec3(0.72), vec3(0.10, 0.80, 1.0), clamp(probeInfo.x, 0.0, 1.0))
-                                      : vec3(0.18);
+        vec3 base = d.w > 0.5  ? vec3(0.85, 0.12, 0.10)
+                  : d.x > -0.5 ? mix(vec3(0.72), vec3(0.10, 0.80, 1.0), clamp(d.x, 0.0, 1.0))
+                               : vec3(0.18);
         c = base * relief;
     } else if (view == 56) {
-        // Interpolation error: EXR holds the error in red and 1 where it is known in green.
-        float known = probeInfo.z;
-        float error = known > 0.0 ? probeInfo.y / known : 0.0;
+        // Interpolation error: EXR holds the error in red and 1 in green where measured.
+        float known = probeIrradianceWeight.z;
+        float error = known > 0.0 ? probeIrradianceWeight.y / known : 0.0;
         if (frame.params.w == 1) c = vec3(known > 0.5 ? error : 0.0, known > 0.5 ? 1.0 : 0.0, 0.0);
         else c = (known > 0.5 ? heat(error) : vec3(0.25)) * (0.75 + 0.25 * max(n.y, 0.0));
     }

@@ -256,7 +256,10 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
             VkDescriptorSet set = gpu_->descriptors->set();
             vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
                                     &set, 0, nullptr);
-            VkDeviceSize offsets[2] = {0, 0};
+            // Views 54 and 56 read the probe pass's second vec4 (the diagnostics) in place of the
+            // first: one attribute and one varying either way, so no view pays for the other.
+            const bool diagnostics = s.debugView == 54 || s.debugView == 56;
+            VkDeviceSize offsets[2] = {0, diagnostics ? VkDeviceSize(16) : VkDeviceSize(0)};
             VkBuffer vb[2] = {gpu_->vertices.handle(), gpu_->probeLight.handle()};
             vkCmdBindVertexBuffers(cb, 0, 2, vb, offsets);
             vkCmdBindIndexBuffer(cb, gpu_->indices.handle(), 0, VK_INDEX_TYPE_UINT32);

@@ -98,14 +98,13 @@ TerrainPipeline::TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass,
 
     VkVertexInputBindingDescription vb[2] = {{0, 24, VK_VERTEX_INPUT_RATE_VERTEX},
                                              {1, 32, VK_VERTEX_INPUT_RATE_VERTEX}};
-    VkVertexInputAttributeDescription va[4] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+    VkVertexInputAttributeDescription va[3] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                                                {1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12},
-                                               {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
-                                               {3, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 16}};
+                                               {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
     VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     vi.vertexBindingDescriptionCount = 2;
     vi.pVertexBindingDescriptions = vb;
-    vi.vertexAttributeDescriptionCount = 4;
+    vi.vertexAttributeDescriptionCount = 3;
     vi.pVertexAttributeDescriptions = va;
     pipeline_ = createGraphicsPipeline(device_, pass, layout_, vertSpirv, fragSpirv, vi, true);
 

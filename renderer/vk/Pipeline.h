@@ -19,8 +19,9 @@ VkPipeline createGraphicsPipeline(VkDevice device, VkRenderPass pass, VkPipeline
 
 class TerrainPipeline {
 public:
-    // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes); binding 1,
-    // two vec4 per vertex from the probe pass (32 bytes).
+    // vertex input: binding 0, interleaved vec3 position + vec3 normal (24 bytes); binding 1, one
+    // of the two vec4 per vertex of the probe pass (stride 32; bound at offset 16 for the
+    // diagnostics).
     TerrainPipeline(const VulkanContext& ctx, VkRenderPass pass, std::span<const uint32_t> vertSpirv,
                     std::span<const uint32_t> fragSpirv, std::span<const uint32_t> markerVert,
                     std::span<const uint32_t> markerFrag, std::span<const uint32_t> leafVert);
