@@ -8,7 +8,7 @@
 #include <benchmark/benchmark.h>
 
 #include "DemImport.h"
-#include "TestLighting.h"
+#include "TestScenes.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"

@@ -17,21 +17,20 @@
 #include "BakeJob.h"
 #include "DemImport.h"
 #include "ShProbeFile.h"
-#include "TestLighting.h"
+#include "TestScenes.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/SphereSampling.h"
 
 using namespace terralux;
+using terralux::test::fieldBaker;
+using terralux::test::flat;
 namespace fs = std::filesystem;
 
 namespace {
 
 const fs::path kDems = fs::path(TERRALUX_TEST_DATA) / "dem";
 
-Heightfield flat(int n, double cell, float h) {
-    return Heightfield(n, n, cell, cell, std::vector<float>(size_t(n) * n, h));
-}
 
 ProbeVolumeSettings adaptive(std::optional<double> minCell = std::nullopt,
                              std::optional<double> maxCell = std::nullopt) {
@@ -374,19 +373,6 @@ TEST(Interpolation, TrilinearOverCellCentresLeavesOutEmptyCells) {
 }
 
 namespace {
-
-// A baker whose irradiance follows an analytic field: a constant sky of radiance f(p).
-ProbeBaker fieldBaker(std::function<float(const glm::vec3&)> f, size_t* baked = nullptr) {
-    return [f, baked](const std::vector<glm::vec3>& p, const std::vector<uint64_t>&) {
-        ProbeBake b;
-        for (const glm::vec3& x : p) b.sh.push_back(sh::projectConstant(glm::vec3(f(x))));
-        b.standardError.assign(p.size(), 0.0f);
-        b.fromBelowShare.assign(p.size(), 0.0f);
-        b.rays = p.size();
-        if (baked) *baked += p.size();
-        return b;
-    };
-}
 
 float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
     const glm::vec3 d = (p - c) / radius;

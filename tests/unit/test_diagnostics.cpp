@@ -13,13 +13,15 @@
 
 #include "DemImport.h"
 #include "ProbeDiagnosticsFile.h"
-#include "TestLighting.h"
+#include "TestScenes.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbeDiagnostics.h"
 
 using namespace terralux;
+using terralux::test::fieldBaker;
+using terralux::test::flat;
 namespace fs = std::filesystem;
 
 namespace {
@@ -38,22 +40,7 @@ uint64_t digestOf(const ShProbeGrid& g) { return shProbeDigest(encodeShProbe(g))
 
 const fs::path kDems = fs::path(TERRALUX_TEST_DATA) / "dem";
 
-Heightfield flat(int n, double cell, float h) {
-    return Heightfield(n, n, cell, cell, std::vector<float>(size_t(n) * n, h));
-}
 
-// A baker whose probes see a constant sky of radiance f(p): interpolation error is then the
-// spatial error of the blend alone.
-ProbeBaker fieldBaker(std::function<float(const glm::vec3&)> f) {
-    return [f](const std::vector<glm::vec3>& p, const std::vector<uint64_t>&) {
-        ProbeBake b;
-        for (const glm::vec3& x : p) b.sh.push_back(sh::projectConstant(glm::vec3(f(x))));
-        b.standardError.assign(p.size(), 0.0f);
-        b.fromBelowShare.assign(p.size(), 0.0f);
-        b.rays = p.size();
-        return b;
-    };
-}
 
 std::vector<sh::ShRgb> bakeField(const ProbeLayout& L, const std::function<float(const glm::vec3&)>& f) {
     return fieldBaker(f)(L.positions, std::vector<uint64_t>(L.positions.size(), 0)).sh;
