@@ -311,8 +311,18 @@ void MainWindow::buildDocks() {
                        "6 pixels wide are left out, so zoom in to see the finest");
     bar->addWidget(leaves);
     connect(leaves, &QCheckBox::toggled, viewport_, &ViewportWindow::setLeaves);
-    connect(viewSelector_, &QComboBox::currentIndexChanged, this,
-            [this](int i) { viewport_->setDebugView(viewSelector_->itemData(i).toInt()); });
+    // The colour key of the diagnostic views, where the status bar keeps it in sight.
+    auto* legend = new QLabel;
+    legend->setObjectName("status.legend");
+    connect(viewSelector_, &QComboBox::currentIndexChanged, this, [this, legend](int i) {
+        const int view = viewSelector_->itemData(i).toInt();
+        viewport_->setDebugView(view);
+        const auto v = findDebugView(std::to_string(view));
+        // The key alone: after the view's title, before any note in parentheses.
+        legend->setText(v && (view == 54 || view == 56)
+                            ? QString::fromUtf8(v->shows).section(':', 1).section(" (", 0, 0).trimmed()
+                            : QString());
+    });
     connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);
 
     frameLabel_ = new QLabel;
@@ -321,6 +331,7 @@ void MainWindow::buildDocks() {
     probeLabel_->setObjectName("status.probes");
     sourceLabel_ = new QLabel;
     sourceLabel_->setObjectName("status.device");
+    statusBar()->addWidget(legend, 1);
     statusBar()->addPermanentWidget(probeLabel_);
     statusBar()->addPermanentWidget(frameLabel_);
     statusBar()->addPermanentWidget(sourceLabel_);

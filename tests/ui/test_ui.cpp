@@ -211,10 +211,15 @@ private slots:
         auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
         QVERIFY(selector);
         QCOMPARE(selector->count(), int(debugViews().size()));
+        auto* legend = w_->findChild<QLabel*>("status.legend");
+        QVERIFY(legend);
         for (int i = 0; i < selector->count(); ++i) {
             selector->setCurrentIndex(i);
             w_->viewport()->renderNow();
             const RenderedImage& shown = w_->viewport()->lastImage();
+            // The diagnostic views keep their colour key in the status bar.
+            const int number = selector->itemData(i).toInt();
+            QCOMPARE(legend->text().contains("red"), number == 54 || number == 56);
             RenderRequest q;
             q.width = shown.width;
             q.height = shown.height;
