@@ -445,7 +445,9 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     BakeOutcome out;
     out.outDir = project.outDir();
     std::filesystem::create_directories(out.outDir);
-    if (scene.exportSettings.gltf) {
+    {
+        // The .shprobe files and their sidecars, and the scene when export.gltf is on: staged
+        // together and committed with rollback, so a failed export leaves the earlier files.
         GltfSceneInput in;
         in.heightfield = &hf;
         in.albedo = scene.terrain.albedo;
@@ -453,18 +455,9 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         in.volumes = grids;
         in.bake = bakeInfo;
         in.generatorVersion = TERRALUX_VERSION;
+        in.scene = scene.exportSettings.gltf;
         const GltfExportResult r = exportGltfScene(out.outDir, in);
         out.files = r.files;
-    } else {
-        std::filesystem::create_directories(out.outDir / "sh_coeffs");
-        for (const auto& g : grids) {
-            const auto path = out.outDir / "sh_coeffs" / (g.name + ".shprobe");
-            writeShProbeFile(path, g.grid);
-            out.files.push_back(path);
-            const auto sidecar = out.outDir / "sh_coeffs" / probeDiagnosticsFileName(g.name);
-            writeFileAtomically(sidecar, g.diagnostics);
-            out.files.push_back(sidecar);
-        }
     }
 
     out.report = {

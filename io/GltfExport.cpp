@@ -320,6 +320,7 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
                              std::vector<uint8_t>(v->diagnostics.begin(), v->diagnostics.end())});
         grids.push_back(probeGridEntry(*v));
     }
+    if (!input.scene) return files;
 
     try {
         ojson doc;

@@ -47,6 +47,8 @@ struct GltfSceneInput {
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
     // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride.
     size_t meshMaxVertices = size_t(1) << 20;
+    // false: only the sh_coeffs files (export.gltf off), staged and committed the same way.
+    bool scene = true;
 };
 
 struct GltfExportResult {

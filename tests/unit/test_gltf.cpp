@@ -509,3 +509,27 @@ TEST_F(GltfExport, RejectsInvalidInputBeforeWritingAnything) {
 }
 
 }  // namespace
+
+// export.gltf off: the probe files and their sidecars only, through the same staged commit.
+TEST_F(GltfExport, SceneOffWritesOnlyTheProbeFilesAndSidecars) {
+    const Heightfield hf = makeHeightfield(5, 4);
+    GltfSceneInput in = sampleInput(hf);
+    in.scene = false;
+    in.volumes[0].diagnostics = "{\"volume\": \"zeta\"}\n";
+    const GltfExportResult res = exportGltfScene(dir, in);
+    const std::vector<fs::path> expected = {dir / "sh_coeffs/alpha.shprobe", dir / "sh_coeffs/zeta.shprobe",
+                                            dir / "sh_coeffs/zeta.probes.json"};
+    EXPECT_EQ(res.files, expected);
+    EXPECT_FALSE(fs::exists(dir / "scene.gltf"));
+    EXPECT_FALSE(fs::exists(dir / "scene.bin"));
+    EXPECT_EQ(readShProbeFile(dir / "sh_coeffs/zeta.shprobe"), in.volumes[0].grid);
+    std::ifstream sidecar(dir / "sh_coeffs/zeta.probes.json");
+    std::string text((std::istreambuf_iterator<char>(sidecar)), {});
+    EXPECT_EQ(text, in.volumes[0].diagnostics);
+    // Nothing staged is left behind.
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        EXPECT_TRUE(name.find(".tmp") == std::string::npos && name.find(".staging") == std::string::npos)
+            << e.path();
+    }
+}
