@@ -60,8 +60,12 @@ void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
     bound_.clear();
     boundVolumes_ = sceneToJson(project_.scene).at("probe_volumes").dump();
-    for (const auto& v : volumes)
-        if (v.diagnostics) bound_[v.name] = overlayOf(*v.diagnostics);
+    hasErrorMap_ = false;
+    for (const auto& v : volumes) {
+        if (!v.diagnostics) continue;
+        bound_[v.name] = overlayOf(*v.diagnostics);
+        hasErrorMap_ = hasErrorMap_ || !v.diagnostics->errorMap.empty();
+    }
     updateOverlays();
 }
 

@@ -50,6 +50,8 @@ public:
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     const OrbitCamera& defaultCamera() const { return base_.camera; }
+    // Whether any bound volume carries an interpolation-error map (view 56 has data to show).
+    bool hasErrorMap() const { return hasErrorMap_; }
 
     const Heightfield& heightfield() const { return terrain_.heightfield; }
     TerrainRenderer& renderer() { return *renderer_; }
@@ -67,6 +69,7 @@ private:
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
+    bool hasErrorMap_ = false;
     DemImportResult terrain_;
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;
