@@ -2,7 +2,9 @@
 
 #include <cfloat>
 #include <cmath>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -173,9 +175,12 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
     }
 
     const json& em = member(j, "error_map", name);
+    if (!em.is_object()) fail(name, "'error_map' must be an object, not " + em.dump());
     const std::vector<float> size = numbers(em, "size", name + ": error_map", 2);
     const std::vector<float> origin = numbers(em, "origin", name + ": error_map", 2);
-    if (size.size() != 2 || origin.size() != 2) fail(name, "error_map: size and origin take 2 numbers");
+    if (size.size() != 2 || origin.size() != 2)
+        fail(name, "error_map: size " + em.at("size").dump() + " and origin " + em.at("origin").dump() +
+                       " must be 2 numbers each");
     if (size[0] < 0 || size[1] < 0 || size[0] > kMaxErrorMapResolution ||
         size[1] > kMaxErrorMapResolution || size[0] != std::floor(size[0]) || size[1] != std::floor(size[1]))
         fail(name, "error_map: size " + em.at("size").dump() + " must be whole numbers in [0, " +
@@ -185,8 +190,8 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
     m.nz = uint32_t(size[1]);
     m.x0 = origin[0];
     m.z0 = origin[1];
-    const json& step = member(em, "step", name);
-    const json& height = member(em, "height", name);
+    const json& step = member(em, "step", name + ": error_map");
+    const json& height = member(em, "height", name + ": error_map");
     // The file holds millimetres: a step below that cannot come from a bake.
     if (!step.is_number() || !(step.get<double>() >= 1e-3) || !(step.get<double>() <= FLT_MAX))
         fail(name, "error_map: step " + step.dump() + " must be a number >= 0.001 (m)");
@@ -206,7 +211,7 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
 ProbeDiagnostics readProbeDiagnosticsFile(const std::filesystem::path& path, const ShProbeGrid& grid,
                                           uint64_t shprobeDigest) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw ProbeDiagnosticsError(path.string() + ": cannot open");
+    if (!in) throw ProbeDiagnosticsError(path.string() + ": cannot open (" + std::strerror(errno) + ")");
     std::stringstream ss;
     ss << in.rdbuf();
     return decodeProbeDiagnostics(ss.str(), path.string(), grid, shprobeDigest);

@@ -14,10 +14,7 @@ ErrorMapStats errorMapStats(const ErrorMap& map) {
         if (std::isfinite(x)) e.push_back(x);
     s.points = e.size();
     s.uncovered = map.error.size() - e.size();
-    const Spread d = spreadOf(std::move(e));
-    s.mean = d.mean;
-    s.p95 = d.p95;
-    s.max = d.max;
+    static_cast<Spread&>(s) = spreadOf(std::move(e));
     return s;
 }
 

@@ -29,13 +29,12 @@ struct ErrorMap {
     std::vector<float> error;  // nx·nz, i fastest; NaN where no probe covers the point
 
     bool empty() const { return error.empty(); }
-    bool operator==(const ErrorMap&) const = default;
 };
 
-struct ErrorMapStats {
+// Mean, 95th percentile and max over the covered points.
+struct ErrorMapStats : Spread {
     size_t points = 0;     // covered by probes
     size_t uncovered = 0;  // above the terrain inside the grid footprint with no probe around
-    double mean = 0.0, p95 = 0.0, max = 0.0;
 };
 ErrorMapStats errorMapStats(const ErrorMap& map);
 
@@ -49,7 +48,6 @@ struct ProbeDiagnostics {
     std::vector<glm::vec4> leaves;
     ErrorMap errorMap;
 
-    bool operator==(const ProbeDiagnostics&) const = default;
 };
 
 // Positions, moves, rejections and leaves of a layout (no error map).

@@ -278,7 +278,18 @@ TEST(ProbeDiagnosticsFile, RejectsWhatDoesNotBelongToTheShProbe) {
     nlohmann::json missing = nlohmann::json::parse(good);
     missing.erase("leaves");
     EXPECT_EQ(error(missing.dump()), "v.probes.json: missing 'leaves'");
-    EXPECT_THROW(readProbeDiagnosticsFile("/nonexistent/v.probes.json", grid, digestOf(grid)), ProbeDiagnosticsError);
+    nlohmann::json noStep = nlohmann::json::parse(good);
+    noStep["error_map"].erase("step");
+    EXPECT_EQ(error(noStep.dump()), "v.probes.json: error_map: missing 'step'");
+    EXPECT_EQ(error(edited("error_map", 3)), "v.probes.json: 'error_map' must be an object, not 3");
+    EXPECT_EQ(error(edited("error_map.origin", {1, 2, 3, 4})),
+              "v.probes.json: error_map: size [2,1] and origin [1,2,3,4] must be 2 numbers each");
+    try {
+        readProbeDiagnosticsFile("/nonexistent/v.probes.json", grid, digestOf(grid));
+        ADD_FAILURE() << "a missing file was read";
+    } catch (const ProbeDiagnosticsError& e) {
+        EXPECT_STREQ(e.what(), "/nonexistent/v.probes.json: cannot open (No such file or directory)");
+    }
     // FNV-1a 64 of "a" (the published test vector).
     const uint8_t a = 'a';
     EXPECT_EQ(shProbeDigest(std::span<const uint8_t>(&a, 1)), 0xaf63dc4c8601ec8cull);
