@@ -1,5 +1,7 @@
 #include "vk/ComputePipeline.h"
 
+#include "vk/Descriptors.h"
+
 namespace terralux::vk {
 
 ProbeVertexPass::ProbeVertexPass(const VulkanContext& ctx, std::span<const uint32_t> spirv)
@@ -38,18 +40,7 @@ ProbeVertexPass::ProbeVertexPass(const VulkanContext& ctx, std::span<const uint3
     vkDestroyShaderModule(device_, module, nullptr);
     check(r, "vkCreateComputePipelines");
 
-    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 6}};
-    VkDescriptorPoolCreateInfo dpi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    dpi.maxSets = 1;
-    dpi.poolSizeCount = 2;
-    dpi.pPoolSizes = sizes;
-    check(vkCreateDescriptorPool(device_, &dpi, nullptr, &pool_), "vkCreateDescriptorPool (compute)");
-    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    ai.descriptorPool = pool_;
-    ai.descriptorSetCount = 1;
-    ai.pSetLayouts = &setLayout_;
-    check(vkAllocateDescriptorSets(device_, &ai, &set_), "vkAllocateDescriptorSets (compute)");
+    set_ = allocateSingleSet(device_, setLayout_, 6, &pool_);
 }
 
 ProbeVertexPass::~ProbeVertexPass() {
@@ -63,18 +54,7 @@ void ProbeVertexPass::record(VkCommandBuffer cb, const Buffer& uniforms, const B
                              const Buffer& cells, const Buffer& volumes, const Buffer& vertices,
                              const Buffer& out, const Buffer& errors, uint32_t vertexCount) {
     const Buffer* buffers[7] = {&uniforms, &probes, &cells, &volumes, &vertices, &out, &errors};
-    VkDescriptorBufferInfo info[7];
-    VkWriteDescriptorSet w[7]{};
-    for (uint32_t i = 0; i < 7; ++i) {
-        info[i] = {buffers[i]->handle(), 0, VK_WHOLE_SIZE};
-        w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        w[i].dstSet = set_;
-        w[i].dstBinding = i;
-        w[i].descriptorCount = 1;
-        w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        w[i].pBufferInfo = &info[i];
-    }
-    vkUpdateDescriptorSets(device_, 7, w, 0, nullptr);
+    writeBufferSet(device_, set_, buffers);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set_, 0, nullptr);
     vkCmdPushConstants(cb, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, 4, &vertexCount);
