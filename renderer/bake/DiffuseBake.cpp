@@ -206,10 +206,7 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
                            const std::vector<glm::vec3>& positions,
                            const std::vector<uint8_t>& valid, int rays,
                            const std::vector<uint64_t>& seeds, const BakeControl& control) {
-    ProbeBake out;
-    out.sh.assign(positions.size(), sh::ShRgb{});
-    out.standardError.assign(positions.size(), 0.0f);
-    out.fromBelowShare.assign(positions.size(), 0.0f);
+    ProbeBake out(positions.size());
     rays = std::max(rays, 1);
     const float weight = 4.0f * kPi / float(rays);
     std::atomic<uint64_t> traced{0};
@@ -285,10 +282,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                                 const std::vector<glm::vec3>& positions,
                                 const std::vector<uint8_t>& valid, int rays,
                                 const std::vector<uint64_t>& seeds, const BakeControl& control) {
-    ProbeBake out;
-    out.sh.assign(positions.size(), sh::ShRgb{});
-    out.standardError.assign(positions.size(), 0.0f);
-    out.fromBelowShare.assign(positions.size(), 0.0f);
+    ProbeBake out(positions.size());
     rays = std::max(rays, 1);
     const int depth = bounces == 0 ? 0 : referencePathLength(L.albedo);
     const float weight = 4.0f * kPi / float(rays);

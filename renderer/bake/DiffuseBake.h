@@ -87,6 +87,10 @@ struct ProbeBake {
     // reached from below by a probe inside it, so any valid probe has 0.
     std::vector<float> fromBelowShare;
     uint64_t rays = 0;                  // rays traced for the probes themselves
+
+    ProbeBake() = default;
+    // n probes, all zero.
+    explicit ProbeBake(size_t n) : sh(n), standardError(n, 0.0f), fromBelowShare(n, 0.0f) {}
 };
 
 // Bakes the probes at `positions` (skipping those with valid[i] == 0). Deterministic: each probe's

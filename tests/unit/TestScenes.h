@@ -21,10 +21,8 @@ inline Heightfield flat(int n, double cell, float h) {
 // spatial error of the blend alone. `baked` (optional) counts the probes it bakes.
 inline ProbeBaker fieldBaker(std::function<float(const glm::vec3&)> f, size_t* baked = nullptr) {
     return [f, baked](const std::vector<glm::vec3>& p, const std::vector<uint64_t>&) {
-        ProbeBake b;
-        for (const glm::vec3& x : p) b.sh.push_back(sh::projectConstant(glm::vec3(f(x))));
-        b.standardError.assign(p.size(), 0.0f);
-        b.fromBelowShare.assign(p.size(), 0.0f);
+        ProbeBake b(p.size());
+        for (size_t i = 0; i < p.size(); ++i) b.sh[i] = sh::projectConstant(glm::vec3(f(p[i])));
         b.rays = p.size();
         if (baked) *baked += p.size();
         return b;
