@@ -486,9 +486,7 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
     }
 
     const size_t n = out.layout.positions.size();
-    out.bake.sh.assign(n, sh::ShRgb{});
-    out.bake.standardError.assign(n, 0.0f);
-    out.bake.fromBelowShare.assign(n, 0.0f);
+    out.bake = ProbeBake(n);
     for (size_t i = 0; i < n; ++i) {
         if (!out.layout.valid[i]) continue;
         const BakedProbe& b = store.at(out.layout.probeKeys[i]);
