@@ -44,6 +44,12 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
+    // Placement reads only the volumes' settings and this renderer's terrain: edits of the sun,
+    // sky or camera keep the markers they had.
+    const std::string volumes = sceneToJson(scene).at("probe_volumes").dump();
+    if (volumes == placedVolumes_) return updateOverlays();
+    placedVolumes_ = volumes;
+    ++placements_;
     placed_.clear();
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;

@@ -50,6 +50,9 @@ public:
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     const OrbitCamera& defaultCamera() const { return base_.camera; }
+    // How often the probe volumes were placed for the overlays (edits that do not touch them
+    // place nothing).
+    size_t placements() const { return placements_; }
     // Whether any bound volume carries an interpolation-error map (view 56 has data to show).
     bool hasErrorMap() const { return hasErrorMap_; }
 
@@ -69,6 +72,8 @@ private:
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
+    std::string placedVolumes_;  // probe_volumes JSON of placed_
+    size_t placements_ = 0;
     bool hasErrorMap_ = false;
     DemImportResult terrain_;
     RenderSettings base_;

@@ -1,19 +1,66 @@
 #include "SceneLighting.h"
 
+#include <atomic>
+#include <filesystem>
+#include <list>
+#include <mutex>
 #include <numbers>
 
 #include "EnvironmentImage.h"
 
 namespace terralux {
 
+namespace {
+
+// An edit of the sun or a camera move must not read and filter the HDR again: the last few
+// environments are kept, keyed by everything that shapes them. A file rewritten on disk (new
+// time or size) is a new key.
+struct SkyKey {
+    std::string path;
+    std::filesystem::file_time_type time;
+    std::uintmax_t size = 0;
+    float rotation = 0.0f, intensity = 0.0f;
+    glm::vec3 tint{0.0f};
+    bool operator==(const SkyKey&) const = default;
+};
+
+std::mutex skyMutex;
+std::list<std::pair<SkyKey, Sky>> skyCache;  // most recent first
+std::atomic<size_t> skyReads{0};
+constexpr size_t kSkyCacheEntries = 4;
+
+}  // namespace
+
+size_t hdrSkyReads() { return skyReads.load(); }
+
 Sky skyOf(const Project& p) {
     const SkySettings& s = p.scene.sky;
     if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
-    RgbImage img = readEquirectImage(p.hdrPath().string());
+    const std::string path = p.hdrPath().string();
+    SkyKey key{path, {}, 0, float(s.rotationDeg), float(s.intensity), s.color};
+    std::error_code ec;
+    key.time = std::filesystem::last_write_time(path, ec);
+    key.size = ec ? 0 : std::filesystem::file_size(path, ec);
+    {
+        std::lock_guard lock(skyMutex);
+        for (auto it = skyCache.begin(); it != skyCache.end(); ++it)
+            if (it->first == key) {
+                skyCache.splice(skyCache.begin(), skyCache, it);
+                return it->second;  // levels are shared, so the copy is cheap
+            }
+    }
+    RgbImage img = readEquirectImage(path);
+    ++skyReads;
     // The image's colour is the sky; sky.color tints it (white leaves it as it is).
     for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= s.color[int(i % 3)];
-    return Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
-                         float(s.rotationDeg));
+    Sky sky = Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
+                            float(s.rotationDeg));
+    if (!ec) {
+        std::lock_guard lock(skyMutex);
+        skyCache.emplace_front(key, sky);
+        if (skyCache.size() > kSkyCacheEntries) skyCache.pop_back();
+    }
+    return sky;
 }
 
 BakeLighting lightingOf(const Project& p) {

@@ -8,8 +8,11 @@
 namespace terralux {
 
 // Uniform sky, or the HDR (tinted by sky.color, × intensity, turned by rotation). Throws
-// ImageError for an unreadable HDR.
+// ImageError for an unreadable HDR. HDR skies are cached by path, file time and size, rotation,
+// tint and intensity: edits of anything else reuse the filtered environment.
 Sky skyOf(const Project& project);
+// How many times an HDR was read and filtered since start (for tests of the cache).
+size_t hdrSkyReads();
 // Sun, sky and albedo; the caller sets the tracer.
 BakeLighting lightingOf(const Project& project);
 

@@ -37,6 +37,7 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
     if (!(intensity >= 0.0f) || !std::isfinite(intensity))
         throw std::invalid_argument("sky intensity must be finite and >= 0");
     Sky s;
+    std::vector<Level> levels;
     Level base{width, height, std::vector<glm::vec3>(size_t(width) * height)};
     for (size_t i = 0; i < base.texels.size(); ++i) {
         const glm::vec3 t(rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
@@ -47,11 +48,11 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
                                         " is negative or not finite");
         base.texels[i] = t * intensity;
     }
-    s.levels_.push_back(std::move(base));
+    levels.push_back(std::move(base));
     // Box-filtered pyramid, each texel weighted by its solid angle (∝ sin θ) so the poles do not
     // dominate the average.
-    while (s.levels_.back().width > 1 || s.levels_.back().height > 1) {
-        const Level& f = s.levels_.back();
+    while (levels.back().width > 1 || levels.back().height > 1) {
+        const Level& f = levels.back();
         Level c{std::max(1, f.width / 2), std::max(1, f.height / 2), {}};
         c.texels.assign(size_t(c.width) * c.height, glm::vec3(0.0f));
         for (int y = 0; y < c.height; ++y)
@@ -68,15 +69,16 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
                     }
                 c.texels[size_t(y) * c.width + x] = wsum > 0 ? sum / wsum : glm::vec3(0.0f);
             }
-        s.levels_.push_back(std::move(c));
+        levels.push_back(std::move(c));
     }
+    s.levels_ = std::make_shared<const std::vector<Level>>(std::move(levels));
     s.rotation_ = float(rotationDeg / 360.0 - std::floor(rotationDeg / 360.0));
     s.computeSh();
     return s;
 }
 
 void Sky::computeSh() {
-    const Level& l = levels_.front();
+    const Level& l = levels_->front();
     sh_ = sh::ShRgb{};
     openUp_ = glm::vec3(0.0f);
     const double dphi = 2.0 * std::numbers::pi / l.width;
@@ -112,22 +114,22 @@ glm::vec3 Sky::sample(const Level& level, float u, float v) const {
 }
 
 glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
-    if (levels_.empty()) return uniform_;
+    if (!levels_) return uniform_;
     const float phi = std::atan2(dir.x, -dir.z);
     float u = 0.5f + phi / (2.0f * kPi) - rotation_;
     u -= std::floor(u);
     const float v = std::acos(std::clamp(dir.y, -1.0f, 1.0f)) / kPi;
-    const Level& base = levels_.front();
+    const Level& base = levels_->front();
     // Level whose texel (at the equator) covers about `solidAngle`; blend the two nearest.
     const float texel0 = 2.0f * kPi * kPi / float(base.width * base.height);
     float lod = solidAngle > texel0 ? 0.5f * std::log2(solidAngle / texel0) : 0.0f;
-    lod = std::min(lod, float(levels_.size() - 1));
+    lod = std::min(lod, float(levels_->size() - 1));
     const int l0 = int(lod);
-    const int l1 = std::min(l0 + 1, int(levels_.size()) - 1);
+    const int l1 = std::min(l0 + 1, int(levels_->size()) - 1);
     const float t = lod - l0;
-    const glm::vec3 a = sample(levels_[size_t(l0)], u, v);
+    const glm::vec3 a = sample((*levels_)[size_t(l0)], u, v);
     if (t <= 0.0f || l1 == l0) return a;
-    return glm::mix(a, sample(levels_[size_t(l1)], u, v), t);
+    return glm::mix(a, sample((*levels_)[size_t(l1)], u, v), t);
 }
 
 }  // namespace terralux

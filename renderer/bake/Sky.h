@@ -6,6 +6,7 @@
 // with φ = atan2(x, −z) the azimuth clockwise from north (−Z) toward east (+X). At rotation 0 the
 // image centre column faces north.
 
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -31,7 +32,7 @@ public:
     static Sky equirect(std::vector<float> rgb, int width, int height, float intensity,
                         float rotationDeg);
 
-    bool isUniform() const { return levels_.empty(); }
+    bool isUniform() const { return !levels_; }
     // Radiance toward `dir`, averaged over about `solidAngle` steradians around it (the share of
     // the sphere one sample stands for). Prefiltering a peaky HDR this way removes most of the
     // variance of a few hundred samples at the cost of blur below the SH's own resolution.
@@ -50,7 +51,8 @@ private:
     void computeSh();
 
     glm::vec3 uniform_{0.0f};
-    std::vector<Level> levels_;
+    // Immutable once built and shared between copies: a Sky is cheap to copy into every bake.
+    std::shared_ptr<const std::vector<Level>> levels_;
     float rotation_ = 0.0f;  // in u units [0, 1)
     sh::ShRgb sh_;
     glm::vec3 openUp_{0.0f};

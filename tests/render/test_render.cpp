@@ -391,3 +391,18 @@ TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
     r.setProbes({v});
     EXPECT_EQ(test::compareImages(r.render(q).rgba, plain.rgba, kW, kH).maxAbs, 0.0);
 }
+
+TEST_F(RenderTest, EditsThatDoNotTouchTheVolumesPlaceNothing) {
+    Project p = sampleProject("placements", 6, 6);
+    ProjectRenderer r(*ctx_, p);
+    const size_t placed = r.placements();
+    EXPECT_EQ(placed, 1u);
+    p.scene.sun.elevationDeg = 12.0;
+    p.scene.sky.intensity *= 2.0;
+    p.scene.camera.azimuthDeg = 90.0;
+    r.setProject(p);
+    EXPECT_EQ(r.placements(), placed) << "a sun, sky or camera edit placed the volumes again";
+    p.scene.probeVolumes[0].gridDims = {7, 1, 5};
+    r.setProject(p);
+    EXPECT_EQ(r.placements(), placed + 1) << "a grid edit must place the volume again";
+}
