@@ -23,6 +23,7 @@
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbePlacement.h"
+#include "ParameterTable.h"
 #include "Project.h"
 #include "SampleTerrain.h"
 #include "TerrainLoading.h"
@@ -48,6 +49,10 @@ Commands:
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
+  --print-schema                Print the JSON Schema (draft 2020-12) of the project file, for
+                                editors that check a project as it is typed.
+  --print-reference             Print the parameter reference (Markdown): every parameter with
+                                its type, default, range, unit and meaning.
   --help, -h                    Show this help.
   --version                     Show the version.
 
@@ -91,6 +96,8 @@ struct Args {
     QCommandLineParser parser;
     QCommandLineOption info{"info", "Describe a DEM."};
     QCommandLineOption printProject{"print-project", "Print the effective project."};
+    QCommandLineOption printSchema{"print-schema", "Print the project JSON Schema."};
+    QCommandLineOption printReference{"print-reference", "Print the parameter reference."};
     QCommandLineOption help{QStringList{"help", "h"}, "Show help."};
     QCommandLineOption version{"version", "Show the version."};
     QCommandLineOption dem{"dem", "Terrain file.", "FILE"};
@@ -112,7 +119,7 @@ struct Args {
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
-        parser.addOptions({info, printProject, help, version, dem, set, threads, quiet, bake, out,
+        parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, render, size, debugView, camera, noProbes,
                            device, dryRun, overlay});
     }
@@ -445,9 +452,11 @@ int runCommandLine(int argc, char** argv) {
             return kExitOk;
         }
         const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
-                             int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render));
+                             int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render)) +
+                             int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference));
         if (commands > 1)
-            throw UsageError("choose one command: --bake, --render, --info or --print-project");
+            throw UsageError("choose one command: --bake, --render, --info, --print-project, "
+                             "--print-schema or --print-reference");
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
             const int n = a.parser.value(a.threads).toInt(&ok);
@@ -463,6 +472,13 @@ int runCommandLine(int argc, char** argv) {
         if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.render)) return commandRender(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);
+        if (a.parser.isSet(a.printSchema) || a.parser.isSet(a.printReference)) {
+            if (!a.parser.positionalArguments().isEmpty())
+                throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) + "'");
+            if (a.parser.isSet(a.printSchema)) std::cout << projectSchema().dump(2) << "\n";
+            else std::cout << parameterReferenceMarkdown();
+            return kExitOk;
+        }
         if (!a.parser.positionalArguments().isEmpty())
             throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) +
                              "' (no command given)");

@@ -1,6 +1,6 @@
 #pragma once
 // The project document: a versioned JSON file holding a SceneDescription, validated against
-// LIGHTING.md's rules. Paths inside it are relative to the project file.
+// the rules of the parameter table (ParameterTable.h). Paths inside it are relative to the project file.
 
 #include <filesystem>
 #include <stdexcept>
@@ -40,14 +40,11 @@ struct Project {
 // Defaults, as JSON: every key the document may hold.
 nlohmann::json defaultProjectJson();
 nlohmann::json sceneToJson(const SceneDescription& scene);
-// Validates every value. `source` prefixes messages (a file name, or "--set").
+// Reads and validates every parameter of the table (app/ParameterTable.h); absent keys take
+// their defaults, an unknown key is an error. `source` prefixes messages (a file name, or
+// "--set"); `warnings` is for notes that do not stop a load (none today).
 SceneDescription sceneFromJson(const nlohmann::json& doc, const std::string& source,
                                std::vector<std::string>* warnings);
-
-// Merges `doc` over the defaults (probe volume entries over the default volume); keys the
-// defaults do not have are dropped with a warning naming their path.
-nlohmann::json mergeOverDefaults(const nlohmann::json& doc, const std::string& source,
-                                 std::vector<std::string>* warnings);
 
 // Applies one `key.path=value` override; the path must name an existing parameter
 // (`probe_volumes[0].grid_dims`, `sun.elevation_deg`). The value is JSON, or a bare string, or a

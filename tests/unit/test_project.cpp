@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "Project.h"
+#include "ImageFile.h"
+#include "SceneLighting.h"
 #include "TerrainLoading.h"
 
 using namespace terralux;
@@ -62,59 +64,59 @@ TEST_P(ProjectRules, RejectsWithPathValueAndRule) {
 INSTANTIATE_TEST_SUITE_P(
     AllRules, ProjectRules,
     ::testing::Values(
-        Rule{"probe_volumes[0].grid_dims=[0,8]", "p.json: probe_volumes[0].grid_dims[0] = 0: must be in [1, 4096]"},
+        Rule{"probe_volumes[0].grid_dims=[0,8]", "p.json: probe_volumes[0].grid_dims[0] = 0: must be in [1, 65536]"},
         Rule{"probe_volumes[0].grid_dims=[65,64]", "p.json: probe_volumes[0].grid_dims = [65,64]: must be >= 1 each with a product <= 4096 (is 4160)"},
         Rule{"probe_volumes[0].grid_dims=[8]", "p.json: probe_volumes[0].grid_dims = [8]: must be an array of 2 numbers"},
         Rule{"probe_volumes[0].grid_dims=[2.5,8]", "p.json: probe_volumes[0].grid_dims[0] = 2.5: must be an integer"},
         Rule{"probe_volumes[0].height_offset=\"x\"", "p.json: probe_volumes[0].height_offset = \"x\": must be a number"},
-        Rule{"probe_volumes[0].ray_count=0", "p.json: probe_volumes[0].ray_count = 0: must be in [1, 1048576]"},
-        Rule{"probe_volumes[0].spacing=[0,10]", "p.json: probe_volumes[0].spacing[0] = 0: must be > 0"},
-        Rule{"probe_volumes[0].spacing=[10,-1]", "p.json: probe_volumes[0].spacing[1] = -1: must be > 0"},
-        Rule{"probe_volumes[0].fallback_blend_distance=-1", "p.json: probe_volumes[0].fallback_blend_distance = -1: must be >= 0"},
+        Rule{"probe_volumes[0].ray_count=0", "p.json: probe_volumes[0].ray_count = 0: must be in [1, 1048576] or null"},
+        Rule{"probe_volumes[0].spacing=[0,10]", "p.json: probe_volumes[0].spacing[0] = 0: must be in (0, 1000000]"},
+        Rule{"probe_volumes[0].spacing=[10,-1]", "p.json: probe_volumes[0].spacing[1] = -1: must be in (0, 1000000]"},
+        Rule{"probe_volumes[0].fallback_blend_distance=-1", "p.json: probe_volumes[0].fallback_blend_distance = -1: must be in [0, 10000000] or null"},
         Rule{"probe_volumes[0].name=a/b", "p.json: probe_volumes[0].name = \"a/b\": must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)"},
         Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box | adaptive"},
-        Rule{"probe_volumes[0].adaptive.min_cell_size=0", "p.json: probe_volumes[0].adaptive.min_cell_size = 0: must be > 0"},
-        Rule{"probe_volumes[0].adaptive.max_cell_size=-4", "p.json: probe_volumes[0].adaptive.max_cell_size = -4: must be > 0"},
+        Rule{"probe_volumes[0].adaptive.min_cell_size=0", "p.json: probe_volumes[0].adaptive.min_cell_size = 0: must be in (0, 1000000] or null"},
+        Rule{"probe_volumes[0].adaptive.max_cell_size=-4", "p.json: probe_volumes[0].adaptive.max_cell_size = -4: must be in (0, 10000000] or null"},
         Rule{"probe_volumes[0].adaptive={\"min_cell_size\":30,\"max_cell_size\":100}", "p.json: probe_volumes[0].adaptive.max_cell_size = 100: must be min_cell_size (30) times 2^k, k in [0, 16]"},
         Rule{"probe_volumes[0].adaptive={\"min_cell_size\":32,\"max_cell_size\":16}", "p.json: probe_volumes[0].adaptive.max_cell_size = 16: must be min_cell_size (32) times 2^k, k in [0, 16]"},
         Rule{"probe_volumes[0].adaptive={\"min_cell_size\":1,\"max_cell_size\":131072}", "p.json: probe_volumes[0].adaptive.max_cell_size = 131072: must be min_cell_size (1) times 2^k, k in [0, 16]"},
-        Rule{"probe_volumes[0].adaptive.height_range=-1", "p.json: probe_volumes[0].adaptive.height_range = -1: must be >= 0"},
-        Rule{"probe_volumes[0].adaptive.size=[100,0,100]", "p.json: probe_volumes[0].adaptive.size[1] = 0: must be > 0"},
-        Rule{"probe_volumes[0].adaptive.size=[100,100]", "p.json: probe_volumes[0].adaptive.size = [100,100]: must be an array of 3 numbers"},
-        Rule{"probe_volumes[0].adaptive.surface_band=-2", "p.json: probe_volumes[0].adaptive.surface_band = -2: must be >= 0"},
+        Rule{"probe_volumes[0].adaptive.height_range=-1", "p.json: probe_volumes[0].adaptive.height_range = -1: must be in [0, 100000]"},
+        Rule{"probe_volumes[0].adaptive.size=[100,0,100]", "p.json: probe_volumes[0].adaptive.size[1] = 0: must be in (0, 10000000]"},
+        Rule{"probe_volumes[0].adaptive.size=[100,100]", "p.json: probe_volumes[0].adaptive.size = [100,100]: must be an array of 3 numbers or null"},
+        Rule{"probe_volumes[0].adaptive.surface_band=-2", "p.json: probe_volumes[0].adaptive.surface_band = -2: must be in [0, 1000000] or null"},
         Rule{"probe_volumes[0].adaptive.tolerance=0", "p.json: probe_volumes[0].adaptive.tolerance = 0: must be in (0, 1] or null"},
         Rule{"probe_volumes[0].adaptive.tolerance=1.5", "p.json: probe_volumes[0].adaptive.tolerance = 1.5: must be in (0, 1] or null"},
-        Rule{"probe_volumes[0].adaptive.max_probes=0", "p.json: probe_volumes[0].adaptive.max_probes = 0: must be in [1, 2147483647]"},
+        Rule{"probe_volumes[0].adaptive.max_probes=0", "p.json: probe_volumes[0].adaptive.max_probes = 0: must be in [1, 2147483647] or null"},
         Rule{"probe_volumes[0].adaptive.max_bytes=2.5", "p.json: probe_volumes[0].adaptive.max_bytes = 2.5: must be an integer"},
-        Rule{"probe_volumes[0].adaptive.max_bytes=0", "p.json: probe_volumes[0].adaptive.max_bytes = 0: must be in [1, 9007199254740992]"},
+        Rule{"probe_volumes[0].adaptive.max_bytes=0", "p.json: probe_volumes[0].adaptive.max_bytes = 0: must be in [1, 9007199254740992] or null"},
         Rule{"probe_volumes[0].adaptive.max_move_share=0.6", "p.json: probe_volumes[0].adaptive.max_move_share = 0.6: must be in [0, 0.5]"},
         Rule{"probe_volumes[0].adaptive=3", "p.json: probe_volumes[0].adaptive = 3: must be an object"},
         Rule{"sky.color=[0.5,-1,1]", "p.json: sky.color[1] = -1: three components, each in [0, inf]"},
         Rule{"sky.color=[1,1]", "p.json: sky.color = [1,1]: must be an array of 3 numbers"},
-        Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be >= 0"},
+        Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be in [0, 100000]"},
         Rule{"sky.mode=hdr", "p.json: sky.hdr = \"\": must name an image when sky.mode is \"hdr\""},
-        Rule{"reflection_probes.grid_dims=[17,16]", "p.json: reflection_probes.grid_dims = [17,16]: must be >= 1 each with a product <= 256"},
+        Rule{"reflection_probes.grid_dims=[17,16]", "p.json: reflection_probes.grid_dims = [17,16]: must be >= 1 each with a product <= 256 (is 272)"},
         Rule{"reflection_probes.grid_dims=[0,1]", "p.json: reflection_probes.grid_dims[0] = 0: must be in [1, 256]"},
         Rule{"reflection_probes.ray_count=0", "p.json: reflection_probes.ray_count = 0: must be in [1, 1048576]"},
         Rule{"reflection_probes.strength=1.5", "p.json: reflection_probes.strength = 1.5: must be in [0, 1]"},
         Rule{"reflection_probes.ground_color=[1,1,-0.1]", "p.json: reflection_probes.ground_color[2] = -0.1: three components, each in [0, inf]"},
         Rule{"sun.elevation_deg=91", "p.json: sun.elevation_deg = 91: must be in [-90, 90]"},
-        Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be >= 0"},
+        Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be in [0, 1000000]"},
         Rule{"sun.angular_radius_deg=50", "p.json: sun.angular_radius_deg = 50: must be in [0, 45]"},
-        Rule{"terrain.vertical_scale=0", "p.json: terrain.vertical_scale = 0: must be > 0"},
+        Rule{"terrain.vertical_scale=0", "p.json: terrain.vertical_scale = 0: must be in (0, 100]"},
         Rule{"terrain.albedo=[0.5,1.2,0.5]", "p.json: terrain.albedo[1] = 1.2: three components, each in [0, 1]"},
         Rule{"terrain.max_resolution=1", "p.json: terrain.max_resolution = 1: must be 0 (off) or >= 2"},
         Rule{"terrain.skirt=maybe", "p.json: terrain.skirt = \"maybe\": must be true or false"},
         Rule{"bake.quality=ultra", "p.json: bake.quality = \"ultra\": must be one of draft | standard | high | reference"},
-        Rule{"bake.bounces=17", "p.json: bake.bounces = 17: must be in [0, 16]"},
-        Rule{"bake.rays=0", "p.json: bake.rays = 0: must be in [1, 1048576]"},
+        Rule{"bake.bounces=17", "p.json: bake.bounces = 17: must be in [0, 16] or null"},
+        Rule{"bake.rays=0", "p.json: bake.rays = 0: must be in [1, 1048576] or null"},
         Rule{"bake.sh_encoding=rgb", "p.json: bake.sh_encoding = \"rgb\": must be one of radiance | irradiance"},
         Rule{"export.out_dir=\"\"", "p.json: export.out_dir = \"\": must name a folder"},
-        Rule{"export.default_ambient=-0.1", "p.json: export.default_ambient = -0.1: must be >= 0"},
+        Rule{"export.default_ambient=-0.1", "p.json: export.default_ambient = -0.1: must be in [0, 100]"},
         Rule{"camera.elevation_deg=90", "p.json: camera.elevation_deg = 90: must be in [-89.9, 89.9]"},
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
-        Rule{"camera.radius=0", "p.json: camera.radius = 0: must be > 0"},
-        Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers"},
+        Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
+        Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
         Rule{"version=2", "p.json: version = 2: is newer than this Terralux reads (1)"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -191,21 +193,35 @@ TEST(Project, OverridesReachEveryParameterAndRejectUnknownPaths) {
         return std::string();
     };
     EXPECT_EQ(err("sun.elevaton_deg=3"),
-              "--set sun.elevaton_deg: unknown parameter 'sun.elevaton_deg' (terralux --print-project lists them)");
+              "--set sun.elevaton_deg: unknown parameter 'sun.elevaton_deg' (did you mean 'sun.elevation_deg'?)");
+    EXPECT_EQ(err("sun.zenith=3"),
+              "--set sun.zenith: unknown parameter 'sun.zenith' (terralux --print-project lists them)");
     EXPECT_EQ(err("probe_volumes[3].grid_dims=[2,2]"),
               "--set probe_volumes[3].grid_dims: unknown parameter 'probe_volumes[3]' (there are 1)");
     EXPECT_EQ(err("sun"), "--set sun: expected key.path=value");
     EXPECT_EQ(err("=3"), "--set =3: expected key.path=value");
 }
 
-TEST(Project, UnknownKeysWarnAndAreDropped) {
-    std::vector<std::string> warnings;
-    json doc = {{"sun", {{"elevation_deg", 20}, {"colour", {1, 1, 1}}}}, {"extra", 1}};
-    const SceneDescription s = sceneFromJson(doc, "p.json", &warnings);
-    EXPECT_DOUBLE_EQ(s.sun.elevationDeg, 20.0);
-    ASSERT_EQ(warnings.size(), 2u);
-    EXPECT_EQ(warnings[0], "p.json: unknown key 'extra' ignored");
-    EXPECT_EQ(warnings[1], "p.json: unknown key 'sun.colour' ignored");
+TEST(Project, UnknownKeysAreErrorsNamingTheKey) {
+    // A misspelt key in a file must not bake with the default.
+    auto err = [](const json& doc) {
+        try {
+            sceneFromJson(doc, "p.json", nullptr);
+        } catch (const ProjectError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(err({{"sun", {{"elevaton_deg", 20}}}}),
+              "p.json: unknown key 'sun.elevaton_deg' (did you mean 'sun.elevation_deg'?)");
+    EXPECT_EQ(err({{"lighting", 1}}), "p.json: unknown key 'lighting' (terralux --print-project lists them)");
+    EXPECT_EQ(err({{"probe_volumes", {{{"name", "a"}, {"grid_dim", {4, 4}}}}}}),
+              "p.json: unknown key 'probe_volumes[0].grid_dim' (did you mean 'probe_volumes[].grid_dims'?)");
+    EXPECT_EQ(err({{"probe_volumes", {{{"adaptive", {{"tolerence", 0.1}}}}}}}),
+              "p.json: unknown key 'probe_volumes[0].adaptive.tolerence' (did you mean 'probe_volumes[].adaptive.tolerance'?)");
+    EXPECT_EQ(err({{"sun", 3}}), "p.json: sun = 3: must be an object");
+    // An editor's schema reference is allowed at the top.
+    EXPECT_EQ(err({{"$schema", "./terralux.schema.json"}, {"sun", {{"elevation_deg", 20}}}}), "");
 }
 
 TEST(Project, PartialVolumesTakeTheDefaults) {
@@ -291,4 +307,33 @@ TEST(Project, EffectiveProjectAppliesFileThenOverrides) {
     EXPECT_EQ(p.demPath(), dir / "x.tif");
     EXPECT_THROW(loadEffectiveProject((dir / "p.json").string(), {"sun.elevation_deg=100"}, "", nullptr),
                  ProjectError);
+}
+
+TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
+    const fs::path dir = fs::temp_directory_path() / "terralux_sky_cache";
+    fs::create_directories(dir);
+    const fs::path hdr = dir / "sky.exr";
+    std::vector<float> rgba(16 * 8 * 4, 1.0f);
+    writeImage(hdr, 16, 8, rgba);
+    Project p;
+    p.scene.sky.mode = SkyMode::Hdr;
+    p.scene.sky.hdr = hdr.string();
+    const size_t before = hdrSkyReads();
+    const Sky first = skyOf(p);
+    EXPECT_EQ(hdrSkyReads(), before + 1);
+    p.scene.sun.elevationDeg = 7.0;
+    p.scene.camera.azimuthDeg = 10.0;
+    const Sky again = skyOf(p);
+    EXPECT_EQ(hdrSkyReads(), before + 1) << "a sun or camera edit read the HDR again";
+    EXPECT_EQ(first.sh().c[0], again.sh().c[0]);
+    p.scene.sky.rotationDeg = 90.0;
+    skyOf(p);
+    EXPECT_EQ(hdrSkyReads(), before + 2) << "a rotation is a new environment";
+    // The file rewritten on disk (other size) is read again even with the same settings.
+    rgba.assign(32 * 16 * 4, 2.0f);
+    writeImage(hdr, 32, 16, rgba);
+    const Sky rewritten = skyOf(p);
+    EXPECT_EQ(hdrSkyReads(), before + 3);
+    EXPECT_GT(rewritten.sh().c[0].x, 1.5f * first.sh().c[0].x);
+    fs::remove_all(dir);
 }

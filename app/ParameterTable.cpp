@@ -1,0 +1,668 @@
+#include "ParameterTable.h"
+
+#include "Project.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <type_traits>
+
+namespace terralux {
+
+using nlohmann::json;
+
+namespace {
+
+// ---- Converting fields to and from JSON values that passed their row's checks -------------
+
+template <class T>
+struct IsOptional : std::false_type {};
+template <class T>
+struct IsOptional<std::optional<T>> : std::true_type {};
+
+template <class T>
+json fieldToJson(const T& v, const std::vector<std::string>& choices) {
+    if constexpr (IsOptional<T>::value) {
+        return v ? fieldToJson(*v, choices) : json(nullptr);
+    } else if constexpr (std::is_enum_v<T>) {
+        return choices.at(size_t(v));
+    } else if constexpr (std::is_same_v<T, glm::vec3>) {
+        return json{double(v.x), double(v.y), double(v.z)};
+    } else {
+        return json(v);
+    }
+}
+
+template <class T>
+T fieldFromJson(const json& v, const std::vector<std::string>& choices) {
+    if constexpr (IsOptional<T>::value) {
+        if (v.is_null()) return std::nullopt;
+        return fieldFromJson<typename T::value_type>(v, choices);
+    } else if constexpr (std::is_enum_v<T>) {
+        const std::string s = v.get<std::string>();
+        for (size_t i = 0; i < choices.size(); ++i)
+            if (choices[i] == s) return T(i);
+        return T(0);
+    } else if constexpr (std::is_same_v<T, glm::vec3>) {
+        return glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+    } else if constexpr (std::is_same_v<T, long long>) {
+        return v.is_number_unsigned() ? (long long)v.get<unsigned long long>() : v.get<long long>();
+    } else if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+        return T(v.get<double>());
+    } else {
+        return v.get<T>();
+    }
+}
+
+// ---- A fluent row builder ---------------------------------------------------------------------
+
+class Row {
+public:
+    Row(std::string path, ParamType type) {
+        s_.path = std::move(path);
+        s_.type = type;
+        if (type == ParamType::Color) s_.minItems = s_.maxItems = 3;
+    }
+    Row& range(double lo, double hi) { s_.min = lo; s_.max = hi; return *this; }
+    Row& above(double lo, double hi) { s_.min = lo; s_.minExclusive = true; s_.max = hi; return *this; }
+    Row& items(int lo, int hi) { s_.minItems = lo; s_.maxItems = hi; return *this; }
+    Row& scalarToo() { s_.scalarAllowed = true; return *this; }
+    Row& choices(std::vector<std::string> c) { s_.choices = std::move(c); return *this; }
+    Row& pattern(std::string re, std::string rule) { s_.pattern = std::move(re); s_.patternRule = std::move(rule); return *this; }
+    Row& autoMeans(std::string m) { s_.autoMeaning = std::move(m); return *this; }
+    Row& unit(std::string u) { s_.unit = std::move(u); return *this; }
+    Row& label(std::string l) { s_.label = std::move(l); return *this; }
+    Row& about(std::string d) { s_.description = std::move(d); return *this; }
+    Row& redoes(unsigned i) { s_.invalidates = i; return *this; }
+    Row& decimals(int d) { s_.decimals = d; return *this; }
+    Row& slider() { s_.slider = true; return *this; }
+    Row& noUiRow() { s_.uiRow = false; return *this; }
+    Row& count(std::function<int(const SceneDescription&, size_t)> f) { s_.items = std::move(f); return *this; }
+
+    // A field of a scene section (SceneDescription::sun, ::sky, ...).
+    template <class Section, class T>
+    Row& field(Section SceneDescription::*section, T Section::*member) {
+        s_.get = [=, choices = s_.choices](const SceneDescription& s, size_t) {
+            return fieldToJson(s.*section.*member, choices);
+        };
+        s_.set = [=, choices = s_.choices](SceneDescription& s, size_t, const json& v) {
+            s.*section.*member = fieldFromJson<T>(v, choices);
+        };
+        return *this;
+    }
+    template <class T>
+    Row& volume(T ProbeVolumeSettings::*member) {
+        s_.get = [=, choices = s_.choices](const SceneDescription& s, size_t i) {
+            return fieldToJson(s.probeVolumes.at(i).*member, choices);
+        };
+        s_.set = [=, choices = s_.choices](SceneDescription& s, size_t i, const json& v) {
+            s.probeVolumes.at(i).*member = fieldFromJson<T>(v, choices);
+        };
+        return *this;
+    }
+    template <class T>
+    Row& adaptive(T AdaptiveVolumeSettings::*member) {
+        s_.get = [=, choices = s_.choices](const SceneDescription& s, size_t i) {
+            return fieldToJson(s.probeVolumes.at(i).adaptive.*member, choices);
+        };
+        s_.set = [=, choices = s_.choices](SceneDescription& s, size_t i, const json& v) {
+            s.probeVolumes.at(i).adaptive.*member = fieldFromJson<T>(v, choices);
+        };
+        return *this;
+    }
+    Row& custom(std::function<json(const SceneDescription&, size_t)> get,
+                std::function<void(SceneDescription&, size_t, const json&)> set) {
+        s_.get = std::move(get);
+        s_.set = std::move(set);
+        return *this;
+    }
+
+    ParameterSpec s_;
+};
+
+std::string number(double d) {
+    if (std::isinf(d)) return d > 0 ? "inf" : "-inf";
+    if (std::floor(d) == d && std::abs(d) < 1e18) return std::to_string((long long)d);
+    std::ostringstream s;
+    s.precision(15);
+    s << d;
+    return s.str();
+}
+
+// The rule on a grid's size: each >= 1 and a product within the limit.
+void checkProduct(const std::array<int, 3>& d, long long limit) {
+    const long long product = (long long)d[0] * d[1] * d[2];
+    if (product > limit)
+        throw ParameterRejection{"must be >= 1 each with a product <= " + std::to_string(limit) +
+                                 " (is " + std::to_string(product) + ")", ""};
+}
+
+// Deepest octree: max_cell_size up to min_cell_size x 2^16 (seed 001's own defaults are 2^5).
+constexpr int kMaxOctreeLevels = 16;
+
+std::vector<ParameterSpec> buildTable() {
+    std::vector<Row> rows;
+    auto add = [&rows](Row r) -> Row& { rows.push_back(std::move(r)); return rows.back(); };
+    using T = ParamType;
+
+    // Terrain.
+    add(Row("terrain.dem", T::String))
+        .label("DEM").about("Elevation raster GDAL reads (GeoTIFF, SRTM .hgt, ASCII grid, VRT, /vsizip/...); relative to the project file; empty = the embedded sample")
+        .redoes(kReimport).field(&SceneDescription::terrain, &TerrainSettings::dem);
+    add(Row("terrain.vertical_scale", T::Number)).above(0.0, 100.0).unit("×").label("Vertical scale")
+        .about("Multiplies every height before lighting").redoes(kReimport)
+        .field(&SceneDescription::terrain, &TerrainSettings::verticalScale);
+    add(Row("terrain.albedo", T::Color)).range(0.0, 1.0).label("Albedo")
+        .about("Lambertian reflectance of the ground, linear RGB").redoes(kUpload | kRebake)
+        .field(&SceneDescription::terrain, &TerrainSettings::albedo);
+    add(Row("terrain.max_resolution", T::Integer)).range(0, 65536).unit("cells").label("Max resolution")
+        .about("Longest side after area-averaged resampling; 0 = the source resolution (1 is not a grid)")
+        .redoes(kReimport)
+        .custom([](const SceneDescription& s, size_t) { return json(s.terrain.maxResolution); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    if (v.get<int>() == 1) throw ParameterRejection{"must be 0 (off) or >= 2", ""};
+                    s.terrain.maxResolution = v.get<int>();
+                });
+    add(Row("terrain.skirt", T::Boolean)).label("Ground beyond border")
+        .about("The ground continues beyond the footprint at the border height (rays leaving the DEM still meet terrain)")
+        .redoes(kRebake).field(&SceneDescription::terrain, &TerrainSettings::skirt);
+
+    // Sun.
+    add(Row("sun.azimuth_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
+        .label("Sun azimuth").about("Direction of the sun, clockwise from north (-Z) toward east (+X)")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::azimuthDeg);
+    add(Row("sun.elevation_deg", T::Number)).range(-90.0, 90.0).unit("°").decimals(1).slider()
+        .label("Sun elevation").about("Angle of the sun above the horizon")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::elevationDeg);
+    add(Row("sun.illuminance", T::Number)).range(0.0, 1.0e6).label("Sun illuminance")
+        .about("Illuminance on a surface facing the sun, scene-linear (the sky's radiance is in the same units)")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::illuminance);
+    add(Row("sun.color", T::Color)).range(0.0, kUnbounded).label("Sun colour")
+        .about("Linear RGB tint of the sun's illuminance").redoes(kUpload | kRebake)
+        .field(&SceneDescription::sun, &SunSettings::color);
+    add(Row("sun.angular_radius_deg", T::Number)).range(0.0, 45.0).unit("°").label("Sun radius")
+        .about("Angular radius of the sun's disc (0.27° for the real sun): soft shadow size")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::angularRadiusDeg);
+
+    // Sky.
+    add(Row("sky.mode", T::Choice)).choices({"uniform", "hdr"}).label("Sky")
+        .about("uniform: one radiance from every direction; hdr: an equirectangular image")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::mode);
+    add(Row("sky.color", T::Color)).range(0.0, kUnbounded).label("Sky colour")
+        .about("Radiance of the uniform sky, linear RGB").redoes(kUpload | kRebake)
+        .field(&SceneDescription::sky, &SkySettings::color);
+    add(Row("sky.intensity", T::Number)).range(0.0, 1.0e5).label("Sky intensity")
+        .about("Multiplies the sky's radiance (uniform colour or HDR image)").redoes(kUpload | kRebake)
+        .field(&SceneDescription::sky, &SkySettings::intensity);
+    add(Row("sky.hdr", T::String)).label("HDR image")
+        .about("Equirectangular HDR or EXR sky, for mode hdr; relative to the project file")
+        .redoes(kUpload | kRebake)
+        .custom([](const SceneDescription& s, size_t) { return json(s.sky.hdr); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    s.sky.hdr = v.get<std::string>();
+                    if (s.sky.mode == SkyMode::Hdr && s.sky.hdr.empty())
+                        throw ParameterRejection{"must name an image when sky.mode is \"hdr\"", ""};
+                });
+    add(Row("sky.rotation_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
+        .label("HDR rotation").about("Turns the HDR sky about +Y").redoes(kUpload | kRebake)
+        .field(&SceneDescription::sky, &SkySettings::rotationDeg);
+
+    // Probe volumes: every row below is per volume.
+    const auto isBox = [](const SceneDescription& s, size_t i) {
+        return s.probeVolumes.at(i).placement == ProbePlacement::Box;
+    };
+    const auto isAdaptive = [](const SceneDescription& s, size_t i) {
+        return s.probeVolumes.at(i).placement == ProbePlacement::Adaptive;
+    };
+    add(Row("probe_volumes[].name", T::String))
+        .pattern("[A-Za-z0-9_-]{1,64}", "must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)")
+        .label("Name").about("File stem of the volume's .shprobe; unique among volumes")
+        .redoes(kNothing).noUiRow().volume(&ProbeVolumeSettings::name);
+    add(Row("probe_volumes[].enabled", T::Boolean)).label("Enabled")
+        .about("Baked, exported and drawn").redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::enabled);
+    add(Row("probe_volumes[].placement", T::Choice)).choices({"terrain", "box", "adaptive"}).label("Placement")
+        .about("terrain: a grid following the ground; box: a 3-D grid of cells; adaptive: an octree, fine near the ground")
+        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::placement);
+    add(Row("probe_volumes[].grid_dims", T::IntegerList)).items(2, 3).range(1, kMaxBoxGridProbes)
+        .label("Grid (probes)")
+        .about("terrain: [nx, nz] probes (product <= 4096); box: [nx, ny, nz] cells (product <= 65536); adaptive volumes ignore it")
+        .redoes(kReplace | kRebake)
+        .count([=](const SceneDescription& s, size_t i) { return isAdaptive(s, i) ? -1 : isBox(s, i) ? 3 : 2; })
+        .custom(
+            [=](const SceneDescription& s, size_t i) {
+                const ProbeVolumeSettings& v = s.probeVolumes.at(i);
+                // Adaptive volumes keep the terrain default, so a document reads back as written.
+                const auto& d = isAdaptive(s, i) ? ProbeVolumeSettings{}.gridDims : v.gridDims;
+                return isBox(s, i) ? json{d[0], d[1], d[2]} : json{d[0], d[2]};
+            },
+            [=](SceneDescription& s, size_t i, const json& v) {
+                if (isAdaptive(s, i)) return;
+                std::array<int, 3> d{1, 1, 1};
+                if (isBox(s, i)) {
+                    d = {v[0].get<int>(), v[1].get<int>(), v[2].get<int>()};
+                    checkProduct(d, kMaxBoxGridProbes);
+                } else {
+                    d = {v[0].get<int>(), 1, v[1].get<int>()};
+                    checkProduct(d, kMaxTerrainGridProbes);
+                }
+                s.probeVolumes.at(i).gridDims = d;
+            });
+    add(Row("probe_volumes[].origin", T::NumberList)).items(2, 3).range(-1.0e7, 1.0e7).unit("m")
+        .autoMeans("auto-span: the grid spans the terrain footprint (adaptive: its min corner at the lowest terrain)")
+        .label("Origin")
+        .about("terrain: (x, z) of the first probe; box and adaptive: (x, y, z) of the min corner; engine space")
+        .redoes(kReplace | kRebake)
+        .count([=](const SceneDescription& s, size_t i) { return isBox(s, i) || isAdaptive(s, i) ? 3 : 2; })
+        .custom(
+            [=](const SceneDescription& s, size_t i) {
+                const auto& o = s.probeVolumes.at(i).origin;
+                if (!o) return json(nullptr);
+                return isBox(s, i) || isAdaptive(s, i) ? json{o->x, o->y, o->z} : json{o->x, o->z};
+            },
+            [=](SceneDescription& s, size_t i, const json& v) {
+                auto& o = s.probeVolumes.at(i).origin;
+                if (v.is_null()) { o.reset(); return; }
+                o = v.size() == 3 ? glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>())
+                                  : glm::vec3(v[0].get<float>(), 0.0f, v[1].get<float>());
+            });
+    add(Row("probe_volumes[].spacing", T::NumberList)).items(2, 2).scalarToo().above(0.0, 1.0e6).unit("m")
+        .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
+        .about("terrain: [sx, sz] between probes; box: the cube edge, one number; adaptive volumes ignore it")
+        .redoes(kReplace | kRebake)
+        .count([=](const SceneDescription& s, size_t i) { return isAdaptive(s, i) ? -1 : isBox(s, i) ? 0 : 2; })
+        .custom(
+            [=](const SceneDescription& s, size_t i) {
+                const auto& sp = s.probeVolumes.at(i).spacing;
+                if (!sp || isAdaptive(s, i)) return json(nullptr);
+                return isBox(s, i) ? json(double(sp->x)) : json{sp->x, sp->z};
+            },
+            [=](SceneDescription& s, size_t i, const json& v) {
+                auto& sp = s.probeVolumes.at(i).spacing;
+                if (v.is_null() || isAdaptive(s, i)) { sp.reset(); return; }
+                if (v.is_number()) { sp = glm::vec3(v.get<float>()); return; }
+                const float x = v[0].get<float>(), z = v[1].get<float>();
+                sp = glm::vec3(x, std::min(x, z), z);
+            });
+    add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
+        .about("terrain placement: probes sit this far above the bilinear terrain height")
+        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset);
+    add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("the bake quality preset decides")
+        .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)
+        .volume(&ProbeVolumeSettings::rayCount);
+    add(Row("probe_volumes[].fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
+        .autoMeans("2 × the smallest spacing").label("Fallback blend")
+        .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
+        .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance);
+    add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
+        .autoMeans("the DEM's cell size").label("Adaptive: min cell")
+        .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
+        .adaptive(&AdaptiveVolumeSettings::minCellSize);
+    add(Row("probe_volumes[].adaptive.max_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
+        .autoMeans("16 × min_cell_size").label("Adaptive: max cell")
+        .about("Largest octree cell; must be min_cell_size × 2^k, k in [0, 16]").redoes(kReplace | kRebake)
+        .custom([](const SceneDescription& s, size_t i) {
+                    const auto& m = s.probeVolumes.at(i).adaptive.maxCellSize;
+                    return m ? json(*m) : json(nullptr);
+                },
+                [](SceneDescription& s, size_t i, const json& v) {
+                    AdaptiveVolumeSettings& a = s.probeVolumes.at(i).adaptive;
+                    if (v.is_null()) { a.maxCellSize.reset(); return; }
+                    const double max = v.get<double>();
+                    if (a.minCellSize) {
+                        const double ratio = max / *a.minCellSize;
+                        const double k = std::round(std::log2(ratio));
+                        if (!(ratio >= 1.0) || k > kMaxOctreeLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
+                            throw ParameterRejection{"must be min_cell_size (" + number(*a.minCellSize) +
+                                                         ") times 2^k, k in [0, " + std::to_string(kMaxOctreeLevels) + "]",
+                                                     ""};
+                    }
+                    a.maxCellSize = max;
+                });
+    add(Row("probe_volumes[].adaptive.height_range", T::Number)).range(0.0, 1.0e5).unit("m").decimals(1)
+        .label("Adaptive: above terrain").about("Auto box: from the lowest terrain up to the highest plus this")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::heightRange);
+    add(Row("probe_volumes[].adaptive.size", T::NumberList)).items(3, 3).above(0.0, 1.0e7).unit("m")
+        .autoMeans("the auto box over the terrain footprint").label("Adaptive: box size")
+        .about("Explicit box edges (x, y, z) from the origin; grows to whole min cells")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::size);
+    add(Row("probe_volumes[].adaptive.surface_band", T::Number)).range(0.0, 1.0e6).unit("m")
+        .autoMeans("one min cell").label("Adaptive: surface band")
+        .about("A cell this close above the surface goes down to the minimum size").redoes(kReplace | kRebake)
+        .adaptive(&AdaptiveVolumeSettings::surfaceBand);
+    add(Row("probe_volumes[].adaptive.tolerance", T::Number)).above(0.0, 1.0).decimals(3)
+        .autoMeans("geometric refinement only").label("Adaptive: error tolerance")
+        .about("Relative interpolation error that splits a leaf (error-driven refinement)")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::tolerance);
+    add(Row("probe_volumes[].adaptive.max_probes", T::Integer)).range(1, std::numeric_limits<int>::max())
+        .autoMeans("no limit").label("Adaptive: max probes").about("Probe budget of the error-driven refinement")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::maxProbes);
+    add(Row("probe_volumes[].adaptive.max_bytes", T::Integer)).range(1, double(1ll << 53)).unit("bytes")
+        .autoMeans("no limit").label("Adaptive: max bytes").about(".shprobe size budget of the error-driven refinement")
+        .redoes(kReplace | kRebake).noUiRow().adaptive(&AdaptiveVolumeSettings::maxBytes);
+    add(Row("probe_volumes[].adaptive.max_move_share", T::Number)).range(0.0, 0.5).unit("of a cell")
+        .label("Adaptive: max move")
+        .about("A minimum leaf whose centre is inside the terrain moves its probe up at most this share of its edge")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::maxMoveShare);
+
+    // Reflection probes.
+    add(Row("reflection_probes.enabled", T::Boolean)).label("Reflection probes")
+        .about("Terrain-local reflection probes").redoes(kNothing).noUiRow()
+        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::enabled);
+    add(Row("reflection_probes.grid_dims", T::IntegerList)).items(2, 2).range(1, kMaxReflectionProbes)
+        .label("Reflection grid").about("[nx, nz] probes, product <= 256").redoes(kNothing).noUiRow()
+        .custom([](const SceneDescription& s, size_t) {
+                    return json{s.reflectionProbes.gridDims[0], s.reflectionProbes.gridDims[1]};
+                },
+                [](SceneDescription& s, size_t, const json& v) {
+                    checkProduct({v[0].get<int>(), v[1].get<int>(), 1}, kMaxReflectionProbes);
+                    s.reflectionProbes.gridDims = {v[0].get<int>(), v[1].get<int>()};
+                });
+    add(Row("reflection_probes.height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m")
+        .label("Reflection height").about("Probes sit this far above the terrain").redoes(kNothing).noUiRow()
+        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::heightOffset);
+    add(Row("reflection_probes.ray_count", T::Integer)).range(1, 1 << 20).label("Reflection rays")
+        .about("Rays per reflection probe").redoes(kNothing).noUiRow()
+        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::rayCount);
+    add(Row("reflection_probes.ground_color", T::Color)).range(0.0, kUnbounded).label("Reflection ground")
+        .about("Colour below the horizon of reflection probes").redoes(kNothing).noUiRow()
+        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::groundColor);
+    add(Row("reflection_probes.strength", T::Number)).range(0.0, 1.0).label("Reflection strength")
+        .about("Weight of the reflection probes").redoes(kNothing).noUiRow()
+        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::strength);
+
+    // Bake.
+    add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
+        .about("Preset of rays, bounces and irradiance cache (rays and bounces below override it)")
+        .redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::quality);
+    add(Row("bake.rays", T::Integer)).range(1, 1 << 20).autoMeans("the preset decides").label("Rays per probe")
+        .about("Rays traced per probe").redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::rays);
+    add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("the preset decides").label("Bounces")
+        .about("Light bounces off the terrain; 0 = sky visibility only").redoes(kNothing)
+        .field(&SceneDescription::bake, &BakeSettings::bounces);
+    add(Row("bake.sh_encoding", T::Choice)).choices({"radiance", "irradiance"}).label("SH encoding")
+        .about("radiance: SH projection of what the probe sees; irradiance: pre-convolved with the cosine lobe")
+        .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::encoding);
+    add(Row("bake.deringing", T::Boolean)).label("Deringing")
+        .about("Window each probe's SH just enough that its irradiance is nowhere negative")
+        .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::deringing);
+    add(Row("bake.error_map_resolution", T::Integer)).range(0, kMaxErrorMapResolution).unit("points")
+        .label("Error map points a side")
+        .about("Points along the longer side of each volume's interpolation-error map (view 56); 0 = no map; each costs one probe bake")
+        .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::errorMapResolution);
+
+    // Camera (edited by the viewport, stored in the project).
+    add(Row("camera.target", T::NumberList)).items(3, 3).range(-1.0e7, 1.0e7).unit("m")
+        .autoMeans("the footprint centre at the mean terrain height").label("Camera target")
+        .about("Point the orbit camera looks at, engine space").redoes(kRedraw).noUiRow()
+        .field(&SceneDescription::camera, &CameraSettings::target);
+    add(Row("camera.radius", T::Number)).above(0.0, 1.0e8).unit("m").autoMeans("frames the whole footprint")
+        .label("Camera distance").about("Distance from the target").redoes(kRedraw).noUiRow()
+        .field(&SceneDescription::camera, &CameraSettings::radius);
+    add(Row("camera.azimuth_deg", T::Number)).range(-360.0, 360.0).unit("°").label("Camera azimuth")
+        .about("Where the camera stands, clockwise from north").redoes(kRedraw).noUiRow()
+        .field(&SceneDescription::camera, &CameraSettings::azimuthDeg);
+    add(Row("camera.elevation_deg", T::Number)).range(-89.9, 89.9).unit("°").label("Camera elevation")
+        .about("Angle of the camera above the target's horizon").redoes(kRedraw).noUiRow()
+        .field(&SceneDescription::camera, &CameraSettings::elevationDeg);
+    add(Row("camera.fov_deg", T::Number)).range(1.0, 150.0).unit("°").label("Field of view")
+        .about("Vertical field of view").redoes(kRedraw).noUiRow()
+        .field(&SceneDescription::camera, &CameraSettings::fovDeg);
+
+    // Export.
+    add(Row("export.out_dir", T::String)).pattern(".+", "must name a folder").label("Output folder")
+        .about("Where bakes are written; relative to the project file").redoes(kNothing)
+        .field(&SceneDescription::exportSettings, &ExportSettings::outDir);
+    add(Row("export.gltf", T::Boolean)).label("glTF scene").about("Write scene.gltf with the probe-grid extension")
+        .redoes(kNothing).field(&SceneDescription::exportSettings, &ExportSettings::gltf);
+    add(Row("export.default_scale", T::Number)).range(-100.0, 100.0).decimals(3).label("SH scale")
+        .about("Default SH scale written into each .shprobe; engines multiply the probes by it")
+        .redoes(kUpload).field(&SceneDescription::exportSettings, &ExportSettings::defaultScale);
+    add(Row("export.default_ambient", T::Number)).range(0.0, 100.0).decimals(3).label("Ambient term")
+        .about("Default ambient term written into each .shprobe").redoes(kNothing)
+        .field(&SceneDescription::exportSettings, &ExportSettings::defaultAmbient);
+
+    std::vector<ParameterSpec> table;
+    table.reserve(rows.size());
+    for (Row& r : rows) table.push_back(std::move(r.s_));
+    return table;
+}
+
+}  // namespace
+
+std::string ParameterSpec::localPath() const {
+    return perVolume() ? path.substr(std::string("probe_volumes[].").size()) : path;
+}
+
+json ParameterSpec::defaultValue() const {
+    const SceneDescription scene;  // holds one default probe volume
+    return get(scene, 0);
+}
+
+std::string ParameterSpec::rangeText() const {
+    if (type == ParamType::Choice) {
+        std::string list;
+        for (const auto& c : choices) list += (list.empty() ? "" : " | ") + c;
+        return "one of " + list;
+    }
+    if (std::isinf(max)) return std::string(minExclusive ? "> " : ">= ") + number(min);
+    return std::string(minExclusive ? "(" : "[") + number(min) + ", " + number(max) + (maxExclusive ? ")" : "]");
+}
+
+const std::vector<ParameterSpec>& parameterTable() {
+    static const std::vector<ParameterSpec> table = buildTable();
+    return table;
+}
+
+std::string normaliseParameterPath(const std::string& path) {
+    std::string out;
+    for (size_t i = 0; i < path.size(); ++i) {
+        out += path[i];
+        if (path[i] == '[') {
+            const size_t close = path.find(']', i);
+            if (close == std::string::npos) return path;
+            i = close;
+            out += ']';
+        }
+    }
+    return out;
+}
+
+const ParameterSpec* findParameter(const std::string& path) {
+    const std::string key = normaliseParameterPath(path);
+    for (const auto& p : parameterTable())
+        if (p.path == key) return &p;
+    return nullptr;
+}
+
+unsigned invalidatedBy(const std::string& path) {
+    if (path.empty()) return kUpload | kRebake | kReplace | kReimport;
+    if (const ParameterSpec* spec = findParameter(path)) return spec->invalidates;
+    std::string key = normaliseParameterPath(path);
+    if (key == "probe_volumes" || key == "probe_volumes[]") key = "probe_volumes[]";
+    unsigned flags = 0;
+    for (const auto& p : parameterTable())
+        if (p.path.rfind(key + ".", 0) == 0) flags |= p.invalidates;
+    return flags & ~kNothing;
+}
+
+bool isParameterSection(const std::string& path) {
+    const std::string key = normaliseParameterPath(path) + ".";
+    for (const auto& p : parameterTable())
+        if (p.path.rfind(key, 0) == 0) return true;
+    return false;
+}
+
+}  // namespace terralux
+
+namespace terralux {
+
+namespace {
+
+std::string typeName(const ParameterSpec& s) {
+    switch (s.type) {
+        case ParamType::Number: return "number";
+        case ParamType::Integer: return "integer";
+        case ParamType::Boolean: return "boolean";
+        case ParamType::String: return "string";
+        case ParamType::Choice: return "choice";
+        case ParamType::Color: return "RGB";
+        case ParamType::NumberList:
+            return s.minItems == s.maxItems ? std::to_string(s.minItems) + " numbers"
+                                            : std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " numbers";
+        case ParamType::IntegerList:
+            return s.minItems == s.maxItems ? std::to_string(s.minItems) + " integers"
+                                            : std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " integers";
+    }
+    return "";
+}
+
+void bounds(json& out, const ParameterSpec& s) {
+    if (!std::isinf(s.min)) out[s.minExclusive ? "exclusiveMinimum" : "minimum"] = s.min;
+    if (!std::isinf(s.max)) out[s.maxExclusive ? "exclusiveMaximum" : "maximum"] = s.max;
+}
+
+json leafSchema(const ParameterSpec& s) {
+    json out;
+    switch (s.type) {
+        case ParamType::Number:
+        case ParamType::Integer:
+            out["type"] = s.type == ParamType::Integer ? "integer" : "number";
+            bounds(out, s);
+            break;
+        case ParamType::Boolean: out["type"] = "boolean"; break;
+        case ParamType::String:
+            out["type"] = "string";
+            if (!s.pattern.empty()) out["pattern"] = "^(" + s.pattern + ")$";
+            break;
+        case ParamType::Choice: out["enum"] = s.choices; break;
+        case ParamType::Color:
+        case ParamType::NumberList:
+        case ParamType::IntegerList: {
+            json item = {{"type", s.type == ParamType::IntegerList ? "integer" : "number"}};
+            bounds(item, s);
+            out = {{"type", "array"}, {"items", item}, {"minItems", s.minItems}, {"maxItems", s.maxItems}};
+            if (s.scalarAllowed) out = {{"anyOf", json::array({item, out})}};
+            break;
+        }
+    }
+    if (s.nullable()) out = {{"anyOf", json::array({out, {{"type", "null"}}})}};
+    std::string d = s.description;
+    if (!s.unit.empty()) d += " [" + s.unit + "]";
+    if (s.nullable()) d += ". null: " + *s.autoMeaning;
+    out["title"] = s.label;
+    out["description"] = d;
+    out["default"] = s.defaultValue();
+    return out;
+}
+
+json objectSchema() {
+    return {{"type", "object"}, {"additionalProperties", false}, {"properties", json::object()}};
+}
+
+// Inserts `leaf` at the dotted `path` of an object schema, making sections on the way.
+void insert(json& schema, const std::string& path, json leaf) {
+    const size_t dot = path.find('.');
+    json& props = schema["properties"];
+    if (dot == std::string::npos) {
+        props[path] = std::move(leaf);
+        return;
+    }
+    const std::string head = path.substr(0, dot);
+    if (!props.contains(head)) props[head] = objectSchema();
+    insert(props[head], path.substr(dot + 1), std::move(leaf));
+}
+
+std::string invalidationText(unsigned i) {
+    if (i & kNothing) return "bake only";
+    if (i & kReimport) return "re-import";
+    if (i & kReplace) return "re-place";
+    if (i & kRebake) return "preview bake";
+    if (i & kUpload) return "upload";
+    return "redraw";
+}
+
+std::string cell(std::string s) {
+    std::string out;
+    for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+}
+
+}  // namespace
+
+ParameterDock parameterDock(const ParameterSpec& spec) {
+    const std::string section = spec.path.substr(0, spec.path.find_first_of(".["));
+    if (section == "terrain") return {"dock.terrain", "Terrain"};
+    if (section == "sun" || section == "sky") return {"dock.sunSky", "Sun & Sky"};
+    if (section == "probe_volumes") return {"dock.probeVolumes", "Probe Volumes"};
+    if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
+    return {"", ""};
+}
+
+std::string uiObjectName(const ParameterSpec& spec) {
+    return "param." + (spec.perVolume() ? "volume." + spec.localPath() : spec.path);
+}
+
+double uiMinimum(const ParameterSpec& spec) {
+    return spec.minExclusive ? spec.min + std::pow(10.0, -spec.decimals) : spec.min;
+}
+
+std::string autoShort(const ParameterSpec& spec) {
+    if (!spec.autoMeaning) return "";
+    const std::string& m = *spec.autoMeaning;
+    return m.substr(0, m.find(':'));
+}
+
+json projectSchema() {
+    json schema = objectSchema();
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema";
+    schema["$id"] = "https://terralux.dev/schema/project-1.json";
+    schema["title"] = "Terralux project";
+    schema["description"] =
+        "A Terralux project file. Every key is optional: an absent key takes its default; an unknown key is an error.";
+    auto& props = schema["properties"];
+    props["$schema"] = {{"type", "string"}, {"description", "The schema an editor checks this file against"}};
+    props["format"] = {{"const", "terralux-project"}, {"description", "Marks the file as a Terralux project"}, {"default", "terralux-project"}};
+    props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", 1},
+                        {"description", "Project format version"}, {"default", 1}};
+    json volume = objectSchema();
+    for (const auto& s : parameterTable()) {
+        if (s.perVolume()) insert(volume, s.localPath(), leafSchema(s));
+        else insert(schema, s.path, leafSchema(s));
+    }
+    props["probe_volumes"] = {{"type", "array"},
+                              {"description", "Probe volumes, each baked into its own .shprobe"},
+                              {"items", volume},
+                              {"default", json::array({json::object()})}};
+    return schema;
+}
+
+std::string parameterReferenceMarkdown() {
+    std::ostringstream md;
+    md << "# Project parameters\n\n"
+          "Generated from the parameter table (`app/ParameterTable.cpp`) by\n"
+          "`terralux --print-reference`; do not edit by hand. Every parameter is reachable by\n"
+          "`--set PATH=VALUE`; rows under `probe_volumes[]` take an index (`probe_volumes[0].grid_dims`).\n"
+          "`null` means \"auto\" where the last column says what auto does. \"Edit redoes\" is the\n"
+          "work an edit in the authoring window costs: redraw < upload < preview bake < re-place <\n"
+          "re-import; \"bake only\" parameters change nothing on screen.\n";
+    std::string section;
+    for (const auto& s : parameterTable()) {
+        const std::string head = s.perVolume() ? "probe_volumes[]" : s.path.substr(0, s.path.find('.'));
+        if (head != section) {
+            section = head;
+            md << "\n## `" << section << "`\n\n"
+               << "| parameter | type | default | allowed | unit | edit redoes | null (auto) | description |\n"
+               << "|---|---|---|---|---|---|---|---|\n";
+        }
+        std::string allowed;
+        if (s.type == ParamType::Choice) allowed = s.rangeText();
+        else if (s.type == ParamType::String) allowed = s.patternRule.empty() ? "any" : s.patternRule;
+        else if (s.type != ParamType::Boolean) allowed = (s.type == ParamType::Color || s.type == ParamType::NumberList || s.type == ParamType::IntegerList ? "each " : "") + s.rangeText();
+        md << "| `" << s.path << "` | " << typeName(s) << " | `" << cell(s.defaultValue().dump()) << "` | "
+           << cell(allowed) << " | " << cell(s.unit) << " | " << invalidationText(s.invalidates) << " | "
+           << cell(s.autoMeaning.value_or("")) << " | " << cell(s.description) << " |\n";
+    }
+    return md.str();
+}
+
+}  // namespace terralux

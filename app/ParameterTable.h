@@ -1,0 +1,123 @@
+#pragma once
+// The one table of project parameters. Each row declares a parameter once, with everything that
+// reads it: its JSON path, type, range or choices, what `null` ("auto") means, unit, label and
+// description, the work an edit invalidates, and the field of the SceneDescription it binds to.
+// The project reader and writer, the validation messages, `--set`, the UI rows and their limits,
+// `terralux --print-schema` and the parameter reference (docs/parameters.md) are all generated
+// from it. Adding a parameter is one row here plus the code that uses the field.
+
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/SceneDescription.h"
+
+namespace terralux {
+
+enum class ParamType {
+    Number,       // a finite double in [min, max]
+    Integer,      // a whole number in [min, max]
+    Boolean,
+    String,       // optionally matching `pattern`
+    Choice,       // one of `choices`
+    Color,        // three numbers, each in [min, max]
+    NumberList,   // minItems..maxItems numbers, each in [min, max] (scalarAllowed: or one number)
+    IntegerList,  // minItems..maxItems whole numbers, each in [min, max]
+};
+
+// What an edit of a parameter invalidates, cheapest first. The UI does no more than this.
+enum Invalidation : unsigned {
+    kRedraw = 0,           // draw the next frame with the new value
+    kUpload = 1u << 0,     // new lighting or material uniforms for the renderer
+    kRebake = 1u << 1,     // the draft probe preview is baked again
+    kReplace = 1u << 2,    // probe volumes are placed again (overlays, estimate)
+    kReimport = 1u << 3,   // the DEM is imported again (everything above follows)
+    kNothing = 1u << 4,    // read only by the bake and the exporters: nothing to redraw
+};
+
+inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+
+struct ParameterSpec {
+    // "sun.elevation_deg"; rows of each probe volume are "probe_volumes[].grid_dims".
+    std::string path;
+    ParamType type = ParamType::Number;
+    double min = -kUnbounded, max = kUnbounded;
+    bool minExclusive = false, maxExclusive = false;
+    int minItems = 0, maxItems = 0;  // lists
+    bool scalarAllowed = false;      // a NumberList that may also be one number
+    std::vector<std::string> choices;
+    std::string pattern, patternRule;  // strings: a regex, and the rule it enforces in words
+    // Set when `null` is allowed: what it means ("auto-span", "the preset decides").
+    std::optional<std::string> autoMeaning;
+    std::string unit, label, description;
+    unsigned invalidates = kRedraw;
+    int decimals = 2;     // UI precision
+    bool slider = false;  // UI: a slider beside the spin box (angles)
+    bool uiRow = true;    // shown as a dock row (false: edited elsewhere, or by the viewport)
+    // Lists whose length depends on other parameters (a box grid has 3 dims, a terrain grid 2):
+    // the exact count for this scene, 0 for one plain number, -1 when the row is not read.
+    std::function<int(const SceneDescription&, size_t volume)> items;
+
+    // Binding to the scene. `volume` indexes probe_volumes for per-volume rows.
+    std::function<nlohmann::json(const SceneDescription&, size_t volume)> get;
+    // Receives a value that passed the row's own checks; may reject with the row's context.
+    std::function<void(SceneDescription&, size_t volume, const nlohmann::json&)> set;
+
+    bool perVolume() const { return path.rfind("probe_volumes[].", 0) == 0; }
+    // The path below probe_volumes[] for per-volume rows ("grid_dims"), else the path.
+    std::string localPath() const;
+    // The default, read from a default-constructed scene (or probe volume).
+    nlohmann::json defaultValue() const;
+    bool nullable() const { return autoMeaning.has_value(); }
+    // "[0, 90]", "(0, 1]", "> 0", "one of a | b": the rule as validation messages state it.
+    std::string rangeText() const;
+};
+
+// Thrown by a row's `set` (or a rule between rows) when a value that passed the row's own checks
+// breaks a rule that involves other parameters. `subPath` names an element ("[1]") if any.
+struct ParameterRejection {
+    std::string rule;
+    std::string subPath;
+};
+
+const std::vector<ParameterSpec>& parameterTable();
+
+// The row for a path with or without volume indices ("probe_volumes[2].grid_dims" and
+// "probe_volumes[].grid_dims" both find it); nullptr when no row has that path.
+const ParameterSpec* findParameter(const std::string& path);
+
+// "probe_volumes[2].grid_dims" -> "probe_volumes[].grid_dims".
+std::string normaliseParameterPath(const std::string& path);
+
+// What an edit at `path` invalidates: its row's flags, or every flag of the rows below a section
+// ("probe_volumes[0]", "sun"); everything for "" (a new or reopened project).
+unsigned invalidatedBy(const std::string& path);
+
+// Sections that hold rows ("sun", "probe_volumes[].adaptive"): JSON objects in the project.
+bool isParameterSection(const std::string& path);
+
+// The authoring window's dock that edits a row (its objectName and title).
+struct ParameterDock {
+    std::string objectName, title;
+};
+ParameterDock parameterDock(const ParameterSpec& spec);
+// The objectName of a row's editor: "param.sun.elevation_deg"; rows of the selected probe
+// volume are "param.volume.<key>". Lists add ".0", ".1", ...; a slider adds ".slider"; the
+// "auto" box of a nullable list adds ".auto".
+std::string uiObjectName(const ParameterSpec& spec);
+// The smallest value a UI spin box offers: the minimum, or one display step above an excluded one.
+double uiMinimum(const ParameterSpec& spec);
+// A short word for the null ("auto") value in a spin box: the meaning up to its first colon.
+std::string autoShort(const ParameterSpec& spec);
+
+// JSON Schema (draft 2020-12) of the project file, generated from the table.
+nlohmann::json projectSchema();
+// The parameter reference in Markdown (docs/parameters.md), generated from the table.
+std::string parameterReferenceMarkdown();
+
+}  // namespace terralux
