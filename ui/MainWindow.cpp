@@ -27,6 +27,7 @@
 
 #include "DemImport.h"
 #include "ParameterPanels.h"
+#include "ParameterTable.h"
 #include "PreviewBake.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
@@ -99,11 +100,19 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
 
     connect(doc_, &ProjectDocument::terrainChanged, this, &MainWindow::rebuildRenderer);
     connect(doc_, &ProjectDocument::parametersChanged, this, [this](const QString& path) {
-        refreshLighting();
-        updateEstimate();
-        if (path.isEmpty() || path.startsWith("probe_volumes") || path.startsWith("sun") ||
-            path.startsWith("sky") || path.startsWith("terrain") || path.startsWith("export.default"))
-            schedulePreview();
+        // The parameter table says what an edit invalidates; do that much and no more.
+        const unsigned work = invalidatedBy(path.toStdString());
+        if (work & (kUpload | kRebake | kReplace | kReimport)) refreshLighting();
+        else viewport_->requestUpdate();
+        if ((work & (kReplace | kReimport)) || path.startsWith("bake.")) updateEstimate();
+        if (work & (kRebake | kReplace | kReimport)) schedulePreview();
+    });
+    connect(doc_, &ProjectDocument::terrainEditFailed, this,
+            [this](const QString& m) { showError("Terrain", m); });
+    connect(doc_, &ProjectDocument::terrainLoadingChanged, this, [this](bool loading) {
+        terrainBusy_->setVisible(loading);
+        if (loading) statusBar()->showMessage("importing the terrain…");
+        else statusBar()->clearMessage();
     });
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateTitle);
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
@@ -193,10 +202,7 @@ void MainWindow::buildDocks() {
     importDem->setObjectName("terrain.import");
     tv->addWidget(importDem);
     auto* tf = new ParameterForm(doc_);
-    tf->addNumber("terrain.vertical_scale", "Vertical scale", 0.01, 100.0, 2, "×");
-    tf->addColor("terrain.albedo", "Albedo");
-    tf->addInteger("terrain.max_resolution", "Max resolution", 2, 65536, "source");
-    tf->addBool("terrain.skirt", "Ground beyond border");
+    tf->addParameters("terrain.");
     tv->addWidget(tf);
     tv->addStretch(1);
     connectRejected(tf);
@@ -209,16 +215,8 @@ void MainWindow::buildDocks() {
 
     // Sun & Sky.
     auto* sky = new ParameterForm(doc_);
-    sky->addNumber("sun.azimuth_deg", "Sun azimuth", 0.0, 360.0, 1, "°", true);
-    sky->addNumber("sun.elevation_deg", "Sun elevation", -90.0, 90.0, 1, "°", true);
-    sky->addNumber("sun.illuminance", "Sun illuminance", 0.0, 1000.0, 2, "");
-    sky->addColor("sun.color", "Sun colour");
-    sky->addNumber("sun.angular_radius_deg", "Sun radius", 0.0, 45.0, 2, "°");
-    sky->addChoice("sky.mode", "Sky", {"uniform", "hdr"});
-    sky->addColor("sky.color", "Sky colour");
-    sky->addNumber("sky.intensity", "Sky intensity", 0.0, 1000.0, 2, "");
-    sky->addText("sky.hdr", "HDR image");
-    sky->addNumber("sky.rotation_deg", "HDR rotation", 0.0, 360.0, 1, "°", true);
+    sky->addParameters("sun.");
+    sky->addParameters("sky.");
     auto* importHdr = new QPushButton("Import HDR…");
     importHdr->setObjectName("sky.import");
     sky->addWidget("", importHdr);
@@ -238,16 +236,8 @@ void MainWindow::buildDocks() {
     auto* bakeWidget = new QWidget;
     auto* bv = new QVBoxLayout(bakeWidget);
     auto* bf = new ParameterForm(doc_);
-    bf->addChoice("bake.quality", "Quality", {"draft", "standard", "high", "reference"});
-    bf->addInteger("bake.rays", "Rays per probe", 1, 1 << 20, "preset");
-    bf->addInteger("bake.bounces", "Bounces", 0, 16, "preset");
-    bf->addChoice("bake.sh_encoding", "SH encoding", {"radiance", "irradiance"});
-    bf->addBool("bake.deringing", "Deringing");
-    bf->addInteger("bake.error_map_resolution", "Error map points a side", 0, kMaxErrorMapResolution);
-    bf->addText("export.out_dir", "Output folder");
-    bf->addBool("export.gltf", "glTF scene");
-    bf->addNumber("export.default_scale", "SH scale", -100.0, 100.0, 3, "");
-    bf->addNumber("export.default_ambient", "Ambient term", 0.0, 100.0, 3, "");
+    bf->addParameters("bake.");
+    bf->addParameters("export.");
     connectRejected(bf);
     bv->addWidget(bf);
     estimate_ = new QLabel;
@@ -334,6 +324,13 @@ void MainWindow::buildDocks() {
     statusBar()->addWidget(legend, 1);
     statusBar()->addPermanentWidget(probeLabel_);
     statusBar()->addPermanentWidget(frameLabel_);
+    terrainBusy_ = new QProgressBar;
+    terrainBusy_->setObjectName("status.terrainBusy");
+    terrainBusy_->setRange(0, 0);  // busy: the import reports no fraction
+    terrainBusy_->setMaximumWidth(120);
+    terrainBusy_->setFormat("importing");
+    terrainBusy_->setVisible(false);
+    statusBar()->addPermanentWidget(terrainBusy_);
     statusBar()->addPermanentWidget(sourceLabel_);
     sourceLabel_->setText(QString::fromStdString(ctx_->deviceName()));
 }
@@ -449,6 +446,7 @@ bool MainWindow::openProject(const QString& file) {
 
 bool MainWindow::importDemFile(const QString& file) {
     QString error;
+    // The import runs on a worker; a file it cannot read reaches terrainEditFailed.
     if (doc_->importDem(file, &error)) return true;
     showError("Import DEM", error);
     return false;

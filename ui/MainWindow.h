@@ -81,6 +81,7 @@ private:
     QLabel* estimate_ = nullptr;
     QLabel* eta_ = nullptr;
     QLabel* frameLabel_ = nullptr;
+    QProgressBar* terrainBusy_ = nullptr;
     QLabel* probeLabel_ = nullptr;
     QLabel* sourceLabel_ = nullptr;
     QLabel* terrainSummary_ = nullptr;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <QCheckBox>
 #include <QColorDialog>
@@ -19,6 +20,7 @@
 #include <QSpinBox>
 #include <QVBoxLayout>
 
+#include "ParameterTable.h"
 #include "ProjectDocument.h"
 
 namespace terralux {
@@ -31,13 +33,18 @@ ParameterForm::ParameterForm(ProjectDocument* doc, QWidget* parent)
     connect(doc_, &ProjectDocument::parametersChanged, this, [this] { refresh(); });
 }
 
-QString ParameterForm::objectNameFor(const std::string& path) const {
-    return QString::fromStdString("param." + namePrefix_ + path);
+void ParameterForm::setVolume(int volume) {
+    volume_ = volume;
+    refresh();
+}
+
+std::string ParameterForm::docPath(const ParameterSpec& spec) const {
+    return spec.perVolume() ? "probe_volumes[" + std::to_string(volume_) + "]." + spec.localPath() : spec.path;
 }
 
 void ParameterForm::set(const std::string& path, const json& value) {
     QString error;
-    if (!doc_->setParameter(full(path), value, &error)) {
+    if (!doc_->setParameter(path, value, &error)) {
         emit rejected(error);
         refresh();  // back to the valid value
     }
@@ -54,155 +61,218 @@ void ParameterForm::showEvent(QShowEvent* e) {
 
 void ParameterForm::addWidget(const QString& label, QWidget* w) { form_->addRow(label, w); }
 
-void ParameterForm::addNumber(const std::string& path, const QString& label, double min, double max,
-                              int decimals, const QString& unit, bool slider) {
+void ParameterForm::addParameters(const std::string& prefix) {
+    for (const auto& spec : parameterTable())
+        if (spec.uiRow && spec.path.rfind(prefix, 0) == 0) addParameter(spec.path);
+}
+
+void ParameterForm::addParameter(const std::string& path) {
+    const ParameterSpec* spec = findParameter(path);
+    if (!spec) throw std::logic_error("no parameter " + path);
+    switch (spec->type) {
+        case ParamType::Number: return addNumber(*spec);
+        case ParamType::Integer: return addInteger(*spec);
+        case ParamType::Boolean: return addBool(*spec);
+        case ParamType::String: return addText(*spec);
+        case ParamType::Choice: return addChoice(*spec);
+        case ParamType::Color: return addColor(*spec);
+        case ParamType::NumberList:
+        case ParamType::IntegerList: return addList(*spec);
+    }
+}
+
+void ParameterForm::addRow(const ParameterSpec& spec, QWidget* editor) {
+    QString tip = QString::fromStdString(spec.description);
+    if (spec.type != ParamType::Boolean && spec.type != ParamType::String)
+        tip += QString::fromStdString("\nAllowed: " + (spec.type == ParamType::Choice ? spec.rangeText() : "each " + spec.rangeText()) +
+                                      (spec.unit.empty() ? "" : " " + spec.unit));
+    if (spec.autoMeaning) tip += QString::fromStdString("\nAuto: " + *spec.autoMeaning);
+    tip += QString::fromStdString("\nProject path: " + spec.path);
+    auto* label = new QLabel(QString::fromStdString(spec.label), this);
+    label->setToolTip(tip);
+    editor->setToolTip(tip);
+    form_->addRow(label, editor);
+}
+
+void ParameterForm::addNumber(const ParameterSpec& spec) {
     auto* row = new QWidget(this);
     auto* h = new QHBoxLayout(row);
     h->setContentsMargins(0, 0, 0, 0);
     auto* spin = new QDoubleSpinBox(row);
-    spin->setObjectName(objectNameFor(path));
-    spin->setRange(min, max);
-    spin->setDecimals(decimals);
-    spin->setSingleStep(std::pow(10.0, -std::min(decimals, 2)) * (max - min > 100 ? 10 : 1));
+    const QString name = QString::fromStdString(uiObjectName(spec));
+    spin->setObjectName(name);
+    const double step = std::pow(10.0, -spec.decimals);
+    const double lo = uiMinimum(spec), hi = spec.max;
+    const bool nullable = spec.nullable();
+    // A nullable number shows its "auto" text one step below the smallest value.
+    spin->setDecimals(spec.decimals);
+    spin->setRange(nullable ? lo - step : lo, hi);
+    if (nullable) spin->setSpecialValueText(QString::fromStdString(autoShort(spec)));
+    spin->setSingleStep(std::pow(10.0, -std::min(spec.decimals, 2)) * (hi - lo > 100 ? 10 : 1));
     spin->setKeyboardTracking(false);
-    if (!unit.isEmpty()) spin->setSuffix(" " + unit);
+    if (!spec.unit.empty()) spin->setSuffix(QString::fromStdString(" " + spec.unit));
     QSlider* s = nullptr;
-    if (slider) {
+    if (spec.slider) {
         s = new QSlider(Qt::Horizontal, row);
-        s->setObjectName(objectNameFor(path) + ".slider");
+        s->setObjectName(name + ".slider");
         s->setRange(0, 1000);
         h->addWidget(s, 1);
         connect(s, &QSlider::valueChanged, this, [=, this](int v) {
-            set(path, min + (max - min) * v / 1000.0);
+            set(docPath(spec), lo + (hi - lo) * v / 1000.0);
         });
     }
-    h->addWidget(spin, slider ? 0 : 1);
-    connect(spin, &QDoubleSpinBox::valueChanged, this, [=, this](double v) { set(path, v); });
+    h->addWidget(spin, s ? 0 : 1);
+    connect(spin, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
+        set(docPath(spec), nullable && v < lo ? json(nullptr) : json(v));
+    });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
-        if (!v.is_number()) return;
+        const json v = doc_->value(docPath(spec));
         QSignalBlocker b1(spin);
-        spin->setValue(v.get<double>());
-        if (s) {
+        spin->setValue(v.is_number() ? v.get<double>() : lo - step);
+        if (s && v.is_number()) {
             QSignalBlocker b2(s);
-            s->setValue(int(std::lround((v.get<double>() - min) / (max - min) * 1000.0)));
+            s->setValue(int(std::lround((v.get<double>() - lo) / (hi - lo) * 1000.0)));
         }
     });
-    form_->addRow(label, row);
+    addRow(spec, row);
 }
 
-void ParameterForm::addInteger(const std::string& path, const QString& label, int min, int max,
-                               const QString& nullText) {
+void ParameterForm::addInteger(const ParameterSpec& spec) {
     auto* spin = new QSpinBox(this);
-    spin->setObjectName(objectNameFor(path));
-    spin->setRange(nullText.isEmpty() ? min : min - 1, max);
+    spin->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    const int lo = int(spec.min), hi = int(std::min<double>(spec.max, std::numeric_limits<int>::max()));
+    const bool nullable = spec.nullable();
+    spin->setRange(nullable ? lo - 1 : lo, hi);
     spin->setKeyboardTracking(false);
-    if (!nullText.isEmpty()) spin->setSpecialValueText(nullText);
+    if (nullable) spin->setSpecialValueText(QString::fromStdString(autoShort(spec)));
+    if (!spec.unit.empty()) spin->setSuffix(QString::fromStdString(" " + spec.unit));
     connect(spin, &QSpinBox::valueChanged, this, [=, this](int v) {
-        set(path, (!nullText.isEmpty() && v == min - 1) ? json(nullptr) : json(v));
+        set(docPath(spec), nullable && v < lo ? json(nullptr) : json(v));
     });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         QSignalBlocker b(spin);
-        spin->setValue(v.is_number() ? v.get<int>() : min - 1);
+        spin->setValue(v.is_number() ? v.get<int>() : lo - 1);
     });
-    form_->addRow(label, spin);
+    addRow(spec, spin);
 }
 
-void ParameterForm::addOptionalNumber(const std::string& path, const QString& label, double max,
-                                      int decimals, const QString& unit, const QString& nullText) {
-    auto* spin = new QDoubleSpinBox(this);
-    spin->setObjectName(objectNameFor(path));
-    spin->setRange(-1.0, max);
-    spin->setDecimals(decimals);
-    spin->setSpecialValueText(nullText);
-    spin->setKeyboardTracking(false);
-    if (!unit.isEmpty()) spin->setSuffix(" " + unit);
-    connect(spin, &QDoubleSpinBox::valueChanged, this, [=, this](double v) {
-        set(path, v < 0.0 ? json(nullptr) : json(v));
-    });
-    refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
-        QSignalBlocker b(spin);
-        spin->setValue(v.is_number() ? v.get<double>() : -1.0);
-    });
-    form_->addRow(label, spin);
-}
-
-void ParameterForm::addIntegerArray(const std::string& path, const QString& label, int count,
-                                    int min, int max) {
+void ParameterForm::addList(const ParameterSpec& spec) {
     auto* row = new QWidget(this);
     auto* h = new QHBoxLayout(row);
     h->setContentsMargins(0, 0, 0, 0);
-    std::vector<QSpinBox*> spins;
-    for (int i = 0; i < count; ++i) {
-        auto* spin = new QSpinBox(row);
-        spin->setObjectName(objectNameFor(path) + "." + QString::number(i));
-        spin->setRange(min, max);
+    const QString name = QString::fromStdString(uiObjectName(spec));
+    const bool integer = spec.type == ParamType::IntegerList;
+    QCheckBox* autoBox = nullptr;
+    if (spec.nullable()) {
+        autoBox = new QCheckBox("auto", row);
+        autoBox->setObjectName(name + ".auto");
+        h->addWidget(autoBox);
+    }
+    std::vector<QAbstractSpinBox*> spins;
+    for (int i = 0; i < spec.maxItems; ++i) {
+        QAbstractSpinBox* spin;
+        if (integer) {
+            auto* sb = new QSpinBox(row);
+            sb->setRange(int(spec.min), int(std::min<double>(spec.max, std::numeric_limits<int>::max())));
+            spin = sb;
+        } else {
+            auto* sb = new QDoubleSpinBox(row);
+            sb->setDecimals(spec.decimals);
+            sb->setRange(uiMinimum(spec), spec.max);
+            if (!spec.unit.empty()) sb->setSuffix(QString::fromStdString(" " + spec.unit));
+            spin = sb;
+        }
+        spin->setObjectName(name + "." + QString::number(i));
         spin->setKeyboardTracking(false);
         h->addWidget(spin);
         spins.push_back(spin);
     }
-    for (auto* spin : spins)
-        connect(spin, &QSpinBox::valueChanged, this, [=, this] {
-            // As many values as the parameter holds now (2 for terrain grids, 3 for boxes).
-            const json current = doc_->value(full(path));
-            const size_t n = current.is_array() ? std::min(current.size(), spins.size()) : spins.size();
-            json a = json::array();
-            for (size_t i = 0; i < n; ++i) a.push_back(spins[i]->value());
-            set(path, a);
-        });
+    auto number = [integer](QAbstractSpinBox* s) {
+        return integer ? json(static_cast<QSpinBox*>(s)->value()) : json(static_cast<QDoubleSpinBox*>(s)->value());
+    };
+    // How many numbers the parameter holds in this scene: 0 means one plain number (box spacing).
+    auto count = [=, this]() -> int {
+        const json current = doc_->value(docPath(spec));
+        if (current.is_array()) return int(current.size());
+        if (current.is_number()) return 0;
+        const int n = spec.items ? spec.items(doc_->project().scene, size_t(volume_)) : spec.maxItems;
+        return n < 0 ? spec.maxItems : n;
+    };
+    auto commit = [=, this] {
+        if (autoBox && autoBox->isChecked()) return set(docPath(spec), nullptr);
+        const int n = count();
+        if (n == 0) return set(docPath(spec), number(spins[0]));
+        json a = json::array();
+        for (int i = 0; i < n && i < int(spins.size()); ++i) a.push_back(number(spins[size_t(i)]));
+        set(docPath(spec), a);
+    };
+    for (auto* spin : spins) {
+        if (integer) connect(static_cast<QSpinBox*>(spin), &QSpinBox::valueChanged, this, commit);
+        else connect(static_cast<QDoubleSpinBox*>(spin), &QDoubleSpinBox::valueChanged, this, commit);
+    }
+    if (autoBox) connect(autoBox, &QCheckBox::toggled, this, commit);
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
+        const int n = std::max(count(), 1);
+        if (autoBox) {
+            QSignalBlocker b(autoBox);
+            autoBox->setChecked(v.is_null());
+        }
         for (size_t i = 0; i < spins.size(); ++i) {
             QSignalBlocker b(spins[i]);
-            spins[i]->setVisible(v.is_array() && i < v.size());
-            if (v.is_array() && i < v.size()) spins[i]->setValue(v[i].get<int>());
+            spins[i]->setVisible(int(i) < n);
+            spins[i]->setEnabled(!v.is_null());
+            const json e = v.is_array() && i < v.size() ? v[i] : v.is_number() && i == 0 ? v : json();
+            if (!e.is_number()) continue;
+            if (integer) static_cast<QSpinBox*>(spins[i])->setValue(e.get<int>());
+            else static_cast<QDoubleSpinBox*>(spins[i])->setValue(e.get<double>());
         }
     });
-    form_->addRow(label, row);
+    addRow(spec, row);
 }
 
-void ParameterForm::addBool(const std::string& path, const QString& label) {
+void ParameterForm::addBool(const ParameterSpec& spec) {
     auto* box = new QCheckBox(this);
-    box->setObjectName(objectNameFor(path));
-    connect(box, &QCheckBox::toggled, this, [=, this](bool on) { set(path, on); });
+    box->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    connect(box, &QCheckBox::toggled, this, [=, this](bool on) { set(docPath(spec), on); });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         QSignalBlocker b(box);
         box->setChecked(v.is_boolean() && v.get<bool>());
     });
-    form_->addRow(label, box);
+    addRow(spec, box);
 }
 
-void ParameterForm::addChoice(const std::string& path, const QString& label, const QStringList& choices) {
+void ParameterForm::addChoice(const ParameterSpec& spec) {
     auto* combo = new QComboBox(this);
-    combo->setObjectName(objectNameFor(path));
-    combo->addItems(choices);
+    combo->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    for (const auto& c : spec.choices) combo->addItem(QString::fromStdString(c));
     connect(combo, &QComboBox::currentTextChanged, this,
-            [=, this](const QString& t) { set(path, t.toStdString()); });
+            [=, this](const QString& t) { set(docPath(spec), t.toStdString()); });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         QSignalBlocker b(combo);
         if (v.is_string()) combo->setCurrentText(QString::fromStdString(v.get<std::string>()));
     });
-    form_->addRow(label, combo);
+    addRow(spec, combo);
 }
 
-void ParameterForm::addColor(const std::string& path, const QString& label) {
+void ParameterForm::addColor(const ParameterSpec& spec) {
     auto* button = new QPushButton(this);
-    button->setObjectName(objectNameFor(path));
+    button->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    const QString title = QString::fromStdString(spec.label);
     connect(button, &QPushButton::clicked, this, [=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         // Linear values above 1 (sky radiance) are kept as an intensity on top of the colour.
         const double peak = std::max({v[0].get<double>(), v[1].get<double>(), v[2].get<double>(), 1.0});
         const QColor start = QColor::fromRgbF(float(v[0].get<double>() / peak), float(v[1].get<double>() / peak),
                                               float(v[2].get<double>() / peak));
-        const QColor c = QColorDialog::getColor(start, this, label);
-        if (c.isValid()) set(path, json{c.redF() * peak, c.greenF() * peak, c.blueF() * peak});
+        const QColor c = QColorDialog::getColor(start, this, title);
+        if (c.isValid()) set(docPath(spec), json{c.redF() * peak, c.greenF() * peak, c.blueF() * peak});
     });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         if (!v.is_array() || v.size() != 3) return;
         const QColor c = QColor::fromRgbF(float(std::min(1.0, v[0].get<double>())),
                                           float(std::min(1.0, v[1].get<double>())),
@@ -212,19 +282,19 @@ void ParameterForm::addColor(const std::string& path, const QString& label) {
         button->setStyleSheet(QString("QPushButton { background: %1; color: %2 }")
                                   .arg(c.name(), c.lightnessF() > 0.5 ? "black" : "white"));
     });
-    form_->addRow(label, button);
+    addRow(spec, button);
 }
 
-void ParameterForm::addText(const std::string& path, const QString& label) {
+void ParameterForm::addText(const ParameterSpec& spec) {
     auto* edit = new QLineEdit(this);
-    edit->setObjectName(objectNameFor(path));
-    connect(edit, &QLineEdit::editingFinished, this, [=, this] { set(path, edit->text().toStdString()); });
+    edit->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    connect(edit, &QLineEdit::editingFinished, this, [=, this] { set(docPath(spec), edit->text().toStdString()); });
     refreshers_.push_back([=, this] {
-        const json v = doc_->value(full(path));
+        const json v = doc_->value(docPath(spec));
         QSignalBlocker b(edit);
         edit->setText(v.is_string() ? QString::fromStdString(v.get<std::string>()) : QString());
     });
-    form_->addRow(label, edit);
+    addRow(spec, edit);
 }
 
 ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
@@ -246,27 +316,12 @@ ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
     buttons->addWidget(rename);
     v->addLayout(buttons);
     form_ = new ParameterForm(doc_, this);
-    form_->setNamePrefix("volume.");
-    form_->addBool("enabled", "Enabled");
-    form_->addChoice("placement", "Placement", {"terrain", "box", "adaptive"});
-    form_->addIntegerArray("grid_dims", "Grid (probes)", 3, 1, 4096);
-    form_->addNumber("height_offset", "Height offset", -1000.0, 10000.0, 2, "m");
-    form_->addInteger("ray_count", "Rays per probe", 1, 1 << 20, "preset");
-    form_->addOptionalNumber("fallback_blend_distance", "Fallback blend", 1e7, 1, "m", "2 × spacing");
-    // Adaptive placement (seed 001's octree): cell sizes, the surface band, error-driven
-    // refinement and its budgets.
-    form_->addOptionalNumber("adaptive.min_cell_size", "Adaptive: min cell", 1e6, 2, "m", "DEM cell");
-    form_->addOptionalNumber("adaptive.max_cell_size", "Adaptive: max cell", 1e7, 2, "m", "16 × min");
-    form_->addNumber("adaptive.height_range", "Adaptive: above terrain", 0.0, 1e5, 1, "m");
-    form_->addOptionalNumber("adaptive.surface_band", "Adaptive: surface band", 1e6, 2, "m", "1 min cell");
-    form_->addOptionalNumber("adaptive.tolerance", "Adaptive: error tolerance", 1.0, 3, "", "geometric only");
-    form_->addInteger("adaptive.max_probes", "Adaptive: max probes", 1, std::numeric_limits<int>::max(), "no limit");
-    form_->addNumber("adaptive.max_move_share", "Adaptive: max move", 0.0, 0.5, 2, "of a cell");
+    form_->addParameters("probe_volumes[].");
     v->addWidget(form_);
     v->addStretch(1);
     connect(form_, &ParameterForm::rejected, this, &ProbeVolumesPanel::rejected);
     connect(list_, &QListWidget::currentRowChanged, this, [this](int row) {
-        if (row >= 0) form_->setPrefix("probe_volumes[" + std::to_string(row) + "].");
+        if (row >= 0) form_->setVolume(row);
         form_->setEnabled(row >= 0);
     });
     connect(add, &QPushButton::clicked, this, [this] {
@@ -319,7 +374,7 @@ void ProbeVolumesPanel::refresh() {
     for (const auto& v : volumes) list_->addItem(QString::fromStdString(v["name"].get<std::string>()));
     const int row = volumes.empty() ? -1 : std::clamp(keep < 0 ? 0 : keep, 0, int(volumes.size()) - 1);
     list_->setCurrentRow(row);
-    if (row >= 0) form_->setPrefix("probe_volumes[" + std::to_string(row) + "].");
+    if (row >= 0) form_->setVolume(row);
     form_->setEnabled(row >= 0);
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-// Dock panels that edit project parameters by JSON path. Every row's editor is named
-// "param.<path>" (e.g. "param.sun.elevation_deg", "param.volume.grid_dims.0"), so Qt Test suites
+// Dock panels that edit project parameters by JSON path. Every row's editor is named by
+// uiObjectName (e.g. "param.sun.elevation_deg", "param.volume.grid_dims.0"), so Qt Test suites
 // can find it; docs/UI_OBJECT_NAMES.md lists them all.
 
 #include <functional>
@@ -18,28 +18,22 @@ class QLabel;
 namespace terralux {
 
 class ProjectDocument;
+struct ParameterSpec;
 
-// A form whose rows read and write document parameters. `prefix` is prepended to the paths of
-// rows added with a relative path (the probe-volume rows use "probe_volumes[i].").
+// A form whose rows read and write document parameters, built from the parameter table.
 class ParameterForm : public QWidget {
     Q_OBJECT
 public:
     ParameterForm(ProjectDocument* doc, QWidget* parent = nullptr);
-    void setPrefix(const std::string& prefix) { prefix_ = prefix; refresh(); }
-    // Object names become "param.<namePrefix><path>"; set before adding rows.
-    void setNamePrefix(const std::string& p) { namePrefix_ = p; }
+    // Per-volume rows edit probe_volumes[volume].
+    void setVolume(int volume);
 
-    void addNumber(const std::string& path, const QString& label, double min, double max,
-                   int decimals, const QString& unit, bool slider = false);
-    void addInteger(const std::string& path, const QString& label, int min, int max,
-                    const QString& nullText = QString());  // nullText: min means null
-    void addOptionalNumber(const std::string& path, const QString& label, double max, int decimals,
-                           const QString& unit, const QString& nullText);
-    void addIntegerArray(const std::string& path, const QString& label, int count, int min, int max);
-    void addBool(const std::string& path, const QString& label);
-    void addChoice(const std::string& path, const QString& label, const QStringList& choices);
-    void addColor(const std::string& path, const QString& label);
-    void addText(const std::string& path, const QString& label);
+    // The editor of one row of the parameter table (app/ParameterTable.h): its widget, limits,
+    // unit, "auto" text and tooltip all come from the row. `path` is the table's path
+    // ("sun.elevation_deg", "probe_volumes[].grid_dims").
+    void addParameter(const std::string& path);
+    // Every UI row of the table whose path starts with `prefix`, in table order.
+    void addParameters(const std::string& prefix);
     void addWidget(const QString& label, QWidget* w);
 
     void refresh();
@@ -51,12 +45,20 @@ protected:
     void showEvent(QShowEvent* e) override;
 
 private:
-    std::string full(const std::string& path) const { return prefix_ + path; }
-    QString objectNameFor(const std::string& path) const;
+    void addNumber(const ParameterSpec& spec);
+    void addInteger(const ParameterSpec& spec);
+    void addList(const ParameterSpec& spec);
+    void addBool(const ParameterSpec& spec);
+    void addChoice(const ParameterSpec& spec);
+    void addColor(const ParameterSpec& spec);
+    void addText(const ParameterSpec& spec);
+    void addRow(const ParameterSpec& spec, QWidget* editor);
+    // The document path a row edits (per-volume rows: of the selected volume).
+    std::string docPath(const ParameterSpec& spec) const;
     void set(const std::string& path, const nlohmann::json& value);
     ProjectDocument* doc_;
     QFormLayout* form_;
-    std::string prefix_, namePrefix_;
+    int volume_ = 0;
     std::vector<std::function<void()>> refreshers_;
 };
 

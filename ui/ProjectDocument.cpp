@@ -3,7 +3,11 @@
 #include <QFileInfo>
 #include <QUndoCommand>
 
+#include <QCoreApplication>
+#include <QThread>
+
 #include "EnvironmentImage.h"
+#include "ParameterTable.h"
 #include "TerrainLoading.h"
 
 namespace terralux {
@@ -26,9 +30,32 @@ private:
     nlohmann::json before_, after_;
 };
 
+// An edit that changes the terrain: it keeps both imported terrains, so undo and redo never
+// import again.
+class SetTerrainCommand : public QUndoCommand {
+public:
+    SetTerrainCommand(ProjectDocument* doc, std::string path, nlohmann::json before, nlohmann::json after,
+                      std::shared_ptr<DemImportResult> terrainBefore, std::shared_ptr<DemImportResult> terrainAfter)
+        : QUndoCommand(QString::fromStdString("Set " + path)), doc_(doc), path_(std::move(path)),
+          before_(std::move(before)), after_(std::move(after)), terrainBefore_(std::move(terrainBefore)),
+          terrainAfter_(std::move(terrainAfter)) {}
+    void undo() override { doc_->apply(path_, before_, terrainBefore_); }
+    void redo() override { doc_->apply(path_, after_, terrainAfter_); }
+
+private:
+    ProjectDocument* doc_;
+    std::string path_;
+    nlohmann::json before_, after_;
+    std::shared_ptr<DemImportResult> terrainBefore_, terrainAfter_;
+};
+
+// Edits the parameter table marks as re-importing the DEM (or a whole section holding one).
 bool touchesTerrain(const std::string& path) {
-    return path.rfind("terrain.dem", 0) == 0 || path.rfind("terrain.vertical_scale", 0) == 0 ||
-           path.rfind("terrain.max_resolution", 0) == 0 || path == "terrain" || path.empty();
+    if (path.empty()) return true;
+    if (const ParameterSpec* spec = findParameter(path)) return (spec->invalidates & kReimport) != 0;
+    for (const auto& spec : parameterTable())
+        if ((spec.invalidates & kReimport) && spec.path.rfind(path + ".", 0) == 0) return true;
+    return false;
 }
 
 // The JSON value at a `--set` path ("probe_volumes[0].grid_dims"), through its JSON pointer
@@ -117,9 +144,12 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
         applyOverride(next, path + "=" + value.dump());
         Project candidate = project_;
         candidate.scene = sceneFromJson(next, "project", nullptr);
-        if (touchesTerrain(path)) (void)loadProjectTerrain(candidate);  // fails before any change
         const nlohmann::json before = at(json_, path);
         if (before == at(next, path)) return true;
+        if (touchesTerrain(path)) {
+            startTerrainEdit(path, before, at(next, path), candidate);
+            return true;
+        }
         undo_.push(new SetParameterCommand(this, path, before, at(next, path)));
         return true;
     } catch (const std::exception& e) {
@@ -128,11 +158,50 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
     }
 }
 
-void ProjectDocument::apply(const std::string& path, const nlohmann::json& value) {
+ProjectDocument::~ProjectDocument() {
+    if (loader_.joinable()) loader_.join();
+}
+
+void ProjectDocument::startTerrainEdit(const std::string& path, nlohmann::json before,
+                                       nlohmann::json after, Project candidate) {
+    if (loader_.joinable()) loader_.join();  // an earlier import's result is superseded
+    const unsigned generation = ++loadGeneration_;
+    emit terrainLoadingChanged(true);
+    loader_ = std::thread([this, generation, path, before = std::move(before), after = std::move(after),
+                           candidate = std::move(candidate)] {
+        std::shared_ptr<DemImportResult> terrain;
+        QString error;
+        try {
+            terrain = std::make_shared<DemImportResult>(loadProjectTerrain(candidate));
+        } catch (const std::exception& e) {
+            error = QString::fromStdString(e.what());
+        }
+        QMetaObject::invokeMethod(this, [this, generation, path, before, after, terrain, error] {
+            if (generation != loadGeneration_) return;  // a newer terrain edit is under way
+            landedGeneration_ = generation;
+            emit terrainLoadingChanged(false);
+            if (!terrain) {
+                emit terrainEditFailed(error);
+                return;
+            }
+            undo_.push(new SetTerrainCommand(this, path, before, after, terrain_, terrain));
+        }, Qt::QueuedConnection);
+    });
+}
+
+void ProjectDocument::waitForTerrain() {
+    while (terrainLoading()) {
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 20);
+        QThread::msleep(5);
+    }
+}
+
+void ProjectDocument::apply(const std::string& path, const nlohmann::json& value,
+                            std::shared_ptr<DemImportResult> terrain) {
     applyOverride(json_, path + "=" + value.dump());
     project_.scene = sceneFromJson(json_, "project", nullptr);
-    if (touchesTerrain(path)) {
-        terrain_ = std::make_shared<DemImportResult>(loadProjectTerrain(project_));
+    if (terrain) {
+        terrain_ = std::move(terrain);
         emit terrainChanged();
     }
     emit parametersChanged(QString::fromStdString(path));

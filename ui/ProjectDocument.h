@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <thread>
 
 #include <QObject>
 #include <QString>
@@ -31,8 +32,13 @@ public:
     QString fileName() const;  // empty for an unsaved project
 
     // Validates `value` at `path` and pushes it as an undoable edit. On a rule violation nothing
-    // changes and `error` gets the one-line message.
+    // changes and `error` gets the one-line message. An edit of the terrain's DEM, scale or
+    // resolution imports the DEM once, on a worker (terrainLoading); the edit lands when the
+    // import succeeds, and terrainEditFailed says why when it does not (nothing changes then).
     bool setParameter(const std::string& path, const nlohmann::json& value, QString* error);
+    bool terrainLoading() const { return loadGeneration_ != landedGeneration_; }
+    // Blocks (processing events) until no terrain import is running; for tests and shutdown.
+    void waitForTerrain();
     // Camera moves from the viewport: stored, marked as unsaved, not undoable (like a view).
     void setCameraQuietly(const nlohmann::json& camera);
 
@@ -44,21 +50,32 @@ public:
     bool importDem(const QString& file, QString* error);
     bool importHdr(const QString& file, QString* error);
 
-    // Used by the undo commands: applies an already validated value.
-    void apply(const std::string& path, const nlohmann::json& value);
+    // Used by the undo commands: applies an already validated value (with the terrain imported
+    // for it, for terrain edits).
+    void apply(const std::string& path, const nlohmann::json& value,
+               std::shared_ptr<DemImportResult> terrain = nullptr);
 
 signals:
     void parametersChanged(const QString& path);  // "" = everything
     void terrainChanged();
+    void terrainLoadingChanged(bool loading);
+    void terrainEditFailed(const QString& message);
     void fileChanged();
 
+public:
+    ~ProjectDocument() override;
+
 private:
+    void startTerrainEdit(const std::string& path, nlohmann::json before, nlohmann::json after,
+                          Project candidate);
     void reset(const Project& project, std::shared_ptr<DemImportResult> terrain);
     Project project_;
     nlohmann::json json_;
     std::shared_ptr<DemImportResult> terrain_;
     QUndoStack undo_;
     bool dirtyOutsideUndo_ = false;
+    std::thread loader_;
+    unsigned loadGeneration_ = 0, landedGeneration_ = 0;
 };
 
 }  // namespace terralux

@@ -1,13 +1,16 @@
 // The authoring window driven by Qt Test through objectNames, under Xvfb (ctest wraps it in
 // xvfb-run); skips, saying why, without a display or a Vulkan device.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMessageBox>
 #include <QProgressBar>
 #include <QPushButton>
@@ -18,6 +21,7 @@
 
 #include "ImageCompare.h"
 #include "MainWindow.h"
+#include "ParameterTable.h"
 #include "RenderJob.h"
 #include "render/DebugViews.h"
 
@@ -235,14 +239,23 @@ private slots:
         const nlohmann::json project = w_->document()->json();
         const int undoSteps = w_->document()->undoStack()->count();
         QString dialogText;
-        QTimer::singleShot(200, [&] {
+        // The import runs on a worker, so the dialog comes when it fails; poll for it.
+        QTimer poll;
+        poll.setInterval(20);
+        connect(&poll, &QTimer::timeout, [&] {
             if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget())) {
                 dialogText = box->objectName() + ": " + box->text();
                 box->accept();
             }
         });
+        poll.start();
         const QString bad = QString::fromStdString((fs::path(TERRALUX_TEST_DATA) / "dem" / "not_a_raster.tif").string());
-        QVERIFY(!w_->importDemFile(bad));
+        QVERIFY(w_->importDemFile(bad));
+        QVERIFY(w_->findChild<QProgressBar*>("status.terrainBusy")->isVisible() || !dialogText.isEmpty() || w_->document()->terrainLoading());
+        QTRY_VERIFY_WITH_TIMEOUT(!dialogText.isEmpty(), 20000);
+        poll.stop();
+        QVERIFY(!w_->document()->terrainLoading());
+        QVERIFY(!w_->findChild<QProgressBar*>("status.terrainBusy")->isVisible());
         QVERIFY2(dialogText.startsWith("errorDialog: ") && dialogText.contains("not_a_raster.tif"), qPrintable(dialogText));
         QCOMPARE(w_->document()->terrain().heightfield.width(), width);
         QVERIFY(w_->document()->json() == project);
@@ -285,6 +298,72 @@ private slots:
         QCOMPARE(asked, QString("recoveryDialog"));
         QCOMPARE(w_->document()->project().scene.sun.azimuthDeg, 77.0);
         QVERIFY(!fs::exists(autosave));
+    }
+
+    // Every dock row takes its limits from the parameter table: walk the table, not a list.
+    void dockLimitsEqualTheTable() {
+        int checked = 0;
+        for (const ParameterSpec& spec : parameterTable()) {
+            if (!spec.uiRow) continue;
+            const QString name = QString::fromStdString(uiObjectName(spec));
+            const QString where = QString::fromStdString(spec.path) + " (" + name + ")";
+            switch (spec.type) {
+            case ParamType::Number: {
+                auto* spin = w_->findChild<QDoubleSpinBox*>(name);
+                QVERIFY2(spin, qPrintable(where));
+                const double step = std::pow(10.0, -spin->decimals());
+                QCOMPARE(spin->minimum(), spec.nullable() ? uiMinimum(spec) - step : uiMinimum(spec));
+                QCOMPARE(spin->maximum(), spec.max);
+                QCOMPARE(spin->specialValueText().isEmpty(), !spec.nullable());
+                break;
+            }
+            case ParamType::Integer: {
+                auto* spin = w_->findChild<QSpinBox*>(name);
+                QVERIFY2(spin, qPrintable(where));
+                QCOMPARE(spin->minimum(), int(spec.min) - (spec.nullable() ? 1 : 0));
+                QCOMPARE(spin->maximum(), int(std::min<double>(spec.max, std::numeric_limits<int>::max())));
+                break;
+            }
+            case ParamType::NumberList:
+            case ParamType::IntegerList:
+                QVERIFY2(w_->findChild<QAbstractSpinBox*>(name + ".0"), qPrintable(where));
+                QCOMPARE(bool(w_->findChild<QCheckBox*>(name + ".auto")), spec.nullable());
+                for (int i = 0; i < spec.maxItems; ++i) {
+                    const QString element = name + "." + QString::number(i);
+                    if (spec.type == ParamType::IntegerList) {
+                        auto* spin = w_->findChild<QSpinBox*>(element);
+                        QVERIFY2(spin, qPrintable(element));
+                        QCOMPARE(spin->minimum(), int(spec.min));
+                        QCOMPARE(spin->maximum(), int(std::min<double>(spec.max, std::numeric_limits<int>::max())));
+                    } else {
+                        auto* spin = w_->findChild<QDoubleSpinBox*>(element);
+                        QVERIFY2(spin, qPrintable(element));
+                        QCOMPARE(spin->minimum(), uiMinimum(spec));
+                        QCOMPARE(spin->maximum(), spec.max);
+                    }
+                }
+                break;
+            case ParamType::Choice: {
+                auto* combo = w_->findChild<QComboBox*>(name);
+                QVERIFY2(combo, qPrintable(where));
+                QCOMPARE(combo->count(), int(spec.choices.size()));
+                for (int i = 0; i < combo->count(); ++i)
+                    QCOMPARE(combo->itemText(i).toStdString(), spec.choices[size_t(i)]);
+                break;
+            }
+            case ParamType::Boolean:
+                QVERIFY2(w_->findChild<QCheckBox*>(name), qPrintable(where));
+                break;
+            case ParamType::Color:
+                QVERIFY2(w_->findChild<QPushButton*>(name), qPrintable(where));
+                break;
+            case ParamType::String:
+                QVERIFY2(w_->findChild<QLineEdit*>(name), qPrintable(where));
+                break;
+            }
+            ++checked;
+        }
+        QVERIFY(checked > 30);
     }
 
     void screenshot() {
