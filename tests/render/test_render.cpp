@@ -114,9 +114,9 @@ TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
     ProjectRenderer withProbes(*ctx_, sampleProject("disabled", 8, 8));
     ASSERT_EQ(withProbes.loadProbes(true), 1u);
     ProjectRenderer without(*ctx_, sampleProject("none", 8, 8));  // no probes loaded at all
-    const RenderedImage off = draw(withProbes, 0, false);
-    const RenderedImage none = draw(without, 0, true);
-    const RenderedImage on = draw(withProbes, 0, true);
+    const RenderedImage off = draw(withProbes, kViewBeauty, false);
+    const RenderedImage none = draw(without, kViewBeauty, true);
+    const RenderedImage on = draw(withProbes, kViewBeauty, true);
     const auto d = test::compareImages(off.rgba, none.rgba, kW, kH);
     EXPECT_LE(d.maxAbs, 1.0 / 255.0);
     EXPECT_GT(meanAbsDiff(on, off), 0.5 / 255.0) << "probe lighting changes the image";
@@ -125,8 +125,8 @@ TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
 TEST_F(RenderTest, OneByOneGridWeighsOneEverywhere) {
     ProjectRenderer r(*ctx_, sampleProject("one", 1, 1));
     ASSERT_EQ(r.loadProbes(true), 1u);
-    const RenderedImage w = draw(r, 51);
-    const RenderedImage albedo = draw(r, 1);
+    const RenderedImage w = draw(r, kViewProbeWeight);
+    const RenderedImage albedo = draw(r, kViewAlbedo);
     size_t terrain = 0;
     for (size_t i = 0; i < size_t(kW) * kH; ++i) {
         // Terrain pixels are those the albedo view paints (the background is cleared to black).
@@ -173,7 +173,7 @@ TEST_F(RenderTest, PlateauIsBrighterThanValleyFloorInProbeIrradiance) {
     RenderRequest q;
     q.width = kW;
     q.height = kW;
-    q.debugView = 50;
+    q.debugView = kViewProbeIrradiance;
     q.linearOutput = true;
     const RenderedImage img = r.render(q);
     // Mean over a vertical strip of pixels (the valley runs north-south, i.e. along image rows).
@@ -194,7 +194,7 @@ TEST_F(RenderTest, PlateauIsBrighterThanValleyFloorInProbeIrradiance) {
 }
 
 TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
-    auto linear50 = [&](ProjectRenderer& r) { return draw(r, 50, true, true); };
+    auto linearProbeIrradiance = [&](ProjectRenderer& r) { return draw(r, kViewProbeIrradiance, true, true); };
     auto relDiff = [](const RenderedImage& a, const RenderedImage& b) {
         double num = 0, den = 0;
         for (size_t i = 0; i < a.rgba.size(); ++i) {
@@ -212,7 +212,7 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
     ASSERT_EQ(rb.loadProbes(true), 1u);
     ProjectRenderer rc(*ctx_, sampleProject("gridC", 2, 2));
     ASSERT_EQ(rc.loadProbes(true), 1u);
-    const RenderedImage ia = linear50(ra), ib = linear50(rb), ic = linear50(rc);
+    const RenderedImage ia = linearProbeIrradiance(ra), ib = linearProbeIrradiance(rb), ic = linearProbeIrradiance(rc);
     EXPECT_GT(relDiff(ia, ib), 0.2) << "sky colour";
     EXPECT_GT(relDiff(ia, ic), 0.01) << "probe grid";
 }
@@ -220,9 +220,9 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
 TEST_F(RenderTest, EveryViewDiffersFromBeauty) {
     ProjectRenderer r(*ctx_, sampleProject("views", 8, 8));
     ASSERT_EQ(r.loadProbes(true), 1u);
-    const RenderedImage beauty = draw(r, 0);
+    const RenderedImage beauty = draw(r, kViewBeauty);
     for (const auto& v : debugViews()) {
-        if (v.number == 0) continue;
+        if (v.number == kViewBeauty) continue;
         EXPECT_GT(meanAbsDiff(draw(r, v.number), beauty), 2.0 / 255.0) << v.number << " " << v.name;
     }
 }
@@ -252,7 +252,7 @@ GpuProbeVolume halves(const Heightfield& hf) {
 
 // Pixels the albedo view paints (the background is cleared to black).
 std::vector<size_t> terrainPixels(ProjectRenderer& r) {
-    const RenderedImage albedo = draw(r, 1);
+    const RenderedImage albedo = draw(r, kViewAlbedo);
     std::vector<size_t> out;
     for (size_t i = 0; i < size_t(kW) * kH; ++i)
         if (albedo.rgba[i * 4] > 0.0f) out.push_back(i);
@@ -276,23 +276,23 @@ TEST_F(RenderTest, ValidityViewShowsWhereMovedProbesLightAndWhereNoProbeIsLeft) 
 
     GpuProbeVolume v = halves(r.heightfield());
     r.setProbes({v});
-    const RenderedImage placed = draw(r, 54);
+    const RenderedImage placed = draw(r, kViewProbeValidity);
     EXPECT_EQ(count(placed, cyan), 0u);
     EXPECT_GT(count(placed, grey), terrain.size() * 9 / 10);
 
     v.diagnostics->moved = {0, 1};
     r.setProbes({v});
-    const RenderedImage moved = draw(r, 54);
+    const RenderedImage moved = draw(r, kViewProbeValidity);
     EXPECT_GT(count(moved, cyan), terrain.size() / 4) << "the east half is lit by a moved probe";
     EXPECT_GT(count(moved, grey), terrain.size() / 4) << "the west half is not";
 
     GpuProbeVolume empty = v;
     std::fill(empty.occupancy.begin(), empty.occupancy.end(), -1);  // every probe rejected
     r.setProbes({empty});
-    EXPECT_GT(count(draw(r, 54), red), terrain.size() * 9 / 10);
+    EXPECT_GT(count(draw(r, kViewProbeValidity), red), terrain.size() * 9 / 10);
     // A second volume that lights the same ground: nothing is left unlit.
     r.setProbes({empty, v});
-    EXPECT_EQ(count(draw(r, 54), red), 0u);
+    EXPECT_EQ(count(draw(r, kViewProbeValidity), red), 0u);
 }
 
 TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
@@ -308,7 +308,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     m.error = {0.05f, 0.05f, 0.05f, 0.05f};
     r.setProbes({v});
     // EXR: the error itself in red, 1 in green where measured.
-    RenderedImage img = draw(r, 56, true, true);
+    RenderedImage img = draw(r, kViewInterpolationError, true, true);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4], 0.05f, 1e-4f) << "pixel " << i;
         ASSERT_NEAR(img.rgba[i * 4 + 1], 1.0f, 1e-3f) << "pixel " << i;  // half-float target
@@ -317,7 +317,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // West column 0, east column 20 %: every value in between, both ends on the heat ramp.
     m.error = {0.0f, 0.2f, 0.0f, 0.2f};
     r.setProbes({v});
-    img = draw(r, 56, true, true);
+    img = draw(r, kViewInterpolationError, true, true);
     float lo = 1.0f, hi = 0.0f;
     for (size_t i : terrain) {
         lo = std::min(lo, img.rgba[i * 4]);
@@ -326,7 +326,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     EXPECT_LT(lo, 0.01f);
     EXPECT_GT(hi, 0.19f);
     EXPECT_LE(hi, 0.2f + 1e-4f);
-    const RenderedImage shown = draw(r, 56);
+    const RenderedImage shown = draw(r, kViewInterpolationError);
     size_t blue = 0, redPixels = 0;
     for (size_t i : terrain) {
         const float* c = &shown.rgba[i * 4];
@@ -337,10 +337,10 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     EXPECT_GT(blue, 0u);
     EXPECT_GT(redPixels, 0u);
     // The map lands where the bake measured it: its east column (x > 0) is the east half, which
-    // view 54 shows through the probe that lights it.
+    // the probe-validity view shows through the probe that lights it.
     v.diagnostics->moved = {0, 1};
     r.setProbes({v});
-    const RenderedImage validity = draw(r, 54);
+    const RenderedImage validity = draw(r, kViewProbeValidity);
     size_t agree = 0, high = 0;
     for (size_t i : terrain) {
         const float* c = &validity.rgba[i * 4];
@@ -359,8 +359,8 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // Unmeasured points (no probe around them at bake time): no value, grey.
     m.error.assign(4, NAN);
     r.setProbes({v});
-    img = draw(r, 56, true, true);
-    const RenderedImage grey = draw(r, 56);
+    img = draw(r, kViewInterpolationError, true, true);
+    const RenderedImage grey = draw(r, kViewInterpolationError);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4 + 1], 0.0f, 1e-3f) << "pixel " << i;
         ASSERT_NEAR(grey.rgba[i * 4], grey.rgba[i * 4 + 2], 1e-3f) << "pixel " << i;
@@ -377,7 +377,7 @@ TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
     RenderRequest q;
     q.width = kW;
     q.height = kH;
-    q.debugView = 1;
+    q.debugView = kViewAlbedo;
     const RenderedImage plain = r.render(q);
     q.leaves = true;
     const RenderedImage lines = r.render(q);
