@@ -1,6 +1,7 @@
 // Render tests on the real Vulkan path (Mesa lavapipe in CI): golden images of every debug view
 // and behaviour checks. They skip, saying why, when no Vulkan device exists, and fail on any
 // validation-layer message.
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,11 @@
 #include "RenderJob.h"
 #include "TerrainLoading.h"
 #include "render/DebugViews.h"
+#include "render/FrameGraph.h"
+#include "vk/Descriptors.h"
+#include "vk/Image.h"
+#include "vk/RenderPass.h"
+#include "vk/Sampler.h"
 
 using namespace terralux;
 namespace fs = std::filesystem;
@@ -390,4 +396,154 @@ TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
     v.diagnostics->leaves.clear();
     r.setProbes({v});
     EXPECT_EQ(test::compareImages(r.render(q).rgba, plain.rgba, kW, kH).maxAbs, 0.0);
+}
+
+namespace {
+
+// Whether any pass of the frame is, touches or binds anything of the probe subsystem.
+std::string probeMention(const std::vector<PassInfo>& passes) {
+    for (const auto& p : passes) {
+        if (p.name.find("probe") != std::string::npos) return "pass " + p.name;
+        for (const auto& b : p.bindings)
+            if (b.find("probe") != std::string::npos) return p.name + " binds " + b;
+        for (const auto& u : p.uses)
+            if (u.resource.find("probe") != std::string::npos) return p.name + " uses " + u.resource;
+    }
+    return "";
+}
+
+std::vector<std::string> passNames(const std::vector<PassInfo>& passes) {
+    std::vector<std::string> out;
+    for (const auto& p : passes) out.push_back(p.name);
+    return out;
+}
+
+bool binds(const std::vector<PassInfo>& passes, const std::string& pass, const std::string& binding) {
+    for (const auto& p : passes)
+        if (p.name == pass)
+            for (const auto& b : p.bindings)
+                if (b == binding) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
+    using Names = std::vector<std::string>;
+    ProjectRenderer without(*ctx_, sampleProject("novolumes", 8, 8));  // no probes loaded at all
+    EXPECT_FALSE(without.renderer().hasProbeResources());
+    for (const auto& v : debugViews()) {
+        draw(without, v.number);
+        const std::string mention = probeMention(without.renderer().lastFramePasses());
+        EXPECT_TRUE(mention.empty()) << v.name << ": " << mention;
+    }
+    const RenderedImage none = draw(without, kViewBeauty);
+    EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+
+    ProjectRenderer with(*ctx_, sampleProject("volumes", 8, 8));
+    ASSERT_EQ(with.loadProbes(true), 1u);
+    EXPECT_TRUE(with.renderer().hasProbeResources());
+    // Probes on: the probe pass runs once after the volumes changed; the terrain reads its light.
+    draw(with, kViewBeauty);
+    const auto& first = with.renderer().lastFramePasses();
+    EXPECT_EQ(passNames(first), (Names{"probe-vertices", "terrain", "readback"}));
+    EXPECT_TRUE(binds(first, "probe-vertices", "probe-coefficients"));
+    EXPECT_TRUE(binds(first, "terrain", "vertex:probe-light"));
+    draw(with, kViewBeauty);
+    EXPECT_EQ(passNames(with.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+    EXPECT_TRUE(binds(with.renderer().lastFramePasses(), "terrain", "vertex:probe-light"));
+    // Probes off: nothing of them takes part, and the image is the one without volumes.
+    const RenderedImage off = draw(with, kViewBeauty, false);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    EXPECT_EQ(test::compareImages(off.rgba, none.rgba, kW, kH).maxAbs, 0.0);
+    // Views that do not read probe light leave the probes out too.
+    draw(with, kViewAlbedo);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    // Unbinding the volumes frees the subsystem.
+    with.setProbes({});
+    EXPECT_FALSE(with.renderer().hasProbeResources());
+    const RenderedImage unbound = draw(with, kViewBeauty);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    EXPECT_EQ(test::compareImages(unbound.rgba, none.rgba, kW, kH).maxAbs, 0.0);
+}
+
+TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
+    ProjectRenderer r(*ctx_, sampleProject("finite", 8, 8));
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    for (const auto& v : debugViews())
+        for (bool linear : {false, true}) {
+            const RenderedImage img = draw(r, v.number, true, linear);
+            ASSERT_EQ(img.rgba.size(), size_t(kW) * kH * 4);
+            size_t nonFinite = 0, differing = 0;
+            for (size_t i = 0; i < img.rgba.size(); ++i) {
+                nonFinite += !std::isfinite(img.rgba[i]);
+                differing += img.rgba[i] != img.rgba[i % 4];
+            }
+            EXPECT_EQ(nonFinite, 0u) << v.name << (linear ? " (linear)" : "");
+            EXPECT_GT(differing, size_t(kW) * kH / 8) << v.name << (linear ? " (linear)" : "") << " is blank";
+        }
+}
+
+// The device layer's target kinds, samplers and image bindings, through the frame graph: a depth
+// target drawn (cleared) by a depth-only pass, then read by shaders along with a layered and a
+// cube target, with no validation message.
+TEST_F(RenderTest, DeviceLayerTargetsSamplersAndImageBindings) {
+    const vk::VulkanContext& ctx = *ctx_;
+    vk::Image depth = vk::Image::depthTarget(ctx, 64, 64);
+    vk::Image cascades = vk::Image::depthTarget(ctx, 64, 64, 4);
+    vk::Image layered = vk::Image::layeredTarget(ctx, 32, 32, 3);
+    vk::Image cube = vk::Image::cubeTarget(ctx, 16);
+    vk::Image color = vk::Image::colorTarget(ctx, 8, 8);
+    EXPECT_EQ(cascades.desc().layers, 4u);
+    EXPECT_EQ(cube.desc().layers, 6u);
+    EXPECT_EQ(depth.aspect(), VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT));
+    const vk::Sampler shadow = vk::Sampler::depthCompare(ctx), linear = vk::Sampler::linearClamp(ctx),
+                      nearest = vk::Sampler::nearestClamp(ctx);
+    vk::Buffer block = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    vk::Buffer data = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    constexpr VkShaderStageFlags fragment = VK_SHADER_STAGE_FRAGMENT_BIT;
+    const vk::DescriptorSet set = vk::DescriptorSetBuilder()
+                                      .uniform(0, "block", block, fragment)
+                                      .storage(1, "data", data, fragment)
+                                      .image(2, "shadow-map", depth.view(), shadow.handle(), fragment)
+                                      .image(3, "cascades", cascades.view(), shadow.handle(), fragment)
+                                      .image(4, "layers", layered.view(), linear.handle(), fragment)
+                                      .image(5, "cube", cube.view(), linear.handle(), fragment)
+                                      .image(6, "color", color.view(), nearest.handle(), fragment)
+                                      .build(ctx);
+    EXPECT_EQ(set.bindingNames(), (std::vector<std::string>{"block", "data", "shadow-map", "cascades",
+                                                            "layers", "cube", "color"}));
+
+    const vk::RenderPass depthOnly(ctx, {{}, vk::kDepthFormat, true, true});
+    const VkImageView attachment = depth.view();
+    const vk::Framebuffer framebuffer(ctx, depthOnly, {&attachment, 1}, 64, 64);
+    FrameGraph graph;
+    graph.importImage("shadow-map", depth.handle(), depth.aspect());
+    graph.importImage("cascades", cascades.handle(), cascades.aspect(), 4);
+    graph.importImage("layers", layered.handle(), layered.aspect(), 3);
+    graph.importImage("cube", cube.handle(), cube.aspect(), 6);
+    graph.importImage("color", color.handle(), color.aspect());
+    graph.addPass({"shadow", {{"shadow-map", Access::DepthAttachmentClear}}, {}}, [&](VkCommandBuffer cb) {
+        VkClearValue clear{};
+        clear.depthStencil = {1.0f, 0};
+        VkRenderPassBeginInfo rbi{};
+        rbi.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+        rbi.renderPass = depthOnly.handle();
+        rbi.framebuffer = framebuffer.handle();
+        rbi.renderArea = {{0, 0}, {64, 64}};
+        rbi.clearValueCount = 1;
+        rbi.pClearValues = &clear;
+        vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdEndRenderPass(cb);
+    });
+    graph.addPass({"lit",
+                   {{"shadow-map", Access::FragmentSampledRead},
+                    {"cascades", Access::FragmentSampledRead},
+                    {"layers", Access::FragmentSampledRead},
+                    {"cube", Access::FragmentSampledRead},
+                    {"color", Access::FragmentSampledRead}},
+                   set.bindingNames()},
+                  nullptr);
+    ctx.submitAndWait([&](VkCommandBuffer cb) { graph.execute(cb); });
+    EXPECT_EQ(graph.lastFrame().size(), 2u);
 }
