@@ -15,6 +15,7 @@ struct ShadingPoint {
     // probes in the blend (-1 where no probe lights the point), y interpolation error × known,
     // z known (1 = measured), w 1 = inside a volume with no probe to light it.
     vec4 probe;
+    vec3 linear;  // sceneLinear()
 };
 
 float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
@@ -34,14 +35,11 @@ vec3 sceneLinear(ShadingPoint s) {
     return s.albedo / PI * (sun * ndotl + ambient) + spec * sun;
 }
 
-vec3 viewBeauty(ShadingPoint s) { return display(sceneLinear(s)); }
+vec3 viewBeauty(ShadingPoint s) { return display(s.linear); }
 vec3 viewAlbedo(ShadingPoint s) { return linearOutput() ? s.albedo : srgb(s.albedo); }
 vec3 viewNormal(ShadingPoint s) { return s.normal * 0.5 + 0.5; }
 vec3 viewNdotL(ShadingPoint s) { return vec3(sunNdotL(s)); }
-vec3 viewLinear(ShadingPoint s) {
-    vec3 linear = sceneLinear(s);
-    return linearOutput() ? linear : clamp(linear, 0.0, 1.0);
-}
+vec3 viewLinear(ShadingPoint s) { return linearOutput() ? s.linear : clamp(s.linear, 0.0, 1.0); }
 vec3 viewProbeIrradiance(ShadingPoint s) { return display(s.probe.rgb * s.probe.a / PI); }
 vec3 viewProbeWeight(ShadingPoint s) { return vec3(s.probe.a); }
 
@@ -76,6 +74,9 @@ vec3 viewInterpolationError(ShadingPoint s) {
 }
 
 vec3 shadeView(int view, ShadingPoint s) {
+    // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
+    // views that need the full shading share one evaluation.
+    s.linear = sceneLinear(s);
     switch (view) {
 #define TLX_VIEW(NAME, NUMBER) case kView##NAME: return view##NAME(s);
 #include "debug_views.def"
