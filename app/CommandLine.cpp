@@ -407,11 +407,13 @@ int commandRender(const Args& a) {
     const size_t volumes = request.probes ? renderer.loadProbes(true, &note, &probeWarnings) : 0;
     if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
     // Only the views that need the diagnostics complain about their absence.
-    if (request.debugView == 54 || request.debugView == 56)
+    if (findDebugView(request.debugView)->needs.probeDiagnostics)
         for (const auto& w : probeWarnings) std::cerr << "terralux: warning: " << w << "\n";
-    if (request.debugView == 56 && volumes > 0 && probeWarnings.empty() && !renderer.hasErrorMap())
+    if (request.debugView == kViewInterpolationError && volumes > 0 && probeWarnings.empty() &&
+        !renderer.hasErrorMap())
         std::cerr << "terralux: note: this bake measured no interpolation-error map "
-                     "(bake.error_map_resolution = 0, or no volume over the terrain): view 56 is grey\n";
+                     "(bake.error_map_resolution = 0, or no volume over the terrain): view "
+                  << kViewInterpolationError << " is grey\n";
     const RenderedImage img = renderer.render(request);
     writeImage(image, img.width, img.height, img.rgba);
     const auto view = findDebugView(std::to_string(request.debugView));

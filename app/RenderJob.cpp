@@ -8,6 +8,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
+#include "render/DebugViews.h"
 #include "render/OrbitCamera.h"
 
 namespace terralux {
@@ -132,7 +133,7 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
             if (std::filesystem::exists(sidecar))
                 gv.diagnostics = readProbeDiagnosticsFile(sidecar, g, shProbeDigest(bytes));
             else if (warnings)
-                warnings->push_back(sidecar.string() + ": missing (bake again for views 54 and 56)");
+                warnings->push_back(sidecar.string() + ": missing (bake again for " + diagnosticsViewList() + ")");
         } catch (const ProbeDiagnosticsError& e) {
             if (warnings) warnings->push_back(e.what());
         }
@@ -145,6 +146,14 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
 RenderedImage ProjectRenderer::render(const RenderRequest& r) { return render(r, base_.camera); }
 
 RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera& camera) {
+    return renderer_->render(settingsOf(r, camera));
+}
+
+bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera, vk::Swapchain& swapchain) {
+    return renderer_->present(settingsOf(r, camera), swapchain);
+}
+
+RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCamera& camera) const {
     RenderSettings s = base_;
     s.camera = camera;
     s.width = r.width;
@@ -154,7 +163,7 @@ RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera&
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
-    return renderer_->render(s);
+    return s;
 }
 
 }  // namespace terralux

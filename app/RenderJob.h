@@ -38,7 +38,7 @@ public:
     // <volume>.probes.json diagnostics when present and matching; when any .shprobe is missing
     // and `bakeIfMissing`, bakes the project first (its own quality settings). Returns the number
     // of volumes bound; `note` says what happened, `warnings` gets one line per unreadable or
-    // stale diagnostics file (views 54 and 56 then show no data for that volume).
+    // stale diagnostics file (the diagnostics views then show no data for that volume).
     size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr,
                       std::vector<std::string>* warnings = nullptr);
     // Binds probe volumes computed elsewhere (the UI's draft preview).
@@ -49,11 +49,14 @@ public:
     RenderedImage render(const RenderRequest& request);
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
+    // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
+    bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
     const OrbitCamera& defaultCamera() const { return base_.camera; }
     // How often the probe volumes were placed for the overlays (edits that do not touch them
     // place nothing).
     size_t placements() const { return placements_; }
-    // Whether any bound volume carries an interpolation-error map (view 56 has data to show).
+    // Whether any bound volume carries an interpolation-error map (the interpolation-error view
+    // has data to show).
     bool hasErrorMap() const { return hasErrorMap_; }
 
     const Heightfield& heightfield() const { return terrain_.heightfield; }
@@ -68,6 +71,7 @@ private:
     // Per volume, the overlays follow the bound probes where they carry diagnostics and were
     // baked from the current probe-volume settings; otherwise the placement of those settings.
     void updateOverlays();
+    RenderSettings settingsOf(const RenderRequest& request, const OrbitCamera& camera) const;
 
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name

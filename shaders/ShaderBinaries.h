@@ -5,7 +5,8 @@
 #include <span>
 
 namespace terralux::shaders {
-std::span<const uint32_t> terrainVert();
+std::span<const uint32_t> terrainVert();            // without probe light
+std::span<const uint32_t> terrainProbeLightVert();  // with the probe pass's per-vertex light
 std::span<const uint32_t> terrainFrag();
 std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> markersVert();

@@ -3,22 +3,25 @@
 // Probe irradiance and blend weight for every terrain vertex, once per change of probes: the
 // draw then reads it as a vertex attribute, so probe lighting costs a frame almost nothing.
 layout(local_size_x = 64) in;
-#include "frame.glsl"
+#include "blocks/glsl.h"
+#include "blocks/probes.h"
+#include "sh.glsl"
 #include "probes.glsl"
 
-layout(set = 0, binding = 4, std430) readonly buffer Vertices { float v[]; } vertices;  // pos, normal
-// Per vertex: (probe irradiance, blend weight), then the diagnostics of views 54 and 56: (moved
+// Every volume's interpolation-error map (ProbeVolumeRecord.errorMap), -1 where no probe
+// covered the point.
+layout(set = TLX_SET_SUBSYSTEM, binding = 4, std430) readonly buffer Errors { float e[]; } errors;
+layout(set = TLX_SET_SUBSYSTEM, binding = 5, std430) readonly buffer Vertices { float v[]; } vertices;  // pos, normal
+// Per vertex: (probe irradiance, blend weight), then the diagnostics of the probe-validity and
+// interpolation-error views: (moved
 // share, or -1 where no probe lights the vertex; interpolation error × known; known: 1 where the
 // error was measured; 1 = inside a volume with no probe to light it). The error is premultiplied
 // so that the rasteriser's blend, divided by the blended `known`, stays the error near
 // unmeasured vertices instead of fading towards 0.
-layout(set = 0, binding = 5, std430) writeonly buffer ProbeLight { vec4 v[]; } probeLight;
-// Every volume's interpolation-error map (Volume.errorMap), -1 where no probe covered the point.
-layout(set = 0, binding = 6, std430) readonly buffer Errors { float e[]; } errors;
-layout(push_constant) uniform Count { uint vertexCount; } pc;
+layout(set = TLX_SET_SUBSYSTEM, binding = 6, std430) writeonly buffer ProbeLight { vec4 v[]; } probeLight;
 
 // Bilinear over the map points around (x, z); uncovered points drop out. known = 0: no value.
-float mapError(Volume vol, vec2 xz, out float known) {
+float mapError(ProbeVolumeRecord vol, vec2 xz, out float known) {
     known = 0.0;
     ivec2 size = vol.errorMap.yz;
     if (size.x <= 0 || size.y <= 0) return 0.0;
@@ -47,14 +50,14 @@ float mapError(Volume vol, vec2 xz, out float known) {
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= pc.vertexCount) return;
+    if (i >= uint(probeSet.counts.y)) return;
     vec3 p = vec3(vertices.v[6 * i], vertices.v[6 * i + 1], vertices.v[6 * i + 2]);
     vec3 n = normalize(vec3(vertices.v[6 * i + 3], vertices.v[6 * i + 4], vertices.v[6 * i + 5]));
     float weight = 0.0, moved = 0.0, known = 0.0, error = 0.0;
     int volume = -1;
     bool unlit = false;
     vec3 irradiance = probeIrradiance(p, n, weight, moved, volume, unlit);
-    if (volume >= 0) error = mapError(volumes.v[volume], p.xz, known);
+    if (volume >= 0 && probeSet.flags.x == 1) error = mapError(volumes.v[volume], p.xz, known);
     probeLight.v[2 * i] = vec4(irradiance, weight);
     probeLight.v[2 * i + 1] = vec4(volume >= 0 ? moved : -1.0, error * known, known, unlit ? 1.0 : 0.0);
 }

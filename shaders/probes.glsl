@@ -1,35 +1,14 @@
-// Probe lighting shared by the terrain stages (include after frame.glsl).
+// Probe lighting: the probe pass's buffers and the engine's probe lookup (include after
+// blocks/glsl.h, blocks/probes.h and sh.glsl).
+#ifndef TLX_PROBES_GLSL
+#define TLX_PROBES_GLSL
 
-const float PI = 3.14159265358979;
+// 9 per probe, RGB in xyz; coeffs[9 i].w = 1 when probe i was moved up out of the terrain.
+layout(set = TLX_SET_SUBSYSTEM, binding = 1, std430) readonly buffer Probes { vec4 coeffs[]; } probes;
+layout(set = TLX_SET_SUBSYSTEM, binding = 2, std430) readonly buffer Cells { int cell[]; } cells;
+layout(set = TLX_SET_SUBSYSTEM, binding = 3, std430) readonly buffer Volumes { ProbeVolumeRecord v[]; } volumes;
 
-// Irradiance of SH radiance coefficients for normal n: Σ Â_l L_k Y_k(n) (Ramamoorthi and
-// Hanrahan 2001), basis of FORMATS.md. `convolved` = the coefficients already hold Â_l L_k.
-vec3 shIrradiance(vec3 c[9], vec3 n, bool convolved) {
-    float y[9];
-    y[0] = 0.282095;
-    y[1] = 0.488603 * n.y;
-    y[2] = 0.488603 * n.z;
-    y[3] = 0.488603 * n.x;
-    y[4] = 1.092548 * n.x * n.y;
-    y[5] = 1.092548 * n.y * n.z;
-    y[6] = 0.315392 * (3.0 * n.z * n.z - 1.0);
-    y[7] = 1.092548 * n.x * n.z;
-    y[8] = 0.546274 * (n.x * n.x - n.y * n.y);
-    const float a0 = convolved ? 1.0 : PI, a1 = convolved ? 1.0 : 2.0 * PI / 3.0,
-                a2 = convolved ? 1.0 : PI / 4.0;
-    vec3 e = a0 * c[0] * y[0];
-    for (int k = 1; k < 4; ++k) e += a1 * c[k] * y[k];
-    for (int k = 4; k < 9; ++k) e += a2 * c[k] * y[k];
-    return e;
-}
-
-vec3 skyIrradiance(vec3 n) {
-    vec3 c[9];
-    for (int k = 0; k < 9; ++k) c[k] = frame.skySh[k].rgb;
-    return max(shIrradiance(c, n, false), vec3(0.0));
-}
-
-int cellIndex(Volume vol, ivec3 c) {
+int cellIndex(ProbeVolumeRecord vol, ivec3 c) {
     return vol.occupancy.x + c.x + c.y * vol.dimsProbe.x + c.z * vol.dimsProbe.x * vol.dimsProbe.y;
 }
 
@@ -47,8 +26,8 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
     volume = -1;
     unlit = false;
     bool inBox = false;
-    for (int vi = 0; vi < frame.params.y; ++vi) {
-        Volume vol = volumes.v[vi];
+    for (int vi = 0; vi < probeSet.counts.x; ++vi) {
+        ProbeVolumeRecord vol = volumes.v[vi];
         vec3 lo = vol.originSpacing.xyz;
         float h = vol.originSpacing.w;
         ivec3 dims = vol.dimsProbe.xyz;
@@ -92,3 +71,5 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
     unlit = inBox;  // no volume lit p, and one of them contains it
     return vec3(0.0);
 }
+
+#endif

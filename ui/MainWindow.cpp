@@ -309,7 +309,7 @@ void MainWindow::buildDocks() {
         viewport_->setDebugView(view);
         const auto v = findDebugView(std::to_string(view));
         // The key alone: after the view's title, before any note in parentheses.
-        legend->setText(v && (view == 54 || view == 56)
+        legend->setText(v && v->needs.probeDiagnostics
                             ? QString::fromUtf8(v->shows).section(':', 1).section(" (", 0, 0).trimmed()
                             : QString());
     });

@@ -1,6 +1,7 @@
 #include "ViewportWindow.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <QExposeEvent>
@@ -63,21 +64,29 @@ bool ViewportWindow::event(QEvent* e) {
     return QWindow::event(e);
 }
 
-void ViewportWindow::renderNow() {
-    if (!renderer_) return;
+void ViewportWindow::updateSize() {
     const qreal dpr = devicePixelRatio();
     request_.width = uint32_t(std::max(1, int(width() * dpr)));
     request_.height = uint32_t(std::max(1, int(height() * dpr)));
-    last_ = renderer_->render(request_, camera_);
-    if (isExposed()) {
-        if (!swapchain_) {
-            VkSurfaceKHR surface = QVulkanInstance::surfaceForWindow(this);
-            if (surface) swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
-        }
-        if (swapchain_)
-            swapchain_->present(renderer_->renderer().lastImage(), request_.width, request_.height);
+}
+
+void ViewportWindow::renderNow() {
+    if (!renderer_ || !isExposed()) return;
+    const auto start = std::chrono::steady_clock::now();
+    updateSize();
+    if (!swapchain_) {
+        VkSurfaceKHR surface = QVulkanInstance::surfaceForWindow(this);
+        if (!surface) return;
+        swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
     }
-    emit frameRendered(last_.milliseconds);
+    if (!renderer_->present(request_, camera_, *swapchain_)) return;
+    emit frameRendered(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+}
+
+RenderedImage ViewportWindow::grabImage() {
+    if (!renderer_) return {};
+    updateSize();
+    return renderer_->render(request_, camera_);
 }
 
 void ViewportWindow::orbit(float dAz, float dEl) {

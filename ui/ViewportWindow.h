@@ -1,6 +1,7 @@
 #pragma once
 // The live viewport: a Vulkan window that presents the renderer's offscreen image (the same
-// draw as `terralux --render`), with an orbit camera on the mouse and keys.
+// draw as `terralux --render`) with frames in flight, never reading pixels back or waiting for
+// the GPU per frame; an orbit camera on the mouse and keys.
 //   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom
 //   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
 
@@ -32,12 +33,15 @@ public:
     void setProbeLighting(bool on);
     void setProbePositions(bool on);
     void setLeaves(bool on);
-    // The last image drawn (row 0 at the top), for tests and screenshots.
-    const RenderedImage& lastImage() const { return last_; }
-    // Draws now (synchronously) instead of at the next update.
+    // Draws the current view again and reads it back (row 0 at the top), waiting for the GPU:
+    // for tests and screenshots, never per frame.
+    RenderedImage grabImage();
+    // Records and submits a frame now instead of at the next update.
     void renderNow();
 
 signals:
+    // Wall time the frame took on this thread: recording, submitting and any wait for a free
+    // frame slot (which, with every slot busy, is the GPU's frame time).
     void frameRendered(double milliseconds);
     void cameraChanged();
 
@@ -50,6 +54,7 @@ protected:
     void keyPressEvent(QKeyEvent* e) override;
 
 private:
+    void updateSize();
     void orbit(float dAzimuth, float dElevation);
     void pan(float dx, float dy);
     void zoom(float factor);
@@ -58,7 +63,6 @@ private:
     std::unique_ptr<vk::Swapchain> swapchain_;
     OrbitCamera camera_;
     RenderRequest request_;
-    RenderedImage last_;
     QPointF lastMouse_;
 };
 

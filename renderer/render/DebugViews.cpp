@@ -2,24 +2,36 @@
 
 namespace terralux {
 
+const std::vector<int>& shaderViewNumbers() {
+    static const std::vector<int> numbers = {
+#define TLX_VIEW(NAME, NUMBER) NUMBER,
+#include "debug_views.def"
+#undef TLX_VIEW
+    };
+    return numbers;
+}
+
 const std::vector<DebugView>& debugViews() {
+    constexpr ViewNeeds none{}, light{true, false, false}, diagnostics{false, true, false},
+        diagnosticsAndMarkers{false, true, true};
     static const std::vector<DebugView> views = {
-        {0, "beauty", "final image", false},
-        {1, "albedo", "surface albedo", false},
-        {2, "normal", "world normal as colour", false},
-        {30, "ndotl", "N·L", false},
-        {32, "linear", "pre-tonemap colour", true},
-        {50, "probe-irradiance", "probe irradiance × weight", true},
-        {51, "probe-weight", "probe blend weight", false},
-        {54, "probe-validity",
+        {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, light},
+        {kViewAlbedo, "albedo", "surface albedo", false, ViewBackground::Black, none},
+        {kViewNormal, "normal", "world normal as colour", false, ViewBackground::Black, none},
+        {kViewNdotL, "ndotl", "N·L", false, ViewBackground::Black, none},
+        {kViewLinear, "linear", "pre-tonemap colour", true, ViewBackground::LinearSky, light},
+        {kViewProbeIrradiance, "probe-irradiance", "probe irradiance × weight", true,
+         ViewBackground::Black, light},
+        {kViewProbeWeight, "probe-weight", "probe blend weight", false, ViewBackground::Black, light},
+        {kViewProbeValidity, "probe-validity",
          "invalid / relocated probes: grey lit by probes at their placement, cyan by moved probes, "
          "red inside a volume with no valid probe; markers cyan moved, red rejected (with the probe "
          "overlay also gold valid)",
-         false},
-        {56, "interpolation-error",
+         false, ViewBackground::Black, diagnosticsAndMarkers},
+        {kViewInterpolationError, "interpolation-error",
          "interpolation error heat map: blue 0 %, cyan 2.5 %, green 5 %, yellow 7.5 %, red 10 % and "
          "above, grey unmeasured (EXR: error in red, 1 in green where measured)",
-         true},
+         true, ViewBackground::Black, diagnostics},
     };
     return views;
 }
@@ -30,10 +42,26 @@ std::optional<DebugView> findDebugView(const std::string& s) {
     return std::nullopt;
 }
 
+std::optional<DebugView> findDebugView(int number) {
+    for (const auto& v : debugViews())
+        if (v.number == number) return v;
+    return std::nullopt;
+}
+
 std::string debugViewList() {
     std::string out;
     for (const auto& v : debugViews())
         out += (out.empty() ? "" : ", ") + std::to_string(v.number) + " " + v.name;
+    return out;
+}
+
+std::string diagnosticsViewList() {
+    std::vector<std::string> numbers;
+    for (const auto& v : debugViews())
+        if (v.needs.probeDiagnostics) numbers.push_back(std::to_string(v.number));
+    std::string out = numbers.size() == 1 ? "view " : "views ";
+    for (size_t i = 0; i < numbers.size(); ++i)
+        out += (i == 0 ? "" : i + 1 == numbers.size() ? " and " : ", ") + numbers[i];
     return out;
 }
 

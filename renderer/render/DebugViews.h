@@ -1,5 +1,6 @@
 #pragma once
-// The debug views of LIGHTING.md, selectable by number or name everywhere (UI, CLI, tests).
+// The debug views of LIGHTING.md: one table, read by the CLI, the UI selector, the renderer and
+// the tests. The numbers come from shaders/debug_views.def, which the shaders read too.
 
 #include <optional>
 #include <string>
@@ -7,18 +8,46 @@
 
 namespace terralux {
 
+// kViewBeauty, kViewAlbedo, ...: the view numbers as named constants.
+#define TLX_VIEW(NAME, NUMBER) inline constexpr int kView##NAME = NUMBER;
+#include "debug_views.def"
+#undef TLX_VIEW
+
+// Every view number the shaders know, in the order of debug_views.def.
+const std::vector<int>& shaderViewNumbers();
+
+// What the view's clear colour (where no terrain is drawn) is.
+enum class ViewBackground {
+    Black,
+    Sky,        // the sky toward the horizon, exposed and tonemapped like the beauty image
+    LinearSky,  // the same sky, scene-linear (clamped to [0, 1] in a PNG)
+};
+
+// The passes and inputs a view needs beyond the terrain pass.
+struct ViewNeeds {
+    bool probeLight = false;        // the probe pass's per-vertex irradiance and weight
+    bool probeDiagnostics = false;  // its diagnostics half (moved share, error map) instead
+    bool probeMarkers = false;      // the overlay pass with moved and rejected probes marked
+};
+
 struct DebugView {
     int number;
     const char* name;
     const char* shows;
     bool linear;  // EXR holds scene-linear values; PNG holds the display encoding
+    ViewBackground background;
+    ViewNeeds needs;
 };
 
 // The views this renderer draws, in LIGHTING.md order.
 const std::vector<DebugView>& debugViews();
 // By number ("50") or name ("probe-irradiance"); nullopt when unknown or not drawn.
 std::optional<DebugView> findDebugView(const std::string& numberOrName);
+// By number; nullopt when unknown.
+std::optional<DebugView> findDebugView(int number);
 // "0 beauty, 1 albedo, …" for messages and --help.
 std::string debugViewList();
+// "views 54 and 56": the views that read the bake's probe diagnostics, for messages.
+std::string diagnosticsViewList();
 
 }  // namespace terralux

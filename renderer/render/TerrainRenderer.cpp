@@ -8,49 +8,84 @@
 #include <glm/mat4x4.hpp>
 
 #include "ShaderBinaries.h"
+#include "render/DebugViews.h"
+#include "render/UniformBlocks.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
 #include "vk/Descriptors.h"
-#include "vk/OffscreenTarget.h"
+#include "vk/Image.h"
 #include "vk/Pipeline.h"
+#include "vk/PipelineLayout.h"
+#include "vk/Readback.h"
+#include "vk/RenderPass.h"
 
 namespace terralux {
 
 namespace {
 
-// std140 mirror of `Frame` in shaders/frame.glsl.
-struct FrameUniforms {
-    glm::mat4 viewProj;
-    glm::vec4 cameraPos;
-    glm::vec4 sunDirection;
-    glm::vec4 sunIlluminance;
-    glm::vec4 albedo;
-    glm::vec4 skySh[9];
-    int32_t params[4];
-    glm::vec4 exposure;
-    glm::vec4 overlay;
-};
-static_assert(sizeof(FrameUniforms) == 320);
+// Frame-graph resource names.
+const char* const kColor = "color";
+const char* const kDepth = "depth";
+const char* const kReadback = "readback";
+const char* const kSwapchain = "swapchain";
+const char* const kVertices = "terrain-vertices";
+const char* const kIndices = "terrain-indices";
+const char* const kMarkers = "markers";
+const char* const kLeaves = "leaves";
+const char* const kProbeCoefficients = "probe-coefficients";
+const char* const kProbeCells = "probe-cells";
+const char* const kProbeVolumes = "probe-volumes";
+const char* const kProbeErrorMaps = "probe-error-maps";
+const char* const kProbeLight = "probe-light";
 
-// std430 mirror of `Volume`.
-struct VolumeRecord {
-    glm::vec4 originSpacing;
-    int32_t dimsProbe[4];
-    int32_t occupancy[4];
-    glm::vec4 blend;
-    int32_t errorMap[4];
-    glm::vec4 errorGrid;
-};
-static_assert(sizeof(VolumeRecord) == 96);
+// Smallest octree leaf the leaf overlay draws, in pixels on screen.
+constexpr float kSmallestLeafPixels = 6.0f;
+
+constexpr VkShaderStageFlags kVertexFragment = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
 
 }  // namespace
 
+// The probe subsystem: present only while volumes are bound.
+struct ProbeResources {
+    vk::Buffer block, coeffs, cells, volumes, errors, light;
+    vk::DescriptorSet set;
+    bool lightStale = true;  // the probe pass has not run since the volumes changed
+};
+
+// What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
+struct FrameSlot {
+    vk::Buffer camera, surface, sunSky, overlay;
+    vk::DescriptorSet view, lights, overlays;
+};
+
+struct RenderTarget {
+    vk::Image color, depth;
+    vk::Framebuffer framebuffer;
+    vk::Readback readback;
+};
+
 struct TerrainRenderer::Gpu {
-    vk::Buffer vertices, indices, uniforms, probes, cells, volumes, probeLight, errors, markers, leaves;
-    std::unique_ptr<vk::ProbeVertexPass> probePass;
-    std::unique_ptr<vk::OffscreenTarget> target;
-    std::unique_ptr<vk::TerrainPipeline> pipeline;
-    std::unique_ptr<vk::TerrainDescriptors> descriptors;
+    vk::Buffer vertices, indices, markers, leaves;
+    std::unique_ptr<ProbeResources> probes;
+    std::vector<FrameSlot> slots;
+    std::unique_ptr<RenderTarget> target;
+    vk::RenderPass clearPass, drawPass;
+    vk::UniqueSetLayout emptySet;
+    vk::PipelineLayout terrainLayout, overlayLayout, probeLayout;
+    // Built on first use: lavapipe compiles a pipeline when it is created.
+    vk::UniquePipeline terrainPlain, terrainProbeLight, markerPipeline, leafPipeline, probePass;
+    FrameGraph graph;
+};
+
+struct TerrainRenderer::Output {
+    bool readback = true;
+    VkImage swapchainImage = VK_NULL_HANDLE;
+    VkExtent2D extent{0, 0};
 };
 
 TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget)
@@ -83,45 +118,90 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     vertexCount_ = vertices.size() / 6;
     indexCount_ = indices.size();
 
-    gpu_->vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
-                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    gpu_->probeLight = vk::Buffer(ctx_, std::max<size_t>(vertexCount(), 1) * 32,
-                                  VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    gpu_->probePass = std::make_unique<vk::ProbeVertexPass>(ctx_, shaders::probeVerticesComp());
-    gpu_->indices = vk::Buffer::deviceLocal(ctx_, indices.data(), std::max<size_t>(indices.size(), 1) * 4,
-                                            VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    gpu_->uniforms = vk::Buffer::hostVisible(ctx_, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    setProbeVolumes({});
+    vertexCount_ = vertices.size() / 6;
+    indexCount_ = indices.size();
+
+    Gpu& g = *gpu_;
+    g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
+                                         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    g.indices = vk::Buffer::deviceLocal(ctx_, indices.data(), std::max<size_t>(indices.size(), 1) * 4,
+                                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    g.graph.importBuffer(kVertices, g.vertices.handle(), true);
+    g.graph.importBuffer(kIndices, g.indices.handle(), true);
+
+    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i) {
+        FrameSlot f;
+        auto ubo = [&](size_t bytes) {
+            return vk::Buffer::hostVisible(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+        };
+        f.camera = ubo(sizeof(blocks::CameraBlock));
+        f.surface = ubo(sizeof(blocks::SurfaceBlock));
+        f.sunSky = ubo(sizeof(blocks::SunSkyBlock));
+        f.overlay = ubo(sizeof(blocks::OverlayBlock));
+        f.view = vk::DescriptorSetBuilder()
+                     .uniform(blocks::CameraBlock::kBinding, "camera", f.camera, kVertexFragment)
+                     .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, VK_SHADER_STAGE_FRAGMENT_BIT)
+                     .build(ctx_);
+        f.lights = vk::DescriptorSetBuilder()
+                       .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, VK_SHADER_STAGE_FRAGMENT_BIT)
+                       .build(ctx_);
+        f.overlays = vk::DescriptorSetBuilder()
+                         .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
+                         .build(ctx_);
+        g.slots.push_back(std::move(f));
+    }
+    g.emptySet = vk::DescriptorSetBuilder().buildLayout(ctx_);
+    static_assert(TLX_SET_VIEW == 0 && TLX_SET_LIGHTS == 1 && TLX_SET_SUBSYSTEM == 2);
+    const VkDescriptorSetLayout terrainSets[] = {g.slots[0].view.layout(), g.slots[0].lights.layout()};
+    g.terrainLayout = vk::PipelineLayout(ctx_, terrainSets);
+    const VkDescriptorSetLayout overlaySets[] = {g.slots[0].view.layout(), g.emptySet.get(),
+                                                 g.slots[0].overlays.layout()};
+    g.overlayLayout = vk::PipelineLayout(ctx_, overlaySets);
+
+    const VkFormat colorFormats[] = {vk::kColorFormat};
+    g.clearPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, true, true});
+    g.drawPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, false, true});
 }
 
-TerrainRenderer::~TerrainRenderer() = default;
+TerrainRenderer::~TerrainRenderer() {
+    // Frames in flight may still read what is about to be destroyed.
+    if (gpu_) ctx_.waitIdle();
+}
+
+bool TerrainRenderer::hasProbeResources() const { return gpu_->probes != nullptr; }
+
+const std::vector<PassInfo>& TerrainRenderer::lastFramePasses() const { return gpu_->graph.lastFrame(); }
 
 void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes) {
+    Gpu& g = *gpu_;
+    ctx_.waitIdle();  // no frame may still read the old buffers
+    for (const char* name : {kProbeCoefficients, kProbeCells, kProbeVolumes, kProbeErrorMaps, kProbeLight})
+        g.graph.forget(name);
+    g.probes.reset();
+    volumeCount_ = 0;
+    anyErrorMap_ = false;
+    probeBytes_ = 0;
+    if (volumes.empty()) return;
+
     std::vector<glm::vec4> coeffs;
     std::vector<int32_t> cells;
-    std::vector<VolumeRecord> records;
+    std::vector<blocks::ProbeVolumeRecord> records;
     std::vector<float> errors;
     for (const auto& v : volumes) {
-        VolumeRecord rec{};
+        blocks::ProbeVolumeRecord rec{};
         rec.originSpacing = glm::vec4(v.origin, v.spacing);
-        rec.dimsProbe[0] = int32_t(v.dims.x);
-        rec.dimsProbe[1] = int32_t(v.dims.y);
-        rec.dimsProbe[2] = int32_t(v.dims.z);
-        rec.dimsProbe[3] = int32_t(coeffs.size() / 9);
-        rec.occupancy[0] = int32_t(cells.size());
-        rec.occupancy[1] = v.irradianceEncoded ? 1 : 0;
+        rec.dimsProbe = glm::ivec4(glm::ivec3(v.dims), int32_t(coeffs.size() / 9));
+        rec.occupancy = glm::ivec4(int32_t(cells.size()), v.irradianceEncoded ? 1 : 0, 0, 0);
         rec.blend = glm::vec4(v.fallbackBlendDistance, v.scale, 0.0f, 0.0f);
         static const ProbeDiagnostics none;
         const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
         const ErrorMap& m = d.errorMap;
         // A map that does not hold nx·nz values (or has no step) is no map.
         if (m.error.size() == size_t(m.nx) * m.nz && m.step > 0.0f && !m.error.empty()) {
-            rec.errorMap[0] = int32_t(errors.size());
-            rec.errorMap[1] = int32_t(m.nx);
-            rec.errorMap[2] = int32_t(m.nz);
+            rec.errorMap = glm::ivec4(int32_t(errors.size()), int32_t(m.nx), int32_t(m.nz), 0);
             rec.errorGrid = glm::vec4(m.x0, m.z0, m.step, 0.0f);
             for (float e : m.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
+            anyErrorMap_ = true;
         }
         for (size_t i = 0; i < v.coeffs.size(); ++i) {
             const float moved = i < d.moved.size() && d.moved[i] ? 1.0f : 0.0f;
@@ -133,100 +213,205 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     }
     volumeCount_ = int(records.size());
     probeBytes_ = coeffs.size() * sizeof(glm::vec4) + cells.size() * 4;
+    // Storage buffers may not be empty: a placeholder element where there is nothing to hold.
     if (errors.empty()) errors.push_back(-1.0f);
-    // Storage buffers may not be empty: a placeholder element when there is nothing to bind.
     if (coeffs.empty()) coeffs.push_back(glm::vec4(0.0f));
     if (cells.empty()) cells.push_back(-1);
-    if (records.empty()) records.push_back(VolumeRecord{});
-    ctx_.submitAndWait([](VkCommandBuffer) {});  // no draw may still read the old buffers
-    gpu_->probes = vk::Buffer::deviceLocal(ctx_, coeffs.data(), coeffs.size() * sizeof(glm::vec4),
-                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    gpu_->cells = vk::Buffer::deviceLocal(ctx_, cells.data(), cells.size() * 4,
-                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    gpu_->volumes = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(VolumeRecord),
-                                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    gpu_->errors = vk::Buffer::deviceLocal(ctx_, errors.data(), errors.size() * 4,
-                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    if (gpu_->descriptors)
-        gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
 
-    // Probe light per vertex, once per change of probes (the pass reads only the volume count
-    // from the frame uniforms).
-    FrameUniforms u{};
-    u.params[1] = volumeCount_;
-    gpu_->uniforms.write(&u, sizeof u);
-    ctx_.submitAndWait([&](VkCommandBuffer cb) {
-        gpu_->probePass->record(cb, gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes,
-                                gpu_->vertices, gpu_->probeLight, gpu_->errors, uint32_t(vertexCount_));
-    });
-}
-
-VkImage TerrainRenderer::lastImage() const {
-    return gpu_->target ? gpu_->target->colorImage() : VK_NULL_HANDLE;
+    auto p = std::make_unique<ProbeResources>();
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    p->coeffs = vk::Buffer::deviceLocal(ctx_, coeffs.data(), coeffs.size() * sizeof(glm::vec4), storage);
+    p->cells = vk::Buffer::deviceLocal(ctx_, cells.data(), cells.size() * 4, storage);
+    p->volumes = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(records[0]), storage);
+    p->errors = vk::Buffer::deviceLocal(ctx_, errors.data(), errors.size() * 4, storage);
+    p->light = vk::Buffer(ctx_, std::max<size_t>(vertexCount_, 1) * 32,
+                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    blocks::ProbesBlock block;
+    block.counts = glm::ivec4(volumeCount_, int32_t(vertexCount_), 0, 0);
+    block.flags = glm::ivec4(anyErrorMap_ ? 1 : 0, 0, 0, 0);
+    p->block = vk::Buffer::hostVisible(ctx_, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    p->block.write(&block, sizeof block);
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    p->set = vk::DescriptorSetBuilder()
+                 .uniform(blocks::ProbesBlock::kBinding, "probes", p->block, compute)
+                 .storage(1, kProbeCoefficients, p->coeffs, compute)
+                 .storage(2, kProbeCells, p->cells, compute)
+                 .storage(3, kProbeVolumes, p->volumes, compute)
+                 .storage(4, kProbeErrorMaps, p->errors, compute)
+                 .storage(5, kVertices, g.vertices, compute)
+                 .storage(6, kProbeLight, p->light, compute)
+                 .build(ctx_);
+    g.graph.importBuffer(kProbeCoefficients, p->coeffs.handle(), true);
+    g.graph.importBuffer(kProbeCells, p->cells.handle(), true);
+    g.graph.importBuffer(kProbeVolumes, p->volumes.handle(), true);
+    g.graph.importBuffer(kProbeErrorMaps, p->errors.handle(), true);
+    g.graph.importBuffer(kProbeLight, p->light.handle());
+    g.probes = std::move(p);
 }
 
 void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions) {
-    ctx_.submitAndWait([](VkCommandBuffer) {});  // no draw may still read the old buffer
+    ctx_.waitIdle();  // no frame may still read the old buffer
+    gpu_->graph.forget(kMarkers);
     markerCount_ = uint32_t(positions.size());
-    if (positions.empty()) {
-        gpu_->markers = vk::Buffer();
-        return;
-    }
+    gpu_->markers = vk::Buffer();
+    if (positions.empty()) return;
     gpu_->markers = vk::Buffer::deviceLocal(ctx_, positions.data(), positions.size() * sizeof(glm::vec4),
                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    gpu_->graph.importBuffer(kMarkers, gpu_->markers.handle(), true);
 }
 
 void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
-    ctx_.submitAndWait([](VkCommandBuffer) {});  // no draw may still read the old buffer
+    ctx_.waitIdle();  // no frame may still read the old buffer
+    gpu_->graph.forget(kLeaves);
     leafCount_ = uint32_t(leaves.size());
     smallestLeaf_ = 1.0f;
-    if (leaves.empty()) {
-        gpu_->leaves = vk::Buffer();
-        return;
-    }
+    gpu_->leaves = vk::Buffer();
+    if (leaves.empty()) return;
     smallestLeaf_ = leaves.front().w;
     for (const auto& l : leaves) smallestLeaf_ = std::min(smallestLeaf_, l.w);
     gpu_->leaves = vk::Buffer::deviceLocal(ctx_, leaves.data(), leaves.size() * sizeof(glm::vec4),
                                            VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    gpu_->graph.importBuffer(kLeaves, gpu_->leaves.handle(), true);
+}
+
+void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height) {
+    Gpu& g = *gpu_;
+    if (g.target && g.target->color.width() == width && g.target->color.height() == height) return;
+    ctx_.waitIdle();  // frames in flight may still draw into the old target
+    for (const char* name : {kColor, kDepth, kReadback}) g.graph.forget(name);
+    g.target.reset();
+    auto t = std::make_unique<RenderTarget>(RenderTarget{
+        vk::Image::colorTarget(ctx_, width, height), vk::Image::depthTarget(ctx_, width, height), {},
+        vk::Readback(ctx_, width, height)});
+    const VkImageView views[] = {t->color.view(), t->depth.view()};
+    t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, width, height);
+    g.graph.importImage(kColor, t->color.handle(), t->color.aspect());
+    g.graph.importImage(kDepth, t->depth.handle(), t->depth.aspect());
+    g.graph.importBuffer(kReadback, t->readback.buffer());
+    g.target = std::move(t);
 }
 
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
-    if (!gpu_->target || gpu_->target->width() != s.width || gpu_->target->height() != s.height) {
-        gpu_->target.reset();
-        gpu_->target = std::make_unique<vk::OffscreenTarget>(ctx_, s.width, s.height);
-        // Render passes of the same formats are compatible: one pipeline serves every size.
-        if (!gpu_->pipeline) {
-            gpu_->pipeline = std::make_unique<vk::TerrainPipeline>(
-                ctx_, gpu_->target->renderPass(), shaders::terrainVert(), shaders::terrainFrag(),
-                shaders::markersVert(), shaders::markersFrag(), shaders::leavesVert());
-            gpu_->descriptors = std::make_unique<vk::TerrainDescriptors>(ctx_, gpu_->pipeline->setLayout());
-            gpu_->descriptors->update(gpu_->uniforms, gpu_->probes, gpu_->cells, gpu_->volumes);
-        }
+    ensureTarget(s.width, s.height);
+    // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
+    ctx_.waitIdle();
+    ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, s, Output{}); });
+    RenderedImage img;
+    img.width = s.width;
+    img.height = s.height;
+    img.rgba = gpu_->target->readback.pixels();
+    img.milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return img;
+}
+
+bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain) {
+    ensureTarget(s.width, s.height);
+    const std::optional<vk::SwapchainFrame> frame = swapchain.begin();
+    if (!frame) return false;
+    Output out;
+    out.readback = false;
+    out.swapchainImage = frame->image;
+    out.extent = frame->extent;
+    recordFrame(frame->cb, frame->slot, s, out);
+    swapchain.submitAndPresent(*frame);
+    return true;
+}
+
+void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
+                                  const Output& out) {
+    Gpu& g = *gpu_;
+    FrameSlot& slot = g.slots[slotIndex];
+    const DebugView view = findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty));
+    // The probe subsystem takes part only when volumes are bound, probes are on and the view
+    // reads their light.
+    ProbeResources* probes =
+        g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
+    const bool drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
+    const bool drawLeaves = s.showLeaves && leafCount_ > 0;
+
+    // Pipelines, built on first use.
+    if (probes && !g.probePass) {
+        const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), probes->set.layout()};
+        g.probeLayout = vk::PipelineLayout(ctx_, sets);
+        g.probePass = vk::createComputePipeline(ctx_, g.probeLayout.handle(), shaders::probeVerticesComp());
     }
+    const VkVertexInputBindingDescription meshBinding{0, 24, VK_VERTEX_INPUT_RATE_VERTEX};
+    const VkVertexInputAttributeDescription position{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+        normal{1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12};
+    if (!probes && !g.terrainPlain) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::terrainVert();
+        d.frag = shaders::terrainFrag();
+        d.bindings = {meshBinding};
+        d.attributes = {position, normal};
+        g.terrainPlain = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), g.terrainLayout.handle(), d);
+    }
+    if (probes && !g.terrainProbeLight) {
+        // Probe light: one of the probe pass's two vec4 per vertex (stride 32; bound at offset 16
+        // for the diagnostics).
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::terrainProbeLightVert();
+        d.frag = shaders::terrainFrag();
+        d.bindings = {meshBinding, {1, 32, VK_VERTEX_INPUT_RATE_VERTEX}};
+        d.attributes = {position, normal, {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
+        g.terrainProbeLight = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), g.terrainLayout.handle(), d);
+    }
+    const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
+    const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
+    if (drawMarkers && !g.markerPipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::markersVert();
+        d.frag = shaders::markersFrag();
+        d.bindings = {instance};
+        d.attributes = {record};
+        d.depthWrite = false;
+        g.markerPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.overlayLayout.handle(), d);
+    }
+    if (drawLeaves && !g.leafPipeline) {
+        // The 12 edges of each leaf box as a line list.
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::leavesVert();
+        d.frag = shaders::markersFrag();
+        d.bindings = {instance};
+        d.attributes = {record};
+        d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
+        d.depthWrite = false;
+        g.leafPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.overlayLayout.handle(), d);
+    }
+
+    // This slot's uniform blocks (the GPU finished the slot's previous frame).
     const float extent = std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(),
                                    hf_.maxHeight() - hf_.minHeight(), 1.0f});
-    FrameUniforms u{};
-    u.viewProj = s.camera.viewProjection(float(s.width) / float(s.height), extent);
-    u.cameraPos = glm::vec4(s.camera.position(), 1.0f);
-    u.sunDirection = glm::vec4(s.sun.direction, 0.0f);
-    u.sunIlluminance = glm::vec4(s.sun.illuminance, 0.0f);
-    u.albedo = glm::vec4(s.albedo, 1.0f);
-    for (int k = 0; k < 9; ++k) u.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
-    u.params[0] = s.debugView;
-    u.params[1] = volumeCount_;
-    u.params[2] = s.probes ? 1 : 0;
-    u.params[3] = s.linearOutput ? 1 : 0;
-    u.exposure = glm::vec4(s.exposure, s.roughness, float(s.width), float(s.height));
-    u.overlay = glm::vec4(smallestLeaf_, s.showProbePositions ? 1.0f : 0.0f, 0.0f, 0.0f);
-    gpu_->uniforms.write(&u, sizeof u);
+    blocks::CameraBlock camera;
+    camera.viewProj = s.camera.viewProjection(float(s.width) / float(s.height), extent);
+    camera.position = glm::vec4(s.camera.position(), 1.0f);
+    camera.viewport = glm::vec4(float(s.width), float(s.height), 1.0f / float(s.width), 1.0f / float(s.height));
+    camera.view = glm::ivec4(s.debugView, s.linearOutput ? 1 : 0, view.needs.probeDiagnostics ? 1 : 0, 0);
+    slot.camera.write(&camera, sizeof camera);
+    blocks::SurfaceBlock surface;
+    surface.albedo = glm::vec4(s.albedo, 1.0f);
+    surface.material = glm::vec4(s.roughness, s.exposure, 0.0f, 0.0f);
+    slot.surface.write(&surface, sizeof surface);
+    blocks::SunSkyBlock sunSky;
+    sunSky.sunDirection = glm::vec4(s.sun.direction, s.sun.angularRadius);
+    sunSky.sunIlluminance = glm::vec4(s.sun.illuminance, 0.0f);
+    for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
+    slot.sunSky.write(&sunSky, sizeof sunSky);
+    if (drawMarkers || drawLeaves) {
+        blocks::OverlayBlock overlay;
+        overlay.leaves = glm::vec4(smallestLeaf_, kSmallestLeafPixels, 0.0f, 0.0f);
+        overlay.markers = glm::ivec4(s.showProbePositions ? 1 : 0, 1, 0, 0);
+        slot.overlay.write(&overlay, sizeof overlay);
+    }
 
-    // Background: the sky toward the horizon, in the same encoding as the view.
+    // Background: the sky toward the horizon where the view shows it, in the view's encoding.
     glm::vec3 bg(0.0f);
-    if (s.debugView == 0 || s.debugView == 32) {
-        const glm::vec3 horizon = glm::max(sh::evalRadiance(s.skySh, glm::normalize(glm::vec3(0.0f, 0.2f, -1.0f))), glm::vec3(0.0f));
-        bg = horizon;
-        if (!s.linearOutput && s.debugView == 0) {
+    if (view.background != ViewBackground::Black) {
+        bg = glm::max(sh::evalRadiance(s.skySh, glm::normalize(glm::vec3(0.0f, 0.2f, -1.0f))), glm::vec3(0.0f));
+        if (!s.linearOutput && view.background == ViewBackground::Sky) {
+            // tonemap.glsl's display(), for the one colour the shader does not draw.
             auto aces = [](float x) { return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f); };
             auto srgb = [](float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f; };
             for (int i = 0; i < 3; ++i) bg[i] = srgb(aces(bg[i] * s.exposure));
@@ -235,66 +420,144 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
         }
     }
 
-    vk::OffscreenTarget& target = *gpu_->target;
-    ctx_.submitAndWait([&](VkCommandBuffer cb) {
-        VkClearValue clear[2];
-        clear[0].color = {{bg.x, bg.y, bg.z, 1.0f}};
-        clear[1].depthStencil = {1.0f, 0};
-        VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-        rbi.renderPass = target.renderPass();
-        rbi.framebuffer = target.framebuffer();
-        rbi.renderArea = {{0, 0}, {s.width, s.height}};
-        rbi.clearValueCount = 2;
-        rbi.pClearValues = clear;
-        vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-        if (indexCount_ > 0) {
-            VkViewport vp{0, 0, float(s.width), float(s.height), 0.0f, 1.0f};
-            VkRect2D sc{{0, 0}, {s.width, s.height}};
-            vkCmdSetViewport(cb, 0, 1, &vp);
-            vkCmdSetScissor(cb, 0, 1, &sc);
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->handle());
-            VkDescriptorSet set = gpu_->descriptors->set();
-            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
-                                    &set, 0, nullptr);
-            // Views 54 and 56 read the probe pass's second vec4 (the diagnostics) in place of the
-            // first: one attribute and one varying either way, so no view pays for the other.
-            const bool diagnostics = s.debugView == 54 || s.debugView == 56;
-            VkDeviceSize offsets[2] = {0, diagnostics ? VkDeviceSize(16) : VkDeviceSize(0)};
-            VkBuffer vb[2] = {gpu_->vertices.handle(), gpu_->probeLight.handle()};
-            vkCmdBindVertexBuffers(cb, 0, 2, vb, offsets);
-            vkCmdBindIndexBuffer(cb, gpu_->indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(cb, uint32_t(indexCount_), 1, 0, 0, 0);
+    FrameGraph& graph = g.graph;
+    graph.beginFrame();
+    const uint32_t w = s.width, h = s.height;
+    auto setViewport = [w, h](VkCommandBuffer c) {
+        VkViewport vp{0, 0, float(w), float(h), 0.0f, 1.0f};
+        VkRect2D sc{{0, 0}, {w, h}};
+        vkCmdSetViewport(c, 0, 1, &vp);
+        vkCmdSetScissor(c, 0, 1, &sc);
+    };
+    VkFramebuffer framebuffer = g.target->framebuffer.handle();
+
+    if (probes && probes->lightStale) {
+        PassInfo info{"probe-vertices",
+                      {{kProbeCoefficients, Access::ComputeStorageRead},
+                       {kProbeCells, Access::ComputeStorageRead},
+                       {kProbeVolumes, Access::ComputeStorageRead},
+                       {kProbeErrorMaps, Access::ComputeStorageRead},
+                       {kVertices, Access::ComputeStorageRead},
+                       {kProbeLight, Access::ComputeStorageWrite}},
+                      probes->set.bindingNames()};
+        const uint32_t n = uint32_t(vertexCount_);
+        graph.addPass(std::move(info), [&g, probes, n](VkCommandBuffer c) {
+            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probePass.get());
+            VkDescriptorSet set = probes->set.handle();
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probeLayout.handle(),
+                                    TLX_SET_SUBSYSTEM, 1, &set, 0, nullptr);
+            vkCmdDispatch(c, (n + 63) / 64, 1, 1);
+        });
+    }
+
+    {
+        PassInfo info{"terrain",
+                      {{kColor, Access::ColorAttachmentClear},
+                       {kDepth, Access::DepthAttachmentClear},
+                       {kVertices, Access::VertexAttributeRead},
+                       {kIndices, Access::IndexRead}},
+                      concat(concat(slot.view.bindingNames(), slot.lights.bindingNames()),
+                             {std::string("vertex:") + kVertices, std::string("index:") + kIndices})};
+        if (probes) {
+            info.uses.push_back({kProbeLight, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kProbeLight);
         }
-        // Overlays: per-instance vec4 records, same layout and descriptor set as the terrain.
-        auto overlay = [&](VkPipeline pipeline, const vk::Buffer& instances, uint32_t vertices,
-                           uint32_t count) {
-            VkViewport vp{0, 0, float(s.width), float(s.height), 0.0f, 1.0f};
-            VkRect2D sc{{0, 0}, {s.width, s.height}};
-            vkCmdSetViewport(cb, 0, 1, &vp);
-            vkCmdSetScissor(cb, 0, 1, &sc);
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-            VkDescriptorSet set = gpu_->descriptors->set();
-            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, gpu_->pipeline->layout(), 0, 1,
-                                    &set, 0, nullptr);
-            VkDeviceSize offset = 0;
-            VkBuffer b = instances.handle();
-            vkCmdBindVertexBuffers(cb, 0, 1, &b, &offset);
-            vkCmdDraw(cb, vertices, count, 0, 0);
-        };
-        if (s.showLeaves && leafCount_ > 0) overlay(gpu_->pipeline->leaves(), gpu_->leaves, 24, leafCount_);
-        // View 54 is about the probes themselves: their markers are part of it.
-        if ((s.showProbePositions || s.debugView == 54) && markerCount_ > 0)
-            overlay(gpu_->pipeline->markers(), gpu_->markers, 6, markerCount_);
-        vkCmdEndRenderPass(cb);
-        target.recordReadback(cb);
-    });
-    RenderedImage img;
-    img.width = s.width;
-    img.height = s.height;
-    img.rgba = target.pixels();
-    img.milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return img;
+        // The diagnostics views read the probe pass's second vec4 in place of the first: one
+        // attribute and one varying either way, so no view pays for the other.
+        const VkDeviceSize probeOffset = view.needs.probeDiagnostics ? 16 : 0;
+        const uint32_t indexCount = uint32_t(indexCount_);
+        graph.addPass(std::move(info), [&g, &slot, probes, probeOffset, indexCount, bg, w, h, framebuffer,
+                                        setViewport](VkCommandBuffer c) {
+            VkClearValue clear[2];
+            clear[0].color = {{bg.x, bg.y, bg.z, 1.0f}};
+            clear[1].depthStencil = {1.0f, 0};
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = g.clearPass.handle();
+            rbi.framebuffer = framebuffer;
+            rbi.renderArea = {{0, 0}, {w, h}};
+            rbi.clearValueCount = 2;
+            rbi.pClearValues = clear;
+            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            if (indexCount > 0) {
+                setViewport(c);
+                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                                  probes ? g.terrainProbeLight.get() : g.terrainPlain.get());
+                const VkDescriptorSet sets[] = {slot.view.handle(), slot.lights.handle()};
+                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(),
+                                        TLX_SET_VIEW, 2, sets, 0, nullptr);
+                const VkBuffer vb[2] = {g.vertices.handle(), probes ? probes->light.handle() : VK_NULL_HANDLE};
+                const VkDeviceSize offsets[2] = {0, probeOffset};
+                vkCmdBindVertexBuffers(c, 0, probes ? 2 : 1, vb, offsets);
+                vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+                vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+            }
+            vkCmdEndRenderPass(c);
+        });
+    }
+
+    if (drawMarkers || drawLeaves) {
+        PassInfo info{"overlays",
+                      {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
+                      concat(slot.view.bindingNames(), slot.overlays.bindingNames())};
+        if (drawLeaves) {
+            info.uses.push_back({kLeaves, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kLeaves);
+        }
+        if (drawMarkers) {
+            info.uses.push_back({kMarkers, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kMarkers);
+        }
+        const uint32_t leafCount = drawLeaves ? leafCount_ : 0, markerCount = drawMarkers ? markerCount_ : 0;
+        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, w, h, framebuffer,
+                                        setViewport](VkCommandBuffer c) {
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = g.drawPass.handle();
+            rbi.framebuffer = framebuffer;
+            rbi.renderArea = {{0, 0}, {w, h}};
+            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            setViewport(c);
+            const VkDescriptorSet view = slot.view.handle(), overlay = slot.overlays.handle();
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
+                                    TLX_SET_VIEW, 1, &view, 0, nullptr);
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
+                                    TLX_SET_SUBSYSTEM, 1, &overlay, 0, nullptr);
+            auto draw = [&](VkPipeline pipeline, const vk::Buffer& instances, uint32_t vertices, uint32_t count) {
+                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+                const VkDeviceSize offset = 0;
+                const VkBuffer b = instances.handle();
+                vkCmdBindVertexBuffers(c, 0, 1, &b, &offset);
+                vkCmdDraw(c, vertices, count, 0, 0);
+            };
+            if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
+            if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
+            vkCmdEndRenderPass(c);
+        });
+    }
+
+    if (out.readback) {
+        RenderTarget& t = *g.target;
+        graph.addPass({"readback", {{kColor, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
+                      [&t](VkCommandBuffer c) { t.readback.recordCopy(c, t.color.handle()); });
+        graph.addFinalUse({kReadback, Access::HostRead});
+    } else {
+        graph.importImage(kSwapchain, out.swapchainImage, VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT);
+        const VkImage source = g.target->color.handle(), dest = out.swapchainImage;
+        const VkExtent2D dstExtent = out.extent;
+        graph.addPass({"present", {{kColor, Access::TransferRead}, {kSwapchain, Access::TransferWrite}}, {}},
+                      [source, dest, w, h, dstExtent](VkCommandBuffer c) {
+                          VkImageBlit blit{};
+                          blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          blit.srcOffsets[1] = {int32_t(w), int32_t(h), 1};
+                          blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          blit.dstOffsets[1] = {int32_t(dstExtent.width), int32_t(dstExtent.height), 1};
+                          vkCmdBlitImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
+                                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
+                      });
+        graph.addFinalUse({kSwapchain, Access::Present});
+    }
+    graph.execute(cb);
+    if (probes) probes->lightStale = false;
 }
 
 }  // namespace terralux

@@ -1,7 +1,9 @@
 #pragma once
-// Draws the terrain offscreen the way the engine will light it, or one of the debug views. The
-// same path serves `terralux --render`, the render tests and the UI viewport (which presents
-// the image).
+// Draws the terrain offscreen the way the engine will light it, or one of the debug views. A frame
+// is an ordered list of passes (FrameGraph): the probe pass (compute, only after the probes
+// changed), the terrain, the overlays (probe markers, octree leaves), then either the readback
+// (`terralux --render`, the tests, a viewport grab) or the blit to a window's swapchain. A
+// subsystem the frame does not use adds no pass and no binding.
 
 #include <array>
 #include <cstdint>
@@ -15,8 +17,10 @@
 #include "bake/ProbeDiagnostics.h"
 #include "bake/Sky.h"
 #include "bake/SphericalHarmonics.h"
+#include "render/FrameGraph.h"
 #include "render/OrbitCamera.h"
 #include "terrain/Heightfield.h"
+#include "vk/Swapchain.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux {
@@ -32,7 +36,7 @@ struct GpuProbeVolume {
     float fallbackBlendDistance = 0.0f;
     bool irradianceEncoded = false;                // coefficients hold Â_l L_k
     float scale = 1.0f;                            // the file's default SH scale
-    // What the bake wrote beside the file (moved probes for view 54, the error map for view 56);
+    // What the bake wrote beside the file (moved probes and the error map of the diagnostics views);
     // unset for bakes without it.
     std::optional<ProbeDiagnostics> diagnostics;
 };
@@ -40,7 +44,7 @@ struct GpuProbeVolume {
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
-    bool probes = true;           // false: exactly the image without probe lighting
+    bool probes = true;           // false: exactly the image without probes (no probe pass)
     bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
     OrbitCamera camera;
     glm::vec3 albedo{0.3f};
@@ -48,7 +52,7 @@ struct RenderSettings {
     sh::ShRgb skySh;
     float exposure = 1.0f;
     float roughness = 0.8f;
-    bool showProbePositions = false;  // the overlay of setProbePositions (view 54 always marks
+    bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
 };
@@ -67,14 +71,22 @@ public:
                     size_t vertexBudget = size_t(1) << 20);
     ~TerrainRenderer();
 
+    // Binds the volumes (none: the probe subsystem and its buffers go away); the next frame that
+    // needs probe light runs the probe pass.
     void setProbeVolumes(const std::vector<GpuProbeVolume>& volumes);
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.
     void setProbePositions(const std::vector<glm::vec4>& positions);
     // Octree leaves for the leaf overlay: min corner xyz, w edge (metres).
     void setProbeLeaves(const std::vector<glm::vec4>& leaves);
+    // Draws a frame and reads it back, waiting for the GPU.
     RenderedImage render(const RenderSettings& settings);
-    // The colour image of the last render (TRANSFER_SRC_OPTIMAL), for a presenter.
-    VkImage lastImage() const;
+    // Draws a frame into the swapchain's next image (a blit of the offscreen colour target, no
+    // readback) without waiting for the GPU. False when nothing could be shown.
+    bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
+    // The passes of the last frame, in order, with what each used and bound.
+    const std::vector<PassInfo>& lastFramePasses() const;
+    // Whether the probe subsystem holds GPU resources (volumes are bound).
+    bool hasProbeResources() const;
 
     int meshStride() const { return stride_; }
     size_t vertexCount() const { return vertexCount_; }
@@ -83,12 +95,16 @@ public:
 
 private:
     struct Gpu;
+    struct Output;
+    void recordFrame(VkCommandBuffer cb, uint32_t slot, const RenderSettings& s, const Output& out);
+    void ensureTarget(uint32_t width, uint32_t height);
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;
     int stride_ = 1;
     size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0;
     int volumeCount_ = 0;
+    bool anyErrorMap_ = false;
     uint32_t markerCount_ = 0, leafCount_ = 0;
     float smallestLeaf_ = 1.0f;
 };

@@ -7,48 +7,29 @@ namespace terralux::vk {
 
 Buffer::Buffer(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
                VkMemoryPropertyFlags properties)
-    : device_(ctx.device()), size_(size) {
+    : size_(size) {
+    VkDevice device = ctx.device();
     VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     bci.size = size > 0 ? size : 16;
     bci.usage = usage;
     bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    check(vkCreateBuffer(device_, &bci, nullptr, &buffer_), "vkCreateBuffer");
+    VkBuffer buffer = VK_NULL_HANDLE;
+    check(vkCreateBuffer(device, &bci, nullptr, &buffer), "vkCreateBuffer");
+    buffer_ = UniqueBuffer(device, buffer);
     VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(device_, buffer_, &req);
+    vkGetBufferMemoryRequirements(device, buffer, &req);
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, properties);
-    check(vkAllocateMemory(device_, &ai, nullptr, &memory_), "vkAllocateMemory (buffer)");
-    check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
-}
-
-Buffer::~Buffer() { release(); }
-
-void Buffer::release() {
-    if (!device_) return;
-    if (mapped_) vkUnmapMemory(device_, memory_);
-    if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
-    if (memory_) vkFreeMemory(device_, memory_, nullptr);
-    device_ = VK_NULL_HANDLE;
-    buffer_ = VK_NULL_HANDLE;
-    memory_ = VK_NULL_HANDLE;
-    mapped_ = nullptr;
-}
-
-Buffer& Buffer::operator=(Buffer&& o) noexcept {
-    if (this != &o) {
-        release();
-        device_ = std::exchange(o.device_, VK_NULL_HANDLE);
-        buffer_ = std::exchange(o.buffer_, VK_NULL_HANDLE);
-        memory_ = std::exchange(o.memory_, VK_NULL_HANDLE);
-        size_ = std::exchange(o.size_, 0);
-        mapped_ = std::exchange(o.mapped_, nullptr);
-    }
-    return *this;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    check(vkAllocateMemory(device, &ai, nullptr, &memory), "vkAllocateMemory (buffer)");
+    memory_ = UniqueMemory(device, memory);
+    check(vkBindBufferMemory(device, buffer, memory, 0), "vkBindBufferMemory");
 }
 
 void* Buffer::map() {
-    if (!mapped_) check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+    if (!mapped_)
+        check(vkMapMemory(memory_.device(), memory_.get(), 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
     return mapped_;
 }
 

@@ -3,7 +3,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
+#include "vk/Handle.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux::vk {
@@ -13,11 +15,18 @@ public:
     Buffer() = default;
     Buffer(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
            VkMemoryPropertyFlags properties);
-    ~Buffer();
-    Buffer(Buffer&& o) noexcept { *this = std::move(o); }
-    Buffer& operator=(Buffer&& o) noexcept;
-    Buffer(const Buffer&) = delete;
-    Buffer& operator=(const Buffer&) = delete;
+    Buffer(Buffer&& o) noexcept
+        : memory_(std::move(o.memory_)), buffer_(std::move(o.buffer_)),
+          size_(std::exchange(o.size_, 0)), mapped_(std::exchange(o.mapped_, nullptr)) {}
+    Buffer& operator=(Buffer&& o) noexcept {
+        if (this != &o) {
+            buffer_ = std::move(o.buffer_);  // the old buffer before the memory it is bound to
+            memory_ = std::move(o.memory_);
+            size_ = std::exchange(o.size_, 0);
+            mapped_ = std::exchange(o.mapped_, nullptr);
+        }
+        return *this;
+    }
 
     // A device-local buffer holding `bytes`, uploaded through a host-visible staging buffer.
     static Buffer deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
@@ -25,16 +34,16 @@ public:
     // A host-visible, coherent buffer (uniforms, readback).
     static Buffer hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
 
-    VkBuffer handle() const { return buffer_; }
+    VkBuffer handle() const { return buffer_.get(); }
     VkDeviceSize size() const { return size_; }
-    void* map();   // host-visible only; stays mapped until destruction
+    explicit operator bool() const { return bool(buffer_); }
+    void* map();   // host-visible only; stays mapped until destruction (freeing unmaps)
     void write(const void* bytes, VkDeviceSize size, VkDeviceSize offset = 0);
 
 private:
-    void release();
-    VkDevice device_ = VK_NULL_HANDLE;
-    VkBuffer buffer_ = VK_NULL_HANDLE;
-    VkDeviceMemory memory_ = VK_NULL_HANDLE;
+    // Declared in destruction order: the buffer goes before the memory bound to it.
+    UniqueMemory memory_;
+    UniqueBuffer buffer_;
     VkDeviceSize size_ = 0;
     void* mapped_ = nullptr;
 };

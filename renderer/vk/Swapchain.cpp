@@ -4,40 +4,52 @@
 
 namespace terralux::vk {
 
+namespace {
+UniqueSemaphore makeSemaphore(VkDevice device) {
+    VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VkSemaphore s = VK_NULL_HANDLE;
+    check(vkCreateSemaphore(device, &sci, nullptr, &s), "vkCreateSemaphore");
+    return UniqueSemaphore(device, s);
+}
+}  // namespace
+
 Swapchain::Swapchain(const VulkanContext& ctx, VkSurfaceKHR surface) : ctx_(ctx), surface_(surface) {
     VkBool32 supported = VK_FALSE;
     check(vkGetPhysicalDeviceSurfaceSupportKHR(ctx_.physicalDevice(), ctx_.queueFamily(), surface_, &supported),
           "vkGetPhysicalDeviceSurfaceSupportKHR");
     if (!supported) throw VulkanError("Vulkan: " + ctx_.deviceName() + " cannot present to this window");
-    VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    check(vkCreateSemaphore(ctx_.device(), &sci, nullptr, &acquired_), "vkCreateSemaphore");
-    check(vkCreateSemaphore(ctx_.device(), &sci, nullptr, &blitted_), "vkCreateSemaphore");
-    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(ctx_.device(), &fci, nullptr, &fence_), "vkCreateFence");
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = ctx_.commandPool();
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    check(vkAllocateCommandBuffers(ctx_.device(), &ai, &cb_), "vkAllocateCommandBuffers");
+    for (Slot& s : slots_) {
+        s.acquired = makeSemaphore(ctx_.device());
+        VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        fci.flags = VK_FENCE_CREATE_SIGNALED_BIT;  // a slot starts free
+        VkFence f = VK_NULL_HANDLE;
+        check(vkCreateFence(ctx_.device(), &fci, nullptr, &f), "vkCreateFence");
+        s.done = UniqueFence(ctx_.device(), f);
+        s.cb = ctx_.allocateCommandBuffer();
+    }
 }
 
 Swapchain::~Swapchain() {
-    vkDeviceWaitIdle(ctx_.device());
-    destroy();
-    vkFreeCommandBuffers(ctx_.device(), ctx_.commandPool(), 1, &cb_);
-    vkDestroyFence(ctx_.device(), fence_, nullptr);
-    vkDestroySemaphore(ctx_.device(), acquired_, nullptr);
-    vkDestroySemaphore(ctx_.device(), blitted_, nullptr);
+    waitIdle();
+    destroySwapchain();
 }
 
-void Swapchain::destroy() {
-    if (swapchain_) vkDestroySwapchainKHR(ctx_.device(), swapchain_, nullptr);
-    swapchain_ = VK_NULL_HANDLE;
+void Swapchain::waitIdle() {
+    for (Slot& s : slots_) {
+        VkFence f = s.done.get();
+        if (f) vkWaitForFences(ctx_.device(), 1, &f, VK_TRUE, UINT64_MAX);
+    }
+}
+
+void Swapchain::destroySwapchain() {
+    presentable_.clear();
+    swapchain_.reset();
     images_.clear();
 }
 
 bool Swapchain::recreate() {
-    vkDeviceWaitIdle(ctx_.device());
+    // Every frame that used the old images must be done with them.
+    waitIdle();
     VkSurfaceCapabilitiesKHR caps;
     check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physicalDevice(), surface_, &caps),
           "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
@@ -56,10 +68,9 @@ bool Swapchain::recreate() {
             break;
         }
     extent_ = caps.currentExtent;
-    VkSwapchainKHR old = swapchain_;
     VkSwapchainCreateInfoKHR ci{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
     ci.surface = surface_;
-    ci.minImageCount = std::max(2u, caps.minImageCount);
+    ci.minImageCount = std::max(kFramesInFlight + 1, caps.minImageCount);
     if (caps.maxImageCount) ci.minImageCount = std::min(ci.minImageCount, caps.maxImageCount);
     ci.imageFormat = format_;
     ci.imageColorSpace = space;
@@ -73,81 +84,79 @@ bool Swapchain::recreate() {
         ci.compositeAlpha = VK_COMPOSITE_ALPHA_INHERIT_BIT_KHR;
     ci.presentMode = VK_PRESENT_MODE_FIFO_KHR;
     ci.clipped = VK_TRUE;
-    ci.oldSwapchain = old;
-    check(vkCreateSwapchainKHR(ctx_.device(), &ci, nullptr, &swapchain_), "vkCreateSwapchainKHR");
-    if (old) vkDestroySwapchainKHR(ctx_.device(), old, nullptr);
-    vkGetSwapchainImagesKHR(ctx_.device(), swapchain_, &n, nullptr);
+    ci.oldSwapchain = swapchain_.get();
+    VkSwapchainKHR created = VK_NULL_HANDLE;
+    check(vkCreateSwapchainKHR(ctx_.device(), &ci, nullptr, &created), "vkCreateSwapchainKHR");
+    destroySwapchain();
+    swapchain_ = UniqueSwapchain(ctx_.device(), created);
+    vkGetSwapchainImagesKHR(ctx_.device(), created, &n, nullptr);
     images_.resize(n);
-    vkGetSwapchainImagesKHR(ctx_.device(), swapchain_, &n, images_.data());
+    vkGetSwapchainImagesKHR(ctx_.device(), created, &n, images_.data());
+    for (uint32_t i = 0; i < n; ++i) presentable_.push_back(makeSemaphore(ctx_.device()));
     return true;
 }
 
-bool Swapchain::present(VkImage source, uint32_t width, uint32_t height) {
+std::optional<SwapchainFrame> Swapchain::begin() {
+    Slot& slot = slots_[next_];
+    VkFence fence = slot.done.get();
+    check(vkWaitForFences(ctx_.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (frame slot)");
+
     VkSurfaceCapabilitiesKHR caps;
     check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physicalDevice(), surface_, &caps),
           "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
     if (!swapchain_ || caps.currentExtent.width != extent_.width || caps.currentExtent.height != extent_.height)
-        if (!recreate()) return false;
+        if (!recreate()) return std::nullopt;
     uint32_t index = 0;
-    VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
+    VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_.get(), UINT64_MAX, slot.acquired.get(),
+                                       VK_NULL_HANDLE, &index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
-        if (!recreate()) return false;
-        r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
+        if (!recreate()) return std::nullopt;
+        r = vkAcquireNextImageKHR(ctx_.device(), swapchain_.get(), UINT64_MAX, slot.acquired.get(),
+                                  VK_NULL_HANDLE, &index);
     }
     if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR) check(r, "vkAcquireNextImageKHR");
 
+    check(vkResetCommandBuffer(slot.cb.get(), 0), "vkResetCommandBuffer");
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkResetCommandBuffer(cb_, 0), "vkResetCommandBuffer");
-    check(vkBeginCommandBuffer(cb_, &bi), "vkBeginCommandBuffer");
-    auto transition = [&](VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess,
-                          VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
-        VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-        b.oldLayout = from;
-        b.newLayout = to;
-        b.srcAccessMask = srcAccess;
-        b.dstAccessMask = dstAccess;
-        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.image = images_[index];
-        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        vkCmdPipelineBarrier(cb_, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
-    };
-    transition(VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-    VkImageBlit blit{};
-    blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    blit.srcOffsets[1] = {int32_t(width), int32_t(height), 1};
-    blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    blit.dstOffsets[1] = {int32_t(extent_.width), int32_t(extent_.height), 1};
-    vkCmdBlitImage(cb_, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images_[index],
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
-    transition(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_WRITE_BIT, 0,
-               VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
-    check(vkEndCommandBuffer(cb_), "vkEndCommandBuffer");
+    check(vkBeginCommandBuffer(slot.cb.get(), &bi), "vkBeginCommandBuffer");
+    SwapchainFrame f;
+    f.cb = slot.cb.get();
+    f.slot = next_;
+    f.imageIndex = index;
+    f.image = images_[index];
+    f.extent = extent_;
+    return f;
+}
 
+void Swapchain::submitAndPresent(const SwapchainFrame& f) {
+    Slot& slot = slots_[f.slot];
+    next_ = (f.slot + 1) % kFramesInFlight;
+    check(vkEndCommandBuffer(f.cb), "vkEndCommandBuffer");
     const VkPipelineStageFlags wait = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    VkSemaphore acquired = slot.acquired.get(), presentable = presentable_[f.imageIndex].get();
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.waitSemaphoreCount = 1;
-    si.pWaitSemaphores = &acquired_;
+    si.pWaitSemaphores = &acquired;
     si.pWaitDstStageMask = &wait;
     si.commandBufferCount = 1;
-    si.pCommandBuffers = &cb_;
+    si.pCommandBuffers = &f.cb;
     si.signalSemaphoreCount = 1;
-    si.pSignalSemaphores = &blitted_;
-    check(vkResetFences(ctx_.device(), 1, &fence_), "vkResetFences");
-    check(vkQueueSubmit(ctx_.queue(), 1, &si, fence_), "vkQueueSubmit (present)");
+    si.pSignalSemaphores = &presentable;
+    VkFence fence = slot.done.get();
+    check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences");
+    check(vkQueueSubmit(ctx_.queue(), 1, &si, fence), "vkQueueSubmit (frame)");
+    VkSwapchainKHR sc = swapchain_.get();
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
     pi.waitSemaphoreCount = 1;
-    pi.pWaitSemaphores = &blitted_;
+    pi.pWaitSemaphores = &presentable;
     pi.swapchainCount = 1;
-    pi.pSwapchains = &swapchain_;
-    pi.pImageIndices = &index;
-    r = vkQueuePresentKHR(ctx_.queue(), &pi);
-    check(vkWaitForFences(ctx_.device(), 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences (present)");
-    if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) destroy();
+    pi.pSwapchains = &sc;
+    pi.pImageIndices = &f.imageIndex;
+    const VkResult r = vkQueuePresentKHR(ctx_.queue(), &pi);
+    // The next begin() recreates it for the new size.
+    if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) extent_ = {0, 0};
     else check(r, "vkQueuePresentKHR");
-    return true;
 }
 
 }  // namespace terralux::vk

@@ -1,12 +1,27 @@
 #pragma once
-// Presents rendered images in a window: the swapchain for a surface, and a blit of the offscreen
-// colour image into the acquired swapchain image.
+// Presents rendered frames in a window with up to kFramesInFlight frames queued: each frame slot
+// has its own command buffer, fence and acquire semaphore, so the CPU records the next frame
+// while the GPU draws the last and waits only when every slot is still busy.
 
+#include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "vk/Handle.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux::vk {
+
+inline constexpr uint32_t kFramesInFlight = 2;
+
+// One frame being recorded: the slot's command buffer (begun) and the acquired image.
+struct SwapchainFrame {
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    uint32_t slot = 0;        // 0 .. kFramesInFlight-1: which per-frame resources to use
+    uint32_t imageIndex = 0;
+    VkImage image = VK_NULL_HANDLE;
+    VkExtent2D extent{0, 0};
+};
 
 class Swapchain {
 public:
@@ -16,23 +31,34 @@ public:
     Swapchain(const Swapchain&) = delete;
     Swapchain& operator=(const Swapchain&) = delete;
 
-    // Blits `source` (TRANSFER_SRC_OPTIMAL, `width` x `height`) to the window and presents it.
-    // Recreates the swapchain when the window size changed; false when nothing could be shown
-    // (a zero-sized window).
-    bool present(VkImage source, uint32_t width, uint32_t height);
+    // Waits until the next slot is free (its frame of kFramesInFlight ago has finished),
+    // acquires an image (recreating the swapchain when the window size changed) and begins the
+    // slot's command buffer. nullopt when nothing can be shown (a zero-sized window). The image
+    // is in an undefined layout; the frame leaves it in PRESENT_SRC_KHR, having waited for
+    // the acquire at the transfer stage.
+    std::optional<SwapchainFrame> begin();
+    // Ends the command buffer, submits it and queues the image for presentation. No wait.
+    void submitAndPresent(const SwapchainFrame& frame);
+    // Waits for every slot (before resources the frames use are destroyed).
+    void waitIdle();
 
 private:
     bool recreate();
-    void destroy();
+    void destroySwapchain();
+    struct Slot {
+        UniqueCommandBuffer cb;
+        UniqueFence done;
+        UniqueSemaphore acquired;
+    };
     const VulkanContext& ctx_;
     VkSurfaceKHR surface_;
-    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+    UniqueSwapchain swapchain_;
     VkFormat format_ = VK_FORMAT_UNDEFINED;
     VkExtent2D extent_{0, 0};
     std::vector<VkImage> images_;
-    VkSemaphore acquired_ = VK_NULL_HANDLE, blitted_ = VK_NULL_HANDLE;
-    VkFence fence_ = VK_NULL_HANDLE;
-    VkCommandBuffer cb_ = VK_NULL_HANDLE;
+    std::vector<UniqueSemaphore> presentable_;  // per image: its frame's commands finished
+    Slot slots_[kFramesInFlight];
+    uint32_t next_ = 0;
 };
 
 }  // namespace terralux::vk

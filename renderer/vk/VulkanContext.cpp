@@ -47,6 +47,15 @@ int typeRank(VkPhysicalDeviceType t) {
 }  // namespace
 
 VulkanContext::VulkanContext(const ContextOptions& options) {
+    try {
+        create(options);
+    } catch (...) {
+        destroy();
+        throw;
+    }
+}
+
+void VulkanContext::create(const ContextOptions& options) {
     std::string choice = options.device;
     if (choice.empty())
         if (const char* env = std::getenv("TERRALUX_VK_DEVICE")) choice = env;
@@ -129,9 +138,6 @@ VulkanContext::VulkanContext(const ContextOptions& options) {
     }
     if (physical_ == VK_NULL_HANDLE) {
         const std::string found = names.empty() ? "none" : names;
-        vkDestroyInstance(instance_, nullptr);
-        if (messenger_) messenger_ = VK_NULL_HANDLE;
-        instance_ = VK_NULL_HANDLE;
         throw VulkanUnavailable("no Vulkan device with graphics" +
                                 (choice.empty() ? std::string() : " matching '" + choice + "'") +
                                 " (devices: " + found + ")");
@@ -161,19 +167,26 @@ VulkanContext::VulkanContext(const ContextOptions& options) {
     check(vkCreateFence(device_, &fci, nullptr, &fence_), "vkCreateFence");
 }
 
-VulkanContext::~VulkanContext() {
+VulkanContext::~VulkanContext() { destroy(); }
+
+void VulkanContext::destroy() {
     if (device_) {
         vkDeviceWaitIdle(device_);
-        vkDestroyFence(device_, fence_, nullptr);
-        vkDestroyCommandPool(device_, pool_, nullptr);
+        if (fence_) vkDestroyFence(device_, fence_, nullptr);
+        if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
         vkDestroyDevice(device_, nullptr);
     }
+    fence_ = VK_NULL_HANDLE;
+    pool_ = VK_NULL_HANDLE;
+    device_ = VK_NULL_HANDLE;
     if (messenger_) {
-        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        auto destroyMessenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
             vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-        if (destroy) destroy(instance_, messenger_, nullptr);
+        if (destroyMessenger) destroyMessenger(instance_, messenger_, nullptr);
     }
+    messenger_ = VK_NULL_HANDLE;
     if (instance_) vkDestroyInstance(instance_, nullptr);
+    instance_ = VK_NULL_HANDLE;
 }
 
 uint32_t VulkanContext::memoryType(uint32_t typeBits, VkMemoryPropertyFlags required) const {
@@ -183,13 +196,21 @@ uint32_t VulkanContext::memoryType(uint32_t typeBits, VkMemoryPropertyFlags requ
     throw VulkanError("Vulkan: no memory type with the required properties");
 }
 
-void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
+UniqueCommandBuffer VulkanContext::allocateCommandBuffer() const {
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = pool_;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
+    return UniqueCommandBuffer(device_, pool_, cb);
+}
+
+void VulkanContext::waitIdle() const { check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle"); }
+
+void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
+    const UniqueCommandBuffer owned = allocateCommandBuffer();
+    VkCommandBuffer cb = owned.get();
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
@@ -201,7 +222,6 @@ void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& re
     check(vkResetFences(device_, 1, &fence_), "vkResetFences");
     check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
     check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-    vkFreeCommandBuffers(device_, pool_, 1, &cb);
 }
 
 }  // namespace terralux::vk

@@ -11,6 +11,8 @@
 
 #include <vulkan/vulkan.h>
 
+#include "vk/Handle.h"
+
 namespace terralux::vk {
 
 // No Vulkan loader, no instance or no usable device: the CPU bake still works, rendering does not.
@@ -63,10 +65,18 @@ public:
 
     uint32_t memoryType(uint32_t typeBits, VkMemoryPropertyFlags required) const;
 
-    // Records commands into a one-time command buffer, submits it and waits.
+    // A primary command buffer from the context's pool, freed when it goes out of scope.
+    UniqueCommandBuffer allocateCommandBuffer() const;
+    // Records commands into a one-time command buffer, submits it and waits. The command buffer
+    // is freed on every path, a throw from `record` included.
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
+    // Waits until the queue has finished everything submitted so far.
+    void waitIdle() const;
 
 private:
+    // Destroys whatever exists, in reverse order of creation; safe on a half-built context.
+    void create(const ContextOptions& options);
+    void destroy();
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
     VkPhysicalDevice physical_ = VK_NULL_HANDLE;

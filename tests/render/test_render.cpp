@@ -1,6 +1,7 @@
 // Render tests on the real Vulkan path (Mesa lavapipe in CI): golden images of every debug view
 // and behaviour checks. They skip, saying why, when no Vulkan device exists, and fail on any
 // validation-layer message.
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,11 @@
 #include "RenderJob.h"
 #include "TerrainLoading.h"
 #include "render/DebugViews.h"
+#include "render/FrameGraph.h"
+#include "vk/Descriptors.h"
+#include "vk/Image.h"
+#include "vk/RenderPass.h"
+#include "vk/Sampler.h"
 
 using namespace terralux;
 namespace fs = std::filesystem;
@@ -114,9 +120,9 @@ TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
     ProjectRenderer withProbes(*ctx_, sampleProject("disabled", 8, 8));
     ASSERT_EQ(withProbes.loadProbes(true), 1u);
     ProjectRenderer without(*ctx_, sampleProject("none", 8, 8));  // no probes loaded at all
-    const RenderedImage off = draw(withProbes, 0, false);
-    const RenderedImage none = draw(without, 0, true);
-    const RenderedImage on = draw(withProbes, 0, true);
+    const RenderedImage off = draw(withProbes, kViewBeauty, false);
+    const RenderedImage none = draw(without, kViewBeauty, true);
+    const RenderedImage on = draw(withProbes, kViewBeauty, true);
     const auto d = test::compareImages(off.rgba, none.rgba, kW, kH);
     EXPECT_LE(d.maxAbs, 1.0 / 255.0);
     EXPECT_GT(meanAbsDiff(on, off), 0.5 / 255.0) << "probe lighting changes the image";
@@ -125,8 +131,8 @@ TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
 TEST_F(RenderTest, OneByOneGridWeighsOneEverywhere) {
     ProjectRenderer r(*ctx_, sampleProject("one", 1, 1));
     ASSERT_EQ(r.loadProbes(true), 1u);
-    const RenderedImage w = draw(r, 51);
-    const RenderedImage albedo = draw(r, 1);
+    const RenderedImage w = draw(r, kViewProbeWeight);
+    const RenderedImage albedo = draw(r, kViewAlbedo);
     size_t terrain = 0;
     for (size_t i = 0; i < size_t(kW) * kH; ++i) {
         // Terrain pixels are those the albedo view paints (the background is cleared to black).
@@ -173,7 +179,7 @@ TEST_F(RenderTest, PlateauIsBrighterThanValleyFloorInProbeIrradiance) {
     RenderRequest q;
     q.width = kW;
     q.height = kW;
-    q.debugView = 50;
+    q.debugView = kViewProbeIrradiance;
     q.linearOutput = true;
     const RenderedImage img = r.render(q);
     // Mean over a vertical strip of pixels (the valley runs north-south, i.e. along image rows).
@@ -194,7 +200,7 @@ TEST_F(RenderTest, PlateauIsBrighterThanValleyFloorInProbeIrradiance) {
 }
 
 TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
-    auto linear50 = [&](ProjectRenderer& r) { return draw(r, 50, true, true); };
+    auto linearProbeIrradiance = [&](ProjectRenderer& r) { return draw(r, kViewProbeIrradiance, true, true); };
     auto relDiff = [](const RenderedImage& a, const RenderedImage& b) {
         double num = 0, den = 0;
         for (size_t i = 0; i < a.rgba.size(); ++i) {
@@ -212,7 +218,7 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
     ASSERT_EQ(rb.loadProbes(true), 1u);
     ProjectRenderer rc(*ctx_, sampleProject("gridC", 2, 2));
     ASSERT_EQ(rc.loadProbes(true), 1u);
-    const RenderedImage ia = linear50(ra), ib = linear50(rb), ic = linear50(rc);
+    const RenderedImage ia = linearProbeIrradiance(ra), ib = linearProbeIrradiance(rb), ic = linearProbeIrradiance(rc);
     EXPECT_GT(relDiff(ia, ib), 0.2) << "sky colour";
     EXPECT_GT(relDiff(ia, ic), 0.01) << "probe grid";
 }
@@ -220,9 +226,9 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
 TEST_F(RenderTest, EveryViewDiffersFromBeauty) {
     ProjectRenderer r(*ctx_, sampleProject("views", 8, 8));
     ASSERT_EQ(r.loadProbes(true), 1u);
-    const RenderedImage beauty = draw(r, 0);
+    const RenderedImage beauty = draw(r, kViewBeauty);
     for (const auto& v : debugViews()) {
-        if (v.number == 0) continue;
+        if (v.number == kViewBeauty) continue;
         EXPECT_GT(meanAbsDiff(draw(r, v.number), beauty), 2.0 / 255.0) << v.number << " " << v.name;
     }
 }
@@ -252,7 +258,7 @@ GpuProbeVolume halves(const Heightfield& hf) {
 
 // Pixels the albedo view paints (the background is cleared to black).
 std::vector<size_t> terrainPixels(ProjectRenderer& r) {
-    const RenderedImage albedo = draw(r, 1);
+    const RenderedImage albedo = draw(r, kViewAlbedo);
     std::vector<size_t> out;
     for (size_t i = 0; i < size_t(kW) * kH; ++i)
         if (albedo.rgba[i * 4] > 0.0f) out.push_back(i);
@@ -276,23 +282,23 @@ TEST_F(RenderTest, ValidityViewShowsWhereMovedProbesLightAndWhereNoProbeIsLeft) 
 
     GpuProbeVolume v = halves(r.heightfield());
     r.setProbes({v});
-    const RenderedImage placed = draw(r, 54);
+    const RenderedImage placed = draw(r, kViewProbeValidity);
     EXPECT_EQ(count(placed, cyan), 0u);
     EXPECT_GT(count(placed, grey), terrain.size() * 9 / 10);
 
     v.diagnostics->moved = {0, 1};
     r.setProbes({v});
-    const RenderedImage moved = draw(r, 54);
+    const RenderedImage moved = draw(r, kViewProbeValidity);
     EXPECT_GT(count(moved, cyan), terrain.size() / 4) << "the east half is lit by a moved probe";
     EXPECT_GT(count(moved, grey), terrain.size() / 4) << "the west half is not";
 
     GpuProbeVolume empty = v;
     std::fill(empty.occupancy.begin(), empty.occupancy.end(), -1);  // every probe rejected
     r.setProbes({empty});
-    EXPECT_GT(count(draw(r, 54), red), terrain.size() * 9 / 10);
+    EXPECT_GT(count(draw(r, kViewProbeValidity), red), terrain.size() * 9 / 10);
     // A second volume that lights the same ground: nothing is left unlit.
     r.setProbes({empty, v});
-    EXPECT_EQ(count(draw(r, 54), red), 0u);
+    EXPECT_EQ(count(draw(r, kViewProbeValidity), red), 0u);
 }
 
 TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
@@ -308,7 +314,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     m.error = {0.05f, 0.05f, 0.05f, 0.05f};
     r.setProbes({v});
     // EXR: the error itself in red, 1 in green where measured.
-    RenderedImage img = draw(r, 56, true, true);
+    RenderedImage img = draw(r, kViewInterpolationError, true, true);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4], 0.05f, 1e-4f) << "pixel " << i;
         ASSERT_NEAR(img.rgba[i * 4 + 1], 1.0f, 1e-3f) << "pixel " << i;  // half-float target
@@ -317,7 +323,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // West column 0, east column 20 %: every value in between, both ends on the heat ramp.
     m.error = {0.0f, 0.2f, 0.0f, 0.2f};
     r.setProbes({v});
-    img = draw(r, 56, true, true);
+    img = draw(r, kViewInterpolationError, true, true);
     float lo = 1.0f, hi = 0.0f;
     for (size_t i : terrain) {
         lo = std::min(lo, img.rgba[i * 4]);
@@ -326,7 +332,7 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     EXPECT_LT(lo, 0.01f);
     EXPECT_GT(hi, 0.19f);
     EXPECT_LE(hi, 0.2f + 1e-4f);
-    const RenderedImage shown = draw(r, 56);
+    const RenderedImage shown = draw(r, kViewInterpolationError);
     size_t blue = 0, redPixels = 0;
     for (size_t i : terrain) {
         const float* c = &shown.rgba[i * 4];
@@ -337,10 +343,10 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     EXPECT_GT(blue, 0u);
     EXPECT_GT(redPixels, 0u);
     // The map lands where the bake measured it: its east column (x > 0) is the east half, which
-    // view 54 shows through the probe that lights it.
+    // the probe-validity view shows through the probe that lights it.
     v.diagnostics->moved = {0, 1};
     r.setProbes({v});
-    const RenderedImage validity = draw(r, 54);
+    const RenderedImage validity = draw(r, kViewProbeValidity);
     size_t agree = 0, high = 0;
     for (size_t i : terrain) {
         const float* c = &validity.rgba[i * 4];
@@ -359,8 +365,8 @@ TEST_F(RenderTest, InterpolationErrorViewShowsTheBakedMap) {
     // Unmeasured points (no probe around them at bake time): no value, grey.
     m.error.assign(4, NAN);
     r.setProbes({v});
-    img = draw(r, 56, true, true);
-    const RenderedImage grey = draw(r, 56);
+    img = draw(r, kViewInterpolationError, true, true);
+    const RenderedImage grey = draw(r, kViewInterpolationError);
     for (size_t i : terrain) {
         ASSERT_NEAR(img.rgba[i * 4 + 1], 0.0f, 1e-3f) << "pixel " << i;
         ASSERT_NEAR(grey.rgba[i * 4], grey.rgba[i * 4 + 2], 1e-3f) << "pixel " << i;
@@ -377,7 +383,7 @@ TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
     RenderRequest q;
     q.width = kW;
     q.height = kH;
-    q.debugView = 1;
+    q.debugView = kViewAlbedo;
     const RenderedImage plain = r.render(q);
     q.leaves = true;
     const RenderedImage lines = r.render(q);
@@ -405,4 +411,154 @@ TEST_F(RenderTest, EditsThatDoNotTouchTheVolumesPlaceNothing) {
     p.scene.probeVolumes[0].gridDims = {7, 1, 5};
     r.setProject(p);
     EXPECT_EQ(r.placements(), placed + 1) << "a grid edit must place the volume again";
+}
+
+namespace {
+
+// Whether any pass of the frame is, touches or binds anything of the probe subsystem.
+std::string probeMention(const std::vector<PassInfo>& passes) {
+    for (const auto& p : passes) {
+        if (p.name.find("probe") != std::string::npos) return "pass " + p.name;
+        for (const auto& b : p.bindings)
+            if (b.find("probe") != std::string::npos) return p.name + " binds " + b;
+        for (const auto& u : p.uses)
+            if (u.resource.find("probe") != std::string::npos) return p.name + " uses " + u.resource;
+    }
+    return "";
+}
+
+std::vector<std::string> passNames(const std::vector<PassInfo>& passes) {
+    std::vector<std::string> out;
+    for (const auto& p : passes) out.push_back(p.name);
+    return out;
+}
+
+bool binds(const std::vector<PassInfo>& passes, const std::string& pass, const std::string& binding) {
+    for (const auto& p : passes)
+        if (p.name == pass)
+            for (const auto& b : p.bindings)
+                if (b == binding) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
+    using Names = std::vector<std::string>;
+    ProjectRenderer without(*ctx_, sampleProject("novolumes", 8, 8));  // no probes loaded at all
+    EXPECT_FALSE(without.renderer().hasProbeResources());
+    for (const auto& v : debugViews()) {
+        draw(without, v.number);
+        const std::string mention = probeMention(without.renderer().lastFramePasses());
+        EXPECT_TRUE(mention.empty()) << v.name << ": " << mention;
+    }
+    const RenderedImage none = draw(without, kViewBeauty);
+    EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+
+    ProjectRenderer with(*ctx_, sampleProject("volumes", 8, 8));
+    ASSERT_EQ(with.loadProbes(true), 1u);
+    EXPECT_TRUE(with.renderer().hasProbeResources());
+    // Probes on: the probe pass runs once after the volumes changed; the terrain reads its light.
+    draw(with, kViewBeauty);
+    const auto& first = with.renderer().lastFramePasses();
+    EXPECT_EQ(passNames(first), (Names{"probe-vertices", "terrain", "readback"}));
+    EXPECT_TRUE(binds(first, "probe-vertices", "probe-coefficients"));
+    EXPECT_TRUE(binds(first, "terrain", "vertex:probe-light"));
+    draw(with, kViewBeauty);
+    EXPECT_EQ(passNames(with.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+    EXPECT_TRUE(binds(with.renderer().lastFramePasses(), "terrain", "vertex:probe-light"));
+    // Probes off: nothing of them takes part, and the image is the one without volumes.
+    const RenderedImage off = draw(with, kViewBeauty, false);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    EXPECT_EQ(test::compareImages(off.rgba, none.rgba, kW, kH).maxAbs, 0.0);
+    // Views that do not read probe light leave the probes out too.
+    draw(with, kViewAlbedo);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    // Unbinding the volumes frees the subsystem.
+    with.setProbes({});
+    EXPECT_FALSE(with.renderer().hasProbeResources());
+    const RenderedImage unbound = draw(with, kViewBeauty);
+    EXPECT_EQ(probeMention(with.renderer().lastFramePasses()), "");
+    EXPECT_EQ(test::compareImages(unbound.rgba, none.rgba, kW, kH).maxAbs, 0.0);
+}
+
+TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
+    ProjectRenderer r(*ctx_, sampleProject("finite", 8, 8));
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    for (const auto& v : debugViews())
+        for (bool linear : {false, true}) {
+            const RenderedImage img = draw(r, v.number, true, linear);
+            ASSERT_EQ(img.rgba.size(), size_t(kW) * kH * 4);
+            size_t nonFinite = 0, differing = 0;
+            for (size_t i = 0; i < img.rgba.size(); ++i) {
+                nonFinite += !std::isfinite(img.rgba[i]);
+                differing += img.rgba[i] != img.rgba[i % 4];
+            }
+            EXPECT_EQ(nonFinite, 0u) << v.name << (linear ? " (linear)" : "");
+            EXPECT_GT(differing, size_t(kW) * kH / 8) << v.name << (linear ? " (linear)" : "") << " is blank";
+        }
+}
+
+// The device layer's target kinds, samplers and image bindings, through the frame graph: a depth
+// target drawn (cleared) by a depth-only pass, then read by shaders along with a layered and a
+// cube target, with no validation message.
+TEST_F(RenderTest, DeviceLayerTargetsSamplersAndImageBindings) {
+    const vk::VulkanContext& ctx = *ctx_;
+    vk::Image depth = vk::Image::depthTarget(ctx, 64, 64);
+    vk::Image cascades = vk::Image::depthTarget(ctx, 64, 64, 4);
+    vk::Image layered = vk::Image::layeredTarget(ctx, 32, 32, 3);
+    vk::Image cube = vk::Image::cubeTarget(ctx, 16);
+    vk::Image color = vk::Image::colorTarget(ctx, 8, 8);
+    EXPECT_EQ(cascades.desc().layers, 4u);
+    EXPECT_EQ(cube.desc().layers, 6u);
+    EXPECT_EQ(depth.aspect(), VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT));
+    const vk::Sampler shadow = vk::Sampler::depthCompare(ctx), linear = vk::Sampler::linearClamp(ctx),
+                      nearest = vk::Sampler::nearestClamp(ctx);
+    vk::Buffer block = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    vk::Buffer data = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    constexpr VkShaderStageFlags fragment = VK_SHADER_STAGE_FRAGMENT_BIT;
+    const vk::DescriptorSet set = vk::DescriptorSetBuilder()
+                                      .uniform(0, "block", block, fragment)
+                                      .storage(1, "data", data, fragment)
+                                      .image(2, "shadow-map", depth.view(), shadow.handle(), fragment)
+                                      .image(3, "cascades", cascades.view(), shadow.handle(), fragment)
+                                      .image(4, "layers", layered.view(), linear.handle(), fragment)
+                                      .image(5, "cube", cube.view(), linear.handle(), fragment)
+                                      .image(6, "color", color.view(), nearest.handle(), fragment)
+                                      .build(ctx);
+    EXPECT_EQ(set.bindingNames(), (std::vector<std::string>{"block", "data", "shadow-map", "cascades",
+                                                            "layers", "cube", "color"}));
+
+    const vk::RenderPass depthOnly(ctx, {{}, vk::kDepthFormat, true, true});
+    const VkImageView attachment = depth.view();
+    const vk::Framebuffer framebuffer(ctx, depthOnly, {&attachment, 1}, 64, 64);
+    FrameGraph graph;
+    graph.importImage("shadow-map", depth.handle(), depth.aspect());
+    graph.importImage("cascades", cascades.handle(), cascades.aspect(), 4);
+    graph.importImage("layers", layered.handle(), layered.aspect(), 3);
+    graph.importImage("cube", cube.handle(), cube.aspect(), 6);
+    graph.importImage("color", color.handle(), color.aspect());
+    graph.addPass({"shadow", {{"shadow-map", Access::DepthAttachmentClear}}, {}}, [&](VkCommandBuffer cb) {
+        VkClearValue clear{};
+        clear.depthStencil = {1.0f, 0};
+        VkRenderPassBeginInfo rbi{};
+        rbi.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+        rbi.renderPass = depthOnly.handle();
+        rbi.framebuffer = framebuffer.handle();
+        rbi.renderArea = {{0, 0}, {64, 64}};
+        rbi.clearValueCount = 1;
+        rbi.pClearValues = &clear;
+        vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdEndRenderPass(cb);
+    });
+    graph.addPass({"lit",
+                   {{"shadow-map", Access::FragmentSampledRead},
+                    {"cascades", Access::FragmentSampledRead},
+                    {"layers", Access::FragmentSampledRead},
+                    {"cube", Access::FragmentSampledRead},
+                    {"color", Access::FragmentSampledRead}},
+                   set.bindingNames()},
+                  nullptr);
+    ctx.submitAndWait([&](VkCommandBuffer cb) { graph.execute(cb); });
+    EXPECT_EQ(graph.lastFrame().size(), 2u);
 }

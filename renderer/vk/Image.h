@@ -1,0 +1,67 @@
+#pragma once
+// Device images with their memory and views: sampled colour render targets (2D, layered 2D
+// arrays, cubes) and depth targets that shaders can sample (shadow maps). Every target is also a
+// transfer source, so any of them can be read back or presented.
+
+#include <cstdint>
+#include <vector>
+
+#include "vk/Handle.h"
+#include "vk/VulkanContext.h"
+
+namespace terralux::vk {
+
+inline constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+
+enum class ImageShape { Plane, Layers, Cube };
+
+struct ImageDesc {
+    ImageShape shape = ImageShape::Plane;
+    VkFormat format = kColorFormat;
+    uint32_t width = 1, height = 1;
+    uint32_t layers = 1;  // Layers: the array size; Cube: 6
+    VkImageUsageFlags usage = 0;
+};
+
+class Image {
+public:
+    Image() = default;
+    Image(const VulkanContext& ctx, const ImageDesc& desc);
+
+    // A colour target shaders can sample, read back or blit from.
+    static Image colorTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
+                             VkFormat format = kColorFormat);
+    // A 2D array colour target, one layer per slice (cascades, volume slices).
+    static Image layeredTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
+                               uint32_t layers, VkFormat format = kColorFormat);
+    // A cube colour target, one layer per face (reflection probes).
+    static Image cubeTarget(const VulkanContext& ctx, uint32_t size, VkFormat format = kColorFormat);
+    // A depth target shaders can sample, e.g. with a depth-compare sampler (shadow maps); `layers`
+    // > 1 makes a 2D array (one layer per cascade).
+    static Image depthTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
+                             uint32_t layers = 1, VkFormat format = kDepthFormat);
+
+    VkImage handle() const { return image_.get(); }
+    // The whole image as shaders see it: 2D, 2D array or cube.
+    VkImageView view() const { return view_.get(); }
+    // One layer as a 2D view, for a framebuffer attachment.
+    VkImageView layerView(uint32_t layer) const { return layerViews_[layer].get(); }
+    const ImageDesc& desc() const { return desc_; }
+    uint32_t width() const { return desc_.width; }
+    uint32_t height() const { return desc_.height; }
+    VkImageAspectFlags aspect() const { return aspect_; }
+
+private:
+    ImageDesc desc_;
+    VkImageAspectFlags aspect_ = VK_IMAGE_ASPECT_COLOR_BIT;
+    // Declared in destruction order: views, image, then its memory.
+    UniqueMemory memory_;
+    UniqueImage image_;
+    UniqueImageView view_;
+    std::vector<UniqueImageView> layerViews_;
+};
+
+bool isDepthFormat(VkFormat format);
+
+}  // namespace terralux::vk

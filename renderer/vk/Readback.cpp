@@ -1,0 +1,53 @@
+#include "vk/Readback.h"
+
+#include <cstring>
+
+namespace terralux::vk {
+
+namespace {
+// IEEE 754 half to float (the readback format); no library in the dependency set provides it.
+float halfToFloat(uint16_t h) {
+    const uint32_t sign = uint32_t(h & 0x8000) << 16;
+    uint32_t exp = (h >> 10) & 0x1F, mant = h & 0x3FF;
+    uint32_t bits;
+    if (exp == 0) {
+        if (mant == 0) {
+            bits = sign;
+        } else {
+            exp = 127 - 15 + 1;
+            while (!(mant & 0x400)) {
+                mant <<= 1;
+                --exp;
+            }
+            bits = sign | (exp << 23) | ((mant & 0x3FF) << 13);
+        }
+    } else if (exp == 31) {
+        bits = sign | 0x7F800000 | (mant << 13);
+    } else {
+        bits = sign | ((exp - 15 + 127) << 23) | (mant << 13);
+    }
+    float f;
+    std::memcpy(&f, &bits, 4);
+    return f;
+}
+}  // namespace
+
+Readback::Readback(const VulkanContext& ctx, uint32_t width, uint32_t height)
+    : width_(width), height_(height),
+      buffer_(Buffer::hostVisible(ctx, VkDeviceSize(width) * height * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT)) {}
+
+void Readback::recordCopy(VkCommandBuffer cb, VkImage image) const {
+    VkBufferImageCopy copy{};
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.imageExtent = {width_, height_, 1};
+    vkCmdCopyImageToBuffer(cb, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer_.handle(), 1, &copy);
+}
+
+std::vector<float> Readback::pixels() {
+    const auto* half = static_cast<const uint16_t*>(buffer_.map());
+    std::vector<float> out(size_t(width_) * height_ * 4);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = halfToFloat(half[i]);
+    return out;
+}
+
+}  // namespace terralux::vk

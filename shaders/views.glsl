@@ -1,0 +1,88 @@
+// The debug views: kView<Name> constants from debug_views.def, one function per view, and the
+// dispatch over them (include after tonemap.glsl, sky.glsl and brdf.glsl). A view added to the
+// list that has no function here fails the build.
+#ifndef TLX_VIEWS_GLSL
+#define TLX_VIEWS_GLSL
+
+#define TLX_VIEW(NAME, NUMBER) const int kView##NAME = NUMBER;
+#include "debug_views.def"
+#undef TLX_VIEW
+
+// What the views read at one terrain point.
+struct ShadingPoint {
+    vec3 position, normal, albedo;
+    // rgb probe irradiance, a blend weight; in the diagnostics views instead: x share of moved
+    // probes in the blend (-1 where no probe lights the point), y interpolation error × known,
+    // z known (1 = measured), w 1 = inside a volume with no probe to light it.
+    vec4 probe;
+    vec3 linear;  // sceneLinear()
+};
+
+float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
+
+// Scene-linear light leaving the point toward the camera: Lambert + GGX sun, sky irradiance with
+// the baked probe irradiance blended over it (absent probes leave the sky term as it is).
+vec3 sceneLinear(ShadingPoint s) {
+    vec3 n = s.normal;
+    vec3 l = normalize(sunSky.sunDirection.xyz);
+    vec3 v = normalize(camera.position.xyz - s.position);
+    float ndotl = max(dot(n, l), 0.0);
+    vec3 sky = skyIrradiance(n);
+    float weight = s.probe.a;
+    vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb, weight) : sky;
+    vec3 spec = ggxSpecular(n, v, l, surface.material.x);
+    vec3 sun = sunSky.sunIlluminance.rgb;
+    return s.albedo / PI * (sun * ndotl + ambient) + spec * sun;
+}
+
+vec3 viewBeauty(ShadingPoint s) { return display(s.linear); }
+vec3 viewAlbedo(ShadingPoint s) { return linearOutput() ? s.albedo : srgb(s.albedo); }
+vec3 viewNormal(ShadingPoint s) { return s.normal * 0.5 + 0.5; }
+vec3 viewNdotL(ShadingPoint s) { return vec3(sunNdotL(s)); }
+vec3 viewLinear(ShadingPoint s) { return linearOutput() ? s.linear : clamp(s.linear, 0.0, 1.0); }
+vec3 viewProbeIrradiance(ShadingPoint s) { return display(s.probe.rgb * s.probe.a / PI); }
+vec3 viewProbeWeight(ShadingPoint s) { return vec3(s.probe.a); }
+
+// Probe validity: grey where probes at their placement light the ground, cyan as moved probes
+// take part, red inside a volume where no valid probe is left, dark outside.
+vec3 viewProbeValidity(ShadingPoint s) {
+    vec4 d = s.probe;
+    float relief = 0.55 + 0.45 * max(s.normal.y, 0.0);
+    vec3 base = d.w > 0.5  ? vec3(0.85, 0.12, 0.10)
+              : d.x > -0.5 ? mix(vec3(0.72), vec3(0.10, 0.80, 1.0), clamp(d.x, 0.0, 1.0))
+                           : vec3(0.18);
+    return base * relief;
+}
+
+// Heat ramp: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red. Piecewise
+// linear over the stops, without an indexed array (which a CPU driver may build for every
+// fragment).
+vec3 heat(float e) {
+    float t = clamp(e / 0.10, 0.0, 1.0) * 4.0;
+    if (t < 1.0) return mix(vec3(0.05, 0.10, 0.55), vec3(0.0, 0.65, 0.90), t);
+    if (t < 2.0) return mix(vec3(0.0, 0.65, 0.90), vec3(0.15, 0.80, 0.20), t - 1.0);
+    if (t < 3.0) return mix(vec3(0.15, 0.80, 0.20), vec3(1.0, 0.85, 0.10), t - 2.0);
+    return mix(vec3(1.0, 0.85, 0.10), vec3(0.90, 0.10, 0.05), t - 3.0);
+}
+
+// Interpolation error: EXR holds the error in red and 1 in green where measured.
+vec3 viewInterpolationError(ShadingPoint s) {
+    float known = s.probe.z;
+    float error = known > 0.0 ? s.probe.y / known : 0.0;
+    if (linearOutput()) return vec3(known > 0.5 ? error : 0.0, known > 0.5 ? 1.0 : 0.0, 0.0);
+    return (known > 0.5 ? heat(error) : vec3(0.25)) * (0.75 + 0.25 * max(s.normal.y, 0.0));
+}
+
+vec3 shadeView(int view, ShadingPoint s) {
+    // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
+    // views that need the full shading share one evaluation.
+    s.linear = sceneLinear(s);
+    switch (view) {
+#define TLX_VIEW(NAME, NUMBER) case kView##NAME: return view##NAME(s);
+#include "debug_views.def"
+#undef TLX_VIEW
+    }
+    return viewBeauty(s);
+}
+
+#endif
