@@ -104,7 +104,7 @@ ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays
 }
 
 // Where two volumes' grids overlap, the engine reads the one whose file name sorts first
-// (FORMATS.md); the other's probes go unused wherever the first has a probe.
+// (docs/formats.md); the other's probes go unused wherever the first has a probe.
 nlohmann::json overlapReport(const std::vector<GltfProbeVolume>& grids) {
     nlohmann::json out = nlohmann::json::array();
     for (size_t a = 0; a < grids.size(); ++a)
@@ -197,7 +197,7 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
     return j;
 }
 
-// Points at which every adaptive volume measures its interpolation error (LIGHTING.md).
+// Points at which every adaptive volume measures its interpolation error (docs/lighting.md).
 constexpr int kInterpolationPoints = 256;
 
 }  // namespace
@@ -364,7 +364,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             }
         }
 
-        // The interpolation-error map of the probes as the engine will read them (view 56).
+        // The interpolation-error map of the probes as the engine will read them (the interpolation-error debug view).
         ProbeDiagnostics diagnostics = describeProbes(layout);
         if (scene.bake.errorMapResolution > 0) {
             phase = "error map '" + v.name + "'";

@@ -35,7 +35,7 @@
 namespace terralux {
 namespace {
 
-const char* const kUsage = R"(Usage: terralux [PROJECT]              open the authoring window
+const char* const kUsageTemplate = R"(Usage: terralux [PROJECT]              open the authoring window
        terralux COMMAND [OPTIONS]       work headless
 
 Terrain-lighting authoring: import a DEM, bake spherical-harmonics probes, export .shprobe + glTF.
@@ -64,9 +64,7 @@ Options:
   --compare-reference           Also run the brute-force reference and report the error of
                                 every probe against it (slow).
   --size WxH                    Render size (default 1280x720).
-  --debug-view N|NAME           What --render draws: 0 beauty, 1 albedo, 2 normal, 30 ndotl,
-                                32 linear, 50 probe-irradiance, 51 probe-weight,
-                                54 probe-validity, 56 interpolation-error.
+  --debug-view N|NAME           What --render draws: {views}.
   --overlay LIST                --render: draw over the image, comma-separated: probes (probe
                                 positions: gold valid, cyan moved up, red rejected), leaves
                                 (adaptive octree leaves).
@@ -91,6 +89,31 @@ With no project and no --dem, commands use the embedded sample terrain (256 x 25
 
 Exit codes: 0 success, 2 bad usage or invalid input, 3 runtime failure, 130 interrupted.
 )";
+
+// The help text, with the debug views listed from their table and wrapped under their option.
+std::string usage() {
+    std::string text = kUsageTemplate;
+    const std::string marker = "{views}";
+    const size_t at = text.find(marker);
+    const size_t column = at - text.rfind('\n', at) - 1;
+    std::string wrapped;
+    size_t width = column;
+    const auto& views = debugViews();
+    for (size_t i = 0; i < views.size(); ++i) {
+        // "30 ndotl," stays on one line.
+        const std::string entry = std::to_string(views[i].number) + " " + views[i].name + (i + 1 < views.size() ? "," : "");
+        if (i > 0 && width + 1 + entry.size() > 97) {
+            wrapped += "\n" + std::string(32, ' ');
+            width = 32;
+        } else if (i > 0) {
+            wrapped += ' ';
+            ++width;
+        }
+        wrapped += entry;
+        width += entry.size();
+    }
+    return text.replace(at, marker.size(), wrapped);
+}
 
 struct Args {
     QCommandLineParser parser;
@@ -323,7 +346,7 @@ int commandBake(const Args& a) {
                       << m["size"][1].get<int>() << " points, " << fixed(m["height_m"].get<double>(), 2)
                       << " m up): mean " << fixed(100.0 * m["mean"].get<double>(), 2) << " % / p95 "
                       << fixed(100.0 * m["p95"].get<double>(), 2) << " % / max "
-                      << fixed(100.0 * m["max"].get<double>(), 2) << " % (debug view 56)\n";
+                      << fixed(100.0 * m["max"].get<double>(), 2) << " % (debug view " << kViewInterpolationError << ")\n";
         }
     }
     std::cout << "wrote " << outcome.outDir.string() << ":\n";
@@ -446,7 +469,7 @@ int runCommandLine(int argc, char** argv) {
     try {
         if (!a.parser.parse(arguments)) throw UsageError(str(a.parser.errorText()));
         if (a.parser.isSet(a.help)) {
-            std::cout << kUsage;
+            std::cout << usage();
             return kExitOk;
         }
         if (a.parser.isSet(a.version)) {
@@ -484,7 +507,7 @@ int runCommandLine(int argc, char** argv) {
         if (!a.parser.positionalArguments().isEmpty())
             throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) +
                              "' (no command given)");
-        std::cout << kUsage;
+        std::cout << usage();
         return kExitOk;
     } catch (const UsageError& e) {
         std::cerr << "terralux: " << e.what() << "\nTry 'terralux --help'.\n";

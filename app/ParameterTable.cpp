@@ -1,7 +1,11 @@
 #include "ParameterTable.h"
 
+#include <charconv>
+#include <cstdlib>
+
 #include "Project.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -20,6 +24,16 @@ struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
 
+// A float field written as the shortest decimal that reads back as the same float: 0.3f is
+// written 0.3, not 0.30000001192092896.
+double shortest(float f) {
+    char buf[32];
+    const auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
+    return std::strtod(std::string(buf, end).c_str(), nullptr);
+}
+
+json shortest(const glm::vec3& v) { return json{shortest(v.x), shortest(v.y), shortest(v.z)}; }
+
 template <class T>
 json fieldToJson(const T& v, const std::vector<std::string>& choices) {
     if constexpr (IsOptional<T>::value) {
@@ -27,7 +41,9 @@ json fieldToJson(const T& v, const std::vector<std::string>& choices) {
     } else if constexpr (std::is_enum_v<T>) {
         return choices.at(size_t(v));
     } else if constexpr (std::is_same_v<T, glm::vec3>) {
-        return json{double(v.x), double(v.y), double(v.z)};
+        return shortest(v);
+    } else if constexpr (std::is_same_v<T, float>) {
+        return shortest(v);
     } else {
         return json(v);
     }
@@ -257,7 +273,7 @@ std::vector<ParameterSpec> buildTable() {
             [=](const SceneDescription& s, size_t i) {
                 const auto& o = s.probeVolumes.at(i).origin;
                 if (!o) return json(nullptr);
-                return isBox(s, i) || isAdaptive(s, i) ? json{o->x, o->y, o->z} : json{o->x, o->z};
+                return isBox(s, i) || isAdaptive(s, i) ? shortest(*o) : json{shortest(o->x), shortest(o->z)};
             },
             [=](SceneDescription& s, size_t i, const json& v) {
                 auto& o = s.probeVolumes.at(i).origin;
@@ -274,7 +290,7 @@ std::vector<ParameterSpec> buildTable() {
             [=](const SceneDescription& s, size_t i) {
                 const auto& sp = s.probeVolumes.at(i).spacing;
                 if (!sp || isAdaptive(s, i)) return json(nullptr);
-                return isBox(s, i) ? json(double(sp->x)) : json{sp->x, sp->z};
+                return isBox(s, i) ? json(shortest(sp->x)) : json{shortest(sp->x), shortest(sp->z)};
             },
             [=](SceneDescription& s, size_t i, const json& v) {
                 auto& sp = s.probeVolumes.at(i).spacing;
@@ -387,7 +403,7 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::deringing);
     add(Row("bake.error_map_resolution", T::Integer)).range(0, kMaxErrorMapResolution).unit("points")
         .label("Error map points a side")
-        .about("Points along the longer side of each volume's interpolation-error map (view 56); 0 = no map; each costs one probe bake")
+        .about("Points along the longer side of each volume's interpolation-error map (debug view interpolation-error); 0 = no map; each costs one probe bake")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::errorMapResolution);
 
     // Camera (edited by the viewport, stored in the project).
@@ -615,7 +631,7 @@ std::string autoShort(const ParameterSpec& spec) {
 json projectSchema() {
     json schema = objectSchema();
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema";
-    schema["$id"] = "https://terralux.dev/schema/project-1.json";
+    schema["$id"] = "urn:terralux:project:1";
     schema["title"] = "Terralux project";
     schema["description"] =
         "A Terralux project file. Every key is optional: an absent key takes its default; an unknown key is an error.";
@@ -663,6 +679,49 @@ std::string parameterReferenceMarkdown() {
            << cell(s.autoMeaning.value_or("")) << " | " << cell(s.description) << " |\n";
     }
     return md.str();
+}
+
+std::string uiObjectNamesMarkdown() {
+    std::ostringstream out;
+    out << "| dock | parameter editors |\n|---|---|\n";
+    std::vector<std::pair<ParameterDock, std::vector<std::string>>> docks;
+    std::vector<std::string> special;
+    for (const ParameterSpec& spec : parameterTable()) {
+        if (!spec.uiRow) continue;
+        const ParameterDock dock = parameterDock(spec);
+        auto it = std::find_if(docks.begin(), docks.end(),
+                               [&](const auto& d) { return d.first.objectName == dock.objectName; });
+        if (it == docks.end()) it = docks.insert(docks.end(), {dock, {}});
+        const std::string name = uiObjectName(spec);
+        std::string entry = "`" + name + "`";
+        switch (spec.type) {
+        case ParamType::Color: entry += " (colour button)"; break;
+        case ParamType::Choice: entry += " (combo)"; break;
+        case ParamType::Boolean: entry += " (check box)"; break;
+        case ParamType::String: entry += " (line edit)"; break;
+        case ParamType::NumberList:
+        case ParamType::IntegerList:
+            entry = "`" + name + ".0`";
+            for (int k = 1; k < spec.maxItems; ++k) entry += " / `." + std::to_string(k) + "`";
+            if (spec.nullable()) entry += " + `.auto` (check box)";
+            break;
+        default:
+            if (spec.slider) entry += " (+ `.slider`)";
+            break;
+        }
+        it->second.push_back(entry);
+        if (spec.nullable() && (spec.type == ParamType::Number || spec.type == ParamType::Integer))
+            special.push_back("`" + name + "` shows \"" + autoShort(spec) + "\"");
+    }
+    for (const auto& [dock, names] : docks) {
+        out << "| " << dock.title << " (`" << dock.objectName << "`) | ";
+        for (size_t k = 0; k < names.size(); ++k) out << (k ? ", " : "") << names[k];
+        out << " |\n";
+    }
+    out << "\nAt one step below their minimum, nullable spin boxes show what `null` (auto) means: ";
+    for (size_t k = 0; k < special.size(); ++k) out << (k ? ", " : "") << special[k];
+    out << ".\n";
+    return out.str();
 }
 
 }  // namespace terralux

@@ -119,5 +119,8 @@ std::string autoShort(const ParameterSpec& spec);
 nlohmann::json projectSchema();
 // The parameter reference in Markdown (docs/parameters.md), generated from the table.
 std::string parameterReferenceMarkdown();
+// The parameter editors of each dock with their objectNames (docs/UI_OBJECT_NAMES.md), generated
+// from the table.
+std::string uiObjectNamesMarkdown();
 
 }  // namespace terralux

@@ -20,7 +20,7 @@ public:
 };
 
 inline constexpr int kProjectVersion = 1;
-inline constexpr int kMaxTerrainGridProbes = 4096;   // LIGHTING.md, diffuse grid dims
+inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffuse grid dims
 inline constexpr int kMaxBoxGridProbes = 65536;
 inline constexpr int kMaxReflectionProbes = 256;
 inline constexpr int kMaxBounces = 16;

@@ -124,7 +124,7 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
         gv.occupancy = g.occupancy;
         gv.scale = g.defaultScale;
         gv.irradianceEncoded = scene.bake.encoding == ShEncoding::Irradiance;
-        // LIGHTING.md default: twice the smallest probe spacing, which is the cell edge here.
+        // docs/lighting.md default: twice the smallest probe spacing, which is the cell edge here.
         gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
                                                            : 2.0f * g.spacing;
         for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);

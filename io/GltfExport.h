@@ -1,5 +1,5 @@
 #pragma once
-// glTF 2.0 scene export (FORMATS.md): the terrain mesh, its material, the baked SH probe volumes
+// glTF 2.0 scene export (docs/formats.md): the terrain mesh, its material, the baked SH probe volumes
 // and the geo/bake metadata, written as
 //
 //   <outDir>/scene.gltf

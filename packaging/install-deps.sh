@@ -18,6 +18,8 @@ packages=(
   libtinygltf-dev nlohmann-json3-dev libtbb-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the project JSON Schema is checked against --print-project with a real validator
+  python3 python3-jsonschema
   mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
   xvfb xauth fonts-dejavu-core
   # the glTF validator is an npm package, installed by the test set-up

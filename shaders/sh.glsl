@@ -1,4 +1,4 @@
-// Spherical-harmonics irradiance (FORMATS.md basis).
+// Spherical-harmonics irradiance (docs/formats.md basis).
 #ifndef TLX_SH_GLSL
 #define TLX_SH_GLSL
 

@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Terrain shading (LIGHTING.md) and the debug views. It binds the view and the lights only: probe
+// Terrain shading (docs/lighting.md) and the debug views. It binds the view and the lights only: probe
 // light comes in per vertex from the probe pass, when there is one.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"

@@ -1,6 +1,6 @@
 #pragma once
 // Adaptive octree placement of SH probes over a terrain (seed 001's adaptive octree, written as
-// FORMATS.md's .shprobe grid at the minimum cell size), its error-driven refinement, and the
+// docs/formats.md's .shprobe grid at the minimum cell size), its error-driven refinement, and the
 // interpolation model that the refinement and the reported interpolation error share.
 //
 // Geometry. The box (auto: the terrain footprint from the lowest terrain point up to the highest
@@ -19,7 +19,7 @@
 // piecewise-linear surface takes its extremes over a rectangle at the mesh vertices inside it and
 // where the rectangle's edges cross grid lines and cell diagonals.
 //
-// Interpolation model ("interpolated from its neighbours", LIGHTING.md's interpolation error).
+// Interpolation model ("interpolated from its neighbours", docs/lighting.md's interpolation error).
 // An engine reads the .shprobe occupancy grid. Filtered like a 3D texture, a point p gets the
 // trilinear blend of the probes named by the 8 grid cells whose centres surround p; cells
 // holding -1 (terrain, outside) are left out and the weights renormalised. Inside a leaf two or
@@ -28,7 +28,7 @@
 //
 // Error-driven refinement (tolerance set). Each leaf larger than the minimum bakes probes at the
 // centres of its 8 octants, where its children's probes would go. The model gives the leaf's own
-// probe there, so the leaf's error is the largest relative irradiance error (LIGHTING.md probe
+// probe there, so the leaf's error is the largest relative irradiance error (docs/lighting.md probe
 // error: RMS over 256 normals) of its probe against those 8 bakes; above the tolerance it splits
 // and its children keep the octant bakes (same position, same seed). Rounds go one level down at
 // a time; in each round the worst leaves split first, and a budget (max_probes, max_bytes) stops
@@ -105,7 +105,7 @@ struct InterpolationError {
     std::vector<float> errors;
 };
 
-// LIGHTING.md interpolation error: at `count` points drawn uniformly (deterministically from
+// docs/lighting.md interpolation error: at `count` points drawn uniformly (deterministically from
 // `seed`) from the part of the layout's grid box above the terrain, the relative irradiance error
 // of the interpolated probes against a probe baked at the point with `baker`.
 InterpolationError measureInterpolationError(const ProbeLayout& layout,

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU bake of diffuse SH probes over a heightfield (LIGHTING.md "Light transport for bakes").
+// The CPU bake of diffuse SH probes over a heightfield (docs/lighting.md "Light transport for bakes").
 //
 // Probe radiance L(p, ω) is the sky where a ray escapes and, where it hits the terrain, the
 // light that point reflects: albedo/π × its irradiance from the sun (shadowed), the sky
@@ -58,7 +58,7 @@ public:
     IrradianceCache(const BakeLighting& lighting, int resolution, int rays, int sunSamples,
                     int bounces, const BakeControl& control);
     // Irradiance arriving at a hit point: bilinear over the cache on the terrain; on the skirt,
-    // the open sky and the unshadowed sun (LIGHTING.md).
+    // the open sky and the unshadowed sun (docs/lighting.md).
     glm::vec3 at(const RayHit& hit) const;
     // The same without the direct sun at the hit: callers that trace the sun themselves add it
     // exactly (sun shadows are the sharpest part of terrain irradiance, too sharp for the cache).
@@ -82,7 +82,7 @@ private:
 struct ProbeBake {
     std::vector<sh::ShRgb> sh;          // radiance projections per probe (zero when invalid)
     std::vector<float> standardError;   // relative Monte Carlo standard error of E(up) per probe
-    // LIGHTING.md probe validity: the share of a probe's rays whose first hit is the terrain seen
+    // docs/lighting.md probe validity: the share of a probe's rays whose first hit is the terrain seen
     // from below (dot(dir, normal) > 0; the surface normals face up). A heightfield can only be
     // reached from below by a probe inside it, so any valid probe has 0.
     std::vector<float> fromBelowShare;
@@ -124,7 +124,7 @@ struct Spread {
 };
 Spread spreadOf(std::vector<float> values);
 
-// LIGHTING.md probe error: relative RMS of irradiance (luminance) over 256 fixed normals against
+// docs/lighting.md probe error: relative RMS of irradiance (luminance) over 256 fixed normals against
 // the reference, per valid probe; with mean, 95th percentile and max over probes.
 struct ErrorStats {
     std::vector<float> perProbe;

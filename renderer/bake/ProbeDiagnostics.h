@@ -1,8 +1,7 @@
 #pragma once
 // What a bake knows about its probes beyond their coefficients: where each probe sits, which were
 // moved up out of the terrain, which were rejected, the octree leaves, and an interpolation-error
-// map over the ground. The validity and interpolation-error debug views (LIGHTING.md views 54 and
-// 56) and the leaf overlay draw it. `.shprobe` carries none of this, so the bake writes it beside
+// map over the ground. The probe-validity and interpolation-error debug views (docs/lighting.md) and the leaf overlay draw it. `.shprobe` carries none of this, so the bake writes it beside
 // each file (io/ProbeDiagnosticsFile.h).
 
 #include <cstdint>
@@ -19,7 +18,7 @@
 
 namespace terralux {
 
-// LIGHTING.md interpolation error at the points of a regular grid over the ground: point (i, j)
+// docs/lighting.md interpolation error at the points of a regular grid over the ground: point (i, j)
 // lies at (x0 + i·step, z0 + j·step), `height` above the terrain surface. The error is the
 // relative irradiance error of the interpolated probes against a probe baked at the point.
 struct ErrorMap {

@@ -30,7 +30,7 @@ struct OctreeLeaf {
     bool operator==(const OctreeLeaf&) const = default;
 };
 
-// What happened to the probe of a leaf (LIGHTING.md: never a probe inside the terrain).
+// What happened to the probe of a leaf (docs/lighting.md: never a probe inside the terrain).
 enum class LeafProbe : uint8_t {
     Centre,    // at the leaf centre, above the terrain
     Moved,     // a minimum-size leaf whose centre is inside: moved up, within max_move_share

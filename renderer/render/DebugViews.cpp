@@ -65,4 +65,18 @@ std::string diagnosticsViewList() {
     return out;
 }
 
+std::string debugViewsMarkdown() {
+    std::string out = "| view | name | shows | EXR holds | passes beyond the terrain |\n|---:|---|---|---|---|\n";
+    for (const auto& v : debugViews()) {
+        std::string passes;
+        if (v.needs.probeLight) passes = "probe-vertices (light)";
+        if (v.needs.probeDiagnostics) passes = "probe-vertices (diagnostics), the bake's sidecar";
+        if (v.needs.probeMarkers) passes += ", overlays (probe markers)";
+        out += "| " + std::to_string(v.number) + " | `" + v.name + "` | " + v.shows + " | " +
+               (v.linear ? "scene-linear values" : "the display encoding") + " | " +
+               (passes.empty() ? "none" : passes) + " |\n";
+    }
+    return out;
+}
+
 }  // namespace terralux

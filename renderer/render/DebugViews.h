@@ -1,5 +1,5 @@
 #pragma once
-// The debug views of LIGHTING.md: one table, read by the CLI, the UI selector, the renderer and
+// The debug views of docs/lighting.md: one table, read by the CLI, the UI selector, the renderer and
 // the tests. The numbers come from shaders/debug_views.def, which the shaders read too.
 
 #include <optional>
@@ -39,7 +39,7 @@ struct DebugView {
     ViewNeeds needs;
 };
 
-// The views this renderer draws, in LIGHTING.md order.
+// The views this renderer draws, in docs/lighting.md order.
 const std::vector<DebugView>& debugViews();
 // By number ("50") or name ("probe-irradiance"); nullopt when unknown or not drawn.
 std::optional<DebugView> findDebugView(const std::string& numberOrName);
@@ -47,7 +47,9 @@ std::optional<DebugView> findDebugView(const std::string& numberOrName);
 std::optional<DebugView> findDebugView(int number);
 // "0 beauty, 1 albedo, …" for messages and --help.
 std::string debugViewList();
-// "views 54 and 56": the views that read the bake's probe diagnostics, for messages.
+// The view table in Markdown, for docs/lighting.md and the README.
+std::string debugViewsMarkdown();
+// "views 54 and 56" (from the table): the views that read the bake's probe diagnostics, for messages.
 std::string diagnosticsViewList();
 
 }  // namespace terralux

@@ -1,5 +1,5 @@
 #pragma once
-// Every lighting parameter of a Terralux scene, in one place (LIGHTING.md). The project JSON,
+// Every lighting parameter of a Terralux scene, in one place (docs/lighting.md). The project JSON,
 // `--set`, the UI and the bake all read these fields; defaults here are the documented ones.
 
 #include <array>
@@ -55,9 +55,9 @@ inline const char* placementName(ProbePlacement p) {
 // coarse, one probe per leaf at its centre. The .shprobe grid is the box at the minimum cell size.
 struct AdaptiveVolumeSettings {
     // Unset = the DEM's cell size (the larger axis). Probes closer than the terrain samples see
-    // no lighting detail the terrain can produce (LIGHTING.md's 0.5 m suits rooms, not DEMs).
+    // no lighting detail the terrain can produce (docs/lighting.md's 0.5 m suits rooms, not DEMs).
     std::optional<double> minCellSize;
-    // Unset = 16 x min_cell_size, the ratio of LIGHTING.md's terrain example (2 m / 32 m).
+    // Unset = 16 x min_cell_size, the ratio of docs/lighting.md's terrain example (2 m / 32 m).
     // Must be min_cell_size x 2^k: octree cells halve.
     std::optional<double> maxCellSize;
     // Auto box: the terrain footprint from the lowest terrain up to the highest + this, metres.
@@ -68,7 +68,7 @@ struct AdaptiveVolumeSettings {
     // A cell overlaps the surface when it reaches within this height above it; unset = one
     // min cell.
     std::optional<double> surfaceBand;
-    // Relative interpolation error that splits a leaf (LIGHTING.md); unset = geometric only.
+    // Relative interpolation error that splits a leaf (docs/lighting.md); unset = geometric only.
     std::optional<double> tolerance;
     std::optional<int> maxProbes;            // budget for the refinement; unset = none
     std::optional<long long> maxBytes;       // .shprobe file size budget; unset = none
@@ -116,7 +116,7 @@ struct BakeSettings {
     std::optional<int> bounces;       // 0 = sky visibility only; unset = preset
     ShEncoding encoding = ShEncoding::Radiance;
     bool deringing = false;           // window SH so irradiance is never negative
-    // Points along the longer side of each volume's interpolation-error map (debug view 56);
+    // Points along the longer side of each volume's interpolation-error map (the interpolation-error debug view);
     // 0 = no map. Each point costs one probe bake.
     int errorMapResolution = 64;
 };

@@ -1,7 +1,7 @@
 #pragma once
 // The terrain surface every part of Terralux agrees on: bake, viewport and exports.
 //
-// Engine space (FORMATS.md): Y up, X east, Z south, metres, origin at the centre of the DEM
+// Engine space (docs/formats.md): Y up, X east, Z south, metres, origin at the centre of the DEM
 // footprint at height 0. DEM sample (col, row) is mesh vertex (col, row); row 0 is the northern
 // edge, so it lies at the most negative Z. Each cell between four vertices is split into two
 // triangles along one fixed diagonal, from vertex (c, r) to (c + 1, r + 1):
@@ -60,7 +60,7 @@ public:
     }
 
     // Height of the triangle surface at (x, z); outside the footprint the surface continues
-    // at the nearest border point (the skirt of LIGHTING.md).
+    // at the nearest border point (the skirt of docs/lighting.md).
     float surfaceHeight(float x, float z) const;
     // Unit geometric normal of the triangle under (x, z) (the skirt is treated as level).
     glm::vec3 surfaceNormal(float x, float z) const;

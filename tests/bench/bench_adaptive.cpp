@@ -1,6 +1,6 @@
 // Uniform vs adaptive vs error-driven probe placement on two real DEMs (the committed crops of
 // Big Tujunga, 30 m, and the Pica d'Estats massif, SRTM reprojected to 81 m): probe count, .shprobe
-// bytes, bake time and interpolation error (LIGHTING.md), printed as the markdown table of the
+// bytes, bake time and interpolation error (docs/lighting.md), printed as the markdown table of the
 // README. The bake is the standard preset with the project's default sun, sky and albedo; the
 // uniform grid is the octree with max_cell_size = min_cell_size (same box, same rules near the
 // ground, every cell its own probe). Times exclude the irradiance cache, which every placement

@@ -1,5 +1,5 @@
 // Adaptive octree placement (issue: only the probes a scene needs, never one inside the terrain):
-// the geometric rules on real DEMs, the occupancy grid per FORMATS.md, the interpolation model,
+// the geometric rules on real DEMs, the occupancy grid per docs/formats.md, the interpolation model,
 // the error-driven refinement and its budget, the acceptance numbers against a uniform grid, and
 // the whole bake's determinism and report.
 #include <algorithm>

@@ -158,7 +158,7 @@ TEST(ErrorMap, ZeroForUniformLightAndLargestWhereLightChangesFastest) {
     const glm::vec2 at(m.x0 + m.step * float(worst % m.nx), m.z0 + m.step * float(worst / m.nx));
     EXPECT_LT(glm::length(at - glm::vec2(spot.x, spot.z)), 1.5f * m.step) << "worst point " << at.x << ", " << at.y;
     EXPECT_GT(m.error[worst], 0.5f);
-    // Each value is LIGHTING.md's interpolation error at that point.
+    // Each value is docs/lighting.md's interpolation error at that point.
     for (size_t i = 0; i < m.error.size(); i += 97) {
         const glm::vec3 p(m.x0 + m.step * float(i % m.nx), 5.0f, m.z0 + m.step * float(i / m.nx));
         sh::ShRgb interpolated;

@@ -1,4 +1,4 @@
-// glTF scene export: the FORMATS.md layout and extensions, the mesh (triangulation, winding,
+// glTF scene export: the docs/formats.md layout and extensions, the mesh (triangulation, winding,
 // bounds, vertex budget, index width), exact probe-grid metadata, and all-or-nothing writes.
 
 #include "GltfExport.h"
