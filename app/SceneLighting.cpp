@@ -12,15 +12,14 @@ namespace terralux {
 
 namespace {
 
-// An edit of the sun or a camera move must not read and filter the HDR again: the last few
-// environments are kept, keyed by everything that shapes them. A file rewritten on disk (new
-// time or size) is a new key.
+// An edit of the sun, the sky's tint or intensity, or a camera move must not read and filter the
+// HDR again: the last few environments are kept, keyed by file and rotation, and scaled by tint ×
+// intensity on the way out. A file rewritten on disk (new time or size) is a new key.
 struct SkyKey {
     std::string path;
     std::filesystem::file_time_type time;
     std::uintmax_t size = 0;
-    float rotation = 0.0f, intensity = 0.0f;
-    glm::vec3 tint{0.0f};
+    float rotation = 0.0f;
     bool operator==(const SkyKey&) const = default;
 };
 
@@ -37,7 +36,9 @@ Sky skyOf(const Project& p) {
     const SkySettings& s = p.scene.sky;
     if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
     const std::string path = p.hdrPath().string();
-    SkyKey key{path, {}, 0, float(s.rotationDeg), float(s.intensity), s.color};
+    SkyKey key{path, {}, 0, float(s.rotationDeg)};
+    // The image's colour is the sky; sky.color tints it (white leaves it as it is).
+    const glm::vec3 scale = s.color * float(s.intensity);
     std::error_code ec;
     key.time = std::filesystem::last_write_time(path, ec);
     key.size = ec ? 0 : std::filesystem::file_size(path, ec);
@@ -46,21 +47,18 @@ Sky skyOf(const Project& p) {
         for (auto it = skyCache.begin(); it != skyCache.end(); ++it)
             if (it->first == key) {
                 skyCache.splice(skyCache.begin(), skyCache, it);
-                return it->second;  // levels are shared, so the copy is cheap
+                return it->second.scaled(scale);  // levels are shared: no copy of the image
             }
     }
     RgbImage img = readEquirectImage(path);
     ++skyReads;
-    // The image's colour is the sky; sky.color tints it (white leaves it as it is).
-    for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] *= s.color[int(i % 3)];
-    Sky sky = Sky::equirect(std::move(img.rgb), img.width, img.height, float(s.intensity),
-                            float(s.rotationDeg));
+    Sky sky = Sky::equirect(std::move(img.rgb), img.width, img.height, 1.0f, float(s.rotationDeg));
     if (!ec) {
         std::lock_guard lock(skyMutex);
         skyCache.emplace_front(key, sky);
         if (skyCache.size() > kSkyCacheEntries) skyCache.pop_back();
     }
-    return sky;
+    return sky.scaled(scale);
 }
 
 BakeLighting lightingOf(const Project& p) {

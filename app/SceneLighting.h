@@ -8,8 +8,9 @@
 namespace terralux {
 
 // Uniform sky, or the HDR (tinted by sky.color, × intensity, turned by rotation). Throws
-// ImageError for an unreadable HDR. HDR skies are cached by path, file time and size, rotation,
-// tint and intensity: edits of anything else reuse the filtered environment.
+// ImageError for an unreadable HDR. HDR skies are cached by path, file time and size, and
+// rotation; tint and intensity scale the cached environment, so edits of them and of anything
+// else reuse it.
 Sky skyOf(const Project& project);
 // How many times an HDR was read and filtered since start (for tests of the cache).
 size_t hdrSkyReads();

@@ -77,6 +77,15 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
     return s;
 }
 
+Sky Sky::scaled(const glm::vec3& factor) const {
+    if (!levels_) return uniform(uniform_ * factor);
+    Sky s = *this;
+    s.scale_ *= factor;
+    for (auto& c : s.sh_.c) c *= factor;
+    s.openUp_ *= factor;
+    return s;
+}
+
 void Sky::computeSh() {
     const Level& l = levels_->front();
     sh_ = sh::ShRgb{};
@@ -128,8 +137,8 @@ glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
     const int l1 = std::min(l0 + 1, int(levels_->size()) - 1);
     const float t = lod - l0;
     const glm::vec3 a = sample((*levels_)[size_t(l0)], u, v);
-    if (t <= 0.0f || l1 == l0) return a;
-    return glm::mix(a, sample((*levels_)[size_t(l1)], u, v), t);
+    if (t <= 0.0f || l1 == l0) return scale_ * a;
+    return scale_ * glm::mix(a, sample((*levels_)[size_t(l1)], u, v), t);
 }
 
 }  // namespace terralux

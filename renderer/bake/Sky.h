@@ -32,6 +32,10 @@ public:
     static Sky equirect(std::vector<float> rgb, int width, int height, float intensity,
                         float rotationDeg);
 
+    // The same sky with its radiance multiplied per channel (a tint times an intensity), without
+    // filtering the image again: the pyramid and the SH projection are linear in the radiance.
+    Sky scaled(const glm::vec3& factor) const;
+
     bool isUniform() const { return !levels_; }
     // Radiance toward `dir`, averaged over about `solidAngle` steradians around it (the share of
     // the sphere one sample stands for). Prefiltering a peaky HDR this way removes most of the
@@ -54,6 +58,7 @@ private:
     // Immutable once built and shared between copies: a Sky is cheap to copy into every bake.
     std::shared_ptr<const std::vector<Level>> levels_;
     float rotation_ = 0.0f;  // in u units [0, 1)
+    glm::vec3 scale_{1.0f};  // applied to the shared levels on lookup
     sh::ShRgb sh_;
     glm::vec3 openUp_{0.0f};
 };

@@ -1,6 +1,8 @@
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include "Project.h"
@@ -326,6 +328,23 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
     const Sky again = skyOf(p);
     EXPECT_EQ(hdrSkyReads(), before + 1) << "a sun or camera edit read the HDR again";
     EXPECT_EQ(first.sh().c[0], again.sh().c[0]);
+    // Tint and intensity scale the cached environment exactly as filtering the scaled image would.
+    p.scene.sky.color = glm::vec3(1.0f, 0.5f, 0.25f);
+    p.scene.sky.intensity = 4.0;
+    const Sky tinted = skyOf(p);
+    EXPECT_EQ(hdrSkyReads(), before + 1) << "a tint or intensity edit read the HDR again";
+    std::vector<float> rgb(16 * 8 * 3);
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = 4.0f * p.scene.sky.color[int(i % 3)];
+    const Sky direct = Sky::equirect(rgb, 16, 8, 1.0f, 0.0f);
+    for (size_t k = 0; k < direct.sh().c.size(); ++k)
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_NEAR(tinted.sh().c[k][ch], direct.sh().c[k][ch], 1e-4f * std::abs(direct.sh().c[0][ch]));
+    const glm::vec3 toward = glm::normalize(glm::vec3(0.3f, 0.5f, -0.8f));
+    for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(tinted.radiance(toward)[ch], direct.radiance(toward)[ch], 1e-5f);
+        EXPECT_NEAR(tinted.radiance(toward, 0.5f)[ch], direct.radiance(toward, 0.5f)[ch], 1e-5f);
+        EXPECT_NEAR(tinted.openIrradianceUp()[ch], direct.openIrradianceUp()[ch], 1e-4f);
+    }
     p.scene.sky.rotationDeg = 90.0;
     skyOf(p);
     EXPECT_EQ(hdrSkyReads(), before + 2) << "a rotation is a new environment";
