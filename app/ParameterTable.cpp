@@ -86,6 +86,7 @@ public:
     Row& choices(std::vector<std::string> c) { s_.choices = std::move(c); return *this; }
     Row& pattern(std::string re, std::string rule) { s_.pattern = std::move(re); s_.patternRule = std::move(rule); return *this; }
     Row& autoMeans(std::string m) { s_.autoMeaning = std::move(m); return *this; }
+    Row& zeroMeans(std::string m) { s_.zeroText = std::move(m); return *this; }
     Row& unit(std::string u) { s_.unit = std::move(u); return *this; }
     Row& label(std::string l) { s_.label = std::move(l); return *this; }
     Row& about(std::string d) { s_.description = std::move(d); return *this; }
@@ -162,7 +163,7 @@ std::vector<ParameterSpec> buildTable() {
     using T = ParamType;
 
     // Terrain.
-    add(Row("terrain.dem", T::String))
+    add(Row("terrain.dem", T::String)).zeroMeans("embedded sample")
         .label("DEM").about("Elevation raster GDAL reads (GeoTIFF, SRTM .hgt, ASCII grid, VRT, /vsizip/...); relative to the project file; empty = the embedded sample")
         .redoes(kReimport).field(&SceneDescription::terrain, &TerrainSettings::dem);
     add(Row("terrain.vertical_scale", T::Number)).above(0.0, 100.0).unit("×").label("Vertical scale")
@@ -171,7 +172,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("terrain.albedo", T::Color)).range(0.0, 1.0).label("Albedo")
         .about("Lambertian reflectance of the ground, linear RGB").redoes(kUpload | kRebake)
         .field(&SceneDescription::terrain, &TerrainSettings::albedo);
-    add(Row("terrain.max_resolution", T::Integer)).range(0, 65536).unit("cells").label("Max resolution")
+    add(Row("terrain.max_resolution", T::Integer)).range(0, 65536).unit("cells").zeroMeans("source").label("Max resolution")
         .about("Longest side after area-averaged resampling; 0 = the source resolution (1 is not a grid)")
         .redoes(kReimport)
         .custom([](const SceneDescription& s, size_t) { return json(s.terrain.maxResolution); },
@@ -302,19 +303,19 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
         .about("terrain placement: probes sit this far above the bilinear terrain height")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset);
-    add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("the bake quality preset decides")
+    add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
         .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)
         .volume(&ProbeVolumeSettings::rayCount);
     add(Row("probe_volumes[].fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
-        .autoMeans("2 × the smallest spacing").label("Fallback blend")
+        .autoMeans("2 × spacing: twice the smallest probe spacing").label("Fallback blend")
         .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
         .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance);
     add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
-        .autoMeans("the DEM's cell size").label("Adaptive: min cell")
+        .autoMeans("DEM cell: the DEM's cell size").label("Adaptive: min cell")
         .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::minCellSize);
     add(Row("probe_volumes[].adaptive.max_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
-        .autoMeans("16 × min_cell_size").label("Adaptive: max cell")
+        .autoMeans("16 × min: 16 × min_cell_size").label("Adaptive: max cell")
         .about("Largest octree cell; must be min_cell_size × 2^k, k in [0, 16]").redoes(kReplace | kRebake)
         .custom([](const SceneDescription& s, size_t i) {
                     const auto& m = s.probeVolumes.at(i).adaptive.maxCellSize;
@@ -346,7 +347,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("A cell this close above the surface goes down to the minimum size").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::surfaceBand);
     add(Row("probe_volumes[].adaptive.tolerance", T::Number)).above(0.0, 1.0).decimals(3)
-        .autoMeans("geometric refinement only").label("Adaptive: error tolerance")
+        .autoMeans("none: geometric refinement only").label("Adaptive: error tolerance")
         .about("Relative interpolation error that splits a leaf (error-driven refinement)")
         .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::tolerance);
     add(Row("probe_volumes[].adaptive.max_probes", T::Integer)).range(1, std::numeric_limits<int>::max())
@@ -390,9 +391,9 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
         .about("Preset of rays, bounces and irradiance cache (rays and bounces below override it)")
         .redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::quality);
-    add(Row("bake.rays", T::Integer)).range(1, 1 << 20).autoMeans("the preset decides").label("Rays per probe")
+    add(Row("bake.rays", T::Integer)).range(1, 1 << 20).autoMeans("preset: the quality preset decides").label("Rays per probe")
         .about("Rays traced per probe").redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::rays);
-    add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("the preset decides").label("Bounces")
+    add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("preset: the quality preset decides").label("Bounces")
         .about("Light bounces off the terrain; 0 = sky visibility only").redoes(kNothing)
         .field(&SceneDescription::bake, &BakeSettings::bounces);
     add(Row("bake.sh_encoding", T::Choice)).choices({"radiance", "irradiance"}).label("SH encoding")
@@ -401,7 +402,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("bake.deringing", T::Boolean)).label("Deringing")
         .about("Window each probe's SH just enough that its irradiance is nowhere negative")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::deringing);
-    add(Row("bake.error_map_resolution", T::Integer)).range(0, kMaxErrorMapResolution).unit("points")
+    add(Row("bake.error_map_resolution", T::Integer)).range(0, kMaxErrorMapResolution).unit("points").zeroMeans("no map")
         .label("Error map points a side")
         .about("Points along the longer side of each volume's interpolation-error map (debug view interpolation-error); 0 = no map; each costs one probe bake")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::errorMapResolution);
@@ -710,15 +711,20 @@ std::string uiObjectNamesMarkdown() {
             break;
         }
         it->second.push_back(entry);
-        if (spec.nullable() && (spec.type == ParamType::Number || spec.type == ParamType::Integer))
-            special.push_back("`" + name + "` shows \"" + autoShort(spec) + "\"");
+        const bool number = spec.type == ParamType::Number || spec.type == ParamType::Integer;
+        if (spec.nullable() && number)
+            special.push_back("`" + name + "` shows \"" + autoShort(spec) + "\" one step below its minimum for null");
+        else if (!spec.zeroText.empty() && number)
+            special.push_back("`" + name + "` shows \"" + spec.zeroText + "\" at 0");
+        else if (!spec.zeroText.empty())
+            special.push_back("`" + name + "` shows \"" + spec.zeroText + "\" when empty");
     }
     for (const auto& [dock, names] : docks) {
         out << "| " << dock.title << " (`" << dock.objectName << "`) | ";
         for (size_t k = 0; k < names.size(); ++k) out << (k ? ", " : "") << names[k];
         out << " |\n";
     }
-    out << "\nAt one step below their minimum, nullable spin boxes show what `null` (auto) means: ";
+    out << "\nSpecial values are shown as words: ";
     for (size_t k = 0; k < special.size(); ++k) out << (k ? ", " : "") << special[k];
     out << ".\n";
     return out.str();

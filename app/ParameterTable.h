@@ -55,6 +55,9 @@ struct ParameterSpec {
     // Set when `null` is allowed: what it means ("auto-span", "the preset decides").
     std::optional<std::string> autoMeaning;
     std::string unit, label, description;
+    // What the smallest number (0) or the empty string means, shown by the editor in its place
+    // ("source", "no map", "embedded sample"); empty when it means nothing special.
+    std::string zeroText;
     unsigned invalidates = kRedraw;
     int decimals = 2;     // UI precision
     bool slider = false;  // UI: a slider beside the spin box (angles)

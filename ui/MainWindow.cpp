@@ -19,6 +19,7 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
 #include <QStandardPaths>
 #include <QStatusBar>
@@ -53,6 +54,9 @@ QWidget* scrolled(QWidget* w) {
     area->setWidget(w);
     area->setWidgetResizable(true);
     area->setFrameShape(QFrame::NoFrame);
+    // Scroll only vertically: the dock is at least as wide as its rows plus the scroll bar.
+    area->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    area->setMinimumWidth(w->minimumSizeHint().width() + area->verticalScrollBar()->sizeHint().width());
     return area;
 }
 

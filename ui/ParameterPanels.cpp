@@ -145,6 +145,7 @@ void ParameterForm::addInteger(const ParameterSpec& spec) {
     spin->setRange(nullable ? lo - 1 : lo, hi);
     spin->setKeyboardTracking(false);
     if (nullable) spin->setSpecialValueText(QString::fromStdString(autoShort(spec)));
+    else if (!spec.zeroText.empty() && lo == 0) spin->setSpecialValueText(QString::fromStdString(spec.zeroText));
     if (!spec.unit.empty()) spin->setSuffix(QString::fromStdString(" " + spec.unit));
     connect(spin, &QSpinBox::valueChanged, this, [=, this](int v) {
         set(docPath(spec), nullable && v < lo ? json(nullptr) : json(v));
@@ -185,7 +186,10 @@ void ParameterForm::addList(const ParameterSpec& spec) {
         }
         spin->setObjectName(name + "." + QString::number(i));
         spin->setKeyboardTracking(false);
-        h->addWidget(spin);
+        // Share the row's width: three wide spin boxes side by side would widen the dock.
+        spin->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+        spin->setMinimumWidth(56);
+        h->addWidget(spin, 1);
         spins.push_back(spin);
     }
     auto number = [integer](QAbstractSpinBox* s) {
@@ -288,6 +292,7 @@ void ParameterForm::addColor(const ParameterSpec& spec) {
 void ParameterForm::addText(const ParameterSpec& spec) {
     auto* edit = new QLineEdit(this);
     edit->setObjectName(QString::fromStdString(uiObjectName(spec)));
+    if (!spec.zeroText.empty()) edit->setPlaceholderText(QString::fromStdString(spec.zeroText));
     connect(edit, &QLineEdit::editingFinished, this, [=, this] { set(docPath(spec), edit->text().toStdString()); });
     refreshers_.push_back([=, this] {
         const json v = doc_->value(docPath(spec));

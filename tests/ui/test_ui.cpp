@@ -321,6 +321,7 @@ private slots:
                 auto* spin = w_->findChild<QSpinBox*>(name);
                 QVERIFY2(spin, qPrintable(where));
                 QCOMPARE(spin->minimum(), int(spec.min) - (spec.nullable() ? 1 : 0));
+                QCOMPARE(spin->specialValueText().toStdString(), spec.nullable() ? autoShort(spec) : spec.zeroText);
                 QCOMPARE(spin->maximum(), int(std::min<double>(spec.max, std::numeric_limits<int>::max())));
                 break;
             }
