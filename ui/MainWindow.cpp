@@ -631,6 +631,7 @@ void MainWindow::offerRecovery() {
                     QMessageBox::Yes | QMessageBox::No, this);
     box.setObjectName("recoveryDialog");
     if (box.exec() == QMessageBox::Yes) {
+        // The project is read now; its terrain lands from the worker.
         QString error;
         if (!doc_->open(file, &error)) showError("Recover", error);
     }

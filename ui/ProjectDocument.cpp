@@ -8,6 +8,7 @@
 
 #include "EnvironmentImage.h"
 #include "ParameterTable.h"
+#include "SceneLighting.h"
 #include "TerrainLoading.h"
 
 namespace terralux {
@@ -101,8 +102,10 @@ void ProjectDocument::newProject() {
 bool ProjectDocument::open(const QString& file, QString* error) {
     try {
         Project p = loadProject(file.toStdString(), nullptr);
-        auto terrain = std::make_shared<DemImportResult>(loadProjectTerrain(p));
-        reset(p, terrain);
+        startTerrainLoad(p, [this, p, file](std::shared_ptr<DemImportResult> terrain) {
+            reset(p, std::move(terrain));
+            emit projectOpened(file);
+        });
         return true;
     } catch (const std::exception& e) {
         if (error) *error = QString::fromStdString(e.what());
@@ -164,11 +167,18 @@ ProjectDocument::~ProjectDocument() {
 
 void ProjectDocument::startTerrainEdit(const std::string& path, nlohmann::json before,
                                        nlohmann::json after, Project candidate) {
+    startTerrainLoad(std::move(candidate), [this, path, before = std::move(before),
+                                            after = std::move(after)](std::shared_ptr<DemImportResult> terrain) {
+        undo_.push(new SetTerrainCommand(this, path, before, after, terrain_, std::move(terrain)));
+    });
+}
+
+void ProjectDocument::startTerrainLoad(Project candidate,
+                                       std::function<void(std::shared_ptr<DemImportResult>)> land) {
     if (loader_.joinable()) loader_.join();  // an earlier import's result is superseded
     const unsigned generation = ++loadGeneration_;
     emit terrainLoadingChanged(true);
-    loader_ = std::thread([this, generation, path, before = std::move(before), after = std::move(after),
-                           candidate = std::move(candidate)] {
+    loader_ = std::thread([this, generation, candidate = std::move(candidate), land = std::move(land)] {
         std::shared_ptr<DemImportResult> terrain;
         QString error;
         try {
@@ -176,15 +186,15 @@ void ProjectDocument::startTerrainEdit(const std::string& path, nlohmann::json b
         } catch (const std::exception& e) {
             error = QString::fromStdString(e.what());
         }
-        QMetaObject::invokeMethod(this, [this, generation, path, before, after, terrain, error] {
-            if (generation != loadGeneration_) return;  // a newer terrain edit is under way
+        QMetaObject::invokeMethod(this, [this, generation, terrain, error, land] {
+            if (generation != loadGeneration_) return;  // a newer load is under way
             landedGeneration_ = generation;
             emit terrainLoadingChanged(false);
             if (!terrain) {
                 emit terrainEditFailed(error);
                 return;
             }
-            undo_.push(new SetTerrainCommand(this, path, before, after, terrain_, terrain));
+            land(terrain);
         }, Qt::QueuedConnection);
     });
 }
@@ -222,7 +232,12 @@ bool ProjectDocument::importDem(const QString& file, QString* error) {
 bool ProjectDocument::importHdr(const QString& file, QString* error) {
     const std::string abs = std::filesystem::absolute(file.toStdString()).lexically_normal().string();
     try {
-        (void)readEquirectImage(abs);
+        // Read and filter it once, before anything changes: a bad file fails here, and the
+        // sky cache hands the same environment to the renderer and the preview.
+        Project candidate = project_;
+        candidate.scene.sky.mode = SkyMode::Hdr;
+        candidate.scene.sky.hdr = abs;
+        (void)skyOf(candidate);
     } catch (const std::exception& e) {
         if (error) *error = QString::fromStdString(e.what());
         return false;

@@ -2,6 +2,7 @@
 // The open project as the UI edits it: parameters by JSON path (the same paths as `--set`),
 // every edit an undoable command, the imported terrain kept in step with terrain.*.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -43,6 +44,9 @@ public:
     void setCameraQuietly(const nlohmann::json& camera);
 
     void newProject();
+    // Reads and checks the project file at once (a bad file fails here and nothing changes), then
+    // imports its terrain on a worker: the project replaces the open one when its terrain is in
+    // (projectOpened), or terrainEditFailed says why not (and the open project stays).
     bool open(const QString& file, QString* error);
     bool save(QString* error);
     bool saveAs(const QString& file, QString* error);
@@ -61,6 +65,7 @@ signals:
     void terrainLoadingChanged(bool loading);
     void terrainEditFailed(const QString& message);
     void fileChanged();
+    void projectOpened(const QString& file);
 
 public:
     ~ProjectDocument() override;
@@ -68,6 +73,9 @@ public:
 private:
     void startTerrainEdit(const std::string& path, nlohmann::json before, nlohmann::json after,
                           Project candidate);
+    // Imports `candidate`'s terrain on the worker; `land` runs on the UI thread with it, unless a
+    // newer load was started meanwhile.
+    void startTerrainLoad(Project candidate, std::function<void(std::shared_ptr<DemImportResult>)> land);
     void reset(const Project& project, std::shared_ptr<DemImportResult> terrain);
     Project project_;
     nlohmann::json json_;

@@ -262,6 +262,31 @@ private slots:
         QCOMPARE(w_->document()->undoStack()->count(), undoSteps);
     }
 
+    void openingAProjectWhoseDemFailsKeepsTheOpenOne() {
+        const nlohmann::json before = w_->document()->json();
+        const QString file = QString::fromStdString((kOut / "bad_dem.terralux.json").string());
+        {
+            nlohmann::json p = before;
+            p["terrain"]["dem"] = (fs::path(TERRALUX_TEST_DATA) / "dem" / "not_a_raster.tif").string();
+            std::ofstream(file.toStdString()) << p.dump(2);
+        }
+        QString dialogText;
+        QTimer poll;
+        poll.setInterval(20);
+        connect(&poll, &QTimer::timeout, [&] {
+            if (auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget())) {
+                dialogText = box->text();
+                box->accept();
+            }
+        });
+        poll.start();
+        QVERIFY(w_->openProject(file));  // the file itself is fine; its terrain is not
+        QTRY_VERIFY_WITH_TIMEOUT(!dialogText.isEmpty(), 20000);
+        QVERIFY2(dialogText.contains("not_a_raster.tif"), qPrintable(dialogText));
+        QVERIFY(w_->document()->json() == before);
+        QVERIFY(w_->document()->fileName() != file);
+    }
+
     void saveAndReopenKeepsEveryParameter() {
         QString error;
         QVERIFY(w_->document()->setParameter("sun.elevation_deg", 12.5, &error));
@@ -272,6 +297,7 @@ private slots:
         w_->document()->newProject();
         QVERIFY(projectToJson(w_->document()->project()) != saved);
         QVERIFY(w_->openProject(file));
+        w_->document()->waitForTerrain();
         QCOMPARE(QString::fromStdString(projectToJson(w_->document()->project()).dump()), QString::fromStdString(saved.dump()));
         QCOMPARE(w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg")->value(), 12.5);
     }
@@ -296,6 +322,7 @@ private slots:
         });
         w_->offerRecovery();
         QCOMPARE(asked, QString("recoveryDialog"));
+        w_->document()->waitForTerrain();
         QCOMPARE(w_->document()->project().scene.sun.azimuthDeg, 77.0);
         QVERIFY(!fs::exists(autosave));
     }
