@@ -6,7 +6,6 @@
 #include <QCoreApplication>
 #include <QThread>
 
-#include "EnvironmentImage.h"
 #include "ParameterTable.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
