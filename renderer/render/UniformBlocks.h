@@ -24,11 +24,7 @@ namespace terralux::blocks {
 #define TLX_IVEC4(N) alignas(16) glm::ivec4 N{0};
 #define TLX_MAT4(N) alignas(16) glm::mat4 N{1.0f};
 #define TLX_VEC4_ARRAY(N, COUNT) alignas(16) glm::vec4 N[COUNT]{};
-#include "blocks/camera.h"
-#include "blocks/surface.h"
-#include "blocks/sun_sky.h"
-#include "blocks/probes.h"
-#include "blocks/overlay.h"
+#include "blocks/all.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN
@@ -47,11 +43,7 @@ namespace terralux::blocks {
 #define TLX_IVEC4(N) + 16
 #define TLX_MAT4(N) + 64
 #define TLX_VEC4_ARRAY(N, COUNT) + 16 * (COUNT)
-#include "blocks/camera.h"
-#include "blocks/surface.h"
-#include "blocks/sun_sky.h"
-#include "blocks/probes.h"
-#include "blocks/overlay.h"
+#include "blocks/all.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN

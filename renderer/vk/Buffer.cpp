@@ -18,13 +18,8 @@ Buffer::Buffer(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags u
     buffer_ = UniqueBuffer(device, buffer);
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device, buffer, &req);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, properties);
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    check(vkAllocateMemory(device, &ai, nullptr, &memory), "vkAllocateMemory (buffer)");
-    memory_ = UniqueMemory(device, memory);
-    check(vkBindBufferMemory(device, buffer, memory, 0), "vkBindBufferMemory");
+    memory_ = ctx.allocateMemory(req, properties, "buffer");
+    check(vkBindBufferMemory(device, buffer, memory_.get(), 0), "vkBindBufferMemory");
 }
 
 void* Buffer::map() {

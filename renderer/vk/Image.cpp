@@ -42,13 +42,8 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     image_ = UniqueImage(device, image);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device, image, &req);
-    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    ai.allocationSize = req.size;
-    ai.memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    check(vkAllocateMemory(device, &ai, nullptr, &memory), "vkAllocateMemory (image)");
-    memory_ = UniqueMemory(device, memory);
-    check(vkBindImageMemory(device, image, memory, 0), "vkBindImageMemory");
+    memory_ = ctx.allocateMemory(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "image");
+    check(vkBindImageMemory(device, image, memory_.get(), 0), "vkBindImageMemory");
 
     const VkImageViewType type = desc_.shape == ImageShape::Cube     ? VK_IMAGE_VIEW_TYPE_CUBE
                                  : desc_.shape == ImageShape::Layers ? VK_IMAGE_VIEW_TYPE_2D_ARRAY

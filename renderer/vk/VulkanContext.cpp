@@ -196,6 +196,16 @@ uint32_t VulkanContext::memoryType(uint32_t typeBits, VkMemoryPropertyFlags requ
     throw VulkanError("Vulkan: no memory type with the required properties");
 }
 
+UniqueMemory VulkanContext::allocateMemory(const VkMemoryRequirements& requirements,
+                                           VkMemoryPropertyFlags properties, const char* what) const {
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = requirements.size;
+    ai.memoryTypeIndex = memoryType(requirements.memoryTypeBits, properties);
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    check(vkAllocateMemory(device_, &ai, nullptr, &memory), (std::string("vkAllocateMemory (") + what + ")").c_str());
+    return UniqueMemory(device_, memory);
+}
+
 UniqueCommandBuffer VulkanContext::allocateCommandBuffer() const {
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = pool_;

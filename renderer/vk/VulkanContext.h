@@ -67,6 +67,9 @@ public:
 
     // A primary command buffer from the context's pool, freed when it goes out of scope.
     UniqueCommandBuffer allocateCommandBuffer() const;
+    // Memory for a buffer or image with these requirements; `what` names it in the error.
+    UniqueMemory allocateMemory(const VkMemoryRequirements& requirements, VkMemoryPropertyFlags properties,
+                                const char* what) const;
     // Records commands into a one-time command buffer, submits it and waits. The command buffer
     // is freed on every path, a throw from `record` included.
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
