@@ -1,5 +1,6 @@
 #include "CommandLine.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -11,9 +12,12 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <filesystem>
+#include <mutex>
 
 #include <unistd.h>
 
+#include "AtomicFile.h"
 #include "BakeJob.h"
 #include "ImageFile.h"
 #include "RenderJob.h"
@@ -184,7 +188,7 @@ int commandInfo(const Args& a) {
       << (s.sourceCrs.empty() ? std::string("none (taken as metres)") : s.sourceCrs)
       << (s.sourceEpsg ? " (EPSG:" + std::to_string(s.sourceEpsg) + ")" : std::string()) << "\n";
     o << "source pixel: " << s.sourcePixelX << " x " << std::abs(s.sourcePixelY)
-      << (s.geographic ? " deg" : " m") << "\n";
+      << " " << s.sourcePixelUnit << "\n";
     if (s.reprojected)
         o << "reprojected:  " << hf.geo.crsName << " (EPSG:" << hf.geo.epsg << "), bilinear\n";
     o << "grid:         " << hf.width() << " x " << hf.depth() << " vertices"
@@ -213,8 +217,10 @@ extern "C" void onInterrupt(int) { gInterrupted.store(true); }
 class ProgressPrinter {
 public:
     explicit ProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(2)) {}
+    // Called from the bake's worker threads: one at a time.
     void operator()(const std::string& phase, double f) {
         if (quiet_) return;
+        const std::lock_guard lock(mutex_);
         const int percent = int(f * 100.0);
         const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
         if (!tty_ && percent / 10 == last_ / 10 && phase == phase_ && percent != 100) return;
@@ -238,6 +244,7 @@ public:
 private:
     using Clock = std::chrono::steady_clock;
     bool quiet_, tty_;
+    std::mutex mutex_;
     Clock::time_point start_ = Clock::now();
     int last_ = -1;
     double lastDraw_ = 0;
@@ -288,7 +295,14 @@ int commandBake(const Args& a) {
     if (positional.size() > 1) throw UsageError("--bake takes one PROJECT");
     std::vector<std::string> warnings;
     std::vector<std::string> sets;
-    if (a.parser.isSet(a.quality)) sets.push_back("bake.quality=" + str(a.parser.value(a.quality)));
+    if (a.parser.isSet(a.quality)) {
+        // Checked here so the message names the option typed, not the parameter behind it.
+        const std::string q = str(a.parser.value(a.quality));
+        const ParameterSpec* spec = findParameter("bake.quality");
+        if (std::find(spec->choices.begin(), spec->choices.end(), q) == spec->choices.end())
+            throw UsageError("--quality " + q + ": must be " + spec->rangeText());
+        sets.push_back("bake.quality=" + q);
+    }
     for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
     BakeRequest request;
     request.project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
@@ -310,6 +324,20 @@ int commandBake(const Args& a) {
         throw UsageError("--out " + outDir.string() + ": exists and is not a folder");
 
     if (a.parser.isSet(a.dryRun)) return printEstimate(estimateBake(request));
+
+    // A folder that cannot be written fails now, not after the bake. One made here for nothing
+    // (a failed or interrupted bake) is removed again if it stayed empty.
+    const bool existed = std::filesystem::exists(outDir, ec);
+    std::filesystem::create_directories(outDir, ec);
+    if (ec) throw FileWriteError(outDir.string() + ": cannot create the output folder (" + ec.message() + ")");
+    struct RemoveIfEmpty {
+        std::filesystem::path dir;
+        bool keep;
+        ~RemoveIfEmpty() {
+            std::error_code e;
+            if (!keep && std::filesystem::is_empty(dir, e) && !e) std::filesystem::remove(dir, e);
+        }
+    } cleanup{outDir, existed};
 
     std::signal(SIGINT, onInterrupt);
     std::signal(SIGTERM, onInterrupt);
@@ -493,6 +521,8 @@ int runCommandLine(int argc, char** argv) {
             throw UsageError("--dry-run: only with --bake");
         if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
             throw UsageError("--overlay: only with --render");
+        if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))
+            throw UsageError("--quality: only with --bake (elsewhere: --set bake.quality=PRESET)");
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.render)) return commandRender(a);
@@ -518,6 +548,14 @@ int runCommandLine(int argc, char** argv) {
     } catch (const ProjectError& e) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitUsage;
+    } catch (const FileWriteError& e) {
+        std::cerr << "terralux: " << e.what() << "\n";
+        return kExitRuntime;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // "filesystem error: cannot create directories: ..." becomes the path and the reason.
+        std::cerr << "terralux: " << (e.path1().empty() ? std::string() : e.path1().string() + ": ")
+                  << e.code().message() << "\n";
+        return kExitRuntime;
     } catch (const vk::VulkanError& e) {
         std::cerr << "terralux: " << e.what() << "\n";
         return kExitRuntime;

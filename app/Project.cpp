@@ -331,7 +331,12 @@ Project loadProject(const std::filesystem::path& file, std::vector<std::string>*
             const json again = json::parse(in);
             (void)again;
         } catch (const json::parse_error& e) {
-            throw ProjectError(file.string() + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
+            // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error ..."
+            const std::string what = e.what();
+            const size_t at = what.find("at line ");
+            throw ProjectError(file.string() + ": not valid JSON " +
+                               (at != std::string::npos ? what.substr(at)
+                                                        : "(byte " + std::to_string(e.byte) + ")"));
         }
         throw ProjectError(file.string() + ": not valid JSON");
     }

@@ -204,9 +204,10 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     info.sourceWidth = ds->GetRasterXSize();
     info.sourceHeight = ds->GetRasterYSize();
     if (ds->GetRasterCount() < 1) fail(path, "has no raster band");
-    if (info.sourceWidth < 1 || info.sourceHeight < 1)
-        fail(path, "raster is empty (" + std::to_string(info.sourceWidth) + "x" +
-                       std::to_string(info.sourceHeight) + ")");
+    // A surface needs two samples each way: fewer make a footprint of no width and no mesh.
+    if (info.sourceWidth < 2 || info.sourceHeight < 2)
+        fail(path, "raster is " + std::to_string(info.sourceWidth) + " x " +
+                       std::to_string(info.sourceHeight) + " cells; a DEM needs at least 2 x 2");
 
     double gt[6] = {0, 1, 0, 0, 0, -1};
     const bool hasGeoTransform = ds->GetGeoTransform(gt) == CE_None;
@@ -220,6 +221,14 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     if (hasCrs) {
         info.sourceCrs = srsName(*srcSrs);
         info.sourceEpsg = srsEpsg(*srcSrs);
+        if (srcSrs->IsGeographic()) {
+            info.sourcePixelUnit = "deg";
+        } else {
+            const char* unit = nullptr;
+            const double toMetres = srcSrs->GetLinearUnits(&unit);
+            info.sourcePixelUnit = toMetres == 1.0 ? "m" : unit && *unit ? unit : "unknown unit";
+            if (info.sourcePixelUnit == "foot") info.sourcePixelUnit = "ft";
+        }
     } else if (hasGeoTransform) {
         info.warnings.push_back("no CRS: coordinates and cell sizes taken as metres");
     }

@@ -39,6 +39,8 @@ struct DemSourceInfo {
     bool resampled = false;      // maxResolution reduced the grid
     double sourcePixelX = 0.0;   // source units, as the geotransform says
     double sourcePixelY = 0.0;
+    std::string sourcePixelUnit = "m";  // of sourcePixelX/Y: "deg" for a geographic CRS, else the
+                                        // CRS's linear unit ("m", "ft", "US survey foot")
     std::vector<std::string> warnings;  // e.g. no CRS: cells taken as metres
 };
 

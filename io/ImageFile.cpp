@@ -45,14 +45,14 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
         std::replace(why.begin(), why.end(), '\n', ' ');
         std::error_code ec;
         std::filesystem::remove(tmp, ec);
-        throw ImageError(path.string() + ": cannot write (" + why + ")");
+        throw FileWriteError(path.string() + ": cannot write (" + why + ")");
     }
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
     if (ec) {
         const std::string reason = ec.message();
         std::filesystem::remove(tmp, ec);
-        throw ImageError(path.string() + ": cannot replace (" + reason + ")");
+        throw FileWriteError(path.string() + ": cannot replace (" + reason + ")");
     }
 }
 

@@ -12,7 +12,8 @@ enum class ImageEncoding { Display8, LinearFloat };
 
 // rgba: width * height * 4 floats, row 0 at the top. The encoding follows the extension:
 // .exr -> LinearFloat (half-free float32 RGBA), anything else (.png, .tif, ...) -> Display8.
-// Throws ImageError (EnvironmentImage.h) naming the file and the reason.
+// Throws ImageError (EnvironmentImage.h) for data or an extension it cannot encode, and
+// FileWriteError (AtomicFile.h) when the file cannot be written; both name the file and the reason.
 void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
                 const std::vector<float>& rgba);
 ImageEncoding encodingFor(const std::filesystem::path& path);

@@ -288,12 +288,16 @@ TEST(Project, SaveLoadIsLosslessAndPathsStayRelative) {
 
 TEST(Project, BadFilesAreOneLineErrors) {
     const fs::path dir = tempDir("bad");
-    std::ofstream(dir / "broken.json") << "{ \"sun\": { \"elevation_deg\": 10, }";
+    std::ofstream(dir / "broken.json") << "{\n  \"sun\": {\n    \"elevation_deg\": 10,\n  }\n}\n";
     try {
         loadProject(dir / "broken.json", nullptr);
         FAIL();
     } catch (const ProjectError& e) {
-        EXPECT_NE(std::string(e.what()).find("broken.json: not valid JSON (byte"), std::string::npos);
+        // The line and column of the stray '}', and the parser's reason.
+        const std::string m = e.what();
+        EXPECT_NE(m.find("broken.json: not valid JSON at line 4, column 3: syntax error"), std::string::npos) << m;
+        EXPECT_NE(m.find("unexpected '}'"), std::string::npos) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
     }
     EXPECT_THROW(loadProject(dir / "missing.json", nullptr), ProjectError);
     std::ofstream(dir / "array.json") << "[1,2]";
