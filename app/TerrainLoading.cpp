@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "EnvironmentImage.h"
 #include "SampleTerrain.h"
 
 namespace terralux {
@@ -24,6 +25,15 @@ Project loadEffectiveProject(const std::string& projectFile, const std::vector<s
     if (!sets.empty() || !demOverride.empty()) {
         for (const std::string& s : sets) applyOverride(doc, s);
         p.scene = sceneFromJson(doc, sets.empty() ? source : "--set", warnings);
+    }
+    // A sky image is checked whenever one is named, even while sky.mode is "uniform": a typo
+    // must not wait for the day the mode is switched.
+    if (!p.scene.sky.hdr.empty()) {
+        try {
+            checkEquirectImage(p.hdrPath().string());
+        } catch (const ImageError& e) {
+            throw ImageError(std::string("sky.hdr: ") + e.what());
+        }
     }
     return p;
 }

@@ -8,7 +8,10 @@
 
 namespace terralux {
 
-RgbImage readEquirectImage(const std::string& path) {
+namespace {
+
+// Opens the image and checks what its header can tell: there, readable, 2:1.
+std::unique_ptr<OIIO::ImageInput> openEquirect(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw ImageError(path + ": no such file");
     auto in = OIIO::ImageInput::open(path);
@@ -23,6 +26,16 @@ RgbImage readEquirectImage(const std::string& path) {
         throw ImageError(path + ": " + std::to_string(spec.width) + "x" +
                          std::to_string(spec.height) +
                          " is not an equirectangular image (width must be twice the height)");
+    return in;
+}
+
+}  // namespace
+
+void checkEquirectImage(const std::string& path) { openEquirect(path)->close(); }
+
+RgbImage readEquirectImage(const std::string& path) {
+    auto in = openEquirect(path);
+    const OIIO::ImageSpec& spec = in->spec();
     const int channels = spec.nchannels;
     std::vector<float> pixels(size_t(spec.width) * spec.height * channels);
     if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data())) {

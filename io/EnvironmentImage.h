@@ -22,5 +22,7 @@ struct RgbImage {
 // ImageError naming the file and the problem: missing, unreadable, not 2:1, negative or
 // non-finite texels.
 RgbImage readEquirectImage(const std::string& path);
+// The checks of the header alone (missing, unreadable, not 2:1), without reading the pixels.
+void checkEquirectImage(const std::string& path);
 
 }  // namespace terralux
