@@ -97,6 +97,20 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
 
 uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
 
+// A volume whose every probe is inside the terrain would export an empty grid and report its
+// error as 0 %: refuse it, naming the setting that put the probes there.
+void requireProbes(const SceneDescription& scene, const ProbeVolumeSettings& v, const ProbeLayout& layout) {
+    if (layout.validCount() > 0) return;
+    const std::string at = "probe_volumes[" + std::to_string(&v - scene.probeVolumes.data()) + "]";
+    std::ostringstream fix;
+    if (v.placement == ProbePlacement::Terrain)
+        fix << "raise " << at << ".height_offset (now " << v.heightOffset << " m)";
+    else
+        fix << "move " << at << ".origin up or enlarge the volume";
+    throw PlacementError("probe_volumes '" + v.name + "': all " + std::to_string(layout.positions.size()) +
+                         " probes are inside the terrain, none is left to bake; " + fix.str());
+}
+
 // Bakes probes seeded by key (adaptive leaves, interpolation-error points).
 ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed,
                       const BakeControl& control) {
@@ -232,6 +246,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     std::vector<size_t> mapPoints;
     for (const auto* v : volumes) {
         layouts.push_back(placeProbes(*v, hf));
+        requireProbes(scene, *v, layouts.back());
         totalProbes += layouts.back().positions.size();
         mapPoints.push_back(errorMapGrid(layouts.back(), hf, scene.bake.errorMapResolution,
                                          errorMapHeight(*v, layouts.back())).error.size());
@@ -529,6 +544,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     std::vector<glm::vec3> all;
     for (const auto* v : setup.volumes) {
         layouts.push_back(placeProbes(*v, hf));
+        requireProbes(project.scene, *v, layouts.back());
         for (size_t i = 0; i < layouts.back().positions.size(); ++i)
             if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
     }

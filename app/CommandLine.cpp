@@ -368,6 +368,9 @@ int commandBake(const Args& a) {
         std::cout << "\n";
         if (v.contains("error_map") && v["error_map"]["size"][0].get<int>() == 0) {
             std::cout << "    no interpolation-error map: the volume's grid is not over the terrain\n";
+        } else if (v.contains("error_map") && v["error_map"]["points"].get<int>() == 0) {
+            // No data is not 0 %.
+            std::cout << "    no interpolation error measured: no point of the map has a probe around it\n";
         } else if (v.contains("error_map")) {
             const auto& m = v["error_map"];
             std::cout << "    interpolation error over the ground (" << m["size"][0].get<int>() << " x "
