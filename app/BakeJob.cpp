@@ -446,7 +446,6 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"rays", q.rays},
         {"bounces", q.bounces},
         {"deringing", scene.bake.deringing},
-        {"bakeTimeSeconds", secondsSince(start)},
     };
     nlohmann::json errorEstimate = nlohmann::json::object();
     for (const auto& vr : volumeReports) {
@@ -460,21 +459,6 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     BakeOutcome out;
     out.outDir = project.outDir();
     std::filesystem::create_directories(out.outDir);
-    {
-        // The .shprobe files and their sidecars, and the scene when export.gltf is on: staged
-        // together and committed with rollback, so a failed export leaves the earlier files.
-        GltfSceneInput in;
-        in.heightfield = &hf;
-        in.albedo = scene.terrain.albedo;
-        in.verticalScale = scene.terrain.verticalScale;
-        in.volumes = grids;
-        in.bake = bakeInfo;
-        in.generatorVersion = TERRALUX_VERSION;
-        in.scene = scene.exportSettings.gltf;
-        const GltfExportResult r = exportGltfScene(out.outDir, in);
-        out.files = r.files;
-    }
-
     out.report = {
         {"generator", std::string("Terralux ") + TERRALUX_VERSION},
         {"terrain",
@@ -499,13 +483,26 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"volumes", volumeReports},
         {"overlaps", overlapReport(grids)},
     };
-    nlohmann::json files = nlohmann::json::array();
-    for (const auto& f : out.files) files.push_back(f.lexically_relative(out.outDir).generic_string());
-    files.push_back("bake_report.json");
-    out.report["files"] = files;
-    const auto reportPath = out.outDir / "bake_report.json";
-    writeFileAtomically(reportPath, out.report.dump(2) + "\n");
-    out.files.push_back(reportPath);
+    {
+        // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
+        // report: staged together and committed with rollback, so a failed export leaves the
+        // earlier files, and an earlier bake's files that this one does not write go.
+        GltfSceneInput in;
+        in.heightfield = &hf;
+        in.albedo = scene.terrain.albedo;
+        in.verticalScale = scene.terrain.verticalScale;
+        in.volumes = grids;
+        in.bake = bakeInfo;
+        in.generatorVersion = TERRALUX_VERSION;
+        in.scene = scene.exportSettings.gltf;
+        // The report lists every file of the bake, itself included, in the order written.
+        in.extraFiles.push_back({"bake_report.json", ""});
+        out.report["files"] = exportedFileNames(in);
+        out.report["time_s"] = secondsSince(start);
+        in.extraFiles.back().second = out.report.dump(2) + "\n";
+        const GltfExportResult r = exportGltfScene(out.outDir, in);
+        out.files = r.files;
+    }
     report("done", 1.0);
     return out;
 }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <set>
 #include <span>
 #include <stdexcept>
 #include <system_error>
@@ -298,15 +299,20 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
     }
 }
 
-std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput& input) {
-    const fs::path gltfPath = outDir / kGltfName;
+// The volumes by file name, which is not always the order of the stems ("a-b.shprobe" < "a.shprobe").
+std::vector<const GltfProbeVolume*> sortedVolumes(const GltfSceneInput& input) {
     std::vector<const GltfProbeVolume*> sorted;
     for (const GltfProbeVolume& v : input.volumes)
         sorted.push_back(&v);
-    // Sorted by file name, which is not always the order of the stems ("a-b.shprobe" < "a.shprobe").
     std::sort(sorted.begin(), sorted.end(), [](const GltfProbeVolume* a, const GltfProbeVolume* b) {
         return a->name + kProbeExt < b->name + kProbeExt;
     });
+    return sorted;
+}
+
+std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput& input) {
+    const fs::path gltfPath = outDir / kGltfName;
+    const std::vector<const GltfProbeVolume*> sorted = sortedVolumes(input);
     checkInput(outDir, input, sorted);
     const Heightfield& hf = *input.heightfield;
 
@@ -320,7 +326,18 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
                              std::vector<uint8_t>(v->diagnostics.begin(), v->diagnostics.end())});
         grids.push_back(probeGridEntry(*v));
     }
-    if (!input.scene) return files;
+    for (const auto& [name, text] : input.extraFiles) {
+        if (name.empty() || fs::path(name).has_parent_path() || name == kGltfName || name == kBinName)
+            throw std::runtime_error(name + ": not a name for an extra top-level file");
+    }
+    auto addExtras = [&] {
+        for (const auto& [name, text] : input.extraFiles)
+            files.push_back({name, std::vector<uint8_t>(text.begin(), text.end())});
+    };
+    if (!input.scene) {
+        addExtras();
+        return files;
+    }
 
     try {
         ojson doc;
@@ -356,6 +373,7 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
         throw std::runtime_error(gltfPath.string() + ": cannot encode the glTF JSON (" +
                                  e.what() + ")");
     }
+    addExtras();
     return files;
 }
 
@@ -428,7 +446,26 @@ struct Replaced {
 // Moves every staged file into place. Before a target is replaced, its current file is hard-linked
 // (or copied) into the staging directory, so that a later failure can put every replaced file
 // back. Throws after the rollback.
-void commit(const fs::path& outDir, const fs::path& staging, const std::vector<PendingFile>& files) {
+// What an earlier export left that this one owns but does not write: every regular file in
+// sh_coeffs/ and the owned top-level names, less the files being written now.
+std::vector<fs::path> staleOwnedFiles(const fs::path& outDir, const std::vector<PendingFile>& files,
+                                      const std::vector<std::string>& ownedNames) {
+    std::set<fs::path> writing;
+    for (const auto& f : files) writing.insert(f.relative);
+    std::vector<fs::path> stale;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(outDir / kProbeDir, ec)) {
+        const fs::path relative = fs::path(kProbeDir) / e.path().filename();
+        if (e.is_regular_file(ec) && !writing.count(relative)) stale.push_back(relative);
+    }
+    for (const auto& name : ownedNames)
+        if (!writing.count(name) && fs::is_regular_file(outDir / name, ec)) stale.push_back(name);
+    std::sort(stale.begin(), stale.end());
+    return stale;
+}
+
+void commit(const fs::path& outDir, const fs::path& staging, const std::vector<PendingFile>& files,
+            const std::vector<fs::path>& stale) {
     std::vector<Replaced> done;
     const fs::path probeDir = outDir / kProbeDir;
     bool createdProbeDir = false;
@@ -443,6 +480,18 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
                 throw FileWriteError(probeDir.string() + ": cannot create directory (" +
                                      (ec ? ec.message() : std::string("exists, not a directory")) + ")");
             }
+        }
+        // Owned files this export does not write go into the staging directory (removed with
+        // it), so that engines loading every file of sh_coeffs/ see only this bake.
+        for (size_t i = 0; i < stale.size(); ++i) {
+            const fs::path target = outDir / stale[i], kept = staging / ("stale-" + std::to_string(i));
+            std::error_code ec;
+            fs::rename(target, kept, ec);
+            if (ec)
+                throw FileWriteError(target.string() + ": cannot remove the earlier bake's file (" +
+                                     ec.message() + ")");
+            // Rolled back like a replaced file: the earlier file goes back, nothing new is removed.
+            done.push_back({target, kept});
         }
         for (size_t i = 0; i < files.size(); ++i) {
             const fs::path target = outDir / files[i].relative;
@@ -490,6 +539,22 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
 
 }  // namespace
 
+std::vector<std::string> exportedFileNames(const GltfSceneInput& input) {
+    std::vector<std::string> names;
+    for (const auto* v : sortedVolumes(input)) {
+        names.push_back((fs::path(kProbeDir) / (v->name + kProbeExt)).generic_string());
+        if (!v->diagnostics.empty())
+            names.push_back((fs::path(kProbeDir) / probeDiagnosticsFileName(v->name)).generic_string());
+    }
+    if (input.scene) {
+        if (input.heightfield && input.heightfield->width() >= 2 && input.heightfield->depth() >= 2)
+            names.push_back(kBinName);
+        names.push_back(kGltfName);
+    }
+    for (const auto& extra : input.extraFiles) names.push_back(extra.first);
+    return names;
+}
+
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input) {
     // Everything is encoded before the filesystem is touched.
     const std::vector<PendingFile> files = buildFiles(outDir, input);
@@ -516,7 +581,9 @@ GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const Gltf
         result.files.push_back(outDir / f.relative);
         result.bytes += f.bytes.size();
     }
-    commit(outDir, staging.path(), files);
+    std::vector<std::string> owned{kGltfName, kBinName};
+    for (const auto& extra : input.extraFiles) owned.push_back(extra.first);
+    commit(outDir, staging.path(), files, staleOwnedFiles(outDir, files, owned));
     return result;
 }
 

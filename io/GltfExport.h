@@ -49,6 +49,8 @@ struct GltfSceneInput {
     size_t meshMaxVertices = size_t(1) << 20;
     // false: only the sh_coeffs files (export.gltf off), staged and committed the same way.
     bool scene = true;
+    // More top-level files written with the rest (the bake report): name and contents.
+    std::vector<std::pair<std::string, std::string>> extraFiles;
 };
 
 struct GltfExportResult {
@@ -61,13 +63,17 @@ struct GltfExportResult {
 // into place (the .shprobe files, then scene.bin, then scene.gltf). If any step fails, the files
 // already replaced are restored, the staging directory is removed, and the files in outDir stay
 // byte-identical to what they were before the call.
-// Files of an earlier export that this one does not write are left alone: the .shprobe files of
-// volumes no longer present are NOT deleted, nor is an old scene.bin when the new scene has no mesh.
+// The export owns every file in outDir/sh_coeffs/, scene.gltf, scene.bin and the extra files, and
+// replaces them as a whole: an owned file this export does not write (the .shprobe of a renamed
+// volume, scene.gltf when the scene is off) is removed in the same commit, and put back if the
+// commit fails. Nothing else in outDir is touched.
 // A heightfield with a single row or column has no triangles: the scene then has no mesh, no buffer
 // and no scene.bin, only the extensions (TERRALUX_geo.meshStride is 1).
 // Throws FileWriteError for filesystem failures, ShProbeError for a grid that cannot be encoded and
 // std::runtime_error for other invalid input, each with a one-line message naming the file.
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input);
+// The files exportGltfScene writes for `input`, relative to outDir, in the order it commits them.
+std::vector<std::string> exportedFileNames(const GltfSceneInput& input);
 
 // Reads scene.gltf back with tinygltf and returns the VULKAN_SCHNEE_engine_properties.shProbeGrids
 // array as written (for tests and tools). Throws std::runtime_error naming the file if it does not

@@ -25,8 +25,41 @@ case "$case_" in
   threads)
     "$terralux" --bake --out "$work/a" --quiet --threads 1 --quality draft >/dev/null || fail "1 thread"
     "$terralux" --bake --out "$work/b" --quiet --threads 2 --quality draft >/dev/null || fail "2 threads"
-    cmp "$work/a/sh_coeffs/probes.shprobe" "$work/b/sh_coeffs/probes.shprobe" || fail ".shprobe differs"
-    cmp "$work/a/scene.bin" "$work/b/scene.bin" || fail "scene.bin differs"
+    # Every file is the same byte for byte, except the report's timings and thread count.
+    (cd "$work/a" && find . -type f | sort) >"$work/a.list"
+    (cd "$work/b" && find . -type f | sort) >"$work/b.list"
+    cmp -s "$work/a.list" "$work/b.list" || fail "the two bakes wrote different files"
+    while read -r f; do
+      [ "$f" = "./bake_report.json" ] && continue
+      cmp -s "$work/a/$f" "$work/b/$f" || fail "$f differs between 1 and 2 threads"
+    done <"$work/a.list"
+    untimed() { python3 -c '
+import json, sys
+def strip(v):
+    if isinstance(v, dict):
+        return {k: strip(x) for k, x in v.items() if k != "threads" and not k.endswith("time_s")}
+    if isinstance(v, list):
+        return [strip(x) for x in v]
+    return v
+print(json.dumps(strip(json.load(open(sys.argv[1]))), sort_keys=True))' "$1"; }
+    [ "$(untimed "$work/a/bake_report.json")" = "$(untimed "$work/b/bake_report.json")" ] ||
+      fail "bake_report.json differs beyond timings"
+    grep -q "TimeSeconds\|time_s" "$work/a/scene.gltf" && fail "scene.gltf carries a timing"
+    ;;
+  replace)
+    # A renamed volume and a scene switched off leave none of the earlier bake's files behind.
+    "$terralux" --bake --out "$work/out" --quiet --quality draft >/dev/null || fail "first bake"
+    echo mine >"$work/out/notes.txt"
+    "$terralux" --bake --out "$work/out" --quiet --quality draft --set 'probe_volumes[0].name=valley' \
+      --set export.gltf=false >/dev/null || fail "second bake"
+    [ -e "$work/out/sh_coeffs/probes.shprobe" ] && fail "the renamed volume's old .shprobe stayed"
+    [ -e "$work/out/sh_coeffs/probes.probes.json" ] && fail "the renamed volume's old sidecar stayed"
+    [ -e "$work/out/scene.gltf" ] && fail "scene.gltf stayed with export.gltf off"
+    [ -e "$work/out/scene.bin" ] && fail "scene.bin stayed with export.gltf off"
+    [ -f "$work/out/sh_coeffs/valley.shprobe" ] || fail "no valley.shprobe"
+    [ "$(cat "$work/out/notes.txt")" = mine ] || fail "a file the bake does not own was touched"
+    python3 -c 'import json,sys; f=json.load(open(sys.argv[1]))["files"]; sys.exit(f != ["sh_coeffs/valley.shprobe", "sh_coeffs/valley.probes.json", "bake_report.json"])' \
+      "$work/out/bake_report.json" || fail "the report does not list exactly the files written"
     ;;
   interrupt)
     "$terralux" --bake --out "$work/out" --quiet --quality draft >/dev/null || fail "first bake"

@@ -56,6 +56,11 @@ ShProbeGrid makeGrid(int seed) {
     return g;
 }
 
+std::string readText(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 std::vector<uint8_t> readBytes(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -428,21 +433,48 @@ TEST_F(GltfExport, FailureInAFreshDirectoryLeavesNothingBehind) {
     EXPECT_TRUE(fs::is_empty(dir / "scene.gltf"));
 }
 
-TEST_F(GltfExport, StaleProbeFilesAreKept) {
+TEST_F(GltfExport, OwnedFilesAreReplacedAsAWholeAndNothingElseIsTouched) {
     const Heightfield hf = makeHeightfield(5, 4);
     GltfSceneInput in = sampleInput(hf);
+    in.extraFiles = {{"bake_report.json", "{\"first\": true}\n"}};
     exportGltfScene(dir, in);
-    const auto zetaBytes = readBytes(dir / "sh_coeffs/zeta.shprobe");
+    ASSERT_TRUE(fs::exists(dir / "sh_coeffs/zeta.shprobe"));
+    // Files the user keeps beside the bake.
+    std::ofstream(dir / "notes.txt") << "mine";
+    fs::create_directories(dir / "sh_coeffs/keep");
 
+    // "zeta" renamed away, and the scene switched off: engines must not find the old files.
     in.volumes = {{"alpha", makeGrid(4), {}}};
+    in.scene = false;
+    in.extraFiles = {{"bake_report.json", "{\"second\": true}\n"}};
     const GltfExportResult res = exportGltfScene(dir, in);
-    EXPECT_EQ(res.files.size(), 3u);
-    const json entries = readShProbeGridEntries(dir / "scene.gltf");
-    ASSERT_EQ(entries.size(), 1u);
-    EXPECT_EQ(entries[0]["volumeName"], "alpha");
-    EXPECT_EQ(entries[0]["probeCount"], 6);
+    EXPECT_EQ(res.files, (std::vector<fs::path>{dir / "sh_coeffs/alpha.shprobe", dir / "bake_report.json"}));
+    EXPECT_EQ(exportedFileNames(in), (std::vector<std::string>{"sh_coeffs/alpha.shprobe", "bake_report.json"}));
+    EXPECT_FALSE(fs::exists(dir / "sh_coeffs/zeta.shprobe"));
+    EXPECT_FALSE(fs::exists(dir / "scene.gltf"));
+    EXPECT_FALSE(fs::exists(dir / "scene.bin"));
     EXPECT_EQ(readShProbeFile(dir / "sh_coeffs/alpha.shprobe"), makeGrid(4));
-    EXPECT_EQ(readBytes(dir / "sh_coeffs/zeta.shprobe"), zetaBytes);
+    EXPECT_EQ(readText(dir / "bake_report.json"), "{\"second\": true}\n");
+    EXPECT_EQ(readText(dir / "notes.txt"), "mine");
+    EXPECT_TRUE(fs::is_directory(dir / "sh_coeffs/keep"));
+    for (const auto& e : fs::directory_iterator(dir))
+        EXPECT_EQ(e.path().filename().string().find(".staging"), std::string::npos);
+}
+
+TEST_F(GltfExport, AFailedCommitPutsTheRemovedFilesBack) {
+    const Heightfield hf = makeHeightfield(5, 4);
+    GltfSceneInput in = sampleInput(hf);
+    in.extraFiles = {{"bake_report.json", "old\n"}};
+    exportGltfScene(dir, in);
+    const auto zeta = readBytes(dir / "sh_coeffs/zeta.shprobe");
+    const auto gltf = readBytes(dir / "scene.gltf");
+    // The report cannot be replaced (a directory stands in its place after the first export).
+    fs::remove(dir / "bake_report.json");
+    fs::create_directories(dir / "bake_report.json");
+    in.volumes = {{"alpha", makeGrid(4), {}}};
+    EXPECT_THROW(exportGltfScene(dir, in), FileWriteError);
+    EXPECT_EQ(readBytes(dir / "sh_coeffs/zeta.shprobe"), zeta);
+    EXPECT_EQ(readBytes(dir / "scene.gltf"), gltf);
 }
 
 TEST_F(GltfExport, HeightfieldsWithoutTrianglesExportAMeshlessScene) {
