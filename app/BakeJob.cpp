@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -477,6 +478,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
           {"cache_points", cache ? size_t(cache->pointsX()) * size_t(cache->pointsZ()) : size_t(0)},
           {"cache_rays", cache ? q.cacheRays : 0},
           {"cache_time_s", cacheSeconds}}},
+        {"sh_encoding", scene.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
+        {"inputs", bakeInputs(project)},
         {"threads", threads},
         {"rays", totalRays},
         {"time_s", secondsSince(start)},
@@ -504,6 +507,63 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         out.files = r.files;
     }
     report("done", 1.0);
+    return out;
+}
+
+namespace {
+
+nlohmann::json fileIdentity(const std::filesystem::path& path) {
+    std::error_code ec;
+    nlohmann::json id = {{"path", path.lexically_normal().generic_string()}};
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec) id["bytes"] = size;
+    const auto time = std::filesystem::last_write_time(path, ec);
+    if (!ec) id["modified_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count();
+    return id;
+}
+
+// "a.b[2].c" -> value, for every leaf.
+void flatten(const nlohmann::json& v, const std::string& path, std::map<std::string, nlohmann::json>& out) {
+    if (v.is_object() && !v.empty()) {
+        for (const auto& [k, x] : v.items()) flatten(x, path.empty() ? k : path + "." + k, out);
+    } else if (v.is_array() && !v.empty() && (v[0].is_object())) {
+        for (size_t i = 0; i < v.size(); ++i) flatten(v[i], path + "[" + std::to_string(i) + "]", out);
+    } else {
+        out[path] = v;
+    }
+}
+
+}  // namespace
+
+nlohmann::json bakeInputs(const Project& project) {
+    nlohmann::json settings = sceneToJson(project.scene);
+    // Not read by a bake: where the camera stands, where the files go, and the reflection-probe
+    // settings no bake computes yet.
+    settings.erase("camera");
+    settings.erase("reflection_probes");
+    settings["export"].erase("out_dir");
+    nlohmann::json files = {{"dem", project.demPath().empty() ? nlohmann::json("embedded sample")
+                                                              : fileIdentity(project.demPath())}};
+    if (project.scene.sky.mode == SkyMode::Hdr) files["hdr"] = fileIdentity(project.hdrPath());
+    return {{"settings", settings}, {"files", files}};
+}
+
+std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const nlohmann::json& now) {
+    std::map<std::string, nlohmann::json> a, b;
+    flatten(baked, "", a);
+    flatten(now, "", b);
+    std::vector<std::string> out;
+    auto name = [](const std::string& path) {
+        // "settings.sun.elevation_deg" is the project's "sun.elevation_deg".
+        return path.rfind("settings.", 0) == 0 ? path.substr(9) : path;
+    };
+    for (const auto& [path, v] : b) {
+        const auto it = a.find(path);
+        if (it == a.end()) out.push_back(name(path) + ": not in the bake, now " + v.dump());
+        else if (it->second != v) out.push_back(name(path) + ": baked " + it->second.dump() + ", now " + v.dump());
+    }
+    for (const auto& [path, v] : a)
+        if (!b.count(path)) out.push_back(name(path) + ": baked " + v.dump() + ", not in the project");
     return out;
 }
 

@@ -30,6 +30,15 @@ struct BakeOutcome {
     std::vector<std::filesystem::path> files;
 };
 
+// What a bake depends on: every parameter it reads (the project less the camera, the output
+// folder and what no bake reads yet) and the identity (path, size, modification time) of the DEM
+// and HDR files. bake_report.json records it as "inputs"; a bake whose inputs differ from the
+// project's is stale.
+nlohmann::json bakeInputs(const Project& project);
+// Where two bakeInputs differ, one line each: "probe_volumes[0].grid_dims: baked [8,8], now
+// [32,32]". Empty when they are the same.
+std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const nlohmann::json& now);
+
 // Phase name and progress in [0, 1] of the whole bake.
 using BakeProgress = std::function<void(const std::string& phase, double fraction)>;
 

@@ -75,6 +75,10 @@ Options:
   --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
                                 degrees, radius in metres (default: the project's camera).
   --no-probes                   Render without probe lighting.
+  --no-rebake                   --render: draw the bake in the output folder even when it is
+                                stale (its recorded settings or input files differ from the
+                                project's), saying what differs; without it such a bake is
+                                baked again first.
   --device NAME                 Vulkan device: cpu, gpu, or part of its name
                                 (default: discrete GPU, integrated, then CPU).
   --dry-run                     With --bake: place the probes and print, per volume, the probe
@@ -135,6 +139,7 @@ struct Args {
     QCommandLineOption out{"out", "Output folder.", "DIR"};
     QCommandLineOption quality{"quality", "Preset.", "PRESET"};
     QCommandLineOption compareReference{"compare-reference", "Compare with the reference."};
+    QCommandLineOption noRebake{"no-rebake", "Draw a stale bake."};
     QCommandLineOption render{"render", "Render."};
     QCommandLineOption size{"size", "Size.", "WxH"};
     QCommandLineOption debugView{"debug-view", "View.", "N"};
@@ -147,7 +152,7 @@ struct Args {
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
-                           quality, compareReference, render, size, debugView, camera, noProbes,
+                           quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
                            device, dryRun, overlay});
     }
 };
@@ -458,8 +463,14 @@ int commandRender(const Args& a) {
     ProjectRenderer renderer(*ctx, project);
     std::string note;
     std::vector<std::string> probeWarnings;
-    const size_t volumes = request.probes ? renderer.loadProbes(true, &note, &probeWarnings) : 0;
+    const size_t volumes =
+        request.probes ? renderer.loadProbes(!a.parser.isSet(a.noRebake), &note, &probeWarnings) : 0;
     if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
+    if (!renderer.staleBake().empty()) {
+        std::cerr << "terralux: warning: " << project.outDir().string() << " holds a stale bake (--no-rebake draws it):";
+        for (const auto& d : renderer.staleBake()) std::cerr << (&d == &renderer.staleBake().front() ? " " : "; ") << d;
+        std::cerr << "\n";
+    }
     // Only the views that need the diagnostics complain about their absence.
     if (findDebugView(request.debugView)->needs.probeDiagnostics)
         for (const auto& w : probeWarnings) std::cerr << "terralux: warning: " << w << "\n";
@@ -524,6 +535,8 @@ int runCommandLine(int argc, char** argv) {
             throw UsageError("--dry-run: only with --bake");
         if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
             throw UsageError("--overlay: only with --render");
+        if (a.parser.isSet(a.noRebake) && !a.parser.isSet(a.render))
+            throw UsageError("--no-rebake: only with --render");
         if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))
             throw UsageError("--quality: only with --bake (elsewhere: --set bake.quality=PRESET)");
         if (a.parser.isSet(a.info)) return commandInfo(a);

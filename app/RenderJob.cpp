@@ -1,5 +1,7 @@
 #include "RenderJob.h"
 
+#include <fstream>
+
 #include <numbers>
 
 #include "BakeJob.h"
@@ -96,19 +98,52 @@ void ProjectRenderer::updateOverlays() {
 
 ProjectRenderer::~ProjectRenderer() = default;
 
-size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
-                                   std::vector<std::string>* warnings) {
+namespace {
+
+nlohmann::json readReport(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return nullptr;
+    nlohmann::json report = nlohmann::json::parse(in, nullptr, false);
+    return report.is_object() ? report : nlohmann::json(nullptr);
+}
+
+// Why the bake in the folder is not the project's: its differences, or what is missing.
+std::vector<std::string> staleness(const Project& project, const nlohmann::json& report) {
+    const std::filesystem::path dir = project.outDir();
+    for (const auto& v : project.scene.probeVolumes)
+        if (v.enabled && !std::filesystem::exists(dir / "sh_coeffs" / (v.name + ".shprobe")))
+            return {"no sh_coeffs/" + v.name + ".shprobe"};
+    if (report.is_null()) return {"no readable bake_report.json"};
+    if (!report.contains("inputs")) return {"bake_report.json records no inputs (an older bake)"};
+    return bakeInputDifferences(report["inputs"], bakeInputs(project));
+}
+
+std::string summary(const std::vector<std::string>& differences) {
+    std::string s = differences.front();
+    if (differences.size() > 1) s += " and " + std::to_string(differences.size() - 1) + " more";
+    return s;
+}
+
+}  // namespace
+
+size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<std::string>* warnings) {
     const SceneDescription& scene = project_.scene;
     const std::filesystem::path dir = project_.outDir() / "sh_coeffs";
-    bool missing = false;
-    for (const auto& v : scene.probeVolumes)
-        if (v.enabled && !std::filesystem::exists(dir / (v.name + ".shprobe"))) missing = true;
-    if (missing && bakeIfMissing) {
+    nlohmann::json report = readReport(project_.outDir() / "bake_report.json");
+    staleBake_ = staleness(project_, report);
+    if (!staleBake_.empty() && rebake) {
         BakeRequest request;
         request.project = project_;
         runBake(request, nullptr, nullptr);
-        if (note) *note = "baked " + project_.outDir().string() + " first (no earlier bake there)";
+        if (note) *note = "baked " + project_.outDir().string() + " first (" +
+                          (report.is_null() ? std::string("no earlier bake there") : "the bake there is stale: " + summary(staleBake_)) + ")";
+        report = readReport(project_.outDir() / "bake_report.json");
+        staleBake_.clear();
     }
+    // The encoding the probes were written in, not the one the project asks for now.
+    const bool irradiance = report.is_object() && report.contains("sh_encoding")
+                                ? report["sh_encoding"] == "irradiance"
+                                : scene.bake.encoding == ShEncoding::Irradiance;
     std::vector<GpuProbeVolume> volumes;
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
@@ -123,7 +158,7 @@ size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
         gv.spacing = g.spacing;
         gv.occupancy = g.occupancy;
         gv.scale = g.defaultScale;
-        gv.irradianceEncoded = scene.bake.encoding == ShEncoding::Irradiance;
+        gv.irradianceEncoded = irradiance;
         // docs/lighting.md default: twice the smallest probe spacing, which is the cell edge here.
         gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
                                                            : 2.0f * g.spacing;

@@ -35,12 +35,16 @@ public:
     ~ProjectRenderer();
 
     // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder, with its
-    // <volume>.probes.json diagnostics when present and matching; when any .shprobe is missing
-    // and `bakeIfMissing`, bakes the project first (its own quality settings). Returns the number
-    // of volumes bound; `note` says what happened, `warnings` gets one line per unreadable or
-    // stale diagnostics file (the diagnostics views then show no data for that volume).
-    size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr,
+    // <volume>.probes.json diagnostics when present and matching, and the SH encoding the bake
+    // wrote (from its report). When the bake there is missing or stale (its recorded inputs
+    // differ from the project's, bakeInputs) and `rebake`, bakes the project first. Returns the
+    // number of volumes bound; `note` says what was baked and why, `warnings` gets one line per
+    // unreadable or stale diagnostics file; staleBake() says what differs when a stale bake
+    // was drawn.
+    size_t loadProbes(bool rebake, std::string* note = nullptr,
                       std::vector<std::string>* warnings = nullptr);
+    // What differs between the bake loadProbes last drew and the project (empty: current).
+    const std::vector<std::string>& staleBake() const { return staleBake_; }
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes);
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
@@ -79,6 +83,7 @@ private:
     std::string placedVolumes_;  // probe_volumes JSON of placed_
     size_t placements_ = 0;
     bool hasErrorMap_ = false;
+    std::vector<std::string> staleBake_;
     DemImportResult terrain_;
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;

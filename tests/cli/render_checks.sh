@@ -32,7 +32,8 @@ grep -q "^terralux: warning: .*probes.probes.json: probe_count 3 does not match 
 grep -q "^terralux: --overlay probes,grid: 'grid' is not one of probes, leaves$" stderr || fail "overlay message: $(cat stderr)"
 # A bake without a map: view 56 says why it is grey.
 "$terralux" --bake --quiet --quality draft --out nomap --set bake.error_map_resolution=0 >/dev/null || fail "bake without a map"
-"$terralux" --render --out nomap.png --size 32x32 --debug-view 56 --set export.out_dir="$work/nomap" --quiet >stdout 2>stderr \
+"$terralux" --render --out nomap.png --size 32x32 --debug-view 56 --set export.out_dir="$work/nomap" \
+  --set bake.quality=draft --set bake.error_map_resolution=0 --quiet >stdout 2>stderr \
   || fail "view 56 without a map exited $?"
 grep -q "^terralux: note: this bake measured no interpolation-error map (bake.error_map_resolution = 0" stderr \
   || fail "no note for a bake without a map: $(cat stderr)"

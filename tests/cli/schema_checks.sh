@@ -41,9 +41,14 @@ def walk(node, path):
 walk(json.load(open(sys.argv[1])), "")
 PY
 
+# A 4 x 2 Radiance HDR sky (flat RGBE scanlines, allowed below 8 pixels wide).
+python3 -c '
+import sys
+with open(sys.argv[1], "wb") as f:
+    f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n" + bytes([128, 128, 128, 129]) * 8)' "$out/sky.hdr"
 i=0
 for sets in "" \
-  "--set sun.elevation_deg=-5 --set sky.mode=hdr --set sky.hdr=sky.exr" \
+  "--set sun.elevation_deg=-5 --set sky.mode=hdr --set sky.hdr=$out/sky.hdr" \
   "--set probe_volumes[0].placement=box --set probe_volumes[0].grid_dims=4,2,3 --set probe_volumes[0].spacing=50 --set probe_volumes[0].origin=0,100,0" \
   "--set probe_volumes[0].placement=adaptive --set probe_volumes[0].adaptive.size=3000,1200,2000 --set probe_volumes[0].adaptive.tolerance=0.03" \
   "--set bake.rays=128 --set bake.bounces=0 --set camera.radius=5000 --set camera.target=0,10,0"; do

@@ -12,6 +12,7 @@
 #include "ImageCompare.h"
 #include "ImageFile.h"
 #include "RenderJob.h"
+#include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "render/DebugViews.h"
 #include "render/FrameGraph.h"
@@ -561,4 +562,37 @@ TEST_F(RenderTest, DeviceLayerTargetsSamplersAndImageBindings) {
                   nullptr);
     ctx.submitAndWait([&](VkCommandBuffer cb) { graph.execute(cb); });
     EXPECT_EQ(graph.lastFrame().size(), 2u);
+}
+
+TEST_F(RenderTest, ProbesAreDecodedWithTheEncodingOfTheBakeNotOfTheProject) {
+    Project baked = sampleProject("encoding", 4, 4);
+    baked.scene.bake.encoding = ShEncoding::Irradiance;
+    ProjectRenderer a(*ctx_, baked);
+    ASSERT_EQ(a.loadProbes(true), 1u);
+    EXPECT_TRUE(a.staleBake().empty());
+    const RenderedImage matching = draw(a, kViewProbeIrradiance, true, true);
+    // The project now asks for radiance, but the files hold irradiance until the next bake.
+    Project edited = baked;
+    edited.scene.bake.encoding = ShEncoding::Radiance;
+    ProjectRenderer b(*ctx_, edited);
+    ASSERT_EQ(b.loadProbes(false), 1u);
+    ASSERT_EQ(b.staleBake().size(), 1u);
+    EXPECT_NE(b.staleBake()[0].find("bake.sh_encoding: baked \"irradiance\", now \"radiance\""), std::string::npos)
+        << b.staleBake()[0];
+    EXPECT_EQ(test::compareImages(draw(b, kViewProbeIrradiance, true, true).rgba, matching.rgba, kW, kH).maxAbs, 0.0);
+}
+
+TEST_F(RenderTest, AStaleBakeIsBakedAgainBeforeItIsDrawn) {
+    Project p = sampleProject("stale", 4, 4);
+    {
+        ProjectRenderer first(*ctx_, p);
+        ASSERT_EQ(first.loadProbes(true), 1u);
+    }
+    p.scene.probeVolumes[0].gridDims = {6, 1, 5};
+    ProjectRenderer r(*ctx_, p);
+    std::string note;
+    ASSERT_EQ(r.loadProbes(true, &note), 1u);
+    EXPECT_NE(note.find("the bake there is stale: probe_volumes[0].grid_dims: baked [4,4], now [6,5]"), std::string::npos) << note;
+    EXPECT_TRUE(r.staleBake().empty());
+    EXPECT_EQ(readShProbeFile(p.outDir() / "sh_coeffs" / "probes.shprobe").probes.size(), 30u);
 }
