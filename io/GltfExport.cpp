@@ -139,6 +139,13 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
     const size_t indexCount = 6 * (nc - 1) * (nr - 1);
     // 65535 is the primitive-restart value of 16-bit indices, so it may not be used as an index.
     const bool wideIndices = vertexCount > 65535;
+    // Buffer views address bytes with 32-bit offsets in most loaders.
+    const double binBytes = double(vertexCount) * 32.0 + double(indexCount) * (wideIndices ? 4 : 2);
+    if (binBytes > double(std::numeric_limits<uint32_t>::max())) {
+        throw std::runtime_error(gltfPath.string() + ": the terrain mesh of " + std::to_string(nc) + " x " +
+                                 std::to_string(nr) + " vertices needs " + std::to_string(int(binBytes / (1 << 30))) +
+                                 " GiB, over the 4 GiB a glTF buffer can address; lower terrain.max_resolution");
+    }
 
     std::vector<uint8_t>& bin = mesh.bin;
     bin.reserve(vertexCount * 32 + indexCount * (wideIndices ? 4 : 2) + 4);

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -45,8 +46,9 @@ struct GltfSceneInput {
     nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object
     std::string generatorVersion;                    // asset.generator = "Terralux <version>"
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
-    // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride.
-    size_t meshMaxVertices = size_t(1) << 20;
+    // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride. The
+    // default is no budget: the exported mesh is the surface the bake traced, sample for sample.
+    size_t meshMaxVertices = std::numeric_limits<size_t>::max();
     // false: only the sh_coeffs files (export.gltf off), staged and committed the same way.
     bool scene = true;
     // More top-level files written with the rest (the bake report): name and contents.

@@ -565,3 +565,20 @@ TEST_F(GltfExport, SceneOffWritesOnlyTheProbeFilesAndSidecars) {
             << e.path();
     }
 }
+
+// The bake traces every DEM sample, so the exported mesh has them all, whatever the size.
+TEST_F(GltfExport, TheMeshIsTheTracedSurfaceAboveAMillionVertices) {
+    Heightfield hf = makeHeightfield(1100, 1000);
+    GltfSceneInput in = sampleInput(hf);
+    exportGltfScene(dir, in);
+    const json doc = readJson(dir / "scene.gltf");
+    EXPECT_EQ(doc["extensions"]["TERRALUX_geo"]["meshStride"], 1);
+    const json& prim = doc["meshes"][0]["primitives"][0];
+    const json& position = doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
+    EXPECT_EQ(position["count"], 1100 * 1000);
+    EXPECT_FLOAT_EQ(position["max"][1].get<float>(), hf.maxHeight());
+    EXPECT_FLOAT_EQ(position["min"][1].get<float>(), hf.minHeight());
+    const json& indices = doc["accessors"][prim["indices"].get<int>()];
+    EXPECT_EQ(indices["componentType"], 5125);  // UNSIGNED_INT
+    EXPECT_EQ(indices["count"], 6 * 1099 * 999);
+}
