@@ -98,6 +98,52 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
 
 uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
 
+// The mean error a suggested terrain grid aims at.
+constexpr double kSuggestTargetMeanError = 0.02;
+
+// For a volume whose interpolation error is high: what to set instead, each with the probes and
+// time the dry run's calibration estimates. Bilinear interpolation error falls with the square
+// of the probe spacing, so a terrain grid aiming at the target grows by sqrt(mean / target) a
+// side, within the 4096-probe limit; past that an error-driven adaptive volume is the way.
+nlohmann::json suggestions(const BakeRequest& request, size_t index, double meanError) {
+    nlohmann::json out = nlohmann::json::array();
+    if (!(meanError > kSuggestAboveMeanError)) return out;
+    const ProbeVolumeSettings& v = request.project.scene.probeVolumes[index];
+    const std::string at = "probe_volumes[" + std::to_string(index) + "].";
+    std::vector<std::vector<std::string>> candidates;
+    if (v.placement == ProbePlacement::Terrain) {
+        const double grow = std::sqrt(meanError / kSuggestTargetMeanError);
+        double nx = std::ceil(v.gridDims[0] * grow), nz = std::ceil(v.gridDims[2] * grow);
+        const double fit = std::sqrt(double(kMaxTerrainGridProbes) / (nx * nz));
+        if (fit < 1.0) nx = std::floor(nx * fit), nz = std::floor(nz * fit);
+        if (nx * nz > double(v.gridDims[0]) * v.gridDims[2])
+            candidates.push_back({at + "grid_dims=" + std::to_string(int(nx)) + "," + std::to_string(int(nz))});
+    }
+    if (v.placement != ProbePlacement::Adaptive || !v.adaptive.tolerance)
+        candidates.push_back({at + "placement=adaptive", at + "adaptive.tolerance=0.02"});
+    for (const auto& sets : candidates) {
+        BakeRequest r = request;
+        nlohmann::json doc = projectToJson(r.project);
+        for (const auto& s : sets) applyOverride(doc, s);
+        r.project.scene = sceneFromJson(doc, "suggestion", nullptr);
+        try {
+            const BakeEstimate e = estimateBake(r);
+            const VolumeEstimate* ve = nullptr;
+            for (const auto& x : e.volumes)
+                if (x.name == v.name) ve = &x;
+            if (!ve) continue;
+            out.push_back({{"set", sets},
+                           {"probes", ve->probes},
+                           {"probes_max", ve->probesMax},
+                           {"estimated_time_s", e.seconds},
+                           {"estimated_max_time_s", e.secondsMax}});
+        } catch (const std::exception&) {
+            // A suggestion the estimate refuses (a placement limit) is not made.
+        }
+    }
+    return out;
+}
+
 // A volume whose every probe is inside the terrain would export an empty grid and report its
 // error as 0 %: refuse it, naming the setting that put the probes there.
 void requireProbes(const SceneDescription& scene, const ProbeVolumeSettings& v, const ProbeLayout& layout) {
@@ -448,6 +494,13 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"bounces", q.bounces},
         {"deringing", scene.bake.deringing},
     };
+    // High interpolation error: say what would lower it, with the dry run's estimates.
+    for (size_t vi = 0; vi < volumes.size(); ++vi) {
+        nlohmann::json& vr = volumeReports[vi];
+        if (!vr.contains("error_map") || vr["error_map"]["points"].get<size_t>() == 0) continue;
+        const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
+        vr["suggestions"] = suggestions(request, index, vr["error_map"]["mean"].get<double>());
+    }
     nlohmann::json errorEstimate = nlohmann::json::object();
     for (const auto& vr : volumeReports) {
         nlohmann::json e = {{"standardError", vr["standard_error"]}};

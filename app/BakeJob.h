@@ -39,6 +39,9 @@ nlohmann::json bakeInputs(const Project& project);
 // [32,32]". Empty when they are the same.
 std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const nlohmann::json& now);
 
+// Above this mean interpolation error a bake's report suggests denser probes ("suggestions").
+inline constexpr double kSuggestAboveMeanError = 0.05;
+
 // Phase name and progress in [0, 1] of the whole bake.
 using BakeProgress = std::function<void(const std::string& phase, double fraction)>;
 

@@ -384,6 +384,21 @@ int commandBake(const Args& a) {
                       << fixed(100.0 * m["p95"].get<double>(), 2) << " % / max "
                       << fixed(100.0 * m["max"].get<double>(), 2) << " % (debug view " << kViewInterpolationError << ")\n";
         }
+        if (v.contains("suggestions") && !v["suggestions"].empty()) {
+            std::cout << "    that is more than " << int(std::lround(100.0 * kSuggestAboveMeanError))
+                      << " % on average; denser probes lower it:\n";
+            for (const auto& s : v["suggestions"]) {
+                std::cout << "     ";
+                for (const auto& set : s["set"]) std::cout << " --set " << set.get<std::string>();
+                std::cout << "  (" << s["probes"].get<size_t>() << " probes";
+                if (s["probes_max"].get<size_t>() > s["probes"].get<size_t>())
+                    std::cout << ", up to " << s["probes_max"].get<size_t>();
+                std::cout << ", about " << duration(s["estimated_time_s"].get<double>());
+                if (s["estimated_max_time_s"].get<double>() > s["estimated_time_s"].get<double>())
+                    std::cout << ", up to " << duration(s["estimated_max_time_s"].get<double>());
+                std::cout << ")\n";
+            }
+        }
     }
     std::cout << "wrote " << outcome.outDir.string() << ":\n";
     for (const auto& f : outcome.files)
