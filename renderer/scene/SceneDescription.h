@@ -89,7 +89,7 @@ struct ProbeVolumeSettings {
     std::optional<glm::vec3> origin;
     // Terrain: (sx, sz) between probes; Box: cube edge in .x. Unset = auto-span.
     std::optional<glm::vec3> spacing;
-    double heightOffset = 5.0;       // terrain placement: metres above the bilinear terrain height
+    double heightOffset = 5.0;       // terrain placement: metres above the triangle surface
     std::optional<int> rayCount;     // unset = the bake quality preset decides
     std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
     AdaptiveVolumeSettings adaptive;
