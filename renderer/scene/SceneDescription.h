@@ -115,7 +115,9 @@ struct BakeSettings {
     std::optional<int> rays;          // per probe; unset = preset
     std::optional<int> bounces;       // 0 = sky visibility only; unset = preset
     ShEncoding encoding = ShEncoding::Radiance;
-    bool deringing = false;           // window SH so irradiance is never negative
+    // Window SH just enough that irradiance is never negative (a truncated L2 projection of
+    // strongly directional light rings below zero); probes already non-negative are untouched.
+    bool deringing = true;
     // Points along the longer side of each volume's interpolation-error map (the interpolation-error debug view);
     // 0 = no map. Each point costs one probe bake.
     int errorMapResolution = 64;

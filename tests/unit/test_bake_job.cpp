@@ -49,6 +49,26 @@ float minIrradianceOf(const ShProbeGrid& g) {
 
 }  // namespace
 
+// Issue: black sky, sun on the horizon. The light is the sunlit slopes' bounce, strongly
+// directional, and its L2 projection rings below zero for some normals.
+TEST(BakeDefaults, NoExportedProbeHasNegativeIrradiance) {
+    const fs::path dir = tempDir("negative");
+    Project p = cropProject(dir / "on", 16);
+    p.scene.sky.color = glm::vec3(0.0f);
+    p.scene.sun.elevationDeg = 0.0;
+    const BakeOutcome on = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const ShProbeGrid g = readShProbeFile(dir / "on" / "sh_coeffs/probes.shprobe");
+    ASSERT_GT(g.probes.size(), 200u);
+    EXPECT_GE(minIrradianceOf(g), 0.0f);
+    EXPECT_GT(on.report["volumes"][0]["deringing"]["probes_windowed"].get<int>(), 0);
+    // Without the window the same bake has negative irradiance: the case is a real one.
+    p.scene.bake.deringing = false;
+    p.scene.exportSettings.outDir = (dir / "off").string();
+    runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    EXPECT_LT(minIrradianceOf(readShProbeFile(dir / "off" / "sh_coeffs/probes.shprobe")), 0.0f);
+    fs::remove_all(dir);
+}
+
 // The reported standard error against the error each preset really has: the same probes at
 // 16384 rays on the same irradiance cache leave only the sampling error of the preset's rays.
 // Compared as root mean squares over the probes (a standard error is the RMS of the error).
