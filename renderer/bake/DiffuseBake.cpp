@@ -135,6 +135,18 @@ std::array<int, 2> IrradianceCache::gridPoints(const Heightfield& hf, int resolu
                        std::max(hf.depth(), 2))};
 }
 
+int cacheResolutionFor(const Heightfield& hf, const BakeQuality& q, uint64_t probeRays) {
+    int resolution = std::max(q.cacheResolution, 2);
+    auto cacheRays = [&](int r) {
+        const std::array<int, 2> n = IrradianceCache::gridPoints(hf, r);
+        return uint64_t(n[0]) * uint64_t(n[1]) * uint64_t(std::max(q.cacheRays, 1));
+    };
+    // Twice the probe rays: the cost stays below 3x the probes', under the 4x step in rays per
+    // probe between presets, and halves the extra error of a cut cache against a budget of 1x.
+    while (resolution > 2 && cacheRays(resolution) > 2 * probeRays) --resolution;
+    return resolution;
+}
+
 IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays, int sunSamples,
                                  int bounces, const BakeControl& control)
     : lighting_(&L) {
@@ -150,6 +162,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
     dz_ = spanZ > 0 ? spanZ / float(nz_ - 1) : 1.0f;
     const size_t points = size_t(nx_) * nz_;
     rays = std::max(rays, 1);
+    rays_ = rays;
 
     std::vector<glm::vec3> direct(points);
     sunDirect_.assign(points, glm::vec3(0.0f));
