@@ -39,6 +39,10 @@ double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
+constexpr const char* kReferenceNote =
+    "not computed: with quality reference the probes are the reference itself; standard_error "
+    "gives their Monte Carlo error";
+
 nlohmann::json stats(const std::vector<float>& v) {
     const Spread s = spreadOf(v);
     return {{"mean", s.mean}, {"p95", s.p95}, {"max", s.max}};
@@ -261,6 +265,21 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
 // Points at which every adaptive volume measures its interpolation error (docs/lighting.md).
 constexpr int kInterpolationPoints = 256;
 
+int raysOf(const BakeSetup& b, const ProbeVolumeSettings& v) { return v.rayCount ? *v.rayCount : b.q.rays; }
+
+// Probe rays the bake is known to trace before it starts: every volume's placed probes, its
+// interpolation points (adaptive) and its error-map points. Refinement octants come on top.
+uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& layouts,
+                          const std::vector<size_t>& mapPoints) {
+    uint64_t rays = 0;
+    for (size_t vi = 0; vi < b.volumes.size(); ++vi) {
+        const uint64_t probes = layouts[vi].validCount() + mapPoints[vi] +
+                                (layouts[vi].octree ? kInterpolationPoints : 0);
+        rays += probes * uint64_t(raysOf(b, *b.volumes[vi]));
+    }
+    return rays;
+}
+
 }  // namespace
 
 BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
@@ -308,17 +327,19 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
 
     std::unique_ptr<IrradianceCache> cache;
     const auto cacheStart = Clock::now();
+    const int cacheResolution = cacheResolutionFor(hf, q, plannedProbeRays(setup, layouts, mapPoints));
     if (!referenceMode && q.bounces > 0) {
         BakeControl c{[&](double f) { report("irradiance cache", base + cacheShare * f); }, cancel};
-        cache = std::make_unique<IrradianceCache>(lighting, q.cacheResolution, q.cacheRays,
+        cache = std::make_unique<IrradianceCache>(lighting, cacheResolution, q.cacheRays,
                                                   q.sunSamples, q.bounces - 1, c);
     }
     const double cacheSeconds = secondsSince(cacheStart);
+    const uint64_t cacheRays = cache ? cache->rays() : 0;
     base += cacheShare;
 
     nlohmann::json volumeReports = nlohmann::json::array();
     std::vector<GltfProbeVolume> grids;
-    uint64_t totalRays = 0;
+    uint64_t totalRays = 0, referenceRays = 0;
     size_t done = 0, doneWork = 0;
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *volumes[vi];
@@ -326,7 +347,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         const auto volumeStart = Clock::now();
         const double share = totalProbes ? double(layout.positions.size()) / double(totalProbes) : 1.0;
         const uint64_t seed = volumeSeed(vi);
-        const int rays = v.rayCount ? *v.rayCount : q.rays;
+        const int rays = raysOf(setup, v);
         std::string phase = "probes '" + v.name + "'";
         const double probeWork = double(layout.positions.size()), mapWork = double(mapPoints[vi]);
         BakeControl c{[&](double f) {
@@ -397,24 +418,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         vr["validity"] = {{"rays_from_below", stats(below)},
                           {"probes_with_rays_from_below", fromBelow}};
 
-        if (request.compareReference && !referenceMode) {
-            BakeControl rc{[&](double f) {
-                               report("reference '" + v.name + "'",
-                                      base + probeShare + refShare * (double(done) / double(totalProbes) + share * f));
-                           },
-                           cancel};
-            const int refRays = qualityPreset(QualityPreset::Reference).rays;
-            const auto refStart = Clock::now();
-            const ProbeBake ref = referenceProbes(lighting, q.bounces, layout.positions,
-                                                  layout.valid, refRays, seed ^ 0xF00Dull, rc);
-            const ErrorStats err = compareToReference(bake.sh, ref.sh, layout.valid);
-            vr["reference_error"] = {{"mean", err.mean}, {"p95", err.p95}, {"max", err.max},
-                                     {"reference_rays_per_probe", refRays},
-                                     {"reference_path_length", q.bounces == 0 ? 0 : referencePathLength(lighting.albedo)},
-                                     {"reference_time_s", secondsSince(refStart)}};
-        }
-
-        // Radiance projections, optionally windowed so irradiance is never negative.
+        // Radiance projections, optionally windowed so irradiance is never negative. Before the
+        // reference comparison, so that measures the probes as they are written.
         int windowed = 0;
         float strongest = INFINITY;
         for (size_t i = 0; i < bake.sh.size(); ++i) {
@@ -424,6 +429,30 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
                 ++windowed;
                 strongest = std::min(strongest, d.width);
             }
+        }
+
+        if (request.compareReference && referenceMode) {
+            // The probes are the reference path tracer's own: a comparison would set the reference
+            // against itself, so only its Monte Carlo error (standard_error) says anything.
+            vr["reference_error"] = {{"mean", nullptr}, {"p95", nullptr}, {"max", nullptr},
+                                     {"note", kReferenceNote}};
+        } else if (request.compareReference) {
+            BakeControl rc{[&](double f) {
+                               report("reference '" + v.name + "'",
+                                      base + probeShare + refShare * (double(done) / double(totalProbes) + share * f));
+                           },
+                           cancel};
+            const int refRays = qualityPreset(QualityPreset::Reference).rays;
+            const auto refStart = Clock::now();
+            const ProbeBake ref = referenceProbes(lighting, q.bounces, layout.positions,
+                                                  layout.valid, refRays, seed ^ 0xF00Dull, rc);
+            referenceRays += ref.rays;
+            const ErrorStats err = compareToReference(bake.sh, ref.sh, layout.valid);
+            vr["reference_error"] = {{"mean", err.mean}, {"p95", err.p95}, {"max", err.max},
+                                     {"reference_rays_per_probe", refRays},
+                                     {"reference_path_length", q.bounces == 0 ? 0 : referencePathLength(lighting.albedo)},
+                                     {"reference_rays", ref.rays},
+                                     {"reference_time_s", secondsSince(refStart)}};
         }
 
         // The interpolation-error map of the probes as the engine will read them (the interpolation-error debug view).
@@ -528,13 +557,17 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
          {{"preset", qualityName(scene.bake.quality)},
           {"rays", q.rays},
           {"bounces", q.bounces},
+          {"cache_resolution", cache ? cacheResolution : 0},
           {"cache_points", cache ? size_t(cache->pointsX()) * size_t(cache->pointsZ()) : size_t(0)},
           {"cache_rays", cache ? q.cacheRays : 0},
           {"cache_time_s", cacheSeconds}}},
         {"sh_encoding", scene.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
         {"inputs", bakeInputs(project)},
         {"threads", threads},
-        {"rays", totalRays},
+        {"rays", totalRays + cacheRays + referenceRays},
+        {"probe_rays", totalRays},
+        {"cache_rays", cacheRays},
+        {"reference_rays", referenceRays},
         {"time_s", secondsSince(start)},
         {"volumes", volumeReports},
         {"overlaps", overlapReport(grids)},
@@ -636,6 +669,18 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     e.rays = q.rays;
     e.bounces = q.bounces;
 
+    std::vector<ProbeLayout> layouts;
+    std::vector<size_t> points;
+    std::vector<glm::vec3> all;
+    for (const auto* v : setup.volumes) {
+        layouts.push_back(placeProbes(*v, hf));
+        requireProbes(project.scene, *v, layouts.back());
+        points.push_back(errorMapGrid(layouts.back(), hf, scene.bake.errorMapResolution,
+                                      errorMapHeight(*v, layouts.back())).error.size());
+        for (size_t i = 0; i < layouts.back().positions.size(); ++i)
+            if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
+    }
+
     // The cache: a small one with the real ray counts, scaled by the point count.
     std::unique_ptr<IrradianceCache> cache;
     if (!setup.referenceMode && q.bounces > 0) {
@@ -645,19 +690,12 @@ BakeEstimate estimateBake(const BakeRequest& request) {
                                                   q.cacheRays, q.sunSamples, q.bounces - 1,
                                                   BakeControl{});
         const double seconds = secondsSince(t);
-        const std::array<int, 2> full = IrradianceCache::gridPoints(hf, q.cacheResolution);
+        const std::array<int, 2> full = IrradianceCache::gridPoints(
+            hf, cacheResolutionFor(hf, q, plannedProbeRays(setup, layouts, points)));
         e.cacheSeconds = seconds * double(full[0]) * double(full[1]) /
                          double(cache->pointsX() * cache->pointsZ());
     }
 
-    std::vector<ProbeLayout> layouts;
-    std::vector<glm::vec3> all;
-    for (const auto* v : setup.volumes) {
-        layouts.push_back(placeProbes(*v, hf));
-        requireProbes(project.scene, *v, layouts.back());
-        for (size_t i = 0; i < layouts.back().positions.size(); ++i)
-            if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
-    }
 
     // Probes: a few of the volumes' own, spread over them, baked as the bake would.
     double secondsPerProbeRay = 0.0;
@@ -729,8 +767,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
                 probesMax = probes;
             }
         }
-        const ErrorMap map = errorMapGrid(L, hf, scene.bake.errorMapResolution, errorMapHeight(v, L));
-        ve.errorMapPoints = map.error.size();
+        ve.errorMapPoints = points[vi];
         probes += double(ve.errorMapPoints);
         probesMax += double(ve.errorMapPoints);
         ve.seconds = probes * perProbe;

@@ -365,7 +365,9 @@ int commandBake(const Args& a) {
                   << " probes (" << v["invalid_probes"].get<size_t>() << " inside the terrain), "
                   << v["bytes"].get<uint64_t>() << " bytes, standard error mean "
                   << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " %";
-        if (v.contains("reference_error"))
+        if (v.contains("reference_error") && v["reference_error"]["mean"].is_null())
+            std::cout << "\n    error vs reference " << v["reference_error"]["note"].get<std::string>();
+        else if (v.contains("reference_error"))
             std::cout << ", error vs reference mean "
                       << fixed(100.0 * v["reference_error"]["mean"].get<double>(), 2) << " % / p95 "
                       << fixed(100.0 * v["reference_error"]["p95"].get<double>(), 2) << " % / max "

@@ -301,7 +301,7 @@ std::vector<ParameterSpec> buildTable() {
                 sp = glm::vec3(x, std::min(x, z), z);
             });
     add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
-        .about("terrain placement: probes sit this far above the bilinear terrain height")
+        .about("terrain placement: probes sit this far above the triangle surface the bake traces; 0 or less leaves them on or in it, unbaked")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset);
     add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
         .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)

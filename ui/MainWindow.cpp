@@ -575,7 +575,12 @@ void MainWindow::updateEstimate() {
         return;
     }
     // Cache rays plus probe rays at the throughput measured by the bake benchmark on two cores.
-    const double cacheRays = double(q.cacheResolution) * q.cacheResolution * (q.cacheRays + q.sunSamples);
+    const bool cached = p.scene.bake.quality != QualityPreset::Reference &&
+                        (p.scene.bake.bounces ? *p.scene.bake.bounces : q.bounces) > 0;
+    const std::array<int, 2> cachePoints = IrradianceCache::gridPoints(
+        doc_->terrain().heightfield, cacheResolutionFor(doc_->terrain().heightfield, q, uint64_t(rays)));
+    const double cacheRays =
+        cached ? double(cachePoints[0]) * cachePoints[1] * (q.cacheRays + q.sunSamples) : 0.0;
     const double seconds = (rays * (p.scene.bake.quality == QualityPreset::Reference ? 8.0 : 1.5) + cacheRays) / 3.0e6;
     estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, %4 error-map points, about %5 s")
                            .arg(probes).arg(invalid).arg(formatBytes(double(bytes))).arg(mapPoints)

@@ -33,6 +33,12 @@ struct BakeQuality {
 BakeQuality qualityPreset(QualityPreset preset);
 const char* qualityName(QualityPreset preset);
 
+// The irradiance-cache resolution a bake uses (docs/lighting.md "Irradiance cache"): the
+// preset's, lowered until the cache traces no more than twice the bake's `probeRays`.
+// The cache only serves the probe rays' terrain hits, so a few probes need no dense cache, and
+// a bake's cost then grows with its rays per probe: presets stay ordered by cost at any size.
+int cacheResolutionFor(const Heightfield& hf, const BakeQuality& q, uint64_t probeRays);
+
 struct BakeLighting {
     const HeightfieldTracer* tracer = nullptr;
     Sky sky = Sky::uniform(glm::vec3(0.0f));
@@ -65,13 +71,15 @@ public:
     glm::vec3 indirectAt(const RayHit& hit) const;
     int pointsX() const { return nx_; }
     int pointsZ() const { return nz_; }
+    // Hemisphere rays traced (shadow rays toward the sun not counted, as for probes).
+    uint64_t rays() const { return uint64_t(nx_) * uint64_t(nz_) * uint64_t(rays_); }
     // The (x, z) point counts a cache of `resolution` gets over `hf`, without building it.
     static std::array<int, 2> gridPoints(const Heightfield& hf, int resolution);
 
 private:
     glm::vec3 interpolate(const std::vector<glm::vec3>& e, float x, float z) const;
     const BakeLighting* lighting_;
-    int nx_ = 0, nz_ = 0;
+    int nx_ = 0, nz_ = 0, rays_ = 0;
     float x0_ = 0, z0_ = 0, dx_ = 1, dz_ = 1;
     glm::vec3 skirt_{0.0f};
     std::vector<glm::vec3> irradiance_;

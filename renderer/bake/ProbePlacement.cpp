@@ -74,27 +74,15 @@ uint64_t ProbeLayout::fileBytes() const {
 
 namespace {
 
-// Bilinear height over the DEM samples (seed 000's probe height rule). It can differ from the
-// drawn triangle surface, so validity is checked against that surface separately.
-float bilinearHeight(const Heightfield& hf, float x, float z) {
-    const double gx = std::clamp(double(x) / hf.cellSizeX() + 0.5 * (hf.width() - 1), 0.0, double(hf.width() - 1));
-    const double gz = std::clamp(double(z) / hf.cellSizeZ() + 0.5 * (hf.depth() - 1), 0.0, double(hf.depth() - 1));
-    const int c = std::min(int(gx), std::max(hf.width() - 2, 0));
-    const int r = std::min(int(gz), std::max(hf.depth() - 2, 0));
-    const int c1 = std::min(c + 1, hf.width() - 1), r1 = std::min(r + 1, hf.depth() - 1);
-    const double fx = gx - c, fz = gz - r;
-    return float((1 - fz) * ((1 - fx) * hf.at(c, r) + fx * hf.at(c1, r)) +
-                 fz * ((1 - fx) * hf.at(c, r1) + fx * hf.at(c1, r1)));
-}
-
 std::string num(double v) {
     std::ostringstream s;
     s << v;
     return s.str();
 }
 
-// Terrain-following grid (seed 000): nx × nz probes at the terrain height plus the
-// offset. Auto-span puts the end probes on the footprint edges; a 1-wide axis is centred.
+// Terrain-following grid (seed 000): nx × nz probes at the height of the triangle surface the
+// bake traces plus the offset (a bilinear height can be metres below that surface, so a
+// positive offset could leave a probe inside the terrain). Auto-span puts the end probes on the footprint edges; a 1-wide axis is centred.
 ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
     const std::string where = "probe_volumes '" + v.name + "'";
     ProbeLayout L;
@@ -120,9 +108,12 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
     for (int k = 0; k < nz; ++k)
         for (int i = 0; i < nx; ++i) {
             const float x = first.x + spacing.x * float(i), z = first.z + spacing.z * float(k);
-            const glm::vec3 p(x, bilinearHeight(hf, x, z) + float(v.heightOffset), z);
+            const float ground = hf.surfaceHeight(x, z);
+            glm::vec3 p(x, ground + float(v.heightOffset), z);
+            // An offset below the float spacing at this height would round onto the surface.
+            if (v.heightOffset > 0.0 && !(p.y > ground)) p.y = std::nextafter(ground, INFINITY);
             L.positions.push_back(p);
-            L.valid.push_back(p.y > hf.surfaceHeight(x, z) ? 1 : 0);
+            L.valid.push_back(p.y > ground ? 1 : 0);
         }
 
     // Occupancy: cubic cells of the smaller probe spacing (or, for a single probe, of the

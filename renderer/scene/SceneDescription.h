@@ -89,7 +89,7 @@ struct ProbeVolumeSettings {
     std::optional<glm::vec3> origin;
     // Terrain: (sx, sz) between probes; Box: cube edge in .x. Unset = auto-span.
     std::optional<glm::vec3> spacing;
-    double heightOffset = 5.0;       // terrain placement: metres above the bilinear terrain height
+    double heightOffset = 5.0;       // terrain placement: metres above the triangle surface
     std::optional<int> rayCount;     // unset = the bake quality preset decides
     std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
     AdaptiveVolumeSettings adaptive;
@@ -115,7 +115,9 @@ struct BakeSettings {
     std::optional<int> rays;          // per probe; unset = preset
     std::optional<int> bounces;       // 0 = sky visibility only; unset = preset
     ShEncoding encoding = ShEncoding::Radiance;
-    bool deringing = false;           // window SH so irradiance is never negative
+    // Window SH just enough that irradiance is never negative (a truncated L2 projection of
+    // strongly directional light rings below zero); probes already non-negative are untouched.
+    bool deringing = true;
     // Points along the longer side of each volume's interpolation-error map (the interpolation-error debug view);
     // 0 = no map. Each point costs one probe bake.
     int errorMapResolution = 64;

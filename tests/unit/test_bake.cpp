@@ -249,6 +249,33 @@ TEST(Placement, ProbesInsideTheTerrainAreInvalidAndOnlyStraddlingCellsBorrow) {
     EXPECT_EQ(placeProbes(below, hf).validCount(), 0u);
 }
 
+TEST(Placement, TerrainGridProbesSitTheOffsetAboveTheTracedSurface) {
+    // 3 x 3 cells whose fixed diagonals run along ridges: the triangle surface stands up to 50 m
+    // above the bilinear height (100 on the diagonal, bilinear 50 at a cell centre), so probes 5 m
+    // above the bilinear height were inside the terrain.
+    std::vector<float> h(4 * 4);
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) h[size_t(r) * 4 + c] = (r + c) % 2 ? 0.0f : 100.0f;
+    const Heightfield hf(4, 4, 30.0, 30.0, std::move(h));
+    ProbeVolumeSettings v;
+    v.gridDims = {8, 1, 8};
+    const ProbeLayout L = placeProbes(v, hf);
+    ASSERT_EQ(L.positions.size(), 64u);
+    EXPECT_EQ(L.validCount(), 64u);
+    for (const glm::vec3& p : L.positions)
+        EXPECT_FLOAT_EQ(p.y, hf.surfaceHeight(p.x, p.z) + 5.0f) << p.x << " " << p.z;
+    // The tracer agrees: no probe sees the terrain from below.
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting light = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
+    const ProbeBake b = bakeProbes(light, nullptr, 0, L.positions, L.valid, 64, 1, {});
+    for (float share : b.fromBelowShare) EXPECT_EQ(share, 0.0f);
+    // Any positive offset, however small against the height, stays above the surface.
+    v.heightOffset = 1e-6;
+    EXPECT_EQ(placeProbes(v, hf).validCount(), 64u);
+    v.heightOffset = 0.0;
+    EXPECT_EQ(placeProbes(v, hf).validCount(), 0u);
+}
+
 TEST(SurfaceRange, IsExactOverRandomRectangles) {
     std::vector<float> h(23 * 17);
     Rng rng(11);
