@@ -311,7 +311,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
         .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance);
     add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
-        .autoMeans("DEM cell: the DEM's cell size").label("Adaptive: min cell")
+        .autoMeans("auto: the DEM's cell size, or 1/128 of the box's longer horizontal side when larger").label("Adaptive: min cell")
         .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::minCellSize);
     add(Row("probe_volumes[].adaptive.max_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
