@@ -65,6 +65,8 @@ void ProjectRenderer::setProject(const Project& project) {
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
+    boundProbes_ = 0;
+    for (const auto& v : volumes) boundProbes_ += v.coeffs.size();
     bound_.clear();
     boundVolumes_ = sceneToJson(project_.scene).at("probe_volumes").dump();
     hasErrorMap_ = false;
@@ -97,9 +99,10 @@ void ProjectRenderer::updateOverlays() {
 ProjectRenderer::~ProjectRenderer() = default;
 
 size_t ProjectRenderer::loadProbes(bool bakeIfMissing, std::string* note,
-                                   std::vector<std::string>* warnings) {
+                                   std::vector<std::string>* warnings,
+                                   const std::filesystem::path& from) {
     const SceneDescription& scene = project_.scene;
-    const std::filesystem::path dir = project_.outDir() / "sh_coeffs";
+    const std::filesystem::path dir = (from.empty() ? project_.outDir() : from) / "sh_coeffs";
     bool missing = false;
     for (const auto& v : scene.probeVolumes)
         if (v.enabled && !std::filesystem::exists(dir / (v.name + ".shprobe"))) missing = true;

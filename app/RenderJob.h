@@ -39,10 +39,14 @@ public:
     // and `bakeIfMissing`, bakes the project first (its own quality settings). Returns the number
     // of volumes bound; `note` says what happened, `warnings` gets one line per unreadable or
     // stale diagnostics file (the diagnostics views then show no data for that volume).
+    // `from`: another output folder to read (an export elsewhere); empty: the project's own.
     size_t loadProbes(bool bakeIfMissing, std::string* note = nullptr,
-                      std::vector<std::string>* warnings = nullptr);
+                      std::vector<std::string>* warnings = nullptr,
+                      const std::filesystem::path& from = {});
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes);
+    // Probes of the bound volumes (what the viewport lights with), whatever the settings say now.
+    size_t boundProbeCount() const { return boundProbes_; }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
@@ -78,6 +82,7 @@ private:
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     std::string placedVolumes_;  // probe_volumes JSON of placed_
     size_t placements_ = 0;
+    size_t boundProbes_ = 0;
     bool hasErrorMap_ = false;
     DemImportResult terrain_;
     RenderSettings base_;
