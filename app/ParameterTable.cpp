@@ -95,6 +95,7 @@ public:
     Row& slider() { s_.slider = true; return *this; }
     Row& noUiRow() { s_.uiRow = false; return *this; }
     Row& count(std::function<int(const SceneDescription&, size_t)> f) { s_.items = std::move(f); return *this; }
+    Row& onlyWhen(std::function<bool(const SceneDescription&, size_t)> f) { s_.readWhen = std::move(f); return *this; }
 
     // A field of a scene section (SceneDescription::sun, ::sky, ...).
     template <class Section, class T>
@@ -302,7 +303,10 @@ std::vector<ParameterSpec> buildTable() {
             });
     add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
         .about("terrain placement: probes sit this far above the triangle surface the bake traces; 0 or less leaves them on or in it, unbaked")
-        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset);
+        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset)
+        .onlyWhen([](const SceneDescription& s, size_t i) {
+            return s.probeVolumes.at(i).placement == ProbePlacement::Terrain;
+        });
     add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
         .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)
         .volume(&ProbeVolumeSettings::rayCount);
@@ -311,7 +315,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
         .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance);
     add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
-        .autoMeans("DEM cell: the DEM's cell size").label("Adaptive: min cell")
+        .autoMeans("auto: the DEM's cell size, or 1/128 of the box's longer horizontal side when larger").label("Adaptive: min cell")
         .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::minCellSize);
     add(Row("probe_volumes[].adaptive.max_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
@@ -440,7 +444,11 @@ std::vector<ParameterSpec> buildTable() {
 
     std::vector<ParameterSpec> table;
     table.reserve(rows.size());
-    for (Row& r : rows) table.push_back(std::move(r.s_));
+    for (Row& r : rows) {
+        // The adaptive section is read by adaptive volumes only (placeAdaptive).
+        if (r.s_.path.rfind("probe_volumes[].adaptive.", 0) == 0 && !r.s_.readWhen) r.onlyWhen(isAdaptive);
+        table.push_back(std::move(r.s_));
+    }
     return table;
 }
 
@@ -448,6 +456,11 @@ std::vector<ParameterSpec> buildTable() {
 
 std::string ParameterSpec::localPath() const {
     return perVolume() ? path.substr(std::string("probe_volumes[].").size()) : path;
+}
+
+bool ParameterSpec::isRead(const SceneDescription& scene, size_t volume) const {
+    if (items && items(scene, volume) < 0) return false;
+    return !readWhen || readWhen(scene, volume);
 }
 
 json ParameterSpec::defaultValue() const {

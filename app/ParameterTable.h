@@ -65,6 +65,9 @@ struct ParameterSpec {
     // Lists whose length depends on other parameters (a box grid has 3 dims, a terrain grid 2):
     // the exact count for this scene, 0 for one plain number, -1 when the row is not read.
     std::function<int(const SceneDescription&, size_t volume)> items;
+    // Rows that are read only in some scenes but keep their value in the others (adaptive.*
+    // rows of a terrain volume): false where the row is not read. Unset: always read.
+    std::function<bool(const SceneDescription&, size_t volume)> readWhen;
 
     // Binding to the scene. `volume` indexes probe_volumes for per-volume rows.
     std::function<nlohmann::json(const SceneDescription&, size_t volume)> get;
@@ -77,6 +80,9 @@ struct ParameterSpec {
     // The default, read from a default-constructed scene (or probe volume).
     nlohmann::json defaultValue() const;
     bool nullable() const { return autoMeaning.has_value(); }
+    // Whether this scene reads the row (for per-volume rows, of volume `volume`, which must
+    // exist): `items` not -1 and `readWhen` not false. The docks hide rows that are not read.
+    bool isRead(const SceneDescription& scene, size_t volume) const;
     // "[0, 90]", "(0, 1]", "> 0", "one of a | b": the rule as validation messages state it.
     std::string rangeText() const;
 };

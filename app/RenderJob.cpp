@@ -67,6 +67,8 @@ void ProjectRenderer::setProject(const Project& project) {
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
+    boundProbes_ = 0;
+    for (const auto& v : volumes) boundProbes_ += v.coeffs.size();
     bound_.clear();
     boundVolumes_ = sceneToJson(project_.scene).at("probe_volumes").dump();
     hasErrorMap_ = false;
@@ -108,8 +110,8 @@ nlohmann::json readReport(const std::filesystem::path& file) {
 }
 
 // Why the bake in the folder is not the project's: its differences, or what is missing.
-std::vector<std::string> staleness(const Project& project, const nlohmann::json& report) {
-    const std::filesystem::path dir = project.outDir();
+std::vector<std::string> staleness(const Project& project, const std::filesystem::path& dir,
+                                   const nlohmann::json& report) {
     for (const auto& v : project.scene.probeVolumes)
         if (v.enabled && !std::filesystem::exists(dir / "sh_coeffs" / (v.name + ".shprobe")))
             return {"no sh_coeffs/" + v.name + ".shprobe"};
@@ -126,12 +128,15 @@ std::string summary(const std::vector<std::string>& differences) {
 
 }  // namespace
 
-size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<std::string>* warnings) {
+size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<std::string>* warnings,
+                                   const std::filesystem::path& from) {
     const SceneDescription& scene = project_.scene;
-    const std::filesystem::path dir = project_.outDir() / "sh_coeffs";
-    nlohmann::json report = readReport(project_.outDir() / "bake_report.json");
-    staleBake_ = staleness(project_, report);
-    if (!staleBake_.empty() && rebake) {
+    const std::filesystem::path folder = from.empty() ? project_.outDir() : from;
+    const std::filesystem::path dir = folder / "sh_coeffs";
+    nlohmann::json report = readReport(folder / "bake_report.json");
+    staleBake_ = staleness(project_, folder, report);
+    // Only the project's own folder is baked again; another folder is drawn as it is.
+    if (!staleBake_.empty() && rebake && from.empty()) {
         BakeRequest request;
         request.project = project_;
         runBake(request, nullptr, nullptr);

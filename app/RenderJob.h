@@ -40,13 +40,17 @@ public:
     // differ from the project's, bakeInputs) and `rebake`, bakes the project first. Returns the
     // number of volumes bound; `note` says what was baked and why, `warnings` gets one line per
     // unreadable or stale diagnostics file; staleBake() says what differs when a stale bake
-    // was drawn.
+    // was drawn. `from`: another output folder to read (an export elsewhere; never baked
+    // again); empty: the project's own.
     size_t loadProbes(bool rebake, std::string* note = nullptr,
-                      std::vector<std::string>* warnings = nullptr);
+                      std::vector<std::string>* warnings = nullptr,
+                      const std::filesystem::path& from = {});
     // What differs between the bake loadProbes last drew and the project (empty: current).
     const std::vector<std::string>& staleBake() const { return staleBake_; }
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes);
+    // Probes of the bound volumes (what the viewport lights with), whatever the settings say now.
+    size_t boundProbeCount() const { return boundProbes_; }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
@@ -82,6 +86,7 @@ private:
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     std::string placedVolumes_;  // probe_volumes JSON of placed_
     size_t placements_ = 0;
+    size_t boundProbes_ = 0;
     bool hasErrorMap_ = false;
     std::vector<std::string> staleBake_;
     DemImportResult terrain_;

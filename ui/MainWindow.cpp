@@ -1,5 +1,10 @@
 #include "MainWindow.h"
 
+#include <functional>
+
+#include <QAbstractSpinBox>
+#include <cmath>
+
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
@@ -12,23 +17,31 @@
 #include <QFileInfo>
 #include <QFormLayout>
 #include <QHBoxLayout>
+#include <QHeaderView>
+#include <QKeyEvent>
 #include <QLabel>
+#include <QLineEdit>
+#include <QLocale>
 #include <QMenuBar>
 #include <QMessageBox>
-#include <QPlainTextEdit>
 #include <QProgressBar>
+#include <QProxyStyle>
 #include <QPushButton>
 #include <QScrollArea>
 #include <QScrollBar>
 #include <QSettings>
 #include <QStandardPaths>
 #include <QStatusBar>
+#include <QStyleOptionTab>
+#include <QTabBar>
+#include <QTableWidget>
 #include <QToolBar>
 #include <QVBoxLayout>
 
 #include "DemImport.h"
 #include "ParameterPanels.h"
 #include "ParameterTable.h"
+#include "BakeJob.h"
 #include "PreviewBake.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
@@ -60,6 +73,45 @@ QWidget* scrolled(QWidget* w) {
     return area;
 }
 
+// QMainWindow shows a tabbed dock's title as its tab label, where '&' marks a mnemonic; dock
+// titles are plain text ("Sun & Sky", as in the title bar), so the dock tabs draw them literally.
+class DockTabStyle : public QProxyStyle {
+public:
+    void drawControl(ControlElement element, const QStyleOption* option, QPainter* painter,
+                     const QWidget* widget) const override {
+        if (element == CE_TabBarTabLabel)
+            if (const auto* tab = qstyleoption_cast<const QStyleOptionTab*>(option)) {
+                QStyleOptionTab literal(*tab);
+                literal.text.replace('&', "&&");
+                return QProxyStyle::drawControl(element, &literal, painter, widget);
+            }
+        QProxyStyle::drawControl(element, option, painter, widget);
+    }
+    QSize sizeFromContents(ContentsType type, const QStyleOption* option, const QSize& size,
+                           const QWidget* widget) const override {
+        QSize out = QProxyStyle::sizeFromContents(type, option, size, widget);
+        if (type == CT_TabBarTab)
+            if (const auto* tab = qstyleoption_cast<const QStyleOptionTab*>(option))
+                // The tab bar measured the label without its '&'s.
+                out.rwidth() += int(tab->text.count('&')) * tab->fontMetrics.horizontalAdvance('&');
+        return out;
+    }
+};
+
+// Whether Undo/Redo typed into `w` should reach the document's undo stack rather than the widget.
+// Spin boxes commit every value they show, so their own text undo only confuses; a line edit
+// keeps its text undo while it holds typing of its own (setText after a commit clears it).
+bool documentUndoWins(QWidget* w, bool undo) {
+    for (QWidget* p = w; p; p = p->parentWidget())
+        if (qobject_cast<QAbstractSpinBox*>(p)) return true;
+    if (auto* edit = qobject_cast<QLineEdit*>(w)) return !(undo ? edit->isUndoAvailable() : edit->isRedoAvailable());
+    return true;
+}
+
+QString percent(const nlohmann::json& v) {
+    return v.is_number() ? QString("%1 %").arg(v.get<double>() * 100.0, 0, 'f', 2) : QString("—");
+}
+
 QString formatBytes(double bytes) {
     if (bytes < 1024) return QString::number(bytes) + " B";
     if (bytes < 1024 * 1024) return QString::number(bytes / 1024.0, 'f', 1) + " KiB";
@@ -70,6 +122,8 @@ QString formatBytes(double bytes) {
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectDocument(this)) {
     setObjectName("mainWindow");
+    tabStyle_ = new DockTabStyle;
+    tabStyle_->setParent(this);
     // Our device, on an instance Qt can make surfaces for.
     {
         QVulkanInstance probe;
@@ -101,6 +155,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
                                    : 60000);
     connect(&autosaveTimer_, &QTimer::timeout, this, &MainWindow::autosave);
     autosaveTimer_.start();
+    // Undo and redo reach the document from every dock, floating ones too (eventFilter).
+    qApp->installEventFilter(this);
 
     connect(doc_, &ProjectDocument::terrainChanged, this, &MainWindow::rebuildRenderer);
     connect(doc_, &ProjectDocument::parametersChanged, this, [this](const QString& path) {
@@ -119,6 +175,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         else statusBar()->clearMessage();
     });
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateTitle);
+    connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateOutputPath);
+    connect(doc_, &ProjectDocument::parametersChanged, this, &MainWindow::updateOutputPath);
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
         frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
     });
@@ -137,13 +195,17 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(bake_, &BakeController::finished, this, [this](const nlohmann::json& report) {
         progress_->setValue(100);
         eta_->setText(QString("done in %1 s").arg(report["time_s"].get<double>(), 0, 'f', 2));
-        report_->setPlainText(QString::fromStdString(report.dump(2)));
+        showReport(report);
         bakeButton_->setEnabled(true);
         cancelButton_->setEnabled(false);
         if (renderer_) {
+            // Show what this bake wrote, wherever it went, and say where that was.
+            const auto own = bakeFolder();
             renderer_->setProject(doc_->project());
-            renderer_->loadProbes(false);
-            probeSource_ = "last bake";
+            renderer_->loadProbes(false, nullptr, nullptr, bakeOutDir_);
+            probeSource_ = withStaleness(own && *own == bakeOutDir_
+                                             ? QString("last bake")
+                                             : "export in " + QString::fromStdString(bakeOutDir_.string()));
             viewport_->renderNow();
             updateStatus();
         }
@@ -164,6 +226,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     rebuildRenderer();
     updateEstimate();
     updateTitle();
+    updateOutputPath();
     resize(1400, 860);
 }
 
@@ -184,6 +247,7 @@ QString MainWindow::autosaveDir() {
 
 void MainWindow::buildDocks() {
     auto dock = [this](const QString& title, const QString& name, QWidget* w) {
+        // A dock title is plain text: '&' needs no escaping here (unlike buttons and actions).
         auto* d = new QDockWidget(title, this);
         d->setObjectName(name);
         d->setWidget(scrolled(w));
@@ -229,10 +293,11 @@ void MainWindow::buildDocks() {
         if (!f.isEmpty()) importHdrFile(f);
     });
     connectRejected(sky);
-    auto* skyDock = dock("Sun && Sky", "dock.sunSky", sky);
+    auto* skyDock = dock("Sun & Sky", "dock.sunSky", sky);
 
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
+    volumesPanel_ = volumes;
     connectRejected(volumes);
     auto* volumesDock = dock("Probe Volumes", "dock.probeVolumes", volumes);
 
@@ -244,6 +309,11 @@ void MainWindow::buildDocks() {
     bf->addParameters("export.");
     connectRejected(bf);
     bv->addWidget(bf);
+    outputPath_ = new QLabel;
+    outputPath_->setObjectName("bake.outputPath");
+    outputPath_->setWordWrap(true);
+    outputPath_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    bv->addWidget(outputPath_);
     estimate_ = new QLabel;
     estimate_->setObjectName("bake.estimate");
     estimate_->setWordWrap(true);
@@ -265,14 +335,24 @@ void MainWindow::buildDocks() {
     eta_ = new QLabel;
     eta_->setObjectName("bake.eta");
     bv->addWidget(eta_);
-    report_ = new QPlainTextEdit;
+    // The last bake's report: a row per figure, a column per volume (bake_report.json has all).
+    report_ = new QTableWidget;
     report_->setObjectName("bake.report");
-    report_->setReadOnly(true);
+    report_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+    report_->setSelectionMode(QAbstractItemView::NoSelection);
+    report_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
     report_->setMinimumHeight(120);
     bv->addWidget(report_, 1);
+    // What would lower a high interpolation error, with its estimated cost (the report's).
+    suggestions_ = new QLabel;
+    suggestions_->setObjectName("bake.suggestions");
+    suggestions_->setWordWrap(true);
+    suggestions_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+    suggestions_->hide();
+    bv->addWidget(suggestions_);
     connect(bakeButton_, &QPushButton::clicked, this, [this] { startBake(); });
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
-    auto* bakeDock = dock("Bake && Export", "dock.bakeExport", bakeWidget);
+    auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
 
     for (auto* f : {tf, sky, bf}) f->refresh();
     tabifyDockWidget(terrainDock, skyDock);
@@ -358,24 +438,8 @@ void MainWindow::buildMenus() {
         const QString f = QFileDialog::getOpenFileName(this, "Open project", QString(), "Terralux projects (*.json);;All files (*)");
         if (!f.isEmpty()) openProject(f);
     });
-    action(file, "&Save", "action.save", QKeySequence::Save, [this] {
-        QString error;
-        if (doc_->fileName().isEmpty()) {
-            const QString f = QFileDialog::getSaveFileName(this, "Save project", "project.terralux.json", "Terralux projects (*.json)");
-            if (f.isEmpty()) return;
-            if (!doc_->saveAs(f, &error)) showError("Save", error);
-            else addRecent(f);
-        } else if (!doc_->save(&error)) {
-            showError("Save", error);
-        }
-    });
-    action(file, "Save &As…", "action.saveAs", QKeySequence::SaveAs, [this] {
-        const QString f = QFileDialog::getSaveFileName(this, "Save project as", "project.terralux.json", "Terralux projects (*.json)");
-        if (f.isEmpty()) return;
-        QString error;
-        if (!doc_->saveAs(f, &error)) showError("Save As", error);
-        else addRecent(f);
-    });
+    action(file, "&Save", "action.save", QKeySequence::Save, [this] { saveInteractively(false); });
+    action(file, "Save &As…", "action.saveAs", QKeySequence::SaveAs, [this] { saveInteractively(true); });
     file->addSeparator();
     action(file, "Import &DEM…", "action.importDem", QKeySequence("Ctrl+I"), [this] {
         findChild<QPushButton*>("terrain.import")->click();
@@ -384,7 +448,7 @@ void MainWindow::buildMenus() {
         findChild<QPushButton*>("sky.import")->click();
     });
     action(file, "&Export to folder…", "action.export", QKeySequence("Ctrl+E"), [this] {
-        const QString dir = QFileDialog::getExistingDirectory(this, "Bake and export into");
+        const QString dir = askExportFolder();
         if (!dir.isEmpty()) startBake(dir);
     });
     recentMenu_ = file->addMenu("&Recent files");
@@ -408,9 +472,12 @@ void MainWindow::buildMenus() {
     QAction* undo = doc_->undoStack()->createUndoAction(this, "&Undo");
     undo->setObjectName("action.undo");
     undo->setShortcut(QKeySequence::Undo);
+    // Whatever has focus, floating docks included; eventFilter keeps spin boxes from taking it.
+    undo->setShortcutContext(Qt::ApplicationShortcut);
     QAction* redo = doc_->undoStack()->createRedoAction(this, "&Redo");
     redo->setObjectName("action.redo");
     redo->setShortcut(QKeySequence::Redo);
+    redo->setShortcutContext(Qt::ApplicationShortcut);
     edit->addAction(undo);
     edit->addAction(redo);
 
@@ -424,7 +491,11 @@ void MainWindow::buildMenus() {
         connect(a, &QAction::triggered, this, [this, index] { viewSelector_->setCurrentIndex(index); });
     }
     QMenu* panels = view->addMenu("&Panels");
-    for (auto* d : findChildren<QDockWidget*>()) panels->addAction(d->toggleViewAction());
+    for (auto* d : findChildren<QDockWidget*>()) {
+        // Menu text marks mnemonics with '&'; the title's own '&' is doubled to show as one.
+        d->toggleViewAction()->setText(d->windowTitle().replace('&', "&&"));
+        panels->addAction(d->toggleViewAction());
+    }
 
     QMenu* bakeMenu = menuBar()->addMenu("&Bake");
     bakeMenu->setObjectName("menu.bake");
@@ -480,11 +551,179 @@ bool MainWindow::maybeSave() {
     box.setObjectName("unsavedDialog");
     const int answer = box.exec();
     if (answer == QMessageBox::Cancel) return false;
-    if (answer == QMessageBox::Save) {
-        findChild<QAction*>("action.save")->trigger();
-        return !doc_->isModified();
-    }
+    if (answer == QMessageBox::Save) return saveInteractively(false) && !doc_->isModified();
     return true;
+}
+
+QString MainWindow::projectFileName(const QString& chosen) {
+    if (chosen.isEmpty() || chosen.endsWith(".json", Qt::CaseInsensitive)) return chosen;
+    if (chosen.endsWith(".terralux", Qt::CaseInsensitive)) return chosen + ".json";
+    return chosen + ".terralux.json";
+}
+
+QString MainWindow::askProjectFile(const QString& title) {
+    QFileDialog dialog(this, title, QString(), "Terralux projects (*.json)");
+    dialog.setObjectName("saveDialog");
+    dialog.setAcceptMode(QFileDialog::AcceptSave);
+    dialog.selectFile(doc_->fileName().isEmpty() ? QString("project.terralux.json") : doc_->fileName());
+    if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return {};
+    const QString chosen = dialog.selectedFiles().first();
+    const QString file = projectFileName(chosen);
+    // The dialog asked about overwriting the name typed, not the one with the suffix added.
+    if (file != chosen && QFileInfo::exists(file)) {
+        QMessageBox box(QMessageBox::Warning, title, QString("%1 exists. Replace it?").arg(file),
+                        QMessageBox::Yes | QMessageBox::Cancel, this);
+        box.setObjectName("replaceDialog");
+        if (box.exec() != QMessageBox::Yes) return {};
+    }
+    return file;
+}
+
+bool MainWindow::saveProjectAs(const QString& chosen) {
+    const QString file = projectFileName(chosen);
+    QString error;
+    if (!doc_->saveAs(file, &error)) {
+        showError("Save As", error);
+        return false;
+    }
+    addRecent(file);
+    return true;
+}
+
+bool MainWindow::saveInteractively(bool as) {
+    if (as || doc_->fileName().isEmpty()) {
+        const QString file = askProjectFile(as ? "Save project as" : "Save project");
+        return !file.isEmpty() && saveProjectAs(file);
+    }
+    QString error;
+    if (doc_->save(&error)) return true;
+    showError("Save", error);
+    return false;
+}
+
+QString MainWindow::askExportFolder() {
+    QFileDialog dialog(this, "Bake and export into");
+    dialog.setObjectName("exportDialog");
+    dialog.setFileMode(QFileDialog::Directory);
+    dialog.setOption(QFileDialog::ShowDirsOnly);
+    if (dialog.exec() != QDialog::Accepted || dialog.selectedFiles().isEmpty()) return {};
+    return dialog.selectedFiles().first();
+}
+
+std::optional<std::filesystem::path> MainWindow::bakeFolder() const {
+    const Project& p = doc_->project();
+    const std::filesystem::path dir(p.scene.exportSettings.outDir);
+    if (dir.is_absolute()) return dir.lexically_normal();
+    // Untitled: a relative folder would land wherever Terralux was started from.
+    if (p.file.empty()) return std::nullopt;
+    return std::filesystem::absolute(p.outDir()).lexically_normal();
+}
+
+void MainWindow::updateOutputPath() {
+    if (const auto dir = bakeFolder())
+        outputPath_->setText("Bake writes to " + QString::fromStdString(dir->string()));
+    else
+        outputPath_->setText(QString("Bake writes to \"%1\" beside the project file: save the project "
+                                     "first (Bake asks), or use File > Export to folder")
+                                 .arg(QString::fromStdString(doc_->project().scene.exportSettings.outDir)));
+}
+
+size_t MainWindow::boundProbeCount() const { return renderer_ ? renderer_->boundProbeCount() : 0; }
+
+bool MainWindow::event(QEvent* e) {
+    if (e->type() == QEvent::ChildPolished)
+        if (auto* bar = qobject_cast<QTabBar*>(static_cast<QChildEvent*>(e)->child()); bar && bar->style() != tabStyle_)
+            bar->setStyle(tabStyle_);  // the dock tabs QMainWindow makes (DockTabStyle)
+    return QMainWindow::event(e);
+}
+
+bool MainWindow::eventFilter(QObject* watched, QEvent* e) {
+    if (e->type() == QEvent::ShortcutOverride) {
+        auto* key = static_cast<QKeyEvent*>(e);
+        const bool undo = key->matches(QKeySequence::Undo), redo = key->matches(QKeySequence::Redo);
+        auto* w = qobject_cast<QWidget*>(watched);
+        bool ours = false;
+        for (QWidget* p = w; p && !ours; p = p->parentWidget()) ours = p == this;
+        if ((undo || redo) && ours && documentUndoWins(w, undo)) {
+            // Not overridden: the key goes to the shortcut, the document's undo or redo action.
+            e->ignore();
+            return true;
+        }
+    }
+    return QMainWindow::eventFilter(watched, e);
+}
+
+void MainWindow::showReport(const nlohmann::json& report) {
+    using nlohmann::json;
+    struct Figure {
+        const char* label;
+        std::function<QString(const json&)> cell;
+    };
+    auto number = [](const json& v) { return v.is_number() ? QLocale().toString(v.get<double>(), 'f', 0) : QString("—"); };
+    // Adaptive volumes measure interpolation error at random points; the others by their map.
+    auto interpolation = [](const json& v, const char* key) {
+        if (v.contains("interpolation_error")) return percent(v["interpolation_error"].value(key, json()));
+        if (v.contains("error_map")) return percent(v["error_map"].value(key, json()));
+        return QString("—");
+    };
+    const std::vector<Figure> figures = {
+        {"Placement", [](const json& v) { return QString::fromStdString(v.value("placement", "")); }},
+        {"Probes", [&](const json& v) { return number(v.value("probes", json())); }},
+        {"Invalid (in terrain)", [&](const json& v) { return number(v.value("invalid_probes", json())); }},
+        {"Rays", [&](const json& v) { return number(v.value("rays", json())); }},
+        {"Time", [](const json& v) { return QString("%1 s").arg(v.value("time_s", 0.0), 0, 'f', 2); }},
+        {"File size", [](const json& v) { return formatBytes(v.value("bytes", 0.0)); }},
+        {"Standard error (mean)", [](const json& v) { return percent(v["standard_error"].value("mean", json())); }},
+        {"Standard error (max)", [](const json& v) { return percent(v["standard_error"].value("max", json())); }},
+        {"Interpolation error (mean)", [&](const json& v) { return interpolation(v, "mean"); }},
+        {"Interpolation error (p95)", [&](const json& v) { return interpolation(v, "p95"); }},
+        {"Interpolation error (max)", [&](const json& v) { return interpolation(v, "max"); }},
+    };
+    const json& volumes = report["volumes"];
+    report_->clear();
+    report_->setRowCount(int(figures.size()));
+    report_->setColumnCount(int(volumes.size()));
+    QStringList rows, columns;
+    for (const auto& f : figures) rows << f.label;
+    for (const auto& v : volumes) columns << QString::fromStdString(v.value("name", ""));
+    report_->setVerticalHeaderLabels(rows);
+    report_->setHorizontalHeaderLabels(columns);
+    // Every figure at once: the dock scrolls as a whole, the table itself should not.
+    report_->setMinimumHeight(report_->horizontalHeader()->sizeHint().height() + 2 * report_->frameWidth() +
+                              report_->verticalHeader()->defaultSectionSize() * report_->rowCount() +
+                              (report_->horizontalScrollBar()->isVisible() ? report_->horizontalScrollBar()->height() : 0));
+    for (size_t c = 0; c < volumes.size(); ++c)
+        for (size_t r = 0; r < figures.size(); ++r) {
+            auto* item = new QTableWidgetItem(figures[r].cell(volumes[c]));
+            item->setTextAlignment(Qt::AlignRight | Qt::AlignVCenter);
+            report_->setItem(int(r), int(c), item);
+        }
+    QString advice;
+    for (const auto& v : volumes) {
+        if (!v.contains("suggestions") || v["suggestions"].empty()) continue;
+        advice += QString("<p><b>%1</b>: interpolation error %2 on average, above %3 %. Denser probes lower it:")
+                      .arg(QString::fromStdString(v.value("name", "")))
+                      .arg(percent(v["error_map"].value("mean", json())))
+                      .arg(int(std::lround(100.0 * kSuggestAboveMeanError)));
+        for (const auto& s : v["suggestions"]) {
+            QStringList sets;
+            for (const auto& x : s["set"]) sets << QString::fromStdString(x.get<std::string>()).toHtmlEscaped();
+            advice += QString("<br>&nbsp;&nbsp;<tt>%1</tt>: %2 probes, about %3 s")
+                          .arg(sets.join(", "))
+                          .arg(QLocale().toString(s["probes"].get<double>(), 'f', 0))
+                          .arg(s["estimated_time_s"].get<double>(), 0, 'f', 1);
+            if (s["estimated_max_time_s"].get<double>() > s["estimated_time_s"].get<double>())
+                advice += QString(" (up to %1 s)").arg(s["estimated_max_time_s"].get<double>(), 0, 'f', 0);
+        }
+        advice += "</p>";
+    }
+    suggestions_->setText(advice);
+    suggestions_->setVisible(!advice.isEmpty());
+    report_->setToolTip(QString("Total %1 rays in %2 s on %3 threads; everything is in %4")
+                            .arg(QLocale().toString(report.value("rays", 0.0), 'f', 0))
+                            .arg(report.value("time_s", 0.0), 0, 'f', 2)
+                            .arg(report.value("threads", 0))
+                            .arg(QString::fromStdString((bakeOutDir_ / "bake_report.json").string())));
 }
 
 void MainWindow::closeEvent(QCloseEvent* e) {
@@ -502,8 +741,10 @@ void MainWindow::rebuildRenderer() {
     viewport_->setRenderer(nullptr);
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain());
     viewport_->setCamera(renderer_->defaultCamera());
-    const size_t baked = renderer_->loadProbes(false);
-    probeSource_ = baked ? "last bake" : "";
+    // An untitled project with a relative output folder has no bake of its own yet.
+    const auto folder = bakeFolder();
+    const size_t baked = folder ? renderer_->loadProbes(false, nullptr, nullptr, *folder) : 0;
+    probeSource_ = baked ? withStaleness("last bake") : QString();
     viewport_->setRenderer(renderer_.get());
     const Heightfield& hf = doc_->terrain().heightfield;
     const DemSourceInfo& s = doc_->terrain().source;
@@ -544,8 +785,18 @@ void MainWindow::startPreview() {
                 viewport_->renderNow();
                 updateStatus();
             }, Qt::QueuedConnection);
+        } catch (const PlacementError&) {
+            // Settings the bake would refuse (the Probe Volumes dock says why): light with
+            // nothing rather than with the probes of settings that are gone.
+            QMetaObject::invokeMethod(this, [this, generation] {
+                if (generation != previewGeneration_ || !renderer_) return;
+                renderer_->setProbes({});
+                probeSource_ = "no preview: placement failed";
+                viewport_->renderNow();
+                updateStatus();
+            }, Qt::QueuedConnection);
         } catch (const std::exception&) {
-            // Cancelled by a newer edit, or settings the bake would refuse (the panel says why).
+            // Cancelled by a newer edit.
         }
     });
 }
@@ -557,9 +808,14 @@ void MainWindow::updateEstimate() {
     double rays = 0;
     BakeQuality q = qualityPreset(p.scene.bake.quality);
     if (p.scene.bake.rays) q.rays = *p.scene.bake.rays;
-    try {
-        for (const auto& v : p.scene.probeVolumes) {
-            if (!v.enabled) continue;
+    // Placement errors go next to the settings they name (Probe Volumes dock) and to the status
+    // bar; the estimate says it has none.
+    std::vector<QString> errors(p.scene.probeVolumes.size());
+    QString firstError;
+    for (size_t i = 0; i < p.scene.probeVolumes.size(); ++i) {
+        const auto& v = p.scene.probeVolumes[i];
+        if (!v.enabled) continue;
+        try {
             const ProbeLayout l = placeProbes(v, doc_->terrain().heightfield);
             probes += l.validCount();
             invalid += l.positions.size() - l.validCount();
@@ -569,9 +825,15 @@ void MainWindow::updateEstimate() {
                                                errorMapHeight(v, l)).error.size();
             mapPoints += points;
             rays += double(points) * (v.rayCount ? *v.rayCount : q.rays);
+        } catch (const std::exception& e) {
+            errors[i] = QString::fromStdString(e.what());
+            if (firstError.isEmpty()) firstError = errors[i];
         }
-    } catch (const std::exception& e) {
-        estimate_->setText(QString::fromStdString(e.what()));
+    }
+    volumesPanel_->setPlacementErrors(errors);
+    if (!firstError.isEmpty()) {
+        estimate_->setText("No estimate: " + firstError);
+        statusBar()->showMessage(firstError, 15000);
         return;
     }
     // Cache rays plus probe rays at the throughput measured by the bake benchmark on two cores.
@@ -592,21 +854,61 @@ void MainWindow::updateTitle() {
     setWindowTitle(QString("%1%2 — Terralux").arg(name, doc_->isModified() ? " *" : ""));
 }
 
+QString MainWindow::withStaleness(const QString& source) const {
+    // The same test as --render: the bake's recorded inputs against the project's.
+    const auto& stale = renderer_->staleBake();
+    if (stale.empty()) return source;
+    return source + ", stale: " + QString::fromStdString(stale.front()) +
+           (stale.size() > 1 ? QString(" and %1 more").arg(stale.size() - 1) : QString());
+}
+
 void MainWindow::updateStatus() {
     if (!renderer_) return;
-    size_t probes = 0;
-    for (const auto& v : doc_->project().scene.probeVolumes)
-        if (v.enabled) probes += size_t(v.gridDims[0]) * size_t(v.gridDims[1]) * size_t(v.gridDims[2]);
+    // What the viewport holds, not what the settings would place (adaptive volumes ignore grids).
     probeLabel_->setText(QString("%1 probes (%2), %3 on the GPU")
-                             .arg(probes)
+                             .arg(renderer_->boundProbeCount())
                              .arg(probeSource_.isEmpty() ? "not baked" : probeSource_)
                              .arg(formatBytes(double(renderer_->renderer().probeBytes()))));
 }
 
 void MainWindow::startBake(const QString& outDir) {
     if (bake_->running()) return;
+    std::filesystem::path dir;
+    if (!outDir.isEmpty()) {
+        dir = std::filesystem::absolute(outDir.toStdString()).lexically_normal();
+    } else if (const auto own = bakeFolder()) {
+        dir = *own;
+    } else {
+        // Untitled with a relative output folder: the launch folder is no place for a bake.
+        QMessageBox box(QMessageBox::Question, "Bake",
+                        QString("This project has no file yet, so its output folder \"%1\" is relative to "
+                                "nothing. Save the project to bake beside it, or choose a folder for this bake.")
+                            .arg(QString::fromStdString(doc_->project().scene.exportSettings.outDir)),
+                        QMessageBox::Cancel, this);
+        box.setObjectName("bakeLocationDialog");
+        QPushButton* save = box.addButton("Save Project…", QMessageBox::AcceptRole);
+        save->setObjectName("bakeLocation.save");
+        QPushButton* choose = box.addButton("Choose Folder…", QMessageBox::ActionRole);
+        choose->setObjectName("bakeLocation.choose");
+        box.exec();
+        if (box.clickedButton() == save) {
+            if (saveInteractively(false) && bakeFolder()) startBake();
+        } else if (box.clickedButton() == choose) {
+            const QString folder = askExportFolder();
+            if (!folder.isEmpty()) startBake(folder);
+        }
+        return;
+    }
     Project p = doc_->project();
-    if (!outDir.isEmpty()) p.scene.exportSettings.outDir = outDir.toStdString();
+    p.scene.exportSettings.outDir = dir.string();
+    bakeOutDir_ = dir;
+    // The last report belongs to the last bake: gone once a new one starts.
+    report_->clear();
+    report_->setRowCount(0);
+    suggestions_->clear();
+    suggestions_->hide();
+    report_->setColumnCount(0);
+    report_->setToolTip(QString());
     progress_->setValue(0);
     eta_->setText("starting");
     bakeButton_->setEnabled(false);

@@ -2,7 +2,9 @@
 // The authoring window: menus, the parameter docks, the live Vulkan viewport, background bakes.
 
 #include <atomic>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include <QMainWindow>
@@ -18,11 +20,14 @@ class QComboBox;
 class QLabel;
 class QProgressBar;
 class QPushButton;
-class QPlainTextEdit;
+class QProxyStyle;
+class QTableWidget;
 class QMenu;
 class QCheckBox;
 
 namespace terralux {
+
+class ProbeVolumesPanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -39,8 +44,19 @@ public:
     // Imports a DEM or HDR as File > Import does after its file dialog: an error dialog on failure.
     bool importDemFile(const QString& file);
     bool importHdrFile(const QString& file);
-    // What the viewport's probes come from: "last bake", "draft preview" or "" (none yet).
+    // What the viewport's probes come from: "last bake" (the project's output folder),
+    // "export in <folder>" (a bake written elsewhere), "draft preview" or "" (none yet).
     const QString& probeSource() const { return probeSource_; }
+    // Probes the viewport lights with now (the bound preview or bake).
+    size_t boundProbeCount() const;
+    // The absolute folder Bake writes: export.out_dir, relative to the project file. None for an
+    // untitled project with a relative out_dir (Bake asks to save it or for a folder).
+    std::optional<std::filesystem::path> bakeFolder() const;
+    // A project file name as saved: a name not ending in .json gets ".terralux.json" (".json"
+    // after ".terralux"), so File > Open lists it.
+    static QString projectFileName(const QString& chosen);
+    // Saves to `chosen` (with projectFileName's suffix) or shows the error dialog.
+    bool saveProjectAs(const QString& chosen);
     // Where autosaves go (TERRALUX_AUTOSAVE_DIR, else the user's data folder).
     static QString autosaveDir();
     // After an unclean exit: offers the autosaved project back.
@@ -50,12 +66,20 @@ public:
 
 protected:
     void closeEvent(QCloseEvent* e) override;
+    bool event(QEvent* e) override;
+    bool eventFilter(QObject* watched, QEvent* e) override;
 
 private:
     void buildMenus();
     void buildDocks();
     void showError(const QString& title, const QString& message);
     bool maybeSave();
+    // File > Save (as = false: only asks for a name when untitled) and Save As.
+    bool saveInteractively(bool as);
+    QString askProjectFile(const QString& title);
+    QString askExportFolder();
+    void showReport(const nlohmann::json& report);
+    void updateOutputPath();
     void rebuildRenderer();
     void refreshLighting();
     void schedulePreview();
@@ -63,6 +87,8 @@ private:
     void updateEstimate();
     void updateTitle();
     void updateStatus();
+    // "last bake" or "last bake, stale: <what differs>" for the bake the renderer just loaded.
+    QString withStaleness(const QString& source) const;
     void addRecent(const QString& file);
 
 public:
@@ -88,7 +114,12 @@ private:
     QProgressBar* progress_ = nullptr;
     QPushButton* bakeButton_ = nullptr;
     QPushButton* cancelButton_ = nullptr;
-    QPlainTextEdit* report_ = nullptr;
+    QTableWidget* report_ = nullptr;
+    QLabel* suggestions_ = nullptr;
+    QLabel* outputPath_ = nullptr;
+    ProbeVolumesPanel* volumesPanel_ = nullptr;
+    QProxyStyle* tabStyle_ = nullptr;
+    std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;
     QTimer previewTimer_, autosaveTimer_;
     std::thread previewWorker_;

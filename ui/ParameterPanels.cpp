@@ -15,9 +15,11 @@
 #include <QLineEdit>
 #include <QListWidget>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QSignalBlocker>
 #include <QSlider>
 #include <QSpinBox>
+#include <QStyle>
 #include <QVBoxLayout>
 
 #include "ParameterTable.h"
@@ -92,6 +94,40 @@ void ParameterForm::addRow(const ParameterSpec& spec, QWidget* editor) {
     label->setToolTip(tip);
     editor->setToolTip(tip);
     form_->addRow(label, editor);
+    labels_.push_back({&spec, label, editor, tip});
+    // A row the current settings do not read (grid_dims of an adaptive volume) is hidden, so
+    // nothing on screen looks editable that changes nothing; its value is kept.
+    refreshers_.push_back([=, this] { form_->setRowVisible(editor, isRead(spec)); });
+}
+
+QSize ParameterForm::minimumSizeHint() const {
+    QSize size = QWidget::minimumSizeHint();
+    int label = 0, field = 0;
+    for (const RowLabel& r : labels_) {
+        label = std::max(label, r.label->sizeHint().width());
+        field = std::max(field, r.editor->minimumSizeHint().width());
+    }
+    const int spacing = form_->horizontalSpacing() >= 0 ? form_->horizontalSpacing()
+                                                        : style()->pixelMetric(QStyle::PM_LayoutHorizontalSpacing);
+    const QMargins m = form_->contentsMargins();
+    size.setWidth(std::max(size.width(), m.left() + label + spacing + field + m.right()));
+    return size;
+}
+
+void ParameterForm::markProblem(const QString& message) {
+    for (const RowLabel& r : labels_) {
+        // The row's own path as a whole word: "adaptive.max_cell_size", not "max_cell_size" inside it.
+        const QRegularExpression named("(^|[^\\w.])" + QRegularExpression::escape(QString::fromStdString(r.spec->localPath())) + "\\b");
+        const bool hit = !message.isEmpty() && named.match(message).hasMatch();
+        r.label->setStyleSheet(hit ? "QLabel { color: #c62828; font-weight: bold }" : "");
+        r.label->setToolTip(hit ? message + "\n\n" + r.tip : r.tip);
+    }
+}
+
+bool ParameterForm::isRead(const ParameterSpec& spec) const {
+    const SceneDescription& scene = doc_->project().scene;
+    if (spec.perVolume() && size_t(volume_) >= scene.probeVolumes.size()) return false;
+    return spec.isRead(scene, spec.perVolume() ? size_t(volume_) : 0);
 }
 
 void ParameterForm::addNumber(const ParameterSpec& spec) {
@@ -200,6 +236,7 @@ void ParameterForm::addList(const ParameterSpec& spec) {
         const json current = doc_->value(docPath(spec));
         if (current.is_array()) return int(current.size());
         if (current.is_number()) return 0;
+        if (!isRead(spec)) return spec.maxItems;
         const int n = spec.items ? spec.items(doc_->project().scene, size_t(volume_)) : spec.maxItems;
         return n < 0 ? spec.maxItems : n;
     };
@@ -320,6 +357,12 @@ ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
     buttons->addWidget(remove);
     buttons->addWidget(rename);
     v->addLayout(buttons);
+    error_ = new QLabel(this);
+    error_->setObjectName("volumes.placementError");
+    error_->setWordWrap(true);
+    error_->setStyleSheet("QLabel { color: #c62828; font-weight: bold }");
+    error_->setVisible(false);
+    v->addWidget(error_);
     form_ = new ParameterForm(doc_, this);
     form_->addParameters("probe_volumes[].");
     v->addWidget(form_);
@@ -328,6 +371,7 @@ ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
     connect(list_, &QListWidget::currentRowChanged, this, [this](int row) {
         if (row >= 0) form_->setVolume(row);
         form_->setEnabled(row >= 0);
+        showPlacementError();
     });
     connect(add, &QPushButton::clicked, this, [this] {
         editVolumes([](json& volumes) {
@@ -363,6 +407,19 @@ ProbeVolumesPanel::ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent)
 
 int ProbeVolumesPanel::currentVolume() const { return list_->currentRow(); }
 void ProbeVolumesPanel::selectVolume(int index) { list_->setCurrentRow(index); }
+
+void ProbeVolumesPanel::setPlacementErrors(std::vector<QString> errors) {
+    errors_ = std::move(errors);
+    showPlacementError();
+}
+
+void ProbeVolumesPanel::showPlacementError() {
+    const int row = currentVolume();
+    const QString message = row >= 0 && size_t(row) < errors_.size() ? errors_[size_t(row)] : QString();
+    error_->setText(message);
+    error_->setVisible(!message.isEmpty());
+    form_->markProblem(message);
+}
 
 void ProbeVolumesPanel::editVolumes(const std::function<void(json&)>& edit, const QString&) {
     json volumes = doc_->value("probe_volumes");

@@ -37,6 +37,12 @@ public:
     void addWidget(const QString& label, QWidget* w);
 
     void refresh();
+    // Marks the rows a placement error names (by their path below the volume, e.g.
+    // "adaptive.min_cell_size") with the message; "" clears the marks.
+    void markProblem(const QString& message);
+    // Wide enough for every row, hidden ones too: a dock sized for the shown rows would
+    // squeeze the rows another placement shows.
+    QSize minimumSizeHint() const override;
 
 signals:
     void rejected(const QString& message);
@@ -55,11 +61,20 @@ private:
     void addRow(const ParameterSpec& spec, QWidget* editor);
     // The document path a row edits (per-volume rows: of the selected volume).
     std::string docPath(const ParameterSpec& spec) const;
+    // Whether the document reads the row now (per-volume rows: for the selected volume).
+    bool isRead(const ParameterSpec& spec) const;
     void set(const std::string& path, const nlohmann::json& value);
     ProjectDocument* doc_;
     QFormLayout* form_;
     int volume_ = 0;
     std::vector<std::function<void()>> refreshers_;
+    struct RowLabel {
+        const ParameterSpec* spec;
+        QLabel* label;
+        QWidget* editor;
+        QString tip;
+    };
+    std::vector<RowLabel> labels_;
 };
 
 // Probe Volumes: the list of volumes (add, remove, rename) and the selected volume's settings.
@@ -69,16 +84,22 @@ public:
     ProbeVolumesPanel(ProjectDocument* doc, QWidget* parent = nullptr);
     int currentVolume() const;
     void selectVolume(int index);
+    // Per volume, why its placement fails ("" where it works): shown for the selected volume
+    // above its settings, with the rows the message names marked.
+    void setPlacementErrors(std::vector<QString> errors);
 
 signals:
     void rejected(const QString& message);
 
 private:
     void refresh();
+    void showPlacementError();
     void editVolumes(const std::function<void(nlohmann::json&)>& edit, const QString& what);
     ProjectDocument* doc_;
     QListWidget* list_;
     ParameterForm* form_;
+    QLabel* error_;
+    std::vector<QString> errors_;
 };
 
 }  // namespace terralux

@@ -123,7 +123,13 @@ bool ProjectDocument::save(QString* error) {
 bool ProjectDocument::saveAs(const QString& file, QString* error) {
     try {
         const std::filesystem::path target = std::filesystem::absolute(file.toStdString());
-        saveProject(project_, target);
+        Project toSave = project_;
+        // An untitled project's relative output folder ("bake") means beside the project once it
+        // has a file, not beside the folder Terralux was started from.
+        std::string& out = toSave.scene.exportSettings.outDir;
+        if (project_.file.empty() && std::filesystem::path(out).is_relative())
+            out = (target.parent_path() / out).lexically_normal().string();
+        saveProject(toSave, target);
         // Relative paths now resolve against the new folder.
         Project reloaded = loadProject(target, nullptr);
         project_ = reloaded;

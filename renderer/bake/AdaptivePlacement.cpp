@@ -45,25 +45,21 @@ uint64_t flatIndex(const OctreeLeaf& l, const std::array<uint32_t, 3>& dims) {
     return uint64_t(l.x) + uint64_t(l.y) * dims[0] + uint64_t(l.z) * dims[0] * dims[1];
 }
 
+}  // namespace
+
+double autoMinCellSize(const Heightfield& hf, const glm::dvec3& box) {
+    return std::max({double(hf.cellSizeX()), double(hf.cellSizeZ()),
+                     std::max(box.x, box.z) / kAutoMinCellsAlongBox});
+}
+
+namespace {
+
 // The octree of one volume: resolved settings, box and the surface ranges of its columns.
 class Octree {
 public:
     Octree(const ProbeVolumeSettings& v, const Heightfield& hf) : hf_(hf), v_(v) {
         const std::string where = "probe_volumes '" + v.name + "'";
         const AdaptiveVolumeSettings& a = v.adaptive;
-        m_ = a.minCellSize ? *a.minCellSize : std::max(hf.cellSizeX(), hf.cellSizeZ());
-        const double maxCell = a.maxCellSize ? *a.maxCellSize : 16.0 * m_;
-        const double ratio = maxCell / m_;
-        const double k = std::round(std::log2(ratio));
-        if (!(ratio >= 1.0) || k > kMaxLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
-            throw PlacementError(where + ": adaptive.max_cell_size = " + num(maxCell) +
-                                 " must be min_cell_size (" + num(m_) +
-                                 (a.minCellSize ? "" : ", the DEM cell size") + ") times 2^k, k in [0, " +
-                                 std::to_string(kMaxLevels) + "]");
-        levels_ = int(k);
-        band_ = a.surfaceBand ? *a.surfaceBand : m_;
-        share_ = a.maxMoveShare;
-
         glm::dvec3 size;
         if (v.origin) {
             origin_ = glm::dvec3(*v.origin);
@@ -77,6 +73,19 @@ public:
                               double(hf.maxHeight()) + a.heightRange - origin_.y,
                               double(hf.maxZ()) - hf.minZ());
         }
+        m_ = a.minCellSize ? *a.minCellSize : autoMinCellSize(hf, size);
+        const double maxCell = a.maxCellSize ? *a.maxCellSize : 16.0 * m_;
+        const double ratio = maxCell / m_;
+        const double k = std::round(std::log2(ratio));
+        if (!(ratio >= 1.0) || k > kMaxLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
+            throw PlacementError(where + ": adaptive.max_cell_size = " + num(maxCell) +
+                                 " must be min_cell_size (" + num(m_) +
+                                 (a.minCellSize ? "" : ", the auto size") + ") times 2^k, k in [0, " +
+                                 std::to_string(kMaxLevels) + "]");
+        levels_ = int(k);
+        band_ = a.surfaceBand ? *a.surfaceBand : m_;
+        share_ = a.maxMoveShare;
+
         // Whole minimum cells; the box grows to the next one (1e-6 forgives rounding).
         double cells = 1.0;
         for (int i = 0; i < 3; ++i) {

@@ -41,11 +41,19 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/ext/vector_double3.hpp>
 
 #include "bake/DiffuseBake.h"
 #include "bake/ProbePlacement.h"
 
 namespace terralux {
+
+// The minimum cell an adaptive volume gets when min_cell_size is unset: the DEM cell, but no
+// finer than 1/kAutoMinCellsAlongBox of the box's longer horizontal side. A 90 m DEM of 110 km
+// at its own cell needs 5.6 M probes and 1 GB (or exceeds kMaxOccupancyCells); 128 cells along
+// the box keep every DEM in the tens of thousands of probes, a few seconds of bake.
+inline constexpr double kAutoMinCellsAlongBox = 128.0;
+double autoMinCellSize(const Heightfield& hf, const glm::dvec3& boxSize);
 
 // Geometric adaptive placement (no refinement). Throws PlacementError for settings that only
 // the terrain can check (auto sizes), an occupancy grid over kMaxOccupancyCells, or a budget the

@@ -54,8 +54,10 @@ inline const char* placementName(ProbePlacement p) {
 // a box; cells that overlap the terrain surface band go down to the minimum, open air stays
 // coarse, one probe per leaf at its centre. The .shprobe grid is the box at the minimum cell size.
 struct AdaptiveVolumeSettings {
-    // Unset = the DEM's cell size (the larger axis). Probes closer than the terrain samples see
-    // no lighting detail the terrain can produce (docs/lighting.md's 0.5 m suits rooms, not DEMs).
+    // Unset = the DEM's cell size (the larger axis), but at least 1/128 of the box's longer
+    // horizontal side (autoMinCellSize). Probes closer than the terrain samples see no lighting
+    // detail the terrain can produce (docs/lighting.md's 0.5 m suits rooms, not DEMs); the floor
+    // keeps a whole SRTM tile in tens of thousands of probes instead of millions.
     std::optional<double> minCellSize;
     // Unset = 16 x min_cell_size, the ratio of docs/lighting.md's terrain example (2 m / 32 m).
     // Must be min_cell_size x 2^k: octree cells halve.

@@ -1,6 +1,7 @@
 // The authoring window driven by Qt Test through objectNames, under Xvfb (ctest wraps it in
 // xvfb-run); skips, saying why, without a display or a Vulkan device.
 #include <cmath>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -9,9 +10,15 @@
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFormLayout>
+#include <QStatusBar>
+#include <QTableWidget>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMessageBox>
+#include <QPointer>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QScreen>
@@ -21,8 +28,12 @@
 
 #include "ImageCompare.h"
 #include "MainWindow.h"
+#include "ParameterPanels.h"
 #include "ParameterTable.h"
+#include "bake/ProbePlacement.h"
+#include "BakeJob.h"
 #include "RenderJob.h"
+#include "TerrainLoading.h"
 #include "render/DebugViews.h"
 
 using namespace terralux;
@@ -40,6 +51,58 @@ std::string fileBytes(const fs::path& p) {
 // Waits for the next draft preview or bake to reach the viewport.
 bool waitForProbes(MainWindow& w, const QString& source, int ms = 20000) {
     return QTest::qWaitFor([&] { return w.probeSource() == source; }, ms);
+}
+
+// Answers modal dialogs as they open (they come from exec(), so poll): each handler gets the
+// active modal widget and returns true when it dealt with it; handlers run once, in order.
+class DialogAnswers {
+public:
+    explicit DialogAnswers(std::vector<std::function<bool(QWidget*)>> handlers) : handlers_(std::move(handlers)) {
+        timer_.setInterval(20);
+        QObject::connect(&timer_, &QTimer::timeout, [this] {
+            QWidget* w = QApplication::activeModalWidget();
+            if (w && next_ < handlers_.size() && w != last_ && handlers_[next_](w)) {
+                last_ = w;
+                ++next_;
+            }
+        });
+        timer_.start();
+    }
+    bool done() const { return next_ == handlers_.size(); }
+
+private:
+    std::vector<std::function<bool(QWidget*)>> handlers_;
+    size_t next_ = 0;
+    QPointer<QWidget> last_;  // a new dialog may reuse a closed one's address
+    QTimer timer_;
+};
+
+// A handler that picks `path` in the file dialog named `name`.
+std::function<bool(QWidget*)> pickFile(const QString& name, const fs::path& path) {
+    return [name, path](QWidget* w) {
+        auto* d = qobject_cast<QFileDialog*>(w);
+        if (!d || d->objectName() != name) return false;
+        d->selectFile(QString::fromStdString(path.string()));
+        // The dialog fills its name field from its file model, asynchronously: type the path too.
+        if (auto* name = d->findChild<QLineEdit*>("fileNameEdit")) name->setText(QString::fromStdString(path.string()));
+        static_cast<QDialog*>(d)->accept();  // QFileDialog::accept, as the Save button
+        return true;
+    };
+}
+
+// The widget a form row shows (a spin box's row holds its slider; a list row its spin boxes).
+QWidget* rowOf(QWidget* editor) {
+    while (editor->parentWidget() && !qobject_cast<ParameterForm*>(editor->parentWidget())) editor = editor->parentWidget();
+    return editor;
+}
+
+// Cheap bakes for tests that only need one to land.
+void quickBakeSettings(ProjectDocument& doc) {
+    QString error;
+    QVERIFY(doc.setParameter("bake.quality", "draft", &error));
+    QVERIFY(doc.setParameter("bake.error_map_resolution", 0, &error));  // the preview's too
+    QVERIFY(doc.setParameter("bake.bounces", 0, &error));
+    QVERIFY(doc.setParameter("bake.rays", 16, &error));
 }
 
 }  // namespace
@@ -191,11 +254,40 @@ private slots:
         QVERIFY(waitForProbes(*w_, "last bake"));
         const std::string bytes = fileBytes(shprobe), gltf = fileBytes(kOut / "bake" / "scene.gltf");
 
+        // The report is a table, a column per volume, with the figures of bake_report.json.
+        auto* table = w_->findChild<QTableWidget*>("bake.report");
+        QVERIFY(table);
+        const nlohmann::json report = nlohmann::json::parse(fileBytes(kOut / "bake" / "bake_report.json"));
+        QCOMPARE(table->columnCount(), 1);
+        QCOMPARE(table->horizontalHeaderItem(0)->text(), QString("probes"));
+        auto figure = [&](const QString& row) {
+            for (int r = 0; r < table->rowCount(); ++r)
+                if (table->verticalHeaderItem(r)->text() == row) return table->item(r, 0)->text();
+            return QString("no row " + row);
+        };
+        const nlohmann::json& volume = report["volumes"][0];
+        QCOMPARE(figure("Probes"), QLocale().toString(volume["probes"].get<double>(), 'f', 0));
+        QCOMPARE(figure("Invalid (in terrain)"), QLocale().toString(volume["invalid_probes"].get<double>(), 'f', 0));
+        QCOMPARE(figure("Rays"), QLocale().toString(volume["rays"].get<double>(), 'f', 0));
+        QCOMPARE(figure("Interpolation error (p95)"),
+                 QString("%1 %").arg(volume["error_map"]["p95"].get<double>() * 100.0, 0, 'f', 2));
+        QCOMPARE(figure("Standard error (mean)"),
+                 QString("%1 %").arg(volume["standard_error"]["mean"].get<double>() * 100.0, 0, 'f', 2));
+        QVERIFY(figure("File size").endsWith("KiB"));
+        // The default 8 x 8 grid interpolates badly: the dock says what to set instead.
+        auto* advice = w_->findChild<QLabel*>("bake.suggestions");
+        QVERIFY(advice);
+        QCOMPARE(advice->isVisible(), !volume["suggestions"].empty());
+        QVERIFY(!volume["suggestions"].empty());
+        QVERIFY2(advice->text().contains("probe_volumes[0].grid_dims=") && advice->text().contains("probes, about"),
+                 qPrintable(advice->text()));
+
         QString error;
         QVERIFY(w_->document()->setParameter("bake.quality", "reference", &error));
         QVERIFY(w_->document()->setParameter("probe_volumes[0].grid_dims", nlohmann::json{64, 64}, &error));
         w_->findChild<QPushButton*>("bake.start")->click();
         QVERIFY(w_->bakes()->running());
+        QCOMPARE(table->rowCount(), 0);  // a new bake clears the last one's report
         QTest::qWait(300);
         w_->findChild<QPushButton*>("bake.cancel")->click();
         QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running(); }, 60000));
@@ -285,6 +377,30 @@ private slots:
         QVERIFY2(dialogText.contains("not_a_raster.tif"), qPrintable(dialogText));
         QVERIFY(w_->document()->json() == before);
         QVERIFY(w_->document()->fileName() != file);
+    }
+
+    // A bake whose recorded settings differ from the project's is labelled stale, as --render says.
+    void aStaleBakeIsMarked() {
+        const fs::path dir = kOut / "stale";
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        Project p = loadEffectiveProject("", {"bake.quality=draft", "bake.error_map_resolution=0"}, "", nullptr);
+        const fs::path file = dir / "p.terralux.json";
+        saveProject(p, file);
+        BakeRequest bake;
+        bake.project = loadProject(file, nullptr);
+        runBake(bake, nullptr, nullptr);
+        QVERIFY(w_->openProject(QString::fromStdString(file.string())));
+        w_->document()->waitForTerrain();
+        auto* label = w_->findChild<QLabel*>("status.probes");
+        QVERIFY2(label->text().contains("(last bake)"), qPrintable(label->text()));
+        // The same project with another grid: its bake no longer matches.
+        p.scene.probeVolumes[0].gridDims = {6, 1, 6};
+        saveProject(p, file);
+        QVERIFY(w_->openProject(QString::fromStdString(file.string())));
+        w_->document()->waitForTerrain();
+        QVERIFY2(label->text().contains("last bake, stale: probe_volumes[0].grid_dims: baked [8,8], now [6,6]"),
+                 qPrintable(label->text()));
     }
 
     void saveAndReopenKeepsEveryParameter() {
@@ -394,11 +510,213 @@ private slots:
         QVERIFY(checked > 30);
     }
 
+
+
+
+
+
+
+
+
+
+    // Dock conventions, each a tracker item (one window for all: cheap checks share its start).
+    void dockEditingConventions() {
+        // Undo/Redo typed in any dock reach the document; a line edit's own typing undoes first (undoShortcutsReachTheDocumentFromAnyDock)
+        {
+            QApplication::setActiveWindow(w_.get());
+            QVERIFY(QTest::qWaitForWindowActive(w_.get()));
+            w_->findChild<QDockWidget*>("dock.sunSky")->raise();
+            auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
+            QVERIFY(elevation);
+            const double before = elevation->value();
+            elevation->setFocus();
+            elevation->setValue(12.0);
+            QCOMPARE(w_->document()->project().scene.sun.elevationDeg, 12.0);
+            QTest::keySequence(elevation, QKeySequence::Undo);
+            QCOMPARE(w_->document()->project().scene.sun.elevationDeg, before);
+            QCOMPARE(elevation->value(), before);
+            QTest::keySequence(elevation, QKeySequence::Redo);
+            QCOMPARE(w_->document()->project().scene.sun.elevationDeg, 12.0);
+
+            w_->findChild<QDockWidget*>("dock.bakeExport")->raise();
+            auto* out = w_->findChild<QLineEdit*>("param.export.out_dir");
+            QVERIFY(out);
+            const QString committed = out->text();
+            const int steps = w_->document()->undoStack()->index();
+            out->setFocus();
+            out->end(false);
+            QTest::keyClicks(out, "_typed");
+            QTest::keySequence(out, QKeySequence::Undo);
+            QCOMPARE(out->text(), committed);
+            QCOMPARE(w_->document()->undoStack()->index(), steps);
+            QTest::keySequence(out, QKeySequence::Undo);  // nothing typed left: the document's turn
+            QCOMPARE(w_->document()->undoStack()->index(), steps - 1);
+        }
+        // Dock titles are plain text (dockTitlesShowOneAmpersand)
+        {
+            QCOMPARE(w_->findChild<QDockWidget*>("dock.sunSky")->windowTitle(), QString("Sun & Sky"));
+            QCOMPARE(w_->findChild<QDockWidget*>("dock.bakeExport")->windowTitle(), QString("Bake & Export"));
+            // Menus read '&' as a mnemonic: the Panels entries double it to show one.
+            QCOMPARE(w_->findChild<QDockWidget*>("dock.sunSky")->toggleViewAction()->text(), QString("Sun && Sky"));
+        }
+        // Rows the placement does not read are hidden, walking the table (rowsThePlacementIgnoresAreHidden)
+        {
+            auto* panel = w_->findChild<ProbeVolumesPanel*>();
+            QVERIFY(panel);
+            auto* placement = w_->findChild<QComboBox*>("param.volume.placement");
+            for (const QString mode : {"adaptive", "box", "terrain"}) {
+                placement->setCurrentText(mode);
+                const SceneDescription& scene = w_->document()->project().scene;
+                int hidden = 0;
+                for (const ParameterSpec& spec : parameterTable()) {
+                    if (!spec.uiRow || !spec.perVolume()) continue;
+                    const QString name = QString::fromStdString(uiObjectName(spec));
+                    QWidget* editor = w_->findChild<QWidget*>(name);
+                    if (!editor) editor = w_->findChild<QWidget*>(name + ".0");
+                    QVERIFY2(editor, qPrintable(name));
+                    QCOMPARE(rowOf(editor)->isVisibleTo(panel), spec.isRead(scene, 0));
+                    hidden += !spec.isRead(scene, 0);
+        }
+            QVERIFY(hidden > 0);
+        }
+        placement->setCurrentText("adaptive");
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.volume.grid_dims.0"))->isVisibleTo(panel));
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.volume.adaptive.tolerance"))->isVisibleTo(panel));
+        placement->setCurrentText("terrain");
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.volume.grid_dims.0"))->isVisibleTo(panel));
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.volume.adaptive.tolerance"))->isVisibleTo(panel));
+            }
+        // Max_resolution 'source' sends 0, never null (maxResolutionSourceSendsZero)
+        {
+            auto* spin = w_->findChild<QSpinBox*>("param.terrain.max_resolution");
+            QVERIFY(spin);
+            spin->setValue(128);
+            w_->document()->waitForTerrain();
+            QCOMPARE(w_->document()->terrain().heightfield.width(), 128);
+            spin->setValue(0);
+            w_->document()->waitForTerrain();
+            const nlohmann::json v = w_->document()->value("terrain.max_resolution");
+            QVERIFY2(v.is_number_integer() && v.get<int>() == 0, v.dump().c_str());
+            QCOMPARE(spin->text(), QString("source"));
+            QCOMPARE(w_->document()->terrain().heightfield.width(), 256);
+        }
+    }
+
+    // Where projects and bakes go: Save As suffix, an untitled bake, an export elsewhere.
+    void savingAndBakingGoWhereTheUserSays() {
+        // An untitled project asks where to bake; the dock shows the absolute folder (untitledProjectBakesWhereTheUserSays)
+        {
+            quickBakeSettings(*w_->document());
+            auto* where = w_->findChild<QLabel*>("bake.outputPath");
+            QVERIFY(where);
+            QVERIFY2(where->text().contains(QString::fromStdString((kOut / "bake").string())), qPrintable(where->text()));
+            QString error;
+            QVERIFY(w_->document()->setParameter("export.out_dir", "bake", &error));
+            QVERIFY2(where->text().contains("save the project first"), qPrintable(where->text()));
+            const bool launchHadBake = fs::exists(fs::current_path() / "bake");
+            const fs::path folder = kOut / "untitled";
+            fs::create_directories(folder);
+            DialogAnswers answers({[](QWidget* w) {
+                                       if (w->objectName() != "bakeLocationDialog") return false;
+                                       w->findChild<QPushButton*>("bakeLocation.save")->click();
+                                       return true;
+                                   },
+                                   pickFile("saveDialog", folder / "project")});
+            w_->findChild<QPushButton*>("bake.start")->click();
+            QVERIFY(answers.done());
+            QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 60000));
+            QVERIFY(fs::exists(folder / "project.terralux.json"));
+            QVERIFY(fs::exists(folder / "bake" / "sh_coeffs" / "probes.shprobe"));
+            QCOMPARE(fs::exists(fs::current_path() / "bake"), launchHadBake);
+            QVERIFY2(where->text().endsWith(QString::fromStdString((folder / "bake").string())), qPrintable(where->text()));
+        }
+        // After Export to folder the viewport shows the exported probes, labelled so (exportedProbesAreWhatTheViewportShows)
+        {
+            // The project's own bake (above) is bound: 8 x 8 probes.
+            QCOMPARE(w_->probeSource(), QString("last bake"));
+            QCOMPARE(w_->boundProbeCount(), size_t(64));
+            QString error;
+            QVERIFY(w_->document()->setParameter("probe_volumes[0].grid_dims", nlohmann::json{4, 4}, &error));
+            const fs::path folder = kOut / "exported";
+            fs::create_directories(folder);
+            DialogAnswers answers({pickFile("exportDialog", folder)});
+            w_->findChild<QAction*>("action.export")->trigger();
+            QVERIFY(answers.done());
+            const QString source = "export in " + QString::fromStdString(fs::absolute(folder).lexically_normal().string());
+            QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == source; }, 60000));
+            QVERIFY(fs::exists(folder / "sh_coeffs" / "probes.shprobe"));
+            QCOMPARE(w_->boundProbeCount(), size_t(16));
+            QVERIFY(w_->findChild<QLabel*>("status.probes")->text().contains(source));
+        }
+        // A name without .json gets .terralux.json (saveAsAddsTheProjectSuffix)
+        {
+            QCOMPARE(MainWindow::projectFileName("a.json"), QString("a.json"));
+            QCOMPARE(MainWindow::projectFileName("a.terralux"), QString("a.terralux.json"));
+            QCOMPARE(MainWindow::projectFileName("a.v2"), QString("a.v2.terralux.json"));
+            const fs::path typed = kOut / "named";
+            DialogAnswers answers({pickFile("saveDialog", typed)});
+            w_->findChild<QAction*>("action.saveAs")->trigger();
+            QVERIFY(answers.done());
+            const fs::path saved = kOut / "named.terralux.json";
+            QVERIFY2(fs::exists(saved), qPrintable(w_->document()->fileName()));
+            QVERIFY(!fs::exists(typed));
+            QCOMPARE(fs::path(w_->document()->fileName().toStdString()), saved);
+        }
+    }
+
+    // Adaptive volumes in the window: the status bar counts the preview, placement errors show.
+    void adaptivePreviewCountsAndErrors() {
+        // The status bar counts what the preview holds (statusCountsTheProbesTheViewportHolds)
+        {
+            quickBakeSettings(*w_->document());
+            QString error;
+            QVERIFY(w_->document()->setParameter("probe_volumes[0].placement", "adaptive", &error));
+            // A coarser octree than the default: the same bug, a quicker preview.
+            QVERIFY(w_->document()->setParameter("probe_volumes[0].adaptive.min_cell_size", 240.0, &error));
+            const size_t placed = placeProbes(w_->document()->project().scene.probeVolumes[0],
+                                              w_->document()->terrain().heightfield).validCount();
+            QVERIFY(placed > 1000);
+            QVERIFY(QTest::qWaitFor([&] { return w_->boundProbeCount() == placed; }, 30000));
+            const QString label = w_->findChild<QLabel*>("status.probes")->text();
+            QVERIFY2(label.startsWith(QString("%1 probes (draft preview)").arg(placed)), qPrintable(label));
+        }
+        // A placement error shows beside the setting it names, and lights nothing (placementErrorsShowInTheProbeVolumesDock)
+        {
+            QString error;
+            QVERIFY(w_->document()->setParameter("probe_volumes[0].adaptive.min_cell_size", 0.5, &error));
+            auto* message = w_->findChild<QLabel*>("volumes.placementError");
+            QVERIFY(message);
+            QVERIFY(message->isVisibleTo(w_.get()));
+            QVERIFY2(message->text().contains("occupancy grid") && message->text().contains("adaptive.min_cell_size"),
+                     qPrintable(message->text()));
+            QVERIFY(w_->statusBar()->currentMessage().contains("occupancy grid"));
+            auto* form = qobject_cast<QFormLayout*>(rowOf(w_->findChild<QWidget*>("param.volume.adaptive.min_cell_size"))->parentWidget()->layout());
+            QVERIFY(form);
+            auto* minLabel = qobject_cast<QLabel*>(form->labelForField(rowOf(w_->findChild<QWidget*>("param.volume.adaptive.min_cell_size"))));
+            auto* maxLabel = qobject_cast<QLabel*>(form->labelForField(rowOf(w_->findChild<QWidget*>("param.volume.adaptive.max_cell_size"))));
+            QVERIFY(minLabel && maxLabel);
+            QVERIFY(minLabel->styleSheet().contains("color"));
+            QVERIFY(maxLabel->styleSheet().isEmpty());
+            QVERIFY(waitForProbes(*w_, "no preview: placement failed"));
+            QCOMPARE(w_->boundProbeCount(), size_t(0));
+            w_->findChild<QAction*>("action.undo")->trigger();
+            QVERIFY(!message->isVisibleTo(w_.get()));
+            QVERIFY(minLabel->styleSheet().isEmpty());
+        }
+    }
+
     void screenshot() {
         w_->viewport()->renderNow();
         QTest::qWait(500);
         const QPixmap shot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(shot.save(QString::fromStdString((kOut / "main_window.png").string())));
+        // The Bake & Export dock after a (quick) bake: output folder and report table.
+        quickBakeSettings(*w_->document());
+        w_->findChild<QDockWidget*>("dock.bakeExport")->raise();
+        w_->startBake();
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 60000));
+        QTest::qWait(200);
+        QVERIFY(w_->findChild<QTableWidget*>("bake.report")->parentWidget()->grab().save(QString::fromStdString((kOut / "bake_dock.png").string())));
     }
 };
 

@@ -161,7 +161,8 @@ TEST_P(RealDem, NoProbeInsideEveryCellMappedLeavesDisjointFileReadsBack) {
     const Heightfield& hf = dem.heightfield;
     const ProbeVolumeSettings v = adaptive();
     const ProbeLayout L = placeProbes(v, hf);
-    // Defaults: the DEM cell, 16 times that, a band of one cell.
+    // Defaults: the DEM cell (these crops are under 128 cells a side), 16 times that, a band of
+    // one cell.
     const double cell = std::max(hf.cellSizeX(), hf.cellSizeZ());
     EXPECT_DOUBLE_EQ(L.octree->minCell, cell);
     EXPECT_DOUBLE_EQ(L.octree->maxCell, 16.0 * cell);
@@ -304,6 +305,43 @@ TEST(AdaptivePlacement, CentreInsideIsMovedUpOrBorrowsTheProbeAbove) {
     }
 }
 
+// The default settings place a moderate octree on every DEM a user is likely to import: the
+// committed crops and, when the shared data is there, whole SRTM tiles (90 m over 110 km, where
+// the DEM cell alone made 5.6 M probes or overflowed the occupancy grid).
+class DefaultAdaptiveOnDem : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DefaultAdaptiveOnDem, PlacesTensOfThousandsOfProbes) {
+    const std::string name = GetParam();
+    const bool shared = name.rfind("shared/", 0) == 0;
+    const fs::path file = shared ? fs::path(TERRALUX_SHARED_DATA) / "dem" / name.substr(7) : kDems / name;
+    if (!fs::exists(file)) GTEST_SKIP() << file << " is absent (shared data not installed)";
+    const DemImportResult dem = importDem(file.string());
+    const Heightfield& hf = dem.heightfield;
+    ProbeLayout L;
+    ASSERT_NO_THROW(L = placeProbes(adaptive(), hf));
+    const double longer = std::max(double(hf.maxX()) - hf.minX(), double(hf.maxZ()) - hf.minZ());
+    EXPECT_DOUBLE_EQ(L.octree->minCell,
+                     std::max({double(hf.cellSizeX()), double(hf.cellSizeZ()), longer / 128.0}));
+    EXPECT_LE(std::max(L.cellDims[0], L.cellDims[2]), 129u);
+    EXPECT_GE(L.validCount(), 1000u);
+    EXPECT_LE(L.validCount(), 100000u);
+    EXPECT_LE(L.fileBytes(), 20ull << 20);
+    std::cout << name << ": " << L.validCount() << " probes, min cell " << L.octree->minCell << " m\n";
+}
+INSTANTIATE_TEST_SUITE_P(Dems, DefaultAdaptiveOnDem,
+                         ::testing::Values("bigtujunga_utm11_crop.tif", "n42e001_voids_crop.tif",
+                                           "rainier_crop.tif", "orkhon_crop.asc", "shared/N42E001.hgt",
+                                           "shared/mt_rainier_90m.tif", "shared/srtm_bigtujunga30m_utm11.tif",
+                                           "shared/topotoolbox_exampleDEM.asc"),
+                         [](const auto& info) {
+                             std::string n = info.param;
+                             if (n.rfind("shared/", 0) == 0) n = "shared_" + n.substr(7);
+                             n = n.substr(0, n.find('.'));
+                             for (char& c : n)
+                                 if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                             return n;
+                         });
+
 TEST(AdaptivePlacement, SettingsTheTerrainDecidesAreChecked) {
     const Heightfield hf = flat(11, 30.0, 0.0f);
     auto message = [&](const ProbeVolumeSettings& v) {
@@ -317,7 +355,7 @@ TEST(AdaptivePlacement, SettingsTheTerrainDecidesAreChecked) {
     ProbeVolumeSettings v = adaptive(std::nullopt, 100.0);
     v.name = "valley";
     EXPECT_EQ(message(v), "probe_volumes 'valley': adaptive.max_cell_size = 100 must be "
-                          "min_cell_size (30, the DEM cell size) times 2^k, k in [0, 16]");
+                          "min_cell_size (30, the auto size) times 2^k, k in [0, 16]");
     v = adaptive(0.25);
     v.name = "fine";
     EXPECT_EQ(message(v), "probe_volumes 'fine': occupancy grid of 576000000 cells (1200 x 400 x "
