@@ -48,8 +48,9 @@ Commands:
   --bake [PROJECT]              Bake every enabled probe volume and export .shprobe files, a glTF
                                 scene and bake_report.json into the output folder.
   --render [PROJECT]            Render the terrain lit by the probes of the last bake in the
-                                output folder (baking first when there is none) into --out IMAGE
-                                (.png display-encoded, .exr scene-linear), on the Vulkan device.
+                                output folder (baking first when there is none or it is stale)
+                                into --out IMAGE (.png display-encoded, .exr scene-linear), on
+                                the Vulkan device.
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
