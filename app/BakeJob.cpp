@@ -628,6 +628,9 @@ nlohmann::json bakeInputs(const Project& project) {
     settings.erase("camera");
     settings.erase("reflection_probes");
     settings["export"].erase("out_dir");
+    // Files count by what they resolve to (below), not by how the project spells their path.
+    settings["terrain"].erase("dem");
+    settings["sky"].erase("hdr");
     nlohmann::json files = {{"dem", project.demPath().empty() ? nlohmann::json("embedded sample")
                                                               : fileIdentity(project.demPath())}};
     if (project.scene.sky.mode == SkyMode::Hdr) files["hdr"] = fileIdentity(project.hdrPath());
