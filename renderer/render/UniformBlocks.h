@@ -24,15 +24,7 @@ namespace terralux::blocks {
 #define TLX_IVEC4(N) alignas(16) glm::ivec4 N{0};
 #define TLX_MAT4(N) alignas(16) glm::mat4 N{1.0f};
 #define TLX_VEC4_ARRAY(N, COUNT) alignas(16) glm::vec4 N[COUNT]{};
-#include "blocks/all.h"
-#undef TLX_BLOCK_BEGIN
-#undef TLX_BLOCK_END
-#undef TLX_STRUCT_BEGIN
-#undef TLX_STRUCT_END
-#undef TLX_VEC4
-#undef TLX_IVEC4
-#undef TLX_MAT4
-#undef TLX_VEC4_ARRAY
+#include "blocks/all.h"  // expands the blocks, then undefines the TLX_ macros
 
 // std140 sizes: every member kind used here is a multiple of 16 bytes.
 #define TLX_BLOCK_BEGIN(NAME, SET, BINDING) static_assert(sizeof(NAME) == 0
@@ -43,14 +35,6 @@ namespace terralux::blocks {
 #define TLX_IVEC4(N) + 16
 #define TLX_MAT4(N) + 64
 #define TLX_VEC4_ARRAY(N, COUNT) + 16 * (COUNT)
-#include "blocks/all.h"
-#undef TLX_BLOCK_BEGIN
-#undef TLX_BLOCK_END
-#undef TLX_STRUCT_BEGIN
-#undef TLX_STRUCT_END
-#undef TLX_VEC4
-#undef TLX_IVEC4
-#undef TLX_MAT4
-#undef TLX_VEC4_ARRAY
+#include "blocks/all.h"  // expands the blocks, then undefines the TLX_ macros
 
 }  // namespace terralux::blocks

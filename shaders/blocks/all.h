@@ -1,8 +1,17 @@
 // Every uniform block and storage struct, in one list: C++ expands it once for the structs and
-// once for their std140/std430 size checks (renderer/render/UniformBlocks.h). A new subsystem's
-// block is one more line here.
+// once for their std140/std430 size checks (renderer/render/UniformBlocks.h), defining the TLX_
+// macros before each inclusion; they are undefined here after it. A new subsystem's block is one
+// more line here.
 #include "blocks/camera.h"
 #include "blocks/surface.h"
 #include "blocks/sun_sky.h"
 #include "blocks/probes.h"
 #include "blocks/overlay.h"
+#undef TLX_BLOCK_BEGIN
+#undef TLX_BLOCK_END
+#undef TLX_STRUCT_BEGIN
+#undef TLX_STRUCT_END
+#undef TLX_VEC4
+#undef TLX_IVEC4
+#undef TLX_MAT4
+#undef TLX_VEC4_ARRAY
