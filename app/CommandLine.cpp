@@ -484,7 +484,12 @@ int commandRender(const Args& a) {
     const size_t volumes =
         request.probes ? renderer.loadProbes(!a.parser.isSet(a.noRebake), &note, &probeWarnings) : 0;
     if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
-    if (!renderer.staleBake().empty()) {
+    if (request.probes && volumes == 0) {
+        // --no-rebake with nothing baked: say so, rather than call a missing bake stale.
+        std::cerr << "terralux: warning: " << project.outDir().string()
+                  << " holds no bake to draw (--no-rebake): " << renderer.staleBake().front()
+                  << "; rendering without probes\n";
+    } else if (!renderer.staleBake().empty()) {
         std::cerr << "terralux: warning: " << project.outDir().string() << " holds a stale bake (--no-rebake draws it):";
         for (const auto& d : renderer.staleBake()) std::cerr << (&d == &renderer.staleBake().front() ? " " : "; ") << d;
         std::cerr << "\n";
