@@ -225,6 +225,101 @@ std::vector<ParameterSpec> buildTable() {
         .label("HDR rotation").about("Turns the HDR sky about +Y").redoes(kUpload | kRebake)
         .field(&SceneDescription::sky, &SkySettings::rotationDeg);
 
+    // Shadows.
+    const auto manualSplits = [](const SceneDescription& s, size_t) {
+        return s.shadows.splitMode == SplitMode::Manual && s.shadows.cascades > 1 ? s.shadows.cascades - 1 : -1;
+    };
+    const auto shadowsOn = [](const SceneDescription& s, size_t) { return s.shadows.enabled; };
+    add(Row("shadows.enabled", T::Boolean)).label("Sun shadows")
+        .about("Cascaded shadow maps darken the direct sun where the terrain blocks it")
+        .redoes(kUpload).field(&SceneDescription::shadows, &ShadowSettings::enabled);
+    add(Row("shadows.cascades", T::Integer)).range(1, 4).label("Cascades")
+        .about("Shadow maps along the view, each covering a slice of it: more gives sharper near shadows")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::cascades);
+    add(Row("shadows.split_mode", T::Choice)).choices({"practical", "manual"}).label("Split mode")
+        .about("practical: split distances from split_lambda; manual: the distances in splits")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::splitMode);
+    add(Row("shadows.split_lambda", T::Number)).range(0.0, 1.0).decimals(2).slider().label("Split lambda")
+        .about("Practical splits (Zhang et al. 2006): C_i = λ·C_log + (1 − λ)·C_uni; λ weights the logarithmic term: 0 = uniform, 1 = logarithmic")
+        .redoes(kUpload)
+        .onlyWhen([](const SceneDescription& s, size_t) {
+            return s.shadows.enabled && s.shadows.splitMode == SplitMode::Practical && s.shadows.cascades > 1;
+        })
+        .field(&SceneDescription::shadows, &ShadowSettings::splitLambda);
+    add(Row("shadows.max_distance", T::Number)).above(0.0, 1.0e7).unit("m").decimals(0)
+        .autoMeans("the farthest terrain in view").label("Shadow distance")
+        .about("Distance from the camera where the last cascade ends; farther terrain gets the sun unshadowed")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::maxDistance);
+    add(Row("shadows.splits", T::NumberList)).items(1, 3).above(0.0, 1.0e7).unit("m").decimals(0)
+        .autoMeans("none: practical mode computes them").label("Split distances")
+        .about("manual mode: where each cascade but the last ends, metres from the camera, strictly increasing and below the shadow distance")
+        .redoes(kUpload).count(manualSplits)
+        .custom([](const SceneDescription& s, size_t) {
+                    return s.shadows.splits ? json(*s.shadows.splits) : json(nullptr);
+                },
+                [=](SceneDescription& s, size_t, const json& v) {
+                    auto& sp = s.shadows.splits;
+                    if (v.is_null()) {
+                        sp.reset();
+                        if (manualSplits(s, 0) > 0)
+                            throw ParameterRejection{"must list " + std::to_string(manualSplits(s, 0)) +
+                                                         " distances when split_mode is \"manual\"", ""};
+                        return;
+                    }
+                    sp = v.get<std::vector<double>>();
+                    const int n = manualSplits(s, 0);
+                    if (n < 0) return;  // kept for a switch back to manual
+                    if (int(sp->size()) != n)
+                        throw ParameterRejection{"must list cascades - 1 = " + std::to_string(n) +
+                                                     " distances (has " + std::to_string(sp->size()) + ")", ""};
+                    for (size_t i = 1; i < sp->size(); ++i)
+                        if (!((*sp)[i] > (*sp)[i - 1]))
+                            throw ParameterRejection{"must be strictly increasing (" + number((*sp)[i]) +
+                                                         " follows " + number((*sp)[i - 1]) + ")",
+                                                     "[" + std::to_string(i) + "]"};
+                    if (s.shadows.maxDistance && !(sp->back() < *s.shadows.maxDistance))
+                        throw ParameterRejection{"must end below shadows.max_distance (" +
+                                                     number(*s.shadows.maxDistance) + ")",
+                                                 "[" + std::to_string(sp->size() - 1) + "]"};
+                });
+    add(Row("shadows.map_resolution", T::Integer)).range(512, 4096).unit("texels").label("Map resolution")
+        .about("Texels along each side of each cascade's shadow map")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::mapResolution);
+    add(Row("shadows.depth_bias", T::Number)).range(0.0, 100.0).unit("texels").label("Depth bias")
+        .about("Moves the receiver toward the sun by this many cascade texels: removes self-shadowing acne")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::depthBias);
+    add(Row("shadows.normal_bias", T::Number)).range(0.0, 100.0).unit("texels").label("Normal bias")
+        .about("Moves the receiver along its normal by this many cascade texels: removes acne on slopes facing away")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::normalBias);
+    add(Row("shadows.filter", T::Choice)).choices({"pcss", "pcf", "hard"}).label("Filter")
+        .about("pcss: penumbrae from the sun's size that harden at contact (Fernando 2005); pcf: a fixed soft edge; hard: one comparison")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::filter);
+
+    // Height fog.
+    const auto fogOn = [](const SceneDescription& s, size_t) { return s.fog.enabled; };
+    add(Row("fog.enabled", T::Boolean)).label("Height fog")
+        .about("Exponential height fog over the terrain and the sky")
+        .redoes(kUpload).field(&SceneDescription::fog, &FogSettings::enabled);
+    add(Row("fog.density", T::Number)).range(0.0, 1.0).unit("1/m").decimals(6).label("Density")
+        .about("Extinction coefficient at the base height")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::density);
+    add(Row("fog.height_falloff", T::Number)).range(0.0, 1.0).unit("1/m").decimals(6).label("Height falloff")
+        .about("Density falls by e for every 1/falloff metres above the base height; 0 = the same at every height")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::heightFalloff);
+    add(Row("fog.base_height", T::Number)).range(-1.0e5, 1.0e5).unit("m").decimals(1)
+        .autoMeans("the lowest terrain").label("Base height")
+        .about("Height where the density is fog.density, engine space")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::baseHeight);
+    add(Row("fog.color", T::Color)).range(0.0, kUnbounded).autoMeans("the sky's mean radiance").label("Fog colour")
+        .about("Radiance the fog scatters toward the camera from the sky, linear RGB")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::color);
+    add(Row("fog.inscatter", T::Number)).range(0.0, 100.0).label("Sun inscatter")
+        .about("Scales the sunlight the fog scatters toward the camera")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::inscatter);
+    add(Row("fog.anisotropy", T::Number)).range(-0.95, 0.95).slider().label("Anisotropy")
+        .about("Henyey–Greenstein g of the sun's inscatter: > 0 glows around the sun, 0 scatters evenly")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::anisotropy);
+
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
@@ -429,6 +524,10 @@ std::vector<ParameterSpec> buildTable() {
         .about("Vertical field of view").redoes(kRedraw).noUiRow()
         .field(&SceneDescription::camera, &CameraSettings::fovDeg);
 
+    add(Row("camera.exposure_ev", T::Number)).range(-16.0, 16.0).unit("EV").decimals(1).slider().label("Exposure")
+        .about("Exposure compensation in stops before the ACES tone curve: +1 doubles the displayed light")
+        .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::exposureEv);
+
     // Export.
     add(Row("export.out_dir", T::String)).pattern(".+", "must name a folder").label("Output folder")
         .about("Where bakes are written; relative to the project file").redoes(kNothing)
@@ -625,6 +724,8 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "sun" || section == "sky") return {"dock.sunSky", "Sun & Sky"};
     if (section == "probe_volumes") return {"dock.probeVolumes", "Probe Volumes"};
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
+    if (section == "shadows") return {"dock.shadows", "Shadows"};
+    if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
     return {"", ""};
 }
 

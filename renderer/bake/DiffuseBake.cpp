@@ -89,18 +89,24 @@ glm::vec3 sunIrradiance(const BakeLighting& L, const glm::vec3& p, const glm::ve
                         Rng& rng) {
     const float cosine = glm::dot(n, L.sun.direction);
     if (cosine <= 0.0f || samples <= 0 || L.sun.illuminance == glm::vec3(0.0f)) return glm::vec3(0.0f);
+    return L.sun.illuminance * cosine * sunVisibility(*L.tracer, L.sun, p, n, samples, rng);
+}
+
+}  // namespace
+
+float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const glm::vec3& p,
+                    const glm::vec3& n, int samples, Rng& rng) {
+    if (glm::dot(n, sun.direction) <= 0.0f || samples <= 0) return 0.0f;
     int visible = 0;
     const glm::vec3 o = liftOff(p, n);
     for (int s = 0; s < samples; ++s) {
         // Stratified over the disk's cos-θ range.
         const float u1 = (float(s) + rng.next()) / float(samples);
-        const glm::vec3 d = sampleCone(L.sun.direction, L.sun.angularRadius, u1, rng.next());
-        if (!L.tracer->occluded(o, d, INFINITY)) ++visible;
+        const glm::vec3 d = sampleCone(sun.direction, sun.angularRadius, u1, rng.next());
+        if (!tracer.occluded(o, d, INFINITY)) ++visible;
     }
-    return L.sun.illuminance * cosine * (float(visible) / float(samples));
+    return float(visible) / float(samples);
 }
-
-}  // namespace
 
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 

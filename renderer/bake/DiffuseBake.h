@@ -142,6 +142,13 @@ ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
                               const std::vector<sh::ShRgb>& reference,
                               const std::vector<uint8_t>& valid);
 float luminance(const glm::vec3& c);
+
+class Rng;
+// Share of the sun's disc visible from surface point p with normal n: `samples` shadow rays,
+// stratified over the disc, against the traced surface (0 where the sun is behind the surface).
+// The bake's sun term is this × cos θ × E_sun; the sun-visibility debug view draws it.
+float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const glm::vec3& p,
+                    const glm::vec3& n, int samples, Rng& rng);
 // The per-probe term of that metric: relative RMS of irradiance luminance over the 256 fixed
 // normals of `value` against `reference` (0 when the reference is black).
 float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference);

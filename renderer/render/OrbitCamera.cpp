@@ -35,11 +35,17 @@ glm::vec3 OrbitCamera::position() const {
                                        -std::cos(az) * std::cos(el));
 }
 
+OrbitCamera::Planes OrbitCamera::planes(float extent) const {
+    Planes p;
+    p.farPlane = radius + 2.0f * extent;
+    p.nearPlane = std::max(p.farPlane * 1e-5f, 0.05f);
+    return p;
+}
+
 glm::mat4 OrbitCamera::viewProjection(float aspect, float extent) const {
     const glm::mat4 view = glm::lookAt(position(), target, glm::vec3(0.0f, 1.0f, 0.0f));
-    const float farPlane = radius + 2.0f * extent;
-    const float nearPlane = std::max(farPlane * 1e-5f, 0.05f);
-    glm::mat4 proj = glm::perspectiveRH_ZO(glm::radians(fovDeg), aspect, nearPlane, farPlane);
+    const Planes p = planes(extent);
+    glm::mat4 proj = glm::perspectiveRH_ZO(glm::radians(fovDeg), aspect, p.nearPlane, p.farPlane);
     proj[1][1] *= -1.0f;  // Vulkan's clip-space y points down
     return proj * view;
 }

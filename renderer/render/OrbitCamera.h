@@ -21,7 +21,12 @@ struct OrbitCamera {
     // mean height, radius framing the whole footprint.
     static OrbitCamera fromSettings(const CameraSettings& s, const Heightfield& hf);
     glm::vec3 position() const;
-    // Vulkan clip space (y down, depth 0..1), near/far fitted to the radius and `extent`.
+    // Near and far planes fitted to the radius and the scene's `extent` (its largest side).
+    struct Planes {
+        float nearPlane = 0.05f, farPlane = 1.0f;
+    };
+    Planes planes(float extent) const;
+    // Vulkan clip space (y down, depth 0..1), near/far from planes().
     glm::mat4 viewProjection(float aspect, float extent) const;
 };
 

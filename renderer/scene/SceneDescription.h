@@ -132,6 +132,42 @@ struct ExportSettings {
     double defaultAmbient = 0.1;
 };
 
+enum class SplitMode { Practical, Manual };
+enum class ShadowFilter { Pcss, Pcf, Hard };
+
+// Cascaded sun shadows (docs/lighting.md, "Shadows"). Cascades cover the view from the near plane
+// to the shadow distance; each is a square orthographic depth map fitted to its slice of the view
+// as a bounding sphere and snapped to its texels.
+struct ShadowSettings {
+    bool enabled = true;
+    int cascades = 4;                          // 1..4
+    SplitMode splitMode = SplitMode::Practical;
+    // Practical split scheme (Zhang et al. 2006): C_i = λ·C_log + (1 − λ)·C_uni; λ weights the
+    // logarithmic term.
+    double splitLambda = 0.75;
+    // Manual: the cascades − 1 inner split distances (metres from the camera), strictly
+    // increasing and below the shadow distance; unset in practical mode.
+    std::optional<std::vector<double>> splits;
+    // Shadow distance; unset = the farthest terrain in view.
+    std::optional<double> maxDistance;
+    int mapResolution = 2048;                  // texels a side, 512..4096
+    double depthBias = 1.0;                    // texels of the cascade, along the light
+    double normalBias = 1.5;                   // texels of the cascade, along the surface normal
+    ShadowFilter filter = ShadowFilter::Pcss;
+};
+
+// Exponential height fog (docs/lighting.md, "Height fog"): extinction
+// σ(h) = density · exp(−height_falloff · (h − base_height)).
+struct FogSettings {
+    bool enabled = false;
+    double density = 2.0e-5;                   // 1/m at the base height
+    double heightFalloff = 1.0 / 1200.0;       // 1/m
+    std::optional<double> baseHeight;          // metres; unset = the lowest terrain
+    std::optional<glm::vec3> color;            // ambient inscatter radiance; unset = the sky's mean
+    double inscatter = 1.0;                    // scales the sun's inscatter
+    double anisotropy = 0.6;                   // Henyey–Greenstein g, (−1, 1)
+};
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -140,6 +176,7 @@ struct CameraSettings {
     double azimuthDeg = 210.0;        // clockwise from north, where the camera stands
     double elevationDeg = 35.0;       // (-90, 90)
     double fovDeg = 45.0;             // vertical, (1, 150)
+    double exposureEv = 0.0;          // stops: the display multiplies scene light by 2^EV
 };
 
 struct SceneDescription {
@@ -151,6 +188,8 @@ struct SceneDescription {
     BakeSettings bake;
     ExportSettings exportSettings;
     CameraSettings camera;
+    ShadowSettings shadows;
+    FogSettings fog;
 };
 
 }  // namespace terralux
