@@ -1,5 +1,6 @@
 #include "RenderJob.h"
 
+#include <cmath>
 #include <fstream>
 
 #include <numbers>
@@ -47,6 +48,10 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
+    base_.exposure = float(std::exp2(scene.camera.exposureEv));
+    base_.shadows = scene.shadows;
+    base_.fog = resolvedFog(scene.fog, lighting.sky, terrain_.heightfield);
+    base_.skirt = scene.terrain.skirt;
     // Placement reads only the volumes' settings and this renderer's terrain: edits of the sun,
     // sky or camera keep the markers they had.
     const std::string volumes = sceneToJson(scene).at("probe_volumes").dump();
@@ -204,6 +209,36 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
     return s;
+}
+
+ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width, uint32_t height) {
+    RenderRequest q;
+    q.width = width;
+    q.height = height;
+    q.linearOutput = true;
+    q.probes = false;
+    q.debugView = kViewSunVisibility;
+    const RenderedImage traced = renderer.render(q);
+    q.debugView = kViewShadow;
+    renderer.render(q);  // the first frame of a new view may build its pipeline: not its time
+    const RenderedImage mapped = renderer.render(q);
+    ShadowAgreement a;
+    a.shadowMilliseconds = mapped.milliseconds;
+    size_t off = 0;
+    double sum = 0.0;
+    // Both views write the value in red and 1 in green on terrain.
+    for (size_t i = 0; i + 3 < traced.rgba.size(); i += 4) {
+        if (traced.rgba[i + 1] < 0.5f || mapped.rgba[i + 1] < 0.5f) continue;
+        ++a.terrainPixels;
+        const double d = std::abs(double(traced.rgba[i]) - double(mapped.rgba[i]));
+        sum += d;
+        if (d > 0.5) ++off;
+    }
+    if (a.terrainPixels > 0) {
+        a.disagreeing = double(off) / double(a.terrainPixels);
+        a.meanAbsDifference = sum / double(a.terrainPixels);
+    }
+    return a;
 }
 
 }  // namespace terralux

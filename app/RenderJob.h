@@ -26,6 +26,18 @@ struct RenderRequest {
     bool leaves = false;          // overlay of the adaptive volumes' octree leaves
 };
 
+class ProjectRenderer;
+
+// How far the shadow maps are from the exact sun visibility: the shadow view (31) and the traced
+// sun-visibility view (29) drawn scene-linear with the same camera, compared on terrain pixels.
+struct ShadowAgreement {
+    size_t terrainPixels = 0;
+    double disagreeing = 0.0;     // share of terrain pixels where the two differ by more than 0.5
+    double meanAbsDifference = 0.0;
+    double shadowMilliseconds = 0.0;  // the frame time of view 31
+};
+ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width, uint32_t height);
+
 class ProjectRenderer {
 public:
     // Loads the terrain and sky; the Vulkan context must outlive this object.

@@ -6,6 +6,8 @@
 #include <mutex>
 #include <numbers>
 
+#include <glm/common.hpp>
+
 #include "EnvironmentImage.h"
 
 namespace terralux {
@@ -59,6 +61,14 @@ Sky skyOf(const Project& p) {
         if (skyCache.size() > kSkyCacheEntries) skyCache.pop_back();
     }
     return sky.scaled(scale);
+}
+
+FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfield& terrain) {
+    FogSettings f = fog;
+    if (!f.baseHeight) f.baseHeight = double(terrain.minHeight());
+    // The mean radiance over the sphere is the SH DC term times Y_00 = 1 / (2√π).
+    if (!f.color) f.color = glm::max(sky.sh().c[0] * 0.28209479f, glm::vec3(0.0f));
+    return f;
 }
 
 BakeLighting lightingOf(const Project& p) {

@@ -17,4 +17,8 @@ size_t hdrSkyReads();
 // Sun, sky and albedo; the caller sets the tracer.
 BakeLighting lightingOf(const Project& project);
 
+// The fog as the renderer draws it: base height and colour resolved (unset base height = the lowest
+// terrain; unset colour = the sky's mean radiance over the sphere).
+FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfield& terrain);
+
 }  // namespace terralux

@@ -7,7 +7,11 @@
 namespace terralux::shaders {
 std::span<const uint32_t> terrainVert();            // without probe light
 std::span<const uint32_t> terrainProbeLightVert();  // with the probe pass's per-vertex light
-std::span<const uint32_t> terrainFrag();
+std::span<const uint32_t> terrainFrag();        // the sun unshadowed
+std::span<const uint32_t> terrainShadowFrag();  // with the shadow cascades bound
+std::span<const uint32_t> fullscreenVert();
+std::span<const uint32_t> skyBackgroundFrag();
+std::span<const uint32_t> shadowDepthVert();
 std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();

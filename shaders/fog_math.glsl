@@ -10,8 +10,9 @@
 // (a horizontal ray, or no falloff) g takes its series 1 − x/2 + x²/6 − x³/24: no division by zero.
 float fogOpticalDepth(float density, float falloff, float startAboveBase, float dirY, float distance) {
     float x = max(falloff * dirY * distance, -80.0f);  // e^80 is within float range
-    float g = abs(x) < 1.0e-2f ? 1.0f - x * (0.5f - x * (1.0f / 6.0f - x * (1.0f / 24.0f)))
-                               : (1.0f - exp(-x)) / x;
+    float series = 1.0f - x * (0.5f - x * (0.16666667f - x * 0.041666667f));
+    float g = series;
+    if (abs(x) >= 1.0e-2f) g = (1.0f - exp(-x)) / x;
     return density * exp(max(-falloff * startAboveBase, -80.0f)) * distance * g;
 }
 

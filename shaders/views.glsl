@@ -1,5 +1,5 @@
 // The debug views: kView<Name> constants from debug_views.def, one function per view, and the
-// dispatch over them (include after tonemap.glsl, sky.glsl and brdf.glsl). A view added to the
+// dispatch over them (include after tonemap.glsl, sky.glsl, brdf.glsl, shadows.glsl and fog.glsl). A view added to the
 // list that has no function here fails the build.
 #ifndef TLX_VIEWS_GLSL
 #define TLX_VIEWS_GLSL
@@ -13,9 +13,12 @@ struct ShadingPoint {
     vec3 position, normal, albedo;
     // rgb probe irradiance, a blend weight; in the diagnostics views instead: x share of moved
     // probes in the blend (-1 where no probe lights the point), y interpolation error × known,
-    // z known (1 = measured), w 1 = inside a volume with no probe to light it.
+    // z known (1 = measured), w 1 = inside a volume with no probe to light it; in the
+    // sun-visibility view: x the traced visibility.
     vec4 probe;
-    vec3 linear;  // sceneLinear()
+    float shadow;      // sunShadow(): 1 lit, 0 in shadow
+    float fogAmount;   // 1 − the fog's transmittance to the camera
+    vec3 linear;       // sceneLinear(), seen through the fog
 };
 
 float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
@@ -31,7 +34,8 @@ vec3 sceneLinear(ShadingPoint s) {
     float weight = s.probe.a;
     vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb, weight) : sky;
     vec3 spec = ggxSpecular(n, v, l, surface.material.x);
-    vec3 sun = sunSky.sunIlluminance.rgb;
+    // Probes hold no direct sun: the sun alone is shadowed by the cascades.
+    vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
     return s.albedo / PI * (sun * ndotl + ambient) + spec * sun;
 }
 
@@ -52,6 +56,22 @@ vec3 viewProbeValidity(ShadingPoint s) {
               : d.x > -0.5 ? mix(vec3(0.72), vec3(0.10, 0.80, 1.0), clamp(d.x, 0.0, 1.0))
                            : vec3(0.18);
     return base * relief;
+}
+
+// The scalar views write the value in red and 1 in green (terrain) to EXR, grey to PNG.
+vec3 scalarView(float value) { return linearOutput() ? vec3(value, 1.0, 0.0) : vec3(clamp(value, 0.0, 1.0)); }
+vec3 viewSunVisibility(ShadingPoint s) { return scalarView(s.probe.x); }
+vec3 viewShadow(ShadingPoint s) { return scalarView(s.shadow); }
+vec3 viewFog(ShadingPoint s) { return scalarView(s.fogAmount); }
+
+// Cascade index: red, green, blue, yellow for cascades 0-3, grey beyond the shadow distance, a
+// dark line where one cascade hands over to the next; shaded by N·L so the terrain stays legible.
+vec3 viewCascades(ShadingPoint s) {
+    int c = sunCascade(s.position);
+    vec3 base = c == 0 ? vec3(0.90, 0.25, 0.20) : c == 1 ? vec3(0.25, 0.75, 0.25)
+              : c == 2 ? vec3(0.25, 0.45, 0.95) : c == 3 ? vec3(0.95, 0.85, 0.20) : vec3(0.45);
+    if (nearCascadeBoundary(s.position)) return vec3(0.02);
+    return base * (0.45 + 0.55 * sunNdotL(s));
 }
 
 // Heat ramp: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red. Piecewise
@@ -76,7 +96,12 @@ vec3 viewInterpolationError(ShadingPoint s) {
 vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
     // views that need the full shading share one evaluation.
-    s.linear = sceneLinear(s);
+    s.shadow = sunShadow(s.position, s.normal);
+    vec3 toPoint = s.position - camera.position.xyz;
+    float distance = length(toPoint);
+    vec3 dir = toPoint / max(distance, 1e-6);
+    s.fogAmount = 1.0 - fogTransmittance(dir, distance);
+    s.linear = applyFog(sceneLinear(s), dir, distance);
     switch (view) {
 #define TLX_VIEW(NAME, NUMBER) case kView##NAME: return view##NAME(s);
 #include "debug_views.def"

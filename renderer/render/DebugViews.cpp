@@ -12,14 +12,27 @@ const std::vector<int>& shaderViewNumbers() {
 }
 
 const std::vector<DebugView>& debugViews() {
-    constexpr ViewNeeds none{}, light{true, false, false}, diagnostics{false, true, false},
-        diagnosticsAndMarkers{false, true, true};
+    constexpr ViewNeeds none{}, diagnostics{false, true, false}, diagnosticsAndMarkers{false, true, true},
+        shadows{false, false, false, true}, visibility{false, false, false, false, true},
+        lit{true, false, false, true, false, true}, light{true, false, false};
     static const std::vector<DebugView> views = {
-        {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, light},
+        {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, lit},
         {kViewAlbedo, "albedo", "surface albedo", false, ViewBackground::Black, none},
         {kViewNormal, "normal", "world normal as colour", false, ViewBackground::Black, none},
+        {kViewSunVisibility, "sun-visibility",
+         "share of the sun's disc visible, traced on the CPU by the bake's tracer at each vertex (EXR: "
+         "visibility in red, 1 in green on terrain)",
+         true, ViewBackground::Black, visibility},
         {kViewNdotL, "ndotl", "N·L", false, ViewBackground::Black, none},
-        {kViewLinear, "linear", "pre-tonemap colour", true, ViewBackground::LinearSky, light},
+        {kViewShadow, "shadow", "shadow-map factor of the sun, 1 lit (EXR: factor in red, 1 in green on terrain)",
+         true, ViewBackground::Black, shadows},
+        {kViewLinear, "linear", "pre-tonemap colour", true, ViewBackground::LinearSky, lit},
+        {kViewCascades, "cascades",
+         "shadow cascade index: red, green, blue, yellow for cascades 1-4, grey beyond the shadow "
+         "distance, dark lines at the splits",
+         false, ViewBackground::Black, shadows},
+        {kViewFog, "fog", "fog amount, 1 − transmittance to the camera (EXR: amount in red, 1 in green on terrain)",
+         true, ViewBackground::Black, none},
         {kViewProbeIrradiance, "probe-irradiance", "probe irradiance × weight", true,
          ViewBackground::Black, light},
         {kViewProbeWeight, "probe-weight", "probe blend weight", false, ViewBackground::Black, light},
@@ -72,6 +85,9 @@ std::string debugViewsMarkdown() {
         if (v.needs.probeLight) passes = "probe-vertices (light)";
         if (v.needs.probeDiagnostics) passes = "probe-vertices (diagnostics), the bake's sidecar";
         if (v.needs.probeMarkers) passes += ", overlays (probe markers)";
+        if (v.needs.shadows) passes = "shadow (when shadows are on)" + (passes.empty() ? "" : ", " + passes);
+        if (v.needs.sunVisibility) passes = "CPU sun tracing at the vertices (cached per sun)";
+        if (v.needs.sky) passes += ", sky";
         out += "| " + std::to_string(v.number) + " | `" + v.name + "` | " + v.shows + " | " +
                (v.linear ? "scene-linear values" : "the display encoding") + " | " +
                (passes.empty() ? "none" : passes) + " |\n";

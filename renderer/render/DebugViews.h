@@ -28,6 +28,9 @@ struct ViewNeeds {
     bool probeLight = false;        // the probe pass's per-vertex irradiance and weight
     bool probeDiagnostics = false;  // its diagnostics half (moved share, error map) instead
     bool probeMarkers = false;      // the overlay pass with moved and rejected probes marked
+    bool shadows = false;           // the shadow pass (when the scene's shadows are on)
+    bool sunVisibility = false;     // the sun's visibility traced on the CPU at each vertex
+    bool sky = false;               // the sky pass behind the terrain
 };
 
 struct DebugView {

@@ -4,10 +4,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <map>
 
 #include <glm/mat4x4.hpp>
+#include <tbb/parallel_for.h>
 
 #include "ShaderBinaries.h"
+#include "bake/DiffuseBake.h"
+#include "bake/SphereSampling.h"
 #include "render/DebugViews.h"
 #include "render/UniformBlocks.h"
 #include "vk/Buffer.h"
@@ -18,6 +22,7 @@
 #include "vk/PipelineLayout.h"
 #include "vk/Readback.h"
 #include "vk/RenderPass.h"
+#include "vk/Sampler.h"
 
 namespace terralux {
 
@@ -37,6 +42,11 @@ const char* const kProbeCells = "probe-cells";
 const char* const kProbeVolumes = "probe-volumes";
 const char* const kProbeErrorMaps = "probe-error-maps";
 const char* const kProbeLight = "probe-light";
+const char* const kShadowMaps = "shadow-maps";
+const char* const kSunVisibility = "sun-visibility";
+
+// Shadow rays per vertex of the sun-visibility view, stratified over the sun's disc.
+constexpr int kSunVisibilitySamples = 16;
 
 // Smallest octree leaf the leaf overlay draws, in pixels on screen.
 constexpr float kSmallestLeafPixels = 6.0f;
@@ -58,9 +68,18 @@ struct ProbeResources {
 };
 
 // What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
+// `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do.
 struct FrameSlot {
-    vk::Buffer camera, surface, sunSky, overlay;
-    vk::DescriptorSet view, lights, overlays;
+    vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay;
+    vk::DescriptorSet view, lights, shadowedLights, overlays;
+};
+
+// The shadow subsystem: the cascades' depth maps (one layer each) and a framebuffer per layer.
+struct ShadowResources {
+    vk::Image maps;
+    std::vector<vk::Framebuffer> framebuffers;
+    int resolution = 0, cascades = 0;
+    std::vector<glm::mat4> drawn;  // the light projections the maps hold now (empty: none yet)
 };
 
 struct RenderTarget {
@@ -72,13 +91,24 @@ struct RenderTarget {
 struct TerrainRenderer::Gpu {
     vk::Buffer vertices, indices, markers, leaves;
     std::unique_ptr<ProbeResources> probes;
+    std::unique_ptr<ShadowResources> shadows;
+    // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
+    // sun and surface it was traced for.
+    vk::Buffer sunVisibility;
+    glm::vec4 sunVisibilityKey{0.0f};
+    int sunVisibilitySkirt = -1;
+    std::unique_ptr<HeightfieldTracer> tracer;
+    bool tracerSkirt = true;
     std::vector<FrameSlot> slots;
     std::unique_ptr<RenderTarget> target;
-    vk::RenderPass clearPass, drawPass;
-    vk::UniqueSetLayout emptySet;
-    vk::PipelineLayout terrainLayout, overlayLayout, probeLayout;
-    // Built on first use: lavapipe compiles a pipeline when it is created.
-    vk::UniquePipeline terrainPlain, terrainProbeLight, markerPipeline, leafPipeline, probePass;
+    vk::RenderPass clearPass, drawPass, shadowPass;
+    vk::Sampler compareSampler, depthSampler;
+    vk::UniqueSetLayout emptySet, shadowedLightsLayout;
+    vk::PipelineLayout terrainLayout, shadowedTerrainLayout, overlayLayout, probeLayout, shadowDepthLayout;
+    // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
+    // variant: kProbeLightVariant | kShadowVariant | kFogVariant.
+    std::map<int, vk::UniquePipeline> terrain;
+    vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, probePass;
     FrameGraph graph;
 };
 
@@ -87,6 +117,27 @@ struct TerrainRenderer::Output {
     VkImage swapchainImage = VK_NULL_HANDLE;
     VkExtent2D extent{0, 0};
 };
+
+namespace {
+
+constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4;
+
+// The lights set with the shadow cascades: sun and sky, atmosphere, the cascades' block and their
+// maps (compared, and raw for the PCSS blocker search). `maps` null: the layout alone.
+template <class Gpu>
+vk::DescriptorSetBuilder shadowedLightsBuilder(const FrameSlot& f, VkImageView maps, const Gpu& g) {
+    constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
+    return vk::DescriptorSetBuilder()
+        .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, frag)
+        .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere, frag)
+        .uniform(blocks::ShadowBlock::kBinding, "shadow", f.shadow, frag)
+        .image(TLX_SHADOW_MAP_COMPARE_BINDING, std::string(kShadowMaps) + "(compare)", maps,
+               g.compareSampler.handle(), frag)
+        .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
+               g.depthSampler.handle(), frag);
+}
+
+}  // namespace
 
 TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget)
     : ctx_(ctx), hf_(hf), gpu_(std::make_unique<Gpu>()) {
@@ -117,9 +168,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         }
     vertexCount_ = vertices.size() / 6;
     indexCount_ = indices.size();
-
-    vertexCount_ = vertices.size() / 6;
-    indexCount_ = indices.size();
+    meshVertices_ = vertices;
 
     Gpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
@@ -137,6 +186,8 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.camera = ubo(sizeof(blocks::CameraBlock));
         f.surface = ubo(sizeof(blocks::SurfaceBlock));
         f.sunSky = ubo(sizeof(blocks::SunSkyBlock));
+        f.atmosphere = ubo(sizeof(blocks::AtmosphereBlock));
+        f.shadow = ubo(sizeof(blocks::ShadowBlock));
         f.overlay = ubo(sizeof(blocks::OverlayBlock));
         f.view = vk::DescriptorSetBuilder()
                      .uniform(blocks::CameraBlock::kBinding, "camera", f.camera, kVertexFragment)
@@ -144,6 +195,8 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
                      .build(ctx_);
         f.lights = vk::DescriptorSetBuilder()
                        .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, VK_SHADER_STAGE_FRAGMENT_BIT)
+                       .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere,
+                                VK_SHADER_STAGE_FRAGMENT_BIT)
                        .build(ctx_);
         f.overlays = vk::DescriptorSetBuilder()
                          .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
@@ -161,6 +214,69 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     const VkFormat colorFormats[] = {vk::kColorFormat};
     g.clearPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, true, true});
     g.drawPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, false, true});
+    g.shadowPass = vk::RenderPass(ctx_, {{}, vk::kDepthFormat, true, true});
+    g.compareSampler = vk::Sampler::depthCompare(ctx_);
+    g.depthSampler = vk::Sampler::nearestClamp(ctx_);
+    g.shadowedLightsLayout = shadowedLightsBuilder(g.slots[0], VK_NULL_HANDLE, g).buildLayout(ctx_);
+    const VkDescriptorSetLayout shadowedSets[] = {g.slots[0].view.layout(), g.shadowedLightsLayout.get()};
+    g.shadowedTerrainLayout = vk::PipelineLayout(ctx_, shadowedSets);
+    g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
+}
+
+bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
+
+void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
+    Gpu& g = *gpu_;
+    if (g.shadows && g.shadows->resolution == resolution && g.shadows->cascades == cascades) return;
+    ctx_.waitIdle();  // frames in flight may still read the old maps
+    g.graph.forget(kShadowMaps);
+    for (FrameSlot& f : g.slots) f.shadowedLights = vk::DescriptorSet();
+    g.shadows.reset();
+    if (resolution <= 0) return;
+    auto sh = std::make_unique<ShadowResources>();
+    sh->resolution = resolution;
+    sh->cascades = cascades;
+    sh->maps = vk::Image::depthLayers(ctx_, uint32_t(resolution), uint32_t(resolution), uint32_t(cascades));
+    for (uint32_t i = 0; i < uint32_t(cascades); ++i) {
+        const VkImageView view = sh->maps.layerView(i);
+        sh->framebuffers.emplace_back(ctx_, g.shadowPass, std::span<const VkImageView>(&view, 1),
+                                      uint32_t(resolution), uint32_t(resolution));
+    }
+    for (FrameSlot& f : g.slots) f.shadowedLights = shadowedLightsBuilder(f, sh->maps.view(), g).build(ctx_);
+    g.graph.importImage(kShadowMaps, sh->maps.handle(), sh->maps.aspect(), uint32_t(cascades));
+    g.shadows = std::move(sh);
+}
+
+void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
+    Gpu& g = *gpu_;
+    const glm::vec4 key(sun.direction, sun.angularRadius);
+    if (g.sunVisibility.handle() != VK_NULL_HANDLE && key == g.sunVisibilityKey && g.sunVisibilitySkirt == int(skirt))
+        return;
+    if (!g.tracer || g.tracerSkirt != skirt) {
+        HeightfieldTracer::Options opt;
+        opt.skirt = skirt;
+        g.tracer = std::make_unique<HeightfieldTracer>(hf_, opt);
+        g.tracerSkirt = skirt;
+    }
+    // The bake's own sun term (sunVisibility) at every mesh vertex, on the vertex's normal;
+    // deterministic per vertex. Stride 32 like the probe light: x visibility.
+    std::vector<glm::vec4> values(std::max<size_t>(vertexCount_, 1) * 2, glm::vec4(0.0f));
+    const HeightfieldTracer& tracer = *g.tracer;
+    tbb::parallel_for(size_t(0), vertexCount_, [&](size_t i) {
+        const float* v = &meshVertices_[6 * i];
+        Rng rng(0x5eed0000ull + i);
+        const float vis = sunVisibility(tracer, sun, glm::vec3(v[0], v[1], v[2]),
+                                        glm::vec3(v[3], v[4], v[5]), kSunVisibilitySamples, rng);
+        values[2 * i] = glm::vec4(vis, 0.0f, 0.0f, 0.0f);
+    });
+    ctx_.waitIdle();  // no frame may still read the old buffer
+    g.graph.forget(kSunVisibility);
+    g.sunVisibility = vk::Buffer::deviceLocal(ctx_, values.data(), values.size() * sizeof(glm::vec4),
+                                              VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    g.graph.importBuffer(kSunVisibility, g.sunVisibility.handle(), true);
+    g.sunVisibilityKey = key;
+    g.sunVisibilitySkirt = int(skirt);
+    ++sunTraces_;
 }
 
 TerrainRenderer::~TerrainRenderer() {
@@ -330,6 +446,15 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
     const bool drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
     const bool drawLeaves = s.showLeaves && leafCount_ > 0;
+    // Shadows: the scene has them on, the sun is up and the view draws them.
+    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f;
+    const bool fog = s.fog.enabled;
+    const bool sunVisibility = view.needs.sunVisibility;
+    const bool sky = view.needs.sky;
+    if (sunVisibility) updateSunVisibility(s.sun, s.skirt);
+    if (!s.shadows.enabled) ensureShadowMaps(0, 0);  // a scene without shadows holds no maps
+    if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
+    ShadowResources* shadows = shadowed ? g.shadows.get() : nullptr;
 
     // Pipelines, built on first use.
     if (probes && !g.probePass) {
@@ -340,23 +465,42 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const VkVertexInputBindingDescription meshBinding{0, 24, VK_VERTEX_INPUT_RATE_VERTEX};
     const VkVertexInputAttributeDescription position{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
         normal{1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12};
-    if (!probes && !g.terrainPlain) {
+    // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
+    // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
+    const bool vertexAttribute = probes || sunVisibility;
+    const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
+                        (fog ? kFogVariant : 0);
+    vk::UniquePipeline& terrainPipeline = g.terrain[variant];
+    if (!terrainPipeline) {
         vk::GraphicsPipelineDesc d;
-        d.vert = shaders::terrainVert();
-        d.frag = shaders::terrainFrag();
+        d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
+        d.frag = shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag();
+        d.fragConstants = {fog ? 1u : 0u};
         d.bindings = {meshBinding};
         d.attributes = {position, normal};
-        g.terrainPlain = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), g.terrainLayout.handle(), d);
+        if (vertexAttribute) {
+            d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
+            d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
+        }
+        terrainPipeline = vk::createGraphicsPipeline(
+            ctx_, g.clearPass.handle(), (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle(), d);
     }
-    if (probes && !g.terrainProbeLight) {
-        // Probe light: one of the probe pass's two vec4 per vertex (stride 32; bound at offset 16
-        // for the diagnostics).
+    vk::UniquePipeline& skyPipeline = fog ? g.skyFog : g.skyPlain;
+    if (sky && !skyPipeline) {
         vk::GraphicsPipelineDesc d;
-        d.vert = shaders::terrainProbeLightVert();
-        d.frag = shaders::terrainFrag();
-        d.bindings = {meshBinding, {1, 32, VK_VERTEX_INPUT_RATE_VERTEX}};
-        d.attributes = {position, normal, {2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
-        g.terrainProbeLight = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), g.terrainLayout.handle(), d);
+        d.vert = shaders::fullscreenVert();
+        d.frag = shaders::skyBackgroundFrag();
+        d.fragConstants = {fog ? 1u : 0u};
+        d.depthWrite = false;
+        skyPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.terrainLayout.handle(), d);
+    }
+    if (shadows && !g.shadowDepth) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::shadowDepthVert();
+        d.bindings = {meshBinding};
+        d.attributes = {position};
+        d.colorAttachments = 0;
+        g.shadowDepth = vk::createGraphicsPipeline(ctx_, g.shadowPass.handle(), g.shadowDepthLayout.handle(), d);
     }
     const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
     const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
@@ -384,11 +528,14 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // This slot's uniform blocks (the GPU finished the slot's previous frame).
     const float extent = std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(),
                                    hf_.maxHeight() - hf_.minHeight(), 1.0f});
+    const float aspect = float(s.width) / float(s.height);
     blocks::CameraBlock camera;
-    camera.viewProj = s.camera.viewProjection(float(s.width) / float(s.height), extent);
-    camera.position = glm::vec4(s.camera.position(), 1.0f);
+    camera.viewProj = s.camera.viewProjection(aspect, extent);
+    camera.invViewProj = glm::inverse(camera.viewProj);
+    camera.position = glm::vec4(s.camera.position(), s.camera.planes(extent).farPlane);
     camera.viewport = glm::vec4(float(s.width), float(s.height), 1.0f / float(s.width), 1.0f / float(s.height));
-    camera.view = glm::ivec4(s.debugView, s.linearOutput ? 1 : 0, view.needs.probeDiagnostics ? 1 : 0, 0);
+    camera.view = glm::ivec4(s.debugView, s.linearOutput ? 1 : 0,
+                             sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0, 0);
     slot.camera.write(&camera, sizeof camera);
     blocks::SurfaceBlock surface;
     surface.albedo = glm::vec4(s.albedo, 1.0f);
@@ -399,6 +546,32 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     sunSky.sunIlluminance = glm::vec4(s.sun.illuminance, 0.0f);
     for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
     slot.sunSky.write(&sunSky, sizeof sunSky);
+    blocks::AtmosphereBlock atmosphere;
+    atmosphere.fog = glm::vec4(float(s.fog.density), float(s.fog.heightFalloff), float(s.fog.baseHeight.value_or(0.0)),
+                               float(s.fog.anisotropy));
+    atmosphere.fogColor = glm::vec4(s.fog.color.value_or(glm::vec3(0.0f)), float(s.fog.inscatter));
+    slot.atmosphere.write(&atmosphere, sizeof atmosphere);
+    const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
+    std::vector<glm::mat4> lightMatrices;
+    if (shadows) {
+        const CascadeRange range = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
+        cascades_ = fitCascades(range, s.camera, aspect, s.sun.direction, shadows->resolution, boundsMin, boundsMax);
+        blocks::ShadowBlock block;
+        for (size_t i = 0; i < cascades_.size(); ++i) {
+            block.lightViewProj[i] = cascades_[i].lightViewProj;
+            block.ends[int(i)] = float(cascades_[i].farDistance);
+            block.texel[int(i)] = cascades_[i].texelSize;
+            block.depthRange[int(i)] = cascades_[i].depthRange;
+            lightMatrices.push_back(cascades_[i].lightViewProj);
+        }
+        block.forward = glm::vec4(glm::normalize(s.camera.target - s.camera.position()), float(range.nearDistance));
+        block.bias = glm::vec4(float(s.shadows.depthBias), float(s.shadows.normalBias),
+                               std::tan(s.sun.angularRadius), float(shadows->resolution));
+        block.mode = glm::ivec4(int(cascades_.size()), int(s.shadows.filter), 0, 0);
+        slot.shadow.write(&block, sizeof block);
+    } else if (!s.shadows.enabled) {
+        cascades_.clear();
+    }
     if (drawMarkers || drawLeaves) {
         blocks::OverlayBlock overlay;
         overlay.leaves = glm::vec4(smallestLeaf_, kSmallestLeafPixels, 0.0f, 0.0f);
@@ -406,7 +579,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         slot.overlay.write(&overlay, sizeof overlay);
     }
 
-    // Background: the sky toward the horizon where the view shows it, in the view's encoding.
+    // Background where no pass draws the sky: black, or the sky toward the horizon in the view's
+    // encoding (the sky pass draws over it per pixel).
     glm::vec3 bg(0.0f);
     if (view.background != ViewBackground::Black) {
         bg = glm::max(sh::evalRadiance(s.skySh, glm::normalize(glm::vec3(0.0f, 0.2f, -1.0f))), glm::vec3(0.0f));
@@ -423,9 +597,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     FrameGraph& graph = g.graph;
     graph.beginFrame();
     const uint32_t w = s.width, h = s.height;
-    auto setViewport = [w, h](VkCommandBuffer c) {
-        VkViewport vp{0, 0, float(w), float(h), 0.0f, 1.0f};
-        VkRect2D sc{{0, 0}, {w, h}};
+    auto setViewport = [](VkCommandBuffer c, uint32_t vw, uint32_t vh) {
+        VkViewport vp{0, 0, float(vw), float(vh), 0.0f, 1.0f};
+        VkRect2D sc{{0, 0}, {vw, vh}};
         vkCmdSetViewport(c, 0, 1, &vp);
         vkCmdSetScissor(c, 0, 1, &sc);
     };
@@ -450,24 +624,73 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         });
     }
 
+    // The cascades, drawn again only when their light projections moved (the camera, the sun or
+    // a shadow setting changed).
+    if (shadows && shadows->drawn != lightMatrices) {
+        PassInfo info{"shadow",
+                      {{kShadowMaps, Access::DepthAttachmentClear},
+                       {kVertices, Access::VertexAttributeRead},
+                       {kIndices, Access::IndexRead}},
+                      {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
+        const uint32_t indexCount = uint32_t(indexCount_), res = uint32_t(shadows->resolution);
+        graph.addPass(std::move(info), [&g, shadows, lightMatrices, indexCount, res, setViewport](VkCommandBuffer c) {
+            for (size_t i = 0; i < lightMatrices.size(); ++i) {
+                VkClearValue clear{};
+                clear.depthStencil = {1.0f, 0};
+                VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+                rbi.renderPass = g.shadowPass.handle();
+                rbi.framebuffer = shadows->framebuffers[i].handle();
+                rbi.renderArea = {{0, 0}, {res, res}};
+                rbi.clearValueCount = 1;
+                rbi.pClearValues = &clear;
+                vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+                if (indexCount > 0) {
+                    setViewport(c, res, res);
+                    vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.shadowDepth.get());
+                    vkCmdPushConstants(c, g.shadowDepthLayout.handle(), VK_SHADER_STAGE_VERTEX_BIT, 0,
+                                       sizeof(glm::mat4), &lightMatrices[i]);
+                    const VkBuffer vb = g.vertices.handle();
+                    const VkDeviceSize offset = 0;
+                    vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
+                    vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+                    vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+                }
+                vkCmdEndRenderPass(c);
+            }
+        });
+        shadows->drawn = lightMatrices;
+    }
+
     {
+        vk::DescriptorSet& lights = shadows ? slot.shadowedLights : slot.lights;
         PassInfo info{"terrain",
                       {{kColor, Access::ColorAttachmentClear},
                        {kDepth, Access::DepthAttachmentClear},
                        {kVertices, Access::VertexAttributeRead},
                        {kIndices, Access::IndexRead}},
-                      concat(concat(slot.view.bindingNames(), slot.lights.bindingNames()),
+                      concat(concat(slot.view.bindingNames(), lights.bindingNames()),
                              {std::string("vertex:") + kVertices, std::string("index:") + kIndices})};
+        if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
+        VkBuffer attribute = VK_NULL_HANDLE;
         if (probes) {
             info.uses.push_back({kProbeLight, Access::VertexAttributeRead});
             info.bindings.push_back(std::string("vertex:") + kProbeLight);
+            attribute = probes->light.handle();
+        } else if (sunVisibility) {
+            info.uses.push_back({kSunVisibility, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kSunVisibility);
+            attribute = g.sunVisibility.handle();
         }
+        if (fog) info.bindings.push_back("fog");
         // The diagnostics views read the probe pass's second vec4 in place of the first: one
         // attribute and one varying either way, so no view pays for the other.
-        const VkDeviceSize probeOffset = view.needs.probeDiagnostics ? 16 : 0;
+        const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
         const uint32_t indexCount = uint32_t(indexCount_);
-        graph.addPass(std::move(info), [&g, &slot, probes, probeOffset, indexCount, bg, w, h, framebuffer,
-                                        setViewport](VkCommandBuffer c) {
+        const VkPipeline pipeline = terrainPipeline.get();
+        const VkPipelineLayout layout = (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle();
+        const VkDescriptorSet sets[] = {slot.view.handle(), lights.handle()};
+        graph.addPass(std::move(info), [&g, pipeline, layout, sets, attribute, attributeOffset, indexCount, bg,
+                                        w, h, framebuffer, setViewport](VkCommandBuffer c) {
             VkClearValue clear[2];
             clear[0].color = {{bg.x, bg.y, bg.z, 1.0f}};
             clear[1].depthStencil = {1.0f, 0};
@@ -479,18 +702,37 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             rbi.pClearValues = clear;
             vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
             if (indexCount > 0) {
-                setViewport(c);
-                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS,
-                                  probes ? g.terrainProbeLight.get() : g.terrainPlain.get());
-                const VkDescriptorSet sets[] = {slot.view.handle(), slot.lights.handle()};
-                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(),
-                                        TLX_SET_VIEW, 2, sets, 0, nullptr);
-                const VkBuffer vb[2] = {g.vertices.handle(), probes ? probes->light.handle() : VK_NULL_HANDLE};
-                const VkDeviceSize offsets[2] = {0, probeOffset};
-                vkCmdBindVertexBuffers(c, 0, probes ? 2 : 1, vb, offsets);
+                setViewport(c, w, h);
+                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW, 2, sets, 0, nullptr);
+                const VkBuffer vb[2] = {g.vertices.handle(), attribute};
+                const VkDeviceSize offsets[2] = {0, attributeOffset};
+                vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
                 vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
                 vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
             }
+            vkCmdEndRenderPass(c);
+        });
+    }
+
+    if (sky) {
+        PassInfo info{"sky",
+                      {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
+                      concat(slot.view.bindingNames(), slot.lights.bindingNames())};
+        if (fog) info.bindings.push_back("fog");
+        const VkPipeline pipeline = skyPipeline.get();
+        const VkDescriptorSet sets[] = {slot.view.handle(), slot.lights.handle()};
+        graph.addPass(std::move(info), [&g, pipeline, sets, w, h, framebuffer, setViewport](VkCommandBuffer c) {
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = g.drawPass.handle();
+            rbi.framebuffer = framebuffer;
+            rbi.renderArea = {{0, 0}, {w, h}};
+            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            setViewport(c, w, h);
+            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
+                                    sets, 0, nullptr);
+            vkCmdDraw(c, 3, 1, 0, 0);
             vkCmdEndRenderPass(c);
         });
     }
@@ -515,7 +757,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             rbi.framebuffer = framebuffer;
             rbi.renderArea = {{0, 0}, {w, h}};
             vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            setViewport(c);
+            setViewport(c, w, h);
             const VkDescriptorSet view = slot.view.handle(), overlay = slot.overlays.handle();
             vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
                                     TLX_SET_VIEW, 1, &view, 0, nullptr);

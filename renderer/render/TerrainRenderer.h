@@ -1,7 +1,8 @@
 #pragma once
 // Draws the terrain offscreen the way the engine will light it, or one of the debug views. A frame
 // is an ordered list of passes (FrameGraph): the probe pass (compute, only after the probes
-// changed), the terrain, the overlays (probe markers, octree leaves), then either the readback
+// changed), the sun's shadow cascades (only when the view draws shadows and they moved), the
+// terrain, the sky behind it, the overlays (probe markers, octree leaves), then either the readback
 // (`terralux --render`, the tests, a viewport grab) or the blit to a window's swapchain. A
 // subsystem the frame does not use adds no pass and no binding.
 
@@ -19,6 +20,7 @@
 #include "bake/SphericalHarmonics.h"
 #include "render/FrameGraph.h"
 #include "render/OrbitCamera.h"
+#include "render/ShadowCascades.h"
 #include "terrain/Heightfield.h"
 #include "vk/Swapchain.h"
 #include "vk/VulkanContext.h"
@@ -50,8 +52,12 @@ struct RenderSettings {
     glm::vec3 albedo{0.3f};
     SunLight sun;
     sh::ShRgb skySh;
-    float exposure = 1.0f;
+    float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
     float roughness = 0.8f;
+    ShadowSettings shadows;       // the sun's cascades (shadows.enabled false: no shadow pass)
+    // Height fog with base height and colour resolved (fog.enabled false: no fog code runs).
+    FogSettings fog;
+    bool skirt = true;            // the traced surface of the sun-visibility view (terrain.skirt)
     bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
@@ -87,6 +93,13 @@ public:
     const std::vector<PassInfo>& lastFramePasses() const;
     // Whether the probe subsystem holds GPU resources (volumes are bound).
     bool hasProbeResources() const;
+    // Whether the shadow subsystem holds GPU resources (a frame drew shadows and the scene's
+    // shadows are still on).
+    bool hasShadowResources() const;
+    // The cascades of the last frame that drew shadows (empty when none).
+    const std::vector<Cascade>& lastCascades() const { return cascades_; }
+    // How often the sun's visibility was traced at the vertices (cached per sun and surface).
+    size_t sunVisibilityTraces() const { return sunTraces_; }
 
     int meshStride() const { return stride_; }
     size_t vertexCount() const { return vertexCount_; }
@@ -98,6 +111,8 @@ private:
     struct Output;
     void recordFrame(VkCommandBuffer cb, uint32_t slot, const RenderSettings& s, const Output& out);
     void ensureTarget(uint32_t width, uint32_t height);
+    void ensureShadowMaps(int resolution, int cascades);
+    void updateSunVisibility(const SunLight& sun, bool skirt);
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;
@@ -107,6 +122,9 @@ private:
     bool anyErrorMap_ = false;
     uint32_t markerCount_ = 0, leafCount_ = 0;
     float smallestLeaf_ = 1.0f;
+    std::vector<float> meshVertices_;  // position and normal per vertex, as uploaded
+    std::vector<Cascade> cascades_;
+    size_t sunTraces_ = 0;
 };
 
 }  // namespace terralux

@@ -23,6 +23,7 @@ namespace terralux::blocks {
 #define TLX_VEC4(N) alignas(16) glm::vec4 N{0.0f};
 #define TLX_IVEC4(N) alignas(16) glm::ivec4 N{0};
 #define TLX_MAT4(N) alignas(16) glm::mat4 N{1.0f};
+#define TLX_MAT4_ARRAY(N, COUNT) alignas(16) glm::mat4 N[COUNT]{};
 #define TLX_VEC4_ARRAY(N, COUNT) alignas(16) glm::vec4 N[COUNT]{};
 #include "blocks/all.h"  // expands the blocks, then undefines the TLX_ macros
 
@@ -34,6 +35,7 @@ namespace terralux::blocks {
 #define TLX_VEC4(N) + 16
 #define TLX_IVEC4(N) + 16
 #define TLX_MAT4(N) + 64
+#define TLX_MAT4_ARRAY(N, COUNT) + 64 * (COUNT)
 #define TLX_VEC4_ARRAY(N, COUNT) + 16 * (COUNT)
 #include "blocks/all.h"  // expands the blocks, then undefines the TLX_ macros
 

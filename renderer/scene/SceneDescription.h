@@ -33,7 +33,7 @@ enum class SkyMode { Uniform, Hdr };
 struct SkySettings {
     SkyMode mode = SkyMode::Uniform;
     glm::vec3 color{0.6f, 0.75f, 1.0f};  // each >= 0
-    double intensity = 1.0;              // >= 0
+    double intensity = 0.15;             // >= 0; with the sun's 3, a clear day's ratio (docs/lighting.md)
     std::string hdr;                     // equirectangular image, for mode hdr
     double rotationDeg = 0.0;            // turns the HDR about +Y
 };
@@ -151,15 +151,15 @@ struct ShadowSettings {
     // Shadow distance; unset = the farthest terrain in view.
     std::optional<double> maxDistance;
     int mapResolution = 2048;                  // texels a side, 512..4096
-    double depthBias = 1.0;                    // texels of the cascade, along the light
-    double normalBias = 1.5;                   // texels of the cascade, along the surface normal
+    double depthBias = 1.5;                    // texels of the cascade, along the light
+    double normalBias = 0.3;                   // texels of the cascade, along the surface normal
     ShadowFilter filter = ShadowFilter::Pcss;
 };
 
 // Exponential height fog (docs/lighting.md, "Height fog"): extinction
 // σ(h) = density · exp(−height_falloff · (h − base_height)).
 struct FogSettings {
-    bool enabled = false;
+    bool enabled = true;
     double density = 2.0e-5;                   // 1/m at the base height
     double heightFalloff = 1.0 / 1200.0;       // 1/m
     std::optional<double> baseHeight;          // metres; unset = the lowest terrain

@@ -79,4 +79,10 @@ Image Image::depthTarget(const VulkanContext& ctx, uint32_t width, uint32_t heig
                            VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
 }
 
+Image Image::depthLayers(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t layers) {
+    return Image(ctx, {ImageShape::Layers, kDepthFormat, width, height, layers,
+                       VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                           VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+}
+
 }  // namespace terralux::vk

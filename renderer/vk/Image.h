@@ -42,6 +42,9 @@ public:
     static Image depthTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
                              uint32_t layers = 1, VkFormat format = kDepthFormat);
 
+    // A depth 2D array shaders sample as one (a 2D-array view even for one layer): shadow cascades.
+    static Image depthLayers(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t layers);
+
     VkImage handle() const { return image_.get(); }
     // The whole image as shaders see it: 2D, 2D array or cube.
     VkImageView view() const { return view_.get(); }

@@ -7,7 +7,11 @@ namespace terralux::vk {
 UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pass,
                                       VkPipelineLayout layout, const GraphicsPipelineDesc& desc) {
     const UniqueShaderModule vert = createShaderModule(ctx, desc.vert);
-    const UniqueShaderModule frag = createShaderModule(ctx, desc.frag);
+    const UniqueShaderModule frag = desc.frag.empty() ? UniqueShaderModule() : createShaderModule(ctx, desc.frag);
+    std::vector<VkSpecializationMapEntry> entries;
+    for (uint32_t i = 0; i < desc.fragConstants.size(); ++i) entries.push_back({i, i * 4, 4});
+    const VkSpecializationInfo specialization{uint32_t(entries.size()), entries.data(),
+                                              desc.fragConstants.size() * 4, desc.fragConstants.data()};
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
     stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -16,6 +20,7 @@ UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pas
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = frag.get();
     stages[1].pName = "main";
+    if (!entries.empty()) stages[1].pSpecializationInfo = &specialization;
     VkPipelineVertexInputStateCreateInfo vi{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     vi.vertexBindingDescriptionCount = uint32_t(desc.bindings.size());
     vi.pVertexBindingDescriptions = desc.bindings.data();
@@ -41,14 +46,14 @@ UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pas
     cba.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    cb.attachmentCount = 1;
+    cb.attachmentCount = desc.colorAttachments;
     cb.pAttachments = &cba;
     VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dy{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dy.dynamicStateCount = 2;
     dy.pDynamicStates = dyn;
     VkGraphicsPipelineCreateInfo gpi{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    gpi.stageCount = 2;
+    gpi.stageCount = desc.frag.empty() ? 1 : 2;
     gpi.pStages = stages;
     gpi.pVertexInputState = &vi;
     gpi.pInputAssemblyState = &ia;

@@ -1,6 +1,6 @@
 #pragma once
 // Graphics pipelines: the state every pass shares (depth test, dynamic viewport and scissor, no
-// culling, one colour attachment) with each pass's shaders, vertex input and topology.
+// culling) with each pass's shaders, vertex input, topology and colour attachments.
 
 #include <cstdint>
 #include <span>
@@ -12,7 +12,10 @@
 namespace terralux::vk {
 
 struct GraphicsPipelineDesc {
-    std::span<const uint32_t> vert, frag;
+    std::span<const uint32_t> vert, frag;  // no fragment shader: a depth-only pass
+    // Fragment-shader specialisation constants, by constant_id 0, 1, ... (32-bit each).
+    std::vector<uint32_t> fragConstants;
+    uint32_t colorAttachments = 1;  // 0 for a depth-only pass
     std::vector<VkVertexInputBindingDescription> bindings;
     std::vector<VkVertexInputAttributeDescription> attributes;
     VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;

@@ -5,6 +5,8 @@
 #include "blocks/camera.h"
 #include "blocks/surface.h"
 #include "blocks/sun_sky.h"
+#include "blocks/atmosphere.h"
+#include "blocks/shadows.h"
 #include "blocks/probes.h"
 #include "blocks/overlay.h"
 #undef TLX_BLOCK_BEGIN
@@ -14,4 +16,5 @@
 #undef TLX_VEC4
 #undef TLX_IVEC4
 #undef TLX_MAT4
+#undef TLX_MAT4_ARRAY
 #undef TLX_VEC4_ARRAY

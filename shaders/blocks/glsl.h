@@ -8,4 +8,5 @@
 #define TLX_VEC4(N) vec4 N;
 #define TLX_IVEC4(N) ivec4 N;
 #define TLX_MAT4(N) mat4 N;
+#define TLX_MAT4_ARRAY(N, COUNT) mat4 N[COUNT];
 #define TLX_VEC4_ARRAY(N, COUNT) vec4 N[COUNT];

@@ -1,6 +1,7 @@
 // Render tests on the real Vulkan path (Mesa lavapipe in CI): golden images of every debug view
 // and behaviour checks. They skip, saying why, when no Vulkan device exists, and fail on any
 // validation-layer message.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -126,7 +127,22 @@ TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
     const RenderedImage on = draw(withProbes, kViewBeauty, true);
     const auto d = test::compareImages(off.rgba, none.rgba, kW, kH);
     EXPECT_LE(d.maxAbs, 1.0 / 255.0);
-    EXPECT_GT(meanAbsDiff(on, off), 0.5 / 255.0) << "probe lighting changes the image";
+    // Probes change the ambient term (occluded sky and bounce in place of the open sky): with the
+    // sun off, by more than 1 % of the scene-linear image.
+    Project dark = sampleProject("disabled", 8, 8);
+    dark.scene.sun.illuminance = 0.0;
+    withProbes.setProject(dark);
+    const RenderedImage onLinear = draw(withProbes, kViewLinear, true, true);
+    const RenderedImage offLinear = draw(withProbes, kViewLinear, false, true);
+    const RenderedImage albedo = draw(withProbes, kViewAlbedo);
+    double diff = 0, sum = 0;
+    for (size_t i = 0; i < onLinear.rgba.size(); ++i) {
+        if (i % 4 == 3 || albedo.rgba[i - i % 4] <= 0.0f) continue;  // terrain pixels, rgb
+        diff += std::abs(onLinear.rgba[i] - offLinear.rgba[i]);
+        sum += std::abs(offLinear.rgba[i]);
+    }
+    EXPECT_GT(diff / sum, 0.01) << "probe lighting changes the image";
+    EXPECT_GT(meanAbsDiff(on, off), 0.0);
 }
 
 TEST_F(RenderTest, OneByOneGridWeighsOneEverywhere) {
@@ -454,19 +470,20 @@ TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
         EXPECT_TRUE(mention.empty()) << v.name << ": " << mention;
     }
     const RenderedImage none = draw(without, kViewBeauty);
-    EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+    EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "sky", "readback"}));
 
     ProjectRenderer with(*ctx_, sampleProject("volumes", 8, 8));
     ASSERT_EQ(with.loadProbes(true), 1u);
     EXPECT_TRUE(with.renderer().hasProbeResources());
     // Probes on: the probe pass runs once after the volumes changed; the terrain reads its light.
+    // The shadow maps are drawn once too: the camera and the sun stay where they are.
     draw(with, kViewBeauty);
     const auto& first = with.renderer().lastFramePasses();
-    EXPECT_EQ(passNames(first), (Names{"probe-vertices", "terrain", "readback"}));
+    EXPECT_EQ(passNames(first), (Names{"probe-vertices", "shadow", "terrain", "sky", "readback"}));
     EXPECT_TRUE(binds(first, "probe-vertices", "probe-coefficients"));
     EXPECT_TRUE(binds(first, "terrain", "vertex:probe-light"));
     draw(with, kViewBeauty);
-    EXPECT_EQ(passNames(with.renderer().lastFramePasses()), (Names{"terrain", "readback"}));
+    EXPECT_EQ(passNames(with.renderer().lastFramePasses()), (Names{"terrain", "sky", "readback"}));
     EXPECT_TRUE(binds(with.renderer().lastFramePasses(), "terrain", "vertex:probe-light"));
     // Probes off: nothing of them takes part, and the image is the one without volumes.
     const RenderedImage off = draw(with, kViewBeauty, false);
@@ -595,4 +612,125 @@ TEST_F(RenderTest, AStaleBakeIsBakedAgainBeforeItIsDrawn) {
     EXPECT_NE(note.find("the bake there is stale: probe_volumes[0].grid_dims: baked [4,4], now [6,5]"), std::string::npos) << note;
     EXPECT_TRUE(r.staleBake().empty());
     EXPECT_EQ(readShProbeFile(p.outDir() / "sh_coeffs" / "probes.shprobe").probes.size(), 30u);
+}
+
+TEST_F(RenderTest, ShadowMapsAgreeWithTheTracedSunVisibilityAtTheDefaults) {
+    Project p = sampleProject("shadow_agreement", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    const ShadowAgreement a = measureShadowAgreement(r, 480, 270);
+    EXPECT_GT(a.terrainPixels, 480u * 270u / 5);
+    EXPECT_LE(a.disagreeing, 0.03) << "mean |difference| " << a.meanAbsDifference;
+    // The traced view is cached per sun: drawing it again traces nothing.
+    const size_t traces = r.renderer().sunVisibilityTraces();
+    draw(r, kViewSunVisibility, false, true);
+    EXPECT_EQ(r.renderer().sunVisibilityTraces(), traces);
+    p.scene.sun.azimuthDeg += 20.0;
+    r.setProject(p);
+    draw(r, kViewSunVisibility, false, true);
+    EXPECT_EQ(r.renderer().sunVisibilityTraces(), traces + 1);
+}
+
+TEST_F(RenderTest, ARidgeShadowsTheValleyBehindItAtALowSun) {
+    // The U valley with the sun low in the east: the east wall's shadow falls on the floor's east
+    // side; the west wall faces the sun.
+    Project p = sampleProject("ridge_shadow", 8, 8);
+    p.scene.terrain.dem = writeValleyDem().string();
+    p.scene.camera.elevationDeg = 89.5;
+    p.scene.camera.azimuthDeg = 180.0;
+    p.scene.sun.azimuthDeg = 90.0;
+    p.scene.sun.elevationDeg = 20.0;
+    p.scene.fog.enabled = false;
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    RenderRequest q;
+    q.width = kW;
+    q.height = kW;
+    q.linearOutput = true;
+    q.debugView = kViewSunVisibility;
+    const RenderedImage traced = r.render(q);
+    q.debugView = kViewShadow;
+    const RenderedImage mapped = r.render(q);
+    q.debugView = kViewLinear;
+    const RenderedImage beauty = r.render(q);
+    // A floor pixel (image centre row) just east of the valley's axis is shadowed; one on the
+    // sunlit west wall's plateau is lit. Columns run west to east.
+    size_t shadowedFloor = 0, litFloor = 0;
+    double shadowedLight = 0.0, litLight = 0.0;
+    for (uint32_t y = kW / 3; y < 2 * kW / 3; ++y)
+        for (uint32_t x = 0; x < kW; ++x) {
+            const size_t i = (size_t(y) * kW + x) * 4;
+            if (traced.rgba[i + 1] < 0.5f) continue;
+            if (traced.rgba[i] < 0.01f) {
+                ++shadowedFloor;
+                EXPECT_LT(mapped.rgba[i], 0.5f) << "pixel " << x << "," << y << " is in the traced shadow";
+                shadowedLight += beauty.rgba[i + 1];
+            } else if (traced.rgba[i] > 0.99f) {
+                ++litFloor;
+                litLight += beauty.rgba[i + 1];
+            }
+        }
+    ASSERT_GT(shadowedFloor, 50u);
+    ASSERT_GT(litFloor, 50u);
+    EXPECT_LT(shadowedLight / double(shadowedFloor), 0.5 * litLight / double(litFloor));
+}
+
+TEST_F(RenderTest, FarTerrainIsFoggierThanNearTerrain) {
+    Project p = sampleProject("fog", 8, 8);
+    p.scene.fog.enabled = true;
+    // Fog the same at every height: the amount then grows with distance alone.
+    p.scene.fog.heightFalloff = 0.0;
+    p.scene.fog.density = 1e-4;
+    p.scene.camera.elevationDeg = 15.0;
+    ProjectRenderer r(*ctx_, p);
+    const RenderedImage fog = draw(r, kViewFog, false, true);
+    // Mean fog amount of each image row's terrain pixels; rows higher in the image are farther.
+    std::vector<double> rows;
+    for (uint32_t y = 0; y < kH; ++y) {
+        double s = 0;
+        size_t n = 0;
+        for (uint32_t x = 0; x < kW; ++x) {
+            const size_t i = (size_t(y) * kW + x) * 4;
+            if (fog.rgba[i + 1] < 0.5f) continue;
+            s += fog.rgba[i];
+            ++n;
+        }
+        if (n > kW / 8) rows.push_back(s / double(n));
+    }
+    ASSERT_GT(rows.size(), size_t(kH / 3));
+    const size_t band = rows.size() / 5;
+    double farBand = 0, nearBand = 0;
+    for (size_t i = 0; i < band; ++i) {
+        farBand += rows[i] / double(band);
+        nearBand += rows[rows.size() - 1 - i] / double(band);
+    }
+    EXPECT_GT(farBand, 1.3 * nearBand) << "far " << farBand << " near " << nearBand;
+    EXPECT_GT(nearBand, 0.0);
+    // Without fog the view is zero on the terrain and no pass binds the fog.
+    p.scene.fog.enabled = false;
+    r.setProject(p);
+    const RenderedImage none = draw(r, kViewFog, false, true);
+    for (size_t i = 0; i < none.rgba.size(); i += 4) ASSERT_EQ(none.rgba[i], 0.0f);
+    for (const auto& pass : r.renderer().lastFramePasses())
+        for (const auto& b : pass.bindings) EXPECT_NE(b, "fog") << pass.name;
+}
+
+TEST_F(RenderTest, ShadowsOffDrawsNoShadowPassAndHoldsNoMaps) {
+    Project p = sampleProject("no_shadows", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    draw(r, kViewBeauty, false);
+    EXPECT_TRUE(r.renderer().hasShadowResources());
+    const auto passes = passNames(r.renderer().lastFramePasses());
+    EXPECT_NE(std::find(passes.begin(), passes.end(), "shadow"), passes.end());
+    // The same frame again: the cascades did not move, so the maps are not drawn again.
+    draw(r, kViewBeauty, false);
+    const auto again = passNames(r.renderer().lastFramePasses());
+    EXPECT_EQ(std::find(again.begin(), again.end(), "shadow"), again.end());
+    p.scene.shadows.enabled = false;
+    r.setProject(p);
+    draw(r, kViewBeauty, false);
+    EXPECT_FALSE(r.renderer().hasShadowResources());
+    for (const auto& pass : r.renderer().lastFramePasses()) {
+        EXPECT_NE(pass.name, "shadow");
+        for (const auto& b : pass.bindings) EXPECT_EQ(b.find("shadow"), std::string::npos) << pass.name;
+    }
 }

@@ -44,7 +44,16 @@ TEST(Project, DefaultsAreLightingMdDefaults) {
     EXPECT_DOUBLE_EQ(s.probeVolumes[0].heightOffset, 5.0);
     EXPECT_FALSE(s.probeVolumes[0].spacing.has_value());  // auto-span
     EXPECT_EQ(s.sky.color, glm::vec3(0.6f, 0.75f, 1.0f));
-    EXPECT_DOUBLE_EQ(s.sky.intensity, 1.0);
+    EXPECT_DOUBLE_EQ(s.sky.intensity, 0.15);
+    // A clear day: direct sun on level ground at the default elevation against the uniform sky's
+    // irradiance π·L on it lands within the 4-10 : 1 of docs/lighting.md.
+    const double direct = s.sun.illuminance * std::sin(s.sun.elevationDeg * M_PI / 180.0);
+    const double diffuse = M_PI * s.sky.intensity * (0.2126 * s.sky.color.x + 0.7152 * s.sky.color.y + 0.0722 * s.sky.color.z);
+    EXPECT_GE(direct / diffuse, 4.0);
+    EXPECT_LE(direct / diffuse, 10.0);
+    EXPECT_TRUE(s.shadows.enabled);
+    EXPECT_TRUE(s.fog.enabled);
+    EXPECT_EQ(s.camera.exposureEv, 0.0);
     EXPECT_DOUBLE_EQ(s.sun.angularRadiusDeg, 0.27);
     EXPECT_EQ(s.reflectionProbes.gridDims[0], 4);
     EXPECT_EQ(s.reflectionProbes.rayCount, 16);

@@ -1,0 +1,32 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The sky behind the terrain: its radiance toward each pixel's view ray (from the sky's SH, the
+// horizon's below the horizon), the sun's disc, and the fog between (docs/lighting.md, "Height
+// fog": the sky is fogged at the far plane, so the horizon blends into the haze).
+#include "blocks/glsl.h"
+#include "blocks/camera.h"
+#include "blocks/surface.h"
+#include "blocks/sun_sky.h"
+#include "blocks/atmosphere.h"
+#include "sh.glsl"
+#include "tonemap.glsl"
+#include "fog.glsl"
+
+layout(location = 0) in vec2 ndc;
+layout(location = 0) out vec4 outColor;
+
+void main() {
+    vec4 far = camera.invViewProj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(far.xyz / far.w - camera.position.xyz);
+    vec3 up = normalize(vec3(dir.x, max(dir.y, 0.0), dir.z) + vec3(0.0, 1e-4, 0.0));
+    vec3 c[9];
+    for (int k = 0; k < 9; ++k) c[k] = sunSky.skySh[k].rgb;
+    vec3 radiance = max(shIrradiance(c, up, true), vec3(0.0));
+    // The sun's disc: its illuminance spread over the disc's solid angle π·r².
+    float r = sunSky.sunDirection.w;
+    vec3 l = normalize(sunSky.sunDirection.xyz);
+    if (r > 0.0 && dir.y > 0.0 && dot(dir, l) >= cos(r))
+        radiance += sunSky.sunIlluminance.rgb / (PI * r * r);
+    radiance = applyFog(radiance, dir, camera.position.w);
+    outColor = vec4(display(radiance), 1.0);
+}
