@@ -4,9 +4,11 @@
 #include <cstdlib>
 
 #include "Project.h"
+#include "bake/PhysicalSky.h"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -186,35 +188,47 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kRebake).field(&SceneDescription::terrain, &TerrainSettings::skirt);
 
     // Sun.
+    const auto physical = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Physical; };
+    const auto sunFromSky = [](const SceneDescription& s, size_t) {
+        return s.sky.mode == SkyMode::Physical && s.sun.followSky;
+    };
     add(Row("sun.azimuth_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
         .label("Sun azimuth").about("Direction of the sun, clockwise from north (-Z) toward east (+X)")
         .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::azimuthDeg);
     add(Row("sun.elevation_deg", T::Number)).range(-90.0, 90.0).unit("°").decimals(1).slider()
         .label("Sun elevation").about("Angle of the sun above the horizon")
         .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::elevationDeg);
+    add(Row("sun.follow_sky", T::Boolean)).label("Sun from sky model")
+        .about("Sky mode physical: the sun's colour and illuminance come from the sky model (sun.color and sun.illuminance are not read)")
+        .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sun, &SunSettings::followSky);
     add(Row("sun.illuminance", T::Number)).range(0.0, 1.0e6).label("Sun illuminance")
-        .about("Illuminance on a surface facing the sun, scene-linear (the sky's radiance is in the same units)")
-        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::illuminance);
+        .about("Illuminance on a surface facing the sun, scene-linear (the sky's radiance is in the same units); not read while the sun follows the physical sky")
+        .redoes(kUpload | kRebake).onlyWhen(std::not_fn(sunFromSky))
+        .field(&SceneDescription::sun, &SunSettings::illuminance);
     add(Row("sun.color", T::Color)).range(0.0, kUnbounded).label("Sun colour")
-        .about("Linear RGB tint of the sun's illuminance").redoes(kUpload | kRebake)
-        .field(&SceneDescription::sun, &SunSettings::color);
+        .about("Linear RGB tint of the sun's illuminance; not read while the sun follows the physical sky").redoes(kUpload | kRebake)
+        .onlyWhen(std::not_fn(sunFromSky)).field(&SceneDescription::sun, &SunSettings::color);
     add(Row("sun.angular_radius_deg", T::Number)).range(0.0, 45.0).unit("°").label("Sun radius")
         .about("Angular radius of the sun's disc (0.27° for the real sun): soft shadow size")
         .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::angularRadiusDeg);
 
     // Sky.
-    add(Row("sky.mode", T::Choice)).choices({"uniform", "hdr"}).label("Sky")
-        .about("uniform: one radiance from every direction; hdr: an equirectangular image")
+    const auto hdr = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Hdr; };
+    add(Row("sky.mode", T::Choice)).choices({"uniform", "hdr", "physical"}).label("Sky")
+        .about("uniform: one radiance from every direction; hdr: an equirectangular image; physical: a clear sky from the sun's position and the turbidity (Preetham 1999)")
         .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::mode);
     add(Row("sky.color", T::Color)).range(0.0, kUnbounded).label("Sky colour")
-        .about("Radiance of the uniform sky, linear RGB").redoes(kUpload | kRebake)
-        .field(&SceneDescription::sky, &SkySettings::color);
+        .about("Radiance of the uniform sky, or the tint of the HDR image; linear RGB").redoes(kUpload | kRebake)
+        .onlyWhen(std::not_fn(physical)).field(&SceneDescription::sky, &SkySettings::color);
     add(Row("sky.intensity", T::Number)).range(0.0, 1.0e5).label("Sky intensity")
-        .about("Multiplies the sky's radiance (uniform colour or HDR image)").redoes(kUpload | kRebake)
-        .field(&SceneDescription::sky, &SkySettings::intensity);
+        .about("Multiplies the sky's radiance (uniform colour or HDR image); in mode physical, the exposure of the whole daylight, sun included")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::intensity);
+    add(Row("sky.turbidity", T::Number)).range(kMinTurbidity, kMaxTurbidity).label("Turbidity")
+        .about("Haze of the physical sky: 2 very clear, 3 clear, 6 and above hazy; a hazier sky is brighter and whiter, its sun dimmer and redder")
+        .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sky, &SkySettings::turbidity);
     add(Row("sky.hdr", T::String)).label("HDR image")
         .about("Equirectangular HDR or EXR sky, for mode hdr; relative to the project file")
-        .redoes(kUpload | kRebake)
+        .redoes(kUpload | kRebake).onlyWhen(hdr)
         .custom([](const SceneDescription& s, size_t) { return json(s.sky.hdr); },
                 [](SceneDescription& s, size_t, const json& v) {
                     s.sky.hdr = v.get<std::string>();
@@ -222,7 +236,7 @@ std::vector<ParameterSpec> buildTable() {
                         throw ParameterRejection{"must name an image when sky.mode is \"hdr\"", ""};
                 });
     add(Row("sky.rotation_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
-        .label("HDR rotation").about("Turns the HDR sky about +Y").redoes(kUpload | kRebake)
+        .label("HDR rotation").about("Turns the HDR sky about +Y").redoes(kUpload | kRebake).onlyWhen(hdr)
         .field(&SceneDescription::sky, &SkySettings::rotationDeg);
 
     // Shadows.

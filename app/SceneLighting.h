@@ -7,14 +7,17 @@
 
 namespace terralux {
 
-// Uniform sky, or the HDR (tinted by sky.color, × intensity, turned by rotation). Throws
-// ImageError for an unreadable HDR. HDR skies are cached by path, file time and size, and
-// rotation; tint and intensity scale the cached environment, so edits of them and of anything
-// else reuse it.
+// Uniform sky, the HDR (tinted by sky.color, × intensity, turned by rotation), or the physical
+// sky (× intensity). Throws ImageError for an unreadable HDR. HDR skies are cached by path, file
+// time and size, and rotation; physical skies by sun direction and turbidity. Tint and intensity
+// scale the cached environment, so edits of them and of anything else reuse it.
 Sky skyOf(const Project& project);
 // How many times an HDR was read and filtered since start (for tests of the cache).
 size_t hdrSkyReads();
-// Sun, sky and albedo; the caller sets the tracer.
+// How many times a physical sky was sampled and filtered since start.
+size_t physicalSkyBuilds();
+// Sun, sky and albedo; the caller sets the tracer. In sky mode physical with sun.follow_sky the
+// sun's colour and illuminance are the model's, × sky.intensity.
 BakeLighting lightingOf(const Project& project);
 
 // The fog as the renderer draws it: base height and colour resolved (unset base height = the lowest

@@ -7,6 +7,9 @@
 #include <string>
 
 #include <glm/common.hpp>
+#include <tbb/parallel_for.h>
+
+#include "bake/PhysicalSky.h"
 
 namespace terralux {
 
@@ -75,6 +78,27 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
     s.rotation_ = float(rotationDeg / 360.0 - std::floor(rotationDeg / 360.0));
     s.computeSh();
     return s;
+}
+
+Sky Sky::physical(const PhysicalSky& model, int width, int height) {
+    if (width < 1 || height < 1)
+        throw std::invalid_argument("physical sky: " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " is not an image size");
+    std::vector<float> rgb(size_t(width) * size_t(height) * 3);
+    // The texel centres computeSh() integrates over, at rotation 0.
+    tbb::parallel_for(0, height, [&](int y) {
+        const double theta = std::numbers::pi * (y + 0.5) / height;
+        const float st = float(std::sin(theta)), ct = float(std::cos(theta));
+        for (int x = 0; x < width; ++x) {
+            const float phi = ((x + 0.5f) / width - 0.5f) * 2.0f * kPi;
+            const glm::vec3 r = model.radiance(glm::vec3(st * std::sin(phi), ct, -st * std::cos(phi)));
+            float* out = &rgb[3 * (size_t(y) * width + x)];
+            out[0] = r.x;
+            out[1] = r.y;
+            out[2] = r.z;
+        }
+    });
+    return equirect(std::move(rgb), width, height, 1.0f, 0.0f);
 }
 
 Sky Sky::scaled(const glm::vec3& factor) const {

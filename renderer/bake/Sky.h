@@ -1,6 +1,7 @@
 #pragma once
-// The sky a bake sees: a uniform radiance, or an equirectangular HDR (× intensity, turned about
-// +Y), plus the sun as a separate directional light with an angular radius.
+// The sky a bake sees: a uniform radiance, an equirectangular HDR (× intensity, turned about +Y),
+// or the analytic clear sky (PhysicalSky) sampled into one, plus the sun as a separate
+// directional light with an angular radius.
 //
 // Equirectangular mapping: v = acos(y) / π (v = 0 at the zenith); u = 0.5 + φ / 2π − rotation,
 // with φ = atan2(x, −z) the azimuth clockwise from north (−Z) toward east (+X). At rotation 0 the
@@ -24,6 +25,8 @@ struct SunLight {
 // Direction toward the sun from azimuth (clockwise from north) and elevation, in degrees.
 glm::vec3 sunDirection(double azimuthDeg, double elevationDeg);
 
+class PhysicalSky;
+
 class Sky {
 public:
     static Sky uniform(const glm::vec3& radiance);
@@ -31,6 +34,10 @@ public:
     // sizes or non-finite / negative texels.
     static Sky equirect(std::vector<float> rgb, int width, int height, float intensity,
                         float rotationDeg);
+    // The physical sky's radiance at each texel centre of a width × height equirectangular image
+    // (rotation 0), then as equirect(). The image holds the sky only: the sun is the separate
+    // directional light, and a disc in the image would light the scene twice.
+    static Sky physical(const PhysicalSky& model, int width = 512, int height = 256);
 
     // The same sky with its radiance multiplied per channel (a tint times an intensity), without
     // filtering the image again: the pyramid and the SH projection are linear in the radiance.

@@ -26,9 +26,12 @@ struct SunSettings {
     double illuminance = 3.0;        // E_sun on a surface facing the sun, scene-linear, >= 0
     glm::vec3 color{1.0f, 0.96f, 0.9f};
     double angularRadiusDeg = 0.27;  // [0, 45]
+    // Sky mode physical: the sun's colour and illuminance come from the sky model, and
+    // illuminance and color above are not read.
+    bool followSky = true;
 };
 
-enum class SkyMode { Uniform, Hdr };
+enum class SkyMode { Uniform, Hdr, Physical };
 
 struct SkySettings {
     SkyMode mode = SkyMode::Uniform;
@@ -36,6 +39,7 @@ struct SkySettings {
     double intensity = 0.15;             // >= 0; with the sun's 3, a clear day's ratio (docs/lighting.md)
     std::string hdr;                     // equirectangular image, for mode hdr
     double rotationDeg = 0.0;            // turns the HDR about +Y
+    double turbidity = 3.0;              // mode physical: haze, [1.7, 10]
 };
 
 enum class ProbePlacement { Terrain, Box, Adaptive };

@@ -586,6 +586,41 @@ private slots:
         QVERIFY(rowOf(w_->findChild<QWidget*>("param.volume.grid_dims.0"))->isVisibleTo(panel));
         QVERIFY(!rowOf(w_->findChild<QWidget*>("param.volume.adaptive.tolerance"))->isVisibleTo(panel));
             }
+        // Sun and sky rows the sky mode does not read are hidden, walking the table (rowsTheSkyModeIgnoresAreHidden)
+        {
+            auto* dock = w_->findChild<QDockWidget*>("dock.sunSky");
+            dock->raise();
+            auto* mode = w_->findChild<QComboBox*>("param.sky.mode");
+            auto* follow = w_->findChild<QCheckBox*>("param.sun.follow_sky");
+            QVERIFY(mode && follow);
+            auto rowsMatchTheTable = [&] {
+                const SceneDescription& scene = w_->document()->project().scene;
+                int hidden = 0;
+                for (const ParameterSpec& spec : parameterTable()) {
+                    if (!spec.uiRow || parameterDock(spec).objectName != "dock.sunSky") continue;
+                    const QString name = QString::fromStdString(uiObjectName(spec));
+                    QWidget* editor = w_->findChild<QWidget*>(name);
+                    QVERIFY2(editor, qPrintable(name));
+                    QCOMPARE(rowOf(editor)->isVisibleTo(dock), spec.isRead(scene, 0));
+                    hidden += !spec.isRead(scene, 0);
+                }
+                QVERIFY(hidden > 0);
+            };
+            mode->setCurrentText("physical");
+            QCOMPARE(w_->document()->project().scene.sky.mode, SkyMode::Physical);
+            rowsMatchTheTable();
+            QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sun.illuminance"))->isVisibleTo(dock));
+            QVERIFY(rowOf(w_->findChild<QWidget*>("param.sky.turbidity"))->isVisibleTo(dock));
+            follow->setChecked(false);
+            QVERIFY(!w_->document()->project().scene.sun.followSky);
+            rowsMatchTheTable();
+            QVERIFY(rowOf(w_->findChild<QWidget*>("param.sun.illuminance"))->isVisibleTo(dock));
+            mode->setCurrentText("uniform");
+            rowsMatchTheTable();
+            QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.turbidity"))->isVisibleTo(dock));
+            QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.hdr"))->isVisibleTo(dock));
+            QVERIFY(rowOf(w_->findChild<QWidget*>("param.sky.color"))->isVisibleTo(dock));
+        }
         // Max_resolution 'source' sends 0, never null (maxResolutionSourceSendsZero)
         {
             auto* spin = w_->findChild<QSpinBox*>("param.terrain.max_resolution");

@@ -151,3 +151,22 @@ TEST(ParameterTable, ReferenceListsEveryRow) {
     for (const auto& spec : parameterTable())
         EXPECT_NE(md.find("| `" + spec.path + "` |"), std::string::npos) << spec.path;
 }
+
+TEST(ParameterTable, SunAndSkyRowsAreReadByTheirSkyMode) {
+    auto read = [](const SceneDescription& s, const char* path) { return findParameter(path)->isRead(s, 0); };
+    SceneDescription s;  // uniform
+    for (const char* path : {"sky.color", "sky.intensity", "sun.illuminance", "sun.color"})
+        EXPECT_TRUE(read(s, path)) << path;
+    for (const char* path : {"sky.turbidity", "sun.follow_sky", "sky.hdr", "sky.rotation_deg"})
+        EXPECT_FALSE(read(s, path)) << path;
+    s.sky.mode = SkyMode::Hdr;
+    for (const char* path : {"sky.color", "sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
+        EXPECT_TRUE(read(s, path)) << path;
+    for (const char* path : {"sky.turbidity", "sun.follow_sky"}) EXPECT_FALSE(read(s, path)) << path;
+    s.sky.mode = SkyMode::Physical;
+    for (const char* path : {"sky.turbidity", "sky.intensity", "sun.follow_sky"}) EXPECT_TRUE(read(s, path)) << path;
+    for (const char* path : {"sky.color", "sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
+        EXPECT_FALSE(read(s, path)) << path;
+    s.sun.followSky = false;
+    for (const char* path : {"sun.illuminance", "sun.color"}) EXPECT_TRUE(read(s, path)) << path;
+}

@@ -9,6 +9,7 @@
 #include "ImageFile.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
+#include "bake/PhysicalSky.h"
 
 using namespace terralux;
 using nlohmann::json;
@@ -106,6 +107,10 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"sky.color=[1,1]", "p.json: sky.color = [1,1]: must be an array of 3 numbers"},
         Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be in [0, 100000]"},
         Rule{"sky.mode=hdr", "p.json: sky.hdr = \"\": must name an image when sky.mode is \"hdr\""},
+        Rule{"sky.mode=sunny", "p.json: sky.mode = \"sunny\": must be one of uniform | hdr | physical"},
+        Rule{"sky.turbidity=12", "p.json: sky.turbidity = 12: must be in [1.7, 10]"},
+        Rule{"sky.turbidity=1", "p.json: sky.turbidity = 1: must be in [1.7, 10]"},
+        Rule{"sun.follow_sky=1", "p.json: sun.follow_sky = 1: must be true or false"},
         Rule{"reflection_probes.grid_dims=[17,16]", "p.json: reflection_probes.grid_dims = [17,16]: must be >= 1 each with a product <= 256 (is 272)"},
         Rule{"reflection_probes.grid_dims=[0,1]", "p.json: reflection_probes.grid_dims[0] = 0: must be in [1, 256]"},
         Rule{"reflection_probes.ray_count=0", "p.json: reflection_probes.ray_count = 0: must be in [1, 1048576]"},
@@ -322,6 +327,61 @@ TEST(Project, EffectiveProjectAppliesFileThenOverrides) {
     EXPECT_EQ(p.demPath(), dir / "x.tif");
     EXPECT_THROW(loadEffectiveProject((dir / "p.json").string(), {"sun.elevation_deg=100"}, "", nullptr),
                  ProjectError);
+}
+
+TEST(Project, PhysicalSkyRoundTrips) {
+    json doc = defaultProjectJson();
+    EXPECT_EQ(doc["sky"]["mode"], "uniform");
+    applyOverride(doc, "sky.mode=physical");
+    applyOverride(doc, "sky.turbidity=4.5");
+    applyOverride(doc, "sun.follow_sky=false");
+    const SceneDescription s = sceneFromJson(doc, "--set", nullptr);
+    EXPECT_EQ(s.sky.mode, SkyMode::Physical);
+    EXPECT_DOUBLE_EQ(s.sky.turbidity, 4.5);
+    EXPECT_FALSE(s.sun.followSky);
+    const json written = sceneToJson(s);
+    EXPECT_EQ(written["sky"]["mode"], "physical");
+    EXPECT_EQ(written["sky"]["turbidity"], 4.5);
+    EXPECT_EQ(written["sun"]["follow_sky"], false);
+    EXPECT_EQ(sceneToJson(sceneFromJson(written, "again", nullptr)), written);
+}
+
+TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
+    Project p;
+    p.scene.sky.mode = SkyMode::Physical;
+    p.scene.sky.turbidity = 3.0;
+    p.scene.sky.color = glm::vec3(5.0f, 0.0f, 0.0f);  // not read in mode physical
+    const size_t before = physicalSkyBuilds();
+    const BakeLighting a = lightingOf(p);
+    EXPECT_EQ(physicalSkyBuilds(), before + 1);
+    EXPECT_FALSE(a.sky.isUniform());
+    EXPECT_GT(a.sky.openIrradianceUp().z, a.sky.openIrradianceUp().x) << "a clear sky is blue";
+    const PhysicalSky model(a.sun.direction, 3.0);
+    EXPECT_EQ(a.sun.illuminance, model.sunIlluminance());
+
+    // Intensity exposes sky and sun alike and reuses the cached sky; so does any other edit.
+    p.scene.sky.intensity = 2.0;
+    p.scene.terrain.albedo = glm::vec3(0.5f);
+    const BakeLighting b = lightingOf(p);
+    EXPECT_EQ(physicalSkyBuilds(), before + 1);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_FLOAT_EQ(b.sky.openIrradianceUp()[c], 2.0f * a.sky.openIrradianceUp()[c]);
+        EXPECT_FLOAT_EQ(b.sun.illuminance[c], 2.0f * a.sun.illuminance[c]);
+    }
+    // The sun's direction and the turbidity shape it.
+    p.scene.sun.elevationDeg = 20.0;
+    skyOf(p);
+    EXPECT_EQ(physicalSkyBuilds(), before + 2);
+    p.scene.sky.turbidity = 6.0;
+    skyOf(p);
+    EXPECT_EQ(physicalSkyBuilds(), before + 3);
+
+    // Without follow_sky the sun is the project's own.
+    p.scene.sun.followSky = false;
+    EXPECT_EQ(lightingOf(p).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
+    p.scene.sky.mode = SkyMode::Uniform;
+    p.scene.sun.followSky = true;  // read only in mode physical
+    EXPECT_EQ(lightingOf(p).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
 }
 
 TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
