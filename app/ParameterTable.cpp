@@ -24,13 +24,7 @@ struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
 
-// A float field written as the shortest decimal that reads back as the same float: 0.3f is
-// written 0.3, not 0.30000001192092896.
-double shortest(float f) {
-    char buf[32];
-    const auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
-    return std::strtod(std::string(buf, end).c_str(), nullptr);
-}
+double shortest(float f) { return shortestDecimal(f); }
 
 json shortest(const glm::vec3& v) { return json{shortest(v.x), shortest(v.y), shortest(v.z)}; }
 
@@ -552,6 +546,12 @@ std::vector<ParameterSpec> buildTable() {
 }
 
 }  // namespace
+
+double shortestDecimal(float f) {
+    char buf[32];
+    const auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
+    return std::strtod(std::string(buf, end).c_str(), nullptr);
+}
 
 std::string ParameterSpec::localPath() const {
     return perVolume() ? path.substr(std::string("probe_volumes[].").size()) : path;
