@@ -14,7 +14,21 @@ namespace terralux {
 Sky skyOf(const Project& project);
 // How many times an HDR was read and filtered since start (for tests of the cache).
 size_t hdrSkyReads();
+// The authored sun as a light: direction toward it, illuminance × colour, radius in radians.
+SunLight sunOf(const SunSettings& sun);
 // Sun, sky and albedo; the caller sets the tracer.
 BakeLighting lightingOf(const Project& project);
+
+// The aspect ratio TERRALUX_lighting's cascade splits are computed for (shadows.computed_for_aspect).
+inline constexpr double kLightingExportAspect = 16.0 / 9.0;
+
+// The TERRALUX_lighting glTF extension (docs/formats.md, "glTF scene"): what an engine needs to
+// light the terrain as the project does. The sun as `lighting` lights it; the sky, shadows and fog
+// sections as the project writes them (sceneToJson), with the cascade splits for the project's
+// camera over `hf` and what fog's unset values resolve to; and the exposure.
+nlohmann::json lightingExtension(const Project& project, const Heightfield& hf,
+                                 const BakeLighting& lighting);
+// The same with the project's own lighting (lightingOf).
+nlohmann::json lightingExtension(const Project& project, const Heightfield& hf);
 
 }  // namespace terralux
