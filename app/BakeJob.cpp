@@ -582,6 +582,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         in.verticalScale = scene.terrain.verticalScale;
         in.volumes = grids;
         in.bake = bakeInfo;
+        in.lighting = lightingExtension(project, hf, lighting);
         in.generatorVersion = TERRALUX_VERSION;
         in.scene = scene.exportSettings.gltf;
         // The report lists every file of the bake, itself included, in the order written.

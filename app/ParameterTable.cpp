@@ -26,13 +26,7 @@ struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
 
-// A float field written as the shortest decimal that reads back as the same float: 0.3f is
-// written 0.3, not 0.30000001192092896.
-double shortest(float f) {
-    char buf[32];
-    const auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
-    return std::strtod(std::string(buf, end).c_str(), nullptr);
-}
+double shortest(float f) { return shortestDecimal(f); }
 
 json shortest(const glm::vec3& v) { return json{shortest(v.x), shortest(v.y), shortest(v.z)}; }
 
@@ -218,10 +212,12 @@ std::vector<ParameterSpec> buildTable() {
         .about("uniform: one radiance from every direction; hdr: an equirectangular image; physical: a clear sky from the sun's position and the turbidity (Preetham 1999)")
         .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::mode);
     add(Row("sky.color", T::Color)).range(0.0, kUnbounded).label("Sky colour")
-        .about("Radiance of the uniform sky, or the tint of the HDR image; linear RGB").redoes(kUpload | kRebake)
-        .onlyWhen(std::not_fn(physical)).field(&SceneDescription::sky, &SkySettings::color);
+        .about("Radiance of the uniform sky, linear RGB; the default with the default sun is a clear day's direct-to-diffuse ratio")
+        .redoes(kUpload | kRebake)
+        .onlyWhen([](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Uniform; })
+        .field(&SceneDescription::sky, &SkySettings::color);
     add(Row("sky.intensity", T::Number)).range(0.0, 1.0e5).label("Sky intensity")
-        .about("Multiplies the sky's radiance (uniform colour or HDR image); in mode physical, the exposure of the whole daylight, sun included")
+        .about("Multiplies the sky's radiance (the uniform colour or the HDR image); in mode physical, the exposure of the whole daylight, sun included")
         .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::intensity);
     add(Row("sky.turbidity", T::Number)).range(kMinTurbidity, kMaxTurbidity).label("Turbidity")
         .about("Haze of the physical sky: 2 very clear, 3 clear, 6 and above hazy; a hazier sky is brighter and whiter, its sun dimmer and redder")
@@ -566,6 +562,12 @@ std::vector<ParameterSpec> buildTable() {
 }
 
 }  // namespace
+
+double shortestDecimal(float f) {
+    char buf[32];
+    const auto end = std::to_chars(buf, buf + sizeof buf, f).ptr;
+    return std::strtod(std::string(buf, end).c_str(), nullptr);
+}
 
 std::string ParameterSpec::localPath() const {
     return perVolume() ? path.substr(std::string("probe_volumes[].").size()) : path;

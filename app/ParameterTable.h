@@ -124,6 +124,10 @@ double uiMinimum(const ParameterSpec& spec);
 // A short word for the null ("auto") value in a spin box: the meaning up to its first colon.
 std::string autoShort(const ParameterSpec& spec);
 
+// A float as the shortest decimal that reads back as the same float (0.3f is 0.3, not
+// 0.30000001192092896): how the project writes its float fields, and the exporters theirs.
+double shortestDecimal(float f);
+
 // JSON Schema (draft 2020-12) of the project file, generated from the table.
 nlohmann::json projectSchema();
 // The parameter reference in Markdown (docs/parameters.md), generated from the table.

@@ -1,6 +1,7 @@
 #include "SceneLighting.h"
 
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <list>
 #include <mutex>
@@ -10,13 +11,15 @@
 
 #include "EnvironmentImage.h"
 #include "bake/PhysicalSky.h"
+#include "ParameterTable.h"
+#include "render/ShadowCascades.h"
 
 namespace terralux {
 
 namespace {
 
-// An edit of the sun, the sky's tint or intensity, or a camera move must not read and filter the
-// HDR again: the last few environments are kept, keyed by file and rotation, and scaled by tint ×
+// An edit of the sun, the sky's intensity, or a camera move must not read and filter the
+// HDR again: the last few environments are kept, keyed by file and rotation, and scaled by the
 // intensity on the way out. A file rewritten on disk (new time or size) is a new key.
 struct SkyKey {
     std::string path;
@@ -75,8 +78,8 @@ Sky skyOf(const Project& p) {
     if (s.mode == SkyMode::Physical) return physicalSkyOf(p.scene).scaled(glm::vec3(float(s.intensity)));
     const std::string path = p.hdrPath().string();
     SkyKey key{path, {}, 0, float(s.rotationDeg)};
-    // The image's colour is the sky; sky.color tints it (white leaves it as it is).
-    const glm::vec3 scale = s.color * float(s.intensity);
+    // The image's colour is the sky (sky.color is the uniform sky's); intensity scales it.
+    const glm::vec3 scale(float(s.intensity));
     std::error_code ec;
     key.time = std::filesystem::last_write_time(path, ec);
     key.size = ec ? 0 : std::filesystem::file_size(path, ec);
@@ -107,6 +110,14 @@ FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfiel
     return f;
 }
 
+SunLight sunOf(const SunSettings& s) {
+    SunLight sun;
+    sun.direction = sunDirection(s.azimuthDeg, s.elevationDeg);
+    sun.illuminance = s.color * float(s.illuminance);
+    sun.angularRadius = float(s.angularRadiusDeg * std::numbers::pi / 180.0);
+    return sun;
+}
+
 BakeLighting lightingOf(const Project& p) {
     const SceneDescription& scene = p.scene;
     BakeLighting l;
@@ -120,6 +131,65 @@ BakeLighting lightingOf(const Project& p) {
     l.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
     l.albedo = scene.terrain.albedo;
     return l;
+}
+
+namespace {
+
+nlohmann::json shortest(const glm::vec3& v) {
+    return {shortestDecimal(v.x), shortestDecimal(v.y), shortestDecimal(v.z)};
+}
+
+}  // namespace
+
+nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const BakeLighting& l) {
+    const SceneDescription& scene = p.scene;
+    // The project's own writer: the sections read exactly as --print-project prints them, and a
+    // parameter added to the table appears here with no edit.
+    const nlohmann::json authored = sceneToJson(scene);
+    nlohmann::json ext = nlohmann::json::object();
+    // Sections an engine takes as authored; a later feature's section is one more name here.
+    for (const char* section : {"sky", "shadows", "fog"}) ext[section] = authored.at(section);
+    ext["exposure_ev"] = authored.at("camera").at("exposure_ev");
+
+    // The sun as the bake and the renderer light with it (BakeLighting), so a sky model that
+    // moves or tints the sun shows here, beside the authored azimuth and elevation; illuminance ×
+    // color is the per-channel illuminance they use. Values the authored sun gives exactly stay
+    // as authored: recovering them from the floats would only add rounding.
+    nlohmann::json& sun = ext["sun"] = authored.at("sun");
+    const SunLight asAuthored = sunOf(scene.sun);
+    sun["direction"] = shortest(l.sun.direction);
+    if (l.sun.illuminance != asAuthored.illuminance) {
+        // The authored scalar where there is one; the colour carries the rest.
+        const double e = scene.sun.illuminance > 0.0 ? scene.sun.illuminance : 1.0;
+        sun["illuminance"] = e;
+        sun["color"] = shortest(l.sun.illuminance / float(e));
+    }
+    if (l.sun.angularRadius != asAuthored.angularRadius)
+        sun["angular_radius_deg"] =
+            shortestDecimal(float(double(l.sun.angularRadius) * 180.0 / std::numbers::pi));
+
+    // Where the cascades split the project camera's view of the terrain box. They depend on the
+    // camera, so an engine with its own camera recomputes them (from split_lambda when practical).
+    const OrbitCamera camera = OrbitCamera::fromSettings(scene.camera, hf);
+    const glm::vec3 lo(hf.minX(), hf.minHeight(), hf.minZ()), hi(hf.maxX(), hf.maxHeight(), hf.maxZ());
+    const CascadeRange range = cascadeRange(scene.shadows, camera, float(kLightingExportAspect), lo, hi);
+    nlohmann::json& shadows = ext["shadows"];
+    shadows["computed_splits"] = range.ends;
+    shadows["computed_range"] = {range.nearDistance, range.farDistance};
+    shadows["computed_for_aspect"] = kLightingExportAspect;
+
+    // What fog's unset ("auto") values stand for: the lowest terrain, and the sky's mean radiance,
+    // L_0 · Y_0 (the DC term spread over 4π steradians; Y_0 = 1/(2√π), docs/lighting.md).
+    const nlohmann::json& fogAuthored = authored.at("fog");
+    nlohmann::json& fog = ext["fog"];
+    fog["resolved_base_height"] = scene.fog.baseHeight ? fogAuthored.at("base_height")
+                                                       : nlohmann::json(shortestDecimal(hf.minHeight()));
+    fog["resolved_color"] = scene.fog.color ? fogAuthored.at("color") : shortest(*resolvedFog(scene.fog, l.sky, hf).color);
+    return ext;
+}
+
+nlohmann::json lightingExtension(const Project& project, const Heightfield& hf) {
+    return lightingExtension(project, hf, lightingOf(project));
 }
 
 }  // namespace terralux

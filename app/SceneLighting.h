@@ -7,7 +7,7 @@
 
 namespace terralux {
 
-// Uniform sky, the HDR (tinted by sky.color, × intensity, turned by rotation), or the physical
+// Uniform sky, the HDR (× intensity, turned by rotation), or the physical
 // sky (× intensity). Throws ImageError for an unreadable HDR. HDR skies are cached by path, file
 // time and size, and rotation; physical skies by sun direction and turbidity. Tint and intensity
 // scale the cached environment, so edits of them and of anything else reuse it.
@@ -23,5 +23,21 @@ BakeLighting lightingOf(const Project& project);
 // The fog as the renderer draws it: base height and colour resolved (unset base height = the lowest
 // terrain; unset colour = the sky's mean radiance over the sphere).
 FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfield& terrain);
+// The authored sun as a light: direction toward it, illuminance × colour, radius in radians.
+SunLight sunOf(const SunSettings& sun);
+// Sun, sky and albedo; the caller sets the tracer.
+BakeLighting lightingOf(const Project& project);
+
+// The aspect ratio TERRALUX_lighting's cascade splits are computed for (shadows.computed_for_aspect).
+inline constexpr double kLightingExportAspect = 16.0 / 9.0;
+
+// The TERRALUX_lighting glTF extension (docs/formats.md, "glTF scene"): what an engine needs to
+// light the terrain as the project does. The sun as `lighting` lights it; the sky, shadows and fog
+// sections as the project writes them (sceneToJson), with the cascade splits for the project's
+// camera over `hf` and what fog's unset values resolve to; and the exposure.
+nlohmann::json lightingExtension(const Project& project, const Heightfield& hf,
+                                 const BakeLighting& lighting);
+// The same with the project's own lighting (lightingOf).
+nlohmann::json lightingExtension(const Project& project, const Heightfield& hf);
 
 }  // namespace terralux

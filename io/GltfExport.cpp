@@ -33,6 +33,7 @@ using ojson = nlohmann::ordered_json;
 constexpr const char* kEngineExtension = "VULKAN_SCHNEE_engine_properties";
 constexpr const char* kGeoExtension = "TERRALUX_geo";
 constexpr const char* kBakeExtension = "TERRALUX_bake";
+constexpr const char* kLightingExtension = "TERRALUX_lighting";
 constexpr const char* kGltfName = "scene.gltf";
 constexpr const char* kBinName = "scene.bin";
 constexpr const char* kProbeDir = "sh_coeffs";
@@ -293,6 +294,11 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
         throw std::runtime_error(gltfPath.string() + ": the " + kBakeExtension +
                                  " metadata must be a JSON object, not " + input.bake.type_name());
     }
+    if (!input.lighting.is_null() && !input.lighting.is_object()) {
+        throw std::runtime_error(gltfPath.string() + ": the " + kLightingExtension +
+                                 " metadata must be a JSON object or null, not " +
+                                 input.lighting.type_name());
+    }
     for (size_t i = 0; i < sorted.size(); ++i) {
         const std::string& name = sorted[i]->name;
         if (!validVolumeName(name)) {
@@ -353,6 +359,8 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
                                           ? std::string("Terralux")
                                           : "Terralux " + input.generatorVersion}};
         doc["extensionsUsed"] = {kEngineExtension, kGeoExtension, kBakeExtension};
+        if (input.lighting.is_object())
+            doc["extensionsUsed"].push_back(kLightingExtension);
         MeshBuild mesh;
         const bool hasMesh = hf.width() >= 2 && hf.depth() >= 2;
         if (hasMesh)
@@ -372,6 +380,8 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
               {"meshStride", mesh.stride}}},
             {kBakeExtension, ojson(input.bake)},
         };
+        if (input.lighting.is_object())
+            doc["extensions"][kLightingExtension] = ojson(input.lighting);
         if (hasMesh)
             files.push_back({kBinName, std::move(mesh.bin)});
         const std::string text = doc.dump(2) + "\n";

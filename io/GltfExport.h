@@ -8,12 +8,13 @@
 //
 // Engine space is glTF space (Y up, right-handed: X east, Y up, Z south), so nothing is converted.
 // The mesh uses the bake's triangulation (Heightfield.h) wound counter-clockwise seen from +Y, so
-// glTF front faces point up. Three root-level extensions are listed in `extensionsUsed` and never
+// glTF front faces point up. The root-level extensions are listed in `extensionsUsed` and never
 // in `extensionsRequired`:
 //   VULKAN_SCHNEE_engine_properties  {"shProbeGrids": [...]} one entry per .shprobe file, sorted by
 //                                    file name; every number equals that file's header exactly
 //   TERRALUX_geo                     CRS, origin, vertical scale, cell size, grid size, mesh stride
 //   TERRALUX_bake                    the caller's JSON object, verbatim
+//   TERRALUX_lighting                the caller's JSON object, verbatim, when it gives one
 
 #include <cstddef>
 #include <cstdint>
@@ -44,6 +45,9 @@ struct GltfSceneInput {
     double verticalScale = 1.0;  // recorded in TERRALUX_geo; the heights are exported as they are
     std::vector<GltfProbeVolume> volumes;
     nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object
+    // TERRALUX_lighting: an object (the bake writes the project's lighting, app/SceneLighting.h),
+    // or null for no such extension.
+    nlohmann::json lighting = nullptr;
     std::string generatorVersion;                    // asset.generator = "Terralux <version>"
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
     // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride. The

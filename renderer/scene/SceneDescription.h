@@ -35,8 +35,10 @@ enum class SkyMode { Uniform, Hdr, Physical };
 
 struct SkySettings {
     SkyMode mode = SkyMode::Uniform;
-    glm::vec3 color{0.6f, 0.75f, 1.0f};  // each >= 0
-    double intensity = 0.15;             // >= 0; with the sun's 3, a clear day's ratio (docs/lighting.md)
+    // Uniform sky radiance, each >= 0: with the sun's 3, a clear day's direct-to-diffuse ratio
+    // (docs/lighting.md, "Sun and sky").
+    glm::vec3 color{0.09f, 0.11f, 0.15f};
+    double intensity = 1.0;              // >= 0
     std::string hdr;                     // equirectangular image, for mode hdr
     double rotationDeg = 0.0;            // turns the HDR about +Y
     double turbidity = 3.0;              // mode physical: haze, [1.7, 10]

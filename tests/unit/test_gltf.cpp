@@ -240,6 +240,9 @@ TEST_F(GltfExport, WritesTheLayoutAndTheContract) {
     EXPECT_EQ(geo["gridSize"], json({5, 4}));
     EXPECT_EQ(geo["meshStride"], 1);
     EXPECT_EQ(doc["extensions"]["TERRALUX_bake"], in.bake);
+    // No lighting given, no lighting extension.
+    EXPECT_FALSE(doc["extensions"].contains("TERRALUX_lighting"));
+    EXPECT_EQ(std::count(m.extensionsUsed.begin(), m.extensionsUsed.end(), "TERRALUX_lighting"), 0);
 
     // One node with the terrain mesh in the default scene.
     ASSERT_EQ(m.meshes.size(), 1u);
@@ -294,6 +297,22 @@ TEST_F(GltfExport, WritesTheLayoutAndTheContract) {
     EXPECT_EQ(pbr.baseColorFactor, (std::vector<double>{0.25, 0.5, double(0.7f), 1.0}));
     EXPECT_EQ(pbr.metallicFactor, 0.0);
     EXPECT_EQ(pbr.roughnessFactor, 1.0);
+}
+
+TEST_F(GltfExport, LightingIsWrittenVerbatimAsAnOptionalExtension) {
+    const Heightfield hf = makeHeightfield(5, 4);
+    GltfSceneInput in = sampleInput(hf);
+    in.lighting = {{"sun", {{"direction", {0.0, 1.0, 0.0}}, {"illuminance", 3.0}}},
+                   {"exposure_ev", -0.5}};
+    exportGltfScene(dir, in);
+    const json doc = readJson(dir / "scene.gltf");
+    EXPECT_EQ(doc["extensions"]["TERRALUX_lighting"], in.lighting);
+    EXPECT_EQ(doc["extensionsUsed"], json({"VULKAN_SCHNEE_engine_properties", "TERRALUX_geo",
+                                           "TERRALUX_bake", "TERRALUX_lighting"}));
+    EXPECT_FALSE(doc.contains("extensionsRequired"));
+    Loaded l = load(dir / "scene.gltf");
+    ASSERT_TRUE(l.ok) << l.err;
+    EXPECT_EQ(l.warn, "");
 }
 
 TEST_F(GltfExport, GridsAreSortedByFileNameNotByStem) {
@@ -532,6 +551,9 @@ TEST_F(GltfExport, RejectsInvalidInputBeforeWritingAnything) {
     in = sampleInput(hf);
     in.bake = json::array();
     expectRejected(in, "TERRALUX_bake metadata must be a JSON object");
+    in = sampleInput(hf);
+    in.lighting = json::array();
+    expectRejected(in, "TERRALUX_lighting metadata must be a JSON object or null");
     in = sampleInput(hf);
     in.verticalScale = std::nan("");
     expectRejected(in, "scene.gltf: the vertical scale and the geo origin must be finite");

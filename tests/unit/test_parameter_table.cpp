@@ -160,9 +160,9 @@ TEST(ParameterTable, SunAndSkyRowsAreReadByTheirSkyMode) {
     for (const char* path : {"sky.turbidity", "sun.follow_sky", "sky.hdr", "sky.rotation_deg"})
         EXPECT_FALSE(read(s, path)) << path;
     s.sky.mode = SkyMode::Hdr;
-    for (const char* path : {"sky.color", "sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
+    for (const char* path : {"sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
         EXPECT_TRUE(read(s, path)) << path;
-    for (const char* path : {"sky.turbidity", "sun.follow_sky"}) EXPECT_FALSE(read(s, path)) << path;
+    for (const char* path : {"sky.turbidity", "sun.follow_sky", "sky.color"}) EXPECT_FALSE(read(s, path)) << path;
     s.sky.mode = SkyMode::Physical;
     for (const char* path : {"sky.turbidity", "sky.intensity", "sun.follow_sky"}) EXPECT_TRUE(read(s, path)) << path;
     for (const char* path : {"sky.color", "sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})

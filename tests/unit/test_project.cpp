@@ -44,8 +44,8 @@ TEST(Project, DefaultsAreLightingMdDefaults) {
     EXPECT_EQ(s.probeVolumes[0].gridDims[2], 8);
     EXPECT_DOUBLE_EQ(s.probeVolumes[0].heightOffset, 5.0);
     EXPECT_FALSE(s.probeVolumes[0].spacing.has_value());  // auto-span
-    EXPECT_EQ(s.sky.color, glm::vec3(0.6f, 0.75f, 1.0f));
-    EXPECT_DOUBLE_EQ(s.sky.intensity, 0.15);
+    EXPECT_EQ(s.sky.color, glm::vec3(0.09f, 0.11f, 0.15f));
+    EXPECT_DOUBLE_EQ(s.sky.intensity, 1.0);
     // A clear day: direct sun on level ground at the default elevation against the uniform sky's
     // irradiance π·L on it lands within the 4-10 : 1 of docs/lighting.md.
     const double direct = s.sun.illuminance * std::sin(s.sun.elevationDeg * M_PI / 180.0);
@@ -401,13 +401,14 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
     const Sky again = skyOf(p);
     EXPECT_EQ(hdrSkyReads(), before + 1) << "a sun or camera edit read the HDR again";
     EXPECT_EQ(first.sh().c[0], again.sh().c[0]);
-    // Tint and intensity scale the cached environment exactly as filtering the scaled image would.
+    // Intensity scales the cached environment exactly as filtering the scaled image would; the
+    // uniform sky's colour does not touch an HDR sky.
     p.scene.sky.color = glm::vec3(1.0f, 0.5f, 0.25f);
     p.scene.sky.intensity = 4.0;
     const Sky tinted = skyOf(p);
-    EXPECT_EQ(hdrSkyReads(), before + 1) << "a tint or intensity edit read the HDR again";
+    EXPECT_EQ(hdrSkyReads(), before + 1) << "an intensity edit read the HDR again";
     std::vector<float> rgb(16 * 8 * 3);
-    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = 4.0f * p.scene.sky.color[int(i % 3)];
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = 4.0f;
     const Sky direct = Sky::equirect(rgb, 16, 8, 1.0f, 0.0f);
     for (size_t k = 0; k < direct.sh().c.size(); ++k)
         for (int ch = 0; ch < 3; ++ch)

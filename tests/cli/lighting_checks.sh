@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# lighting_checks.sh TERRALUX VALIDATOR WORKDIR BUILD_DIR
+# A bake's scene.gltf carries the project's lighting in TERRALUX_lighting: its sky, shadows and fog
+# sections are what --print-project prints with the same project and --set edits (plus the
+# computed_* and resolved_* keys), the sun agrees with the project's, and the Khronos validator
+# finds no error. Once on the embedded sample, once with a project file whose HDR sky is named
+# relative to it (the extension keeps the path as written).
+set -u
+terralux=$1 validator=$2 work=$3 build=$4
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+
+# check PROJECT_JSON SCENE_GLTF CASCADES [MEAN_SKY_R,G,B]
+check() {
+  python3 - "$@" <<'EOF'
+import json, math, sys
+
+project = json.load(open(sys.argv[1]))
+doc = json.load(open(sys.argv[2]))
+cascades = int(sys.argv[3])
+mean_sky = [float(x) for x in sys.argv[4].split(",")] if len(sys.argv) > 4 else None
+errors = []
+def expect(ok, what):
+    if not ok:
+        errors.append(what)
+def close(a, b, rel=1e-6):
+    return abs(a - b) <= rel * max(1.0, abs(a), abs(b))
+
+expect("TERRALUX_lighting" in doc.get("extensionsUsed", []), "TERRALUX_lighting not in extensionsUsed")
+expect("TERRALUX_lighting" not in doc.get("extensionsRequired", []), "TERRALUX_lighting is required")
+ext = doc.get("extensions", {}).get("TERRALUX_lighting")
+if ext is None:
+    print("FAIL: no extensions.TERRALUX_lighting")
+    sys.exit(1)
+
+# The authored sections, less the keys the extension adds, are the printed project's.
+for section in ("sky", "shadows", "fog"):
+    authored = {k: v for k, v in ext[section].items()
+                if not k.startswith("computed_") and not k.startswith("resolved_")}
+    expect(authored == project[section],
+           f"{section}: {json.dumps(authored, sort_keys=True)} != {json.dumps(project[section], sort_keys=True)}")
+expect(ext["exposure_ev"] == project["camera"]["exposure_ev"], "exposure_ev differs")
+
+sun, psun = ext["sun"], project["sun"]
+for key in ("azimuth_deg", "elevation_deg", "illuminance"):
+    expect(sun[key] == psun[key], f"sun.{key}: {sun[key]} != {psun[key]}")
+expect(close(sun["angular_radius_deg"], psun["angular_radius_deg"]), "sun.angular_radius_deg differs")
+expect(all(close(a, b) for a, b in zip(sun["color"], psun["color"])), "sun.color differs")
+a, e = math.radians(psun["azimuth_deg"]), math.radians(psun["elevation_deg"])
+toward = (math.sin(a) * math.cos(e), math.sin(e), -math.cos(a) * math.cos(e))
+expect(all(close(x, y) for x, y in zip(sun["direction"], toward)),
+       f"sun.direction {sun['direction']} is not toward azimuth/elevation {toward}")
+expect(close(math.sqrt(sum(x * x for x in sun["direction"])), 1.0), "sun.direction is not unit")
+
+shadows = ext["shadows"]
+splits, rng = shadows["computed_splits"], shadows["computed_range"]
+expect(len(splits) == cascades == project["shadows"]["cascades"], f"{len(splits)} splits for {cascades} cascades")
+expect(all(x < y for x, y in zip([rng[0]] + splits, splits)), f"splits {splits} not increasing from {rng[0]}")
+expect(splits[-1] == rng[1], f"last split {splits[-1]} is not the range's far end {rng[1]}")
+expect(close(shadows["computed_for_aspect"], 16 / 9), "computed_for_aspect is not 16/9")
+manual = project["shadows"]["splits"]
+if project["shadows"]["split_mode"] == "manual" and all(rng[0] < x < rng[1] for x in manual):
+    expect(splits[:-1] == manual, f"manual splits {manual} inside the range became {splits[:-1]}")
+
+fog = ext["fog"]
+if project["fog"]["base_height"] is None:
+    expect(isinstance(fog["resolved_base_height"], (int, float)), "fog.resolved_base_height is not a number")
+else:
+    expect(fog["resolved_base_height"] == project["fog"]["base_height"], "fog.resolved_base_height differs")
+if project["fog"]["color"] is not None:
+    expect(fog["resolved_color"] == project["fog"]["color"], "fog.resolved_color differs")
+elif mean_sky is not None:
+    # 1 %: HDR decoders differ by half a mantissa step.
+    expect(all(close(x, y, 1e-2) for x, y in zip(fog["resolved_color"], mean_sky)),
+           f"fog.resolved_color {fog['resolved_color']} is not the sky's mean {mean_sky}")
+
+for message in errors:
+    print("FAIL:", message)
+sys.exit(1 if errors else 0)
+EOF
+}
+
+# validate SCENE_GLTF: zero errors, or skipped when the validator cannot be had.
+validate() {
+  "$validator" "$1" "$build" >"$work/validator.txt" 2>&1
+  rc=$?
+  [ $rc -eq 77 ] && { echo "note: glTF validator unavailable: $(tail -n 1 "$work/validator.txt")"; return 0; }
+  [ $rc -eq 0 ] || { cat "$work/validator.txt"; fail "glTF validator reported errors in $1"; }
+}
+
+# The embedded sample, edited with --set.
+sets=(--set shadows.cascades=3 --set fog.enabled=true --set fog.density=0.0001 --set sun.elevation_deg=12
+      --set bake.error_map_resolution=0)
+"$terralux" --print-project "${sets[@]}" >"$work/sample.json" || fail "--print-project exited $?"
+"$terralux" --bake --quiet --quality draft "${sets[@]}" --out "$work/sample" >/dev/null || fail "bake exited $?"
+# The default uniform sky (0.09, 0.11, 0.15) × 1 is its own mean.
+check "$work/sample.json" "$work/sample/scene.gltf" 3 0.09,0.11,0.15 || fail "sample: TERRALUX_lighting disagrees with --print-project"
+validate "$work/sample/scene.gltf"
+
+# A project file with a relative HDR sky: an 8 x 4 Radiance image of one radiance everywhere.
+mkdir -p "$work/project/skies"
+python3 - "$work/project/skies/even.hdr" <<'EOF' || fail "cannot write the test sky"
+import sys
+with open(sys.argv[1], "wb") as f:
+    f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4 +X 8\n")
+    f.write(bytes([200, 160, 128, 130]) * 32)  # flat scanlines (too short for run-length encoding)
+EOF
+cat >"$work/project/lit.terralux.json" <<'EOF'
+{
+  "sky": {"mode": "hdr", "hdr": "skies/even.hdr", "color": [1, 1, 1], "intensity": 0.5},
+  "shadows": {"cascades": 2, "split_mode": "manual", "splits": [9000]},
+  "fog": {"enabled": true, "base_height": 800, "color": null},
+  "camera": {"exposure_ev": 1.5},
+  "bake": {"error_map_resolution": 0}
+}
+EOF
+"$terralux" --print-project "$work/project/lit.terralux.json" --set sun.azimuth_deg=250 >"$work/lit.json" ||
+  fail "--print-project of the project file exited $?"
+(cd "$work" && "$terralux" --bake --quiet --quality draft project/lit.terralux.json --set sun.azimuth_deg=250 \
+  --out "$work/lit" >/dev/null) || fail "bake of the project file exited $?"
+grep -q '"hdr": "skies/even.hdr"' "$work/lit.json" || fail "--print-project rewrote the HDR path"
+# Radiance's RGBE: (mantissa + 0.5) × 2^(exponent − 136), then × intensity.
+mean=$(python3 -c 'print(",".join(str((m + 0.5) * 2.0 ** (130 - 136) * 0.5) for m in (200, 160, 128)))')
+check "$work/lit.json" "$work/lit/scene.gltf" 2 "$mean" || fail "project file: TERRALUX_lighting disagrees with --print-project"
+validate "$work/lit/scene.gltf"
+echo "ok"

@@ -1,0 +1,202 @@
+// The TERRALUX_lighting glTF extension: the authored sections as the project writes them, the sun
+// the bake lights with, the cascade splits of the project's camera, fog's resolved auto values,
+// and the extension's place in scene.gltf (used, never required).
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+#include <tiny_gltf.h>
+#include <unistd.h>
+
+#include "GltfExport.h"
+#include "Project.h"
+#include "SceneLighting.h"
+#include "render/ShadowCascades.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace terralux;
+
+namespace {
+
+// A hilly 40 × 30 terrain of 25 m cells between about 80 and 420 m.
+Heightfield makeTerrain() {
+    const int w = 40, d = 30;
+    std::vector<float> h(size_t(w) * size_t(d));
+    for (int r = 0; r < d; ++r)
+        for (int c = 0; c < w; ++c)
+            h[size_t(r) * size_t(w) + size_t(c)] =
+                float(250.0 + 120.0 * std::sin(0.21 * c) * std::cos(0.17 * r) + 2.0 * r);
+    return Heightfield(w, d, 25.0, 25.0, std::move(h));
+}
+
+// The default project with `--set`-style edits.
+Project projectWith(const std::vector<std::string>& sets) {
+    json doc = defaultProjectJson();
+    for (const auto& s : sets) applyOverride(doc, s);
+    Project p;
+    p.scene = sceneFromJson(doc, "--set", nullptr);
+    return p;
+}
+
+// A section less the keys the extension adds to it.
+json authoredPart(json section) {
+    for (auto it = section.begin(); it != section.end();)
+        it = it.key().starts_with("computed_") || it.key().starts_with("resolved_") ? section.erase(it)
+                                                                                     : std::next(it);
+    return section;
+}
+
+glm::vec3 vec3Of(const json& a) {
+    return {float(a.at(0).get<double>()), float(a.at(1).get<double>()), float(a.at(2).get<double>())};
+}
+
+const std::vector<std::string> kEdits = {"shadows.cascades=3", "fog.enabled=true", "fog.density=0.0001",
+                                         "sun.elevation_deg=12", "camera.exposure_ev=-1.5",
+                                         "sky.intensity=2"};
+
+}  // namespace
+
+TEST(LightingExtension, AuthoredSectionsAreTheProjectAsWritten) {
+    const Heightfield hf = makeTerrain();
+    const Project p = projectWith(kEdits);
+    const json ext = lightingExtension(p, hf);
+    const json printed = sceneToJson(p.scene);
+    for (const char* section : {"sky", "shadows", "fog"}) {
+        ASSERT_TRUE(ext.contains(section)) << section;
+        EXPECT_EQ(authoredPart(ext[section]), printed[section]) << section;
+    }
+    EXPECT_EQ(ext["shadows"]["cascades"], 3);
+    EXPECT_EQ(ext["fog"]["enabled"], true);
+    EXPECT_EQ(ext["exposure_ev"], printed["camera"]["exposure_ev"]);
+    EXPECT_EQ(ext["exposure_ev"].get<double>(), -1.5);
+    EXPECT_EQ(ext["sky"]["hdr"], "");
+}
+
+TEST(LightingExtension, TheSunIsTheOneTheBakeLightsWith) {
+    const Heightfield hf = makeTerrain();
+    const Project p = projectWith(kEdits);
+    const json sun = lightingExtension(p, hf)["sun"];
+    const json authored = sceneToJson(p.scene)["sun"];
+    EXPECT_EQ(sun["azimuth_deg"], authored["azimuth_deg"]);
+    EXPECT_EQ(sun["elevation_deg"], authored["elevation_deg"]);
+    EXPECT_EQ(sun["illuminance"], authored["illuminance"]);
+    // The shortest decimals of the renderer's floats are the authored ones again.
+    EXPECT_EQ(sun["color"], authored["color"]);
+    EXPECT_EQ(sun["angular_radius_deg"], authored["angular_radius_deg"]);
+    const glm::vec3 d = vec3Of(sun["direction"]);
+    EXPECT_EQ(d, sunDirection(135.0, 12.0));
+    EXPECT_NEAR(glm::length(d), 1.0f, 1e-6f);
+    EXPECT_GT(d.y, 0.0f);
+
+    // Whatever lights the bake is what is written, the authored angles beside it.
+    BakeLighting l = lightingOf(p);
+    l.sun.direction = sunDirection(200.0, 40.0);
+    l.sun.illuminance = glm::vec3(6.0f, 4.5f, 3.0f);
+    l.sun.angularRadius = 0.01f;
+    const json driven = lightingExtension(p, hf, l)["sun"];
+    EXPECT_EQ(vec3Of(driven["direction"]), l.sun.direction);
+    EXPECT_EQ(vec3Of(driven["color"]) * float(driven["illuminance"].get<double>()), l.sun.illuminance);
+    EXPECT_NEAR(driven["angular_radius_deg"].get<double>(), 0.01 * 180.0 / std::numbers::pi, 1e-6);
+    EXPECT_EQ(driven["elevation_deg"], authored["elevation_deg"]);
+    // An authored illuminance of 0 leaves the scale to the colour.
+    const json dark = lightingExtension(projectWith({"sun.illuminance=0"}), hf, l)["sun"];
+    EXPECT_EQ(dark["illuminance"].get<double>(), 1.0);
+    EXPECT_EQ(vec3Of(dark["color"]), l.sun.illuminance);
+}
+
+TEST(LightingExtension, ComputedSplitsAreTheProjectCamerasCascades) {
+    const Heightfield hf = makeTerrain();
+    const glm::vec3 lo(hf.minX(), hf.minHeight(), hf.minZ()), hi(hf.maxX(), hf.maxHeight(), hf.maxZ());
+    // Whole metres inside the default view's shadow range, for manual splits and max_distance.
+    const json whole = lightingExtension(projectWith({}), hf)["shadows"]["computed_range"];
+    const double nearest = whole[0].get<double>(), farthest = whole[1].get<double>();
+    auto inside = [&](double share) { return std::round(nearest + share * (farthest - nearest)); };
+    for (int cascades = 1; cascades <= 4; ++cascades) {
+        for (const std::string mode : {"practical", "manual", "max_distance"}) {
+            SCOPED_TRACE(mode + " " + std::to_string(cascades));
+            std::vector<std::string> sets = {"shadows.cascades=" + std::to_string(cascades)};
+            std::vector<double> manual;
+            if (mode == "manual" && cascades > 1) {
+                json splits = json::array();
+                for (int i = 1; i < cascades; ++i) splits.push_back(inside(0.2 * i));
+                manual = splits.get<std::vector<double>>();
+                sets.push_back("shadows.split_mode=manual");
+                sets.push_back("shadows.splits=" + splits.dump());
+            }
+            if (mode == "max_distance") sets.push_back("shadows.max_distance=" + json(inside(0.7)).dump());
+            const Project p = projectWith(sets);
+            const json shadows = lightingExtension(p, hf)["shadows"];
+            const json& splits = shadows["computed_splits"];
+            const json& range = shadows["computed_range"];
+            ASSERT_EQ(splits.size(), size_t(cascades));
+            ASSERT_EQ(range.size(), 2u);
+            EXPECT_LT(range[0].get<double>(), splits[0].get<double>());
+            for (size_t i = 1; i < splits.size(); ++i)
+                EXPECT_GT(splits[i].get<double>(), splits[i - 1].get<double>()) << i;
+            EXPECT_EQ(splits.back(), range[1]);
+            EXPECT_EQ(shadows["computed_for_aspect"].get<double>(), 16.0 / 9.0);
+
+            const CascadeRange expected = cascadeRange(
+                p.scene.shadows, OrbitCamera::fromSettings(p.scene.camera, hf), 16.0f / 9.0f, lo, hi);
+            EXPECT_EQ(splits, json(expected.ends));
+            EXPECT_EQ(range, json({expected.nearDistance, expected.farDistance}));
+            for (size_t i = 0; i < manual.size(); ++i) EXPECT_EQ(splits[i].get<double>(), manual[i]) << i;
+            if (mode == "max_distance") {
+                EXPECT_EQ(range[1].get<double>(), inside(0.7));
+            }
+        }
+    }
+}
+
+TEST(LightingExtension, FogResolvesItsAutoValues) {
+    const Heightfield hf = makeTerrain();
+    json fog = lightingExtension(projectWith(kEdits), hf)["fog"];
+    EXPECT_TRUE(fog["base_height"].is_null());
+    EXPECT_TRUE(fog["color"].is_null());
+    EXPECT_EQ(float(fog["resolved_base_height"].get<double>()), hf.minHeight());
+    // The mean radiance of the default uniform sky (0.09, 0.11, 0.15) × 2.
+    const glm::vec3 mean = vec3Of(fog["resolved_color"]);
+    EXPECT_NEAR(mean.r, 0.18f, 1e-5f);
+    EXPECT_NEAR(mean.g, 0.22f, 1e-5f);
+    EXPECT_NEAR(mean.b, 0.30f, 1e-5f);
+
+    fog = lightingExtension(projectWith({"fog.base_height=-12.5", "fog.color=0.1,0.2,0.3"}), hf)["fog"];
+    EXPECT_EQ(fog["resolved_base_height"], fog["base_height"]);
+    EXPECT_EQ(fog["resolved_base_height"].get<double>(), -12.5);
+    EXPECT_EQ(fog["resolved_color"], fog["color"]);
+    EXPECT_EQ(fog["resolved_color"], json({0.1, 0.2, 0.3}));
+}
+
+TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {
+    const fs::path dir = fs::temp_directory_path() / ("terralux_test_lighting_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const Heightfield hf = makeTerrain();
+    const Project p = projectWith(kEdits);
+    GltfSceneInput in;
+    in.heightfield = &hf;
+    in.lighting = lightingExtension(p, hf);
+    exportGltfScene(dir, in);
+
+    std::ifstream file(dir / "scene.gltf");
+    const json doc = json::parse(file);
+    const json& used = doc["extensionsUsed"];
+    EXPECT_NE(std::find(used.begin(), used.end(), "TERRALUX_lighting"), used.end());
+    EXPECT_FALSE(doc.contains("extensionsRequired"));
+    EXPECT_EQ(doc["extensions"]["TERRALUX_lighting"], in.lighting);
+
+    tinygltf::TinyGLTF loader;
+    tinygltf::Model model;
+    std::string err, warn;
+    EXPECT_TRUE(loader.LoadASCIIFromFile(&model, &err, &warn, (dir / "scene.gltf").string())) << err;
+    EXPECT_EQ(warn, "");
+    EXPECT_TRUE(model.extensionsRequired.empty());
+    EXPECT_TRUE(model.extensions.count("TERRALUX_lighting"));
+    fs::remove_all(dir);
+}
