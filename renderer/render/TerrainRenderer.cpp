@@ -604,6 +604,15 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         vkCmdSetScissor(c, 0, 1, &sc);
     };
     VkFramebuffer framebuffer = g.target->framebuffer.handle();
+    // A pass that draws on top of what the frame holds (sky, overlays).
+    const auto beginDrawing = [&g, framebuffer, w, h, setViewport](VkCommandBuffer c) {
+        VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+        rbi.renderPass = g.drawPass.handle();
+        rbi.framebuffer = framebuffer;
+        rbi.renderArea = {{0, 0}, {w, h}};
+        vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        setViewport(c, w, h);
+    };
 
     if (probes && probes->lightStale) {
         PassInfo info{"probe-vertices",
@@ -722,13 +731,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         if (fog) info.bindings.push_back("fog");
         const VkPipeline pipeline = skyPipeline.get();
         const VkDescriptorSet sets[] = {slot.view.handle(), slot.lights.handle()};
-        graph.addPass(std::move(info), [&g, pipeline, sets, w, h, framebuffer, setViewport](VkCommandBuffer c) {
-            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-            rbi.renderPass = g.drawPass.handle();
-            rbi.framebuffer = framebuffer;
-            rbi.renderArea = {{0, 0}, {w, h}};
-            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            setViewport(c, w, h);
+        graph.addPass(std::move(info), [&g, pipeline, sets, beginDrawing](VkCommandBuffer c) {
+            beginDrawing(c);
             vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
             vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
                                     sets, 0, nullptr);
@@ -750,14 +754,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             info.bindings.push_back(std::string("vertex:") + kMarkers);
         }
         const uint32_t leafCount = drawLeaves ? leafCount_ : 0, markerCount = drawMarkers ? markerCount_ : 0;
-        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, w, h, framebuffer,
-                                        setViewport](VkCommandBuffer c) {
-            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-            rbi.renderPass = g.drawPass.handle();
-            rbi.framebuffer = framebuffer;
-            rbi.renderArea = {{0, 0}, {w, h}};
-            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            setViewport(c, w, h);
+        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, beginDrawing](VkCommandBuffer c) {
+            beginDrawing(c);
             const VkDescriptorSet view = slot.view.handle(), overlay = slot.overlays.handle();
             vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
                                     TLX_SET_VIEW, 1, &view, 0, nullptr);

@@ -8,6 +8,7 @@
 
 #include "ParameterTable.h"
 #include "Project.h"
+#include "ProjectErrors.h"
 
 using namespace terralux;
 using nlohmann::json;
@@ -20,14 +21,7 @@ std::string concrete(const ParameterSpec& s) {
 }
 
 std::string errorFor(const std::string& path, const json& value, const json& base = defaultProjectJson()) {
-    json doc = base;
-    try {
-        applyOverride(doc, path + "=" + value.dump());
-        sceneFromJson(doc, "p.json", nullptr);
-    } catch (const ProjectError& e) {
-        return e.what();
-    }
-    return "";
+    return test::projectErrorFor(path, value, base);
 }
 
 }  // namespace

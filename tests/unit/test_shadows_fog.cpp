@@ -7,6 +7,7 @@
 
 #include "ParameterTable.h"
 #include "Project.h"
+#include "ProjectErrors.h"
 #include "render/ShadowCascades.h"
 
 namespace terralux::fogmath {
@@ -131,38 +132,24 @@ TEST(HeightFog, PhaseFunctionIsNormalisedAndForwardPeaked) {
     EXPECT_GT(fogmath::henyeyGreenstein(0.6f, 1.0f), fogmath::henyeyGreenstein(0.6f, -1.0f));
 }
 
-namespace {
-
-std::string errorFor(const std::string& path, const json& value, json doc = defaultProjectJson()) {
-    try {
-        applyOverride(doc, path + "=" + value.dump());
-        sceneFromJson(doc, "p.json", nullptr);
-    } catch (const ProjectError& e) {
-        return e.what();
-    }
-    return "";
-}
-
-}  // namespace
-
 TEST(ShadowSettingsFile, ManualSplitsAreValidated) {
     json manual = defaultProjectJson();
     manual["shadows"]["split_mode"] = "manual";
     manual["shadows"]["cascades"] = 3;
-    EXPECT_NE(errorFor("shadows.splits", nullptr, manual).find("must list 2 distances"), std::string::npos)
-        << errorFor("shadows.splits", nullptr, manual);
-    EXPECT_EQ(errorFor("shadows.splits", json{500, 2000}, manual), "");
-    const std::string decreasing = errorFor("shadows.splits", json{2000, 500}, manual);
+    EXPECT_NE(test::projectErrorFor("shadows.splits", nullptr, manual).find("must list 2 distances"), std::string::npos)
+        << test::projectErrorFor("shadows.splits", nullptr, manual);
+    EXPECT_EQ(test::projectErrorFor("shadows.splits", json{500, 2000}, manual), "");
+    const std::string decreasing = test::projectErrorFor("shadows.splits", json{2000, 500}, manual);
     EXPECT_NE(decreasing.find("shadows.splits[1]"), std::string::npos) << decreasing;
     EXPECT_NE(decreasing.find("strictly increasing"), std::string::npos) << decreasing;
-    const std::string count = errorFor("shadows.splits", json{500, 1000, 2000}, manual);
+    const std::string count = test::projectErrorFor("shadows.splits", json{500, 1000, 2000}, manual);
     EXPECT_NE(count.find("2"), std::string::npos) << count;
     manual["shadows"]["max_distance"] = 1500;
-    const std::string beyond = errorFor("shadows.splits", json{500, 2000}, manual);
+    const std::string beyond = test::projectErrorFor("shadows.splits", json{500, 2000}, manual);
     EXPECT_NE(beyond.find("max_distance"), std::string::npos) << beyond;
-    EXPECT_NE(errorFor("shadows.map_resolution", 256).find("[512, 4096]"), std::string::npos);
-    EXPECT_NE(errorFor("shadows.filter", "soft").find("pcss"), std::string::npos);
-    EXPECT_NE(errorFor("fog.anisotropy", 1.0).find("fog.anisotropy"), std::string::npos);
+    EXPECT_NE(test::projectErrorFor("shadows.map_resolution", 256).find("[512, 4096]"), std::string::npos);
+    EXPECT_NE(test::projectErrorFor("shadows.filter", "soft").find("pcss"), std::string::npos);
+    EXPECT_NE(test::projectErrorFor("fog.anisotropy", 1.0).find("fog.anisotropy"), std::string::npos);
 }
 
 TEST(ShadowSettingsFile, SectionsRoundTrip) {
