@@ -46,12 +46,14 @@ CascadeRange cascadeRange(const ShadowSettings& s, const OrbitCamera& camera, fl
     const float extent = std::max({hi.x - lo.x, hi.z - lo.z, hi.y - lo.y, 1.0f});
     const OrbitCamera::Planes planes = camera.planes(extent);
     (void)aspect;
-    // View depth of the terrain box: its corners bound the far end; the near end is the box's
-    // nearest point (the eye inside the box: the near plane).
-    double farthest = 0.0;
-    for (const glm::vec3& c : boxCorners(lo, hi)) farthest = std::max(farthest, double(glm::dot(c - eye, fwd)));
-    const glm::vec3 closest = glm::clamp(eye, lo, hi);
-    double nearest = glm::dot(closest - eye, fwd);
+    // View depth of the terrain box: its corners bound both ends (depth is linear, so a box's
+    // extremes are at corners); the near plane bounds the near end when the eye is inside.
+    double farthest = 0.0, nearest = INFINITY;
+    for (const glm::vec3& c : boxCorners(lo, hi)) {
+        const double d = glm::dot(c - eye, fwd);
+        farthest = std::max(farthest, d);
+        nearest = std::min(nearest, d);
+    }
     CascadeRange r;
     r.nearDistance = std::clamp(nearest, double(planes.nearPlane), double(planes.farPlane));
     r.farDistance = std::clamp(s.maxDistance ? *s.maxDistance : farthest, r.nearDistance + 1e-3,

@@ -25,7 +25,7 @@ struct CascadeRange {
     std::vector<double> ends;  // one per cascade, increasing; ends.back() == farDistance
 };
 
-// The shadow range of a camera over the terrain box: from the nearest terrain (at least the near
+// The shadow range of a camera over the terrain box: from the box's least view depth (at least the near
 // plane) to shadows.max_distance, or to the farthest terrain when unset; practical splits or the
 // manual ones (manual splits beyond the range are clamped into it, keeping their order).
 CascadeRange cascadeRange(const ShadowSettings& settings, const OrbitCamera& camera, float aspect,

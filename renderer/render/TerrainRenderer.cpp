@@ -227,7 +227,8 @@ bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullp
 
 void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
     Gpu& g = *gpu_;
-    if (g.shadows && g.shadows->resolution == resolution && g.shadows->cascades == cascades) return;
+    if (g.shadows ? g.shadows->resolution == resolution && g.shadows->cascades == cascades : resolution <= 0)
+        return;
     ctx_.waitIdle();  // frames in flight may still read the old maps
     g.graph.forget(kShadowMaps);
     for (FrameSlot& f : g.slots) f.shadowedLights = vk::DescriptorSet();
