@@ -224,7 +224,8 @@ void ProjectDocument::apply(const std::string& path, const nlohmann::json& value
 }
 
 void ProjectDocument::setCameraQuietly(const nlohmann::json& camera) {
-    json_["camera"] = camera;
+    // Merged, so that settings the viewport does not move (exposure) stay.
+    json_["camera"].update(camera);
     project_.scene = sceneFromJson(json_, "project", nullptr);
     dirtyOutsideUndo_ = true;
     emit fileChanged();

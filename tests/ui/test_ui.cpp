@@ -606,6 +606,19 @@ private slots:
         QTRY_VERIFY_WITH_TIMEOUT(w_->previewsStarted() == previews + 1, 5000);
     }
 
+    // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).
+    void cameraMovesKeepTheExposure() {
+        auto* exposure = w_->findChild<QDoubleSpinBox*>("param.camera.exposure_ev");
+        QVERIFY(exposure);
+        exposure->setValue(1.5);
+        QCOMPARE(w_->document()->project().scene.camera.exposureEv, 1.5);
+        const double azimuth = w_->document()->project().scene.camera.azimuthDeg;
+        QTest::keyClick(w_->viewport(), Qt::Key_Left);
+        QVERIFY(w_->document()->project().scene.camera.azimuthDeg != azimuth);
+        QCOMPARE(w_->document()->project().scene.camera.exposureEv, 1.5);
+        QCOMPARE(exposure->value(), 1.5);
+    }
+
     // The shadow, cascade and fog views after edits in the docks are the command line's images.
     void shadowAndFogViewsMatchTheRenderCommand() {
         w_->findChild<QComboBox*>("param.shadows.split_mode")->setCurrentText("manual");
