@@ -796,6 +796,8 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 void MainWindow::rebuildRenderer() {
     previewCancel_ = true;
     if (previewWorker_.joinable()) previewWorker_.join();
+    // A preview that finished for the terrain before may still be queued: it must not land.
+    ++previewGeneration_;
     viewport_->setRenderer(nullptr);
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain());
     viewport_->setCamera(renderer_->defaultCamera());
