@@ -387,7 +387,9 @@ private slots:
         const fs::path dir = kOut / "stale";
         fs::remove_all(dir);
         fs::create_directories(dir);
-        Project p = loadEffectiveProject("", {"bake.quality=draft", "bake.error_map_resolution=0"}, "", nullptr);
+        // The bake beside the project: an untitled project's relative out_dir is the launch folder.
+        Project p = loadEffectiveProject("", {"bake.quality=draft", "bake.error_map_resolution=0",
+                                              "export.out_dir=" + (dir / "bake").string()}, "", nullptr);
         const fs::path file = dir / "p.terralux.json";
         saveProject(p, file);
         BakeRequest bake;
