@@ -30,6 +30,7 @@
 #include <QScrollArea>
 #include <QScrollBar>
 #include <QSettings>
+#include <QSignalBlocker>
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QStyleOptionTab>
@@ -38,6 +39,7 @@
 #include <QToolBar>
 #include <QVBoxLayout>
 
+#include "CascadeSplitChart.h"
 #include "DemImport.h"
 #include "ParameterPanels.h"
 #include "ParameterTable.h"
@@ -180,6 +182,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
         frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
     });
+    // The practical cascade splits the Shadows dock shows and writes depend on the view's shape.
+    auto updateAspect = [this] {
+        if (viewport_->width() > 0 && viewport_->height() > 0)
+            doc_->setViewAspect(double(viewport_->width()) / double(viewport_->height()));
+    };
+    connect(viewport_, &QWindow::widthChanged, this, updateAspect);
+    connect(viewport_, &QWindow::heightChanged, this, updateAspect);
     connect(viewport_, &ViewportWindow::cameraChanged, this, [this] {
         const OrbitCamera& c = viewport_->camera();
         doc_->setCameraQuietly({{"target", {c.target.x, c.target.y, c.target.z}},
@@ -295,6 +304,41 @@ void MainWindow::buildDocks() {
     connectRejected(sky);
     auto* skyDock = dock("Sun & Sky", "dock.sunSky", sky);
 
+    // Shadows: the table's rows with the cascade splits over the view below the split rows, and
+    // the cascade view.
+    auto* shadows = new QWidget;
+    auto* sv = new QVBoxLayout(shadows);
+    auto* sf = new ParameterForm(doc_);
+    auto* chartBox = new QWidget;
+    auto* cv = new QVBoxLayout(chartBox);
+    cv->setContentsMargins(0, 4, 0, 4);
+    cv->addWidget(new QLabel("Cascade splits, distance from the camera:"));
+    auto* chart = new CascadeSplitChart(doc_);
+    cv->addWidget(chart);
+    for (const auto& spec : parameterTable()) {
+        if (!spec.uiRow || spec.path.rfind("shadows.", 0) != 0) continue;
+        sf->addParameter(spec.path);
+        if (spec.path == "shadows.splits") sf->addWidget(chartBox);
+    }
+    connectRejected(sf);
+    connectRejected(chart);
+    sv->addWidget(sf);
+    showCascades_ = new QPushButton("Show cascades");
+    showCascades_->setObjectName("shadows.showCascades");
+    showCascades_->setCheckable(true);
+    showCascades_->setToolTip("Shows debug view 34 (each cascade in its colour of the chart); unchecked, "
+                              "the view shown before");
+    sv->addWidget(showCascades_);
+    sv->addStretch(1);
+    auto* shadowsDock = dock("Shadows", "dock.shadows", shadows);
+
+    // Atmosphere: height fog and the exposure of the whole image.
+    auto* atmosphere = new ParameterForm(doc_);
+    atmosphere->addParameters("fog.");
+    atmosphere->addParameter("camera.exposure_ev");
+    connectRejected(atmosphere);
+    auto* atmosphereDock = dock("Atmosphere", "dock.atmosphere", atmosphere);
+
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
@@ -354,8 +398,11 @@ void MainWindow::buildDocks() {
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
     auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
 
-    for (auto* f : {tf, sky, bf}) f->refresh();
+    for (auto* f : {tf, sky, sf, atmosphere, bf}) f->refresh();
+    // The lighting docks share the upper tab group with the terrain.
     tabifyDockWidget(terrainDock, skyDock);
+    tabifyDockWidget(skyDock, shadowsDock);
+    tabifyDockWidget(shadowsDock, atmosphereDock);
     tabifyDockWidget(volumesDock, bakeDock);
     terrainDock->raise();
     volumesDock->raise();
@@ -398,6 +445,17 @@ void MainWindow::buildDocks() {
                             : QString());
     });
     connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);
+    // Show cascades switches to the cascade view and back to the view before it; it follows the
+    // selector when the view changes anywhere else.
+    connect(showCascades_, &QPushButton::toggled, this, [this](bool on) {
+        viewSelector_->setCurrentIndex(viewSelector_->findData(on ? kViewCascades : viewBeforeCascades_));
+    });
+    connect(viewSelector_, &QComboBox::currentIndexChanged, this, [this](int i) {
+        const int view = viewSelector_->itemData(i).toInt();
+        if (view != kViewCascades) viewBeforeCascades_ = view;
+        QSignalBlocker block(showCascades_);
+        showCascades_->setChecked(view == kViewCascades);
+    });
 
     frameLabel_ = new QLabel;
     frameLabel_->setObjectName("status.frame");
@@ -738,6 +796,8 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 void MainWindow::rebuildRenderer() {
     previewCancel_ = true;
     if (previewWorker_.joinable()) previewWorker_.join();
+    // A preview that finished for the terrain before may still be queued: it must not land.
+    ++previewGeneration_;
     viewport_->setRenderer(nullptr);
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain());
     viewport_->setCamera(renderer_->defaultCamera());
@@ -771,6 +831,7 @@ void MainWindow::startPreview() {
     previewCancel_ = true;
     if (previewWorker_.joinable()) previewWorker_.join();
     previewCancel_ = false;
+    ++previewsStarted_;
     const unsigned generation = ++previewGeneration_;
     const Project project = doc_->project();
     auto terrain = doc_->terrainShared();

@@ -49,6 +49,8 @@ public:
     const QString& probeSource() const { return probeSource_; }
     // Probes the viewport lights with now (the bound preview or bake).
     size_t boundProbeCount() const;
+    // Draft previews started so far: edits that change no probes start none.
+    unsigned previewsStarted() const { return previewsStarted_; }
     // The absolute folder Bake writes: export.out_dir, relative to the project file. None for an
     // untitled project with a relative out_dir (Bake asks to save it or for a folder).
     std::optional<std::filesystem::path> bakeFolder() const;
@@ -104,6 +106,8 @@ private:
     BakeController* bake_;
     QComboBox* viewSelector_ = nullptr;
     QCheckBox* probeToggle_ = nullptr;
+    QPushButton* showCascades_ = nullptr;
+    int viewBeforeCascades_ = 0;  // the view Show cascades goes back to
     QLabel* estimate_ = nullptr;
     QLabel* eta_ = nullptr;
     QLabel* frameLabel_ = nullptr;
@@ -125,6 +129,7 @@ private:
     std::thread previewWorker_;
     std::atomic<bool> previewCancel_{false};
     unsigned previewGeneration_ = 0;
+    unsigned previewsStarted_ = 0;
     QString probeSource_;
 };
 

@@ -63,6 +63,8 @@ void ParameterForm::showEvent(QShowEvent* e) {
 
 void ParameterForm::addWidget(const QString& label, QWidget* w) { form_->addRow(label, w); }
 
+void ParameterForm::addWidget(QWidget* w) { form_->addRow(w); }
+
 void ParameterForm::addParameters(const std::string& prefix) {
     for (const auto& spec : parameterTable())
         if (spec.uiRow && spec.path.rfind(prefix, 0) == 0) addParameter(spec.path);

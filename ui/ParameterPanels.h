@@ -35,6 +35,8 @@ public:
     // Every UI row of the table whose path starts with `prefix`, in table order.
     void addParameters(const std::string& prefix);
     void addWidget(const QString& label, QWidget* w);
+    // A row of its own across the label and field columns.
+    void addWidget(QWidget* w);
 
     void refresh();
     // Marks the rows a placement error names (by their path below the volume, e.g.

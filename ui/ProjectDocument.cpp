@@ -150,15 +150,16 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
     try {
         nlohmann::json next = json_;
         applyOverride(next, path + "=" + value.dump());
+        const std::string edited = fitSplits(path, next) ? std::string("shadows") : path;
         Project candidate = project_;
         candidate.scene = sceneFromJson(next, "project", nullptr);
-        const nlohmann::json before = at(json_, path);
-        if (before == at(next, path)) return true;
-        if (touchesTerrain(path)) {
-            startTerrainEdit(path, before, at(next, path), candidate);
+        const nlohmann::json before = at(json_, edited);
+        if (before == at(next, edited)) return true;
+        if (touchesTerrain(edited)) {
+            startTerrainEdit(edited, before, at(next, edited), candidate);
             return true;
         }
-        undo_.push(new SetParameterCommand(this, path, before, at(next, path)));
+        undo_.push(new SetParameterCommand(this, edited, before, at(next, edited)));
         return true;
     } catch (const std::exception& e) {
         if (error) *error = QString::fromStdString(e.what());
@@ -223,10 +224,51 @@ void ProjectDocument::apply(const std::string& path, const nlohmann::json& value
 }
 
 void ProjectDocument::setCameraQuietly(const nlohmann::json& camera) {
-    json_["camera"] = camera;
+    // Merged, so that settings the viewport does not move (exposure) stay.
+    json_["camera"].update(camera);
     project_.scene = sceneFromJson(json_, "project", nullptr);
     dirtyOutsideUndo_ = true;
     emit fileChanged();
+    emit viewChanged();
+}
+
+void ProjectDocument::setViewAspect(double aspect) {
+    if (!(aspect > 0.0) || aspect == viewAspect_) return;
+    viewAspect_ = aspect;
+    emit viewChanged();
+}
+
+CascadeRange ProjectDocument::shadowRange(const ShadowSettings& shadows) const {
+    const Heightfield& hf = terrain_->heightfield;
+    const glm::vec3 lo(hf.minX(), hf.minHeight(), hf.minZ()), hi(hf.maxX(), hf.maxHeight(), hf.maxZ());
+    return cascadeRange(shadows, OrbitCamera::fromSettings(project_.scene.camera, hf), float(viewAspect_), lo, hi);
+}
+
+bool ProjectDocument::fitSplits(const std::string& path, nlohmann::json& next) const {
+    if (path != "shadows.split_mode" && path != "shadows.cascades" && path != "shadows.max_distance") return false;
+    nlohmann::json& shadows = next["shadows"];
+    if (shadows.value("split_mode", "") != "manual") return false;
+    // The section as practical mode reads it, for the count, the distance and the practical splits;
+    // a value it rejects stays rejected by the edit itself.
+    nlohmann::json practical = next;
+    practical["shadows"]["split_mode"] = "practical";
+    practical["shadows"]["splits"] = nullptr;
+    ShadowSettings s;
+    try {
+        s = sceneFromJson(practical, "project", nullptr).shadows;
+    } catch (const std::exception&) {
+        return false;
+    }
+    if (s.cascades < 2) return false;
+    const nlohmann::json& authored = shadows["splits"];
+    std::vector<double> current;
+    if (authored.is_array())
+        for (const auto& d : authored)
+            if (d.is_number()) current.push_back(d.get<double>());
+    const std::vector<double> fitted = fitManualSplits(current, s.cascades, shadowRange(s), s.maxDistance);
+    if (fitted == current) return false;
+    shadows["splits"] = fitted;
+    return true;
 }
 
 bool ProjectDocument::importDem(const QString& file, QString* error) {

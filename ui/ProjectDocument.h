@@ -15,6 +15,7 @@
 
 #include "DemImport.h"
 #include "Project.h"
+#include "render/ShadowCascades.h"
 
 namespace terralux {
 
@@ -36,12 +37,24 @@ public:
     // changes and `error` gets the one-line message. An edit of the terrain's DEM, scale or
     // resolution imports the DEM once, on a worker (terrainLoading); the edit lands when the
     // import succeeds, and terrainEditFailed says why when it does not (nothing changes then).
+    // In manual split mode, an edit of shadows.split_mode, shadows.cascades or
+    // shadows.max_distance that the authored splits no longer fit also writes fitted splits
+    // (fitManualSplits, filled from the practical splits of the current view): one edit of the
+    // whole shadows section.
     bool setParameter(const std::string& path, const nlohmann::json& value, QString* error);
     bool terrainLoading() const { return loadGeneration_ != landedGeneration_; }
     // Blocks (processing events) until no terrain import is running; for tests and shutdown.
     void waitForTerrain();
     // Camera moves from the viewport: stored, marked as unsaved, not undoable (like a view).
     void setCameraQuietly(const nlohmann::json& camera);
+    // The viewport's width / height (16/9 until it has a size): the practical cascade splits
+    // depend on it.
+    void setViewAspect(double aspect);
+    double viewAspect() const { return viewAspect_; }
+    // The cascades of `shadows` over the project camera's view of the terrain at the view aspect,
+    // as the viewport draws them.
+    CascadeRange shadowRange(const ShadowSettings& shadows) const;
+    CascadeRange shadowRange() const { return shadowRange(project_.scene.shadows); }
 
     void newProject();
     // Reads and checks the project file at once (a bad file fails here and nothing changes), then
@@ -66,6 +79,8 @@ signals:
     void terrainEditFailed(const QString& message);
     void fileChanged();
     void projectOpened(const QString& file);
+    // The camera moved or the view's aspect changed (neither is an undoable edit).
+    void viewChanged();
 
 public:
     ~ProjectDocument() override;
@@ -77,11 +92,14 @@ private:
     // newer load was started meanwhile.
     void startTerrainLoad(Project candidate, std::function<void(std::shared_ptr<DemImportResult>)> land);
     void reset(const Project& project, std::shared_ptr<DemImportResult> terrain);
+    // setParameter's companion edit of shadows.splits: whether it changed `next`.
+    bool fitSplits(const std::string& path, nlohmann::json& next) const;
     Project project_;
     nlohmann::json json_;
     std::shared_ptr<DemImportResult> terrain_;
     QUndoStack undo_;
     bool dirtyOutsideUndo_ = false;
+    double viewAspect_ = 16.0 / 9.0;
     std::thread loader_;
     unsigned loadGeneration_ = 0, landedGeneration_ = 0;
 };

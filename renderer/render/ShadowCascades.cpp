@@ -73,6 +73,38 @@ CascadeRange cascadeRange(const ShadowSettings& s, const OrbitCamera& camera, fl
     return r;
 }
 
+std::vector<double> fitManualSplits(const std::vector<double>& authored, int cascades,
+                                    const CascadeRange& practical, std::optional<double> maxDistance) {
+    const size_t n = size_t(std::clamp(cascades, 1, 4) - 1);
+    const double limit = maxDistance ? *maxDistance : INFINITY;
+    std::vector<double> out;
+    for (double d : authored) {
+        if (out.size() == n || !(d > (out.empty() ? 0.0 : out.back())) || !(d < limit)) break;
+        out.push_back(d);
+    }
+    const size_t kept = out.size();
+    for (size_t i = 0; i + 1 < practical.ends.size() && out.size() < n; ++i) {
+        const double d = practical.ends[i];
+        if (d > (out.empty() ? 0.0 : out.back()) && d < limit) out.push_back(d);
+    }
+    if (out.size() < n) {
+        // Authored splits beyond the practical ones: share what is left of the range evenly.
+        const double from = out.empty() ? practical.nearDistance : out.back();
+        double to = std::min(practical.farDistance, limit);
+        if (!(to > from)) to = std::isfinite(limit) ? limit : 2.0 * from + 1.0;
+        const size_t missing = n - out.size();
+        for (size_t k = 1; k <= missing; ++k) out.push_back(from + (to - from) * double(k) / double(missing + 1));
+    }
+    // The dock edits splits in whole metres: added ones start there unless rounding would
+    // reorder them or reach the end of the range.
+    for (size_t i = kept; i < out.size(); ++i) {
+        const double r = std::round(out[i]);
+        const double next = i + 1 < out.size() ? out[i + 1] : std::min(limit, practical.farDistance);
+        if (r > (i ? out[i - 1] : 0.0) && r < next) out[i] = r;
+    }
+    return out;
+}
+
 std::vector<Cascade> fitCascades(const CascadeRange& range, const OrbitCamera& camera, float aspect,
                                  const glm::vec3& sunDirection, int resolution, const glm::vec3& lo,
                                  const glm::vec3& hi) {

@@ -3,6 +3,7 @@
 // view, and each cascade's light projection. Plain maths, no Vulkan: the renderer draws with it
 // and the exporters write the split distances an engine needs.
 
+#include <optional>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -30,6 +31,14 @@ struct CascadeRange {
 // manual ones (manual splits beyond the range are clamped into it, keeping their order).
 CascadeRange cascadeRange(const ShadowSettings& settings, const OrbitCamera& camera, float aspect,
                           const glm::vec3& boundsMin, const glm::vec3& boundsMax);
+
+// Manual split distances for `cascades` cascades (cascades − 1 of them) where the authored ones no
+// longer fit (a switch to manual mode, another cascade count, a shorter shadow distance): the
+// leading `authored` distances that still fit (positive, strictly increasing, below
+// `maxDistance`), then the inner ends of `practical` beyond them, then even steps to its far end.
+// The distances it adds are whole metres where rounding keeps that order.
+std::vector<double> fitManualSplits(const std::vector<double>& authored, int cascades,
+                                    const CascadeRange& practical, std::optional<double> maxDistance);
 
 struct Cascade {
     glm::mat4 lightViewProj{1.0f};  // world to the map's clip space (x, y in [−1, 1], z in [0, 1])

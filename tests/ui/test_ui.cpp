@@ -22,10 +22,12 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QScreen>
+#include <QSignalSpy>
 #include <QSpinBox>
 #include <QTimer>
 #include <QtTest>
 
+#include "CascadeSplitChart.h"
 #include "ImageCompare.h"
 #include "MainWindow.h"
 #include "ParameterPanels.h"
@@ -35,6 +37,7 @@
 #include "RenderJob.h"
 #include "TerrainLoading.h"
 #include "render/DebugViews.h"
+#include "render/ShadowCascades.h"
 
 using namespace terralux;
 namespace fs = std::filesystem;
@@ -384,7 +387,9 @@ private slots:
         const fs::path dir = kOut / "stale";
         fs::remove_all(dir);
         fs::create_directories(dir);
-        Project p = loadEffectiveProject("", {"bake.quality=draft", "bake.error_map_resolution=0"}, "", nullptr);
+        // The bake beside the project: an untitled project's relative out_dir is the launch folder.
+        Project p = loadEffectiveProject("", {"bake.quality=draft", "bake.error_map_resolution=0",
+                                              "export.out_dir=" + (dir / "bake").string()}, "", nullptr);
         const fs::path file = dir / "p.terralux.json";
         saveProject(p, file);
         BakeRequest bake;
@@ -511,13 +516,279 @@ private slots:
     }
 
 
+    // The Shadows and Atmosphere docks hold an editor for every row of their sections, shown
+    // where the scene reads it.
+    void shadowAndAtmosphereDocksHoldTheirRows() {
+        for (const QString& name : {QString("dock.shadows"), QString("dock.atmosphere")}) {
+            auto* dock = w_->findChild<QDockWidget*>(name);
+            QVERIFY2(dock, qPrintable(name));
+            dock->raise();
+            int rows = 0;
+            for (const ParameterSpec& spec : parameterTable()) {
+                if (!spec.uiRow || QString::fromStdString(parameterDock(spec).objectName) != name) continue;
+                const QString editorName = QString::fromStdString(uiObjectName(spec));
+                QWidget* editor = dock->findChild<QWidget*>(editorName);
+                if (!editor) editor = dock->findChild<QWidget*>(editorName + ".0");
+                QVERIFY2(editor, qPrintable(name + ": " + editorName));
+                QCOMPARE(rowOf(editor)->isVisibleTo(dock), spec.isRead(w_->document()->project().scene, 0));
+                ++rows;
+            }
+            QVERIFY(rows >= 8);
+        }
+        QCOMPARE(w_->findChild<QDockWidget*>("dock.shadows")->windowTitle(), QString("Shadows"));
+        QCOMPARE(w_->findChild<QDockWidget*>("dock.atmosphere")->windowTitle(), QString("Atmosphere"));
+        QVERIFY(w_->findChild<QDockWidget*>("dock.atmosphere")->findChild<QDoubleSpinBox*>("param.camera.exposure_ev"));
+        QVERIFY(w_->findChild<QDockWidget*>("dock.shadows")->findChild<CascadeSplitChart*>("shadows.splitChart"));
+        QVERIFY(w_->findChild<QDockWidget*>("dock.shadows")->findChild<QPushButton*>("shadows.showCascades"));
+        // Manual mode shows the split row, and the fog rows follow fog.enabled.
+        w_->findChild<QComboBox*>("param.shadows.split_mode")->setCurrentText("manual");
+        auto* shadowsDock = w_->findChild<QDockWidget*>("dock.shadows");
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.shadows.splits.0"))->isVisibleTo(shadowsDock));
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.shadows.split_lambda"))->isVisibleTo(shadowsDock));
+        w_->findChild<QCheckBox*>("param.fog.enabled")->setChecked(false);
+        auto* atmosphereDock = w_->findChild<QDockWidget*>("dock.atmosphere");
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.fog.density"))->isVisibleTo(atmosphereDock));
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.camera.exposure_ev"))->isVisibleTo(atmosphereDock));
+    }
 
+    // Shadow, fog and exposure edits draw the next frame with the new value and bake nothing; undo
+    // gives the same pixels back. A sky edit, by contrast, bakes the preview again.
+    void shadowAndFogEditsRedrawWithoutBaking() {
+        QApplication::setActiveWindow(w_.get());
+        QVERIFY(QTest::qWaitForWindowActive(w_.get()));
+        w_->viewport()->renderNow();
+        const RenderedImage before = w_->viewport()->grabImage();
+        const unsigned previews = w_->previewsStarted();
+        QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
+        auto check = [&](QWidget* editor, const char* dock, const std::function<void()>& edit, const char* what) {
+            w_->findChild<QDockWidget*>(dock)->raise();
+            frames.clear();
+            const int steps = w_->document()->undoStack()->index();
+            edit();
+            QCOMPARE(w_->document()->undoStack()->index(), steps + 1);
+            // The edit asked for a frame, and that frame draws the new value.
+            QVERIFY2(frames.wait(2000) || !frames.isEmpty(), what);
+            const RenderedImage edited = w_->viewport()->grabImage();
+            const auto d = test::compareImages(edited.rgba, before.rgba, before.width, before.height);
+            QVERIFY2(d.maxAbs > 8.0 / 255.0, qPrintable(QString("%1 changed the image by %2").arg(what).arg(d.maxAbs)));
+            // Ctrl+Z from the dock's own editor reaches the document.
+            editor->setFocus();
+            QTest::keySequence(editor, QKeySequence::Undo);
+            QCOMPARE(w_->document()->undoStack()->index(), steps);
+            const RenderedImage undone = w_->viewport()->grabImage();
+            QVERIFY2(undone.rgba == before.rgba, qPrintable(QString("undo of %1 is not the same image").arg(what)));
+        };
+        auto* shadowsOn = w_->findChild<QCheckBox*>("param.shadows.enabled");
+        QVERIFY(shadowsOn && shadowsOn->isChecked());
+        check(shadowsOn, "dock.shadows", [&] { shadowsOn->setChecked(false); }, "shadows off");
+        QVERIFY(w_->document()->project().scene.shadows.enabled);
+        auto* fogOn = w_->findChild<QCheckBox*>("param.fog.enabled");
+        QVERIFY(fogOn && fogOn->isChecked());
+        check(fogOn, "dock.atmosphere", [&] { fogOn->setChecked(false); }, "fog off");
+        auto* density = w_->findChild<QDoubleSpinBox*>("param.fog.density");
+        QVERIFY(density);
+        check(density, "dock.atmosphere", [&] { density->setValue(density->value() * 20.0); }, "fog density");
+        auto* exposure = w_->findChild<QDoubleSpinBox*>("param.camera.exposure_ev");
+        QVERIFY(exposure);
+        check(exposure, "dock.atmosphere", [&] { exposure->setValue(1.0); }, "exposure");
+        auto* filter = w_->findChild<QComboBox*>("param.shadows.filter");
+        QVERIFY(filter);
+        check(filter, "dock.shadows", [&] { filter->setCurrentText("hard"); }, "shadow filter");
+        // An edit of the whole section (manual mode with its splits) is no different.
+        w_->findChild<QComboBox*>("param.shadows.split_mode")->setCurrentText("manual");
+        QCOMPARE(w_->document()->project().scene.shadows.splitMode, SplitMode::Manual);
+        // Past the preview's debounce: no preview and no bake started, the preview still bound.
+        QTest::qWait(400);
+        QCOMPARE(w_->previewsStarted(), previews);
+        QVERIFY(!w_->bakes()->running());
+        QCOMPARE(w_->probeSource(), QString("draft preview"));
 
+        QString error;
+        QVERIFY(w_->document()->setParameter("sky.intensity", 2.0, &error));
+        QTRY_VERIFY_WITH_TIMEOUT(w_->previewsStarted() == previews + 1, 5000);
+    }
 
+    // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).
+    void cameraMovesKeepTheExposure() {
+        auto* exposure = w_->findChild<QDoubleSpinBox*>("param.camera.exposure_ev");
+        QVERIFY(exposure);
+        exposure->setValue(1.5);
+        QCOMPARE(w_->document()->project().scene.camera.exposureEv, 1.5);
+        const double azimuth = w_->document()->project().scene.camera.azimuthDeg;
+        QTest::keyClick(w_->viewport(), Qt::Key_Left);
+        QVERIFY(w_->document()->project().scene.camera.azimuthDeg != azimuth);
+        QCOMPARE(w_->document()->project().scene.camera.exposureEv, 1.5);
+        QCOMPARE(exposure->value(), 1.5);
+    }
 
+    // The shadow, cascade and fog views after edits in the docks are the command line's images.
+    void shadowAndFogViewsMatchTheRenderCommand() {
+        w_->findChild<QComboBox*>("param.shadows.split_mode")->setCurrentText("manual");
+        QVERIFY(w_->document()->value("shadows.splits").is_array());
+        w_->findChild<QSpinBox*>("param.shadows.cascades")->setValue(3);
+        w_->findChild<QComboBox*>("param.shadows.filter")->setCurrentText("pcf");
+        auto* density = w_->findChild<QDoubleSpinBox*>("param.fog.density");
+        density->setValue(density->value() * 10.0);
+        // Probe lighting off on both sides: the reference has no bake to light with.
+        w_->findChild<QCheckBox*>("viewport.probes")->setChecked(false);
+        vk::VulkanContext ctx;
+        ProjectRenderer reference(ctx, w_->document()->project());
+        auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
+        for (const int view : {kViewShadow, kViewCascades, kViewFog}) {
+            selector->setCurrentIndex(selector->findData(view));
+            w_->viewport()->renderNow();
+            const RenderedImage shown = w_->viewport()->grabImage();
+            RenderRequest q;
+            q.width = shown.width;
+            q.height = shown.height;
+            q.debugView = view;
+            q.probes = false;
+            const RenderedImage cli = reference.render(q, w_->viewport()->camera());
+            const auto d = test::compareImages(shown.rgba, cli.rgba, shown.width, shown.height);
+            QVERIFY2(d.maxAbs <= 1.0 / 255.0, qPrintable(selector->currentText() + QString(": max diff %1").arg(d.maxAbs)));
+        }
+    }
 
+    // The split chart: switching to manual writes the practical splits, a drag moves one split in
+    // one undoable edit, a new cascade count resamples the splits; Show cascades toggles view 34.
+    void splitChartEditsTheSplits() {
+        ProjectDocument& doc = *w_->document();
+        w_->findChild<QDockWidget*>("dock.shadows")->raise();
+        auto* chart = w_->findChild<CascadeSplitChart*>("shadows.splitChart");
+        QVERIFY(chart);
+        QTRY_VERIFY(chart->isVisible());
+        QUndoStack& undo = *doc.undoStack();
+        const int start = undo.index();
+        const ShadowSettings practical = doc.project().scene.shadows;
+        QCOMPARE(practical.splitMode, SplitMode::Practical);
+        QVERIFY(doc.value("shadows.splits").is_null());
+        // The chart spans the renderer's range: the project camera at the viewport's aspect.
+        QCOMPARE(doc.viewAspect(), double(w_->viewport()->width()) / w_->viewport()->height());
+        const CascadeRange drawn = chart->range();
+        {
+            const Heightfield& hf = doc.terrain().heightfield;
+            const CascadeRange expected = cascadeRange(practical, OrbitCamera::fromSettings(doc.project().scene.camera, hf),
+                                                       float(doc.viewAspect()), {hf.minX(), hf.minHeight(), hf.minZ()},
+                                                       {hf.maxX(), hf.maxHeight(), hf.maxZ()});
+            QCOMPARE(drawn.ends, expected.ends);
+            QCOMPARE(drawn.nearDistance, expected.nearDistance);
+            QCOMPARE(drawn.ends.size(), size_t(4));
+        }
 
+        // Practical mode: the handles do not move, and say why.
+        QVERIFY(chart->toolTip().contains("manual"));
+        const QPoint h1 = chart->handlePosition(1);
+        QTest::mousePress(chart, Qt::LeftButton, {}, h1);
+        QTest::mouseMove(chart, h1 + QPoint(40, 0));
+        QTest::mouseRelease(chart, Qt::LeftButton, {}, h1 + QPoint(40, 0));
+        QCOMPARE(undo.index(), start);
 
+        // Switching to manual writes the practical inner ends with it: one edit, nothing rejected.
+        auto* mode = w_->findChild<QComboBox*>("param.shadows.split_mode");
+        mode->setCurrentText("manual");
+        QCOMPARE(undo.index(), start + 1);
+        QCOMPARE(doc.project().scene.shadows.splitMode, SplitMode::Manual);
+        const nlohmann::json written = doc.value("shadows.splits");
+        QVERIFY2(written.is_array() && written.size() == 3, written.dump().c_str());
+        for (size_t i = 0; i < 3; ++i)
+            QVERIFY2(std::abs(written[i].get<double>() - drawn.ends[i]) <= 0.5, written.dump().c_str());
+        QCOMPARE(w_->findChild<QDoubleSpinBox*>("param.shadows.splits.0")->value(), written[0].get<double>());
+        QVERIFY(chart->toolTip().contains("Drag"));
+        undo.undo();
+        QCOMPARE(doc.project().scene.shadows.splitMode, SplitMode::Practical);
+        QVERIFY(doc.value("shadows.splits").is_null());
+        QCOMPARE(mode->currentText(), QString("practical"));
+        undo.redo();
+        QCOMPARE(doc.value("shadows.splits"), written);
+
+        // A drag of the middle handle: the chart follows the mouse, the release is one edit.
+        const std::vector<double> splits = *doc.project().scene.shadows.splits;
+        const QPoint from = chart->handlePosition(1);
+        const QPoint to = from + QPoint(25, 0);
+        QTest::mousePress(chart, Qt::LeftButton, {}, from);
+        QTest::mouseMove(chart, from + QPoint(10, 0));
+        QTest::mouseMove(chart, to);
+        QVERIFY(chart->range().ends[1] > splits[1]);  // live in the chart
+        QCOMPARE(doc.project().scene.shadows.splits->at(1), splits[1]);  // not yet in the document
+        QTest::mouseRelease(chart, Qt::LeftButton, {}, to);
+        QCOMPARE(undo.index(), start + 2);
+        std::vector<double> dragged = *doc.project().scene.shadows.splits;
+        QCOMPARE(dragged[0], splits[0]);
+        QCOMPARE(dragged[2], splits[2]);
+        const double metresPerPixel = (drawn.farDistance - drawn.nearDistance) / (chart->width() - 16);
+        QVERIFY2(std::abs(dragged[1] - chart->distanceAt(to.x())) <= 1.0 + metresPerPixel,
+                 qPrintable(QString("%1 vs %2").arg(dragged[1]).arg(chart->distanceAt(to.x()))));
+        QCOMPARE(dragged[1], std::round(dragged[1]));  // whole metres, as the dock edits them
+        undo.undo();
+        QCOMPARE(*doc.project().scene.shadows.splits, splits);
+        undo.redo();
+
+        // Dragged past its neighbour, a split stops short of it.
+        const QPoint first = chart->handlePosition(0);
+        QTest::mousePress(chart, Qt::LeftButton, {}, first);
+        QTest::mouseMove(chart, QPoint(chart->width() - 2, first.y()));
+        QTest::mouseRelease(chart, Qt::LeftButton, {}, QPoint(chart->width() - 2, first.y()));
+        QCOMPARE(undo.index(), start + 3);
+        dragged = *doc.project().scene.shadows.splits;
+        QVERIFY(dragged[0] < dragged[1] && dragged[0] >= dragged[1] - 1.0);
+        // The last one stays below the shadow distance.
+        QString error;
+        QVERIFY(doc.setParameter("shadows.max_distance", std::round(drawn.farDistance * 0.9), &error));
+        const QPoint last = chart->handlePosition(2);
+        QTest::mousePress(chart, Qt::LeftButton, {}, last);
+        QTest::mouseMove(chart, QPoint(chart->width() + 50, last.y()));
+        QTest::mouseRelease(chart, Qt::LeftButton, {}, QPoint(chart->width() + 50, last.y()));
+        QVERIFY(doc.project().scene.shadows.splits->back() < *doc.project().scene.shadows.maxDistance);
+        QVERIFY(doc.project().scene.shadows.splits->back() > dragged[2]);
+
+        // Another cascade count in manual mode resamples the splits in the same edit.
+        const std::vector<double> four = *doc.project().scene.shadows.splits;
+        auto* cascades = w_->findChild<QSpinBox*>("param.shadows.cascades");
+        int steps = undo.index();
+        cascades->setValue(2);
+        QCOMPARE(undo.index(), steps + 1);
+        QCOMPARE(doc.project().scene.shadows.cascades, 2);
+        QCOMPARE(*doc.project().scene.shadows.splits, std::vector<double>{four[0]});
+        QCOMPARE(chart->range().ends.size(), size_t(2));
+        cascades->setValue(4);
+        QCOMPARE(undo.index(), steps + 2);
+        const std::vector<double> resampled = *doc.project().scene.shadows.splits;
+        QCOMPARE(resampled.size(), size_t(3));
+        QCOMPARE(resampled[0], four[0]);
+        QVERIFY(resampled[1] > resampled[0] && resampled[2] > resampled[1]);
+        QVERIFY(resampled[2] < *doc.project().scene.shadows.maxDistance);
+        undo.undo();
+        undo.undo();
+        QCOMPARE(doc.project().scene.shadows.cascades, 4);
+        QCOMPARE(*doc.project().scene.shadows.splits, four);
+        // A shadow distance below the last split keeps the splits before it.
+        QVERIFY(doc.setParameter("shadows.max_distance", std::round(0.5 * (four[1] + four[2])), &error));
+        QCOMPARE(doc.project().scene.shadows.splits->at(1), four[1]);
+        QVERIFY(doc.project().scene.shadows.splits->at(2) < *doc.project().scene.shadows.maxDistance);
+        // Writing the splits themselves still obeys the table.
+        QVERIFY(!doc.setParameter("shadows.splits", nullptr, &error));
+        QVERIFY(!doc.setParameter("shadows.splits", nlohmann::json{100.0, 50.0, 200.0}, &error));
+
+        // Show cascades: view 34 and back to the view before, following the selector.
+        auto* show = w_->findChild<QPushButton*>("shadows.showCascades");
+        auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
+        QVERIFY(show && show->isCheckable() && !show->isChecked());
+        selector->setCurrentIndex(selector->findData(kViewShadow));
+        show->click();
+        QCOMPARE(selector->currentData().toInt(), kViewCascades);
+        QCOMPARE(w_->viewport()->debugView(), kViewCascades);
+        show->click();
+        QCOMPARE(selector->currentData().toInt(), kViewShadow);
+        QCOMPARE(w_->viewport()->debugView(), kViewShadow);
+        selector->setCurrentIndex(selector->findData(kViewCascades));
+        QVERIFY(show->isChecked());
+        selector->setCurrentIndex(selector->findData(kViewFog));
+        QVERIFY(!show->isChecked());
+        show->click();
+        QCOMPARE(selector->currentData().toInt(), kViewCascades);
+        show->click();
+        QCOMPARE(selector->currentData().toInt(), kViewFog);
+    }
 
     // Dock conventions, each a tracker item (one window for all: cheap checks share its start).
     void dockEditingConventions() {
@@ -752,6 +1023,13 @@ private slots:
         QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 60000));
         QTest::qWait(200);
         QVERIFY(w_->findChild<QTableWidget*>("bake.report")->parentWidget()->grab().save(QString::fromStdString((kOut / "bake_dock.png").string())));
+        // The Shadows dock in manual mode, its split chart with draggable handles.
+        w_->findChild<QComboBox*>("param.shadows.split_mode")->setCurrentText("manual");
+        w_->findChild<QDockWidget*>("dock.shadows")->raise();
+        w_->viewport()->renderNow();
+        QTest::qWait(300);
+        const QPixmap dock = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(dock.save(QString::fromStdString((kOut / "shadows_dock.png").string())));
     }
 };
 

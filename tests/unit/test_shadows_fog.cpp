@@ -62,6 +62,46 @@ TEST(ShadowSplits, RangeCoversTheTerrainAndManualSplitsAreUsed) {
     EXPECT_EQ(r.ends, (std::vector<double>{3000.0, 3500.0, 4000.0}));
 }
 
+TEST(ShadowSplits, ManualSplitsAreFittedToTheCascadeCount) {
+    CascadeRange practical;
+    practical.nearDistance = 100.0;
+    practical.farDistance = 10000.0;
+    practical.ends = {1234.4, 3456.6, 6789.2, 10000.0};
+    // None authored: the practical inner ends, in whole metres.
+    EXPECT_EQ(fitManualSplits({}, 4, practical, std::nullopt), (std::vector<double>{1234.0, 3457.0, 6789.0}));
+    // Fewer cascades keep the leading authored splits; the authored values stay as they are.
+    EXPECT_EQ(fitManualSplits({500.5, 2000.0, 3000.0}, 2, practical, std::nullopt), std::vector<double>{500.5});
+    // More cascades keep the authored ones and fill from the practical ends beyond them.
+    EXPECT_EQ(fitManualSplits({2000.0}, 4, practical, std::nullopt), (std::vector<double>{2000.0, 3457.0, 6789.0}));
+    // Authored splits beyond every practical one: even steps to the far end.
+    EXPECT_EQ(fitManualSplits({8000.0}, 3, practical, std::nullopt), (std::vector<double>{8000.0, 9000.0}));
+    // A shadow distance below the last split drops it and what follows.
+    const auto below = fitManualSplits({1000.0, 5000.0, 9000.0}, 4, practical, 6000.0);
+    ASSERT_EQ(below.size(), 3u);
+    EXPECT_EQ(below[0], 1000.0);
+    EXPECT_EQ(below[1], 5000.0);
+    EXPECT_GT(below[2], 5000.0);
+    EXPECT_LT(below[2], 6000.0);
+    // Out of order or not positive: kept only up to the first that breaks the rule.
+    EXPECT_EQ(fitManualSplits({3000.0, 2000.0, 9000.0}, 4, practical, std::nullopt),
+              (std::vector<double>{3000.0, 3457.0, 6789.0}));
+    EXPECT_EQ(fitManualSplits({0.0}, 2, practical, std::nullopt), std::vector<double>{1234.0});
+    EXPECT_TRUE(fitManualSplits({1000.0}, 1, practical, std::nullopt).empty());
+    // A short range keeps fractions where whole metres would reorder the splits.
+    CascadeRange tiny;
+    tiny.nearDistance = 0.1;
+    tiny.farDistance = 1.0;
+    tiny.ends = {0.3, 0.6, 1.0};
+    EXPECT_EQ(fitManualSplits({}, 3, tiny, std::nullopt), (std::vector<double>{0.3, 0.6}));
+    // The fitted splits pass the project's rules.
+    const auto fitted = fitManualSplits({2000.0}, 4, practical, 9000.0);
+    json doc = projectToJson(Project{});
+    doc["shadows"]["split_mode"] = "manual";
+    doc["shadows"]["max_distance"] = 9000.0;
+    doc["shadows"]["splits"] = fitted;
+    EXPECT_NO_THROW(sceneFromJson(doc, "project", nullptr));
+}
+
 TEST(ShadowSplits, CascadesAreStableAsTheCameraTurns) {
     // The same slice seen from two camera azimuths: the same radius, and light-space centres on
     // the same texel grid (the map moves by whole texels only).
