@@ -180,6 +180,12 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("terrain.skirt", T::Boolean)).label("Ground beyond border")
         .about("The ground continues beyond the footprint at the border height (rays leaving the DEM still meet terrain)")
         .redoes(kRebake).field(&SceneDescription::terrain, &TerrainSettings::skirt);
+    add(Row("terrain.roughness", T::Number)).range(0.25, 1.0).decimals(2).slider().label("Roughness")
+        .about("GGX roughness of the sun's highlight on the ground, before the normal variance widens it (0.25 is the floor)")
+        .redoes(kUpload).field(&SceneDescription::terrain, &TerrainSettings::roughness);
+    add(Row("terrain.specular_aa", T::Boolean)).label("Normal-variance specular")
+        .about("Widens the roughness by the variance of the normals a pixel covers (Toksvig 2005): no sparkle from detail smaller than a pixel")
+        .redoes(kUpload).field(&SceneDescription::terrain, &TerrainSettings::specularAA);
 
     // Sun.
     const auto physical = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Physical; };
@@ -329,6 +335,24 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("fog.anisotropy", T::Number)).range(-0.95, 0.95).slider().label("Anisotropy")
         .about("Henyey–Greenstein g of the sun's inscatter: > 0 glows around the sun, 0 scatters evenly")
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::anisotropy);
+
+    // Micro-detail: the viewport and --render only.
+    const auto detailOn = [](const SceneDescription& s, size_t) { return s.detail.enabled; };
+    add(Row("detail.enabled", T::Boolean)).label("Micro-detail")
+        .about("A procedural detail normal and albedo variation near the camera, in the viewport and --render; the bake never sees it")
+        .redoes(kUpload).field(&SceneDescription::detail, &DetailSettings::enabled);
+    add(Row("detail.normal_strength", T::Number)).range(0.0, 2.0).decimals(2).slider().label("Detail normal")
+        .about("Slope of the tiling detail bump; 0 = no detail normal")
+        .redoes(kUpload).onlyWhen(detailOn).field(&SceneDescription::detail, &DetailSettings::normalStrength);
+    add(Row("detail.scale", T::Number)).range(0.1, 100.0).unit("m").decimals(1).label("Detail repeat")
+        .about("Metres per repeat of the detail bump (triplanar, so steep faces are not stretched)")
+        .redoes(kUpload).onlyWhen(detailOn).field(&SceneDescription::detail, &DetailSettings::scale);
+    add(Row("detail.fade_distance", T::Number)).above(0.0, 1.0e6).unit("m").decimals(0).label("Detail fade")
+        .about("Distance from the camera where the detail normal has faded out, linearly from the camera")
+        .redoes(kUpload).onlyWhen(detailOn).field(&SceneDescription::detail, &DetailSettings::fadeDistance);
+    add(Row("detail.albedo_variation", T::Number)).range(0.0, 0.5).decimals(2).slider().label("Albedo variation")
+        .about("The albedo varies by up to ± this share, in noise over 64 m and 9 m; 0 = none")
+        .redoes(kUpload).onlyWhen(detailOn).field(&SceneDescription::detail, &DetailSettings::albedoVariation);
 
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
@@ -736,11 +760,14 @@ std::string cell(std::string s) {
 
 ParameterDock parameterDock(const ParameterSpec& spec) {
     const std::string section = spec.path.substr(0, spec.path.find_first_of(".["));
-    if (section == "terrain") return {"dock.terrain", "Terrain"};
+    if (section == "terrain" && spec.path != "terrain.roughness" && spec.path != "terrain.specular_aa")
+        return {"dock.terrain", "Terrain"};
     if (section == "sun" || section == "sky") return {"dock.sunSky", "Sun & Sky"};
     if (section == "probe_volumes") return {"dock.probeVolumes", "Probe Volumes"};
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
     if (section == "shadows") return {"dock.shadows", "Shadows"};
+    if (section == "detail" || spec.path == "terrain.roughness" || spec.path == "terrain.specular_aa")
+        return {"dock.surface", "Surface"};
     if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
     return {"", ""};
 }

@@ -45,6 +45,9 @@ void ProjectRenderer::setProject(const Project& project) {
     const SceneDescription& scene = project_.scene;
     const BakeLighting lighting = lightingOf(project_);
     base_.albedo = lighting.albedo;
+    base_.surface.roughness = float(scene.terrain.roughness);
+    base_.surface.specularAA = scene.terrain.specularAA;
+    base_.surface.detail = scene.detail;
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);

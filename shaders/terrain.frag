@@ -11,6 +11,7 @@
 #include "sh.glsl"
 #include "sky.glsl"
 #include "brdf.glsl"
+#include "surface.glsl"
 #include "tonemap.glsl"
 #include "shadows.glsl"
 #include "fog.glsl"
@@ -24,8 +25,32 @@ layout(location = 0) out vec4 outColor;
 void main() {
     ShadingPoint s;
     s.position = worldPos;
-    s.normal = normalize(worldNormal);
-    s.albedo = surface.albedo.rgb;
     s.probe = probeIrradianceWeight;
+    // Every map read comes first, in uniform control flow, so the hardware's derivatives (mip
+    // selection) hold. Off the footprint (the skirt) the mesh normal and open sky stand.
+    vec2 t = footprintT(worldPos);
+    bool inside = onFootprint(t);
+    vec2 uv = surfaceUv(t, surface.mapSizes.xy);
+    vec4 normalAo = texture(surfaceNormalAo, uv);
+    float coarseAo = surface.ao.z > 0.0 ? textureLod(surfaceNormalAo, uv, surface.ao.z).w : normalAo.w;
+    vec3 mapAlbedo = texture(surfaceAlbedoMap, surfaceUv(t, surface.mapSizes.zw)).rgb;
+    s.filled = inside ? texture(surfaceFilled, uv).r : 0.0;
+    float pixelMetres = length(fwidth(worldPos));
+    float distance = length(worldPos - camera.position.xyz);
+
+    float meanLength = length(normalAo.xyz);
+    vec3 base = inside && meanLength > 1e-4 ? normalAo.xyz / meanLength : normalize(worldNormal);
+    s.variance = inside ? toksvigVariance(meanLength) : 0.0;
+    s.aoRaw = inside ? normalAo.w : 1.0;
+    s.ao = surface.ao.x > 0.5 ? s.aoRaw : 1.0;
+    // Probes already hold the occlusion at their own spacing: only the AO finer than that (the
+    // ratio to the AO filtered to the probes' scale) darkens their light (docs/lighting.md).
+    float finer = clamp(s.aoRaw / max(coarseAo, 1e-3), 0.0, 1.0);
+    s.aoProbe = inside && surface.ao.z > 0.0 ? mix(1.0, finer, surface.ao.y) : 1.0;
+    float amount = detailAmount(distance, pixelMetres);
+    s.normal = amount > 0.0 ? detailNormal(base, worldPos, amount) : base;
+    float r = surface.material.x;
+    s.roughness = max(surface.material.z > 0.5 ? widenedRoughness(r, s.variance) : r, surface.material.w);
+    s.albedo = (surface.albedo.w > 0.5 ? mapAlbedo : surface.albedo.rgb) * albedoVariation(worldPos.xz, pixelMetres);
     outColor = vec4(shadeView(camera.view.x, s), 1.0);
 }

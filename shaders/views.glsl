@@ -16,6 +16,12 @@ struct ShadingPoint {
     // z known (1 = measured), w 1 = inside a volume with no probe to light it; in the
     // sun-visibility view: x the traced visibility.
     vec4 probe;
+    float aoRaw;       // precomputed sky visibility (1 where none was computed)
+    float ao;          // what darkens the sky light: aoRaw, or 1 with AO off
+    float aoProbe;     // what darkens the probe light: the AO finer than the probes
+    float variance;    // the normals' variance under the pixel (Toksvig)
+    float roughness;   // GGX roughness after the variance
+    float filled;      // share of filled nodata cells
     float shadow;      // sunShadow(): 1 lit, 0 in shadow
     float fogAmount;   // 1 − the fog's transmittance to the camera
     vec3 linear;       // sceneLinear(), seen through the fog
@@ -23,17 +29,18 @@ struct ShadingPoint {
 
 float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
 
-// Scene-linear light leaving the point toward the camera: Lambert + GGX sun, sky irradiance with
-// the baked probe irradiance blended over it (absent probes leave the sky term as it is).
+// Scene-linear light leaving the point toward the camera: Lambert + GGX sun, sky irradiance
+// (darkened by the AO) with the baked probe irradiance blended over it (absent probes leave the
+// sky term as it is).
 vec3 sceneLinear(ShadingPoint s) {
     vec3 n = s.normal;
     vec3 l = normalize(sunSky.sunDirection.xyz);
     vec3 v = normalize(camera.position.xyz - s.position);
     float ndotl = max(dot(n, l), 0.0);
-    vec3 sky = skyIrradiance(n);
+    vec3 sky = skyIrradiance(n) * s.ao;
     float weight = s.probe.a;
-    vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb, weight) : sky;
-    vec3 spec = ggxSpecular(n, v, l, surface.material.x);
+    vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb * s.aoProbe, weight) : sky;
+    vec3 spec = ggxSpecular(n, v, l, s.roughness);
     // Probes hold no direct sun: the sun alone is shadowed by the cascades.
     vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
     return s.albedo / PI * (sun * ndotl + ambient) + spec * sun;
@@ -60,6 +67,7 @@ vec3 viewProbeValidity(ShadingPoint s) {
 
 // The scalar views write the value in red and 1 in green (terrain) to EXR, grey to PNG.
 vec3 scalarView(float value) { return linearOutput() ? vec3(value, 1.0, 0.0) : vec3(clamp(value, 0.0, 1.0)); }
+vec3 viewAo(ShadingPoint s) { return scalarView(s.aoRaw); }
 vec3 viewSunVisibility(ShadingPoint s) { return scalarView(s.probe.x); }
 vec3 viewShadow(ShadingPoint s) { return scalarView(s.shadow); }
 vec3 viewFog(ShadingPoint s) { return scalarView(s.fogAmount); }
@@ -91,6 +99,19 @@ vec3 viewInterpolationError(ShadingPoint s) {
     float error = known > 0.0 ? s.probe.y / known : 0.0;
     if (linearOutput()) return vec3(known > 0.5 ? error : 0.0, known > 0.5 ? 1.0 : 0.0, 0.0);
     return (known > 0.5 ? heat(error) : vec3(0.25)) * (0.75 + 0.25 * max(s.normal.y, 0.0));
+}
+
+// Normal variance: EXR holds σ² in red; PNG the heat ramp (0.1 and above red), shaded by N·L.
+vec3 viewNormalVariance(ShadingPoint s) {
+    if (linearOutput()) return vec3(s.variance, 1.0, 0.0);
+    return heat(s.variance) * (0.6 + 0.4 * sunNdotL(s));
+}
+
+// Filled voids: the final image with filled cells tinted magenta.
+vec3 viewFilled(ShadingPoint s) {
+    vec3 c = display(s.linear);
+    float luma = dot(c, vec3(0.2126, 0.7152, 0.0722));
+    return mix(c, vec3(1.0, 0.1, 0.9) * (0.35 + 0.65 * luma), 0.75 * clamp(s.filled, 0.0, 1.0));
 }
 
 vec3 shadeView(int view, ShadingPoint s) {

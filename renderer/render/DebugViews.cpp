@@ -19,6 +19,17 @@ const std::vector<DebugView>& debugViews() {
         {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, lit},
         {kViewAlbedo, "albedo", "surface albedo", false, ViewBackground::Black, none},
         {kViewNormal, "normal", "world normal as colour", false, ViewBackground::Black, none},
+        {kViewNormalVariance, "normal-variance",
+         "variance σ² of the terrain normals under each pixel (Toksvig), which widens the specular "
+         "lobe: heat ramp, red at 0.1 and above (EXR: σ² in red, 1 in green on terrain)",
+         true, ViewBackground::Black, none},
+        {kViewFilled, "filled",
+         "the final image with the cells the DEM left as nodata, and the import filled, tinted magenta",
+         false, ViewBackground::Sky, lit},
+        {kViewAo, "ao",
+         "raw ambient occlusion: the cosine-weighted sky visibility from the heightfield's horizons "
+         "(EXR: visibility in red, 1 in green on terrain)",
+         true, ViewBackground::Black, none},
         {kViewSunVisibility, "sun-visibility",
          "share of the sun's disc visible, traced on the CPU by the bake's tracer at each vertex (EXR: "
          "visibility in red, 1 in green on terrain)",

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 
+#include <glm/gtc/packing.hpp>
 #include <glm/mat4x4.hpp>
 #include <tbb/parallel_for.h>
 
@@ -14,6 +15,7 @@
 #include "bake/SphereSampling.h"
 #include "render/DebugViews.h"
 #include "render/UniformBlocks.h"
+#include "terrain/SurfaceMaps.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
 #include "vk/Descriptors.h"
@@ -53,6 +55,10 @@ constexpr float kSmallestLeafPixels = 6.0f;
 
 constexpr VkShaderStageFlags kVertexFragment = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
+const char* const kSurfaceNormalAo = "surface-normal-ao";
+const char* const kSurfaceAlbedo = "surface-albedo";
+const char* const kSurfaceFilled = "surface-filled";
+
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
     a.insert(a.end(), b.begin(), b.end());
     return a;
@@ -88,8 +94,17 @@ struct RenderTarget {
     vk::Readback readback;
 };
 
+// The surface maps the view set binds (SurfaceMaps.h), always present: a terrain without AO or
+// an albedo map binds neutral ones.
+struct SurfaceTextures {
+    vk::Image normalAo, albedo, filled;
+};
+
 struct TerrainRenderer::Gpu {
     vk::Buffer vertices, indices, markers, leaves;
+    SurfaceTextures surface;
+    vk::Sampler trilinear;
+    vk::UniqueSetLayout viewLayout;
     std::unique_ptr<ProbeResources> probes;
     std::unique_ptr<ShadowResources> shadows;
     // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
@@ -135,6 +150,33 @@ vk::DescriptorSetBuilder shadowedLightsBuilder(const FrameSlot& f, VkImageView m
                g.compareSampler.handle(), frag)
         .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
                g.depthSampler.handle(), frag);
+}
+
+// The view set: camera, surface block and the surface maps. `t` null: the layout alone.
+vk::DescriptorSetBuilder viewSetBuilder(const FrameSlot& f, const SurfaceTextures* t, VkSampler sampler) {
+    constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
+    return vk::DescriptorSetBuilder()
+        .uniform(blocks::CameraBlock::kBinding, "camera", f.camera, kVertexFragment)
+        .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, frag)
+        .image(TLX_SURFACE_NORMAL_AO_BINDING, kSurfaceNormalAo, t ? t->normalAo.view() : VK_NULL_HANDLE, sampler, frag)
+        .image(TLX_SURFACE_ALBEDO_BINDING, kSurfaceAlbedo, t ? t->albedo.view() : VK_NULL_HANDLE, sampler, frag)
+        .image(TLX_SURFACE_FILLED_BINDING, kSurfaceFilled, t ? t->filled.view() : VK_NULL_HANDLE, sampler, frag);
+}
+
+// Texel bytes of a level: RGBA16F normal-AO, RGBA8 sRGB albedo, R8 filled share.
+vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
+    vk::MipLevel l{uint32_t(w), uint32_t(h), std::vector<uint8_t>(texels.size() * 8)};
+    for (size_t i = 0; i < texels.size(); ++i) {
+        const uint64_t packed = glm::packHalf4x16(texels[i]);
+        std::memcpy(l.bytes.data() + 8 * i, &packed, 8);
+    }
+    return l;
+}
+
+uint8_t srgbByte(float linear) {
+    const float c = std::clamp(linear, 0.0f, 1.0f);
+    const float e = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+    return uint8_t(std::lround(e * 255.0f));
 }
 
 }  // namespace
@@ -189,10 +231,6 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.atmosphere = ubo(sizeof(blocks::AtmosphereBlock));
         f.shadow = ubo(sizeof(blocks::ShadowBlock));
         f.overlay = ubo(sizeof(blocks::OverlayBlock));
-        f.view = vk::DescriptorSetBuilder()
-                     .uniform(blocks::CameraBlock::kBinding, "camera", f.camera, kVertexFragment)
-                     .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, VK_SHADER_STAGE_FRAGMENT_BIT)
-                     .build(ctx_);
         f.lights = vk::DescriptorSetBuilder()
                        .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, VK_SHADER_STAGE_FRAGMENT_BIT)
                        .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere,
@@ -203,11 +241,15 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
                          .build(ctx_);
         g.slots.push_back(std::move(f));
     }
+    g.trilinear = vk::Sampler::trilinearClamp(ctx_);
+    g.viewLayout = viewSetBuilder(g.slots[0], nullptr, g.trilinear.handle()).buildLayout(ctx_);
+    uploadSurfaceMaps({});
+    setAlbedoMap(0, 0, {});
     g.emptySet = vk::DescriptorSetBuilder().buildLayout(ctx_);
     static_assert(TLX_SET_VIEW == 0 && TLX_SET_LIGHTS == 1 && TLX_SET_SUBSYSTEM == 2);
-    const VkDescriptorSetLayout terrainSets[] = {g.slots[0].view.layout(), g.slots[0].lights.layout()};
+    const VkDescriptorSetLayout terrainSets[] = {g.viewLayout.get(), g.slots[0].lights.layout()};
     g.terrainLayout = vk::PipelineLayout(ctx_, terrainSets);
-    const VkDescriptorSetLayout overlaySets[] = {g.slots[0].view.layout(), g.emptySet.get(),
+    const VkDescriptorSetLayout overlaySets[] = {g.viewLayout.get(), g.emptySet.get(),
                                                  g.slots[0].overlays.layout()};
     g.overlayLayout = vk::PipelineLayout(ctx_, overlaySets);
 
@@ -218,12 +260,81 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     g.compareSampler = vk::Sampler::depthCompare(ctx_);
     g.depthSampler = vk::Sampler::nearestClamp(ctx_);
     g.shadowedLightsLayout = shadowedLightsBuilder(g.slots[0], VK_NULL_HANDLE, g).buildLayout(ctx_);
-    const VkDescriptorSetLayout shadowedSets[] = {g.slots[0].view.layout(), g.shadowedLightsLayout.get()};
+    const VkDescriptorSetLayout shadowedSets[] = {g.viewLayout.get(), g.shadowedLightsLayout.get()};
     g.shadowedTerrainLayout = vk::PipelineLayout(ctx_, shadowedSets);
     g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
 }
 
 bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
+
+void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
+    Gpu& g = *gpu_;
+    const SurfaceMaps maps = buildSurfaceMaps(hf_, ao);
+    std::vector<vk::MipLevel> levels;
+    int w = maps.width, h = maps.height;
+    for (const auto& level : maps.normalAo) {
+        levels.push_back(halfLevel(w, h, level));
+        w = std::max(w / 2, 1);
+        h = std::max(h / 2, 1);
+    }
+    SurfaceTextures next;
+    next.normalAo = vk::Image::texture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
+    next.filled = vk::Image::texture(ctx_, VK_FORMAT_R8_UNORM,
+                                     {vk::MipLevel{uint32_t(maps.width), uint32_t(maps.height), maps.filled}});
+    ctx_.waitIdle();  // no frame may still read the old maps
+    g.surface.normalAo = std::move(next.normalAo);
+    g.surface.filled = std::move(next.filled);
+    surfaceMapSize_ = {maps.width, maps.height};
+    hasAo_ = !ao.empty();
+    if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
+}
+
+void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) {
+    if (!perVertex.empty() && perVertex.size() != hf_.heights().size())
+        throw std::invalid_argument("ambient occlusion needs one value per DEM vertex");
+    uploadSurfaceMaps(perVertex);
+}
+
+void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<glm::vec3>& linear) {
+    Gpu& g = *gpu_;
+    const bool map = width > 0 && height > 0 && linear.size() == size_t(width) * size_t(height);
+    // A full mip chain of box means in linear light, stored sRGB-encoded (the hardware decodes).
+    std::vector<vk::MipLevel> levels;
+    std::vector<glm::vec3> level = map ? linear : std::vector<glm::vec3>{glm::vec3(1.0f)};
+    int w = map ? width : 1, h = map ? height : 1;
+    while (true) {
+        vk::MipLevel l{uint32_t(w), uint32_t(h), std::vector<uint8_t>(level.size() * 4)};
+        for (size_t i = 0; i < level.size(); ++i)
+            for (int c = 0; c < 3; ++c) l.bytes[4 * i + size_t(c)] = srgbByte(level[i][c]);
+        for (size_t i = 0; i < level.size(); ++i) l.bytes[4 * i + 3] = 255;
+        levels.push_back(std::move(l));
+        if (w == 1 && h == 1) break;
+        const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+        std::vector<glm::vec3> next(size_t(nw) * size_t(nh));
+        for (int j = 0; j < nh; ++j)
+            for (int i = 0; i < nw; ++i) {
+                const int x0 = i * w / nw, x1 = (i + 1) * w / nw, y0 = j * h / nh, y1 = (j + 1) * h / nh;
+                glm::vec3 sum(0.0f);
+                for (int y = y0; y < y1; ++y)
+                    for (int x = x0; x < x1; ++x) sum += level[size_t(y) * size_t(w) + size_t(x)];
+                next[size_t(j) * size_t(nw) + size_t(i)] = sum / float((x1 - x0) * (y1 - y0));
+            }
+        level = std::move(next);
+        w = nw;
+        h = nh;
+    }
+    vk::Image image = vk::Image::texture(ctx_, VK_FORMAT_R8G8B8A8_SRGB, levels);
+    ctx_.waitIdle();  // no frame may still read the old map
+    g.surface.albedo = std::move(image);
+    hasAlbedoMap_ = map;
+    albedoMapSize_ = map ? glm::ivec2(width, height) : glm::ivec2(1, 1);
+    buildViewSets();
+}
+
+void TerrainRenderer::buildViewSets() {
+    Gpu& g = *gpu_;
+    for (FrameSlot& f : g.slots) f.view = viewSetBuilder(f, &g.surface, g.trilinear.handle()).build(ctx_);
+}
 
 void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
     Gpu& g = *gpu_;
@@ -298,7 +409,10 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     volumeCount_ = 0;
     anyErrorMap_ = false;
     probeBytes_ = 0;
+    finestProbeSpacing_ = 0.0f;
     if (volumes.empty()) return;
+    for (const auto& v : volumes)
+        finestProbeSpacing_ = finestProbeSpacing_ > 0.0f ? std::min(finestProbeSpacing_, v.spacing) : v.spacing;
 
     std::vector<glm::vec4> coeffs;
     std::vector<int32_t> cells;
@@ -539,8 +653,26 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                              sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0, 0);
     slot.camera.write(&camera, sizeof camera);
     blocks::SurfaceBlock surface;
-    surface.albedo = glm::vec4(s.albedo, 1.0f);
-    surface.material = glm::vec4(s.roughness, s.exposure, 0.0f, 0.0f);
+    const SurfaceLook& look = s.surface;
+    surface.albedo = glm::vec4(s.albedo, hasAlbedoMap_ ? 1.0f : 0.0f);
+    surface.material = glm::vec4(look.roughness, s.exposure, look.specularAA ? 1.0f : 0.0f, look.roughnessFloor);
+    const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
+    surface.footprint = glm::vec4(hf_.minX(), hf_.minZ(), spanX > 0.0f ? 1.0f / spanX : 0.0f,
+                                  spanZ > 0.0f ? 1.0f / spanZ : 0.0f);
+    surface.mapSizes = glm::vec4(glm::vec2(surfaceMapSize_), glm::vec2(albedoMapSize_));
+    // The normal-AO mip level whose texels are as large as the finest probe spacing: the AO at
+    // that scale is what the probes already hold.
+    float probeLevel = 0.0f;
+    if (probes && hasAo_ && finestProbeSpacing_ > 0.0f) {
+        const float texel = std::max(spanX / float(std::max(surfaceMapSize_.x - 1, 1)),
+                                     spanZ / float(std::max(surfaceMapSize_.y - 1, 1)));
+        if (texel > 0.0f) probeLevel = std::max(std::log2(finestProbeSpacing_ / texel), 0.0f);
+    }
+    surface.ao = glm::vec4(look.ao && hasAo_ ? 1.0f : 0.0f, look.ao ? look.aoStrength : 0.0f, probeLevel, 0.0f);
+    const DetailSettings& d = look.detail;
+    surface.detail = d.enabled ? glm::vec4(float(d.normalStrength), float(d.scale), float(d.fadeDistance),
+                                           float(d.albedoVariation))
+                               : glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);
     slot.surface.write(&surface, sizeof surface);
     blocks::SunSkyBlock sunSky;
     sunSky.sunDirection = glm::vec4(s.sun.direction, s.sun.angularRadius);

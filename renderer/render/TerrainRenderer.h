@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "bake/ProbeDiagnostics.h"
@@ -21,6 +22,7 @@
 #include "render/FrameGraph.h"
 #include "render/OrbitCamera.h"
 #include "render/ShadowCascades.h"
+#include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
 #include "vk/Swapchain.h"
 #include "vk/VulkanContext.h"
@@ -43,17 +45,27 @@ struct GpuProbeVolume {
     std::optional<ProbeDiagnostics> diagnostics;
 };
 
+// How the terrain surface is drawn beyond its albedo (docs/lighting.md, "Surface").
+struct SurfaceLook {
+    float roughness = 0.6f;         // GGX, before the normal variance widens it
+    bool specularAA = true;         // widen the roughness by the normals' variance (Toksvig)
+    float roughnessFloor = 0.25f;   // the least roughness after the variance
+    bool ao = true;                 // the AO darkens sky light, and probe light by aoStrength
+    float aoStrength = 1.0f;
+    DetailSettings detail;          // the procedural micro-detail
+};
+
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
     bool probes = true;           // false: exactly the image without probes (no probe pass)
     bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
     OrbitCamera camera;
-    glm::vec3 albedo{0.3f};
+    glm::vec3 albedo{0.3f};       // the constant albedo (when no albedo map is set)
+    SurfaceLook surface;          // roughness, AO use, micro-detail
     SunLight sun;
     sh::ShRgb skySh;
     float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
-    float roughness = 0.8f;
     ShadowSettings shadows;       // the sun's cascades (shadows.enabled false: no shadow pass)
     // Height fog with base height and colour resolved (fog.enabled false: no fog code runs).
     FogSettings fog;
@@ -84,6 +96,15 @@ public:
     void setProbePositions(const std::vector<glm::vec4>& positions);
     // Octree leaves for the leaf overlay: min corner xyz, w edge (metres).
     void setProbeLeaves(const std::vector<glm::vec4>& leaves);
+    // The sky visibility per DEM vertex (horizonSkyVisibility's layout), or empty for none: the
+    // surface maps are built and uploaded again.
+    void setAmbientOcclusion(const std::vector<float>& perVertex);
+    // An albedo map over the footprint (texel centres corner to corner, row 0 north, linear RGB),
+    // or width 0 for the constant albedo of RenderSettings.
+    void setAlbedoMap(int width, int height, const std::vector<glm::vec3>& linear);
+    bool hasAmbientOcclusion() const { return hasAo_; }
+    // Texels a side of the normal-AO map's level 0.
+    glm::ivec2 surfaceMapSize() const { return surfaceMapSize_; }
     // Draws a frame and reads it back, waiting for the GPU.
     RenderedImage render(const RenderSettings& settings);
     // Draws a frame into the swapchain's next image (a blit of the offscreen colour target, no
@@ -113,6 +134,8 @@ private:
     void ensureTarget(uint32_t width, uint32_t height);
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
+    void uploadSurfaceMaps(const std::vector<float>& ao);
+    void buildViewSets();
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;
@@ -125,6 +148,9 @@ private:
     std::vector<float> meshVertices_;  // position and normal per vertex, as uploaded
     std::vector<Cascade> cascades_;
     size_t sunTraces_ = 0;
+    bool hasAo_ = false, hasAlbedoMap_ = false;
+    glm::ivec2 surfaceMapSize_{1, 1}, albedoMapSize_{1, 1};
+    float finestProbeSpacing_ = 0.0f;  // of the bound volumes; 0 without
 };
 
 }  // namespace terralux

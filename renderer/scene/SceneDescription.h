@@ -18,6 +18,18 @@ struct TerrainSettings {
     glm::vec3 albedo{0.3f, 0.3f, 0.3f};  // Lambertian, each in [0, 1]
     int maxResolution = 0;           // 0 = source resolution; else longest side, area-averaged
     bool skirt = true;               // ground continues beyond the footprint at the border height
+    double roughness = 0.6;          // GGX roughness of the sun's highlight, [0.25, 1]
+    bool specularAA = true;          // widen the roughness by the normals' variance (Toksvig)
+};
+
+// Procedural micro-detail: drawn by the viewport and --render, never by the bake (the bake is
+// about light, not texture).
+struct DetailSettings {
+    bool enabled = true;
+    double normalStrength = 0.4;     // slope of the detail bump, [0, 2]
+    double scale = 2.0;              // metres per repeat, [0.1, 100]
+    double fadeDistance = 300.0;     // metres from the camera where the detail is gone, > 0
+    double albedoVariation = 0.1;    // ± share of the albedo, [0, 0.5]
 };
 
 struct SunSettings {
@@ -196,6 +208,7 @@ struct SceneDescription {
     CameraSettings camera;
     ShadowSettings shadows;
     FogSettings fog;
+    DetailSettings detail;
 };
 
 }  // namespace terralux

@@ -1,5 +1,11 @@
 #include "vk/Image.h"
 
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+
+#include "vk/Buffer.h"
+
 namespace terralux::vk {
 
 bool isDepthFormat(VkFormat f) {
@@ -9,12 +15,13 @@ bool isDepthFormat(VkFormat f) {
 
 namespace {
 UniqueImageView makeView(VkDevice device, VkImage image, VkImageViewType type, VkFormat format,
-                         VkImageAspectFlags aspect, uint32_t firstLayer, uint32_t layers) {
+                         VkImageAspectFlags aspect, uint32_t firstLayer, uint32_t layers,
+                         uint32_t mipLevels = 1) {
     VkImageViewCreateInfo vci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     vci.image = image;
     vci.viewType = type;
     vci.format = format;
-    vci.subresourceRange = {aspect, 0, 1, firstLayer, layers};
+    vci.subresourceRange = {aspect, 0, mipLevels, firstLayer, layers};
     VkImageView view = VK_NULL_HANDLE;
     check(vkCreateImageView(device, &vci, nullptr, &view), "vkCreateImageView");
     return UniqueImageView(device, view);
@@ -31,7 +38,7 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     ici.imageType = VK_IMAGE_TYPE_2D;
     ici.format = desc_.format;
     ici.extent = {desc_.width, desc_.height, 1};
-    ici.mipLevels = 1;
+    ici.mipLevels = std::max(desc_.mipLevels, 1u);
     ici.arrayLayers = desc_.layers;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -48,7 +55,7 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     const VkImageViewType type = desc_.shape == ImageShape::Cube     ? VK_IMAGE_VIEW_TYPE_CUBE
                                  : desc_.shape == ImageShape::Layers ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
                                                                      : VK_IMAGE_VIEW_TYPE_2D;
-    view_ = makeView(device, image, type, desc_.format, aspect_, 0, desc_.layers);
+    view_ = makeView(device, image, type, desc_.format, aspect_, 0, desc_.layers, std::max(desc_.mipLevels, 1u));
     for (uint32_t l = 0; l < desc_.layers; ++l)
         layerViews_.push_back(makeView(device, image, VK_IMAGE_VIEW_TYPE_2D, desc_.format, aspect_, l, 1));
 }
@@ -83,6 +90,47 @@ Image Image::depthLayers(const VulkanContext& ctx, uint32_t width, uint32_t heig
     return Image(ctx, {ImageShape::Layers, kDepthFormat, width, height, layers,
                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
                            VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+}
+
+Image Image::texture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels) {
+    if (levels.empty()) throw std::invalid_argument("a texture needs at least one level");
+    Image img(ctx, {ImageShape::Plane, format, levels[0].width, levels[0].height, 1,
+                    VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, uint32_t(levels.size())});
+    size_t total = 0;
+    for (const MipLevel& l : levels) total += (l.bytes.size() + 15) & ~size_t(15);
+    Buffer staging(ctx, std::max<size_t>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    std::vector<VkBufferImageCopy> copies;
+    size_t offset = 0;
+    for (uint32_t i = 0; i < levels.size(); ++i) {
+        staging.write(levels[i].bytes.data(), levels[i].bytes.size(), offset);
+        VkBufferImageCopy c{};
+        c.bufferOffset = offset;
+        c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i, 0, 1};
+        c.imageExtent = {levels[i].width, levels[i].height, 1};
+        copies.push_back(c);
+        offset += (levels[i].bytes.size() + 15) & ~size_t(15);
+    }
+    ctx.submitAndWait([&](VkCommandBuffer cb) {
+        VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.image = img.handle();
+        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(levels.size()), 0, 1};
+        b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                             nullptr, 0, nullptr, 1, &b);
+        vkCmdCopyBufferToImage(cb, staging.handle(), img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               uint32_t(copies.size()), copies.data());
+        b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+        b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0,
+                             nullptr, 0, nullptr, 1, &b);
+    });
+    return img;
 }
 
 }  // namespace terralux::vk

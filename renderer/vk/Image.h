@@ -22,6 +22,13 @@ struct ImageDesc {
     uint32_t width = 1, height = 1;
     uint32_t layers = 1;  // Layers: the array size; Cube: 6
     VkImageUsageFlags usage = 0;
+    uint32_t mipLevels = 1;
+};
+
+// One mip level's texels, tightly packed rows (level 0 first).
+struct MipLevel {
+    uint32_t width = 1, height = 1;
+    std::vector<uint8_t> bytes;
 };
 
 class Image {
@@ -45,6 +52,10 @@ public:
     // A depth 2D array shaders sample as one (a 2D-array view even for one layer): shadow cascades.
     static Image depthLayers(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t layers);
 
+    // A sampled 2D texture holding `levels` (a full or partial mip chain), uploaded through a
+    // staging buffer and left in the shader-read layout.
+    static Image texture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels);
+
     VkImage handle() const { return image_.get(); }
     // The whole image as shaders see it: 2D, 2D array or cube.
     VkImageView view() const { return view_.get(); }
@@ -53,6 +64,7 @@ public:
     const ImageDesc& desc() const { return desc_; }
     uint32_t width() const { return desc_.width; }
     uint32_t height() const { return desc_.height; }
+    uint32_t mipLevels() const { return desc_.mipLevels; }
     VkImageAspectFlags aspect() const { return aspect_; }
 
 private:

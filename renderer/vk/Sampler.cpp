@@ -21,6 +21,13 @@ Sampler::Sampler(const VulkanContext& ctx, const VkSamplerCreateInfo& info) {
 
 Sampler Sampler::linearClamp(const VulkanContext& ctx) { return Sampler(ctx, clampInfo(VK_FILTER_LINEAR)); }
 
+Sampler Sampler::trilinearClamp(const VulkanContext& ctx) {
+    VkSamplerCreateInfo si = clampInfo(VK_FILTER_LINEAR);
+    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+    si.maxLod = VK_LOD_CLAMP_NONE;
+    return Sampler(ctx, si);
+}
+
 Sampler Sampler::nearestClamp(const VulkanContext& ctx) { return Sampler(ctx, clampInfo(VK_FILTER_NEAREST)); }
 
 Sampler Sampler::depthCompare(const VulkanContext& ctx) {

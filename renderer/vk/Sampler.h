@@ -14,6 +14,8 @@ public:
 
     // Bilinear, clamped to the edge.
     static Sampler linearClamp(const VulkanContext& ctx);
+    // Trilinear over every mip level, clamped to the edge (surface textures).
+    static Sampler trilinearClamp(const VulkanContext& ctx);
     // Nearest texel, clamped to the edge (data images, debug reads).
     static Sampler nearestClamp(const VulkanContext& ctx);
     // Depth compare (reference <= stored gives 1), bilinear, clamped to a white border: a point
