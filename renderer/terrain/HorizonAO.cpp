@@ -36,7 +36,9 @@ inline float acosFast(float x) {
     p = p * ax - 0.2145988016f;
     p = p * ax + 1.5707963050f;
     const float r = std::sqrt(std::max(0.0f, 1.0f - ax)) * p;
-    return x < 0.0f ? std::numbers::pi_v<float> - r : r;
+    // acos(−x) = π − acos(x), as arithmetic rather than a select.
+    const float sign = std::copysign(1.0f, x);
+    return 0.5f * std::numbers::pi_v<float> * (1.0f - sign) + sign * r;
 }
 
 // One azimuth slice of the cosine-weighted visibility (Jimenez et al. 2016, GTAO): with the
@@ -135,7 +137,18 @@ void sweepHorizons(const Frame& f, const SweepDir& s, const Columns& cols, doubl
         for (int k = r.begin(); k != r.end(); ++k) {
             int n = 0;
             double lineMax = -std::numeric_limits<double>::infinity();
-            for (int j = 0; j < f.w; ++j) {
+            // Columns where the line is inside 0 <= v <= d - 1, one wider each way for rounding
+            // (the test below is exact).
+            int uLo = 0, uHi = f.w - 1;
+            if (s.slope != 0.0) {
+                const double ua = -k / s.slope, ub = (f.d - 1 - k) / s.slope;
+                uLo = std::max(uLo, int(std::floor(std::min(ua, ub))) - 1);
+                uHi = std::min(uHi, int(std::ceil(std::max(ua, ub))) + 1);
+            } else if (k < 0 || k > f.d - 1) {
+                continue;
+            }
+            const int jLo = s.sigma > 0 ? f.w - 1 - uHi : uLo, jHi = s.sigma > 0 ? f.w - 1 - uLo : uHi;
+            for (int j = jLo; j <= jHi; ++j) {
                 // Walk against the azimuth, so that what lies toward the horizon was seen first.
                 const int u = s.sigma > 0 ? f.w - 1 - j : j;
                 const int i = k + cols.base[size_t(u)];
@@ -214,14 +227,17 @@ void accumulateSlices(const Frame& f, const SweepDir& s, const Columns& cols, co
             const float* row0 = f.h + size_t(v0) * w;
             const float* row1 = f.h + size_t(v1) * w;
             float* a = acc + size_t(v) * w;
-            for (size_t u = 0; u < w; ++u) {
-                const size_t u0 = u > 0 ? u - 1 : 0, u1 = std::min(u + 1, w - 1);
+            const auto add = [&](size_t u, size_t u0, size_t u1) {
                 const float gu = (row[u1] - row[u0]) * invDu[u];
                 const float gv = (row1[u] - row0[u]) * invDv;
                 const float invLen = 1.0f / std::sqrt(1.0f + gu * gu + gv * gv);
                 const float nt = -(gu * s.tu + gv * s.tv) * invLen;
                 a[u] += sliceIntegral(nt, invLen, sinH[u]);
-            }
+            };
+            // Interior columns without clamping, so that the loop vectorises.
+            for (size_t u = 1; u + 1 < w; ++u) add(u, u - 1, u + 1);
+            add(0, 0, std::min<size_t>(1, w - 1));
+            if (w > 1) add(w - 1, w - 2, w - 1);
         }
     });
 }
