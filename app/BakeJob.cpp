@@ -624,12 +624,13 @@ void flatten(const nlohmann::json& v, const std::string& path, std::map<std::str
 
 nlohmann::json bakeInputs(const Project& project) {
     nlohmann::json settings = sceneToJson(project.scene);
-    // Not read by a bake: where the camera stands and its exposure, the shadows and fog the
-    // renderer draws over the probes, where the files go, and the reflection-probe settings no
-    // bake computes yet.
+    // Not read by a bake: where the camera stands and its exposure, the shadows, fog and ambient
+    // occlusion the renderer draws over the probes, where the files go, and the reflection-probe
+    // settings no bake computes yet.
     settings.erase("camera");
     settings.erase("shadows");
     settings.erase("fog");
+    settings.erase("ao");
     settings.erase("reflection_probes");
     settings["export"].erase("out_dir");
     // Files count by what they resolve to (below), not by how the project spells their path.

@@ -330,6 +330,23 @@ std::vector<ParameterSpec> buildTable() {
         .about("Henyey–Greenstein g of the sun's inscatter: > 0 glows around the sun, 0 scatters evenly")
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::anisotropy);
 
+    // Horizon ambient occlusion (docs/lighting.md): a render setting, like shadows and fog. No
+    // dock holds these rows: they are edited in the project file and with --set.
+    const auto aoOn = [](const SceneDescription& s, size_t) { return s.ao.enabled; };
+    add(Row("ao.enabled", T::Boolean)).label("Ambient occlusion").noUiRow()
+        .about("Darkens probe light by the terrain's horizon ambient occlusion, the cosine-weighted share of the sky each vertex sees")
+        .redoes(kUpload).field(&SceneDescription::ao, &AoSettings::enabled);
+    add(Row("ao.directions", T::Integer)).range(8, 64).label("AO directions").noUiRow()
+        .about("Azimuths swept for the horizon at each vertex: more are smoother and cost proportionally more")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::directions);
+    add(Row("ao.max_distance", T::Number)).above(0.0, 1.0e7).unit("m").decimals(0).noUiRow()
+        .autoMeans("unbounded: the whole footprint occludes").label("AO distance")
+        .about("How far the horizon search reaches from each vertex; terrain farther away does not occlude")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::maxDistance);
+    add(Row("ao.strength", T::Number)).range(0.0, 1.0).decimals(2).slider().label("AO strength").noUiRow()
+        .about("How strongly the precomputed AO darkens probe light where probes are coarser than the AO (0 = off, 1 = full)")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::strength);
+
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
