@@ -624,12 +624,13 @@ void flatten(const nlohmann::json& v, const std::string& path, std::map<std::str
 
 nlohmann::json bakeInputs(const Project& project) {
     nlohmann::json settings = sceneToJson(project.scene);
-    // Not read by a bake: where the camera stands and its exposure, the shadows, fog, specular
-    // and micro-detail the renderer draws over the probes, where the files go, and the reflection-probe settings no
-    // bake computes yet.
+    // Not read by a bake: where the camera stands and its exposure, the shadows, fog, ambient
+    // occlusion, specular and micro-detail the renderer draws over the probes, where the files go,
+    // and the reflection-probe settings no bake computes yet.
     settings.erase("camera");
     settings.erase("shadows");
     settings.erase("fog");
+    settings.erase("ao");
     settings.erase("detail");
     settings["terrain"].erase("roughness");
     settings["terrain"].erase("specular_aa");

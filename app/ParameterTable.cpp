@@ -354,6 +354,22 @@ std::vector<ParameterSpec> buildTable() {
         .about("The albedo varies by up to ± this share, in noise over 64 m and 9 m; 0 = none")
         .redoes(kUpload).onlyWhen(detailOn).field(&SceneDescription::detail, &DetailSettings::albedoVariation);
 
+    // Horizon ambient occlusion (docs/lighting.md): a render setting, like shadows and fog.
+    const auto aoOn = [](const SceneDescription& s, size_t) { return s.ao.enabled; };
+    add(Row("ao.enabled", T::Boolean)).label("Ambient occlusion")
+        .about("Darkens the sky light, and probe light coarser than the AO, by the terrain's horizon ambient occlusion: the cosine-weighted share of the sky each vertex sees")
+        .redoes(kUpload).field(&SceneDescription::ao, &AoSettings::enabled);
+    add(Row("ao.directions", T::Integer)).range(8, 64).label("AO directions")
+        .about("Azimuths swept for the horizon at each vertex: more are smoother and cost proportionally more")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::directions);
+    add(Row("ao.max_distance", T::Number)).above(0.0, 1.0e7).unit("m").decimals(0)
+        .autoMeans("unbounded: the whole footprint occludes").label("AO distance")
+        .about("How far the horizon search reaches from each vertex; terrain farther away does not occlude")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::maxDistance);
+    add(Row("ao.strength", T::Number)).range(0.0, 1.0).decimals(2).slider().label("AO strength")
+        .about("How strongly the precomputed AO darkens probe light where probes are coarser than the AO (0 = off, 1 = full)")
+        .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::strength);
+
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
@@ -769,6 +785,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "detail" || spec.path == "terrain.roughness" || spec.path == "terrain.specular_aa")
         return {"dock.surface", "Surface"};
     if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
+    if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     return {"", ""};
 }
 

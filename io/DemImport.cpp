@@ -1,6 +1,8 @@
 #include "DemImport.h"
 
 #include <algorithm>
+#include <array>
+#include <numbers>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -17,6 +19,7 @@
 #include <gdal_utils.h>
 #include <gdalwarper.h>
 #include <ogr_spatialref.h>
+#include <tbb/parallel_for.h>
 
 namespace terralux {
 namespace {
@@ -169,7 +172,109 @@ Window coveredWindow(const std::vector<uint8_t>& cov, int w, int h) {
     return win;
 }
 
+// Membrane (Laplace) fill of the holes, from the current values: successive over-relaxation
+// (Young 1954) of the 5-point Laplacian, each hole (4-connected) on its own with the optimal
+// factor for a square of its larger side L, ω = 2 / (1 + sin(π / (L + 1))), which converges in
+// O(L) sweeps where Gauss–Seidel needs O(L²). Cells on the grid's edge use the neighbours they
+// have (a zero-slope boundary there).
+void membraneFill(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata) {
+    std::vector<int> label(heights.size(), -1);
+    std::vector<std::vector<uint32_t>> holes;
+    for (size_t start = 0; start < heights.size(); ++start) {
+        if (!nodata[start] || label[start] >= 0) continue;
+        const int id = int(holes.size());
+        std::vector<uint32_t> cells{uint32_t(start)};
+        label[start] = id;
+        for (size_t k = 0; k < cells.size(); ++k) {
+            const int x = int(cells[k] % uint32_t(w)), y = int(cells[k] / uint32_t(w));
+            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+            for (int j = 0; j < 4; ++j) {
+                if (nx[j] < 0 || ny[j] < 0 || nx[j] >= w || ny[j] >= h) continue;
+                const size_t n = size_t(ny[j]) * size_t(w) + size_t(nx[j]);
+                if (nodata[n] && label[n] < 0) {
+                    label[n] = id;
+                    cells.push_back(uint32_t(n));
+                }
+            }
+        }
+        std::sort(cells.begin(), cells.end());  // sweep in raster order
+        holes.push_back(std::move(cells));
+    }
+    tbb::parallel_for(size_t(0), holes.size(), [&](size_t id) {
+        const std::vector<uint32_t>& cells = holes[id];
+        const size_t n = cells.size();
+        // Per cell: the sum of its valid neighbours, how many neighbours it has, and which of
+        // them are hole cells (indices into `cells`).
+        std::vector<double> value(n), fixedSum(n, 0.0);
+        std::vector<float> invCount(n);
+        std::vector<std::array<int32_t, 4>> free(n);
+        int x0 = w, x1 = 0, y0 = h, y1 = 0;
+        for (size_t k = 0; k < n; ++k) {
+            const int x = int(cells[k] % uint32_t(w)), y = int(cells[k] / uint32_t(w));
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+            value[k] = heights[cells[k]];
+            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
+            int count = 0;
+            for (int j = 0; j < 4; ++j) {
+                free[k][size_t(j)] = -1;
+                if (nx[j] < 0 || ny[j] < 0 || nx[j] >= w || ny[j] >= h) continue;
+                ++count;
+                const uint32_t c = uint32_t(ny[j]) * uint32_t(w) + uint32_t(nx[j]);
+                if (nodata[c])
+                    free[k][size_t(j)] = int32_t(std::lower_bound(cells.begin(), cells.end(), c) - cells.begin());
+                else
+                    fixedSum[k] += heights[c];
+            }
+            invCount[k] = count > 0 ? 1.0f / float(count) : 0.0f;
+        }
+        const int side = std::max(x1 - x0, y1 - y0) + 1;
+        const double omega = 2.0 / (1.0 + std::sin(std::numbers::pi / (side + 1)));
+        const int maxSweeps = 20 * side + 100;
+        for (int sweep = 0; sweep < maxSweeps; ++sweep) {
+            double largest = 0.0;
+            for (size_t k = 0; k < n; ++k) {
+                double sum = fixedSum[k];
+                for (const int32_t j : free[k])
+                    if (j >= 0) sum += value[size_t(j)];
+                const double delta = omega * (sum * invCount[k] - value[k]);
+                value[k] += delta;
+                largest = std::max(largest, std::fabs(delta));
+            }
+            if (largest < 1e-3) break;
+        }
+        for (size_t k = 0; k < n; ++k) heights[cells[k]] = float(value[k]);
+    });
+}
+
 }  // namespace
+
+void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata, VoidFill method) {
+    if (w < 1 || h < 1 || heights.size() != size_t(w) * size_t(h) || nodata.size() != heights.size())
+        throw DemError("filling nodata cells: grid " + std::to_string(w) + " x " + std::to_string(h) + " has " +
+                       std::to_string(heights.size()) + " heights and " + std::to_string(nodata.size()) +
+                       " mask cells; both must be w x h");
+    const size_t holes = size_t(std::count_if(nodata.begin(), nodata.end(), [](uint8_t v) { return v != 0; }));
+    if (holes == 0) return;
+    if (holes == nodata.size()) throw DemError("filling nodata cells: every cell is nodata; nothing to fill from");
+    registerDriversOnce();
+    QuietGdalErrors quiet;
+    // GDALFillNodata interpolates by inverse distance weighting over a search in four directions,
+    // then runs 3x3 smoothing passes over the filled cells only. The search reaches the whole
+    // grid, so every hole is filled.
+    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+    DatasetPtr fillDs(mem->Create("", w, h, 1, GDT_Float32, nullptr));
+    DatasetPtr maskDs(mem->Create("", w, h, 1, GDT_Byte, nullptr));
+    auto* fb = static_cast<GDALDataset*>(fillDs.get())->GetRasterBand(1);
+    auto* mb = static_cast<GDALDataset*>(maskDs.get())->GetRasterBand(1);
+    std::vector<uint8_t> valid(nodata.size());
+    for (size_t i = 0; i < nodata.size(); ++i) valid[i] = nodata[i] ? 0 : 1;
+    if (fb->RasterIO(GF_Write, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) != CE_None ||
+        mb->RasterIO(GF_Write, 0, 0, w, h, valid.data(), w, h, GDT_Byte, 0, 0, nullptr) != CE_None ||
+        GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr, nullptr) != CE_None ||
+        fb->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) != CE_None)
+        throw DemError(withGdalReason("filling nodata cells failed"));
+    if (method == VoidFill::GdalMembrane) membraneFill(heights, w, h, nodata);
+}
 
 int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
     double lon = std::fmod(longitudeDeg + 180.0, 360.0);
@@ -399,26 +504,12 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
 
     if (nodataCount == heights.size()) fail(path, "every cell is nodata; nothing to import");
 
-    // Fill holes from their valid neighbours: GDALFillNodata interpolates by inverse distance
-    // weighting over a search in four directions, then runs 3x3 smoothing passes over the filled
-    // cells only. The search reaches the whole grid, so every hole is filled.
     if (nodataCount > 0) {
-        GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-        DatasetPtr fillDs(mem->Create("", w, h, 1, GDT_Float32, nullptr));
-        DatasetPtr maskDs(mem->Create("", w, h, 1, GDT_Byte, nullptr));
-        auto* fb = static_cast<GDALDataset*>(fillDs.get())->GetRasterBand(1);
-        auto* mb = static_cast<GDALDataset*>(maskDs.get())->GetRasterBand(1);
-        std::vector<uint8_t> valid(nodata.size());
-        for (size_t i = 0; i < nodata.size(); ++i) valid[i] = nodata[i] ? 0 : 1;
-        if (fb->RasterIO(GF_Write, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
-                CE_None ||
-            mb->RasterIO(GF_Write, 0, 0, w, h, valid.data(), w, h, GDT_Byte, 0, 0, nullptr) !=
-                CE_None ||
-            GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr,
-                           nullptr) != CE_None ||
-            fb->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
-                CE_None)
-            fail(path, withGdalReason("filling nodata cells failed"));
+        try {
+            fillVoids(heights, w, h, nodata);
+        } catch (const DemError& e) {
+            fail(path, e.what());
+        }
     }
 
     // Metric units and the geographic origin of the footprint centre.

@@ -1,6 +1,7 @@
 #pragma once
 // DEM import: any raster GDAL opens, band 1, into an engine-space Heightfield.
 
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -48,6 +49,24 @@ struct DemImportResult {
     Heightfield heightfield;
     DemSourceInfo source;
 };
+
+// How nodata holes are filled (docs/lighting.md, "Terrain").
+enum class VoidFill {
+    // GDALFillNodata: inverse distance weighting over a search in four directions, then 3x3
+    // smoothing passes over the filled cells.
+    Gdal,
+    // Gdal, then the membrane (Laplace) surface over the holes: SOR sweeps over the filled cells
+    // with the valid cells as fixed boundary, until no cell moves by more than 1 mm.
+    GdalMembrane,
+};
+// What importDem uses: the better of the two in the measurements of README.md.
+inline constexpr VoidFill kImportVoidFill = VoidFill::GdalMembrane;
+
+// Fills the cells where nodata[i] != 0 of a row-major w x h grid from the others; cells with
+// nodata[i] == 0 are left unchanged. Every hole is filled if at least one cell is valid. Throws
+// DemError when GDAL fails.
+void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
+               VoidFill method = kImportVoidFill);
 
 // Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.
 DemImportResult importDem(const std::string& path, const DemImportOptions& options = {});

@@ -186,6 +186,15 @@ struct FogSettings {
     double anisotropy = 0.6;                   // Henyey–Greenstein g, (−1, 1)
 };
 
+// Horizon ambient occlusion of the terrain (docs/lighting.md, "Horizon ambient occlusion"),
+// computed by horizonSkyVisibility (terrain/HorizonAO.h).
+struct AoSettings {
+    bool enabled = true;
+    int directions = 32;                       // azimuths swept, 8..64
+    std::optional<double> maxDistance;         // metres the horizon search reaches; unset = unbounded
+    double strength = 1.0;                     // [0, 1]: how strongly AO darkens the probe light
+};
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -209,6 +218,7 @@ struct SceneDescription {
     ShadowSettings shadows;
     FogSettings fog;
     DetailSettings detail;
+    AoSettings ao;
 };
 
 }  // namespace terralux

@@ -174,3 +174,16 @@ TEST(BakeCost, PresetsAreOrderedByRaysTracedOnSmallAndLargeGrids) {
     }
     fs::remove_all(dir);
 }
+
+// Ambient occlusion is drawn over the probes by the renderer: editing it leaves a bake current.
+TEST(BakeJob, AmbientOcclusionIsNotABakeInput) {
+    Project a, b;
+    b.scene.ao.enabled = false;
+    b.scene.ao.directions = 8;
+    b.scene.ao.maxDistance = 100.0;
+    b.scene.ao.strength = 0.5;
+    EXPECT_EQ(bakeInputs(a), bakeInputs(b));
+    EXPECT_FALSE(bakeInputs(a).dump().find("\"ao\"") != std::string::npos);
+    b.scene.sun.elevationDeg = 10.0;
+    EXPECT_NE(bakeInputs(a), bakeInputs(b));
+}

@@ -430,3 +430,32 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
     EXPECT_GT(rewritten.sh().c[0].x, 1.5f * first.sh().c[0].x);
     fs::remove_all(dir);
 }
+
+TEST(Project, AmbientOcclusionSectionDefaultsValidationAndRoundTrip) {
+    const SceneDescription d = sceneFromJson(defaultProjectJson(), "defaults", nullptr);
+    EXPECT_TRUE(d.ao.enabled);
+    EXPECT_EQ(d.ao.directions, 32);
+    EXPECT_FALSE(d.ao.maxDistance.has_value());  // unbounded
+    EXPECT_DOUBLE_EQ(d.ao.strength, 1.0);
+    EXPECT_TRUE(defaultProjectJson()["ao"]["max_distance"].is_null());
+
+    const std::string few = errorFor("ao.directions=4");
+    EXPECT_NE(few.find("ao.directions"), std::string::npos) << few;
+    EXPECT_NE(few.find("4"), std::string::npos) << few;
+    EXPECT_NE(few.find("64"), std::string::npos) << few;
+    EXPECT_NE(errorFor("ao.directions=16.5").find("ao.directions"), std::string::npos);
+    EXPECT_NE(errorFor("ao.strength=1.5").find("ao.strength"), std::string::npos);
+    EXPECT_NE(errorFor("ao.max_distance=0").find("ao.max_distance"), std::string::npos);
+    EXPECT_NE(errorFor("ao.max_distance=-5").find("ao.max_distance"), std::string::npos);
+    EXPECT_EQ(errorFor("ao.max_distance=2500"), "");
+
+    json doc = defaultProjectJson();
+    doc["ao"] = {{"enabled", false}, {"directions", 12}, {"max_distance", 1500.5}, {"strength", 0.25}};
+    const SceneDescription s = sceneFromJson(doc, "p.json", nullptr);
+    EXPECT_FALSE(s.ao.enabled);
+    EXPECT_EQ(s.ao.directions, 12);
+    ASSERT_TRUE(s.ao.maxDistance);
+    EXPECT_DOUBLE_EQ(*s.ao.maxDistance, 1500.5);
+    EXPECT_DOUBLE_EQ(s.ao.strength, 0.25);
+    EXPECT_EQ(sceneToJson(s)["ao"], doc["ao"]);
+}
