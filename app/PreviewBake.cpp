@@ -2,6 +2,7 @@
 
 
 #include "SceneLighting.h"
+#include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
@@ -22,6 +23,7 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
     BakeLighting lighting = lightingOf(project);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
     lighting.tracer = &tracer;
+    lighting.surface = surfaceAlbedoOf(project, hf);
     const BakeQuality q = qualityPreset(QualityPreset::Draft);
     const BakeControl control{nullptr, cancel};
     const IrradianceCache cache(lighting, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, control);

@@ -5,6 +5,7 @@
 
 #include <numbers>
 
+#include "AlbedoImport.h"
 #include "BakeJob.h"
 #include "SceneLighting.h"
 #include "ProbeDiagnosticsFile.h"
@@ -45,6 +46,14 @@ void ProjectRenderer::setProject(const Project& project) {
     const SceneDescription& scene = project_.scene;
     const BakeLighting lighting = lightingOf(project_);
     base_.albedo = lighting.albedo;
+    // A map that cannot be read leaves the constant albedo on screen rather than no picture.
+    albedoError_.clear();
+    try {
+        albedo_ = surfaceAlbedoOf(project_, terrain_.heightfield);
+    } catch (const ImageError& e) {
+        albedo_.reset();
+        albedoError_ = e.what();
+    }
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
