@@ -582,6 +582,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         GltfSceneInput in;
         in.heightfield = &hf;
         in.albedo = scene.terrain.albedo;
+        in.albedoTexture = lighting.surface.get();
         in.verticalScale = scene.terrain.verticalScale;
         in.volumes = grids;
         in.bake = bakeInfo;
