@@ -71,6 +71,21 @@ size_t checkBands(const Heightfield& hf, const SurfaceAlbedo& a, int ring) {
 
 bool isFallback(const glm::vec3& v, const glm::vec3& f) { return v == f; }
 
+// A fallback no map holds.
+const glm::vec3 kMagenta(1.0f, 0.0f, 1.0f);
+
+// Drapes `map` over `hf`, which it covers with room to spare: the field is width x height and
+// holds no fallback anywhere.
+SurfaceAlbedo drapeCovering(const std::string& map, const Heightfield& hf, int width, int height) {
+    SurfaceAlbedo a = importAlbedoMap(map, hf, kDem, kMagenta);
+    EXPECT_EQ(a.width, width);
+    EXPECT_EQ(a.height, height);
+    size_t fallbacks = 0;
+    for (const glm::vec3& v : a.linear) fallbacks += isFallback(v, kMagenta);
+    EXPECT_EQ(fallbacks, 0u);
+    return a;
+}
+
 }  // namespace
 
 TEST(Srgb, DecodingIsTheExactEotf) {
@@ -140,12 +155,9 @@ TEST(SurfaceAlbedo, TexelCentresSpanTheFootprintCornerToCorner) {
 
 TEST(AlbedoMap, UtmMapLiesOnTheDemItWasColouredFrom) {
     const Heightfield hf = importDem(kDem).heightfield;
-    const SurfaceAlbedo a = importAlbedoMap(kUtmMap, hf, kDem, glm::vec3(1.0f, 0.0f, 1.0f));
-    // The map's own 15 m over the 2850 x 1890 m footprint, texel centres on its corners.
-    EXPECT_EQ(a.width, 191);
-    EXPECT_EQ(a.height, 127);
-    // The map covers the footprint with 600 m to spare: no fallback anywhere.
-    for (const glm::vec3& v : a.linear) ASSERT_FALSE(isFallback(v, a.fallback));
+    // The map's own 15 m over the 2850 x 1890 m footprint, texel centres on its corners; it
+    // covers the footprint with 600 m to spare.
+    const SurfaceAlbedo a = drapeCovering(kUtmMap, hf, 191, 127);
     EXPECT_GT(checkBands(hf, a, 1), size_t(3000));
     // Known points: the lowest and the highest vertex of the crop (569 m and 1589 m).
     int lo = 0, hi = 0;
@@ -161,12 +173,9 @@ TEST(AlbedoMap, UtmMapLiesOnTheDemItWasColouredFrom) {
 
 TEST(AlbedoMap, GeographicSixteenBitMapIsReprojectedOntoTheDem) {
     const Heightfield hf = importDem(kDem).heightfield;
-    const SurfaceAlbedo a = importAlbedoMap(kGeoMap, hf, kDem, glm::vec3(1.0f, 0.0f, 1.0f));
     // The map's pixel in the DEM's CRS is the one gdalwarp picks for it (`gdalwarp -t_srs
     // EPSG:32611`: 19.5725 m): 2850 / 19.5725 + 1 and 1890 / 19.5725 + 1 texels.
-    EXPECT_EQ(a.width, 146);
-    EXPECT_EQ(a.height, 97);
-    for (const glm::vec3& v : a.linear) ASSERT_FALSE(isFallback(v, a.fallback));
+    const SurfaceAlbedo a = drapeCovering(kGeoMap, hf, 146, 97);
     // The map went through two nearest-neighbour resamplings (SOURCES.md): band edges moved by up
     // to a pixel, so only vertices two cells inside a band are checked.
     EXPECT_GT(checkBands(hf, a, 2), size_t(2000));
@@ -176,7 +185,7 @@ TEST(AlbedoMap, PartialOverlapFallsBackWhereTheMapEnds) {
     Heightfield hf = importDem(kDem).heightfield;
     // Moved east by its own width: only its western 570 m lie on the map's 600 m margin.
     hf.geo.easting += 2880.0;
-    const glm::vec3 fallback(1.0f, 0.0f, 1.0f);
+    const glm::vec3 fallback = kMagenta;
     const SurfaceAlbedo a = importAlbedoMap(kUtmMap, hf, kDem, fallback);
     const float zMid = 0.5f * (hf.minZ() + hf.maxZ());
     EXPECT_EQ(a.at(hf, hf.maxX(), zMid), fallback);
