@@ -46,13 +46,19 @@ void ProjectRenderer::setProject(const Project& project) {
     const SceneDescription& scene = project_.scene;
     const BakeLighting lighting = lightingOf(project_);
     base_.albedo = lighting.albedo;
-    // A map that cannot be read leaves the constant albedo on screen rather than no picture.
-    albedoError_.clear();
-    try {
-        albedo_ = surfaceAlbedoOf(project_, terrain_.heightfield);
-    } catch (const ImageError& e) {
-        albedo_.reset();
-        albedoError_ = e.what();
+    // The terrain is this renderer's for good: only an edit of the terrain section (or, in mode
+    // map, of the file, which surfaceAlbedoOf notices) makes a new field, not a camera move.
+    const std::string albedoKey = sceneToJson(scene).at("terrain").dump();
+    if (albedoKey != albedoKey_ || scene.terrain.albedoMode == AlbedoMode::Map) {
+        albedoKey_ = albedoKey;
+        // A map that cannot be read leaves the constant albedo on screen rather than no picture.
+        albedoError_.clear();
+        try {
+            albedo_ = surfaceAlbedoOf(project_, terrain_.heightfield);
+        } catch (const ImageError& e) {
+            albedo_.reset();
+            albedoError_ = e.what();
+        }
     }
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();

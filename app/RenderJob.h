@@ -108,6 +108,7 @@ private:
     DemImportResult terrain_;
     std::shared_ptr<const SurfaceAlbedo> albedo_;
     std::string albedoError_;
+    std::string albedoKey_;  // the terrain section albedo_ was made for
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;
 };
