@@ -18,9 +18,6 @@ public:
     using ImageError::ImageError;
 };
 
-// Largest albedo field side: a map finer than this over the footprint is averaged down to it.
-inline constexpr int kMaxAlbedoMapSide = 4096;
-
 // Checks what the header says (exists, GDAL reads it, 3 or 4 bands of 8 or 16 bits) without
 // reading pixels. Throws AlbedoMapError.
 void checkAlbedoMap(const std::string& path);
@@ -40,6 +37,6 @@ void checkAlbedoMap(const std::string& path);
 // is an error naming both files.
 SurfaceAlbedo importAlbedoMap(const std::string& path, const Heightfield& terrain,
                               const std::string& demName, glm::vec3 fallback,
-                              int maxSide = kMaxAlbedoMapSide);
+                              int maxSide = kMaxSurfaceAlbedoSide);
 
 }  // namespace terralux

@@ -59,16 +59,23 @@ SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& r
                          double verticalScale, glm::vec3 fallback) {
     SurfaceAlbedo out;
     out.fallback = fallback;
-    out.width = terrain.width();
-    out.height = terrain.depth();
+    const int w = terrain.width(), d = terrain.depth();
+    const double shrink = std::min(1.0, double(kMaxSurfaceAlbedoSide) / double(std::max(w, d)));
+    out.width = shrink < 1.0 ? std::max(2, int(std::lround(w * shrink))) : w;
+    out.height = shrink < 1.0 ? std::max(2, int(std::lround(d * shrink))) : d;
     out.linear.resize(size_t(out.width) * size_t(out.height));
     const double scale = verticalScale > 0.0 ? verticalScale : 1.0;
-    for (int r = 0; r < out.height; ++r)
-        for (int c = 0; c < out.width; ++c) {
+    // Texel i's centre lies at vertex i (w − 1)/(width − 1): the vertex itself at full size.
+    auto vertexOf = [](int i, int texels, int vertices) {
+        return texels > 1 ? int(std::lround(double(i) * (vertices - 1) / (texels - 1))) : 0;
+    };
+    for (int j = 0; j < out.height; ++j)
+        for (int i = 0; i < out.width; ++i) {
+            const int c = vertexOf(i, out.width, w), r = vertexOf(j, out.height, d);
             const double elevation = (double(terrain.at(c, r)) + terrain.geo.height) / scale;
             const double slope = std::acos(std::clamp(double(terrain.vertexNormal(c, r).y), -1.0, 1.0)) *
                                  180.0 / std::numbers::pi;
-            out.linear[size_t(r) * size_t(out.width) + size_t(c)] = rampColor(ramp, elevation, slope);
+            out.linear[size_t(j) * size_t(out.width) + size_t(i)] = rampColor(ramp, elevation, slope);
         }
     return out;
 }

@@ -12,6 +12,9 @@
 
 namespace terralux {
 
+// Largest albedo field side, for maps and ramps alike (a GPU texture and a PNG of it stay sane).
+inline constexpr int kMaxSurfaceAlbedoSide = 4096;
+
 // Linear albedo over the terrain footprint. Texel centres span the footprint corner to corner:
 // texel (i, j) lies at x = minX + i (maxX − minX)/(width − 1), z = minZ + j (maxZ − minZ)/(height − 1)
 // (row 0 north, like the heightfield). Empty (width 0) means the constant albedo everywhere.
@@ -28,9 +31,11 @@ struct SurfaceAlbedo {
     glm::vec3 maximum() const;
 };
 
-// The ramp at every vertex of the heightfield: a field of the heightfield's own size. Elevation is
-// (vertex height + geo.height) / verticalScale, the DEM's own metres whatever exaggeration the
-// terrain is lit with; slope is the angle of vertexNormal from vertical, as lit.
+// The ramp at every vertex of the heightfield: a field of the heightfield's own size, up to
+// kMaxSurfaceAlbedoSide a side (a larger heightfield gets that many texels, each evaluated at the
+// vertex nearest its centre). Elevation is (vertex height + geo.height) / verticalScale, the DEM's
+// own metres whatever exaggeration the terrain is lit with; slope is the angle of vertexNormal
+// from vertical, as lit.
 SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& ramp,
                          double verticalScale, glm::vec3 fallback);
 

@@ -137,6 +137,22 @@ TEST(Ramp, SnowAboveTheLineRockOnSteepSlopesGroundBelow) {
     }
 }
 
+TEST(Ramp, LargeTerrainsGetAtMostTheLargestFieldSide) {
+    // 5000 x 3 vertices climbing from 0 to 4999 m eastward: 4096 texels across, and the corner
+    // texels are the corner vertices' colours (the first stop, and snow).
+    const int w = 5000, d = 3;
+    std::vector<float> h(size_t(w) * d);
+    for (int r = 0; r < d; ++r)
+        for (int c = 0; c < w; ++c) h[size_t(r) * w + c] = float(c);
+    const Heightfield hf(w, d, 1000.0, 1000.0, h);  // 1000 m cells: a gentle slope, no rock
+    const AlbedoRampSettings ramp;
+    const SurfaceAlbedo a = rampAlbedo(hf, ramp, 1.0, glm::vec3(0.3f));
+    EXPECT_EQ(a.width, kMaxSurfaceAlbedoSide);
+    EXPECT_EQ(a.height, 2);
+    EXPECT_EQ(a.at(hf, hf.minX(), hf.minZ()), ramp.colors.front());
+    EXPECT_EQ(a.at(hf, hf.maxX(), hf.maxZ()), ramp.colors.back());
+}
+
 TEST(SurfaceAlbedo, TexelCentresSpanTheFootprintCornerToCorner) {
     const Heightfield hf = test::flat(5, 10.0, 0.0f);  // x, z in [-20, 20]
     SurfaceAlbedo a;
