@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+
+#include <unistd.h>
 
 #include <glm/common.hpp>
 #include <glm/vector_relational.hpp>
@@ -270,6 +273,30 @@ TEST(AlbedoMap, ProjectModesBuildTheFieldTheBakeUses) {
     EXPECT_EQ(surfaceAlbedoOf(p, hf), map);  // the same file and footprint: imported once
     p.scene.terrain.albedo = glm::vec3(0.5f);
     EXPECT_NE(surfaceAlbedoOf(p, hf), map);  // a new fallback is a new field
+}
+
+TEST(AlbedoParameters, RoundTripThroughTheProjectFile) {
+    const fs::path dir = fs::temp_directory_path() / ("terralux_test_albedo_" + std::to_string(::getpid()));
+    fs::create_directories(dir / "maps");
+    Project p;
+    p.scene.terrain.albedoMode = AlbedoMode::Ramp;
+    p.scene.terrain.albedoMap = (dir / "maps" / "ortho.tif").string();
+    p.scene.terrain.ramp.heights = {100.0, 2500.5, 3000.0};
+    p.scene.terrain.ramp.colors = {{0.1f, 0.2f, 0.3f}, {0.4f, 0.5f, 0.6f}, {0.7f, 0.8f, 0.9f}};
+    p.scene.terrain.ramp.rockColor = {0.33f, 0.22f, 0.11f};
+    p.scene.terrain.ramp.rockSlopeDeg = {30.0, 45.5};
+    saveProject(p, dir / "a.terralux.json");
+    // The map is written relative to the project file, like the DEM.
+    const nlohmann::json doc = nlohmann::json::parse(std::ifstream(dir / "a.terralux.json"));
+    EXPECT_EQ(doc["terrain"]["albedo_map"], "maps/ortho.tif");
+    EXPECT_EQ(doc["terrain"]["ramp_colors"], nlohmann::json({0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9}));
+    const Project back = loadProject(dir / "a.terralux.json", nullptr);
+    nlohmann::json a = sceneToJson(back.scene)["terrain"], b = sceneToJson(p.scene)["terrain"];
+    a.erase("albedo_map");
+    b.erase("albedo_map");
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(back.albedoMapPath(), dir / "maps" / "ortho.tif");
+    fs::remove_all(dir);
 }
 
 TEST(AlbedoBake, InputsFollowTheModeAndTheMapFile) {
