@@ -90,6 +90,9 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     b.tracer = std::make_unique<HeightfieldTracer>(b.terrain.heightfield,
                                                    HeightfieldTracer::Options{scene.terrain.skirt});
     b.lighting.tracer = b.tracer.get();
+    report("loading albedo", 0.015);
+    b.lighting.surface = surfaceAlbedoOf(project, b.terrain.heightfield);
+    if (cancelled()) throw BakeCancelled();
     b.q = qualityPreset(scene.bake.quality);
     if (scene.bake.rays) b.q.rays = *scene.bake.rays;
     if (scene.bake.bounces) b.q.bounces = *scene.bake.bounces;
@@ -450,7 +453,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             const ErrorStats err = compareToReference(bake.sh, ref.sh, layout.valid);
             vr["reference_error"] = {{"mean", err.mean}, {"p95", err.p95}, {"max", err.max},
                                      {"reference_rays_per_probe", refRays},
-                                     {"reference_path_length", q.bounces == 0 ? 0 : referencePathLength(lighting.albedo)},
+                                     {"reference_path_length", q.bounces == 0 ? 0 : referencePathLength(lighting.maxAlbedo())},
                                      {"reference_rays", ref.rays},
                                      {"reference_time_s", secondsSince(refStart)}};
         }
@@ -579,6 +582,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         GltfSceneInput in;
         in.heightfield = &hf;
         in.albedo = scene.terrain.albedo;
+        in.albedoTexture = lighting.surface.get();
         in.verticalScale = scene.terrain.verticalScale;
         in.volumes = grids;
         in.bake = bakeInfo;
@@ -638,10 +642,17 @@ nlohmann::json bakeInputs(const Project& project) {
     settings["export"].erase("out_dir");
     // Files count by what they resolve to (below), not by how the project spells their path.
     settings["terrain"].erase("dem");
+    settings["terrain"].erase("albedo_map");
     settings["sky"].erase("hdr");
+    // The ramp is read in mode ramp only: an edit of it in another mode leaves the bake current.
+    if (project.scene.terrain.albedoMode != AlbedoMode::Ramp)
+        for (const char* key : {"ramp_heights", "ramp_colors", "ramp_rock_color", "ramp_rock_slope"})
+            settings["terrain"].erase(key);
     nlohmann::json files = {{"dem", project.demPath().empty() ? nlohmann::json("embedded sample")
                                                               : fileIdentity(project.demPath())}};
     if (project.scene.sky.mode == SkyMode::Hdr) files["hdr"] = fileIdentity(project.hdrPath());
+    if (project.scene.terrain.albedoMode == AlbedoMode::Map)
+        files["albedo_map"] = fileIdentity(project.albedoMapPath());
     return {{"settings", settings}, {"files", files}};
 }
 

@@ -166,9 +166,78 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("terrain.vertical_scale", T::Number)).above(0.0, 100.0).unit("×").label("Vertical scale")
         .about("Multiplies every height before lighting").redoes(kReimport)
         .field(&SceneDescription::terrain, &TerrainSettings::verticalScale);
+    const auto albedoMode = [](AlbedoMode m) {
+        return [m](const SceneDescription& s, size_t) { return s.terrain.albedoMode == m; };
+    };
+    add(Row("terrain.albedo_mode", T::Choice)).choices({"constant", "map", "ramp"}).label("Albedo source")
+        .about("constant: terrain.albedo everywhere; map: an RGB image draped over the DEM (terrain.albedo_map); ramp: colours by elevation and slope (terrain.ramp_*)")
+        .redoes(kUpload | kRebake).field(&SceneDescription::terrain, &TerrainSettings::albedoMode);
     add(Row("terrain.albedo", T::Color)).range(0.0, 1.0).label("Albedo")
-        .about("Lambertian reflectance of the ground, linear RGB").redoes(kUpload | kRebake)
+        .about("Lambertian reflectance of the ground, linear RGB; in mode map, where the map does not cover the terrain")
+        .redoes(kUpload | kRebake).onlyWhen(std::not_fn(albedoMode(AlbedoMode::Ramp)))
         .field(&SceneDescription::terrain, &TerrainSettings::albedo);
+    add(Row("terrain.albedo_map", T::String)).label("Albedo map")
+        .about("RGB or RGBA raster GDAL reads (orthophoto GeoTIFF, PNG/JPEG with a world file), 8 or 16 bits, sRGB-encoded, for mode map; reprojected onto the DEM; relative to the project file")
+        .redoes(kUpload | kRebake).onlyWhen(albedoMode(AlbedoMode::Map))
+        .custom([](const SceneDescription& s, size_t) { return json(s.terrain.albedoMap); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    s.terrain.albedoMap = v.get<std::string>();
+                    if (s.terrain.albedoMode == AlbedoMode::Map && s.terrain.albedoMap.empty())
+                        throw ParameterRejection{"must name a raster when terrain.albedo_mode is \"map\"", ""};
+                });
+    const auto ramp = albedoMode(AlbedoMode::Ramp);
+    add(Row("terrain.ramp_heights", T::NumberList)).items(2, kMaxRampStops).range(-1.0e4, 1.0e4).unit("m").decimals(0)
+        .label("Ramp heights")
+        .about("Mode ramp: elevations of the colour stops, metres of DEM elevation (before terrain.vertical_scale), strictly increasing; colours are interpolated between stops and held beyond the first and last")
+        .redoes(kUpload | kRebake).onlyWhen(ramp)
+        .custom([](const SceneDescription& s, size_t) { return json(s.terrain.ramp.heights); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    auto& h = s.terrain.ramp.heights;
+                    h = v.get<std::vector<double>>();
+                    for (size_t i = 1; i < h.size(); ++i)
+                        if (!(h[i] > h[i - 1]))
+                            throw ParameterRejection{"must be strictly increasing (" + number(h[i]) +
+                                                         " follows " + number(h[i - 1]) + ")",
+                                                     "[" + std::to_string(i) + "]"};
+                });
+    add(Row("terrain.ramp_colors", T::NumberList)).items(6, 3 * kMaxRampStops).range(0.0, 1.0).decimals(3)
+        .label("Ramp colours")
+        .about("Mode ramp: linear RGB albedo of each stop, three numbers per height in terrain.ramp_heights (r0, g0, b0, r1, ...)")
+        .redoes(kUpload | kRebake).onlyWhen(ramp)
+        .count([](const SceneDescription& s, size_t) { return 3 * int(s.terrain.ramp.heights.size()); })
+        .custom([](const SceneDescription& s, size_t) {
+                    json out = json::array();
+                    for (const glm::vec3& c : s.terrain.ramp.colors)
+                        for (int k = 0; k < 3; ++k) out.push_back(shortest(c[k]));
+                    return out;
+                },
+                [](SceneDescription& s, size_t, const json& v) {
+                    auto& colors = s.terrain.ramp.colors;
+                    colors.clear();
+                    for (size_t i = 0; i + 2 < v.size(); i += 3)
+                        colors.emplace_back(v[i].get<float>(), v[i + 1].get<float>(), v[i + 2].get<float>());
+                });
+    add(Row("terrain.ramp_rock_color", T::Color)).range(0.0, 1.0).label("Rock colour")
+        .about("Mode ramp: linear RGB albedo of steep ground, blended in over terrain.ramp_rock_slope")
+        .redoes(kUpload | kRebake).onlyWhen(ramp)
+        .custom([](const SceneDescription& s, size_t) { return shortest(s.terrain.ramp.rockColor); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    s.terrain.ramp.rockColor = glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+                });
+    add(Row("terrain.ramp_rock_slope", T::NumberList)).items(2, 2).range(0.0, 90.0).unit("°").decimals(1)
+        .label("Rock slope")
+        .about("Mode ramp: [start, end] slope from horizontal over which the ground turns to rock (smoothstep); start < end")
+        .redoes(kUpload | kRebake).onlyWhen(ramp)
+        .custom([](const SceneDescription& s, size_t) {
+                    return json{s.terrain.ramp.rockSlopeDeg[0], s.terrain.ramp.rockSlopeDeg[1]};
+                },
+                [](SceneDescription& s, size_t, const json& v) {
+                    auto& r = s.terrain.ramp.rockSlopeDeg;
+                    r = {v[0].get<double>(), v[1].get<double>()};
+                    if (!(r[1] > r[0]))
+                        throw ParameterRejection{"end must be above start (" + number(r[1]) +
+                                                     " is not above " + number(r[0]) + ")", "[1]"};
+                });
     add(Row("terrain.max_resolution", T::Integer)).range(0, 65536).unit("cells").zeroMeans("source").label("Max resolution")
         .about("Longest side after area-averaged resampling; 0 = the source resolution (1 is not a grid)")
         .redoes(kReimport)
@@ -693,7 +762,9 @@ std::string typeName(const ParameterSpec& s) {
         case ParamType::Color: return "RGB";
         case ParamType::NumberList:
             return s.minItems == s.maxItems ? std::to_string(s.minItems) + " numbers"
-                                            : std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " numbers";
+                   : s.maxItems == s.minItems + 1
+                       ? std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " numbers"
+                       : std::to_string(s.minItems) + " to " + std::to_string(s.maxItems) + " numbers";
         case ParamType::IntegerList:
             return s.minItems == s.maxItems ? std::to_string(s.minItems) + " integers"
                                             : std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " integers";

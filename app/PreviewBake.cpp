@@ -1,7 +1,9 @@
 #include "PreviewBake.h"
 
 
+#include "EnvironmentImage.h"
 #include "SceneLighting.h"
+#include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
@@ -22,6 +24,12 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
     BakeLighting lighting = lightingOf(project);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
     lighting.tracer = &tracer;
+    try {
+        lighting.surface = surfaceAlbedoOf(project, hf);
+    } catch (const ImageError&) {
+        // A map that cannot be read: the preview lights with the constant albedo, as the viewport
+        // draws it (ProjectRenderer::albedoError says why); a bake reports the error.
+    }
     const BakeQuality q = qualityPreset(QualityPreset::Draft);
     const BakeControl control{nullptr, cancel};
     const IrradianceCache cache(lighting, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, control);

@@ -13,7 +13,8 @@ namespace terralux {
 
 // Every enabled volume at draft quality (rays and bounces of the draft preset), with the
 // diagnostics the bake writes (an error map of at most 32 points a side). Throws
-// BakeCancelled when `cancel` is set, PlacementError for bad volume settings.
+// BakeCancelled when `cancel` is set, PlacementError for bad volume settings. The terrain albedo
+// is the project's (surfaceAlbedoOf), or terrain.albedo where its map cannot be read.
 std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
                                           const std::atomic<bool>* cancel);
 

@@ -61,7 +61,7 @@ void checkValue(const ParameterSpec& spec, const json& v, const std::string& pat
         if (scalarForm) return scalar(v, path, integer, orNull);
         const int lo = count > 0 ? count : spec.minItems, hi = count > 0 ? count : spec.maxItems;
         if (!v.is_array() || int(v.size()) < lo || int(v.size()) > hi)
-            reject(source, path, v, "must be an array of " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + " or " + std::to_string(hi)) + " numbers" + orNull);
+            reject(source, path, v, "must be an array of " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + (hi == lo + 1 ? " or " : " to ") + std::to_string(hi)) + " numbers" + orNull);
         for (size_t i = 0; i < v.size(); ++i) scalar(v[i], path + "[" + std::to_string(i) + "]", integer, "");
     };
     switch (spec.type) {
@@ -317,6 +317,7 @@ std::filesystem::path Project::resolve(const std::string& relative) const {
 }
 std::filesystem::path Project::demPath() const { return resolve(scene.terrain.dem); }
 std::filesystem::path Project::hdrPath() const { return resolve(scene.sky.hdr); }
+std::filesystem::path Project::albedoMapPath() const { return resolve(scene.terrain.albedoMap); }
 std::filesystem::path Project::outDir() const { return resolve(scene.exportSettings.outDir); }
 
 Project loadProject(const std::filesystem::path& file, std::vector<std::string>* warnings) {
@@ -361,6 +362,7 @@ void saveProject(const Project& project, const std::filesystem::path& file) {
     };
     rebase(copy.scene.terrain.dem);
     rebase(copy.scene.sky.hdr);
+    rebase(copy.scene.terrain.albedoMap);
     rebase(copy.scene.exportSettings.outDir);
     writeFileAtomically(file, projectToJson(copy).dump(2) + "\n");
 }

@@ -24,6 +24,7 @@ inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffus
 inline constexpr int kMaxBoxGridProbes = 65536;
 inline constexpr int kMaxReflectionProbes = 256;
 inline constexpr int kMaxBounces = 16;
+inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights
 
 struct Project {
     SceneDescription scene;
@@ -34,6 +35,7 @@ struct Project {
     std::filesystem::path resolve(const std::string& relative) const;
     std::filesystem::path demPath() const;    // empty: use the embedded sample
     std::filesystem::path hdrPath() const;
+    std::filesystem::path albedoMapPath() const;  // empty when terrain.albedo_map names none
     std::filesystem::path outDir() const;
 };
 

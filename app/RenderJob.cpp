@@ -5,6 +5,7 @@
 
 #include <numbers>
 
+#include "AlbedoImport.h"
 #include "BakeJob.h"
 #include "SceneLighting.h"
 #include "ProbeDiagnosticsFile.h"
@@ -48,6 +49,20 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.surface.roughness = float(scene.terrain.roughness);
     base_.surface.specularAA = scene.terrain.specularAA;
     base_.surface.detail = scene.detail;
+    // The terrain is this renderer's for good: only an edit of the terrain section (or, in mode
+    // map, of the file, which surfaceAlbedoOf notices) makes a new field, not a camera move.
+    const std::string albedoKey = sceneToJson(scene).at("terrain").dump();
+    if (albedoKey != albedoKey_ || scene.terrain.albedoMode == AlbedoMode::Map) {
+        albedoKey_ = albedoKey;
+        // A map that cannot be read leaves the constant albedo on screen rather than no picture.
+        albedoError_.clear();
+        try {
+            albedo_ = surfaceAlbedoOf(project_, terrain_.heightfield);
+        } catch (const ImageError& e) {
+            albedo_.reset();
+            albedoError_ = e.what();
+        }
+    }
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);

@@ -80,6 +80,10 @@ public:
     bool hasErrorMap() const { return hasErrorMap_; }
 
     const Heightfield& heightfield() const { return terrain_.heightfield; }
+    // The terrain albedo of the project (surfaceAlbedoOf): null in mode constant, and while the
+    // project's albedo map cannot be read (albedoError() says why; the bake reports it too).
+    const std::shared_ptr<const SurfaceAlbedo>& surfaceAlbedo() const { return albedo_; }
+    const std::string& albedoError() const { return albedoError_; }
     TerrainRenderer& renderer() { return *renderer_; }
 
     // One volume's overlay records: probe markers and octree leaves.
@@ -102,6 +106,9 @@ private:
     bool hasErrorMap_ = false;
     std::vector<std::string> staleBake_;
     DemImportResult terrain_;
+    std::shared_ptr<const SurfaceAlbedo> albedo_;
+    std::string albedoError_;
+    std::string albedoKey_;  // the terrain section albedo_ was made for
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;
 };

@@ -2,7 +2,10 @@
 
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <optional>
 
+#include "AlbedoImport.h"
 #include "EnvironmentImage.h"
 #include "SampleTerrain.h"
 
@@ -35,6 +38,8 @@ Project loadEffectiveProject(const std::string& projectFile, const std::vector<s
             throw ImageError(std::string("sky.hdr: ") + e.what());
         }
     }
+    // So is an albedo map, whatever the mode, for the same reason.
+    if (!p.scene.terrain.albedoMap.empty()) checkAlbedoMap(p.albedoMapPath().string());
     return p;
 }
 
@@ -47,6 +52,56 @@ DemImportResult loadProjectTerrain(const Project& project) {
         return importDemFromMemory(kSampleTerrainName, sampleTerrainBytes(), sampleTerrainSize(),
                                    options);
     return importDem(dem.string(), options);
+}
+
+namespace {
+
+// What a map import depends on: the file as it is on disk, the footprint and the fallback.
+struct MapKey {
+    std::string path;
+    std::filesystem::file_time_type time;
+    std::uintmax_t size = 0;
+    int width = 0, depth = 0;
+    double cellX = 0, cellZ = 0;
+    double easting = 0, northing = 0;
+    std::string crs;
+    float fallback[3] = {0, 0, 0};
+    bool operator==(const MapKey&) const = default;
+};
+
+std::mutex mapMutex;
+std::optional<MapKey> lastMapKey;
+std::shared_ptr<const SurfaceAlbedo> lastMap;
+
+}  // namespace
+
+std::shared_ptr<const SurfaceAlbedo> surfaceAlbedoOf(const Project& project, const Heightfield& terrain) {
+    const TerrainSettings& t = project.scene.terrain;
+    switch (t.albedoMode) {
+        case AlbedoMode::Constant: return nullptr;
+        case AlbedoMode::Ramp:
+            return std::make_shared<const SurfaceAlbedo>(rampAlbedo(terrain, t.ramp, t.verticalScale, t.albedo));
+        case AlbedoMode::Map: break;
+    }
+    const std::string path = project.albedoMapPath().string();
+    MapKey key{path, {}, 0, terrain.width(), terrain.depth(), terrain.cellSizeX(), terrain.cellSizeZ(),
+               terrain.geo.easting, terrain.geo.northing, terrain.geo.crsWkt, {t.albedo.x, t.albedo.y, t.albedo.z}};
+    std::error_code ec;
+    key.time = std::filesystem::last_write_time(path, ec);
+    if (!ec) key.size = std::filesystem::file_size(path, ec);
+    {
+        std::lock_guard lock(mapMutex);
+        if (!ec && lastMapKey && *lastMapKey == key) return lastMap;
+    }
+    const std::filesystem::path dem = project.demPath();
+    auto field = std::make_shared<const SurfaceAlbedo>(
+        importAlbedoMap(path, terrain, dem.empty() ? std::string(kSampleTerrainName) : dem.string(), t.albedo));
+    if (!ec) {
+        std::lock_guard lock(mapMutex);
+        lastMapKey = key;
+        lastMap = field;
+    }
+    return field;
 }
 
 }  // namespace terralux

@@ -1,11 +1,13 @@
 #pragma once
 // Shared by every command and, later, the UI: the effective project and its terrain.
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "DemImport.h"
 #include "Project.h"
+#include "terrain/SurfaceAlbedo.h"
 
 namespace terralux {
 
@@ -16,5 +18,11 @@ Project loadEffectiveProject(const std::string& projectFile, const std::vector<s
 
 // The project's DEM, or the embedded sample when it names none.
 DemImportResult loadProjectTerrain(const Project& project);
+
+// The project's terrain albedo over `terrain` (its DEM's import), as the bake, the preview, the
+// renderer and the glTF export all use it: null in mode constant (terrain.albedo everywhere), the
+// ramp, or terrain.albedo_map imported onto the footprint (throws AlbedoMapError). The last map
+// import is kept and reused while the map file, the footprint and terrain.albedo are the same.
+std::shared_ptr<const SurfaceAlbedo> surfaceAlbedoOf(const Project& project, const Heightfield& terrain);
 
 }  // namespace terralux

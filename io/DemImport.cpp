@@ -21,6 +21,8 @@
 #include <ogr_spatialref.h>
 #include <tbb/parallel_for.h>
 
+#include "GdalSupport.h"
+
 namespace terralux {
 namespace {
 
@@ -28,81 +30,30 @@ namespace {
 // holds, so it cannot collide with a real height.
 constexpr double kWarpNodata = -3.0e38;
 
-void registerDriversOnce() {
-    static std::once_flag once;
-    std::call_once(once, [] { GDALAllRegister(); });
-}
-
-// GDAL reports through a global handler; keep its chatter off the user's terminal and fold its
-// last message into ours.
-class QuietGdalErrors {
-public:
-    QuietGdalErrors() {
-        CPLPushErrorHandler(CPLQuietErrorHandler);
-        CPLErrorReset();
-    }
-    ~QuietGdalErrors() { CPLPopErrorHandler(); }
-    static std::string last() {
-        std::string msg = CPLGetLastErrorMsg();
-        std::replace(msg.begin(), msg.end(), '\n', ' ');
-        return msg;
-    }
-};
-
-struct DatasetCloser {
-    void operator()(GDALDatasetH ds) const {
-        if (ds) GDALClose(ds);
-    }
-};
-using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
+using gdal::DatasetPtr;
+using gdal::fmt;
+using gdal::registerDriversOnce;
+using QuietGdalErrors = gdal::QuietErrors;
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
     throw DemError(path + ": " + what);
 }
 
-std::string withGdalReason(const std::string& what) {
-    const std::string reason = QuietGdalErrors::last();
-    return reason.empty() ? what : what + " (" + reason + ")";
-}
-
-// Runs a GDAL command-line utility (gdalwarp / gdal_translate semantics) into memory.
-template <typename NewOptions, typename FreeOptions, typename Run>
-DatasetPtr runUtility(const std::string& path, const std::vector<std::string>& args,
-                      NewOptions newOptions, FreeOptions freeOptions, Run run, const char* what) {
-    CPLStringList argv;
-    for (const auto& a : args) argv.AddString(a.c_str());
-    auto* options = newOptions(argv.List(), nullptr);
-    if (!options) fail(path, withGdalReason(std::string("invalid ") + what + " options"));
-    int usageError = 0;
-    GDALDatasetH out = run(options, &usageError);
-    freeOptions(options);
-    if (!out || usageError) fail(path, withGdalReason(std::string(what) + " failed"));
-    return DatasetPtr(out);
-}
+std::string withGdalReason(const std::string& what) { return gdal::withReason(what); }
 
 DatasetPtr warpTo(const std::string& path, GDALDatasetH src, const std::vector<std::string>& args) {
-    return runUtility(
-        path, args, GDALWarpAppOptionsNew, GDALWarpAppOptionsFree,
-        [&](GDALWarpAppOptions* o, int* usage) {
-            GDALDatasetH srcs[1] = {src};
-            return GDALWarp("", nullptr, 1, srcs, o, usage);
-        },
-        "reprojection");
+    std::string why;
+    DatasetPtr out = gdal::warp(src, args, why);
+    if (!out) fail(path, why);
+    return out;
 }
 
 DatasetPtr translateTo(const std::string& path, GDALDatasetH src,
                        const std::vector<std::string>& args) {
-    return runUtility(
-        path, args, GDALTranslateOptionsNew, GDALTranslateOptionsFree,
-        [&](GDALTranslateOptions* o, int* usage) { return GDALTranslate("", src, o, usage); },
-        "resampling");
-}
-
-std::string fmt(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
+    std::string why;
+    DatasetPtr out = gdal::translate(src, args, why);
+    if (!out) fail(path, why);
+    return out;
 }
 
 std::string srsName(const OGRSpatialReference& srs) {

@@ -1,4 +1,5 @@
 #include "GltfExport.h"
+#include "ImageFile.h"
 #include "ProbeDiagnosticsFile.h"
 
 #include <algorithm>
@@ -47,6 +48,9 @@ constexpr int kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962;
 constexpr int kElementArrayBuffer = 34963;
 constexpr int kTriangles = 4;
+constexpr int kLinear = 9729;
+constexpr int kLinearMipmapLinear = 9987;
+constexpr int kClampToEdge = 33071;
 
 // One file of the layout: where it goes below outDir and what it holds.
 struct PendingFile {
@@ -119,6 +123,15 @@ ojson floats(std::initializer_list<float> values) {
     return a;
 }
 
+// The albedo texture's samples: linear albedo to sRGB-encoded 8 bits, RGB.
+std::vector<uint8_t> srgbSamples(const SurfaceAlbedo& a) {
+    std::vector<uint8_t> out(a.linear.size() * 3);
+    for (size_t i = 0; i < a.linear.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            out[3 * i + size_t(c)] = uint8_t(std::lround(linearToSrgb(a.linear[i][c]) * 255.0f));
+    return out;
+}
+
 // Builds scene.bin and the mesh part of the glTF document.
 struct MeshBuild {
     std::vector<uint8_t> bin;
@@ -173,11 +186,21 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
             putF32(bin, n.z);
         }
     }
+    const SurfaceAlbedo* texture =
+        input.albedoTexture && !input.albedoTexture->empty() ? input.albedoTexture : nullptr;
     const size_t uvOffset = bin.size();
     for (int r : rows) {
         for (int c : cols) {
-            putF32(bin, float(double(c) / double(hf.width() - 1)));
-            putF32(bin, float(double(r) / double(hf.depth() - 1)));
+            const double u = double(c) / double(hf.width() - 1), v = double(r) / double(hf.depth() - 1);
+            if (texture) {
+                // Texel centres span the footprint corner to corner (SurfaceAlbedo.h), and glTF
+                // addresses texel i's centre at (i + 0.5) / size: corners land on corner texels.
+                putF32(bin, float((u * (texture->width - 1) + 0.5) / texture->width));
+                putF32(bin, float((v * (texture->height - 1) + 0.5) / texture->height));
+            } else {
+                putF32(bin, float(u));
+                putF32(bin, float(v));
+            }
         }
     }
     const size_t indexOffset = bin.size();
@@ -202,6 +225,18 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
     }
     const size_t indexBytes = bin.size() - indexOffset;
     padTo4(bin);
+    const size_t imageOffset = bin.size();
+    if (texture) {
+        std::vector<uint8_t> png;
+        try {
+            png = encodePng(uint32_t(texture->width), uint32_t(texture->height), 3, srgbSamples(*texture));
+        } catch (const std::exception& e) {
+            throw std::runtime_error(gltfPath.string() + ": albedo texture: " + e.what());
+        }
+        bin.insert(bin.end(), png.begin(), png.end());
+    }
+    const size_t imageBytes = bin.size() - imageOffset;
+    padTo4(bin);
 
     auto view = [](size_t offset, size_t length, int target) {
         return ojson{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}, {"target", target}};
@@ -216,12 +251,26 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
                              {"indices", 3},
                              {"material", 0},
                              {"mode", kTriangles}}})}}});
-    doc["materials"] = ojson::array({ojson{
-        {"name", "terrain"},
-        {"pbrMetallicRoughness",
-         {{"baseColorFactor", floats({input.albedo.r, input.albedo.g, input.albedo.b, 1.0f})},
-          {"metallicFactor", 0.0},
-          {"roughnessFactor", 1.0}}}}});
+    if (texture) {
+        doc["materials"] = ojson::array({ojson{
+            {"name", "terrain"},
+            {"pbrMetallicRoughness",
+             {{"baseColorTexture", {{"index", 0}, {"texCoord", 0}}},
+              {"baseColorFactor", floats({1.0f, 1.0f, 1.0f, 1.0f})},
+              {"metallicFactor", 0.0},
+              {"roughnessFactor", 1.0}}}}});
+        doc["samplers"] = ojson::array({ojson{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear},
+                                              {"wrapS", kClampToEdge}, {"wrapT", kClampToEdge}}});
+        doc["images"] = ojson::array({ojson{{"name", "terrain albedo"}, {"bufferView", 4}, {"mimeType", "image/png"}}});
+        doc["textures"] = ojson::array({ojson{{"sampler", 0}, {"source", 0}}});
+    } else {
+        doc["materials"] = ojson::array({ojson{
+            {"name", "terrain"},
+            {"pbrMetallicRoughness",
+             {{"baseColorFactor", floats({input.albedo.r, input.albedo.g, input.albedo.b, 1.0f})},
+              {"metallicFactor", 0.0},
+              {"roughnessFactor", 1.0}}}}});
+    }
     doc["accessors"] = ojson::array({
         ojson{{"name", "POSITION"}, {"bufferView", 0}, {"componentType", kFloat},
               {"count", vertexCount}, {"type", "VEC3"},
@@ -240,6 +289,9 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
         view(uvOffset, indexOffset - uvOffset, kArrayBuffer),
         view(indexOffset, indexBytes, kElementArrayBuffer),
     });
+    // An image's view has no target (glTF 2.0, 3.6.2.4: only vertex and index data have one).
+    if (texture)
+        doc["bufferViews"].push_back(ojson{{"buffer", 0}, {"byteOffset", imageOffset}, {"byteLength", imageBytes}});
     doc["buffers"] = ojson::array({ojson{{"uri", kBinName}, {"byteLength", bin.size()}}});
     return mesh;
 }
@@ -284,6 +336,10 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
                                      " = " + std::to_string(a) + " must be in [0, 1]");
         }
     }
+    if (const SurfaceAlbedo* t = input.albedoTexture; t && !t->empty() &&
+        t->linear.size() != size_t(t->width) * size_t(t->height))
+        throw std::runtime_error(gltfPath.string() + ": albedo texture of " + std::to_string(t->width) + " x " +
+                                 std::to_string(t->height) + " texels holds " + std::to_string(t->linear.size()));
     const GeoOrigin& geo = hf->geo;
     if (!std::isfinite(input.verticalScale) || !std::isfinite(geo.easting) ||
         !std::isfinite(geo.northing) || !std::isfinite(geo.height)) {

@@ -3,7 +3,8 @@
 // and the geo/bake metadata, written as
 //
 //   <outDir>/scene.gltf
-//   <outDir>/scene.bin                    only when the terrain has triangles
+//   <outDir>/scene.bin                    only when the terrain has triangles; also holds the
+//                                         terrain's albedo texture (a PNG) when it has one
 //   <outDir>/sh_coeffs/<volume>.shprobe   one file per probe volume
 //
 // Engine space is glTF space (Y up, right-handed: X east, Y up, Z south), so nothing is converted.
@@ -29,6 +30,7 @@
 #include "AtomicFile.h"
 #include "ShProbeFile.h"
 #include "terrain/Heightfield.h"
+#include "terrain/SurfaceAlbedo.h"
 
 namespace terralux {
 
@@ -42,6 +44,10 @@ struct GltfProbeVolume {
 struct GltfSceneInput {
     const Heightfield* heightfield = nullptr;
     glm::vec3 albedo{0.3f};  // base colour factor, each channel in [0, 1]
+    // When set and not empty: the terrain's base colour texture instead (docs/formats.md), an
+    // sRGB-encoded 8-bit PNG embedded in scene.bin, with TEXCOORD_0 on its texel centres and a
+    // white base colour factor. Must be over `heightfield`.
+    const SurfaceAlbedo* albedoTexture = nullptr;
     double verticalScale = 1.0;  // recorded in TERRALUX_geo; the heights are exported as they are
     std::vector<GltfProbeVolume> volumes;
     nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include "AtomicFile.h"
@@ -54,6 +55,24 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
         std::filesystem::remove(tmp, ec);
         throw FileWriteError(path.string() + ": cannot replace (" + reason + ")");
     }
+}
+
+std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, int channels,
+                               const std::vector<uint8_t>& samples) {
+    if (samples.size() != size_t(width) * height * size_t(channels))
+        throw ImageError("PNG encoding: data does not match " + std::to_string(width) + "x" +
+                         std::to_string(height) + "x" + std::to_string(channels));
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("png");
+    OIIO::ImageSpec spec(int(width), int(height), channels, OIIO::TypeDesc::UINT8);
+    if (!out || !out->set_ioproxy(&proxy) || !out->open("memory.png", spec) ||
+        !out->write_image(OIIO::TypeDesc::UINT8, samples.data()) || !out->close()) {
+        std::string why = out ? out->geterror() : OIIO::geterror();
+        std::replace(why.begin(), why.end(), '\n', ' ');
+        throw ImageError("PNG encoding failed (" + why + ")");
+    }
+    return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
 std::vector<float> readImageRgba(const std::filesystem::path& path, uint32_t& width,

@@ -18,6 +18,11 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
                 const std::vector<float>& rgba);
 ImageEncoding encodingFor(const std::filesystem::path& path);
 
+// Encodes 8-bit samples (width * height * channels, row 0 at the top) as a PNG file's bytes, in
+// memory. Throws ImageError when the encoder fails.
+std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, int channels,
+                               const std::vector<uint8_t>& samples);
+
 // Reads an image as RGBA float (8-bit files scaled to [0, 1]); for tests and tools.
 std::vector<float> readImageRgba(const std::filesystem::path& path, uint32_t& width,
                                  uint32_t& height);

@@ -175,6 +175,10 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
     skirtSun_ = L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
     // Hits per point: (x, z) of terrain hits; NaN x marks a skirt hit.
     std::vector<float> hitXZ(points * size_t(rays) * 2);
+    // A varying albedo: per point, the sum of the albedos its skirt hits reflect with (the skirt's
+    // irradiance is one constant, so this is all the gathers need of those hits).
+    const bool varying = L.variesOverTerrain();
+    std::vector<glm::vec3> skirtAlbedoSum(varying ? points : 0);
     BakeControl phase = control;
     phase.progress = control.progress ? [&](double f) { control.progress(0.8 * f); }
                                       : std::function<void(double)>();
@@ -189,7 +193,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
             -(hf.surfaceHeight(x, z + hz) - hf.surfaceHeight(x, z - hz)) / (2 * hz)));
         Rng rng(splitmix64(0x5EEDCACEull ^ uint64_t(i)));
         const glm::vec3 o = liftOff(p, n);
-        glm::vec3 sky(0.0f);
+        glm::vec3 sky(0.0f), skirtAlbedo(0.0f);
         const float offset = rng.next();
         const float solidAngle = 2.0f * kPi / float(rays);
         float* hits = &hitXZ[i * size_t(rays) * 2];
@@ -199,6 +203,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
             if (L.tracer->intersect(o, d, INFINITY, hit)) {
                 hits[2 * r] = hit.onTerrain ? hit.position.x : NAN;
                 hits[2 * r + 1] = hit.position.z;
+                if (!hit.onTerrain && varying) skirtAlbedo += L.albedoAt(hit);
             } else {
                 sky += L.sky.radiance(d, solidAngle);
                 hits[2 * r] = NAN;
@@ -207,6 +212,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
         }
         sunDirect_[i] = sunIrradiance(L, p, n, sunSamples, rng);
         direct[i] = sky * (kPi / float(rays)) + sunDirect_[i];
+        if (varying) skirtAlbedoSum[i] = skirtAlbedo;
     });
 
     // Gathers: E_b = E_0 + albedo / N × Σ E_{b-1}(hit) (cosine-weighted estimator of
@@ -218,6 +224,20 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
         gather.progress = control.progress
                               ? [&](double f) { control.progress(0.8 + 0.2 * (b + f) / bounces); }
                               : std::function<void(double)>();
+        if (varying) {
+            // The light a hit reflects is its own albedo times its irradiance.
+            parallelIndices(points, gather, [&](size_t i) {
+                const float* hits = &hitXZ[i * size_t(rays) * 2];
+                glm::vec3 sum = skirt_ * skirtAlbedoSum[i];
+                for (int r = 0; r < rays; ++r)
+                    if (!std::isnan(hits[2 * r]))
+                        sum += L.surface->at(hf, hits[2 * r], hits[2 * r + 1]) *
+                               interpolate(irradiance_, hits[2 * r], hits[2 * r + 1]);
+                next[i] = direct[i] + sum / float(rays);
+            });
+            irradiance_.swap(next);
+            continue;
+        }
         parallelIndices(points, gather, [&](size_t i) {
             const float* hits = &hitXZ[i * size_t(rays) * 2];
             glm::vec3 sum(0.0f);
@@ -294,7 +314,7 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
                     const glm::vec3 sun = hit.onTerrain
                                               ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
                                               : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
-                    radiance = L.albedo / kPi * (cache->indirectAt(hit) + sun);
+                    radiance = L.albedoAt(hit) / kPi * (cache->indirectAt(hit) + sun);
                 }
             } else {
                 radiance = L.sky.radiance(d, weight);
@@ -331,7 +351,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                                 const std::vector<uint64_t>& seeds, const BakeControl& control) {
     ProbeBake out(positions.size());
     rays = std::max(rays, 1);
-    const int depth = bounces == 0 ? 0 : referencePathLength(L.albedo);
+    const int depth = bounces == 0 ? 0 : referencePathLength(L.maxAlbedo());
     const float weight = 4.0f * kPi / float(rays);
     const glm::vec3 skirt = L.sky.openIrradianceUp() + L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
     std::atomic<uint64_t> traced{0};
@@ -355,7 +375,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
             } else if (depth > 0) {
                 // Path: at each terrain vertex, sun by a shadow ray plus one cosine-weighted
                 // continuation; throughput albedo per bounce.
-                glm::vec3 throughput = L.albedo / kPi;
+                glm::vec3 throughput = L.albedoAt(hit) / kPi;
                 for (int b = 0; b < depth; ++b) {
                     if (!hit.onTerrain) {
                         radiance += throughput * skirt;
@@ -379,8 +399,8 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                         break;
                     }
                     if (b + 1 == depth) break;
-                    throughput *= L.albedo;
                     hit = next;
+                    throughput *= L.albedoAt(hit);
                 }
             }
             sh::accumulate(acc, d0, radiance, weight);

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -20,6 +21,7 @@
 #include "bake/SphericalHarmonics.h"
 #include "bake/Sky.h"
 #include "scene/SceneDescription.h"
+#include "terrain/SurfaceAlbedo.h"
 
 namespace terralux {
 
@@ -44,6 +46,18 @@ struct BakeLighting {
     Sky sky = Sky::uniform(glm::vec3(0.0f));
     SunLight sun;
     glm::vec3 albedo{0.3f};
+    // Albedo that varies over the terrain (a map or the ramp), over the tracer's heightfield;
+    // null or empty: `albedo` everywhere. Shared: lightings are copied, the field is not.
+    std::shared_ptr<const SurfaceAlbedo> surface;
+
+    bool variesOverTerrain() const { return surface && !surface->empty(); }
+    // The albedo a ray hit reflects with.
+    glm::vec3 albedoAt(const RayHit& hit) const {
+        return variesOverTerrain() ? surface->at(tracer->heightfield(), hit.position.x, hit.position.z)
+                                   : albedo;
+    }
+    // Per channel, the largest albedo anywhere on the terrain.
+    glm::vec3 maxAlbedo() const { return variesOverTerrain() ? surface->maximum() : albedo; }
 };
 
 // Progress in [0, 1] of the current phase, and a cancel flag polled between work chunks.

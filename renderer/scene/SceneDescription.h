@@ -12,10 +12,35 @@
 
 namespace terralux {
 
+// Where the terrain's albedo comes from (docs/lighting.md, "Terrain albedo").
+enum class AlbedoMode { Constant, Map, Ramp };
+
+// Albedo by elevation and slope. Heights are metres of DEM elevation, strictly increasing, one
+// linear RGB colour each; between two stops the colour is interpolated linearly, below the first
+// and above the last it is held. Slopes from rockSlopeDeg[0] to [1] blend (smoothstep) to rock.
+// Defaults read as a mountain: green-brown valleys, grey-brown alpine ground, snow from 2800 m,
+// rock from 35 to 50 degrees. Linear albedos within the measured ranges of Oke, "Boundary Layer
+// Climates" (2nd ed., 1987), Table 1.1: grass and soils 0.1-0.25, rock 0.2-0.3, fresh snow
+// 0.75-0.95; vegetation sits low because it is darker in the visible than in the broadband.
+struct AlbedoRampSettings {
+    std::vector<double> heights{0.0, 1800.0, 2600.0, 2800.0};
+    std::vector<glm::vec3> colors{{0.12f, 0.14f, 0.07f},
+                                  {0.19f, 0.17f, 0.12f},
+                                  {0.24f, 0.22f, 0.19f},
+                                  {0.80f, 0.82f, 0.85f}};
+    glm::vec3 rockColor{0.25f, 0.22f, 0.19f};
+    std::array<double, 2> rockSlopeDeg{35.0, 50.0};
+};
+
 struct TerrainSettings {
     std::string dem;                 // path; relative paths are relative to the project file
     double verticalScale = 1.0;      // > 0
-    glm::vec3 albedo{0.3f, 0.3f, 0.3f};  // Lambertian, each in [0, 1]
+    // Lambertian, each in [0, 1]: the whole terrain in mode constant, and where a map does not
+    // cover the footprint in mode map.
+    glm::vec3 albedo{0.3f, 0.3f, 0.3f};
+    AlbedoMode albedoMode = AlbedoMode::Constant;
+    std::string albedoMap;           // RGB(A) raster for mode map; relative to the project file
+    AlbedoRampSettings ramp;         // mode ramp
     int maxResolution = 0;           // 0 = source resolution; else longest side, area-averaged
     bool skirt = true;               // ground continues beyond the footprint at the border height
     double roughness = 0.6;          // GGX roughness of the sun's highlight, [0.25, 1]

@@ -46,6 +46,46 @@ print(json.dumps(strip(json.load(open(sys.argv[1]))), sort_keys=True))' "$1"; }
       fail "bake_report.json differs beyond timings"
     grep -q "TimeSeconds\|time_s" "$work/a/scene.gltf" && fail "scene.gltf carries a timing"
     ;;
+  albedo_map)
+    # An albedo map drapes a PNG texture over the exported terrain; dem is the fixtures' folder.
+    "$terralux" --bake --dem "$dem/bigtujunga_utm11_crop.tif" --out "$work/out" --quality draft --quiet \
+      --set terrain.albedo_mode=map --set terrain.albedo_map="$dem/albedo_utm11.tif" >/dev/null || fail "bake exited $?"
+    python3 - "$work/out/scene.gltf" <<'PY' || fail "the glTF's albedo texture is not as expected"
+import json, struct, sys, zlib, os
+gltf = json.load(open(sys.argv[1]))
+bin_ = open(os.path.join(os.path.dirname(sys.argv[1]), gltf["buffers"][0]["uri"]), "rb").read()
+pbr = gltf["materials"][0]["pbrMetallicRoughness"]
+assert pbr["baseColorTexture"]["index"] == 0, pbr
+assert pbr["baseColorFactor"] == [1.0, 1.0, 1.0, 1.0], pbr
+image = gltf["images"][gltf["textures"][0]["source"]]
+assert image["mimeType"] == "image/png", image
+view = gltf["bufferViews"][image["bufferView"]]
+png = bin_[view.get("byteOffset", 0):view.get("byteOffset", 0) + view["byteLength"]]
+assert png[:8] == b"\x89PNG\r\n\x1a\n", png[:8]
+pos, idat, ihdr = 8, b"", None
+while pos < len(png):
+    n, kind = struct.unpack(">I4s", png[pos:pos + 8])
+    data = png[pos + 8:pos + 8 + n]
+    if kind == b"IHDR": ihdr = struct.unpack(">IIBBBBB", data)
+    if kind == b"IDAT": idat += data
+    pos += 12 + n
+w, h, depth, colour = ihdr[:4]
+# The map's 15 m over the crop's 2850 x 1890 m footprint, texel centres on its corners.
+assert (w, h, depth, colour) == (191, 127, 8, 2), ihdr
+assert len(zlib.decompress(idat)) == h * (1 + 3 * w), "the PNG does not decode to 191 x 127 RGB"
+# TEXCOORD_0 puts the footprint's corners on the corner texels' centres.
+uv = gltf["accessors"][gltf["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"]]
+uvView = gltf["bufferViews"][uv["bufferView"]]
+first = struct.unpack_from("<2f", bin_, uvView["byteOffset"])
+last = struct.unpack_from("<2f", bin_, uvView["byteOffset"] + 8 * (uv["count"] - 1))
+near = lambda a, b: abs(a - b) < 1e-6
+assert near(first[0], 0.5 / w) and near(first[1], 0.5 / h), first
+assert near(last[0], 1 - 0.5 / w) and near(last[1], 1 - 0.5 / h), last
+PY
+    "$validator" "$work/out/scene.gltf" "$build"
+    rc=$?; [ $rc -eq 0 ] || [ $rc -eq 77 ] || fail "glTF validator reported errors"
+    [ $rc -eq 77 ] && exit 77
+    ;;
   replace)
     # A renamed volume and a scene switched off leave none of the earlier bake's files behind.
     "$terralux" --bake --out "$work/out" --quiet --quality draft >/dev/null || fail "first bake"

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 #include <unistd.h>
@@ -603,4 +604,59 @@ TEST_F(GltfExport, TheMeshIsTheTracedSurfaceAboveAMillionVertices) {
     const json& indices = doc["accessors"][prim["indices"].get<int>()];
     EXPECT_EQ(indices["componentType"], 5125);  // UNSIGNED_INT
     EXPECT_EQ(indices["count"], 6 * 1099 * 999);
+}
+
+TEST_F(GltfExport, AnAlbedoFieldIsAnEmbeddedSrgbPngWithUvsOnItsTexelCentres) {
+    const Heightfield hf = makeHeightfield(5, 4);
+    SurfaceAlbedo field;
+    field.width = 3;
+    field.height = 2;
+    field.linear = {glm::vec3(0.0f), glm::vec3(0.5f, 0.2f, 0.1f), glm::vec3(1.0f),
+                    glm::vec3(0.21586050f), glm::vec3(0.8f, 0.82f, 0.85f), glm::vec3(0.0031308f)};
+    GltfSceneInput in = sampleInput(hf);
+    in.albedoTexture = &field;
+    const GltfExportResult res = exportGltfScene(dir, in);
+    // Still the two scene files: the image lives in scene.bin.
+    EXPECT_EQ(res.files.size(), 4u);
+
+    Loaded l = load(dir / "scene.gltf");
+    ASSERT_TRUE(l.ok) << l.err;
+    EXPECT_EQ(l.warn, "");
+    const tinygltf::Model& m = l.model;
+    const tinygltf::PbrMetallicRoughness& pbr = m.materials.at(0).pbrMetallicRoughness;
+    EXPECT_EQ(pbr.baseColorTexture.index, 0);
+    EXPECT_EQ(pbr.baseColorTexture.texCoord, 0);
+    EXPECT_EQ(pbr.baseColorFactor, std::vector<double>({1.0, 1.0, 1.0, 1.0}));
+    const tinygltf::Image& image = m.images.at(size_t(m.textures.at(0).source));
+    EXPECT_EQ(image.mimeType, "image/png");
+    ASSERT_EQ(image.width, 3);
+    ASSERT_EQ(image.height, 2);
+    ASSERT_GE(image.component, 3);
+    // Each texel is the sRGB encoding of its linear albedo, row 0 (north) first.
+    for (size_t i = 0; i < field.linear.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(int(image.image.at(i * size_t(image.component) + size_t(c))),
+                      int(std::lround(linearToSrgb(field.linear[i][c]) * 255.0f)))
+                << "texel " << i << " channel " << c;
+    EXPECT_EQ(int(image.image[3 * size_t(image.component)]), 128);  // 0.21586050 is sRGB 128/255
+
+    // Vertex (col, row) samples the field where SurfaceAlbedo::at does: corners on corner texel
+    // centres, the middle column on the middle texel's centre.
+    const auto& prim = m.meshes.at(0).primitives.at(0);
+    const std::vector<float> uv = floatData(m, prim.attributes.at("TEXCOORD_0"));
+    ASSERT_EQ(uv.size(), size_t(2 * 5 * 4));
+    auto at = [&](int col, int row) { return glm::vec2(uv[2 * size_t(row * 5 + col)], uv[2 * size_t(row * 5 + col) + 1]); };
+    EXPECT_FLOAT_EQ(at(0, 0).x, 0.5f / 3.0f);
+    EXPECT_FLOAT_EQ(at(0, 0).y, 0.5f / 2.0f);
+    EXPECT_FLOAT_EQ(at(2, 0).x, 0.5f);
+    EXPECT_FLOAT_EQ(at(4, 3).x, 1.0f - 0.5f / 3.0f);
+    EXPECT_FLOAT_EQ(at(4, 3).y, 1.0f - 0.5f / 2.0f);
+
+    // An empty field is the constant material, as before.
+    SurfaceAlbedo empty;
+    in.albedoTexture = &empty;
+    exportGltfScene(dir, in);
+    const json doc = readJson(dir / "scene.gltf");
+    EXPECT_FALSE(doc["materials"][0]["pbrMetallicRoughness"].contains("baseColorTexture"));
+    EXPECT_FALSE(doc.contains("images"));
 }

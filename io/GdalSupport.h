@@ -1,0 +1,67 @@
+#pragma once
+// What every GDAL reader in io/ shares: driver registration, quiet errors folded into our
+// messages, and datasets that close themselves. Internal to io/ (nothing outside links GDAL).
+
+#include <algorithm>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <cpl_error.h>
+#include <gdal.h>
+
+namespace terralux::gdal {
+
+inline void registerDriversOnce() {
+    static std::once_flag once;
+    std::call_once(once, [] { GDALAllRegister(); });
+}
+
+// GDAL reports through a global handler; keep its chatter off the user's terminal and fold its
+// last message into ours.
+class QuietErrors {
+public:
+    QuietErrors() {
+        CPLPushErrorHandler(CPLQuietErrorHandler);
+        CPLErrorReset();
+    }
+    ~QuietErrors() { CPLPopErrorHandler(); }
+    QuietErrors(const QuietErrors&) = delete;
+    QuietErrors& operator=(const QuietErrors&) = delete;
+    static std::string last() {
+        std::string msg = CPLGetLastErrorMsg();
+        std::replace(msg.begin(), msg.end(), '\n', ' ');
+        return msg;
+    }
+};
+
+struct DatasetCloser {
+    void operator()(GDALDatasetH ds) const {
+        if (ds) GDALClose(ds);
+    }
+};
+using DatasetPtr = std::unique_ptr<void, DatasetCloser>;
+
+// "what (GDAL's last message)", or just "what" when GDAL said nothing.
+inline std::string withReason(const std::string& what) {
+    const std::string reason = QuietErrors::last();
+    return reason.empty() ? what : what + " (" + reason + ")";
+}
+
+// A number as GDAL's utilities read it back exactly.
+inline std::string fmt(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
+}
+
+// gdalwarp / gdal_translate (their library form) on `src`, with command-line `args`; the result
+// is what `-of` names (MEM in memory). Null on failure, with `why` saying what failed and GDAL's
+// reason.
+DatasetPtr warp(GDALDatasetH src, const std::vector<std::string>& args, std::string& why);
+DatasetPtr translate(GDALDatasetH src, const std::vector<std::string>& args, std::string& why);
+
+}  // namespace terralux::gdal

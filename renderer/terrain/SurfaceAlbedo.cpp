@@ -1,0 +1,94 @@
+#include "terrain/SurfaceAlbedo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/common.hpp>
+
+namespace terralux {
+
+glm::vec3 SurfaceAlbedo::at(const Heightfield& terrain, float x, float z) const {
+    if (empty()) return fallback;
+    const float spanX = terrain.maxX() - terrain.minX(), spanZ = terrain.maxZ() - terrain.minZ();
+    const float fx = width > 1 && spanX > 0.0f
+                         ? std::clamp((x - terrain.minX()) / spanX, 0.0f, 1.0f) * float(width - 1)
+                         : 0.0f;
+    const float fz = height > 1 && spanZ > 0.0f
+                         ? std::clamp((z - terrain.minZ()) / spanZ, 0.0f, 1.0f) * float(height - 1)
+                         : 0.0f;
+    const int ix = std::min(int(fx), std::max(width - 2, 0));
+    const int iz = std::min(int(fz), std::max(height - 2, 0));
+    const int ix1 = std::min(ix + 1, width - 1), iz1 = std::min(iz + 1, height - 1);
+    const float tx = fx - float(ix), tz = fz - float(iz);
+    const size_t row0 = size_t(iz) * size_t(width), row1 = size_t(iz1) * size_t(width);
+    return (1.0f - tz) * ((1.0f - tx) * linear[row0 + ix] + tx * linear[row0 + ix1]) +
+           tz * ((1.0f - tx) * linear[row1 + ix] + tx * linear[row1 + ix1]);
+}
+
+glm::vec3 SurfaceAlbedo::maximum() const {
+    if (empty()) return fallback;
+    glm::vec3 m(0.0f);
+    for (const glm::vec3& a : linear) m = glm::max(m, a);
+    return m;
+}
+
+glm::vec3 rampColor(const AlbedoRampSettings& ramp, double elevation, double slopeDeg) {
+    const auto& h = ramp.heights;
+    const auto& c = ramp.colors;
+    glm::vec3 ground = c.empty() ? glm::vec3(0.0f) : c.front();
+    if (!h.empty() && c.size() == h.size()) {
+        if (elevation >= h.back()) {
+            ground = c.back();
+        } else if (elevation > h.front()) {
+            const size_t k = size_t(std::upper_bound(h.begin(), h.end(), elevation) - h.begin());
+            const float t = float((elevation - h[k - 1]) / (h[k] - h[k - 1]));
+            ground = glm::mix(c[k - 1], c[k], t);
+        }
+    }
+    // smoothstep(e0, e1, slope) = t²(3 − 2t), t = clamp((slope − e0)/(e1 − e0), 0, 1)
+    // (the GLSL definition, GLSL 4.60 specification §8.3).
+    const double e0 = ramp.rockSlopeDeg[0], e1 = ramp.rockSlopeDeg[1];
+    double t = e1 > e0 ? (slopeDeg - e0) / (e1 - e0) : (slopeDeg >= e0 ? 1.0 : 0.0);
+    t = std::clamp(t, 0.0, 1.0);
+    const float rock = float(t * t * (3.0 - 2.0 * t));
+    return glm::mix(ground, ramp.rockColor, rock);
+}
+
+SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& ramp,
+                         double verticalScale, glm::vec3 fallback) {
+    SurfaceAlbedo out;
+    out.fallback = fallback;
+    const int w = terrain.width(), d = terrain.depth();
+    const double shrink = std::min(1.0, double(kMaxSurfaceAlbedoSide) / double(std::max(w, d)));
+    out.width = shrink < 1.0 ? std::max(2, int(std::lround(w * shrink))) : w;
+    out.height = shrink < 1.0 ? std::max(2, int(std::lround(d * shrink))) : d;
+    out.linear.resize(size_t(out.width) * size_t(out.height));
+    const double scale = verticalScale > 0.0 ? verticalScale : 1.0;
+    // Texel i's centre lies at vertex i (w − 1)/(width − 1): the vertex itself at full size.
+    auto vertexOf = [](int i, int texels, int vertices) {
+        return texels > 1 ? int(std::lround(double(i) * (vertices - 1) / (texels - 1))) : 0;
+    };
+    for (int j = 0; j < out.height; ++j)
+        for (int i = 0; i < out.width; ++i) {
+            const int c = vertexOf(i, out.width, w), r = vertexOf(j, out.height, d);
+            const double elevation = (double(terrain.at(c, r)) + terrain.geo.height) / scale;
+            const double slope = std::acos(std::clamp(double(terrain.vertexNormal(c, r).y), -1.0, 1.0)) *
+                                 180.0 / std::numbers::pi;
+            out.linear[size_t(j) * size_t(out.width) + size_t(i)] = rampColor(ramp, elevation, slope);
+        }
+    return out;
+}
+
+// IEC 61966-2-1:1999, §5.2: the piecewise curve with the linear toe below 0.04045.
+float srgbToLinear(float v) {
+    const double e = std::clamp(double(v), 0.0, 1.0);
+    return float(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+}
+
+float linearToSrgb(float v) {
+    const double l = std::clamp(double(v), 0.0, 1.0);
+    return float(l <= 0.0031308 ? l * 12.92 : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055);
+}
+
+}  // namespace terralux
