@@ -583,6 +583,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         in.heightfield = &hf;
         in.albedo = scene.terrain.albedo;
         in.albedoTexture = lighting.surface.get();
+        in.roughness = float(project.scene.terrain.roughness);
         in.verticalScale = scene.terrain.verticalScale;
         in.volumes = grids;
         in.bake = bakeInfo;

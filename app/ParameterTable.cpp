@@ -249,7 +249,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("terrain.skirt", T::Boolean)).label("Ground beyond border")
         .about("The ground continues beyond the footprint at the border height (rays leaving the DEM still meet terrain)")
         .redoes(kRebake).field(&SceneDescription::terrain, &TerrainSettings::skirt);
-    add(Row("terrain.roughness", T::Number)).range(0.25, 1.0).decimals(2).slider().label("Roughness")
+    add(Row("terrain.roughness", T::Number)).range(kRoughnessFloor, 1.0).decimals(2).slider().label("Roughness")
         .about("GGX roughness of the sun's highlight on the ground, before the normal variance widens it (0.25 is the floor)")
         .redoes(kUpload).field(&SceneDescription::terrain, &TerrainSettings::roughness);
     add(Row("terrain.specular_aa", T::Boolean)).label("Normal-variance specular")
@@ -847,14 +847,16 @@ std::string cell(std::string s) {
 
 ParameterDock parameterDock(const ParameterSpec& spec) {
     const std::string section = spec.path.substr(0, spec.path.find_first_of(".["));
-    if (section == "terrain" && spec.path != "terrain.roughness" && spec.path != "terrain.specular_aa")
-        return {"dock.terrain", "Terrain"};
+    // The terrain's surface (its colour and shading) has a dock of its own; the Terrain dock keeps
+    // what shapes the heightfield.
+    const bool surface = spec.path.rfind("terrain.albedo", 0) == 0 || spec.path.rfind("terrain.ramp_", 0) == 0 ||
+                         spec.path == "terrain.roughness" || spec.path == "terrain.specular_aa";
+    if (section == "terrain" && !surface) return {"dock.terrain", "Terrain"};
     if (section == "sun" || section == "sky") return {"dock.sunSky", "Sun & Sky"};
     if (section == "probe_volumes") return {"dock.probeVolumes", "Probe Volumes"};
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
     if (section == "shadows") return {"dock.shadows", "Shadows"};
-    if (section == "detail" || spec.path == "terrain.roughness" || spec.path == "terrain.specular_aa")
-        return {"dock.surface", "Surface"};
+    if (section == "detail" || surface) return {"dock.surface", "Surface"};
     if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     return {"", ""};

@@ -35,8 +35,8 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
     : ProjectRenderer(ctx, project, loadProjectTerrain(project)) {}
 
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
-                                 DemImportResult terrain)
-    : project_(project), terrain_(std::move(terrain)) {
+                                 DemImportResult terrain, bool computeAo)
+    : project_(project), terrain_(std::move(terrain)), computeAo_(computeAo) {
     renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
     setProject(project);
 }
@@ -63,6 +63,19 @@ void ProjectRenderer::setProject(const Project& project) {
             albedoError_ = e.what();
         }
     }
+    if (albedo_.get() != uploadedAlbedo_) {
+        uploadedAlbedo_ = albedo_.get();
+        if (albedo_)
+            renderer_->setAlbedoMap(albedo_->width, albedo_->height, albedo_->linear);
+        else
+            renderer_->setAlbedoMap(0, 0, {});
+    }
+    base_.surface.ao = scene.ao.enabled;
+    base_.surface.aoStrength = float(scene.ao.strength);
+    if (computeAo_ && !aoCurrent()) {
+        const HorizonAoSettings wanted = *wantedAo();
+        setAmbientOcclusion(wanted, horizonSkyVisibility(terrain_.heightfield, wanted));
+    }
     base_.sun = lighting.sun;
     base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
@@ -86,6 +99,23 @@ void ProjectRenderer::setProject(const Project& project) {
         }
     }
     updateOverlays();
+}
+
+std::optional<HorizonAoSettings> ProjectRenderer::wantedAo() const {
+    const AoSettings& ao = project_.scene.ao;
+    if (!ao.enabled) return std::nullopt;
+    return HorizonAoSettings{ao.directions, ao.maxDistance.value_or(0.0)};
+}
+
+bool ProjectRenderer::aoCurrent() const {
+    const auto wanted = wantedAo();
+    if (!wanted) return true;
+    return boundAo_ && boundAo_->directions == wanted->directions && boundAo_->maxDistance == wanted->maxDistance;
+}
+
+void ProjectRenderer::setAmbientOcclusion(const HorizonAoSettings& settings, const std::vector<float>& field) {
+    renderer_->setAmbientOcclusion(field);
+    boundAo_ = settings;
 }
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {

@@ -12,6 +12,7 @@
 #include "DemImport.h"
 #include "Project.h"
 #include "render/TerrainRenderer.h"
+#include "terrain/HorizonAO.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux {
@@ -42,8 +43,11 @@ class ProjectRenderer {
 public:
     // Loads the terrain and sky; the Vulkan context must outlive this object.
     ProjectRenderer(vk::VulkanContext& ctx, const Project& project);
-    // With a terrain already imported (the UI holds one).
-    ProjectRenderer(vk::VulkanContext& ctx, const Project& project, DemImportResult terrain);
+    // With a terrain already imported (the UI holds one). `computeAo` false: the horizon AO of
+    // the project is not computed here but handed in with setAmbientOcclusion (the UI computes
+    // it off its thread); until then the terrain is drawn without AO.
+    ProjectRenderer(vk::VulkanContext& ctx, const Project& project, DemImportResult terrain,
+                    bool computeAo = true);
     ~ProjectRenderer();
 
     // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder, with its
@@ -84,6 +88,13 @@ public:
     // project's albedo map cannot be read (albedoError() says why; the bake reports it too).
     const std::shared_ptr<const SurfaceAlbedo>& surfaceAlbedo() const { return albedo_; }
     const std::string& albedoError() const { return albedoError_; }
+    // The horizon AO field the project asks for: its settings, or null when ao.enabled is off.
+    std::optional<HorizonAoSettings> wantedAo() const;
+    // Whether the bound AO field is the one the project asks for (or none is asked for).
+    bool aoCurrent() const;
+    // Binds a horizon AO field computed for `settings` over this renderer's terrain
+    // (horizonSkyVisibility, one value per vertex).
+    void setAmbientOcclusion(const HorizonAoSettings& settings, const std::vector<float>& field);
     TerrainRenderer& renderer() { return *renderer_; }
 
     // One volume's overlay records: probe markers and octree leaves.
@@ -109,6 +120,9 @@ private:
     std::shared_ptr<const SurfaceAlbedo> albedo_;
     std::string albedoError_;
     std::string albedoKey_;  // the terrain section albedo_ was made for
+    const SurfaceAlbedo* uploadedAlbedo_ = nullptr;  // the field the renderer holds
+    bool computeAo_ = true;
+    std::optional<HorizonAoSettings> boundAo_;  // the settings of the bound AO field
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;
 };

@@ -185,6 +185,16 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     fog["resolved_base_height"] = scene.fog.baseHeight ? fogAuthored.at("base_height")
                                                        : nlohmann::json(shortestDecimal(hf.minHeight()));
     fog["resolved_color"] = scene.fog.color ? fogAuthored.at("color") : shortest(*resolvedFog(scene.fog, l.sky, hf).color);
+
+    // The terrain's specular and occlusion as the renderer shades it (docs/lighting.md, "Terrain
+    // surface"): GGX roughness before the normals' variance widens it, whether it does, the floor
+    // it never goes below, and the horizon AO and micro-detail settings.
+    const nlohmann::json& terrain = authored.at("terrain");
+    ext["surface"] = {{"roughness", terrain.at("roughness")},
+                      {"roughness_floor", kRoughnessFloor},
+                      {"specular_aa", terrain.at("specular_aa")},
+                      {"ao", authored.at("ao")},
+                      {"detail", authored.at("detail")}};
     return ext;
 }
 

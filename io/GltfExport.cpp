@@ -258,7 +258,7 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
              {{"baseColorTexture", {{"index", 0}, {"texCoord", 0}}},
               {"baseColorFactor", floats({1.0f, 1.0f, 1.0f, 1.0f})},
               {"metallicFactor", 0.0},
-              {"roughnessFactor", 1.0}}}}});
+              {"roughnessFactor", double(input.roughness)}}}}});
         doc["samplers"] = ojson::array({ojson{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear},
                                               {"wrapS", kClampToEdge}, {"wrapT", kClampToEdge}}});
         doc["images"] = ojson::array({ojson{{"name", "terrain albedo"}, {"bufferView", 4}, {"mimeType", "image/png"}}});
@@ -269,7 +269,7 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
             {"pbrMetallicRoughness",
              {{"baseColorFactor", floats({input.albedo.r, input.albedo.g, input.albedo.b, 1.0f})},
               {"metallicFactor", 0.0},
-              {"roughnessFactor", 1.0}}}}});
+              {"roughnessFactor", double(input.roughness)}}}}});
     }
     doc["accessors"] = ojson::array({
         ojson{{"name", "POSITION"}, {"bufferView", 0}, {"componentType", kFloat},

@@ -48,6 +48,7 @@ struct GltfSceneInput {
     // sRGB-encoded 8-bit PNG embedded in scene.bin, with TEXCOORD_0 on its texel centres and a
     // white base colour factor. Must be over `heightfield`.
     const SurfaceAlbedo* albedoTexture = nullptr;
+    float roughness = 1.0f;  // the material's roughnessFactor (terrain.roughness), in [0, 1]
     double verticalScale = 1.0;  // recorded in TERRALUX_geo; the heights are exported as they are
     std::vector<GltfProbeVolume> volumes;
     nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object

@@ -1,5 +1,6 @@
 #include "MainWindow.h"
 
+#include <chrono>
 #include <functional>
 
 #include <QAbstractSpinBox>
@@ -242,6 +243,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
 MainWindow::~MainWindow() {
     previewCancel_ = true;
     if (previewWorker_.joinable()) previewWorker_.join();
+    stopAmbientOcclusion();
     bake_->cancel();
     bake_->wait();
     delete viewport_;  // before the device it presents with
@@ -278,8 +280,13 @@ void MainWindow::buildDocks() {
     auto* importDem = new QPushButton("Import DEM…");
     importDem->setObjectName("terrain.import");
     tv->addWidget(importDem);
+    // The rows of one dock of the parameter table (parameterDock), in table order.
+    auto addDockRows = [](ParameterForm* form, const std::string& dockName) {
+        for (const auto& spec : parameterTable())
+            if (spec.uiRow && parameterDock(spec).objectName == dockName) form->addParameter(spec.path);
+    };
     auto* tf = new ParameterForm(doc_);
-    tf->addParameters("terrain.");
+    addDockRows(tf, "dock.terrain");
     tv->addWidget(tf);
     tv->addStretch(1);
     connectRejected(tf);
@@ -338,6 +345,57 @@ void MainWindow::buildDocks() {
     atmosphere->addParameter("camera.exposure_ev");
     connectRejected(atmosphere);
     auto* atmosphereDock = dock("Atmosphere", "dock.atmosphere", atmosphere);
+
+    // Surface: albedo, roughness and micro-detail.
+    auto* surface = new QWidget;
+    auto* uv = new QVBoxLayout(surface);
+    auto* uf = new ParameterForm(doc_);
+    addDockRows(uf, "dock.surface");
+    connectRejected(uf);
+    uv->addWidget(uf);
+    auto* importAlbedo = new QPushButton("Import albedo map…");
+    importAlbedo->setObjectName("surface.importAlbedo");
+    importAlbedo->setToolTip("An orthophoto or any RGB raster GDAL reads, draped over the DEM by its georeferencing");
+    uv->addWidget(importAlbedo);
+    connect(importAlbedo, &QPushButton::clicked, this, [this] {
+        const QString f = QFileDialog::getOpenFileName(this, "Import albedo map", QString(),
+                                                       "Rasters (*.tif *.tiff *.png *.jpg *.jpeg *.vrt *.jp2);;All files (*)");
+        if (f.isEmpty()) return;
+        QString error;
+        if (!doc_->importAlbedoMap(f, &error)) showError("Import albedo map", error);
+    });
+    albedoStatus_ = new QLabel;
+    albedoStatus_->setObjectName("surface.albedoStatus");
+    albedoStatus_->setWordWrap(true);
+    uv->addWidget(albedoStatus_);
+    uv->addStretch(1);
+    auto* surfaceDock = dock("Surface", "dock.surface", surface);
+
+    // Ambient occlusion: its settings and the progress of the field.
+    auto* ao = new QWidget;
+    auto* av = new QVBoxLayout(ao);
+    auto* af = new ParameterForm(doc_);
+    addDockRows(af, "dock.ao");
+    connectRejected(af);
+    av->addWidget(af);
+    aoProgress_ = new QProgressBar;
+    aoProgress_->setObjectName("ao.progress");
+    aoProgress_->setRange(0, 100);
+    aoProgress_->setVisible(false);
+    av->addWidget(aoProgress_);
+    aoStatus_ = new QLabel;
+    aoStatus_->setObjectName("ao.status");
+    aoStatus_->setWordWrap(true);
+    av->addWidget(aoStatus_);
+    auto* showAo = new QPushButton("Show AO");
+    showAo->setObjectName("ao.show");
+    showAo->setToolTip("Shows debug view 28, the sky visibility the renderer darkens with");
+    connect(showAo, &QPushButton::clicked, this, [this] {
+        viewSelector_->setCurrentIndex(viewSelector_->findData(kViewAo));
+    });
+    av->addWidget(showAo);
+    av->addStretch(1);
+    auto* aoDock = dock("Ambient Occlusion", "dock.ao", ao);
 
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
@@ -398,11 +456,13 @@ void MainWindow::buildDocks() {
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
     auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
 
-    for (auto* f : {tf, sky, sf, atmosphere, bf}) f->refresh();
+    for (auto* f : {tf, sky, sf, atmosphere, uf, af, bf}) f->refresh();
     // The lighting docks share the upper tab group with the terrain.
     tabifyDockWidget(terrainDock, skyDock);
     tabifyDockWidget(skyDock, shadowsDock);
     tabifyDockWidget(shadowsDock, atmosphereDock);
+    tabifyDockWidget(atmosphereDock, surfaceDock);
+    tabifyDockWidget(surfaceDock, aoDock);
     tabifyDockWidget(volumesDock, bakeDock);
     terrainDock->raise();
     volumesDock->raise();
@@ -799,7 +859,8 @@ void MainWindow::rebuildRenderer() {
     // A preview that finished for the terrain before may still be queued: it must not land.
     ++previewGeneration_;
     viewport_->setRenderer(nullptr);
-    renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain());
+    stopAmbientOcclusion();
+    renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
     viewport_->setCamera(renderer_->defaultCamera());
     // An untitled project with a relative output folder has no bake of its own yet.
     const auto folder = bakeFolder();
@@ -808,13 +869,16 @@ void MainWindow::rebuildRenderer() {
     viewport_->setRenderer(renderer_.get());
     const Heightfield& hf = doc_->terrain().heightfield;
     const DemSourceInfo& s = doc_->terrain().source;
-    terrainSummary_->setText(QString("%1\n%2 × %3 vertices, %4 × %5 m cells\n%6 … %7 m, %8 nodata cells filled\n%9")
+    const double filledShare = 100.0 * double(hf.nodataCount()) / double(hf.heights().size());
+    terrainSummary_->setText(QString("%1\n%2 × %3 vertices, %4 × %5 m cells\n%6 … %7 m, %8 nodata cells filled (%10 %)\n%9")
                                  .arg(QString::fromStdString(s.path))
                                  .arg(hf.width()).arg(hf.depth())
                                  .arg(hf.cellSizeX(), 0, 'f', 2).arg(hf.cellSizeZ(), 0, 'f', 2)
                                  .arg(hf.minHeight(), 0, 'f', 1).arg(hf.maxHeight(), 0, 'f', 1)
                                  .arg(hf.nodataCount())
-                                 .arg(QString::fromStdString(hf.geo.crsName.empty() ? "no CRS" : hf.geo.crsName)));
+                                 .arg(QString::fromStdString(hf.geo.crsName.empty() ? "no CRS" : hf.geo.crsName))
+                                 .arg(filledShare, 0, 'f', filledShare > 0.0 && filledShare < 0.1 ? 3 : 1));
+    updateAmbientOcclusion();
     if (!baked) schedulePreview();
     updateStatus();
 }
@@ -822,7 +886,83 @@ void MainWindow::rebuildRenderer() {
 void MainWindow::refreshLighting() {
     if (!renderer_) return;
     renderer_->setProject(doc_->project());
+    albedoStatus_->setText(renderer_->albedoError().empty()
+                               ? QString()
+                               : "Drawn with the constant albedo: " + QString::fromStdString(renderer_->albedoError()));
+    updateAmbientOcclusion();
     viewport_->requestUpdate();
+}
+
+void MainWindow::stopAmbientOcclusion() {
+    aoCancel_ = true;
+    if (aoWorker_.joinable()) aoWorker_.join();
+    aoCancel_ = false;
+    aoRunning_.reset();
+    ++aoGeneration_;  // a result already queued must not land
+    if (aoProgress_) aoProgress_->setVisible(false);
+}
+
+void MainWindow::updateAmbientOcclusion() {
+    if (!renderer_) return;
+    const auto wanted = renderer_->wantedAo();
+    if (!wanted) {
+        stopAmbientOcclusion();
+        aoStatus_->setText("Off: sky and probe light are not darkened by the terrain's horizon.");
+        return;
+    }
+    if (renderer_->aoCurrent()) {
+        if (aoRunning_) stopAmbientOcclusion();
+        return;
+    }
+    if (aoRunning_ && aoRunning_->directions == wanted->directions && aoRunning_->maxDistance == wanted->maxDistance)
+        return;
+    stopAmbientOcclusion();
+    aoRunning_ = wanted;
+    const unsigned generation = aoGeneration_;
+    aoProgress_->setValue(0);
+    aoProgress_->setVisible(true);
+    aoStatus_->setText(QString("Computing %1 directions over %2 vertices…")
+                           .arg(wanted->directions)
+                           .arg(QLocale().toString(qulonglong(renderer_->heightfield().heights().size()))));
+    auto terrain = doc_->terrainShared();
+    aoWorker_ = std::thread([this, terrain, settings = *wanted, generation] {
+        const auto start = std::chrono::steady_clock::now();
+        auto shown = std::make_shared<std::atomic<int>>(-1);
+        std::vector<float> field;
+        try {
+            field = horizonSkyVisibility(terrain->heightfield, settings, [this, shown, generation](double f) {
+                const int percent = int(f * 100.0);
+                if (shown->exchange(percent) != percent)
+                    QMetaObject::invokeMethod(this, [this, percent, generation] {
+                        if (generation == aoGeneration_) aoProgress_->setValue(percent);
+                    }, Qt::QueuedConnection);
+                return !aoCancel_.load();
+            });
+        } catch (const std::exception& e) {
+            const QString message = QString::fromStdString(e.what());
+            QMetaObject::invokeMethod(this, [this, message, generation] {
+                if (generation != aoGeneration_) return;
+                aoRunning_.reset();
+                aoProgress_->setVisible(false);
+                aoStatus_->setText("Not computed: " + message);
+            }, Qt::QueuedConnection);
+            return;
+        }
+        if (field.empty()) return;  // cancelled
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        auto result = std::make_shared<std::vector<float>>(std::move(field));
+        QMetaObject::invokeMethod(this, [this, result, settings, seconds, generation] {
+            if (generation != aoGeneration_ || !renderer_) return;
+            renderer_->setAmbientOcclusion(settings, *result);
+            aoRunning_.reset();
+            aoProgress_->setVisible(false);
+            aoStatus_->setText(QString("%1 directions over %2 vertices in %3 s")
+                                   .arg(settings.directions)
+                                   .arg(QLocale().toString(qulonglong(result->size())))
+                                   .arg(seconds, 0, 'f', 2));
+            viewport_->requestUpdate();
+        }, Qt::QueuedConnection);
+    });
 }
 
 void MainWindow::schedulePreview() { previewTimer_.start(); }

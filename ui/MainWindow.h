@@ -84,6 +84,10 @@ private:
     void updateOutputPath();
     void rebuildRenderer();
     void refreshLighting();
+    // Starts the horizon AO the project asks for on a worker, unless the renderer has it or it
+    // is under way; the result lands in the renderer on the UI thread.
+    void updateAmbientOcclusion();
+    void stopAmbientOcclusion();
     void schedulePreview();
     void startPreview();
     void updateEstimate();
@@ -127,6 +131,13 @@ private:
     QMenu* recentMenu_ = nullptr;
     QTimer previewTimer_, autosaveTimer_;
     std::thread previewWorker_;
+    std::thread aoWorker_;
+    std::atomic<bool> aoCancel_{false};
+    unsigned aoGeneration_ = 0;
+    std::optional<HorizonAoSettings> aoRunning_;  // the settings the worker computes
+    QProgressBar* aoProgress_ = nullptr;
+    QLabel* aoStatus_ = nullptr;
+    QLabel* albedoStatus_ = nullptr;
     std::atomic<bool> previewCancel_{false};
     unsigned previewGeneration_ = 0;
     unsigned previewsStarted_ = 0;

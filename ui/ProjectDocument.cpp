@@ -295,4 +295,21 @@ bool ProjectDocument::importHdr(const QString& file, QString* error) {
     return ok;
 }
 
+bool ProjectDocument::importAlbedoMap(const QString& file, QString* error) {
+    const std::string abs = std::filesystem::absolute(file.toStdString()).lexically_normal().string();
+    try {
+        Project candidate = project_;
+        candidate.scene.terrain.albedoMode = AlbedoMode::Map;
+        candidate.scene.terrain.albedoMap = abs;
+        (void)surfaceAlbedoOf(candidate, terrain_->heightfield);
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+    undo_.beginMacro("Import albedo map");
+    const bool ok = setParameter("terrain.albedo_map", abs, error) && setParameter("terrain.albedo_mode", "map", error);
+    undo_.endMacro();
+    return ok;
+}
+
 }  // namespace terralux

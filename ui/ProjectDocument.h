@@ -66,6 +66,9 @@ public:
     // Imports a DEM (checked before anything changes) as an undoable edit of terrain.dem.
     bool importDem(const QString& file, QString* error);
     bool importHdr(const QString& file, QString* error);
+    // Reads the raster as the terrain's albedo map (a file that cannot be read changes nothing)
+    // and switches terrain.albedo_mode to map: one undoable edit.
+    bool importAlbedoMap(const QString& file, QString* error);
 
     // Used by the undo commands: applies an already validated value (with the terrain imported
     // for it, for terrain edits).

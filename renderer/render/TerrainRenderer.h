@@ -49,7 +49,7 @@ struct GpuProbeVolume {
 struct SurfaceLook {
     float roughness = 0.6f;         // GGX, before the normal variance widens it
     bool specularAA = true;         // widen the roughness by the normals' variance (Toksvig)
-    float roughnessFloor = 0.25f;   // the least roughness after the variance
+    float roughnessFloor = float(kRoughnessFloor);   // the least roughness after the variance
     bool ao = true;                 // the AO darkens sky light, and probe light by aoStrength
     float aoStrength = 1.0f;
     DetailSettings detail;          // the procedural micro-detail

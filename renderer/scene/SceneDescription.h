@@ -32,6 +32,10 @@ struct AlbedoRampSettings {
     std::array<double, 2> rockSlopeDeg{35.0, 50.0};
 };
 
+// The least GGX roughness of the terrain, after the normals' variance widens it: below it a
+// heightfield's sun highlight turns to sparkle no mip chain can hold.
+inline constexpr double kRoughnessFloor = 0.25;
+
 struct TerrainSettings {
     std::string dem;                 // path; relative paths are relative to the project file
     double verticalScale = 1.0;      // > 0
@@ -43,7 +47,7 @@ struct TerrainSettings {
     AlbedoRampSettings ramp;         // mode ramp
     int maxResolution = 0;           // 0 = source resolution; else longest side, area-averaged
     bool skirt = true;               // ground continues beyond the footprint at the border height
-    double roughness = 0.6;          // GGX roughness of the sun's highlight, [0.25, 1]
+    double roughness = 0.6;          // GGX roughness of the sun's highlight, [kRoughnessFloor, 1]
     bool specularAA = true;          // widen the roughness by the normals' variance (Toksvig)
 };
 

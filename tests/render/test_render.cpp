@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <iostream>
 #include <memory>
+#include <numbers>
 
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
@@ -245,7 +248,9 @@ TEST_F(RenderTest, EveryViewDiffersFromBeauty) {
     ASSERT_EQ(r.loadProbes(true), 1u);
     const RenderedImage beauty = draw(r, kViewBeauty);
     for (const auto& v : debugViews()) {
-        if (v.number == kViewBeauty) continue;
+        // The sample has no voids, so the filled view is the beauty image there
+        // (FilledViewTintsTheFilledCellsOnly).
+        if (v.number == kViewBeauty || v.number == kViewFilled) continue;
         EXPECT_GT(meanAbsDiff(draw(r, v.number), beauty), 2.0 / 255.0) << v.number << " " << v.name;
     }
 }
@@ -733,4 +738,201 @@ TEST_F(RenderTest, ShadowsOffDrawsNoShadowPassAndHoldsNoMaps) {
         EXPECT_NE(pass.name, "shadow");
         for (const auto& b : pass.bindings) EXPECT_EQ(b.find("shadow"), std::string::npos) << pass.name;
     }
+}
+
+namespace {
+
+// A projected GeoTIFF of n x n heights h(column, row) with `cell` metre cells; NaN heights are
+// written as the band's nodata value.
+fs::path writeDem(const std::string& name, int n, double cell, const std::function<float(int, int)>& h) {
+    const fs::path path = kOut / (name + ".tif");
+    GDALAllRegister();
+    GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), n, n, 1, GDT_Float32, nullptr);
+    double gt[6] = {500000.0, cell, 0.0, 4000000.0, 0.0, -cell};
+    ds->SetGeoTransform(gt);
+    OGRSpatialReference srs;
+    srs.importFromEPSG(32633);
+    ds->SetSpatialRef(&srs);
+    constexpr float kNodata = -9999.0f;
+    ds->GetRasterBand(1)->SetNoDataValue(kNodata);
+    std::vector<float> v(size_t(n) * size_t(n));
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+            const float x = h(c, r);
+            v[size_t(r) * size_t(n) + size_t(c)] = std::isnan(x) ? kNodata : x;
+        }
+    if (ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, v.data(), n, n, GDT_Float32, 0, 0, nullptr) != CE_None)
+        ADD_FAILURE() << "cannot write " << path;
+    GDALClose(ds);
+    return path;
+}
+
+// Straight down on the terrain, north up, square image: columns run west to east.
+Project topDown(Project p, const fs::path& dem) {
+    p.scene.terrain.dem = dem.string();
+    p.scene.camera.elevationDeg = 89.5;
+    p.scene.camera.azimuthDeg = 180.0;
+    p.scene.fog.enabled = false;
+    return p;
+}
+
+RenderedImage drawSquare(ProjectRenderer& r, int view, bool linear, bool probes = true) {
+    RenderRequest q;
+    q.probes = probes;
+    q.width = kW;
+    q.height = kW;
+    q.debugView = view;
+    q.linearOutput = linear;
+    return r.render(q);
+}
+
+// Mean of channel `c` over image columns [x0, x1) of the middle half of the rows.
+double stripMean(const RenderedImage& img, uint32_t x0, uint32_t x1, int c = 0) {
+    double sum = 0.0;
+    size_t count = 0;
+    for (uint32_t y = img.height / 4; y < 3 * img.height / 4; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            sum += img.rgba[(size_t(y) * img.width + x) * 4 + size_t(c)];
+            ++count;
+        }
+    return sum / double(count);
+}
+
+}  // namespace
+
+TEST_F(RenderTest, AoIsDarkerOnAValleyFloorThanOnItsRidges) {
+    Project p = topDown(sampleProject("ao_valley", 8, 8), writeValleyDem());
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    ASSERT_TRUE(r.renderer().hasAmbientOcclusion());
+    const RenderedImage ao = drawSquare(r, kViewAo, true);
+    // The footprint spans about 150 pixels: the floor is the middle 30, the plateaus start 40 out.
+    const double floor = stripMean(ao, kW / 2 - 15, kW / 2 + 15);
+    const double plateauWest = stripMean(ao, kW / 2 - 56, kW / 2 - 48);
+    const double plateauEast = stripMean(ao, kW / 2 + 48, kW / 2 + 56);
+    // The floor, 110 m wide between walls 660 m high, sees a slot of sky; the plateaus nearly all of it.
+    EXPECT_LT(floor, 0.6) << "floor";
+    EXPECT_GT(plateauWest, 0.9) << "west plateau";
+    EXPECT_GT(plateauEast, 0.9) << "east plateau";
+
+    // The beauty image with AO against without, with the probes and with the sky alone. The sky
+    // light of the floor is darkened by the whole AO; probe light only by the AO finer than the
+    // probes (the floor is narrower than their spacing). The plateaus' AO is 1: no change there.
+    const RenderedImage lit = drawSquare(r, kViewLinear, true), litSky = drawSquare(r, kViewLinear, true, false);
+    p.scene.ao.enabled = false;
+    r.setProject(p);
+    const RenderedImage unlit = drawSquare(r, kViewLinear, true), unlitSky = drawSquare(r, kViewLinear, true, false);
+    auto floorOf = [](const RenderedImage& img) { return stripMean(img, kW / 2 - 15, kW / 2 + 15, 1); };
+    auto plateauOf = [](const RenderedImage& img) { return stripMean(img, kW / 2 - 56, kW / 2 - 48, 1); };
+    std::cout << "floor with / without AO: probes " << floorOf(lit) << " / " << floorOf(unlit) << ", sky alone "
+              << floorOf(litSky) << " / " << floorOf(unlitSky) << "\n";
+    EXPECT_LT(floorOf(lit), 0.97 * floorOf(unlit));
+    EXPECT_LT(floorOf(litSky), 0.7 * floorOf(unlitSky));
+    EXPECT_NEAR(plateauOf(lit), plateauOf(unlit), 1e-3 * plateauOf(unlit));
+}
+
+TEST_F(RenderTest, FilledViewTintsTheFilledCellsOnly) {
+    // A gentle slope with a 17 x 17 hole in the middle.
+    const int n = 65;
+    const fs::path dem = writeDem("holed", n, 10.0, [&](int c, int r) {
+        if (std::abs(c - n / 2) <= 8 && std::abs(r - n / 2) <= 8) return std::nanf("");
+        return float(c) * 2.0f + float(r);
+    });
+    ProjectRenderer r(*ctx_, topDown(sampleProject("holed", 4, 4), dem));
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    ASSERT_GT(r.heightfield().nodataCount(), 200u);
+    const RenderedImage filled = drawSquare(r, kViewFilled, false);
+    const RenderedImage beauty = drawSquare(r, kViewBeauty, false);
+    auto magenta = [](const RenderedImage& img, uint32_t x, uint32_t y) {
+        const float* p = &img.rgba[(size_t(y) * img.width + x) * 4];
+        return p[0] - p[1];
+    };
+    // The image centre is inside the hole: tinted. A quarter of the way in is outside it: untouched.
+    EXPECT_GT(magenta(filled, kW / 2, kW / 2), 0.3f);
+    EXPECT_LT(std::abs(magenta(beauty, kW / 2, kW / 2)), 0.1f);
+    for (uint32_t x : {kW / 2 - 45, kW / 2 + 45}) {
+        const size_t i = (size_t(kW / 2) * kW + x) * 4;
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(filled.rgba[i + size_t(c)], beauty.rgba[i + size_t(c)], 1.0f / 255.0f) << x;
+    }
+}
+
+namespace {
+
+// Spatial and temporal sparkle of a grazing-sun highlight: the standard deviation of luminance over
+// the brightest tenth of terrain pixels, and the mean change of those pixels when the camera turns
+// by a quarter degree.
+struct Sparkle {
+    double spatial = 0.0, temporal = 0.0;
+};
+
+Sparkle sparkleOf(ProjectRenderer& r, const OrbitCamera& camera) {
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.debugView = kViewLinear;
+    q.linearOutput = true;
+    q.probes = false;
+    OrbitCamera turned = camera;
+    turned.azimuthDeg += 0.25;
+    const RenderedImage a = r.render(q, camera), b = r.render(q, turned);
+    auto luma = [](const RenderedImage& img, size_t i) {
+        return 0.2126 * img.rgba[i * 4] + 0.7152 * img.rgba[i * 4 + 1] + 0.0722 * img.rgba[i * 4 + 2];
+    };
+    std::vector<std::pair<double, size_t>> pixels;
+    for (size_t i = 0; i < size_t(kW) * kH; ++i)
+        if (a.rgba[i * 4 + 3] > 0.0f && luma(a, i) > 0.0) pixels.emplace_back(luma(a, i), i);
+    std::sort(pixels.rbegin(), pixels.rend());
+    pixels.resize(pixels.size() / 10);
+    double mean = 0.0;
+    for (const auto& [l, i] : pixels) mean += l;
+    mean /= double(pixels.size());
+    Sparkle s;
+    for (const auto& [l, i] : pixels) {
+        s.spatial += (l - mean) * (l - mean);
+        s.temporal += std::abs(luma(b, i) - l);
+    }
+    s.spatial = std::sqrt(s.spatial / double(pixels.size())) / mean;
+    s.temporal /= double(pixels.size()) * mean;
+    return s;
+}
+
+}  // namespace
+
+TEST_F(RenderTest, NormalVarianceCalmsSubPixelRidgesAndLeavesAPlaneAlone) {
+    // Ridges 12 m apart (six cells, so the vertex normals see them) seen from about a kilometre
+    // at a grazing sun: several ridges per pixel.
+    const int n = 257;
+    const fs::path ridges = writeDem("ridges", n, 2.0, [](int c, int) {
+        return 1.2f * std::sin(float(c) * 2.0f * std::numbers::pi_v<float> / 6.0f);
+    });
+    Project p = sampleProject("ridges", 2, 2);
+    p.scene.terrain.dem = ridges.string();
+    p.scene.terrain.roughness = kRoughnessFloor;
+    p.scene.detail.enabled = false;
+    p.scene.shadows.enabled = false;
+    p.scene.fog.enabled = false;
+    p.scene.camera.elevationDeg = 12.0;
+    p.scene.camera.azimuthDeg = 270.0;  // in the west, looking east across the ridges
+    p.scene.sun.azimuthDeg = 90.0;      // low in the east: its glint comes back to the camera
+    p.scene.sun.elevationDeg = 12.0;
+    ProjectRenderer r(*ctx_, p);
+    const OrbitCamera camera = r.defaultCamera();
+    const Sparkle on = sparkleOf(r, camera);
+    p.scene.terrain.specularAA = false;
+    r.setProject(p);
+    const Sparkle off = sparkleOf(r, camera);
+    std::cout << "sparkle with specular_aa on: spatial " << on.spatial << ", temporal " << on.temporal
+              << "; off: spatial " << off.spatial << ", temporal " << off.temporal << "\n";
+    EXPECT_LT(on.spatial, 0.8 * off.spatial) << "on " << on.spatial << " off " << off.spatial;
+    EXPECT_LT(on.temporal, 0.8 * off.temporal) << "on " << on.temporal << " off " << off.temporal;
+
+    // A plane has no normal variance: the image is the same with the widening on or off.
+    Project flat = p;
+    flat.scene.terrain.dem = writeDem("plane", 65, 10.0, [](int, int) { return 100.0f; }).string();
+    ProjectRenderer f(*ctx_, flat);
+    const RenderedImage planeOff = draw(f, kViewLinear, false, true);
+    flat.scene.terrain.specularAA = true;
+    f.setProject(flat);
+    const RenderedImage planeOn = draw(f, kViewLinear, false, true);
+    EXPECT_EQ(planeOn.rgba, planeOff.rgba);
 }
