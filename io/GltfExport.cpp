@@ -336,6 +336,9 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
                                      " = " + std::to_string(a) + " must be in [0, 1]");
         }
     }
+    if (!std::isfinite(input.roughness) || input.roughness < 0.0f || input.roughness > 1.0f)
+        throw std::runtime_error(gltfPath.string() + ": roughness = " + std::to_string(input.roughness) +
+                                 " must be in [0, 1]");
     if (const SurfaceAlbedo* t = input.albedoTexture; t && !t->empty() &&
         t->linear.size() != size_t(t->width) * size_t(t->height))
         throw std::runtime_error(gltfPath.string() + ": albedo texture of " + std::to_string(t->width) + " x " +

@@ -519,7 +519,8 @@ private slots:
     // The Shadows and Atmosphere docks hold an editor for every row of their sections, shown
     // where the scene reads it.
     void shadowAndAtmosphereDocksHoldTheirRows() {
-        for (const QString& name : {QString("dock.shadows"), QString("dock.atmosphere")}) {
+        for (const QString& name : {QString("dock.shadows"), QString("dock.atmosphere"), QString("dock.surface"),
+                                    QString("dock.ao")}) {
             auto* dock = w_->findChild<QDockWidget*>(name);
             QVERIFY2(dock, qPrintable(name));
             dock->raise();
@@ -533,9 +534,14 @@ private slots:
                 QCOMPARE(rowOf(editor)->isVisibleTo(dock), spec.isRead(w_->document()->project().scene, 0));
                 ++rows;
             }
-            QVERIFY(rows >= 8);
+            QVERIFY(rows >= (name == "dock.ao" ? 4 : 8));
         }
         QCOMPARE(w_->findChild<QDockWidget*>("dock.shadows")->windowTitle(), QString("Shadows"));
+        QCOMPARE(w_->findChild<QDockWidget*>("dock.surface")->windowTitle(), QString("Surface"));
+        QCOMPARE(w_->findChild<QDockWidget*>("dock.ao")->windowTitle(), QString("Ambient Occlusion"));
+        // The surface rows left the Terrain dock.
+        QVERIFY(!w_->findChild<QDockWidget*>("dock.terrain")->findChild<QWidget*>("param.terrain.roughness"));
+        QVERIFY(w_->findChild<QDockWidget*>("dock.surface")->findChild<QPushButton*>("surface.importAlbedo"));
         QCOMPARE(w_->findChild<QDockWidget*>("dock.atmosphere")->windowTitle(), QString("Atmosphere"));
         QVERIFY(w_->findChild<QDockWidget*>("dock.atmosphere")->findChild<QDoubleSpinBox*>("param.camera.exposure_ev"));
         QVERIFY(w_->findChild<QDockWidget*>("dock.shadows")->findChild<CascadeSplitChart*>("shadows.splitChart"));
@@ -591,6 +597,12 @@ private slots:
         auto* exposure = w_->findChild<QDoubleSpinBox*>("param.camera.exposure_ev");
         QVERIFY(exposure);
         check(exposure, "dock.atmosphere", [&] { exposure->setValue(1.0); }, "exposure");
+        auto* aoOn = w_->findChild<QCheckBox*>("param.ao.enabled");
+        QVERIFY(aoOn && aoOn->isChecked());
+        check(aoOn, "dock.ao", [&] { aoOn->setChecked(false); }, "ambient occlusion off");
+        auto* roughness = w_->findChild<QDoubleSpinBox*>("param.terrain.roughness");
+        QVERIFY(roughness);
+        check(roughness, "dock.surface", [&] { roughness->setValue(0.25); }, "roughness");
         auto* filter = w_->findChild<QComboBox*>("param.shadows.filter");
         QVERIFY(filter);
         check(filter, "dock.shadows", [&] { filter->setCurrentText("hard"); }, "shadow filter");
@@ -606,6 +618,43 @@ private slots:
         QString error;
         QVERIFY(w_->document()->setParameter("sky.intensity", 2.0, &error));
         QTRY_VERIFY_WITH_TIMEOUT(w_->previewsStarted() == previews + 1, 5000);
+    }
+
+    // The horizon AO is computed on a worker with its progress in the dock, then lands in the
+    // viewport; the settings it was computed for are said.
+    void ambientOcclusionIsComputedOnAWorker() {
+        auto* dock = w_->findChild<QDockWidget*>("dock.ao");
+        dock->raise();
+        auto* status = w_->findChild<QLabel*>("ao.status");
+        auto* progress = w_->findChild<QProgressBar*>("ao.progress");
+        QVERIFY(status && progress);
+        QTRY_VERIFY_WITH_TIMEOUT(status->text().startsWith("32 directions over"), 20000);
+        QVERIFY(!progress->isVisibleTo(dock));
+        QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
+        w_->findChild<QSpinBox*>("param.ao.directions")->setValue(8);
+        QTRY_VERIFY_WITH_TIMEOUT(status->text().startsWith("8 directions over"), 20000);
+        QVERIFY(!progress->isVisibleTo(dock));
+        QTRY_VERIFY_WITH_TIMEOUT(!frames.isEmpty(), 5000);
+        // Off: no worker, and the dock says what that means.
+        w_->findChild<QCheckBox*>("param.ao.enabled")->setChecked(false);
+        QVERIFY(status->text().startsWith("Off"));
+        QVERIFY(w_->document()->undoStack()->canUndo());
+    }
+
+    // The ramp colours the viewport at once (and the preview bakes again: the bake reflects with it).
+    void albedoRampColoursTheTerrain() {
+        w_->findChild<QDockWidget*>("dock.surface")->raise();
+        w_->viewport()->renderNow();
+        const RenderedImage before = w_->viewport()->grabImage();
+        const unsigned previews = w_->previewsStarted();
+        w_->findChild<QComboBox*>("param.terrain.albedo_mode")->setCurrentText("ramp");
+        QCOMPARE(w_->document()->project().scene.terrain.albedoMode, AlbedoMode::Ramp);
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.terrain.ramp_heights.0"))->isVisibleTo(w_->findChild<QDockWidget*>("dock.surface")));
+        w_->viewport()->renderNow();
+        const RenderedImage after = w_->viewport()->grabImage();
+        const auto d = test::compareImages(after.rgba, before.rgba, before.width, before.height);
+        QVERIFY2(d.meanAbs > 4.0 / 255.0, qPrintable(QString("the ramp changed the image by %1").arg(d.meanAbs)));
+        QTRY_VERIFY_WITH_TIMEOUT(w_->previewsStarted() > previews, 5000);
     }
 
     // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).

@@ -155,6 +155,7 @@ protected:
         GltfSceneInput in;
         in.heightfield = &hf;
         in.albedo = {0.25f, 0.5f, 0.7f};
+        in.roughness = 0.6f;
         in.verticalScale = 1.5;
         in.volumes.push_back({"zeta", makeGrid(1), {}});
         in.volumes.push_back({"alpha", makeGrid(0), {}});
@@ -297,7 +298,7 @@ TEST_F(GltfExport, WritesTheLayoutAndTheContract) {
     const tinygltf::PbrMetallicRoughness& pbr = m.materials[0].pbrMetallicRoughness;
     EXPECT_EQ(pbr.baseColorFactor, (std::vector<double>{0.25, 0.5, double(0.7f), 1.0}));
     EXPECT_EQ(pbr.metallicFactor, 0.0);
-    EXPECT_EQ(pbr.roughnessFactor, 1.0);
+    EXPECT_EQ(pbr.roughnessFactor, double(0.6f));  // terrain.roughness
 }
 
 TEST_F(GltfExport, LightingIsWrittenVerbatimAsAnOptionalExtension) {
@@ -549,6 +550,9 @@ TEST_F(GltfExport, RejectsInvalidInputBeforeWritingAnything) {
     in = sampleInput(hf);
     in.albedo.g = 1.5f;
     expectRejected(in, "albedo channel 1");
+    in = sampleInput(hf);
+    in.roughness = std::nanf("");
+    expectRejected(in, "roughness = nan must be in [0, 1]");
     in = sampleInput(hf);
     in.bake = json::array();
     expectRejected(in, "TERRALUX_bake metadata must be a JSON object");

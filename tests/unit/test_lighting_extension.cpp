@@ -79,6 +79,23 @@ TEST(LightingExtension, AuthoredSectionsAreTheProjectAsWritten) {
     EXPECT_EQ(ext["sky"]["hdr"], "");
 }
 
+TEST(LightingExtension, SurfaceCarriesRoughnessAoAndDetail) {
+    const Heightfield hf = makeTerrain();
+    const Project p = projectWith({"terrain.roughness=0.45", "terrain.specular_aa=false", "ao.directions=16",
+                                   "ao.max_distance=800", "ao.strength=0.7", "detail.scale=3.5"});
+    const json surface = lightingExtension(p, hf).at("surface");
+    const json printed = sceneToJson(p.scene);
+    EXPECT_EQ(surface["roughness"].get<double>(), 0.45);
+    EXPECT_EQ(surface["roughness_floor"].get<double>(), kRoughnessFloor);
+    EXPECT_EQ(surface["specular_aa"], false);
+    EXPECT_EQ(surface["ao"], printed["ao"]);
+    EXPECT_EQ(surface["ao"]["directions"], 16);
+    EXPECT_EQ(surface["ao"]["max_distance"].get<double>(), 800.0);
+    EXPECT_EQ(surface["detail"], printed["detail"]);
+    EXPECT_EQ(surface["detail"]["scale"].get<double>(), 3.5);
+    EXPECT_EQ(surface.size(), 5u);
+}
+
 TEST(LightingExtension, TheSunIsTheOneTheBakeLightsWith) {
     const Heightfield hf = makeTerrain();
     const Project p = projectWith(kEdits);
