@@ -51,7 +51,9 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.surface.detail = scene.detail;
     // The terrain is this renderer's for good: only an edit of the terrain section (or, in mode
     // map, of the file, which surfaceAlbedoOf notices) makes a new field, not a camera move.
-    const std::string albedoKey = sceneToJson(scene).at("terrain").dump();
+    nlohmann::json terrainSection = sceneToJson(scene).at("terrain");
+    for (const char* shading : {"roughness", "specular_aa", "skirt"}) terrainSection.erase(shading);
+    const std::string albedoKey = terrainSection.dump();
     if (albedoKey != albedoKey_ || scene.terrain.albedoMode == AlbedoMode::Map) {
         albedoKey_ = albedoKey;
         // A map that cannot be read leaves the constant albedo on screen rather than no picture.

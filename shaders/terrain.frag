@@ -33,8 +33,10 @@ void main() {
     vec2 uv = surfaceUv(t, surface.mapSizes.xy);
     vec4 normalAo = texture(surfaceNormalAo, uv);
     float coarseAo = surface.ao.z > 0.0 ? textureLod(surfaceNormalAo, uv, surface.ao.z).w : normalAo.w;
-    vec3 mapAlbedo = texture(surfaceAlbedoMap, surfaceUv(t, surface.mapSizes.zw)).rgb;
-    s.filled = inside ? texture(surfaceFilled, uv).r : 0.0;
+    // Maps a frame does not read are not sampled (the conditions are uniform, so the derivatives
+    // still hold): on a CPU rasteriser each trilinear lookup is a real cost.
+    vec3 mapAlbedo = surface.albedo.w > 0.5 ? texture(surfaceAlbedoMap, surfaceUv(t, surface.mapSizes.zw)).rgb : vec3(1.0);
+    s.filled = inside && camera.view.x == kViewFilled ? texture(surfaceFilled, uv).r : 0.0;
     float pixelMetres = length(fwidth(worldPos));
     float distance = length(worldPos - camera.position.xyz);
 

@@ -166,6 +166,34 @@ void BM_BeautyShadowsFog(benchmark::State& state) {
 BENCHMARK(BM_BeautyShadowsFog)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
     ->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
+// Beauty at 1280 x 720 with the terrain surface's parts each on or off: horizon AO, the
+// normal-variance specular and the micro-detail (shadows and fog off, so only these differ).
+void BM_BeautySurface(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    Project p = fixtureProject();
+    p.scene.shadows.enabled = false;
+    p.scene.fog.enabled = false;
+    p.scene.ao.enabled = state.range(0) != 0;
+    p.scene.terrain.specularAA = state.range(1) != 0;
+    p.scene.detail.enabled = state.range(2) != 0;
+    f.renderer->setProject(p);  // computes the AO field the first time it is asked for
+    RenderRequest q;
+    q.width = 1280;
+    q.height = 720;
+    f.renderer->render(q);
+    double ms = 0;
+    for (auto _ : state) ms += f.renderer->render(q).milliseconds;
+    state.SetLabel(std::string("ao ") + (state.range(0) ? "on" : "off") + ", specular_aa " +
+                   (state.range(1) ? "on" : "off") + ", detail " + (state.range(2) ? "on" : "off"));
+    state.counters["frame_ms"] = ms / double(state.iterations());
+}
+BENCHMARK(BM_BeautySurface)->Args({0, 0, 0})->Args({1, 0, 0})->Args({0, 1, 0})->Args({0, 0, 1})->Args({1, 1, 1})
+    ->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();
