@@ -89,6 +89,7 @@ public:
     Row& redoes(unsigned i) { s_.invalidates = i; return *this; }
     Row& decimals(int d) { s_.decimals = d; return *this; }
     Row& slider() { s_.slider = true; return *this; }
+    Row& colorList() { s_.colorList = true; return *this; }
     Row& noUiRow() { s_.uiRow = false; return *this; }
     Row& count(std::function<int(const SceneDescription&, size_t)> f) { s_.items = std::move(f); return *this; }
     Row& onlyWhen(std::function<bool(const SceneDescription&, size_t)> f) { s_.readWhen = std::move(f); return *this; }
@@ -201,7 +202,7 @@ std::vector<ParameterSpec> buildTable() {
                                                      "[" + std::to_string(i) + "]"};
                 });
     add(Row("terrain.ramp_colors", T::NumberList)).items(6, 3 * kMaxRampStops).range(0.0, 1.0).decimals(3)
-        .label("Ramp colours")
+        .label("Ramp colours").colorList()
         .about("Mode ramp: linear RGB albedo of each stop, three numbers per height in terrain.ramp_heights (r0, g0, b0, r1, ...)")
         .redoes(kUpload | kRebake).onlyWhen(ramp)
         .count([](const SceneDescription& s, size_t) { return 3 * int(s.terrain.ramp.heights.size()); })
@@ -950,7 +951,9 @@ std::string uiObjectNamesMarkdown() {
         case ParamType::NumberList:
         case ParamType::IntegerList:
             entry = "`" + name + ".0`";
-            for (int k = 1; k < spec.maxItems; ++k) entry += " / `." + std::to_string(k) + "`";
+            for (int k = 1; k < (spec.colorList ? spec.maxItems / 3 : spec.maxItems); ++k)
+                entry += " / `." + std::to_string(k) + "`";
+            if (spec.colorList) entry += " (colour buttons, one per stop)";
             if (spec.nullable()) entry += " + `.auto` (check box)";
             break;
         default:

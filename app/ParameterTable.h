@@ -61,6 +61,7 @@ struct ParameterSpec {
     unsigned invalidates = kRedraw;
     int decimals = 2;     // UI precision
     bool slider = false;  // UI: a slider beside the spin box (angles)
+    bool colorList = false;  // UI: a NumberList of RGB triples, one colour button per triple
     bool uiRow = true;    // shown as a dock row (false: edited elsewhere, or by the viewport)
     // Lists whose length depends on other parameters (a box grid has 3 dims, a terrain grid 2):
     // the exact count for this scene, 0 for one plain number, -1 when the row is not read.

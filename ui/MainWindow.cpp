@@ -65,6 +65,23 @@ std::vector<std::string> surfaceExtensions(QVulkanInstance& inst) {
     return out;
 }
 
+// Keeps a vertically scrolled dock at least as wide as its rows, which grow when a list shows
+// more items (a ramp's stops) than it had when the dock was built.
+class FitWidth : public QObject {
+public:
+    explicit FitWidth(QScrollArea* area) : QObject(area), area_(area) { fit(); }
+    bool eventFilter(QObject* watched, QEvent* e) override {
+        if (e->type() == QEvent::LayoutRequest) fit();
+        return QObject::eventFilter(watched, e);
+    }
+
+private:
+    void fit() {
+        area_->setMinimumWidth(area_->widget()->minimumSizeHint().width() + area_->verticalScrollBar()->sizeHint().width());
+    }
+    QScrollArea* area_;
+};
+
 QWidget* scrolled(QWidget* w) {
     auto* area = new QScrollArea;
     area->setWidget(w);
@@ -72,7 +89,7 @@ QWidget* scrolled(QWidget* w) {
     area->setFrameShape(QFrame::NoFrame);
     // Scroll only vertically: the dock is at least as wide as its rows plus the scroll bar.
     area->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
-    area->setMinimumWidth(w->minimumSizeHint().width() + area->verticalScrollBar()->sizeHint().width());
+    w->installEventFilter(new FitWidth(area));
     return area;
 }
 
@@ -238,6 +255,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     updateTitle();
     updateOutputPath();
     resize(1400, 860);
+    // The viewport is what a TD looks at: the docks start at two fifths of the window, or as wide
+    // as their tab labels need.
+    resizeDocks({findChild<QDockWidget*>("dock.terrain")}, {std::max(width() * 2 / 5, 560)}, Qt::Horizontal);
 }
 
 MainWindow::~MainWindow() {

@@ -1,5 +1,6 @@
 #include "ParameterPanels.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -80,7 +81,7 @@ void ParameterForm::addParameter(const std::string& path) {
         case ParamType::String: return addText(*spec);
         case ParamType::Choice: return addChoice(*spec);
         case ParamType::Color: return addColor(*spec);
-        case ParamType::NumberList:
+        case ParamType::NumberList: return spec->colorList ? addColorList(*spec) : addList(*spec);
         case ParamType::IntegerList: return addList(*spec);
     }
 }
@@ -226,7 +227,12 @@ void ParameterForm::addList(const ParameterSpec& spec) {
         spin->setKeyboardTracking(false);
         // Share the row's width: three wide spin boxes side by side would widen the dock.
         spin->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
-        spin->setMinimumWidth(56);
+        // Wide enough for the values it holds, as a plain spin box would be (capped: a grid's
+        // integer range would otherwise ask for the width of 2^31).
+        spin->setMinimumWidth(std::clamp(spin->minimumSizeHint().width(), 56, 96));
+        // Until the first refresh only the least a list holds is shown, so the dock's width
+        // (taken when it is built) is not that of the longest list.
+        spin->setVisible(i < std::max(spec.minItems, 1));
         h->addWidget(spin, 1);
         spins.push_back(spin);
     }
@@ -301,31 +307,87 @@ void ParameterForm::addChoice(const ParameterSpec& spec) {
     addRow(spec, combo);
 }
 
+namespace {
+
+// Linear RGB in a colour button: the swatch (values above 1, sky radiance, clipped) and the numbers.
+// A swatch alone (a ramp's stops side by side) carries the numbers in its tooltip.
+void showColor(QPushButton* button, double r, double g, double b, bool swatchOnly = false) {
+    const QColor c = QColor::fromRgbF(float(std::min(1.0, r)), float(std::min(1.0, g)), float(std::min(1.0, b)));
+    const QString numbers = QString("%1, %2, %3").arg(r, 0, 'g', 3).arg(g, 0, 'g', 3).arg(b, 0, 'g', 3);
+    if (swatchOnly) button->setToolTip(numbers);
+    else button->setText(numbers);
+    button->setStyleSheet(QString("QPushButton { background: %1; color: %2 }")
+                              .arg(c.name(), c.lightnessF() > 0.5 ? "black" : "white"));
+}
+
+// Asks for a colour starting from linear RGB; values above 1 (sky radiance) are kept as an
+// intensity on top of the colour. False when the user cancels.
+bool pickColor(QWidget* parent, const QString& title, double rgb[3]) {
+    const double peak = std::max({rgb[0], rgb[1], rgb[2], 1.0});
+    const QColor start = QColor::fromRgbF(float(rgb[0] / peak), float(rgb[1] / peak), float(rgb[2] / peak));
+    const QColor c = QColorDialog::getColor(start, parent, title);
+    if (!c.isValid()) return false;
+    rgb[0] = c.redF() * peak;
+    rgb[1] = c.greenF() * peak;
+    rgb[2] = c.blueF() * peak;
+    return true;
+}
+
+}  // namespace
+
 void ParameterForm::addColor(const ParameterSpec& spec) {
     auto* button = new QPushButton(this);
     button->setObjectName(QString::fromStdString(uiObjectName(spec)));
     const QString title = QString::fromStdString(spec.label);
     connect(button, &QPushButton::clicked, this, [=, this] {
         const json v = doc_->value(docPath(spec));
-        // Linear values above 1 (sky radiance) are kept as an intensity on top of the colour.
-        const double peak = std::max({v[0].get<double>(), v[1].get<double>(), v[2].get<double>(), 1.0});
-        const QColor start = QColor::fromRgbF(float(v[0].get<double>() / peak), float(v[1].get<double>() / peak),
-                                              float(v[2].get<double>() / peak));
-        const QColor c = QColorDialog::getColor(start, this, title);
-        if (c.isValid()) set(docPath(spec), json{c.redF() * peak, c.greenF() * peak, c.blueF() * peak});
+        double rgb[3] = {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
+        if (pickColor(this, title, rgb)) set(docPath(spec), json{rgb[0], rgb[1], rgb[2]});
     });
     refreshers_.push_back([=, this] {
         const json v = doc_->value(docPath(spec));
         if (!v.is_array() || v.size() != 3) return;
-        const QColor c = QColor::fromRgbF(float(std::min(1.0, v[0].get<double>())),
-                                          float(std::min(1.0, v[1].get<double>())),
-                                          float(std::min(1.0, v[2].get<double>())));
-        button->setText(QString("%1, %2, %3").arg(v[0].get<double>(), 0, 'g', 3)
-                            .arg(v[1].get<double>(), 0, 'g', 3).arg(v[2].get<double>(), 0, 'g', 3));
-        button->setStyleSheet(QString("QPushButton { background: %1; color: %2 }")
-                                  .arg(c.name(), c.lightnessF() > 0.5 ? "black" : "white"));
+        showColor(button, v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
     });
     addRow(spec, button);
+}
+
+// One colour button per RGB triple of the list (a ramp's stops), as many as the scene holds.
+void ParameterForm::addColorList(const ParameterSpec& spec) {
+    auto* row = new QWidget(this);
+    auto* h = new QHBoxLayout(row);
+    h->setContentsMargins(0, 0, 0, 0);
+    const QString name = QString::fromStdString(uiObjectName(spec));
+    std::vector<QPushButton*> buttons;
+    for (int stop = 0; stop < spec.maxItems / 3; ++stop) {
+        auto* button = new QPushButton(row);
+        button->setObjectName(name + "." + QString::number(stop));
+        button->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+        button->setMinimumWidth(40);
+        button->setVisible(stop < std::max(spec.minItems / 3, 1));
+        h->addWidget(button, 1);
+        buttons.push_back(button);
+        const QString title = QString::fromStdString(spec.label) + " " + QString::number(stop + 1);
+        connect(button, &QPushButton::clicked, this, [=, this] {
+            json v = doc_->value(docPath(spec));
+            const size_t at = 3 * size_t(stop);
+            if (!v.is_array() || v.size() < at + 3) return;
+            double rgb[3] = {v[at].get<double>(), v[at + 1].get<double>(), v[at + 2].get<double>()};
+            if (!pickColor(this, title, rgb)) return;
+            for (size_t k = 0; k < 3; ++k) v[at + k] = rgb[k];
+            set(docPath(spec), v);
+        });
+    }
+    refreshers_.push_back([=, this] {
+        const json v = doc_->value(docPath(spec));
+        for (size_t stop = 0; stop < buttons.size(); ++stop) {
+            const size_t at = 3 * stop;
+            const bool shown = v.is_array() && v.size() >= at + 3;
+            buttons[stop]->setVisible(shown);
+            if (shown) showColor(buttons[stop], v[at].get<double>(), v[at + 1].get<double>(), v[at + 2].get<double>(), true);
+        }
+    });
+    addRow(spec, row);
 }
 
 void ParameterForm::addText(const ParameterSpec& spec) {

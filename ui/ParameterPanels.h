@@ -59,6 +59,7 @@ private:
     void addBool(const ParameterSpec& spec);
     void addChoice(const ParameterSpec& spec);
     void addColor(const ParameterSpec& spec);
+    void addColorList(const ParameterSpec& spec);
     void addText(const ParameterSpec& spec);
     void addRow(const ParameterSpec& spec, QWidget* editor);
     // The document path a row edits (per-volume rows: of the selected volume).

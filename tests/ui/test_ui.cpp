@@ -9,6 +9,7 @@
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
+#include <QColorDialog>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QFileDialog>
@@ -21,6 +22,7 @@
 #include <QPointer>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QScreen>
 #include <QSignalSpy>
 #include <QSpinBox>
@@ -655,6 +657,34 @@ private slots:
         const auto d = test::compareImages(after.rgba, before.rgba, before.width, before.height);
         QVERIFY2(d.meanAbs > 4.0 / 255.0, qPrintable(QString("the ramp changed the image by %1").arg(d.meanAbs)));
         QTRY_VERIFY_WITH_TIMEOUT(w_->previewsStarted() > previews, 5000);
+
+        // One colour button per stop; picking a colour rewrites that stop's triple only.
+        auto* dock = w_->findChild<QDockWidget*>("dock.surface");
+        // The dock widens to its rows (the stops appeared after it was built): none is clipped.
+        auto* area = dock->findChild<QScrollArea*>();
+        QVERIFY(area);
+        QTRY_VERIFY(area->viewport()->width() >= area->widget()->minimumSizeHint().width());
+        const size_t stops = w_->document()->project().scene.terrain.ramp.heights.size();
+        for (size_t k = 0; k < size_t(kMaxRampStops); ++k) {
+            auto* button = w_->findChild<QPushButton*>(QString("param.terrain.ramp_colors.%1").arg(k));
+            QVERIFY(button);
+            QCOMPARE(button->isVisibleTo(dock), k < stops);
+        }
+        const nlohmann::json colorsBefore = w_->document()->value("terrain.ramp_colors");
+        QTimer::singleShot(200, [] {
+            auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
+            if (!dialog) return;
+            dialog->setCurrentColor(QColor::fromRgbF(1.0f, 0.0f, 0.0f));
+            dialog->accept();
+        });
+        w_->findChild<QPushButton*>("param.terrain.ramp_colors.1")->click();
+        const nlohmann::json colorsAfter = w_->document()->value("terrain.ramp_colors");
+        QCOMPARE(colorsAfter.size(), colorsBefore.size());
+        QCOMPARE(colorsAfter[3].get<double>(), 1.0);
+        QCOMPARE(colorsAfter[4].get<double>(), 0.0);
+        QCOMPARE(colorsAfter[5].get<double>(), 0.0);
+        for (size_t i : {0, 1, 2, 6, 7, 8}) QCOMPARE(colorsAfter[i], colorsBefore[i]);
+        QVERIFY(w_->findChild<QPushButton*>("param.terrain.ramp_colors.1")->toolTip() == "1, 0, 0");
     }
 
     // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).
@@ -1079,6 +1109,15 @@ private slots:
         QTest::qWait(300);
         const QPixmap dock = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(dock.save(QString::fromStdString((kOut / "shadows_dock.png").string())));
+        // The Surface dock with the height ramp, the horizon AO landed in the viewport.
+        w_->findChild<QComboBox*>("param.terrain.albedo_mode")->setCurrentText("ramp");
+        w_->findChild<QCheckBox*>("param.ao.enabled")->setChecked(true);
+        QTRY_VERIFY_WITH_TIMEOUT(w_->findChild<QLabel*>("ao.status")->text().contains("directions over"), 20000);
+        w_->findChild<QDockWidget*>("dock.surface")->raise();
+        w_->viewport()->renderNow();
+        QTest::qWait(300);
+        const QPixmap surface = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(surface.save(QString::fromStdString((kOut / "surface_dock.png").string())));
     }
 };
 
