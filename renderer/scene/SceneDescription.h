@@ -42,7 +42,7 @@ struct TerrainSettings {
     // Lambertian, each in [0, 1]: the whole terrain in mode constant, and where a map does not
     // cover the footprint in mode map.
     glm::vec3 albedo{0.3f, 0.3f, 0.3f};
-    AlbedoMode albedoMode = AlbedoMode::Constant;
+    AlbedoMode albedoMode = AlbedoMode::Ramp;
     std::string albedoMap;           // RGB(A) raster for mode map; relative to the project file
     AlbedoRampSettings ramp;         // mode ramp
     int maxResolution = 0;           // 0 = source resolution; else longest side, area-averaged

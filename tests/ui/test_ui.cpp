@@ -477,6 +477,13 @@ private slots:
             }
             case ParamType::NumberList:
             case ParamType::IntegerList:
+                if (spec.colorList) {
+                    // One colour button per triple (the dialog keeps each in [0, 1]).
+                    for (int i = 0; i < spec.maxItems / 3; ++i)
+                        QVERIFY2(w_->findChild<QPushButton*>(name + "." + QString::number(i)), qPrintable(where));
+                    QVERIFY(!w_->findChild<QWidget*>(name + "." + QString::number(spec.maxItems / 3)));
+                    break;
+                }
                 QVERIFY2(w_->findChild<QAbstractSpinBox*>(name + ".0"), qPrintable(where));
                 QCOMPARE(bool(w_->findChild<QCheckBox*>(name + ".auto")), spec.nullable());
                 for (int i = 0; i < spec.maxItems; ++i) {
@@ -646,6 +653,7 @@ private slots:
     // The ramp colours the viewport at once (and the preview bakes again: the bake reflects with it).
     void albedoRampColoursTheTerrain() {
         w_->findChild<QDockWidget*>("dock.surface")->raise();
+        w_->findChild<QComboBox*>("param.terrain.albedo_mode")->setCurrentText("constant");
         w_->viewport()->renderNow();
         const RenderedImage before = w_->viewport()->grabImage();
         const unsigned previews = w_->previewsStarted();

@@ -260,7 +260,9 @@ TEST(AlbedoMap, ProjectModesBuildTheFieldTheBakeUses) {
     Project p;
     p.scene.terrain.dem = kDem;
     const Heightfield hf = loadProjectTerrain(p).heightfield;
-    EXPECT_EQ(surfaceAlbedoOf(p, hf), nullptr);  // constant
+    EXPECT_EQ(p.scene.terrain.albedoMode, AlbedoMode::Ramp);  // the default: terrain, not grey
+    p.scene.terrain.albedoMode = AlbedoMode::Constant;
+    EXPECT_EQ(surfaceAlbedoOf(p, hf), nullptr);
     p.scene.terrain.albedoMode = AlbedoMode::Ramp;
     const auto ramp = surfaceAlbedoOf(p, hf);
     ASSERT_TRUE(ramp);
@@ -301,6 +303,7 @@ TEST(AlbedoParameters, RoundTripThroughTheProjectFile) {
 
 TEST(AlbedoBake, InputsFollowTheModeAndTheMapFile) {
     Project p;
+    p.scene.terrain.albedoMode = AlbedoMode::Constant;
     const nlohmann::json constant = bakeInputs(p);
     Project rampEdited = p;
     rampEdited.scene.terrain.ramp.rockSlopeDeg = {20.0, 30.0};
