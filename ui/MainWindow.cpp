@@ -300,16 +300,17 @@ void MainWindow::buildDocks() {
     auto* importDem = new QPushButton("Import DEM…");
     importDem->setObjectName("terrain.import");
     tv->addWidget(importDem);
-    // The rows of one dock of the parameter table (parameterDock), in table order.
-    auto addDockRows = [](ParameterForm* form, const std::string& dockName) {
+    // A form of the rows of one dock of the parameter table (parameterDock), in table order.
+    auto dockForm = [this, connectRejected](const std::string& dockName) {
+        auto* form = new ParameterForm(doc_);
         for (const auto& spec : parameterTable())
             if (spec.uiRow && parameterDock(spec).objectName == dockName) form->addParameter(spec.path);
+        connectRejected(form);
+        form->refresh();
+        return form;
     };
-    auto* tf = new ParameterForm(doc_);
-    addDockRows(tf, "dock.terrain");
-    tv->addWidget(tf);
+    tv->addWidget(dockForm("dock.terrain"));
     tv->addStretch(1);
-    connectRejected(tf);
     connect(importDem, &QPushButton::clicked, this, [this] {
         const QString f = QFileDialog::getOpenFileName(this, "Import DEM", QString(),
                                                        "Rasters (*.tif *.tiff *.hgt *.asc *.vrt *.zip *.img *.dem);;All files (*)");
@@ -369,10 +370,7 @@ void MainWindow::buildDocks() {
     // Surface: albedo, roughness and micro-detail.
     auto* surface = new QWidget;
     auto* uv = new QVBoxLayout(surface);
-    auto* uf = new ParameterForm(doc_);
-    addDockRows(uf, "dock.surface");
-    connectRejected(uf);
-    uv->addWidget(uf);
+    uv->addWidget(dockForm("dock.surface"));
     auto* importAlbedo = new QPushButton("Import albedo map…");
     importAlbedo->setObjectName("surface.importAlbedo");
     importAlbedo->setToolTip("An orthophoto or any RGB raster GDAL reads, draped over the DEM by its georeferencing");
@@ -394,10 +392,7 @@ void MainWindow::buildDocks() {
     // Ambient occlusion: its settings and the progress of the field.
     auto* ao = new QWidget;
     auto* av = new QVBoxLayout(ao);
-    auto* af = new ParameterForm(doc_);
-    addDockRows(af, "dock.ao");
-    connectRejected(af);
-    av->addWidget(af);
+    av->addWidget(dockForm("dock.ao"));
     aoProgress_ = new QProgressBar;
     aoProgress_->setObjectName("ao.progress");
     aoProgress_->setRange(0, 100);
@@ -476,7 +471,7 @@ void MainWindow::buildDocks() {
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
     auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
 
-    for (auto* f : {tf, sky, sf, atmosphere, uf, af, bf}) f->refresh();
+    for (auto* f : {sky, sf, atmosphere, bf}) f->refresh();
     // The lighting docks share the upper tab group with the terrain.
     tabifyDockWidget(terrainDock, skyDock);
     tabifyDockWidget(skyDock, shadowsDock);

@@ -73,10 +73,11 @@ protected:
 std::unique_ptr<vk::VulkanContext> RenderTest::ctx_;
 std::string RenderTest::skipReason_;
 
-RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear = false) {
+RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear = false,
+                   uint32_t width = kW, uint32_t height = kH) {
     RenderRequest q;
-    q.width = kW;
-    q.height = kH;
+    q.width = width;
+    q.height = height;
     q.debugView = view;
     q.probes = probes;
     q.linearOutput = linear;
@@ -777,13 +778,7 @@ Project topDown(Project p, const fs::path& dem) {
 }
 
 RenderedImage drawSquare(ProjectRenderer& r, int view, bool linear, bool probes = true) {
-    RenderRequest q;
-    q.probes = probes;
-    q.width = kW;
-    q.height = kW;
-    q.debugView = view;
-    q.linearOutput = linear;
-    return r.render(q);
+    return draw(r, view, probes, linear, kW, kW);
 }
 
 // Mean of channel `c` over image columns [x0, x1) of the middle half of the rows.
