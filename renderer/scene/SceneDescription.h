@@ -224,6 +224,35 @@ struct AoSettings {
     double strength = 1.0;                     // [0, 1]: how strongly AO darkens the probe light
 };
 
+// One Gerstner wave (docs/lighting.md, "Water"). Exactly one of amplitude and steepness is set:
+// steepness is k·A (k = 2π / wavelength), the slope of the wave, so A = steepness / k.
+struct GerstnerWave {
+    double directionDeg = 0.0;        // the way it travels, clockwise from north (−Z) toward east (+X)
+    double wavelength = 10.0;         // metres, > 0
+    std::optional<double> amplitude;  // metres, >= 0
+    std::optional<double> steepness;  // k·A, [0, 1]
+    double phase = 0.0;               // radians at t = 0 and the engine origin
+};
+
+enum class WaterReflection { Planar, Sky };
+
+// A lake or sea level: a plane at `level` with Gerstner waves (docs/lighting.md, "Water"). The
+// crests never loop: the waves' summed steepness Σ k_i·A_i is at most 1.
+struct WaterSettings {
+    bool enabled = false;
+    std::optional<double> level;                 // engine-space metres; unset = the DEM's lowest decile
+    glm::vec3 color{0.02f, 0.05f, 0.06f};        // deep-water scatter albedo, linear RGB in [0, 1]
+    glm::vec3 absorption{0.45f, 0.09f, 0.06f};   // extinction per metre, linear RGB, >= 0
+    double roughness = 0.05;                     // GGX, of the sun's highlight on the waves, [0.02, 1]
+    std::vector<GerstnerWave> waves;             // at most kMaxWaves
+    bool depthAware = false;                     // ω² = g·k·tanh(k·h) with the depth h, not g·k
+    double shoreFadeDistance = 50.0;             // metres from shore over which the waves grow to full
+    WaterReflection reflection = WaterReflection::Planar;
+    double reflectionScale = 0.5;                // planar reflection target size / frame size, [0.25, 1]
+    double distortion = 0.02;                    // screen-space offset of the reflection per unit of wave slope, [0, 0.2]
+    static constexpr int kMaxWaves = 8;
+};
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -248,6 +277,7 @@ struct SceneDescription {
     FogSettings fog;
     DetailSettings detail;
     AoSettings ao;
+    WaterSettings water;
 };
 
 }  // namespace terralux
