@@ -73,6 +73,7 @@ Options:
   --overlay LIST                --render: draw over the image, comma-separated: probes (probe
                                 positions: gold valid, cyan moved up, red rejected), leaves
                                 (adaptive octree leaves).
+  --time T                      --render: seconds into the water's wave animation (default 0).
   --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
                                 degrees, radius in metres (default: the project's camera).
   --no-probes                   Render without probe lighting.
@@ -149,12 +150,13 @@ struct Args {
     QCommandLineOption device{"device", "Device.", "NAME"};
     QCommandLineOption dryRun{"dry-run", "Estimate the bake only."};
     QCommandLineOption overlay{"overlay", "Overlays.", "LIST"};
+    QCommandLineOption time{"time", "Seconds.", "T"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay});
+                           device, dryRun, overlay, time});
     }
 };
 
@@ -437,6 +439,13 @@ int commandRender(const Args& a) {
         if (!view) throw UsageError("--debug-view " + v + ": not one of " + debugViewList());
         request.debugView = view->number;
     }
+    if (a.parser.isSet(a.time)) {
+        bool ok = false;
+        const double t = a.parser.value(a.time).toDouble(&ok);
+        if (!ok || !std::isfinite(t) || t < 0.0 || t > 1.0e6)
+            throw UsageError("--time " + str(a.parser.value(a.time)) + ": expected seconds, a number in [0, 1000000]");
+        request.time = t;
+    }
     request.probes = !a.parser.isSet(a.noProbes);
     request.linearOutput = ext == ".exr";
     for (const QString& o : a.parser.values(a.overlay))
@@ -558,6 +567,8 @@ int runCommandLine(int argc, char** argv) {
             throw UsageError("--dry-run: only with --bake");
         if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
             throw UsageError("--overlay: only with --render");
+        if (a.parser.isSet(a.time) && !a.parser.isSet(a.render))
+            throw UsageError("--time: only with --render");
         if (a.parser.isSet(a.noRebake) && !a.parser.isSet(a.render))
             throw UsageError("--no-rebake: only with --render");
         if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))

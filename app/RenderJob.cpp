@@ -85,6 +85,30 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.shadows = scene.shadows;
     base_.fog = resolvedFog(scene.fog, lighting.sky, terrain_.heightfield);
     base_.skirt = scene.terrain.skirt;
+    // Water: the level and the highest crest decide the field and the mesh (built again only when
+    // they change); everything else is uniforms.
+    const WaterSettings& ws = scene.water;
+    base_.water = WaterLook{};
+    if (ws.enabled) {
+        WaterLook& w = base_.water;
+        w.enabled = true;
+        double crest = 0.0;
+        for (const GerstnerWave& wave : ws.waves) {
+            w.waves.push_back(water::waveTerms(wave));
+            crest += w.waves.back().amplitude;
+        }
+        renderer_->setWater(float(water::waterLevel(ws, terrain_.heightfield)), float(crest));
+        w.scatter = ws.color;
+        w.absorption = ws.absorption;
+        w.roughness = float(ws.roughness);
+        w.depthAware = ws.depthAware;
+        w.shoreFadeDistance = float(ws.shoreFadeDistance);
+        w.planarReflection = ws.reflection == WaterReflection::Planar;
+        w.reflectionScale = float(ws.reflectionScale);
+        w.distortion = float(ws.distortion);
+    } else {
+        renderer_->setWater(std::nullopt, 0.0f);
+    }
     // Placement reads only the volumes' settings and this renderer's terrain: edits of the sun,
     // sky or camera keep the markers they had.
     const std::string volumes = sceneToJson(scene).at("probe_volumes").dump();
@@ -258,6 +282,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
+    s.water.time = r.time;
     return s;
 }
 

@@ -25,6 +25,7 @@ struct RenderRequest {
     bool bakeIfMissing = true;
     bool probePositions = false;  // overlay of the enabled volumes' probe positions
     bool leaves = false;          // overlay of the adaptive volumes' octree leaves
+    double time = 0.0;            // seconds: the phase of the water's waves
 };
 
 class ProjectRenderer;

@@ -16,4 +16,7 @@ std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();
 std::span<const uint32_t> leavesVert();
+std::span<const uint32_t> waterVert();
+std::span<const uint32_t> waterFrag();        // the sun unshadowed
+std::span<const uint32_t> waterShadowFrag();  // with the shadow cascades bound
 }  // namespace terralux::shaders

@@ -2,9 +2,10 @@
 #ifndef TLX_BRDF_GLSL
 #define TLX_BRDF_GLSL
 
-// GGX (Walter et al. 2007) with Schlick Fresnel and the Smith-Schlick visibility term, times
-// N·L: the specular response to a light of unit illuminance from l.
-vec3 ggxSpecular(vec3 n, vec3 v, vec3 l, float roughness) {
+// GGX (Walter et al. 2007) with Schlick Fresnel of reflectance f0 at normal incidence and the
+// Smith-Schlick visibility term, times N·L: the specular response to a light of unit illuminance
+// from l.
+vec3 ggxSpecularF0(vec3 n, vec3 v, vec3 l, float roughness, float f0) {
     float ndotl = max(dot(n, l), 0.0);
     float a = roughness * roughness;
     vec3 hv = normalize(l + v);
@@ -12,8 +13,10 @@ vec3 ggxSpecular(vec3 n, vec3 v, vec3 l, float roughness) {
     float d = a * a / (PI * pow(ndoth * ndoth * (a * a - 1.0) + 1.0, 2.0));
     float k = a * 0.5;
     float g = ndotl / (ndotl * (1.0 - k) + k) * ndotv / (ndotv * (1.0 - k) + k);
-    float fres = 0.04 + 0.96 * pow(1.0 - max(dot(hv, v), 0.0), 5.0);
+    float fres = f0 + (1.0 - f0) * pow(1.0 - max(dot(hv, v), 0.0), 5.0);
     return vec3(d * g * fres / max(4.0 * ndotl * ndotv, 1e-4)) * ndotl;
 }
+// Dielectric ground: f0 = 0.04.
+vec3 ggxSpecular(vec3 n, vec3 v, vec3 l, float roughness) { return ggxSpecularF0(n, v, l, roughness, 0.04); }
 
 #endif

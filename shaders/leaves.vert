@@ -27,7 +27,7 @@ void main() {
         vec2 halfSize = 0.5 * camera.viewport.xy;
         vec2 p = c.xy / c.w * halfSize;
         float pixels = max(length(cx.xy / cx.w * halfSize - p), length(cz.xy / cz.w * halfSize - p));
-        if (pixels < overlay.leaves.y) gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // beyond the far plane: clipped
+        if (pixels < overlay.leaves.y) gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
     }
     float level = log2(max(inLeaf.w / max(overlay.leaves.x, 1e-6), 1.0));
     color = mix(vec3(1.0, 0.95, 0.6), vec3(0.35, 0.25, 0.9), clamp(level / 5.0, 0.0, 1.0));

@@ -16,7 +16,7 @@ void main() {
     gl_Position = clip;
     bool valid = inProbe.w > 0.5 && inProbe.w < 1.5;
     if (valid ? overlay.markers.x == 0 : overlay.markers.y == 0)
-        gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // beyond the far plane: clipped
+        gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
     // Valid gold, moved cyan, rejected red.
     color = inProbe.w > 1.5 ? vec3(0.10, 0.80, 1.0) : inProbe.w > 0.5 ? vec3(1.0, 0.85, 0.1) : vec3(1.0, 0.1, 0.1);
 }

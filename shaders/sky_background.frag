@@ -16,7 +16,7 @@ layout(location = 0) in vec2 ndc;
 layout(location = 0) out vec4 outColor;
 
 void main() {
-    vec4 far = camera.invViewProj * vec4(ndc, 1.0, 1.0);
+    vec4 far = camera.invViewProj * vec4(ndc, 0.0, 1.0);  // reversed Z: depth 0 is the far plane
     vec3 dir = normalize(far.xyz / far.w - camera.position.xyz);
     vec3 up = normalize(vec3(dir.x, max(dir.y, 0.0), dir.z) + vec3(0.0, 1e-4, 0.0));
     vec3 c[9];

@@ -82,17 +82,6 @@ vec3 viewCascades(ShadingPoint s) {
     return base * (0.45 + 0.55 * sunNdotL(s));
 }
 
-// Heat ramp: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red. Piecewise
-// linear over the stops, without an indexed array (which a CPU driver may build for every
-// fragment).
-vec3 heat(float e) {
-    float t = clamp(e / 0.10, 0.0, 1.0) * 4.0;
-    if (t < 1.0) return mix(vec3(0.05, 0.10, 0.55), vec3(0.0, 0.65, 0.90), t);
-    if (t < 2.0) return mix(vec3(0.0, 0.65, 0.90), vec3(0.15, 0.80, 0.20), t - 1.0);
-    if (t < 3.0) return mix(vec3(0.15, 0.80, 0.20), vec3(1.0, 0.85, 0.10), t - 2.0);
-    return mix(vec3(1.0, 0.85, 0.10), vec3(0.90, 0.10, 0.05), t - 3.0);
-}
-
 // Interpolation error: EXR holds the error in red and 1 in green where measured.
 vec3 viewInterpolationError(ShadingPoint s) {
     float known = s.probe.z;
@@ -113,6 +102,14 @@ vec3 viewFilled(ShadingPoint s) {
     float luma = dot(c, vec3(0.2126, 0.7152, 0.0722));
     return mix(c, vec3(1.0, 0.1, 0.9) * (0.35 + 0.65 * luma), 0.75 * clamp(s.filled, 0.0, 1.0));
 }
+
+// The water views on land (the water pass draws the water): the mask's land colour, no distance
+// to shore, and the land's normal in the water-normal view.
+vec3 viewWaterMask(ShadingPoint s) {
+    return linearOutput() ? vec3(0.0, 1.0, 0.0) : vec3(0.32, 0.27, 0.20) * (0.6 + 0.4 * sunNdotL(s));
+}
+vec3 viewShoreDistance(ShadingPoint s) { return linearOutput() ? vec3(0.0, 0.0, 0.0) : vec3(0.0); }
+vec3 viewWaterNormal(ShadingPoint s) { return vec3(0.5) * (0.6 + 0.4 * sunNdotL(s)); }
 
 vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two

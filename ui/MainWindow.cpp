@@ -43,6 +43,7 @@
 #include "CascadeSplitChart.h"
 #include "DemImport.h"
 #include "ParameterPanels.h"
+#include "WaterPanel.h"
 #include "ParameterTable.h"
 #include "BakeJob.h"
 #include "PreviewBake.h"
@@ -412,6 +413,16 @@ void MainWindow::buildDocks() {
     av->addStretch(1);
     auto* aoDock = dock("Ambient Occlusion", "dock.ao", ao);
 
+    // Water: the plane, its optics and reflection, the waves and their animation.
+    auto* waterPage = new QWidget;
+    auto* wv = new QVBoxLayout(waterPage);
+    wv->addWidget(dockForm("dock.water"));
+    waterPanel_ = new WaterPanel(doc_, viewport_);
+    connectRejected(waterPanel_);
+    wv->addWidget(waterPanel_);
+    wv->addStretch(1);
+    auto* waterDock = dock("Water", "dock.water", waterPage);
+
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
@@ -478,6 +489,7 @@ void MainWindow::buildDocks() {
     tabifyDockWidget(shadowsDock, atmosphereDock);
     tabifyDockWidget(atmosphereDock, surfaceDock);
     tabifyDockWidget(surfaceDock, aoDock);
+    tabifyDockWidget(aoDock, waterDock);
     tabifyDockWidget(volumesDock, bakeDock);
     terrainDock->raise();
     volumesDock->raise();

@@ -28,6 +28,7 @@ class QCheckBox;
 namespace terralux {
 
 class ProbeVolumesPanel;
+class WaterPanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -126,6 +127,7 @@ private:
     QLabel* suggestions_ = nullptr;
     QLabel* outputPath_ = nullptr;
     ProbeVolumesPanel* volumesPanel_ = nullptr;
+    WaterPanel* waterPanel_ = nullptr;
     QProxyStyle* tabStyle_ = nullptr;
     std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;

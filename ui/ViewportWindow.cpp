@@ -52,6 +52,12 @@ void ViewportWindow::setLeaves(bool on) {
     requestUpdate();
 }
 
+void ViewportWindow::setWaterTime(double seconds) {
+    if (request_.time == seconds) return;
+    request_.time = seconds;
+    requestUpdate();
+}
+
 void ViewportWindow::exposeEvent(QExposeEvent*) {
     if (isExposed()) renderNow();
 }

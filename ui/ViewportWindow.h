@@ -33,6 +33,9 @@ public:
     void setProbeLighting(bool on);
     void setProbePositions(bool on);
     void setLeaves(bool on);
+    // Seconds into the water's wave animation (the Water dock's time slider and Play).
+    void setWaterTime(double seconds);
+    double waterTime() const { return request_.time; }
     // Draws the current view again and reads it back (row 0 at the top), waiting for the GPU:
     // for tests and screenshots, never per frame.
     RenderedImage grabImage();

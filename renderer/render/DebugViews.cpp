@@ -14,7 +14,8 @@ const std::vector<int>& shaderViewNumbers() {
 const std::vector<DebugView>& debugViews() {
     constexpr ViewNeeds none{}, diagnostics{false, true, false}, diagnosticsAndMarkers{false, true, true},
         shadows{false, false, false, true}, visibility{false, false, false, false, true},
-        lit{true, false, false, true, false, true}, light{true, false, false};
+        lit{true, false, false, true, false, true, true, true}, light{true, false, false},
+        waterOnly{false, false, false, false, false, false, true, false};
     static const std::vector<DebugView> views = {
         {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, lit},
         {kViewAlbedo, "albedo", "surface albedo", false, ViewBackground::Black, none},
@@ -56,6 +57,15 @@ const std::vector<DebugView>& debugViews() {
          "interpolation error heat map: blue 0 %, cyan 2.5 %, green 5 %, yellow 7.5 %, red 10 % and "
          "above, grey unmeasured (EXR: error in red, 1 in green where measured)",
          true, ViewBackground::Black, diagnostics},
+        {kViewWaterMask, "water-mask",
+         "water / land: blue where the water surface is in view, brown land (EXR: 1 in red on water, 1 in green everywhere)",
+         true, ViewBackground::Black, waterOnly},
+        {kViewShoreDistance, "shore-distance",
+         "distance from the water to the nearest land: heat ramp from blue at the shore to red at "
+         "water.shore_fade_distance and beyond, black land (EXR: metres in red, 1 in green on water)",
+         true, ViewBackground::Black, waterOnly},
+        {kViewWaterNormal, "water-normal", "the waves' normal as colour; land grey", false, ViewBackground::Black,
+         waterOnly},
     };
     return views;
 }
@@ -99,6 +109,8 @@ std::string debugViewsMarkdown() {
         if (v.needs.shadows) passes = "shadow (when shadows are on)" + (passes.empty() ? "" : ", " + passes);
         if (v.needs.sunVisibility) passes = "CPU sun tracing at the vertices (cached per sun)";
         if (v.needs.sky) passes += ", sky";
+        if (v.needs.waterShading) passes += ", water reflection and water (when the scene has water)";
+        else if (v.needs.water) passes += (passes.empty() ? "" : ", ") + std::string("water (when the scene has water)");
         out += "| " + std::to_string(v.number) + " | `" + v.name + "` | " + v.shows + " | " +
                (v.linear ? "scene-linear values" : "the display encoding") + " | " +
                (passes.empty() ? "none" : passes) + " |\n";

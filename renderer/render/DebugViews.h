@@ -31,6 +31,8 @@ struct ViewNeeds {
     bool shadows = false;           // the shadow pass (when the scene's shadows are on)
     bool sunVisibility = false;     // the sun's visibility traced on the CPU at each vertex
     bool sky = false;               // the sky pass behind the terrain
+    bool water = false;             // the water pass (when the scene has water)
+    bool waterShading = false;      // its reflection and the copy of the frame under it
 };
 
 struct DebugView {

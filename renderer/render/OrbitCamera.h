@@ -28,6 +28,12 @@ struct OrbitCamera {
     Planes planes(float extent) const;
     // Vulkan clip space (y down, depth 0..1), near/far from planes().
     glm::mat4 viewProjection(float aspect, float extent) const;
+    // The camera mirrored in the plane y = level (the planar reflection's view): its position,
+    // and its view-projection with the near plane replaced by the water plane, so that nothing
+    // below the water reaches the reflection (Lengyel 2005, "Oblique View Frustum Depth
+    // Projection and Clipping", JGT 10(2), for Vulkan's 0..1 depth).
+    glm::vec3 reflectedPosition(float level) const;
+    glm::mat4 reflectedViewProjection(float aspect, float extent, float level) const;
 };
 
 }  // namespace terralux

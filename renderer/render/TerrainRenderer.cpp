@@ -7,6 +7,7 @@
 #include <map>
 
 #include <glm/gtc/packing.hpp>
+#include <glm/packing.hpp>
 #include <glm/mat4x4.hpp>
 #include <tbb/parallel_for.h>
 
@@ -46,6 +47,16 @@ const char* const kProbeErrorMaps = "probe-error-maps";
 const char* const kProbeLight = "probe-light";
 const char* const kShadowMaps = "shadow-maps";
 const char* const kSunVisibility = "sun-visibility";
+const char* const kWaterReflection = "water-reflection";
+const char* const kWaterReflectionDepth = "water-reflection-depth";
+const char* const kWaterScene = "water-scene";
+const char* const kWaterVertices = "water-vertices";
+const char* const kWaterIndices = "water-indices";
+const char* const kWaterField = "water-field";
+
+// Vertices along the longer side of the water mesh, at most: the waves longer than two of its
+// cells move it, the shorter ones live in the normal (water.glsl).
+constexpr int kWaterMeshSide = 512;
 
 // Shadow rays per vertex of the sun-visibility view, stratified over the sun's disc.
 constexpr int kSunVisibilitySamples = 16;
@@ -75,9 +86,27 @@ struct ProbeResources {
 
 // What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
 // `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do.
+// `reflectionCamera` and `reflectionView`: the view set again with the camera mirrored in the
+// water (the planar reflection pass).
 struct FrameSlot {
-    vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay;
-    vk::DescriptorSet view, lights, shadowedLights, overlays;
+    vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay, reflectionCamera;
+    vk::DescriptorSet view, lights, shadowedLights, overlays, reflectionView;
+};
+
+// The water subsystem: present only while the scene has water. The field and mesh follow the
+// level; the reflection target and the copy of the frame follow the frame's size.
+struct WaterResources {
+    float level = 0.0f, margin = 0.0f;
+    glm::ivec2 fieldSize{1, 1};
+    vk::Image field;  // RG16F: depth below the level (negative on land), distance to shore
+    vk::Buffer vertices, indices;
+    uint32_t indexCount = 0;
+    float spacing = 1.0f;  // metres between mesh vertices
+    uint32_t width = 0, height = 0, reflectionWidth = 0, reflectionHeight = 0;
+    vk::Image reflection, reflectionDepth, scene;
+    vk::Framebuffer reflectionFramebuffer;
+    std::vector<vk::Buffer> blocks;        // per frame slot: the WaterBlock
+    std::vector<vk::DescriptorSet> sets;   // per frame slot: block, reflection, scene, field
 };
 
 // The shadow subsystem: the cascades' depth maps (one layer each) and a framebuffer per layer.
@@ -107,6 +136,12 @@ struct TerrainRenderer::Gpu {
     vk::UniqueSetLayout viewLayout;
     std::unique_ptr<ProbeResources> probes;
     std::unique_ptr<ShadowResources> shadows;
+    std::unique_ptr<WaterResources> water;
+    vk::Sampler linear;
+    vk::UniqueSetLayout waterLayout;
+    vk::PipelineLayout waterPipelineLayout, shadowedWaterPipelineLayout;
+    // By variant: kShadowVariant | kFogVariant.
+    std::map<int, vk::UniquePipeline> waterPipelines;
     // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
     // sun and surface it was traced for.
     vk::Buffer sunVisibility;
@@ -152,15 +187,40 @@ vk::DescriptorSetBuilder shadowedLightsBuilder(const FrameSlot& f, VkImageView m
                g.depthSampler.handle(), frag);
 }
 
-// The view set: camera, surface block and the surface maps. `t` null: the layout alone.
-vk::DescriptorSetBuilder viewSetBuilder(const FrameSlot& f, const SurfaceTextures* t, VkSampler sampler) {
+// The view set: camera, surface block and the surface maps. `t` null: the layout alone. The
+// surface block reaches the vertex stage too: the water mesh finds its field by the footprint.
+vk::DescriptorSetBuilder viewSetBuilder(const FrameSlot& f, const vk::Buffer& camera, const SurfaceTextures* t,
+                                        VkSampler sampler) {
     constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
     return vk::DescriptorSetBuilder()
-        .uniform(blocks::CameraBlock::kBinding, "camera", f.camera, kVertexFragment)
-        .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, frag)
+        .uniform(blocks::CameraBlock::kBinding, "camera", camera, kVertexFragment)
+        .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, kVertexFragment)
         .image(TLX_SURFACE_NORMAL_AO_BINDING, kSurfaceNormalAo, t ? t->normalAo.view() : VK_NULL_HANDLE, sampler, frag)
         .image(TLX_SURFACE_ALBEDO_BINDING, kSurfaceAlbedo, t ? t->albedo.view() : VK_NULL_HANDLE, sampler, frag)
         .image(TLX_SURFACE_FILLED_BINDING, kSurfaceFilled, t ? t->filled.view() : VK_NULL_HANDLE, sampler, frag);
+}
+
+// The water set: its block, the reflection, the frame under the water and the field (read by the
+// mesh too). Null views: the layout alone.
+vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView reflection, VkImageView scene,
+                                         VkImageView field, VkSampler sampler) {
+    constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
+    return vk::DescriptorSetBuilder()
+        .uniform(blocks::WaterBlock::kBinding, "water", block, kVertexFragment)
+        .image(TLX_WATER_REFLECTION_BINDING, kWaterReflection, reflection, sampler, frag)
+        .image(TLX_WATER_SCENE_BINDING, kWaterScene, scene, sampler, frag)
+        .image(TLX_WATER_FIELD_BINDING, kWaterField, field, sampler, kVertexFragment);
+}
+
+// Bilinear sample of a row-major DEM-grid array at fractional (col, row).
+float gridSample(const std::vector<float>& values, int width, int depth, double col, double row) {
+    col = std::clamp(col, 0.0, double(width - 1));
+    row = std::clamp(row, 0.0, double(depth - 1));
+    const int c0 = std::min(int(col), std::max(width - 2, 0)), r0 = std::min(int(row), std::max(depth - 2, 0));
+    const int c1 = std::min(c0 + 1, width - 1), r1 = std::min(r0 + 1, depth - 1);
+    const double fx = col - c0, fz = row - r0;
+    auto at = [&](int c, int r) { return double(values[size_t(r) * size_t(width) + size_t(c)]); };
+    return float((at(c0, r0) * (1 - fx) + at(c1, r0) * fx) * (1 - fz) + (at(c0, r1) * (1 - fx) + at(c1, r1) * fx) * fz);
 }
 
 // Texel bytes of a level: RGBA16F normal-AO, RGBA8 sRGB albedo, R8 filled share.
@@ -226,6 +286,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
             return vk::Buffer::hostVisible(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         };
         f.camera = ubo(sizeof(blocks::CameraBlock));
+        f.reflectionCamera = ubo(sizeof(blocks::CameraBlock));
         f.surface = ubo(sizeof(blocks::SurfaceBlock));
         f.sunSky = ubo(sizeof(blocks::SunSkyBlock));
         f.atmosphere = ubo(sizeof(blocks::AtmosphereBlock));
@@ -242,7 +303,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         g.slots.push_back(std::move(f));
     }
     g.trilinear = vk::Sampler::trilinearClamp(ctx_);
-    g.viewLayout = viewSetBuilder(g.slots[0], nullptr, g.trilinear.handle()).buildLayout(ctx_);
+    g.viewLayout = viewSetBuilder(g.slots[0], g.slots[0].camera, nullptr, g.trilinear.handle()).buildLayout(ctx_);
     uploadSurfaceMaps({});
     setAlbedoMap(0, 0, {});
     g.emptySet = vk::DescriptorSetBuilder().buildLayout(ctx_);
@@ -263,6 +324,115 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     const VkDescriptorSetLayout shadowedSets[] = {g.viewLayout.get(), g.shadowedLightsLayout.get()};
     g.shadowedTerrainLayout = vk::PipelineLayout(ctx_, shadowedSets);
     g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
+    g.linear = vk::Sampler::linearClamp(ctx_);
+    static const vk::Buffer noBuffer;
+    g.waterLayout = waterSetBuilder(noBuffer, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, g.linear.handle())
+                        .buildLayout(ctx_);
+    const VkDescriptorSetLayout waterSets[] = {g.viewLayout.get(), g.slots[0].lights.layout(), g.waterLayout.get()};
+    g.waterPipelineLayout = vk::PipelineLayout(ctx_, waterSets);
+    const VkDescriptorSetLayout shadowedWaterSets[] = {g.viewLayout.get(), g.shadowedLightsLayout.get(),
+                                                       g.waterLayout.get()};
+    g.shadowedWaterPipelineLayout = vk::PipelineLayout(ctx_, shadowedWaterSets);
+}
+
+bool TerrainRenderer::hasWaterResources() const { return gpu_->water != nullptr; }
+
+glm::ivec2 TerrainRenderer::waterFieldSize() const { return gpu_->water ? gpu_->water->fieldSize : glm::ivec2(0); }
+
+void TerrainRenderer::setWater(std::optional<float> level, float margin) {
+    Gpu& g = *gpu_;
+    if (level && g.water && g.water->level == *level && g.water->margin == margin) return;
+    ctx_.waitIdle();  // frames in flight may still read the old resources
+    for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene, kWaterVertices, kWaterIndices})
+        g.graph.forget(name);
+    g.water.reset();
+    if (!level) return;
+    auto w = std::make_unique<WaterResources>();
+    w->level = *level;
+    w->margin = margin;
+
+    // The field over the footprint, texel centres corner to corner like the surface maps: depth
+    // below the level and distance to shore, from the DEM grid (bilinear where it is coarser).
+    const std::vector<float> shore = water::shoreDistance(hf_, double(*level));
+    const int hw = hf_.width(), hd = hf_.depth();
+    const int fw = std::min(hw, 2048), fd = std::min(hd, 2048);
+    vk::MipLevel texels{uint32_t(fw), uint32_t(fd), std::vector<uint8_t>(size_t(fw) * size_t(fd) * 4)};
+    tbb::parallel_for(0, fd, [&](int j) {
+        const double row = fd > 1 ? double(j) * double(hd - 1) / double(fd - 1) : 0.0;
+        for (int i = 0; i < fw; ++i) {
+            const double col = fw > 1 ? double(i) * double(hw - 1) / double(fw - 1) : 0.0;
+            const float depth = *level - gridSample(hf_.heights(), hw, hd, col, row);
+            const float distance = gridSample(shore, hw, hd, col, row);
+            // Half floats hold ±65504: deeper water and farther shores than that look the same.
+            const glm::vec2 v(std::clamp(depth, -6.0e4f, 6.0e4f), std::isfinite(distance) ? std::min(distance, 6.0e4f) : 6.0e4f);
+            const uint32_t packed = glm::packHalf2x16(v);
+            std::memcpy(texels.bytes.data() + 4 * (size_t(j) * size_t(fw) + size_t(i)), &packed, 4);
+        }
+    });
+    w->fieldSize = {fw, fd};
+    w->field = vk::Image::texture(ctx_, VK_FORMAT_R16G16_SFLOAT, {texels});
+
+    // The mesh: a grid at rest on the plane over the footprint, keeping the cells whose bed lies
+    // below the highest crest somewhere.
+    const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
+    const float longer = std::max({spanX, spanZ, 1e-3f});
+    const float step = longer / float(kWaterMeshSide - 1);
+    const int nx = std::max(int(std::ceil(spanX / step)) + 1, 2), nz = std::max(int(std::ceil(spanZ / step)) + 1, 2);
+    w->spacing = std::max(spanX / float(nx - 1), spanZ / float(nz - 1));
+    std::vector<glm::vec2> rest(size_t(nx) * size_t(nz));
+    std::vector<uint8_t> wet(rest.size());
+    for (int j = 0; j < nz; ++j)
+        for (int i = 0; i < nx; ++i) {
+            const glm::vec2 p(hf_.minX() + spanX * float(i) / float(nx - 1), hf_.minZ() + spanZ * float(j) / float(nz - 1));
+            rest[size_t(j) * size_t(nx) + size_t(i)] = p;
+            wet[size_t(j) * size_t(nx) + size_t(i)] = hf_.surfaceHeight(p.x, p.y) < *level + margin ? 1 : 0;
+        }
+    std::vector<uint32_t> indices;
+    for (int j = 0; j + 1 < nz; ++j)
+        for (int i = 0; i + 1 < nx; ++i) {
+            const uint32_t v00 = uint32_t(j * nx + i), v10 = v00 + 1, v01 = v00 + uint32_t(nx), v11 = v01 + 1;
+            if (wet[v00] || wet[v10] || wet[v01] || wet[v11]) indices.insert(indices.end(), {v00, v01, v11, v00, v11, v10});
+        }
+    w->indexCount = uint32_t(indices.size());
+    if (indices.empty()) indices.push_back(0);
+    w->vertices = vk::Buffer::deviceLocal(ctx_, rest.data(), rest.size() * sizeof(glm::vec2), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    w->indices = vk::Buffer::deviceLocal(ctx_, indices.data(), indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    g.graph.importBuffer(kWaterVertices, w->vertices.handle(), true);
+    g.graph.importBuffer(kWaterIndices, w->indices.handle(), true);
+    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+        w->blocks.push_back(vk::Buffer::hostVisible(ctx_, sizeof(blocks::WaterBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
+    g.water = std::move(w);
+}
+
+void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale) {
+    Gpu& g = *gpu_;
+    WaterResources& w = *g.water;
+    const uint32_t rw = std::max(uint32_t(std::lround(float(width) * reflectionScale)), 1u);
+    const uint32_t rh = std::max(uint32_t(std::lround(float(height) * reflectionScale)), 1u);
+    if (w.width == width && w.height == height && w.reflectionWidth == rw && w.reflectionHeight == rh) return;
+    ctx_.waitIdle();  // frames in flight may still read the old targets
+    for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene}) g.graph.forget(name);
+    w.sets.clear();
+    w.reflection = vk::Image::colorTarget(ctx_, rw, rh);
+    w.reflectionDepth = vk::Image::depthTarget(ctx_, rw, rh);
+    const VkImageView views[] = {w.reflection.view(), w.reflectionDepth.view()};
+    w.reflectionFramebuffer = vk::Framebuffer(ctx_, g.clearPass, views, rw, rh);
+    vk::ImageDesc copy;
+    copy.width = width;
+    copy.height = height;
+    copy.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    w.scene = vk::Image(ctx_, copy);
+    g.graph.importImage(kWaterReflection, w.reflection.handle(), w.reflection.aspect());
+    g.graph.importImage(kWaterReflectionDepth, w.reflectionDepth.handle(), w.reflectionDepth.aspect());
+    g.graph.importImage(kWaterScene, w.scene.handle(), w.scene.aspect());
+    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+        w.sets.push_back(waterSetBuilder(w.blocks[i], w.reflection.view(), w.scene.view(), w.field.view(),
+                                         g.linear.handle())
+                             .build(ctx_));
+    w.width = width;
+    w.height = height;
+    w.reflectionWidth = rw;
+    w.reflectionHeight = rh;
 }
 
 bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
@@ -333,7 +503,10 @@ void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<glm:
 
 void TerrainRenderer::buildViewSets() {
     Gpu& g = *gpu_;
-    for (FrameSlot& f : g.slots) f.view = viewSetBuilder(f, &g.surface, g.trilinear.handle()).build(ctx_);
+    for (FrameSlot& f : g.slots) {
+        f.view = viewSetBuilder(f, f.camera, &g.surface, g.trilinear.handle()).build(ctx_);
+        f.reflectionView = viewSetBuilder(f, f.reflectionCamera, &g.surface, g.trilinear.handle()).build(ctx_);
+    }
 }
 
 void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
@@ -570,6 +743,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     if (!s.shadows.enabled) ensureShadowMaps(0, 0);  // a scene without shadows holds no maps
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     ShadowResources* shadows = shadowed ? g.shadows.get() : nullptr;
+    // Water: the scene has it and the view draws it; the reflection and the copy of the frame
+    // under it only where the view shades it, the reflection only when planar.
+    WaterResources* water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
+    const bool waterShading = water && view.needs.waterShading;
+    const bool planarReflection = waterShading && s.water.planarReflection;
+    if (water) ensureWaterTargets(s.width, s.height, s.water.reflectionScale);
 
     // Pipelines, built on first use.
     if (probes && !g.probePass) {
@@ -601,7 +780,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             ctx_, g.clearPass.handle(), (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle(), d);
     }
     vk::UniquePipeline& skyPipeline = fog ? g.skyFog : g.skyPlain;
-    if (sky && !skyPipeline) {
+    if ((sky || planarReflection) && !skyPipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::fullscreenVert();
         d.frag = shaders::skyBackgroundFrag();
@@ -609,12 +788,25 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         d.depthWrite = false;
         skyPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.terrainLayout.handle(), d);
     }
+    const int waterVariant = (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0);
+    vk::UniquePipeline& waterPipeline = g.waterPipelines[waterVariant];
+    if (water && !waterPipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::waterVert();
+        d.frag = shadows ? shaders::waterShadowFrag() : shaders::waterFrag();
+        d.fragConstants = {fog ? 1u : 0u};
+        d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
+        d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
+        waterPipeline = vk::createGraphicsPipeline(
+            ctx_, g.drawPass.handle(), (shadows ? g.shadowedWaterPipelineLayout : g.waterPipelineLayout).handle(), d);
+    }
     if (shadows && !g.shadowDepth) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::shadowDepthVert();
         d.bindings = {meshBinding};
         d.attributes = {position};
         d.colorAttachments = 0;
+        d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
         g.shadowDepth = vk::createGraphicsPipeline(ctx_, g.shadowPass.handle(), g.shadowDepthLayout.handle(), d);
     }
     const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
@@ -704,6 +896,33 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         slot.shadow.write(&block, sizeof block);
     } else if (!s.shadows.enabled) {
         cascades_.clear();
+    }
+    if (water) {
+        const WaterLook& look = s.water;
+        blocks::WaterBlock block;
+        block.plane = glm::vec4(water->level, float(look.time), look.shoreFadeDistance, look.depthAware ? 1.0f : 0.0f);
+        block.scatter = glm::vec4(look.scatter, look.roughness);
+        block.absorption = glm::vec4(look.absorption, look.planarReflection ? 1.0f : 0.0f);
+        const size_t waves = std::min<size_t>(look.waves.size(), 8);
+        block.look = glm::vec4(look.distortion, float(waves), glm::vec2(water->fieldSize));
+        block.mesh = glm::vec4(water->spacing, 0.0f, 0.0f, 0.0f);
+        for (size_t i = 0; i < waves; ++i) {
+            const water::WaveTerms& wave = look.waves[i];
+            block.waves[i] = glm::vec4(float(wave.direction.x), float(wave.direction.y), float(wave.k), float(wave.amplitude));
+            block.phases[i] = glm::vec4(float(wave.omegaDeep), float(wave.phase), 0.0f, 0.0f);
+        }
+        water->blocks[slotIndex].write(&block, sizeof block);
+    }
+    if (planarReflection) {
+        // The camera mirrored in the plane, drawing scene-linear beauty into the reflection.
+        blocks::CameraBlock mirrored = camera;
+        const float rw = float(water->reflectionWidth), rh = float(water->reflectionHeight);
+        mirrored.viewProj = s.camera.reflectedViewProjection(aspect, extent, water->level);
+        mirrored.invViewProj = glm::inverse(mirrored.viewProj);
+        mirrored.position = glm::vec4(s.camera.reflectedPosition(water->level), camera.position.w);
+        mirrored.viewport = glm::vec4(rw, rh, 1.0f / rw, 1.0f / rh);
+        mirrored.view = glm::ivec4(kViewBeauty, 1, camera.view.z, 0);
+        slot.reflectionCamera.write(&mirrored, sizeof mirrored);
     }
     if (drawMarkers || drawLeaves) {
         blocks::OverlayBlock overlay;
@@ -803,56 +1022,73 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         shadows->drawn = lightMatrices;
     }
 
-    {
-        vk::DescriptorSet& lights = shadows ? slot.shadowedLights : slot.lights;
-        PassInfo info{"terrain",
-                      {{kColor, Access::ColorAttachmentClear},
-                       {kDepth, Access::DepthAttachmentClear},
-                       {kVertices, Access::VertexAttributeRead},
-                       {kIndices, Access::IndexRead}},
-                      concat(concat(slot.view.bindingNames(), lights.bindingNames()),
+    // The terrain draw, shared by the frame and the planar reflection (which binds the mirrored
+    // camera's view set): its uses and bindings beyond the targets, and its recording.
+    vk::DescriptorSet& lights = shadows ? slot.shadowedLights : slot.lights;
+    VkBuffer attribute = VK_NULL_HANDLE;
+    const char* attributeName = nullptr;
+    if (probes) {
+        attribute = probes->light.handle();
+        attributeName = kProbeLight;
+    } else if (sunVisibility) {
+        attribute = g.sunVisibility.handle();
+        attributeName = kSunVisibility;
+    }
+    // The diagnostics views read the probe pass's second vec4 in place of the first: one
+    // attribute and one varying either way, so no view pays for the other.
+    const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
+    const uint32_t indexCount = uint32_t(indexCount_);
+    const VkPipeline terrainHandle = terrainPipeline.get();
+    const VkPipelineLayout terrainLayout = (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle();
+    const VkDescriptorSet lightsSet = lights.handle();
+    const auto terrainPass = [&](const char* name, std::vector<ResourceUse> targets, const vk::DescriptorSet& viewSet) {
+        PassInfo info{name, std::move(targets),
+                      concat(concat(viewSet.bindingNames(), lights.bindingNames()),
                              {std::string("vertex:") + kVertices, std::string("index:") + kIndices})};
+        info.uses.push_back({kVertices, Access::VertexAttributeRead});
+        info.uses.push_back({kIndices, Access::IndexRead});
         if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
-        VkBuffer attribute = VK_NULL_HANDLE;
-        if (probes) {
-            info.uses.push_back({kProbeLight, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + kProbeLight);
-            attribute = probes->light.handle();
-        } else if (sunVisibility) {
-            info.uses.push_back({kSunVisibility, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + kSunVisibility);
-            attribute = g.sunVisibility.handle();
+        if (attributeName) {
+            info.uses.push_back({attributeName, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + attributeName);
         }
         if (fog) info.bindings.push_back("fog");
-        // The diagnostics views read the probe pass's second vec4 in place of the first: one
-        // attribute and one varying either way, so no view pays for the other.
-        const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
-        const uint32_t indexCount = uint32_t(indexCount_);
-        const VkPipeline pipeline = terrainPipeline.get();
-        const VkPipelineLayout layout = (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle();
-        const VkDescriptorSet sets[] = {slot.view.handle(), lights.handle()};
-        graph.addPass(std::move(info), [&g, pipeline, layout, sets, attribute, attributeOffset, indexCount, bg,
-                                        w, h, framebuffer, setViewport](VkCommandBuffer c) {
-            VkClearValue clear[2];
-            clear[0].color = {{bg.x, bg.y, bg.z, 1.0f}};
-            clear[1].depthStencil = {1.0f, 0};
-            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-            rbi.renderPass = g.clearPass.handle();
-            rbi.framebuffer = framebuffer;
-            rbi.renderArea = {{0, 0}, {w, h}};
-            rbi.clearValueCount = 2;
-            rbi.pClearValues = clear;
-            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            if (indexCount > 0) {
-                setViewport(c, w, h);
-                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW, 2, sets, 0, nullptr);
-                const VkBuffer vb[2] = {g.vertices.handle(), attribute};
-                const VkDeviceSize offsets[2] = {0, attributeOffset};
-                vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
-                vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-                vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
-            }
+        return info;
+    };
+    const auto drawTerrain = [&g, terrainHandle, terrainLayout, lightsSet, attribute, attributeOffset,
+                              indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {
+        if (indexCount == 0) return;
+        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainHandle);
+        const VkDescriptorSet sets[] = {viewSet, lightsSet};
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainLayout, TLX_SET_VIEW, 2, sets, 0, nullptr);
+        const VkBuffer vb[2] = {g.vertices.handle(), attribute};
+        const VkDeviceSize offsets[2] = {0, attributeOffset};
+        vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
+        vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+        vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+    };
+    // Begins the clearing render pass on a framebuffer, with the viewport over it.
+    const auto beginClearing = [&g, setViewport](VkCommandBuffer c, VkFramebuffer fb, uint32_t fw, uint32_t fh,
+                                                 glm::vec3 clearColor) {
+        VkClearValue clear[2];
+        clear[0].color = {{clearColor.x, clearColor.y, clearColor.z, 1.0f}};
+        clear[1].depthStencil = {0.0f, 0};  // reversed Z: the far plane
+        VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+        rbi.renderPass = g.clearPass.handle();
+        rbi.framebuffer = fb;
+        rbi.renderArea = {{0, 0}, {fw, fh}};
+        rbi.clearValueCount = 2;
+        rbi.pClearValues = clear;
+        vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+        setViewport(c, fw, fh);
+    };
+    {
+        PassInfo info = terrainPass("terrain", {{kColor, Access::ColorAttachmentClear}, {kDepth, Access::DepthAttachmentClear}},
+                                    slot.view);
+        const VkDescriptorSet viewSet = slot.view.handle();
+        graph.addPass(std::move(info), [drawTerrain, beginClearing, viewSet, bg, w, h, framebuffer](VkCommandBuffer c) {
+            beginClearing(c, framebuffer, w, h, bg);
+            drawTerrain(c, viewSet);
             vkCmdEndRenderPass(c);
         });
     }
@@ -870,6 +1106,82 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
                                     sets, 0, nullptr);
             vkCmdDraw(c, 3, 1, 0, 0);
+            vkCmdEndRenderPass(c);
+        });
+    }
+
+    if (planarReflection) {
+        // The terrain and the sky seen from the mirrored camera, scene-linear, with everything below
+        // the water clipped by the oblique near plane.
+        PassInfo info = terrainPass("water-reflection",
+                                    {{kWaterReflection, Access::ColorAttachmentClear},
+                                     {kWaterReflectionDepth, Access::DepthAttachmentClear}},
+                                    slot.reflectionView);
+        info.bindings.push_back("sky");
+        const VkDescriptorSet viewSet = slot.reflectionView.handle(), skyLights = slot.lights.handle();
+        const VkFramebuffer fb = water->reflectionFramebuffer.handle();
+        const uint32_t rw = water->reflectionWidth, rh = water->reflectionHeight;
+        const VkPipeline skyHandle = skyPipeline.get();
+        graph.addPass(std::move(info), [&g, drawTerrain, beginClearing, setViewport, viewSet, skyLights, fb, rw, rh,
+                                        skyHandle](VkCommandBuffer c) {
+            beginClearing(c, fb, rw, rh, glm::vec3(0.0f));
+            drawTerrain(c, viewSet);
+            vkCmdEndRenderPass(c);
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = g.drawPass.handle();
+            rbi.framebuffer = fb;
+            rbi.renderArea = {{0, 0}, {rw, rh}};
+            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            setViewport(c, rw, rh);
+            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, skyHandle);
+            const VkDescriptorSet sets[] = {viewSet, skyLights};
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
+                                    sets, 0, nullptr);
+            vkCmdDraw(c, 3, 1, 0, 0);
+            vkCmdEndRenderPass(c);
+        });
+    }
+    if (waterShading) {
+        // What lies under the water as the frame drew it, for the refraction.
+        const VkImage source = g.target->color.handle(), dest = water->scene.handle();
+        graph.addPass({"water-scene", {{kColor, Access::TransferRead}, {kWaterScene, Access::TransferWrite}}, {}},
+                      [source, dest, w, h](VkCommandBuffer c) {
+                          VkImageCopy region{};
+                          region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          region.extent = {w, h, 1};
+                          vkCmdCopyImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
+                                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+                      });
+    }
+    if (water) {
+        const vk::DescriptorSet& waterSet = water->sets[slotIndex];
+        PassInfo info{"water",
+                      {{kColor, Access::ColorAttachmentDraw},
+                       {kDepth, Access::DepthAttachmentDraw},
+                       {kWaterVertices, Access::VertexAttributeRead},
+                       {kWaterIndices, Access::IndexRead},
+                       {kWaterReflection, Access::FragmentSampledRead},
+                       {kWaterScene, Access::FragmentSampledRead}},
+                      concat(concat(concat(slot.view.bindingNames(), lights.bindingNames()), waterSet.bindingNames()),
+                             {std::string("vertex:") + kWaterVertices, std::string("index:") + kWaterIndices})};
+        if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
+        if (fog) info.bindings.push_back("fog");
+        const VkPipeline pipeline = waterPipeline.get();
+        const VkPipelineLayout layout = (shadows ? g.shadowedWaterPipelineLayout : g.waterPipelineLayout).handle();
+        const VkDescriptorSet sets[] = {slot.view.handle(), lightsSet, waterSet.handle()};
+        const VkBuffer vb = water->vertices.handle(), ib = water->indices.handle();
+        const uint32_t waterIndices = water->indexCount;
+        graph.addPass(std::move(info), [beginDrawing, pipeline, layout, sets, vb, ib, waterIndices](VkCommandBuffer c) {
+            beginDrawing(c);
+            if (waterIndices > 0) {
+                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW, 3, sets, 0, nullptr);
+                const VkDeviceSize offset = 0;
+                vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
+                vkCmdBindIndexBuffer(c, ib, 0, VK_INDEX_TYPE_UINT32);
+                vkCmdDrawIndexed(c, waterIndices, 1, 0, 0, 0);
+            }
             vkCmdEndRenderPass(c);
         });
     }

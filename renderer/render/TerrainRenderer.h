@@ -25,6 +25,7 @@
 #include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
 #include "vk/Swapchain.h"
+#include "water/Water.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux {
@@ -55,6 +56,22 @@ struct SurfaceLook {
     DetailSettings detail;          // the procedural micro-detail
 };
 
+// The water as a frame draws it (docs/lighting.md, "Water"); setWater holds the level and what
+// is built for it.
+struct WaterLook {
+    bool enabled = false;               // false: no water pass, nothing bound
+    glm::vec3 scatter{0.0f};            // deep-water scatter albedo
+    glm::vec3 absorption{0.0f};         // per metre
+    float roughness = 0.05f;
+    std::vector<water::WaveTerms> waves;
+    bool depthAware = false;
+    float shoreFadeDistance = 0.0f;     // metres
+    bool planarReflection = true;       // false: the sky's radiance is reflected
+    float reflectionScale = 0.5f;       // reflection target size / frame size
+    float distortion = 0.02f;           // reflection offset per unit of wave slope (screen share)
+    double time = 0.0;                  // seconds: the waves' phase
+};
+
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
@@ -73,6 +90,7 @@ struct RenderSettings {
     bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
+    WaterLook water;
 };
 
 struct RenderedImage {
@@ -103,6 +121,13 @@ public:
     // or width 0 for the constant albedo of RenderSettings.
     void setAlbedoMap(int width, int height, const std::vector<glm::vec3>& linear);
     bool hasAmbientOcclusion() const { return hasAo_; }
+    // The water plane at `level` (engine y): the field of depth below the level and distance to
+    // shore, and the mesh over every cell whose bed lies below level + `margin` (the highest a
+    // crest reaches), are built for it. nullopt removes the water subsystem.
+    void setWater(std::optional<float> level, float margin);
+    bool hasWaterResources() const;
+    // Texels a side of the water field (0 without water).
+    glm::ivec2 waterFieldSize() const;
     // Texels a side of the normal-AO map's level 0.
     glm::ivec2 surfaceMapSize() const { return surfaceMapSize_; }
     // Draws a frame and reads it back, waiting for the GPU.
@@ -136,6 +161,7 @@ private:
     void updateSunVisibility(const SunLight& sun, bool skirt);
     void uploadSurfaceMaps(const std::vector<float>& ao);
     void buildViewSets();
+    void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;

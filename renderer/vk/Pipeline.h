@@ -20,6 +20,9 @@ struct GraphicsPipelineDesc {
     std::vector<VkVertexInputAttributeDescription> attributes;
     VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
     bool depthWrite = true;
+    // The camera's passes use reversed Z (near 1, far 0: float depth keeps its precision out to
+    // the far plane, so water meets the shore without fighting); shadow maps keep 0 near.
+    VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
 };
 
 UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pass,

@@ -9,6 +9,7 @@
 #include "blocks/shadows.h"
 #include "blocks/probes.h"
 #include "blocks/overlay.h"
+#include "blocks/water.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN

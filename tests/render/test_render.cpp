@@ -84,42 +84,78 @@ RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear
     return r.render(q);
 }
 
+// Two waves, long and short, 0.6 m and 0.15 m high: the mesh moves and the normals ripple.
+std::vector<GerstnerWave> testWaves() {
+    GerstnerWave a;
+    a.directionDeg = 30.0;
+    a.wavelength = 40.0;
+    a.amplitude = 0.6;
+    GerstnerWave b;
+    b.directionDeg = 100.0;
+    b.wavelength = 9.0;
+    b.amplitude = 0.15;
+    b.phase = 1.0;
+    return {a, b};
+}
+
+// Water `above` metres over the lowest terrain of the renderer's heightfield (engine space).
+Project withWater(Project p, const ProjectRenderer& r, double above, std::vector<GerstnerWave> waves = {}) {
+    p.scene.water.enabled = true;
+    p.scene.water.level = double(r.heightfield().minHeight()) + above;
+    p.scene.water.waves = std::move(waves);
+    return p;
+}
+
+// The sample with a lake in its valleys (a fifth of its relief deep) and two waves: every view
+// then has water to show.
+void addLake(Project& p, ProjectRenderer& r) {
+    const Heightfield& hf = r.heightfield();
+    p = withWater(p, r, 0.2 * double(hf.maxHeight() - hf.minHeight()), testWaves());
+    r.setProject(p);
+}
+
 double meanAbsDiff(const RenderedImage& a, const RenderedImage& b) {
     return test::compareImages(a.rgba, b.rgba, a.width, a.height).meanAbs;
 }
 
 }  // namespace
 
-TEST_F(RenderTest, GoldenImagesOfEveryView) {
-    ProjectRenderer r(*ctx_, sampleProject("golden", 8, 8));
-    ASSERT_EQ(r.loadProbes(true), 1u);
-    const bool update = std::getenv("TERRALUX_UPDATE_GOLDENS") != nullptr;
-    for (const auto& v : debugViews()) {
-        const RenderedImage img = draw(r, v.number);
-        const fs::path golden = kGolden / (std::to_string(v.number) + "-" + v.name + ".png");
-        const fs::path actual = kOut / (std::to_string(v.number) + "-" + v.name + ".png");
-        writeImage(actual, img.width, img.height, img.rgba);
-        if (update) {
-            writeImage(golden, img.width, img.height, img.rgba);
-            continue;
-        }
-        ASSERT_TRUE(fs::exists(golden)) << golden << " missing: run tests/render/update_goldens.sh";
-        uint32_t gw = 0, gh = 0;
-        // Compare what was written (8-bit) with the golden, both through the same quantisation.
-        const auto expected = readImageRgba(golden, gw, gh);
-        const auto got = readImageRgba(actual, gw, gh);
-        ASSERT_EQ(gw, kW);
-        ASSERT_EQ(gh, kH);
-        const auto d = test::compareImages(got, expected, kW, kH);
-        if (d.meanAbs > 2.0 / 255.0 || d.ssim < 0.98) {
-            const fs::path diff = kOut / (std::to_string(v.number) + "-" + v.name + ".diff.png");
-            writeImage(diff, kW, kH, d.diff);
-            ADD_FAILURE() << "view " << v.number << " " << v.name << ": mean |diff| "
-                          << d.meanAbs * 255.0 << "/255, SSIM " << d.ssim << ", max "
-                          << d.maxAbs * 255.0 << "/255 at (" << d.maxX << ", " << d.maxY
-                          << "); diff image " << diff;
-        }
+namespace {
+
+// Compares a kW x kH image with the golden `stem`.png (or writes the golden with
+// TERRALUX_UPDATE_GOLDENS set).
+void checkGolden(const std::string& stem, const RenderedImage& img) {
+    const fs::path golden = kGolden / (stem + ".png");
+    const fs::path actual = kOut / (stem + ".png");
+    writeImage(actual, img.width, img.height, img.rgba);
+    if (std::getenv("TERRALUX_UPDATE_GOLDENS")) {
+        writeImage(golden, img.width, img.height, img.rgba);
+        return;
     }
+    ASSERT_TRUE(fs::exists(golden)) << golden << " missing: run tests/render/update_goldens.sh";
+    uint32_t gw = 0, gh = 0;
+    // Compare what was written (8-bit) with the golden, both through the same quantisation.
+    const auto expected = readImageRgba(golden, gw, gh);
+    const auto got = readImageRgba(actual, gw, gh);
+    ASSERT_EQ(gw, kW);
+    ASSERT_EQ(gh, kH);
+    const auto d = test::compareImages(got, expected, kW, kH);
+    if (d.meanAbs > 2.0 / 255.0 || d.ssim < 0.98) {
+        const fs::path diff = kOut / (stem + ".diff.png");
+        writeImage(diff, kW, kH, d.diff);
+        ADD_FAILURE() << stem << ": mean |diff| " << d.meanAbs * 255.0 << "/255, SSIM " << d.ssim << ", max "
+                      << d.maxAbs * 255.0 << "/255 at (" << d.maxX << ", " << d.maxY << "); diff image " << diff;
+    }
+}
+
+}  // namespace
+
+TEST_F(RenderTest, GoldenImagesOfEveryView) {
+    Project p = sampleProject("golden", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    for (const auto& v : debugViews()) checkGolden(std::to_string(v.number) + "-" + v.name, draw(r, v.number));
 }
 
 TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
@@ -245,7 +281,9 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
 }
 
 TEST_F(RenderTest, EveryViewDiffersFromBeauty) {
-    ProjectRenderer r(*ctx_, sampleProject("views", 8, 8));
+    Project p = sampleProject("views", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
     ASSERT_EQ(r.loadProbes(true), 1u);
     const RenderedImage beauty = draw(r, kViewBeauty);
     for (const auto& v : debugViews()) {
@@ -507,7 +545,9 @@ TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
 }
 
 TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
-    ProjectRenderer r(*ctx_, sampleProject("finite", 8, 8));
+    Project p = sampleProject("finite", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
     ASSERT_EQ(r.loadProbes(true), 1u);
     for (const auto& v : debugViews())
         for (bool linear : {false, true}) {
@@ -519,7 +559,9 @@ TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
                 differing += img.rgba[i] != img.rgba[i % 4];
             }
             EXPECT_EQ(nonFinite, 0u) << v.name << (linear ? " (linear)" : "");
-            EXPECT_GT(differing, size_t(kW) * kH / 8) << v.name << (linear ? " (linear)" : "") << " is blank";
+            // The water-only views colour the lake and leave the land flat (a 50th of the image here).
+            const size_t least = size_t(kW) * kH / (v.needs.water && !v.needs.waterShading ? 50 : 8);
+            EXPECT_GT(differing, least) << v.name << (linear ? " (linear)" : "") << " is blank";
         }
 }
 
@@ -930,4 +972,195 @@ TEST_F(RenderTest, NormalVarianceCalmsSubPixelRidgesAndLeavesAPlaneAlone) {
     f.setProject(flat);
     const RenderedImage planeOn = draw(f, kViewLinear, false, true);
     EXPECT_EQ(planeOn.rgba, planeOff.rgba);
+}
+
+namespace {
+
+// A round basin, 129 x 129 cells of 10 m: 0 m at the centre rising as the square of the
+// distance to 82 m in the corners.
+fs::path writeBasinDem() {
+    return writeDem("basin", 129, 10.0, [](int c, int r) {
+        const float dx = float(c) - 64.0f, dz = float(r) - 64.0f;
+        return 0.01f * (dx * dx + dz * dz);
+    });
+}
+
+// Where the ray through the centre of pixel (x, y) meets the plane y = level.
+glm::vec2 planePoint(const glm::mat4& invViewProj, uint32_t w, uint32_t h, uint32_t x, uint32_t y, float level) {
+    const glm::vec2 ndc((float(x) + 0.5f) / float(w) * 2.0f - 1.0f, (float(y) + 0.5f) / float(h) * 2.0f - 1.0f);
+    glm::vec4 a = invViewProj * glm::vec4(ndc, 0.0f, 1.0f), b = invViewProj * glm::vec4(ndc, 1.0f, 1.0f);
+    const glm::vec3 p0 = glm::vec3(a) / a.w, p1 = glm::vec3(b) / b.w;
+    const float t = (level - p0.y) / (p1.y - p0.y);
+    return {p0.x + t * (p1.x - p0.x), p0.z + t * (p1.z - p0.z)};
+}
+
+// The water mask of a scene-linear view 100: 1 where water is drawn.
+std::vector<uint8_t> waterMask(const RenderedImage& img) {
+    std::vector<uint8_t> m(size_t(img.width) * img.height);
+    for (size_t i = 0; i < m.size(); ++i) m[i] = img.rgba[4 * i] > 0.5f ? 1 : 0;
+    return m;
+}
+
+// Whether any pixel within `radius` of (x, y) differs in the mask from (x, y).
+bool nearEdge(const std::vector<uint8_t>& m, uint32_t w, uint32_t h, uint32_t x, uint32_t y, int radius) {
+    for (int dy = -radius; dy <= radius; ++dy)
+        for (int dx = -radius; dx <= radius; ++dx) {
+            const int px = int(x) + dx, py = int(y) + dy;
+            if (px < 0 || py < 0 || px >= int(w) || py >= int(h)) continue;
+            if (m[size_t(py) * w + size_t(px)] != m[size_t(y) * w + x]) return true;
+        }
+    return false;
+}
+
+}  // namespace
+
+// Top down on a basin with still water: view 100 marks water exactly where the terrain lies
+// below the level, up to one pixel at the shore.
+TEST_F(RenderTest, WaterMaskIsTheCellsBelowTheLevel) {
+    Project p = topDown(sampleProject("water_mask", 2, 2), writeBasinDem());
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 20.0);
+    r.setProject(p);
+    ASSERT_TRUE(r.renderer().hasWaterResources());
+    const RenderedImage img = drawSquare(r, kViewWaterMask, true, false);
+    const Heightfield& hf = r.heightfield();
+    const float level = float(*p.scene.water.level);
+    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+    const glm::mat4 inv = glm::inverse(r.defaultCamera().viewProjection(1.0f, extent));
+    std::vector<uint8_t> expected(size_t(kW) * kW);
+    for (uint32_t y = 0; y < kW; ++y)
+        for (uint32_t x = 0; x < kW; ++x) {
+            const glm::vec2 q = planePoint(inv, kW, kW, x, y, level);
+            expected[size_t(y) * kW + x] = hf.contains(q.x, q.y) && hf.surfaceHeight(q.x, q.y) < level ? 1 : 0;
+        }
+    const std::vector<uint8_t> got = waterMask(img);
+    size_t water = 0, wrong = 0;
+    for (uint32_t y = 0; y < kW; ++y)
+        for (uint32_t x = 0; x < kW; ++x) {
+            const size_t i = size_t(y) * kW + x;
+            water += got[i];
+            if (got[i] != expected[i] && !nearEdge(expected, kW, kW, x, y, 1)) ++wrong;
+        }
+    EXPECT_GT(water, size_t(kW) * kW / 10);  // a lake of radius 450 m in a 1.3 km tile
+    if (wrong > 0) {
+        std::vector<float> shown(img.rgba.size(), 1.0f);
+        for (size_t i = 0; i < got.size(); ++i) {
+            shown[4 * i] = float(got[i]);
+            shown[4 * i + 1] = float(expected[i]);
+            shown[4 * i + 2] = 0.0f;
+        }
+        writeImage(kOut / "water_mask_got_red_expected_green.png", kW, kW, shown);
+    }
+    EXPECT_EQ(wrong, 0u) << "pixels more than one pixel from the shore on the wrong side";
+    // Land in the EXR: 1 in green, 0 in red; water: 1 in both.
+    const size_t centre = (size_t(kW / 2) * kW + kW / 2) * 4;
+    EXPECT_EQ(img.rgba[centre], 1.0f);
+    EXPECT_EQ(img.rgba[centre + 1], 1.0f);
+}
+
+// The waves move the water between t = 0 and 1 s; the land away from the shore stays as it was.
+TEST_F(RenderTest, WavesMoveTheWaterAndLeaveTheLand) {
+    Project p = sampleProject("water_time", 2, 2);
+    p.scene.terrain.dem = writeBasinDem().string();
+    p.scene.camera.elevationDeg = 30.0;
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 20.0, testWaves());
+    r.setProject(p);
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.probes = false;
+    q.debugView = kViewWaterMask;
+    q.linearOutput = true;
+    const std::vector<uint8_t> mask = waterMask(r.render(q));
+    q.debugView = kViewBeauty;
+    q.linearOutput = false;
+    const RenderedImage t0 = r.render(q);
+    q.time = 1.0;
+    const RenderedImage t1 = r.render(q);
+    writeImage(kOut / "water_t0.png", kW, kH, t0.rgba);
+    writeImage(kOut / "water_t1.png", kW, kH, t1.rgba);
+    size_t waterPixels = 0, waterChanged = 0, landChanged = 0;
+    for (uint32_t y = 0; y < kH; ++y)
+        for (uint32_t x = 0; x < kW; ++x) {
+            const size_t i = size_t(y) * kW + x;
+            double d = 0.0;
+            for (int c = 0; c < 3; ++c) d += std::abs(t0.rgba[4 * i + size_t(c)] - t1.rgba[4 * i + size_t(c)]);
+            if (mask[i]) {
+                ++waterPixels;
+                if (d > 1.0 / 255.0) ++waterChanged;
+            } else if (!nearEdge(mask, kW, kH, x, y, 2) && d > 0.0) {
+                ++landChanged;
+            }
+        }
+    ASSERT_GT(waterPixels, 0u);
+    // A second moves the 40 m crests by 7.9 m (ω/k = √(g/k)), a pixel here: much of the water
+    // changes (the deep, dark middle the least).
+    EXPECT_GT(double(waterChanged) / double(waterPixels), 0.3) << waterChanged << " of " << waterPixels;
+    EXPECT_EQ(landChanged, 0u);
+}
+
+// A planar reflection against the sky's: only water pixels change; and a dark mountain behind
+// a lake darkens the water that reflects it, where the sky's reflection stays bright.
+TEST_F(RenderTest, PlanarReflectionShowsTheDarkMountainAndChangesOnlyWater) {
+    // A flat floor at 0 m, and from row 40 northward a wall rising to 600 m.
+    const fs::path dem = writeDem("lake_wall", 129, 10.0, [](int, int r) {
+        return r < 40 ? 600.0f * std::min(1.0f, float(40 - r) / 12.0f) : 0.0f;
+    });
+    Project p = sampleProject("water_reflection", 2, 2);
+    p.scene.terrain.dem = dem.string();
+    p.scene.terrain.albedoMode = AlbedoMode::Constant;
+    p.scene.terrain.albedo = glm::vec3(0.04f);  // a dark mountain
+    p.scene.camera.azimuthDeg = 180.0;          // south of the lake, looking north at the wall
+    p.scene.camera.elevationDeg = 8.0;
+    p.scene.sun.azimuthDeg = 180.0;             // behind the camera: the wall's face is lit
+    p.scene.fog.enabled = false;
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 5.0);
+    // Black, strongly absorbing water: what it shows is its reflection (and the sun's glint).
+    p.scene.water.color = glm::vec3(0.0f);
+    p.scene.water.absorption = glm::vec3(10.0f);
+    r.setProject(p);
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.probes = false;
+    q.debugView = kViewWaterMask;
+    q.linearOutput = true;
+    const std::vector<uint8_t> mask = waterMask(r.render(q));
+    q.debugView = kViewLinear;
+    const RenderedImage planar = r.render(q);
+    p.scene.water.reflection = WaterReflection::Sky;
+    r.setProject(p);
+    const RenderedImage sky = r.render(q);
+    writeImage(kOut / "water_planar.png", kW, kH, planar.rgba);
+    writeImage(kOut / "water_sky.png", kW, kH, sky.rgba);
+    size_t water = 0, darker = 0, brighter = 0, landChanged = 0;
+    for (size_t i = 0; i < mask.size(); ++i) {
+        const float a = planar.rgba[4 * i + 1], b = sky.rgba[4 * i + 1];
+        if (mask[i]) {
+            ++water;
+            if (a < 0.7f * b) ++darker;
+            if (a > 1.05f * b + 1e-4f) ++brighter;
+        } else if (a != b) {
+            ++landChanged;
+        }
+    }
+    ASSERT_GT(water, 0u);
+    EXPECT_EQ(landChanged, 0u);
+    // The wall (far darker than the sky) fills the reflection of the lake's far part; nothing in
+    // this scene is brighter than the sky, so no reflection gains light.
+    EXPECT_GT(double(darker) / double(water), 0.05) << darker << " of " << water << " water pixels";
+    EXPECT_EQ(brighter, 0u);
+}
+
+// Without water the frame has no water pass and binds nothing of it.
+TEST_F(RenderTest, NoWaterNoWaterPass) {
+    ProjectRenderer r(*ctx_, sampleProject("no_water", 2, 2));
+    draw(r, kViewBeauty, false);
+    EXPECT_FALSE(r.renderer().hasWaterResources());
+    for (const auto& pass : r.renderer().lastFramePasses()) {
+        EXPECT_EQ(pass.name.find("water"), std::string::npos) << pass.name;
+        for (const auto& b : pass.bindings) EXPECT_EQ(b.find("water"), std::string::npos) << pass.name;
+    }
 }
