@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <numbers>
 
 #include <QAction>
 #include <QApplication>
@@ -23,6 +24,7 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QScrollArea>
+#include <QSlider>
 #include <QScreen>
 #include <QSignalSpy>
 #include <QSpinBox>
@@ -39,6 +41,7 @@
 #include "RenderJob.h"
 #include "TerrainLoading.h"
 #include "render/DebugViews.h"
+#include "water/Water.h"
 #include "render/ShadowCascades.h"
 
 using namespace terralux;
@@ -1096,6 +1099,73 @@ private slots:
             QVERIFY(!message->isVisibleTo(w_.get()));
             QVERIFY(minLabel->styleSheet().isEmpty());
         }
+    }
+
+    // The Water dock: presets and the wave list edit water.waves undoably; the amplitude and
+    // steepness columns are two faces of one number; Play animates the viewport and Pause stops it.
+    void waterDockEditsWavesAndAnimates() {
+        auto* dock = w_->findChild<QDockWidget*>("dock.water");
+        QVERIFY(dock);
+        dock->raise();
+        w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(true);
+        QVERIFY(w_->document()->project().scene.water.enabled);
+        auto* table = w_->findChild<QTableWidget*>("water.waves");
+        auto* preset = w_->findChild<QComboBox*>("water.preset");
+        QVERIFY(table && preset);
+        const nlohmann::json before = w_->document()->value("water.waves");
+        const int open = preset->findText("open sea");
+        QVERIFY(open > 0);
+        emit preset->activated(open);
+        const size_t openSea = water::wavePreset("open sea").size();
+        QCOMPARE(w_->document()->project().scene.water.waves.size(), openSea);
+        QCOMPARE(table->rowCount(), int(openSea));
+        QCOMPARE(preset->currentIndex(), 0);
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(w_->document()->value("water.waves"), before);
+        w_->findChild<QAction*>("action.redo")->trigger();
+        QCOMPARE(table->rowCount(), int(openSea));
+
+        // Add copies the selected wave turned by 30 degrees; Remove takes it away again.
+        table->selectRow(0);
+        w_->findChild<QPushButton*>("water.addWave")->click();
+        QCOMPARE(table->rowCount(), int(openSea) + 1);
+        const auto& waves = w_->document()->project().scene.water.waves;
+        QCOMPARE(std::fmod(waves.back().directionDeg - waves.front().directionDeg + 360.0, 360.0), 30.0);
+        w_->findChild<QPushButton*>("water.removeWave")->click();
+        QCOMPARE(table->rowCount(), int(openSea));
+
+        // Editing the amplitude makes it the wave's own number; the steepness column follows.
+        table->item(0, 2)->setText("0.25");
+        QCOMPARE(*w_->document()->project().scene.water.waves[0].amplitude, 0.25);
+        QVERIFY(!w_->document()->project().scene.water.waves[0].steepness);
+        const double k = 2.0 * std::numbers::pi / w_->document()->project().scene.water.waves[0].wavelength;
+        QCOMPARE(table->item(0, 3)->text().toDouble(), QString::number(0.25 * k, 'g', 4).toDouble());
+        // A wave set that breaks the steepness rule is refused and the table shows the project.
+        table->item(0, 3)->setText("1.0");
+        QVERIFY(!w_->document()->project().scene.water.waves[0].steepness);
+        QCOMPARE(table->item(0, 2)->text().toDouble(), 0.25);
+
+        // Up and Down reorder.
+        const double first = w_->document()->project().scene.water.waves[0].wavelength;
+        table->selectRow(0);
+        w_->findChild<QPushButton*>("water.waveDown")->click();
+        QCOMPARE(w_->document()->project().scene.water.waves[1].wavelength, first);
+
+        // The time slider sets the viewport's time; Play advances it; Pause stops it.
+        auto* slider = w_->findChild<QSlider*>("water.time");
+        slider->setValue(100);
+        QCOMPARE(w_->viewport()->waterTime(), 10.0);
+        auto* play = w_->findChild<QPushButton*>("water.play");
+        play->click();
+        QTRY_VERIFY_WITH_TIMEOUT(w_->viewport()->waterTime() > 10.2, 3000);
+        play->click();
+        const double stopped = w_->viewport()->waterTime();
+        QTest::qWait(300);
+        QCOMPARE(w_->viewport()->waterTime(), stopped);
+        QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
+        QTest::qWait(300);
+        QCOMPARE(frames.count(), 0);  // paused: no frame without a change
+        w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(false);
     }
 
     void screenshot() {
