@@ -125,6 +125,14 @@ public:
         };
         return *this;
     }
+    template <class T>
+    Row& wave(T GerstnerWave::*member) {
+        s_.get = [=](const SceneDescription& s, size_t i) { return fieldToJson(s.water.waves.at(i).*member, {}); };
+        s_.set = [=](SceneDescription& s, size_t i, const json& v) {
+            s.water.waves.at(i).*member = fieldFromJson<T>(v, {});
+        };
+        return *this;
+    }
     Row& custom(std::function<json(const SceneDescription&, size_t)> get,
                 std::function<void(SceneDescription&, size_t, const json&)> set) {
         s_.get = std::move(get);
@@ -440,6 +448,74 @@ std::vector<ParameterSpec> buildTable() {
         .about("How strongly the precomputed AO darkens probe light where probes are coarser than the AO (0 = off, 1 = full)")
         .redoes(kUpload).onlyWhen(aoOn).field(&SceneDescription::ao, &AoSettings::strength);
 
+    // Water (docs/lighting.md, "Water"): the renderer draws it; the bake's probe rays see it
+    // (enabled, level, color); the glTF exports it.
+    const auto waterOn = [](const SceneDescription& s, size_t) { return s.water.enabled; };
+    const auto planar = [](const SceneDescription& s, size_t) {
+        return s.water.enabled && s.water.reflection == WaterReflection::Planar;
+    };
+    add(Row("water.enabled", T::Boolean)).label("Water")
+        .about("A lake or sea: a level plane at water.level with Gerstner waves over the terrain below it; the viewport and --render draw it, the bake's probe rays see it, the glTF exports it")
+        .redoes(kUpload | kRebake).field(&SceneDescription::water, &WaterSettings::enabled);
+    add(Row("water.level", T::Number)).range(-1.0e5, 1.0e5).unit("m").decimals(1)
+        .autoMeans("the DEM's lowest decile: the 10th percentile of its heights").label("Water level")
+        .about("Height of the water at rest, engine space (DEM elevation × terrain.vertical_scale); the water covers the terrain below it")
+        .redoes(kUpload | kRebake).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::level);
+    add(Row("water.color", T::Color)).range(0.0, 1.0).label("Scatter colour")
+        .about("Deep-water scatter albedo, linear RGB: the share of the light entering the water that the water sends back up, (1 − F)·color·E/π toward a viewer")
+        .redoes(kUpload | kRebake).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::color);
+    add(Row("water.absorption", T::NumberList)).items(3, 3).range(0.0, 100.0).unit("1/m").decimals(3)
+        .label("Absorption")
+        .about("Extinction per metre, linear RGB: light crossing d metres of water keeps exp(−absorption·d), so the bed fades with depth; red goes first in clear water")
+        .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::absorption);
+    add(Row("water.roughness", T::Number)).range(0.02, 1.0).decimals(2).slider().label("Water roughness")
+        .about("GGX roughness of the sun's highlight on the waves; the waves' own normals carry their larger slopes")
+        .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::roughness);
+    add(Row("water.depth_aware", T::Boolean)).label("Depth-aware waves")
+        .about("Waves slow down in the shallows: ω² = g·k·tanh(k·h), h the water depth over the DEM; off: deep water everywhere, ω² = g·k")
+        .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::depthAware);
+    add(Row("water.shore_fade_distance", T::Number)).range(0.0, 1.0e5).unit("m").decimals(1).zeroMeans("no fade")
+        .label("Shore fade")
+        .about("Distance from the shore (the nearest DEM vertex at or above the level) over which the waves grow from nothing to their full amplitude, smoothstep; 0 = no fade")
+        .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::shoreFadeDistance);
+    add(Row("water.reflection", T::Choice)).choices({"planar", "sky"}).label("Reflection")
+        .about("planar: the terrain and sky mirrored in the level water, drawn in a second pass; sky: the sky alone, from its SH")
+        .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::reflection);
+    add(Row("water.reflection_scale", T::Number)).range(0.25, 1.0).decimals(2).slider().label("Reflection scale")
+        .about("Size of the planar reflection's target relative to the frame, each side")
+        .redoes(kUpload).onlyWhen(planar).field(&SceneDescription::water, &WaterSettings::reflectionScale);
+    add(Row("water.distortion", T::Number)).range(0.0, 0.2).decimals(3).label("Reflection distortion")
+        .about("How far the waves shift the planar reflection: screen-space offset per unit of wave slope")
+        .redoes(kUpload).onlyWhen(planar).field(&SceneDescription::water, &WaterSettings::distortion);
+    // The waves: a list of objects the Water dock's wave editor edits as a whole.
+    add(Row("water.waves[].direction_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1)
+        .label("Wave direction").about("Where the wave travels, clockwise from north (-Z) toward east (+X)")
+        .redoes(kUpload).noUiRow().wave(&GerstnerWave::directionDeg);
+    add(Row("water.waves[].wavelength", T::Number)).range(0.1, 1.0e4).unit("m").decimals(2)
+        .label("Wavelength").about("Crest to crest, λ; the wave number is k = 2π/λ and the deep-water angular frequency ω = √(g·k)")
+        .redoes(kUpload).noUiRow().wave(&GerstnerWave::wavelength);
+    add(Row("water.waves[].amplitude", T::Number)).range(0.0, 100.0).unit("m").decimals(3)
+        .autoMeans("from steepness: A = steepness / k").label("Amplitude")
+        .about("Height of a crest above the level, A; exactly one of amplitude and steepness is set")
+        .redoes(kUpload).noUiRow().wave(&GerstnerWave::amplitude);
+    add(Row("water.waves[].steepness", T::Number)).range(0.0, 1.0).decimals(3)
+        .autoMeans("from amplitude: k·A").label("Steepness")
+        .about("k·A, the wave's largest slope; exactly one of amplitude and steepness is set, and the summed k·A of all waves is at most 1 so no crest loops")
+        .redoes(kUpload).noUiRow()
+        .custom([](const SceneDescription& s, size_t i) { return fieldToJson(s.water.waves.at(i).steepness, {}); },
+                [](SceneDescription& s, size_t i, const json& v) {
+                    // Read after amplitude (table order), so the pair is checked here.
+                    GerstnerWave& w = s.water.waves.at(i);
+                    w.steepness = fieldFromJson<std::optional<double>>(v, {});
+                    if (w.steepness && w.amplitude)
+                        throw ParameterRejection{"must be null when amplitude is set (exactly one of amplitude and steepness)", ""};
+                    if (!w.steepness && !w.amplitude)
+                        throw ParameterRejection{"must be set when amplitude is null (exactly one of amplitude and steepness)", ""};
+                });
+    add(Row("water.waves[].phase", T::Number)).range(-100.0, 100.0).unit("rad").decimals(3)
+        .label("Phase").about("Phase at t = 0 and the engine origin, radians (periodic in 2π)")
+        .redoes(kUpload).noUiRow().wave(&GerstnerWave::phase);
+
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
@@ -679,8 +755,20 @@ double shortestDecimal(float f) {
     return std::strtod(std::string(buf, end).c_str(), nullptr);
 }
 
+const std::vector<std::string>& objectLists() {
+    static const std::vector<std::string> lists{"probe_volumes", "water.waves"};
+    return lists;
+}
+
+std::string ParameterSpec::listPath() const {
+    for (const std::string& list : objectLists())
+        if (path.rfind(list + "[].", 0) == 0) return list;
+    return "";
+}
+
 std::string ParameterSpec::localPath() const {
-    return perVolume() ? path.substr(std::string("probe_volumes[].").size()) : path;
+    const std::string list = listPath();
+    return list.empty() ? path : path.substr(list.size() + 3);
 }
 
 bool ParameterSpec::isRead(const SceneDescription& scene, size_t volume) const {
@@ -689,7 +777,8 @@ bool ParameterSpec::isRead(const SceneDescription& scene, size_t volume) const {
 }
 
 json ParameterSpec::defaultValue() const {
-    const SceneDescription scene;  // holds one default probe volume
+    SceneDescription scene;  // holds one default probe volume
+    if (perWave()) scene.water.waves.emplace_back();
     return get(scene, 0);
 }
 
@@ -733,7 +822,8 @@ unsigned invalidatedBy(const std::string& path) {
     if (path.empty()) return kUpload | kRebake | kReplace | kReimport;
     if (const ParameterSpec* spec = findParameter(path)) return spec->invalidates;
     std::string key = normaliseParameterPath(path);
-    if (key == "probe_volumes" || key == "probe_volumes[]") key = "probe_volumes[]";
+    // A whole list ("water.waves") is the rows of its elements ("water.waves[].").
+    if (std::find(objectLists().begin(), objectLists().end(), key) != objectLists().end()) key += "[]";
     unsigned flags = 0;
     for (const auto& p : parameterTable())
         if (p.path.rfind(key + ".", 0) == 0) flags |= p.invalidates;
@@ -860,6 +950,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "detail" || surface) return {"dock.surface", "Surface"};
     if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
+    if (section == "water") return {"dock.water", "Water"};
     return {"", ""};
 }
 
@@ -889,15 +980,22 @@ json projectSchema() {
     props["format"] = {{"const", "terralux-project"}, {"description", "Marks the file as a Terralux project"}, {"default", "terralux-project"}};
     props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", 1},
                         {"description", "Project format version"}, {"default", 1}};
-    json volume = objectSchema();
+    json volume = objectSchema(), wave = objectSchema();
     for (const auto& s : parameterTable()) {
         if (s.perVolume()) insert(volume, s.localPath(), leafSchema(s));
+        else if (s.perWave()) insert(wave, s.localPath(), leafSchema(s));
         else insert(schema, s.path, leafSchema(s));
     }
     props["probe_volumes"] = {{"type", "array"},
                               {"description", "Probe volumes, each baked into its own .shprobe"},
                               {"items", volume},
                               {"default", json::array({json::object()})}};
+    insert(schema, "water.waves",
+           {{"type", "array"},
+            {"maxItems", WaterSettings::kMaxWaves},
+            {"description", "Gerstner waves on the water, each with exactly one of amplitude and steepness; their summed steepness k·A is at most 1"},
+            {"items", wave},
+            {"default", json::array()}});
     return schema;
 }
 
@@ -906,13 +1004,14 @@ std::string parameterReferenceMarkdown() {
     md << "# Project parameters\n\n"
           "Generated from the parameter table (`app/ParameterTable.cpp`) by\n"
           "`terralux --print-reference`; do not edit by hand. Every parameter is reachable by\n"
-          "`--set PATH=VALUE`; rows under `probe_volumes[]` take an index (`probe_volumes[0].grid_dims`).\n"
+          "`--set PATH=VALUE`; rows under `probe_volumes[]` and `water.waves[]` take an index\n"
+          "(`probe_volumes[0].grid_dims`), and a whole list is one JSON array (`--set water.waves=[...]`).\n"
           "`null` means \"auto\" where the last column says what auto does. \"Edit redoes\" is the\n"
           "work an edit in the authoring window costs: redraw < upload < preview bake < re-place <\n"
           "re-import; \"bake only\" parameters change nothing on screen.\n";
     std::string section;
     for (const auto& s : parameterTable()) {
-        const std::string head = s.perVolume() ? "probe_volumes[]" : s.path.substr(0, s.path.find('.'));
+        const std::string head = s.inList() ? s.listPath() + "[]" : s.path.substr(0, s.path.find('.'));
         if (head != section) {
             section = head;
             md << "\n## `" << section << "`\n\n"

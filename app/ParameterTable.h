@@ -43,7 +43,8 @@ enum Invalidation : unsigned {
 inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 struct ParameterSpec {
-    // "sun.elevation_deg"; rows of each probe volume are "probe_volumes[].grid_dims".
+    // "sun.elevation_deg"; rows of each element of a list of objects (objectLists) are
+    // "<list>[].<key>": "probe_volumes[].grid_dims", "water.waves[].wavelength".
     std::string path;
     ParamType type = ParamType::Number;
     double min = -kUnbounded, max = kUnbounded;
@@ -70,15 +71,20 @@ struct ParameterSpec {
     // rows of a terrain volume): false where the row is not read. Unset: always read.
     std::function<bool(const SceneDescription&, size_t volume)> readWhen;
 
-    // Binding to the scene. `volume` indexes probe_volumes for per-volume rows.
+    // Binding to the scene. `volume` indexes the row's list for the rows of a list's elements
+    // (probe_volumes, water.waves), and is 0 for the others.
     std::function<nlohmann::json(const SceneDescription&, size_t volume)> get;
     // Receives a value that passed the row's own checks; may reject with the row's context.
     std::function<void(SceneDescription&, size_t volume, const nlohmann::json&)> set;
 
     bool perVolume() const { return path.rfind("probe_volumes[].", 0) == 0; }
-    // The path below probe_volumes[] for per-volume rows ("grid_dims"), else the path.
+    bool perWave() const { return path.rfind("water.waves[].", 0) == 0; }
+    // The list whose elements hold the row ("probe_volumes", "water.waves"); empty for the rest.
+    std::string listPath() const;
+    bool inList() const { return !listPath().empty(); }
+    // The path inside an element for the rows of a list ("grid_dims"), else the path.
     std::string localPath() const;
-    // The default, read from a default-constructed scene (or probe volume).
+    // The default, read from a default-constructed scene (or probe volume, or wave).
     nlohmann::json defaultValue() const;
     bool nullable() const { return autoMeaning.has_value(); }
     // Whether this scene reads the row (for per-volume rows, of volume `volume`, which must
@@ -97,7 +103,11 @@ struct ParameterRejection {
 
 const std::vector<ParameterSpec>& parameterTable();
 
-// The row for a path with or without volume indices ("probe_volumes[2].grid_dims" and
+// The project's lists of objects, as JSON paths: "probe_volumes" and "water.waves". Each element
+// is an object whose keys are the rows "<list>[].<key>".
+const std::vector<std::string>& objectLists();
+
+// The row for a path with or without element indices ("probe_volumes[2].grid_dims" and
 // "probe_volumes[].grid_dims" both find it); nullptr when no row has that path.
 const ParameterSpec* findParameter(const std::string& path);
 
@@ -105,7 +115,8 @@ const ParameterSpec* findParameter(const std::string& path);
 std::string normaliseParameterPath(const std::string& path);
 
 // What an edit at `path` invalidates: its row's flags, or every flag of the rows below a section
-// ("probe_volumes[0]", "sun"); everything for "" (a new or reopened project).
+// or list ("probe_volumes[0]", "sun", "water.waves"); everything for "" (a new or reopened
+// project).
 unsigned invalidatedBy(const std::string& path);
 
 // Sections that hold rows ("sun", "probe_volumes[].adaptive"): JSON objects in the project.

@@ -10,6 +10,7 @@
 
 #include "AtomicFile.h"
 #include "ParameterTable.h"
+#include "water/Water.h"
 
 namespace terralux {
 namespace {
@@ -130,12 +131,12 @@ void checkKeys(const json& obj, const std::string& path, const std::string& norm
         const std::string key = normalised.empty() ? it.key() : normalised + "." + it.key();
         if (path.empty() && (it.key() == "format" || it.key() == "version" || it.key() == "$schema")) continue;
         if (findParameter(key)) continue;
-        if (key == "probe_volumes") {
+        if (std::find(objectLists().begin(), objectLists().end(), key) != objectLists().end()) {
             if (!it->is_array()) reject(source, child, *it, "must be an array");
             for (size_t i = 0; i < it->size(); ++i) {
                 const std::string at = child + "[" + std::to_string(i) + "]";
                 if (!(*it)[i].is_object()) reject(source, at, (*it)[i], "must be an object");
-                checkKeys((*it)[i], at, "probe_volumes[]", source);
+                checkKeys((*it)[i], at, key + "[]", source);
             }
             continue;
         }
@@ -196,20 +197,36 @@ void readRow(const ParameterSpec& spec, const json& obj, const std::string& pref
     }
 }
 
+// The elements of one list of objects (objectLists), each with every row of its elements.
+json listToJson(const SceneDescription& s, const std::string& list, size_t count) {
+    json out = json::array();
+    for (size_t i = 0; i < count; ++i) {
+        json element = json::object();
+        for (const auto& spec : parameterTable())
+            if (spec.listPath() == list) place(element, spec.localPath(), spec.get(s, i));
+        out.push_back(std::move(element));
+    }
+    return out;
+}
+
+// Reads the rows of every element of `list` from the array `elements`; the scene already holds
+// that many default elements.
+void readList(const std::string& list, const json& elements, SceneDescription& s, const std::string& source) {
+    for (size_t i = 0; i < elements.size(); ++i) {
+        const std::string prefix = list + "[" + std::to_string(i) + "].";
+        for (const auto& spec : parameterTable())
+            if (spec.listPath() == list) readRow(spec, elements[i], prefix, i, s, source);
+    }
+}
+
 }  // namespace
 
 json sceneToJson(const SceneDescription& s) {
     json doc = {{"format", "terralux-project"}, {"version", kProjectVersion}};
-    json volumes = json::array();
-    for (size_t i = 0; i < s.probeVolumes.size(); ++i) {
-        json v = json::object();
-        for (const auto& spec : parameterTable())
-            if (spec.perVolume()) place(v, spec.localPath(), spec.get(s, i));
-        volumes.push_back(std::move(v));
-    }
     for (const auto& spec : parameterTable())
-        if (!spec.perVolume()) place(doc, spec.path, spec.get(s, 0));
-    doc["probe_volumes"] = std::move(volumes);
+        if (!spec.inList()) place(doc, spec.path, spec.get(s, 0));
+    place(doc, "probe_volumes", listToJson(s, "probe_volumes", s.probeVolumes.size()));
+    place(doc, "water.waves", listToJson(s, "water.waves", s.water.waves.size()));
     return doc;
 }
 
@@ -229,20 +246,28 @@ SceneDescription sceneFromJson(const json& doc, const std::string& source,
     }
 
     SceneDescription s;
-    const json* volumes = lookup(doc, "probe_volumes");
-    if (volumes) {
+    if (const json* volumes = lookup(doc, "probe_volumes")) {
         s.probeVolumes.assign(volumes->size(), ProbeVolumeSettings{});
+        readList("probe_volumes", *volumes, s, source);
         std::set<std::string> names;
-        for (size_t i = 0; i < volumes->size(); ++i) {
-            const std::string prefix = "probe_volumes[" + std::to_string(i) + "].";
-            for (const auto& spec : parameterTable())
-                if (spec.perVolume()) readRow(spec, (*volumes)[i], prefix, i, s, source);
+        for (size_t i = 0; i < volumes->size(); ++i)
             if (!names.insert(s.probeVolumes[i].name).second)
-                reject(source, prefix + "name", s.probeVolumes[i].name, "must be unique among volumes");
-        }
+                reject(source, "probe_volumes[" + std::to_string(i) + "].name", s.probeVolumes[i].name,
+                       "must be unique among volumes");
+    }
+    if (const json* waves = lookup(doc, "water.waves")) {
+        if (waves->size() > size_t(WaterSettings::kMaxWaves))
+            reject(source, "water.waves", *waves,
+                   "must hold at most " + std::to_string(WaterSettings::kMaxWaves) + " waves (has " +
+                       std::to_string(waves->size()) + ")");
+        s.water.waves.assign(waves->size(), GerstnerWave{});
+        readList("water.waves", *waves, s, source);
+        // Each wave passed its rows; what is left is the rule of the set (Σ k·A <= 1).
+        if (const std::string rule = water::checkWaves(s.water.waves); !rule.empty())
+            reject(source, "water.waves", *waves, rule);
     }
     for (const auto& spec : parameterTable())
-        if (!spec.perVolume()) readRow(spec, doc, "", 0, s, source);
+        if (!spec.inList()) readRow(spec, doc, "", 0, s, source);
     return s;
 }
 

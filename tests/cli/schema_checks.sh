@@ -51,7 +51,8 @@ for sets in "" \
   "--set sun.elevation_deg=-5 --set sky.mode=hdr --set sky.hdr=$out/sky.hdr" \
   "--set probe_volumes[0].placement=box --set probe_volumes[0].grid_dims=4,2,3 --set probe_volumes[0].spacing=50 --set probe_volumes[0].origin=0,100,0" \
   "--set probe_volumes[0].placement=adaptive --set probe_volumes[0].adaptive.size=3000,1200,2000 --set probe_volumes[0].adaptive.tolerance=0.03" \
-  "--set bake.rays=128 --set bake.bounces=0 --set camera.radius=5000 --set camera.target=0,10,0"; do
+  "--set bake.rays=128 --set bake.bounces=0 --set camera.radius=5000 --set camera.target=0,10,0" \
+  "--set water.enabled=true --set water.level=700 --set water.waves=[{\"wavelength\":20,\"steepness\":0.2},{\"direction_deg\":30,\"wavelength\":5,\"amplitude\":0.1}]"; do
   i=$((i + 1))
   # shellcheck disable=SC2086
   "$terralux" --print-project $sets >"$out/project$i.json" || fail "--print-project $sets exited $?"

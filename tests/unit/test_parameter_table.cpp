@@ -15,13 +15,26 @@ using nlohmann::json;
 
 namespace {
 
-// The path of a row in a document with one probe volume.
+// The path of a row in a document with one probe volume and one wave.
 std::string concrete(const ParameterSpec& s) {
-    return s.perVolume() ? "probe_volumes[0]." + s.localPath() : s.path;
+    return s.inList() ? s.listPath() + "[0]." + s.localPath() : s.path;
 }
 
-std::string errorFor(const std::string& path, const json& value, const json& base = defaultProjectJson()) {
-    return test::projectErrorFor(path, value, base);
+// The defaults with one wave, which sets the one of amplitude and steepness that `spec` is not
+// (exactly one of them is set), so that the row's own default reads back.
+json baseFor(const ParameterSpec& spec) {
+    json doc = defaultProjectJson();
+    if (spec.perWave()) {
+        json wave = json::object();
+        wave[spec.localPath() == "amplitude" ? "steepness" : "amplitude"] = 0.1;
+        doc["water"]["waves"] = json::array({wave});
+        doc = sceneToJson(sceneFromJson(doc, "base", nullptr));  // every key, as --set finds them
+    }
+    return doc;
+}
+
+std::string errorFor(const ParameterSpec& spec, const json& value) {
+    return test::projectErrorFor(concrete(spec), value, baseFor(spec));
 }
 
 }  // namespace
@@ -50,8 +63,13 @@ TEST(ParameterTable, EveryDefaultValidatesAndRoundTrips) {
     EXPECT_EQ(sceneToJson(s), doc);
     for (const auto& spec : parameterTable()) {
         // The default written at its path reads back to the same default.
-        EXPECT_EQ(errorFor(concrete(spec), spec.defaultValue()), "") << spec.path;
-        EXPECT_EQ(spec.get(s, 0), spec.defaultValue()) << spec.path;
+        EXPECT_EQ(errorFor(spec, spec.defaultValue()), "") << spec.path;
+        if (spec.perWave()) {
+            const SceneDescription w = sceneFromJson(baseFor(spec), "defaults", nullptr);
+            EXPECT_EQ(spec.get(w, 0), spec.defaultValue()) << spec.path;
+        } else {
+            EXPECT_EQ(spec.get(s, 0), spec.defaultValue()) << spec.path;
+        }
     }
     // A document holding only its format reads as the defaults.
     EXPECT_EQ(sceneToJson(sceneFromJson(json{{"format", "terralux-project"}}, "p", nullptr)), doc);
@@ -78,37 +96,37 @@ TEST(ParameterTable, EveryBoundIsEnforcedWithItsMessage) {
                 const double v = low ? outside(spec.min, true, spec.minExclusive)
                                      : outside(spec.max, false, spec.maxExclusive);
                 const json value = spec.type == ParamType::Integer ? json((long long)v) : json(v);
-                const std::string message = errorFor(path, value);
+                const std::string message = errorFor(spec, value);
                 EXPECT_EQ(message.rfind("p.json: " + path + " = ", 0), 0u) << message;
                 EXPECT_NE(message.find(": " + rule), std::string::npos) << spec.path << ": " << message;
                 ++checked;
             }
             // Inside the bounds is accepted (unless another rule of the row says otherwise).
-            EXPECT_EQ(errorFor(path, spec.defaultValue()), "") << spec.path;
-            EXPECT_NE(errorFor(path, "text"), "") << spec.path;
+            EXPECT_EQ(errorFor(spec, spec.defaultValue()), "") << spec.path;
+            EXPECT_NE(errorFor(spec, "text"), "") << spec.path;
         }
         if (list && std::isfinite(spec.min)) {
             json value = spec.defaultValue();
             if (value.is_null() || !value.is_array()) continue;
             value[0] = outside(spec.min, true, spec.minExclusive);
             if (spec.type == ParamType::IntegerList) value[0] = (long long)value[0].get<double>();
-            const std::string message = errorFor(path, value);
+            const std::string message = errorFor(spec, value);
             EXPECT_EQ(message.rfind("p.json: " + path + "[0] = ", 0), 0u) << spec.path << ": " << message;
             ++checked;
         }
         if (spec.type == ParamType::Choice) {
-            EXPECT_EQ(errorFor(path, "nonsense"),
+            EXPECT_EQ(errorFor(spec, "nonsense"),
                       "p.json: " + path + " = \"nonsense\": must be " + spec.rangeText());
             ++checked;
         }
         if (spec.type == ParamType::Boolean) {
-            EXPECT_EQ(errorFor(path, 1), "p.json: " + path + " = 1: must be true or false");
+            EXPECT_EQ(errorFor(spec, 1), "p.json: " + path + " = 1: must be true or false");
             ++checked;
         }
         if (!spec.nullable()) {
-            EXPECT_NE(errorFor(path, nullptr), "") << spec.path << " must not accept null";
+            EXPECT_NE(errorFor(spec, nullptr), "") << spec.path << " must not accept null";
         } else {
-            EXPECT_EQ(errorFor(path, nullptr), "") << spec.path << " accepts null (auto)";
+            EXPECT_EQ(errorFor(spec, nullptr), "") << spec.path << " accepts null (auto)";
         }
     }
     EXPECT_GT(checked, 60);
@@ -121,8 +139,11 @@ TEST(ParameterTable, SchemaDescribesEveryLeafAndAcceptsTheDefaults) {
     for (const auto& spec : parameterTable()) {
         const json* node = &schema;
         std::string rest = spec.path;
-        if (spec.perVolume()) {
-            node = &schema["properties"]["probe_volumes"]["items"];
+        if (spec.inList()) {
+            std::string list = spec.listPath();
+            for (size_t dot; (dot = list.find('.')) != std::string::npos; list = list.substr(dot + 1))
+                node = &(*node)["properties"][list.substr(0, dot)];
+            node = &(*node)["properties"][list]["items"];
             rest = spec.localPath();
         }
         for (size_t dot; (dot = rest.find('.')) != std::string::npos; rest = rest.substr(dot + 1))
@@ -163,4 +184,80 @@ TEST(ParameterTable, SunAndSkyRowsAreReadByTheirSkyMode) {
         EXPECT_FALSE(read(s, path)) << path;
     s.sun.followSky = false;
     for (const char* path : {"sun.illuminance", "sun.color"}) EXPECT_TRUE(read(s, path)) << path;
+}
+
+TEST(ParameterTable, WaterRowsBelongToTheWaterDockAndFollowWaterEnabled) {
+    int rows = 0;
+    for (const auto& spec : parameterTable()) {
+        if (spec.path.rfind("water.", 0) != 0) continue;
+        const ParameterDock dock = parameterDock(spec);
+        EXPECT_EQ(dock.objectName, "dock.water") << spec.path;
+        EXPECT_EQ(dock.title, "Water") << spec.path;
+        // The waves are the wave editor's, not dock rows.
+        EXPECT_EQ(spec.uiRow, !spec.perWave()) << spec.path;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 15);
+    SceneDescription s;
+    EXPECT_TRUE(findParameter("water.enabled")->isRead(s, 0));
+    EXPECT_FALSE(findParameter("water.level")->isRead(s, 0));
+    s.water.enabled = true;
+    EXPECT_TRUE(findParameter("water.level")->isRead(s, 0));
+    EXPECT_TRUE(findParameter("water.reflection_scale")->isRead(s, 0));
+    s.water.reflection = WaterReflection::Sky;
+    EXPECT_FALSE(findParameter("water.reflection_scale")->isRead(s, 0));
+    EXPECT_FALSE(findParameter("water.distortion")->isRead(s, 0));
+    // What the bake reads redoes the preview bake; the rest is the renderer's.
+    EXPECT_EQ(invalidatedBy("water.waves"), unsigned(kUpload));
+    EXPECT_EQ(invalidatedBy("water.waves[1].amplitude"), unsigned(kUpload));
+    EXPECT_EQ(invalidatedBy("water.color"), unsigned(kUpload | kRebake));
+    EXPECT_EQ(invalidatedBy("water"), unsigned(kUpload | kRebake));
+}
+
+TEST(ParameterTable, WavesAreAListOfObjectsUnderTheSteepnessRule) {
+    json doc = defaultProjectJson();
+    EXPECT_EQ(doc["water"]["waves"], json::array());
+    doc["water"]["waves"] = json::parse(R"([
+        {"direction_deg": 45, "wavelength": 20, "steepness": 0.3},
+        {"wavelength": 6.283185307179586, "amplitude": 0.25, "phase": 1.5}])");
+    const SceneDescription s = sceneFromJson(doc, "p.json", nullptr);
+    ASSERT_EQ(s.water.waves.size(), 2u);
+    EXPECT_EQ(s.water.waves[0].directionDeg, 45.0);
+    EXPECT_EQ(s.water.waves[0].steepness, 0.3);
+    EXPECT_FALSE(s.water.waves[0].amplitude);
+    EXPECT_EQ(s.water.waves[1].amplitude, 0.25);
+    EXPECT_EQ(s.water.waves[1].phase, 1.5);
+    EXPECT_EQ(s.water.waves[1].directionDeg, 0.0);  // absent keys take their defaults
+    // Written back whole, and read again the same.
+    const json written = sceneToJson(s);
+    EXPECT_EQ(written["water"]["waves"][1],
+              json::parse(R"({"amplitude": 0.25, "direction_deg": 0.0, "phase": 1.5, "steepness": null,
+                               "wavelength": 6.283185307179586})"));
+    EXPECT_EQ(sceneToJson(sceneFromJson(written, "again", nullptr)), written);
+
+    // --set edits one key of one wave, or the whole list; the set's rule names the list.
+    const std::string loop = test::projectErrorFor("water.waves[1].amplitude", 0.75, written);
+    EXPECT_EQ(loop.substr(0, 23), "p.json: water.waves = [");
+    EXPECT_NE(loop.find("...: summed steepness Σ k·A must be <= 1, or the crests loop (is 1.05)"), std::string::npos) << loop;
+    EXPECT_EQ(test::projectErrorFor("water.waves[1].amplitude", 0.7, written), "");  // Σ = 1 exactly
+    EXPECT_EQ(test::projectErrorFor("water.waves", json::array(), written), "");
+
+    // Exactly one of amplitude and steepness.
+    EXPECT_EQ(test::projectErrorFor("water.waves[0].amplitude", 0.5, written),
+              "p.json: water.waves[0].steepness = 0.3: must be null when amplitude is set (exactly one of amplitude and steepness)");
+    EXPECT_EQ(test::projectErrorFor("water.waves[1].amplitude", nullptr, written),
+              "p.json: water.waves[1].steepness = null: must be set when amplitude is null (exactly one of amplitude and steepness)");
+    // At most 8, each an object, keys checked with a suggestion.
+    json nine = defaultProjectJson();
+    nine["water"]["waves"] = json::array();
+    for (int i = 0; i < 9; ++i) nine["water"]["waves"].push_back({{"steepness", 0.01}});
+    EXPECT_NE(test::projectErrorFor("water.enabled", true, nine).find(": must hold at most 8 waves (has 9)"),
+              std::string::npos);
+    EXPECT_EQ(test::projectErrorFor("water.waves", json::array({1}), defaultProjectJson()),
+              "p.json: water.waves[0] = 1: must be an object");
+    EXPECT_EQ(test::projectErrorFor("water.waves", "calm", defaultProjectJson()),
+              "p.json: water.waves = \"calm\": must be an array");
+    EXPECT_EQ(test::projectErrorFor("water.waves", json::parse(R"([{"wavelenght": 3, "steepness": 0.1}])"),
+                                    defaultProjectJson()),
+              "p.json: unknown key 'water.waves[0].wavelenght' (did you mean 'water.waves[].wavelength'?)");
 }
