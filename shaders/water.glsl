@@ -43,8 +43,9 @@ void gerstner(vec2 xz, float depth, float fade, float shortest, out vec3 displac
         vec2 d = water.waves[i].xy;
         float k = water.waves[i].z;
         float wavelength = 2.0 * PI / k;
-        // Full below `shortest`, none below half of it.
-        float keep = clamp(wavelength / max(shortest, 1e-6) * 2.0 - 1.0, 0.0, 1.0);
+        // None at `shortest`, full from twice it: a wave sampled fewer than four times a
+        // wavelength would alias into moiré.
+        float keep = clamp(wavelength / max(shortest, 1e-6) - 1.0, 0.0, 1.0);
         float a = water.waves[i].w * fade * keep;
         float theta = k * dot(d, xz) - waveOmega(i, depth) * water.plane.y + water.phases[i].y;
         float c = cos(theta), s = sin(theta);

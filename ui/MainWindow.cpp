@@ -491,6 +491,11 @@ void MainWindow::buildDocks() {
     tabifyDockWidget(surfaceDock, aoDock);
     tabifyDockWidget(aoDock, waterDock);
     tabifyDockWidget(volumesDock, bakeDock);
+    // Whole tab labels, scrolled when the docks are narrow, rather than "Terr…" and "Wa…".
+    for (auto* bar : findChildren<QTabBar*>()) {
+        bar->setElideMode(Qt::ElideNone);
+        bar->setUsesScrollButtons(true);
+    }
     terrainDock->raise();
     volumesDock->raise();
 

@@ -1113,26 +1113,26 @@ private slots:
         auto* preset = w_->findChild<QComboBox*>("water.preset");
         QVERIFY(table && preset);
         const nlohmann::json before = w_->document()->value("water.waves");
-        const int open = preset->findText("open sea");
-        QVERIFY(open > 0);
-        emit preset->activated(open);
-        const size_t openSea = water::wavePreset("open sea").size();
-        QCOMPARE(w_->document()->project().scene.water.waves.size(), openSea);
-        QCOMPARE(table->rowCount(), int(openSea));
+        const int choppy = preset->findText("choppy lake");
+        QVERIFY(choppy > 0);
+        emit preset->activated(choppy);
+        const size_t choppyWaves = water::wavePreset("choppy lake").size();
+        QCOMPARE(w_->document()->project().scene.water.waves.size(), choppyWaves);
+        QCOMPARE(table->rowCount(), int(choppyWaves));
         QCOMPARE(preset->currentIndex(), 0);
         w_->findChild<QAction*>("action.undo")->trigger();
         QCOMPARE(w_->document()->value("water.waves"), before);
         w_->findChild<QAction*>("action.redo")->trigger();
-        QCOMPARE(table->rowCount(), int(openSea));
+        QCOMPARE(table->rowCount(), int(choppyWaves));
 
         // Add copies the selected wave turned by 30 degrees; Remove takes it away again.
         table->selectRow(0);
         w_->findChild<QPushButton*>("water.addWave")->click();
-        QCOMPARE(table->rowCount(), int(openSea) + 1);
+        QCOMPARE(table->rowCount(), int(choppyWaves) + 1);
         const auto& waves = w_->document()->project().scene.water.waves;
         QCOMPARE(std::fmod(waves.back().directionDeg - waves.front().directionDeg + 360.0, 360.0), 30.0);
         w_->findChild<QPushButton*>("water.removeWave")->click();
-        QCOMPARE(table->rowCount(), int(openSea));
+        QCOMPARE(table->rowCount(), int(choppyWaves));
 
         // Editing the amplitude makes it the wave's own number; the steepness column follows.
         table->item(0, 2)->setText("0.25");
@@ -1196,6 +1196,15 @@ private slots:
         QTest::qWait(300);
         const QPixmap surface = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(surface.save(QString::fromStdString((kOut / "surface_dock.png").string())));
+        // The Water dock with a lake and the choppy preset.
+        w_->findChild<QDockWidget*>("dock.water")->raise();
+        w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(true);
+        auto* preset = w_->findChild<QComboBox*>("water.preset");
+        emit preset->activated(preset->findText("choppy lake"));
+        w_->viewport()->renderNow();
+        QTest::qWait(300);
+        const QPixmap waterShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(waterShot.save(QString::fromStdString((kOut / "water_dock.png").string())));
     }
 };
 
