@@ -90,6 +90,7 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     b.tracer = std::make_unique<HeightfieldTracer>(b.terrain.heightfield,
                                                    HeightfieldTracer::Options{scene.terrain.skirt});
     b.lighting.tracer = b.tracer.get();
+    b.lighting.water = bakeWaterOf(project, b.terrain.heightfield);
     report("loading albedo", 0.015);
     b.lighting.surface = surfaceAlbedoOf(project, b.terrain.heightfield);
     if (cancelled()) throw BakeCancelled();
@@ -420,6 +421,13 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         vr["standard_error"] = stats(se);
         vr["validity"] = {{"rays_from_below", stats(below)},
                           {"probes_with_rays_from_below", fromBelow}};
+        // Probes at or below the water level do not see the water (docs/lighting.md, "Water").
+        if (lighting.water) {
+            size_t under = 0;
+            for (size_t i = 0; i < layout.valid.size(); ++i)
+                under += layout.valid[i] && !(layout.positions[i].y > lighting.water->level);
+            vr["probes_under_water"] = under;
+        }
 
         // Radiance projections, optionally windowed so irradiance is never negative. Before the
         // reference comparison, so that measures the probes as they are written.
@@ -645,6 +653,15 @@ nlohmann::json bakeInputs(const Project& project) {
     settings["terrain"].erase("dem");
     settings["terrain"].erase("albedo_map");
     settings["sky"].erase("hdr");
+    // Of the water the bake reads its level and scatter colour, only while it is on (and the
+    // level's auto value through the DEM's file); waves, absorption and the reflection settings
+    // are the renderer's. Water off is the scene before water existed: no key at all.
+    if (!project.scene.water.enabled)
+        settings.erase("water");
+    else
+        settings["water"] = {{"enabled", true},
+                             {"level", settings["water"]["level"]},
+                             {"color", settings["water"]["color"]}};
     // The ramp is read in mode ramp only: an edit of it in another mode leaves the bake current.
     if (project.scene.terrain.albedoMode != AlbedoMode::Ramp)
         for (const char* key : {"ramp_heights", "ramp_colors", "ramp_rock_color", "ramp_rock_slope"})

@@ -24,6 +24,7 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
     BakeLighting lighting = lightingOf(project);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
     lighting.tracer = &tracer;
+    lighting.water = bakeWaterOf(project, hf);
     try {
         lighting.surface = surfaceAlbedoOf(project, hf);
     } catch (const ImageError&) {

@@ -13,6 +13,7 @@
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "render/ShadowCascades.h"
+#include "water/Water.h"
 
 namespace terralux {
 
@@ -131,6 +132,12 @@ BakeLighting lightingOf(const Project& p) {
     l.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
     l.albedo = scene.terrain.albedo;
     return l;
+}
+
+std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
+    const WaterSettings& w = p.scene.water;
+    if (!w.enabled) return std::nullopt;
+    return BakeWater{float(water::waterLevel(w, hf)), w.color};
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "bake/SphereSampling.h"
+#include "water/Water.h"
 
 namespace terralux {
 namespace {
@@ -92,7 +93,77 @@ glm::vec3 sunIrradiance(const BakeLighting& L, const glm::vec3& p, const glm::ve
     return L.sun.illuminance * cosine * sunVisibility(*L.tracer, L.sun, p, n, samples, rng);
 }
 
+// Where a ray meets the water before `tMax` (the terrain's hit, or +∞), seen from above. A ray
+// that meets the terrain first never reaches water over it: from above the level, the terrain
+// under water lies beyond the plane.
+bool hitsWater(const BakeLighting& L, const glm::vec3& o, const glm::vec3& d, float tMax, glm::vec3& at) {
+    if (!L.water || !(o.y > L.water->level) || !(d.y < 0.0f)) return false;
+    const float t = (L.water->level - o.y) / d.y;
+    if (!(t < tMax)) return false;
+    at = glm::vec3(o.x + t * d.x, L.water->level, o.z + t * d.z);
+    // Without the skirt nothing continues beyond the footprint, the water neither.
+    return L.tracer->options().skirt || L.tracer->heightfield().contains(at.x, at.z);
+}
+
+// What a terrain hit reflects toward the ray: albedo/π × (the cache's indirect light + the sun at
+// the hit, one shadow ray across the disc); the skirt is unshadowed by definition.
+glm::vec3 terrainRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces, const RayHit& hit,
+                          Rng& rng) {
+    if (!(bounces > 0 && cache)) return glm::vec3(0.0f);
+    const glm::vec3 sun = hit.onTerrain ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
+                                        : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
+    return L.albedoAt(hit) / kPi * (cache->indirectAt(hit) + sun);
+}
+
+// The irradiance on the level water surface at `at`: the open sky's (as on the skirt: what the
+// terrain hides of the sky is left out) and the sun through one shadow ray.
+glm::vec3 waterIrradiance(const BakeLighting& L, const glm::vec3& at, Rng& rng) {
+    return L.sky.openIrradianceUp() + sunIrradiance(L, at, glm::vec3(0.0f, 1.0f, 0.0f), 1, rng);
+}
+
+// The light the water at `at` sends back along −d: the mirrored ray's light weighted by Fresnel,
+// and the scatter of what enters. `mirrored` gives the radiance along the reflected ray.
+template <typename Mirrored>
+glm::vec3 waterRadiance(const BakeLighting& L, const glm::vec3& at, const glm::vec3& d, Rng& rng,
+                        Mirrored mirrored) {
+    const float f = waterFresnel(-d.y);
+    const glm::vec3 up(0.0f, 1.0f, 0.0f);
+    const glm::vec3 reflected = mirrored(liftOff(at, up), glm::vec3(d.x, -d.y, d.z));
+    return f * reflected + (1.0f - f) * L.water->scatter / kPi * waterIrradiance(L, at, rng);
+}
+
+// probeRayRadiance with the terrain's hit already traced (`hit` null: the ray escapes).
+glm::vec3 rayRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces, const glm::vec3& o,
+                      const glm::vec3& d, const RayHit* hit, float skyAngle, Rng& rng) {
+    glm::vec3 at;
+    if (hitsWater(L, o, d, hit ? hit->t : INFINITY, at)) {
+        if (bounces <= 0) return glm::vec3(0.0f);
+        // The mirrored ray rises, so it cannot meet the water again: the sky or lit terrain.
+        return waterRadiance(L, at, d, rng, [&](const glm::vec3& ro, const glm::vec3& rd) {
+            RayHit h;
+            return L.tracer->intersect(ro, rd, INFINITY, h) ? terrainRadiance(L, cache, bounces, h, rng)
+                                                            : L.sky.radiance(rd, skyAngle);
+        });
+    }
+    if (hit) return terrainRadiance(L, cache, bounces, *hit, rng);
+    return L.sky.radiance(d, skyAngle);
+}
+
 }  // namespace
+
+float waterFresnel(float cosine) {
+    // Schlick, "An Inexpensive BRDF Model for Physically-based Rendering", CGF 13(3), 1994.
+    const float m = 1.0f - std::clamp(cosine, 0.0f, 1.0f);
+    const float m2 = m * m;
+    return float(water::kWaterF0) + (1.0f - float(water::kWaterF0)) * m2 * m2 * m;
+}
+
+glm::vec3 probeRayRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces,
+                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng) {
+    RayHit hit;
+    const bool terrain = L.tracer->intersect(origin, dir, INFINITY, hit);
+    return rayRadiance(L, cache, bounces, origin, dir, terrain ? &hit : nullptr, skyAngle, rng);
+}
 
 float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const glm::vec3& p,
                     const glm::vec3& n, int samples, Rng& rng) {
@@ -305,20 +376,10 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
         for (int r = 0; r < rays; ++r) {
             const glm::vec3 d = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
             RayHit hit;
-            glm::vec3 radiance(0.0f);
-            if (L.tracer->intersect(positions[i], d, INFINITY, hit)) {
-                fromBelow += glm::dot(d, hit.normal) > 0.0f;
-                if (bounces > 0 && cache) {
-                    // Sun at the hit itself, one shadow ray across the disk; the cache for the
-                    // rest. The skirt is unshadowed by definition.
-                    const glm::vec3 sun = hit.onTerrain
-                                              ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
-                                              : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
-                    radiance = L.albedoAt(hit) / kPi * (cache->indirectAt(hit) + sun);
-                }
-            } else {
-                radiance = L.sky.radiance(d, weight);
-            }
+            const bool terrain = L.tracer->intersect(positions[i], d, INFINITY, hit);
+            if (terrain) fromBelow += glm::dot(d, hit.normal) > 0.0f;
+            const glm::vec3 radiance =
+                rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng);
             sh::accumulate(acc, d, radiance, weight);
             batches.add(r, radiance, d);
         }
@@ -363,6 +424,39 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
         ErrorBatches batches;
         uint64_t count = 0;
         int fromBelow = 0;
+        // The light a path from terrain hit `hit` brings back: at each terrain vertex, sun by a
+        // shadow ray plus one cosine-weighted continuation; throughput albedo per bounce.
+        auto path = [&](RayHit hit) {
+            glm::vec3 radiance(0.0f);
+            glm::vec3 throughput = L.albedoAt(hit) / kPi;
+            for (int b = 0; b < depth; ++b) {
+                if (!hit.onTerrain) {
+                    radiance += throughput * skirt;
+                    break;
+                }
+                const glm::vec3 n = hit.normal;
+                radiance += throughput * sunIrradiance(L, hit.position, n, 1, rng);
+                // Cosine-weighted direction from two fresh random numbers.
+                const float u1 = rng.next(), u2 = rng.next();
+                const float rr = std::sqrt(u1), phi = 2.0f * kPi * u2;
+                glm::vec3 t, bt;
+                basisAround(n, t, bt);
+                const glm::vec3 dir = glm::normalize(rr * std::cos(phi) * t + rr * std::sin(phi) * bt +
+                                                     std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+                const glm::vec3 o = liftOff(hit.position, n);
+                ++count;
+                RayHit next;
+                // E = π × mean radiance under cosine sampling: the π cancels albedo's 1/π.
+                if (!L.tracer->intersect(o, dir, INFINITY, next)) {
+                    radiance += throughput * kPi * L.sky.radiance(dir, 0.0f);
+                    break;
+                }
+                if (b + 1 == depth) break;
+                hit = next;
+                throughput *= L.albedoAt(hit);
+            }
+            return radiance;
+        };
         for (int r = 0; r < rays; ++r) {
             const glm::vec3 d0 = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
             RayHit hit;
@@ -370,38 +464,19 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
             glm::vec3 radiance(0.0f);
             const bool hitSomething = L.tracer->intersect(positions[i], d0, INFINITY, hit);
             if (hitSomething) fromBelow += glm::dot(d0, hit.normal) > 0.0f;
-            if (!hitSomething) {
+            glm::vec3 at;
+            if (hitsWater(L, positions[i], d0, hitSomething ? hit.t : INFINITY, at)) {
+                // The bake's water model, with the mirrored ray followed as a path of its own.
+                if (depth > 0)
+                    radiance = waterRadiance(L, at, d0, rng, [&](const glm::vec3& ro, const glm::vec3& rd) {
+                        RayHit h;
+                        ++count;
+                        return L.tracer->intersect(ro, rd, INFINITY, h) ? path(h) : L.sky.radiance(rd, weight);
+                    });
+            } else if (!hitSomething) {
                 radiance = L.sky.radiance(d0, weight);
             } else if (depth > 0) {
-                // Path: at each terrain vertex, sun by a shadow ray plus one cosine-weighted
-                // continuation; throughput albedo per bounce.
-                glm::vec3 throughput = L.albedoAt(hit) / kPi;
-                for (int b = 0; b < depth; ++b) {
-                    if (!hit.onTerrain) {
-                        radiance += throughput * skirt;
-                        break;
-                    }
-                    const glm::vec3 n = hit.normal;
-                    radiance += throughput * sunIrradiance(L, hit.position, n, 1, rng);
-                    // Cosine-weighted direction from two fresh random numbers.
-                    const float u1 = rng.next(), u2 = rng.next();
-                    const float rr = std::sqrt(u1), phi = 2.0f * kPi * u2;
-                    glm::vec3 t, bt;
-                    basisAround(n, t, bt);
-                    const glm::vec3 dir = glm::normalize(rr * std::cos(phi) * t + rr * std::sin(phi) * bt +
-                                                         std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
-                    const glm::vec3 o = liftOff(hit.position, n);
-                    ++count;
-                    RayHit next;
-                    // E = π × mean radiance under cosine sampling: the π cancels albedo's 1/π.
-                    if (!L.tracer->intersect(o, dir, INFINITY, next)) {
-                        radiance += throughput * kPi * L.sky.radiance(dir, 0.0f);
-                        break;
-                    }
-                    if (b + 1 == depth) break;
-                    hit = next;
-                    throughput *= L.albedoAt(hit);
-                }
+                radiance = path(hit);
             }
             sh::accumulate(acc, d0, radiance, weight);
             batches.add(r, radiance, d0);

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -41,6 +42,15 @@ const char* qualityName(QualityPreset preset);
 // a bake's cost then grows with its rays per probe: presets stay ordered by cost at any size.
 int cacheResolutionFor(const Heightfield& hf, const BakeQuality& q, uint64_t probeRays);
 
+// Water as the probe rays see it (docs/lighting.md, "Water"): a level plane that hides the
+// terrain below it, seen from above. A ray that meets it first brings back the Fresnel-weighted
+// (Schlick, F0 = 0.02) reflection of what the mirrored ray meets, plus the water's scatter,
+// (1 − F)·scatter·E/π, E the irradiance on the level surface from the open sky and the sun.
+struct BakeWater {
+    float level = 0.0f;         // engine y of the plane at rest
+    glm::vec3 scatter{0.0f};    // deep-water scatter albedo (water.color)
+};
+
 struct BakeLighting {
     const HeightfieldTracer* tracer = nullptr;
     Sky sky = Sky::uniform(glm::vec3(0.0f));
@@ -49,6 +59,8 @@ struct BakeLighting {
     // Albedo that varies over the terrain (a map or the ramp), over the tracer's heightfield;
     // null or empty: `albedo` everywhere. Shared: lightings are copied, the field is not.
     std::shared_ptr<const SurfaceAlbedo> surface;
+    // Unset: no water. With the skirt off it ends at the footprint, like the ground.
+    std::optional<BakeWater> water;
 
     bool variesOverTerrain() const { return surface && !surface->empty(); }
     // The albedo a ray hit reflects with.
@@ -158,6 +170,16 @@ ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
 float luminance(const glm::vec3& c);
 
 class Rng;
+// Schlick's approximation of the Fresnel reflectance of water (F0 = 0.02) for light arriving at
+// cos θ = `cosine` from the normal: F0 + (1 − F0)·(1 − cos θ)^5.
+float waterFresnel(float cosine);
+// The radiance one probe ray brings back (docs/lighting.md, "The bake", "Water"): the sky where
+// it escapes (read for `skyAngle` steradians, the solid angle the ray stands for); where it meets
+// the terrain, albedo/π × (the cache's indirect irradiance + the sun through one shadow ray),
+// black without bounces or a cache; where it meets the water first, the water's reflection and
+// scatter (black without bounces: 0 bounces is sky visibility only). Shadow rays draw from `rng`.
+glm::vec3 probeRayRadiance(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
+                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng);
 // Share of the sun's disc visible from surface point p with normal n: `samples` shadow rays,
 // stratified over the disc, against the traced surface (0 where the sun is behind the surface).
 // The bake's sun term is this × cos θ × E_sun; the sun-visibility debug view draws it.

@@ -12,6 +12,8 @@
 #include "TestScenes.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbePlacement.h"
+#include "SceneLighting.h"
+#include "water/Water.h"
 
 using namespace terralux;
 namespace fs = std::filesystem;
@@ -186,4 +188,102 @@ TEST(BakeJob, AmbientOcclusionIsNotABakeInput) {
     EXPECT_FALSE(bakeInputs(a).dump().find("\"ao\"") != std::string::npos);
     b.scene.sun.elevationDeg = 10.0;
     EXPECT_NE(bakeInputs(a), bakeInputs(b));
+}
+
+// The bake reads the water's level and scatter colour while it is on; the rest of the section is
+// the renderer's. Water off is the scene before water: no key at all.
+TEST(BakeJob, WaterInTheInputsIsWhatTheBakeReads) {
+    Project off;
+    const nlohmann::json before = bakeInputs(off);
+    EXPECT_FALSE(before["settings"].contains("water"));
+    Project offEdited = off;
+    offEdited.scene.water.color = glm::vec3(0.5f);
+    offEdited.scene.water.level = 300.0;
+    EXPECT_EQ(bakeInputs(offEdited), before);
+
+    Project on = off;
+    on.scene.water.enabled = true;
+    const nlohmann::json lake = bakeInputs(on);
+    EXPECT_EQ(lake["settings"]["water"],
+              nlohmann::json::parse(R"({"enabled": true, "level": null, "color": [0.02, 0.05, 0.06]})"));
+    EXPECT_EQ(bakeInputDifferences(before, lake),
+              (std::vector<std::string>{"water.color: not in the bake, now [0.02,0.05,0.06]",
+                                        "water.enabled: not in the bake, now true",
+                                        "water.level: not in the bake, now null"}));
+    // Render settings leave the bake current...
+    Project rendered = on;
+    rendered.scene.water.waves = water::wavePreset("open sea");
+    rendered.scene.water.absorption = glm::vec3(1.0f);
+    rendered.scene.water.roughness = 0.3;
+    rendered.scene.water.depthAware = true;
+    rendered.scene.water.shoreFadeDistance = 5.0;
+    rendered.scene.water.reflection = WaterReflection::Sky;
+    EXPECT_EQ(bakeInputs(rendered), lake);
+    // ...the level and the colour do not.
+    Project raised = on;
+    raised.scene.water.level = 650.0;
+    EXPECT_EQ(bakeInputDifferences(lake, bakeInputs(raised)),
+              std::vector<std::string>{"water.level: baked null, now 650.0"});
+    Project tinted = on;
+    tinted.scene.water.color = glm::vec3(0.1f, 0.2f, 0.3f);
+    EXPECT_EQ(bakeInputDifferences(lake, bakeInputs(tinted)).size(), 1u);
+}
+
+TEST(BakeJob, WaterResolvesItsLevelOnTheTerrain) {
+    const Heightfield hf(10, 10, 5.0, 5.0, [] {
+        std::vector<float> h(100);
+        for (int i = 0; i < 100; ++i) h[size_t(i)] = float(i + 1);
+        return h;
+    }());
+    Project p;
+    EXPECT_FALSE(bakeWaterOf(p, hf));
+    p.scene.water.enabled = true;
+    p.scene.water.color = glm::vec3(0.1f, 0.2f, 0.3f);
+    ASSERT_TRUE(bakeWaterOf(p, hf));
+    EXPECT_EQ(bakeWaterOf(p, hf)->level, 10.0f);  // the lowest decile
+    EXPECT_EQ(bakeWaterOf(p, hf)->scatter, glm::vec3(0.1f, 0.2f, 0.3f));
+    p.scene.water.level = 42.5;
+    EXPECT_EQ(bakeWaterOf(p, hf)->level, 42.5f);
+}
+
+// A whole bake over a lake: the probes over the water see it, and the report counts those that
+// sit under its level (they do not see it).
+TEST(BakeJob, ProbesOverALakeSeeTheWater) {
+    const fs::path dir = tempDir("lake");
+    Project dry = cropProject(dir / "dry", 8);
+    dry.scene.bake.quality = QualityPreset::Draft;
+    Project wet = dry;
+    wet.scene.exportSettings.outDir = (dir / "wet").string();
+    wet.scene.water.enabled = true;
+    wet.scene.water.level = 900.0;  // the crop spans 569 to 1589 m
+    wet.scene.probeVolumes[0].heightOffset = 400.0;  // every probe above the water
+    dry.scene.probeVolumes[0].heightOffset = 400.0;
+    const BakeOutcome a = runBake(BakeRequest{dry, 0, false}, {}, nullptr);
+    const BakeOutcome b = runBake(BakeRequest{wet, 0, false}, {}, nullptr);
+    EXPECT_FALSE(a.report["volumes"][0].contains("probes_under_water"));
+    EXPECT_EQ(b.report["volumes"][0]["probes_under_water"], 0);
+    EXPECT_EQ(b.report["inputs"]["settings"]["water"]["level"], 900.0);
+    const ShProbeGrid ga = readShProbeFile(dir / "dry" / "sh_coeffs/probes.shprobe");
+    const ShProbeGrid gb = readShProbeFile(dir / "wet" / "sh_coeffs/probes.shprobe");
+    ASSERT_EQ(ga.probes.size(), gb.probes.size());
+    // The dark water hides the sunlit valley floors: less light from below, the sky's the same.
+    double belowDry = 0.0, belowWet = 0.0, aboveDry = 0.0, aboveWet = 0.0;
+    for (size_t i = 0; i < ga.probes.size(); ++i) {
+        sh::ShRgb sa, sb;
+        sa.c = ga.probes[i].coeffs;
+        sb.c = gb.probes[i].coeffs;
+        belowDry += sh::evalIrradiance(sa, glm::vec3(0, -1, 0)).y;
+        belowWet += sh::evalIrradiance(sb, glm::vec3(0, -1, 0)).y;
+        aboveDry += sh::evalIrradiance(sa, glm::vec3(0, 1, 0)).y;
+        aboveWet += sh::evalIrradiance(sb, glm::vec3(0, 1, 0)).y;
+    }
+    EXPECT_LT(belowWet, 0.9 * belowDry);
+    EXPECT_NEAR(aboveWet, aboveDry, 0.05 * aboveDry);
+    // Under the level: counted.
+    Project deep = wet;
+    deep.scene.exportSettings.outDir = (dir / "deep").string();
+    deep.scene.probeVolumes[0].heightOffset = 5.0;
+    const BakeOutcome c = runBake(BakeRequest{deep, 0, false}, {}, nullptr);
+    EXPECT_GT(c.report["volumes"][0]["probes_under_water"].get<int>(), 0);
+    fs::remove_all(dir);
 }
