@@ -58,7 +58,7 @@ void main() {
     float depth = max(field.x, 0.0);  // metres of water over the bed
     float pixelMetres = length(fwidth(worldPos));
     vec3 displacement, n;
-    gerstner(restPos.xz, depth, shoreFade(field.y), 2.0 * pixelMetres, displacement, n);
+    gerstner(restPos.xz, depth, shoreFade(field.y), pixelMetres, displacement, n);
     vec2 screen = gl_FragCoord.xy * camera.viewport.zw;
     float distortion = water.look.x;
     vec3 planar = texture(reflectionMap, screen + n.xz * distortion).rgb;

@@ -33,7 +33,9 @@ float waveOmega(int i, float depth) {
 // 41 with Q = 1; the normal is the cross product of the surface's exact tangents along z and
 // x, which Finch 2004, GPU Gems ch. 1, eq. 12 approximates to first order). Waves
 // shorter than `shortest` metres (under the pixel, or the mesh) are left out of the
-// displacement and faded out of the normal: what they would add is aliasing.
+// displacement and faded out of the normal: what they would add is aliasing. The fragment
+// shader passes its pixel's footprint (length(fwidth), already about twice a pixel at an angle),
+// the mesh twice its spacing.
 void gerstner(vec2 xz, float depth, float fade, float shortest, out vec3 displacement, out vec3 normal) {
     displacement = vec3(0.0);
     vec3 tx = vec3(1.0, 0.0, 0.0), tz = vec3(0.0, 0.0, 1.0);  // ∂P/∂x, ∂P/∂z
