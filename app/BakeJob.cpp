@@ -596,6 +596,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         in.volumes = grids;
         in.bake = bakeInfo;
         in.lighting = lightingExtension(project, hf, lighting);
+        if (lighting.water)
+            in.water = GltfWater{lighting.water->level, scene.water.color, float(scene.water.roughness)};
         in.generatorVersion = TERRALUX_VERSION;
         in.scene = scene.exportSettings.gltf;
         // The report lists every file of the bake, itself included, in the order written.

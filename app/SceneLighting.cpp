@@ -202,6 +202,24 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
                       {"specular_aa", terrain.at("specular_aa")},
                       {"ao", authored.at("ao")},
                       {"detail", authored.at("detail")}};
+
+    // The water as the project writes it, with what an engine would otherwise derive: the level
+    // in metres and each wave's direction, amplitude, wave number and deep-water angular
+    // frequency (docs/lighting.md, "Water"). No water, no key: such a scene is exported as
+    // before water existed.
+    if (scene.water.enabled) {
+        nlohmann::json& w = ext["water"] = authored.at("water");
+        w["resolved_level"] = scene.water.level ? w.at("level")
+                                                : nlohmann::json(shortestDecimal(float(water::autoLevel(hf))));
+        for (size_t i = 0; i < scene.water.waves.size(); ++i) {
+            const water::WaveTerms t = water::waveTerms(scene.water.waves[i]);
+            nlohmann::json& wave = w.at("waves").at(i);
+            wave["resolved_direction"] = {t.direction.x, t.direction.y};
+            wave["resolved_amplitude"] = t.amplitude;
+            wave["resolved_k"] = t.k;
+            wave["resolved_omega"] = t.omegaDeep;
+        }
+    }
     return ext;
 }
 

@@ -1,6 +1,7 @@
 #include "GltfExport.h"
 #include "ImageFile.h"
 #include "ProbeDiagnosticsFile.h"
+#include "water/Water.h"
 
 #include <algorithm>
 
@@ -35,6 +36,8 @@ constexpr const char* kEngineExtension = "VULKAN_SCHNEE_engine_properties";
 constexpr const char* kGeoExtension = "TERRALUX_geo";
 constexpr const char* kBakeExtension = "TERRALUX_bake";
 constexpr const char* kLightingExtension = "TERRALUX_lighting";
+constexpr const char* kTransmissionExtension = "KHR_materials_transmission";
+constexpr const char* kIorExtension = "KHR_materials_ior";
 constexpr const char* kGltfName = "scene.gltf";
 constexpr const char* kBinName = "scene.bin";
 constexpr const char* kProbeDir = "sh_coeffs";
@@ -130,6 +133,67 @@ std::vector<uint8_t> srgbSamples(const SurfaceAlbedo& a) {
         for (int c = 0; c < 3; ++c)
             out[3 * i + size_t(c)] = uint8_t(std::lround(linearToSrgb(a.linear[i][c]) * 255.0f));
     return out;
+}
+
+// The water plane: the footprint's rectangle at the level, appended to scene.bin (positions,
+// normals, indices) as node, mesh and material 1, all named `water`. Its material transmits
+// (KHR_materials_transmission) with water's index of refraction (KHR_materials_ior), tinted by
+// the deep-water scatter colour, with the waves' highlight roughness.
+void addWaterPlane(const Heightfield& hf, const GltfWater& w, std::vector<uint8_t>& bin, ojson& doc) {
+    const float x0 = hf.minX(), x1 = hf.maxX(), z0 = hf.minZ(), z1 = hf.maxZ();
+    const size_t positionOffset = bin.size();
+    // Corners north-west, south-west, south-east, north-east.
+    for (const auto& [x, z] : {std::pair{x0, z0}, std::pair{x0, z1}, std::pair{x1, z1}, std::pair{x1, z0}}) {
+        putF32(bin, x);
+        putF32(bin, w.level);
+        putF32(bin, z);
+    }
+    const size_t normalOffset = bin.size();
+    for (int i = 0; i < 4; ++i) {
+        putF32(bin, 0.0f);
+        putF32(bin, 1.0f);
+        putF32(bin, 0.0f);
+    }
+    const size_t indexOffset = bin.size();
+    // Counter-clockwise seen from +Y (X east, Z south), as the terrain's triangles.
+    for (uint16_t i : {0, 1, 2, 0, 2, 3})
+        putU16(bin, i);
+    const size_t indexBytes = bin.size() - indexOffset;
+    padTo4(bin);
+
+    const size_t firstView = doc["bufferViews"].size(), firstAccessor = doc["accessors"].size();
+    auto view = [](size_t offset, size_t length, int target) {
+        return ojson{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}, {"target", target}};
+    };
+    doc["bufferViews"].push_back(view(positionOffset, normalOffset - positionOffset, kArrayBuffer));
+    doc["bufferViews"].push_back(view(normalOffset, indexOffset - normalOffset, kArrayBuffer));
+    doc["bufferViews"].push_back(view(indexOffset, indexBytes, kElementArrayBuffer));
+    doc["accessors"].push_back(ojson{{"name", "water POSITION"}, {"bufferView", firstView}, {"componentType", kFloat},
+                                     {"count", 4}, {"type", "VEC3"},
+                                     {"min", floats({x0, w.level, z0})}, {"max", floats({x1, w.level, z1})}});
+    doc["accessors"].push_back(ojson{{"name", "water NORMAL"}, {"bufferView", firstView + 1},
+                                     {"componentType", kFloat}, {"count", 4}, {"type", "VEC3"}});
+    doc["accessors"].push_back(ojson{{"name", "water indices"}, {"bufferView", firstView + 2},
+                                     {"componentType", kUnsignedShort}, {"count", 6}, {"type", "SCALAR"}});
+    const size_t material = doc["materials"].size(), mesh = doc["meshes"].size(), node = doc["nodes"].size();
+    doc["materials"].push_back(ojson{
+        {"name", "water"},
+        {"pbrMetallicRoughness",
+         {{"baseColorFactor", floats({w.color.r, w.color.g, w.color.b, 1.0f})},
+          {"metallicFactor", 0.0},
+          {"roughnessFactor", double(w.roughness)}}},
+        {"extensions",
+         {{kTransmissionExtension, {{"transmissionFactor", 1.0}}}, {kIorExtension, {{"ior", water::kWaterIor}}}}}});
+    doc["meshes"].push_back(ojson{
+        {"name", "water"},
+        {"primitives", ojson::array({ojson{{"attributes", {{"POSITION", firstAccessor}, {"NORMAL", firstAccessor + 1}}},
+                                           {"indices", firstAccessor + 2},
+                                           {"material", material},
+                                           {"mode", kTriangles}}})}});
+    doc["nodes"].push_back(ojson{{"name", "water"}, {"mesh", mesh}});
+    doc["scenes"][0]["nodes"].push_back(node);
+    doc["extensionsUsed"].push_back(kTransmissionExtension);
+    doc["extensionsUsed"].push_back(kIorExtension);
 }
 
 // Builds scene.bin and the mesh part of the glTF document.
@@ -292,6 +356,8 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
     // An image's view has no target (glTF 2.0, 3.6.2.4: only vertex and index data have one).
     if (texture)
         doc["bufferViews"].push_back(ojson{{"buffer", 0}, {"byteOffset", imageOffset}, {"byteLength", imageBytes}});
+    if (input.water)
+        addWaterPlane(hf, *input.water, bin, doc);
     doc["buffers"] = ojson::array({ojson{{"uri", kBinName}, {"byteLength", bin.size()}}});
     return mesh;
 }
@@ -352,6 +418,18 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
     if (!input.bake.is_object()) {
         throw std::runtime_error(gltfPath.string() + ": the " + kBakeExtension +
                                  " metadata must be a JSON object, not " + input.bake.type_name());
+    }
+    if (const auto& w = input.water) {
+        if (!std::isfinite(w->level))
+            throw std::runtime_error(gltfPath.string() + ": water level = " + std::to_string(w->level) +
+                                     " must be finite");
+        for (int c = 0; c < 3; ++c)
+            if (!std::isfinite(w->color[c]) || w->color[c] < 0.0f || w->color[c] > 1.0f)
+                throw std::runtime_error(gltfPath.string() + ": water colour channel " + std::to_string(c) +
+                                         " = " + std::to_string(w->color[c]) + " must be in [0, 1]");
+        if (!std::isfinite(w->roughness) || w->roughness < 0.0f || w->roughness > 1.0f)
+            throw std::runtime_error(gltfPath.string() + ": water roughness = " + std::to_string(w->roughness) +
+                                     " must be in [0, 1]");
     }
     if (!input.lighting.is_null() && !input.lighting.is_object()) {
         throw std::runtime_error(gltfPath.string() + ": the " + kLightingExtension +

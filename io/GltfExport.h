@@ -16,11 +16,15 @@
 //   TERRALUX_geo                     CRS, origin, vertical scale, cell size, grid size, mesh stride
 //   TERRALUX_bake                    the caller's JSON object, verbatim
 //   TERRALUX_lighting                the caller's JSON object, verbatim, when it gives one
+// With water, a second node and mesh named `water`: a rectangle over the footprint at the water
+// level, whose material uses KHR_materials_transmission and KHR_materials_ior (both used, never
+// required).
 
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +45,14 @@ struct GltfProbeVolume {
     std::string diagnostics;
 };
 
+// The water plane of the scene (docs/formats.md, "glTF scene"): the footprint's rectangle at the
+// level, with a transmissive material of index of refraction 1.33.
+struct GltfWater {
+    float level = 0.0f;              // engine y, finite
+    glm::vec3 color{0.0f};           // base colour factor (water.color), each channel in [0, 1]
+    float roughness = 0.05f;         // roughnessFactor (water.roughness), in [0, 1]
+};
+
 struct GltfSceneInput {
     const Heightfield* heightfield = nullptr;
     glm::vec3 albedo{0.3f};  // base colour factor, each channel in [0, 1]
@@ -55,6 +67,8 @@ struct GltfSceneInput {
     // TERRALUX_lighting: an object (the bake writes the project's lighting, app/SceneLighting.h),
     // or null for no such extension.
     nlohmann::json lighting = nullptr;
+    // Unset: no water node (a one-sample-wide heightfield, with no footprint, has none either).
+    std::optional<GltfWater> water;
     std::string generatorVersion;                    // asset.generator = "Terralux <version>"
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
     // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride. The

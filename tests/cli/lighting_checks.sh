@@ -4,7 +4,8 @@
 # sections are what --print-project prints with the same project and --set edits (plus the
 # computed_* and resolved_* keys), the sun agrees with the project's, and the Khronos validator
 # finds no error. Once on the embedded sample, once with a project file whose HDR sky is named
-# relative to it (the extension keeps the path as written).
+# relative to it (the extension keeps the path as written), once with a lake (its section and
+# node; neither without water).
 set -u
 terralux=$1 validator=$2 work=$3 build=$4
 rm -rf "$work" && mkdir -p "$work"
@@ -74,6 +75,58 @@ elif mean_sky is not None:
     expect(all(close(x, y, 1e-2) for x, y in zip(fog["resolved_color"], mean_sky)),
            f"fog.resolved_color {fog['resolved_color']} is not the sky's mean {mean_sky}")
 
+# Water: every setting as the project prints it, the level and the waves resolved, and a water
+# node with a transmissive material; none of it without water.
+used = doc.get("extensionsUsed", [])
+water_nodes = [n for n in doc.get("nodes", []) if n.get("name") == "water"]
+if project["water"]["enabled"]:
+    w = ext.get("water")
+    expect(w is not None, "no TERRALUX_lighting.water with water on")
+    if w is not None:
+        authored = {k: v for k, v in w.items() if not k.startswith("resolved_")}
+        authored["waves"] = [{k: v for k, v in wave.items() if not k.startswith("resolved_")}
+                             for wave in w["waves"]]
+        expect(authored == project["water"],
+               f"water: {json.dumps(authored, sort_keys=True)} != {json.dumps(project['water'], sort_keys=True)}")
+        level = w["resolved_level"]
+        if project["water"]["level"] is not None:
+            expect(level == project["water"]["level"], "water.resolved_level is not the set level")
+        for wave, pw in zip(w["waves"], project["water"]["waves"]):
+            k = 2 * math.pi / pw["wavelength"]
+            a = pw["amplitude"] if pw["amplitude"] is not None else pw["steepness"] / k
+            az = math.radians(pw["direction_deg"])
+            expect(close(wave["resolved_k"], k), f"resolved_k {wave['resolved_k']} != {k}")
+            expect(close(wave["resolved_amplitude"], a), f"resolved_amplitude {wave['resolved_amplitude']} != {a}")
+            expect(close(wave["resolved_omega"], math.sqrt(9.81 * k)), "resolved_omega is not sqrt(g k)")
+            expect(all(close(x, y) for x, y in zip(wave["resolved_direction"], (math.sin(az), -math.cos(az)))),
+                   f"resolved_direction {wave['resolved_direction']}")
+        expect(len(water_nodes) == 1, f"{len(water_nodes)} water nodes")
+        for name in ("KHR_materials_transmission", "KHR_materials_ior"):
+            expect(name in used and name not in doc.get("extensionsRequired", []), f"{name} not used, or required")
+        if water_nodes:
+            mesh = doc["meshes"][water_nodes[0]["mesh"]]
+            prim = mesh["primitives"][0]
+            material = doc["materials"][prim["material"]]
+            pos = doc["accessors"][prim["attributes"]["POSITION"]]
+            expect(close(pos["min"][1], level) and close(pos["max"][1], level),
+                   f"water plane at {pos['min'][1]}..{pos['max'][1]}, level {level}")
+            terrain = doc["accessors"][doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]]
+            expect(close(pos["min"][0], terrain["min"][0]) and close(pos["max"][2], terrain["max"][2]),
+                   "water plane is not the terrain footprint")
+            expect(material["extensions"]["KHR_materials_ior"]["ior"] == 1.33, "water ior is not 1.33")
+            expect(material["extensions"]["KHR_materials_transmission"]["transmissionFactor"] == 1.0,
+                   "water does not transmit")
+            expect(all(close(x, y) for x, y in zip(material["pbrMetallicRoughness"]["baseColorFactor"],
+                                                   project["water"]["color"] + [1.0])),
+                   "water base colour is not water.color")
+            expect(close(material["pbrMetallicRoughness"]["roughnessFactor"], project["water"]["roughness"]),
+                   "water roughness is not water.roughness")
+else:
+    expect("water" not in ext, "TERRALUX_lighting.water without water")
+    expect(not water_nodes, "a water node without water")
+    expect("KHR_materials_transmission" not in used and "KHR_materials_ior" not in used,
+           "material extensions without water")
+
 for message in errors:
     print("FAIL:", message)
 sys.exit(1 if errors else 0)
@@ -123,4 +176,12 @@ grep -q '"hdr": "skies/even.hdr"' "$work/lit.json" || fail "--print-project rewr
 mean=$(python3 -c 'print(",".join(str((m + 0.5) * 2.0 ** (130 - 136) * 0.5) for m in (200, 160, 128)))')
 check "$work/lit.json" "$work/lit/scene.gltf" 2 "$mean" || fail "project file: TERRALUX_lighting disagrees with --print-project"
 validate "$work/lit/scene.gltf"
+
+# The sample with a lake at its auto level, two waves, and the albedo texture beside it.
+sets=(--set water.enabled=true --set water.roughness=0.2 --set water.depth_aware=true --set bake.error_map_resolution=0
+      --set 'water.waves=[{"direction_deg":60,"wavelength":30,"steepness":0.2},{"wavelength":7,"amplitude":0.15,"phase":2}]')
+"$terralux" --print-project "${sets[@]}" >"$work/lake.json" || fail "--print-project of the lake exited $?"
+"$terralux" --bake --quiet --quality draft "${sets[@]}" --out "$work/lake" >/dev/null || fail "bake of the lake exited $?"
+check "$work/lake.json" "$work/lake/scene.gltf" 4 0.09,0.11,0.15 || fail "lake: TERRALUX_lighting or the water node disagrees with --print-project"
+validate "$work/lake/scene.gltf"
 echo "ok"

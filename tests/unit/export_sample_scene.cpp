@@ -1,6 +1,6 @@
 // Writes a small synthetic glTF scene (terrain + two probe volumes) with the exporter, for the
-// Khronos validator test.
-//   export_sample_scene OUT_DIR [WIDTH DEPTH [MESH_MAX_VERTICES]]
+// Khronos validator test; with --water (last), also the water plane and its material.
+//   export_sample_scene OUT_DIR [WIDTH DEPTH [MESH_MAX_VERTICES]] [--water]
 
 #include <cmath>
 #include <cstdio>
@@ -35,8 +35,10 @@ ShProbeGrid syntheticGrid(glm::uvec3 dims, glm::vec3 origin, float spacing, size
 }  // namespace
 
 int main(int argc, char** argv) {
+    const bool water = argc > 2 && std::string(argv[argc - 1]) == "--water";
+    if (water) --argc;
     if (argc != 2 && argc != 4 && argc != 5) {
-        std::fprintf(stderr, "usage: export_sample_scene OUT_DIR [WIDTH DEPTH [MESH_MAX_VERTICES]]\n");
+        std::fprintf(stderr, "usage: export_sample_scene OUT_DIR [WIDTH DEPTH [MESH_MAX_VERTICES]] [--water]\n");
         return 2;
     }
     try {
@@ -62,6 +64,8 @@ int main(int argc, char** argv) {
         in.generatorVersion = "test";
         if (argc == 5)
             in.meshMaxVertices = std::stoul(argv[4]);
+        if (water)
+            in.water = GltfWater{5.0f, {0.02f, 0.05f, 0.06f}, 0.05f};
         const GltfExportResult res = exportGltfScene(argv[1], in);
         for (const auto& f : res.files)
             std::printf("%s\n", f.string().c_str());

@@ -664,3 +664,83 @@ TEST_F(GltfExport, AnAlbedoFieldIsAnEmbeddedSrgbPngWithUvsOnItsTexelCentres) {
     EXPECT_FALSE(doc["materials"][0]["pbrMetallicRoughness"].contains("baseColorTexture"));
     EXPECT_FALSE(doc.contains("images"));
 }
+
+TEST_F(GltfExport, WaterIsAPlaneOverTheFootprintWithATransmissiveMaterial) {
+    const Heightfield hf = makeHeightfield(9, 7);  // 2 x 3 m cells: x in [-8, 8], z in [-9, 9]
+    GltfSceneInput in = sampleInput(hf);
+    // Without water: the terrain alone, and bytes that do not depend on the water's existence.
+    exportGltfScene(dir, in);
+    const std::vector<uint8_t> dryBin = readBytes(dir / "scene.bin");
+    const json dry = readJson(dir / "scene.gltf");
+    EXPECT_EQ(dry["nodes"].size(), 1u);
+    EXPECT_EQ(dry["extensionsUsed"], json({"VULKAN_SCHNEE_engine_properties", "TERRALUX_geo", "TERRALUX_bake"}));
+
+    in.water = GltfWater{104.5f, {0.02f, 0.05f, 0.25f}, 0.1f};
+    exportGltfScene(dir, in);
+    const json doc = readJson(dir / "scene.gltf");
+    EXPECT_EQ(doc["extensionsUsed"],
+              json({"VULKAN_SCHNEE_engine_properties", "TERRALUX_geo", "TERRALUX_bake",
+                    "KHR_materials_transmission", "KHR_materials_ior"}));
+    EXPECT_FALSE(doc.contains("extensionsRequired"));
+    Loaded l = load(dir / "scene.gltf");
+    ASSERT_TRUE(l.ok) << l.err;
+    EXPECT_EQ(l.warn, "");
+    const tinygltf::Model& m = l.model;
+    ASSERT_EQ(m.nodes.size(), 2u);
+    EXPECT_EQ(m.scenes[0].nodes, (std::vector<int>{0, 1}));
+    EXPECT_EQ(m.nodes[1].name, "water");
+    const tinygltf::Mesh& mesh = m.meshes[size_t(m.nodes[1].mesh)];
+    EXPECT_EQ(mesh.name, "water");
+    ASSERT_EQ(mesh.primitives.size(), 1u);
+    const tinygltf::Primitive& prim = mesh.primitives[0];
+    const std::vector<float> pos = floatData(m, prim.attributes.at("POSITION"));
+    const std::vector<float> nrm = floatData(m, prim.attributes.at("NORMAL"));
+    const std::vector<uint32_t> idx = indexData(m, prim.indices);
+    ASSERT_EQ(pos.size(), 12u);
+    ASSERT_EQ(idx.size(), 6u);
+    // The footprint's corners at the level, up-facing, two triangles counter-clockwise from +Y.
+    glm::vec3 lo(INFINITY), hi(-INFINITY);
+    for (size_t i = 0; i < 4; ++i) {
+        lo = glm::min(lo, vec3At(pos, i));
+        hi = glm::max(hi, vec3At(pos, i));
+        EXPECT_EQ(vec3At(nrm, i), glm::vec3(0, 1, 0));
+    }
+    EXPECT_EQ(lo, glm::vec3(hf.minX(), 104.5f, hf.minZ()));
+    EXPECT_EQ(hi, glm::vec3(hf.maxX(), 104.5f, hf.maxZ()));
+    double area = 0.0;
+    for (size_t t = 0; t < 2; ++t) {
+        const glm::vec3 a = vec3At(pos, idx[3 * t]), b = vec3At(pos, idx[3 * t + 1]), c = vec3At(pos, idx[3 * t + 2]);
+        const glm::vec3 n = glm::cross(b - a, c - a);
+        EXPECT_GT(n.y, 0.0f) << "triangle " << t;
+        area += 0.5 * n.y;
+    }
+    EXPECT_NEAR(area, (hf.maxX() - hf.minX()) * (hf.maxZ() - hf.minZ()), 1e-3);
+    // The material: base colour and roughness, transmission and water's index of refraction.
+    const json& mat = doc["materials"][size_t(prim.material)];
+    EXPECT_EQ(mat["name"], "water");
+    EXPECT_EQ(mat["pbrMetallicRoughness"]["baseColorFactor"], json({double(0.02f), double(0.05f), double(0.25f), 1.0}));
+    EXPECT_EQ(mat["pbrMetallicRoughness"]["roughnessFactor"], double(0.1f));
+    EXPECT_EQ(mat["pbrMetallicRoughness"]["metallicFactor"], 0.0);
+    EXPECT_EQ(mat["extensions"]["KHR_materials_transmission"]["transmissionFactor"], 1.0);
+    EXPECT_EQ(mat["extensions"]["KHR_materials_ior"]["ior"], 1.33);
+    // The terrain's part of scene.bin is what it was without water.
+    const std::vector<uint8_t> wetBin = readBytes(dir / "scene.bin");
+    ASSERT_GT(wetBin.size(), dryBin.size());
+    EXPECT_TRUE(std::equal(dryBin.begin(), dryBin.end(), wetBin.begin()));
+    EXPECT_EQ(doc["buffers"][0]["byteLength"], wetBin.size());
+
+    // A heightfield with no footprint has no water plane either; a bad plane is refused.
+    fs::remove_all(dir);
+    const Heightfield line = makeHeightfield(6, 1);
+    GltfSceneInput meshless = sampleInput(line);
+    meshless.water = in.water;
+    exportGltfScene(dir, meshless);
+    EXPECT_FALSE(readJson(dir / "scene.gltf").contains("nodes"));
+    fs::remove_all(dir);
+    GltfSceneInput bad = in;
+    bad.water->level = NAN;
+    EXPECT_THROW(exportGltfScene(dir, bad), std::runtime_error);
+    bad.water = GltfWater{1.0f, {0.5f, 1.5f, 0.0f}, 0.1f};
+    EXPECT_THROW(exportGltfScene(dir, bad), std::runtime_error);
+    EXPECT_FALSE(fs::exists(dir / "scene.gltf"));
+}

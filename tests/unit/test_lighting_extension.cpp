@@ -15,9 +15,11 @@
 #include <unistd.h>
 
 #include "GltfExport.h"
+#include "ParameterTable.h"
 #include "Project.h"
 #include "SceneLighting.h"
 #include "render/ShadowCascades.h"
+#include "water/Water.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -216,4 +218,39 @@ TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {
     EXPECT_TRUE(model.extensionsRequired.empty());
     EXPECT_TRUE(model.extensions.count("TERRALUX_lighting"));
     fs::remove_all(dir);
+}
+
+TEST(LightingExtension, WaterIsEverySettingWithTheLevelAndTheWavesResolved) {
+    const Heightfield hf = makeTerrain();
+    // Off (the default): no water key at all.
+    EXPECT_FALSE(lightingExtension(projectWith({}), hf).contains("water"));
+
+    const Project p = projectWith({"water.enabled=true", "water.depth_aware=true", "water.shore_fade_distance=12",
+                                   R"(water.waves=[{"direction_deg":90,"wavelength":20,"steepness":0.2},)"
+                                   R"({"direction_deg":180,"wavelength":5,"amplitude":0.1,"phase":1}])"});
+    const json w = lightingExtension(p, hf).at("water");
+    const json printed = sceneToJson(p.scene).at("water");
+    // The authored part is the project's section, wave for wave.
+    json authored = authoredPart(w);
+    for (json& wave : authored.at("waves")) wave = authoredPart(wave);
+    EXPECT_EQ(authored, printed);
+    EXPECT_EQ(w["depth_aware"], true);
+    // The auto level resolves to the lowest decile of the terrain, in metres.
+    EXPECT_TRUE(w["level"].is_null());
+    EXPECT_EQ(w["resolved_level"].get<double>(), shortestDecimal(float(water::autoLevel(hf))));
+    EXPECT_GT(w["resolved_level"].get<double>(), hf.minHeight());
+    // Each wave: unit direction (x, z), amplitude, k = 2π/λ and the deep-water ω = √(g·k).
+    const json& east = w["waves"][0];
+    EXPECT_NEAR(east["resolved_direction"][0].get<double>(), 1.0, 1e-15);
+    EXPECT_NEAR(east["resolved_direction"][1].get<double>(), 0.0, 1e-15);
+    EXPECT_NEAR(east["resolved_k"].get<double>(), 2.0 * std::numbers::pi / 20.0, 1e-15);
+    EXPECT_NEAR(east["resolved_amplitude"].get<double>(), 0.2 * 20.0 / (2.0 * std::numbers::pi), 1e-15);
+    EXPECT_NEAR(east["resolved_omega"].get<double>(), std::sqrt(9.81 * 2.0 * std::numbers::pi / 20.0), 1e-12);
+    const json& south = w["waves"][1];
+    EXPECT_NEAR(south["resolved_direction"][1].get<double>(), 1.0, 1e-15);
+    EXPECT_EQ(south["resolved_amplitude"].get<double>(), 0.1);
+    // A set level is written as authored.
+    const json set = lightingExtension(projectWith({"water.enabled=true", "water.level=312.25"}), hf).at("water");
+    EXPECT_EQ(set["resolved_level"].get<double>(), 312.25);
+    EXPECT_EQ(set["waves"], json::array());
 }
