@@ -1001,6 +1001,17 @@ std::vector<uint8_t> waterMask(const RenderedImage& img) {
     return m;
 }
 
+// A kW x kH request without probes.
+RenderRequest unprobed(int view, bool linear) {
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.probes = false;
+    q.debugView = view;
+    q.linearOutput = linear;
+    return q;
+}
+
 // Whether any pixel within `radius` of (x, y) differs in the mask from (x, y).
 bool nearEdge(const std::vector<uint8_t>& m, uint32_t w, uint32_t h, uint32_t x, uint32_t y, int radius) {
     for (int dy = -radius; dy <= radius; ++dy)
@@ -1066,15 +1077,8 @@ TEST_F(RenderTest, WavesMoveTheWaterAndLeaveTheLand) {
     ProjectRenderer r(*ctx_, p);
     p = withWater(p, r, 20.0, testWaves());
     r.setProject(p);
-    RenderRequest q;
-    q.width = kW;
-    q.height = kH;
-    q.probes = false;
-    q.debugView = kViewWaterMask;
-    q.linearOutput = true;
-    const std::vector<uint8_t> mask = waterMask(r.render(q));
-    q.debugView = kViewBeauty;
-    q.linearOutput = false;
+    const std::vector<uint8_t> mask = waterMask(r.render(unprobed(kViewWaterMask, true)));
+    RenderRequest q = unprobed(kViewBeauty, false);
     const RenderedImage t0 = r.render(q);
     q.time = 1.0;
     const RenderedImage t1 = r.render(q);
@@ -1121,14 +1125,8 @@ TEST_F(RenderTest, PlanarReflectionShowsTheDarkMountainAndChangesOnlyWater) {
     p.scene.water.color = glm::vec3(0.0f);
     p.scene.water.absorption = glm::vec3(10.0f);
     r.setProject(p);
-    RenderRequest q;
-    q.width = kW;
-    q.height = kH;
-    q.probes = false;
-    q.debugView = kViewWaterMask;
-    q.linearOutput = true;
-    const std::vector<uint8_t> mask = waterMask(r.render(q));
-    q.debugView = kViewLinear;
+    const std::vector<uint8_t> mask = waterMask(r.render(unprobed(kViewWaterMask, true)));
+    const RenderRequest q = unprobed(kViewLinear, true);
     const RenderedImage planar = r.render(q);
     p.scene.water.reflection = WaterReflection::Sky;
     r.setProject(p);
