@@ -73,14 +73,23 @@ protected:
 std::unique_ptr<vk::VulkanContext> RenderTest::ctx_;
 std::string RenderTest::skipReason_;
 
+// A kW x kH request without probes.
+RenderRequest unprobed(int view, bool linear) {
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    q.probes = false;
+    q.debugView = view;
+    q.linearOutput = linear;
+    return q;
+}
+
 RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear = false,
                    uint32_t width = kW, uint32_t height = kH) {
-    RenderRequest q;
+    RenderRequest q = unprobed(view, linear);
+    q.probes = probes;
     q.width = width;
     q.height = height;
-    q.debugView = view;
-    q.probes = probes;
-    q.linearOutput = linear;
     return r.render(q);
 }
 
@@ -903,12 +912,7 @@ struct Sparkle {
 };
 
 Sparkle sparkleOf(ProjectRenderer& r, const OrbitCamera& camera) {
-    RenderRequest q;
-    q.width = kW;
-    q.height = kH;
-    q.debugView = kViewLinear;
-    q.linearOutput = true;
-    q.probes = false;
+    const RenderRequest q = unprobed(kViewLinear, true);
     OrbitCamera turned = camera;
     turned.azimuthDeg += 0.25;
     const RenderedImage a = r.render(q, camera), b = r.render(q, turned);
@@ -999,17 +1003,6 @@ std::vector<uint8_t> waterMask(const RenderedImage& img) {
     std::vector<uint8_t> m(size_t(img.width) * img.height);
     for (size_t i = 0; i < m.size(); ++i) m[i] = img.rgba[4 * i] > 0.5f ? 1 : 0;
     return m;
-}
-
-// A kW x kH request without probes.
-RenderRequest unprobed(int view, bool linear) {
-    RenderRequest q;
-    q.width = kW;
-    q.height = kH;
-    q.probes = false;
-    q.debugView = view;
-    q.linearOutput = linear;
-    return q;
 }
 
 // Whether any pixel within `radius` of (x, y) differs in the mask from (x, y).
@@ -1160,5 +1153,43 @@ TEST_F(RenderTest, NoWaterNoWaterPass) {
     for (const auto& pass : r.renderer().lastFramePasses()) {
         EXPECT_EQ(pass.name.find("water"), std::string::npos) << pass.name;
         for (const auto& b : pass.bindings) EXPECT_EQ(b.find("water"), std::string::npos) << pass.name;
+    }
+}
+
+// Every water setting the renderer reads changes the water it draws and nothing else.
+TEST_F(RenderTest, EveryWaterSettingChangesOnlyTheWater) {
+    Project p = sampleProject("water_settings", 2, 2);
+    p.scene.terrain.dem = writeBasinDem().string();
+    p.scene.camera.elevationDeg = 25.0;
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 20.0, testWaves());
+    r.setProject(p);
+    const std::vector<uint8_t> mask = waterMask(r.render(unprobed(kViewWaterMask, true)));
+    RenderRequest q = unprobed(kViewLinear, true);
+    q.time = 5.0;
+    const RenderedImage base = r.render(q);
+    const std::vector<std::pair<const char*, std::function<void(WaterSettings&)>>> edits = {
+        {"depth_aware", [](WaterSettings& w) { w.depthAware = true; }},
+        {"shore_fade_distance", [](WaterSettings& w) { w.shoreFadeDistance = 400.0; }},
+        {"roughness", [](WaterSettings& w) { w.roughness = 0.6; }},
+        {"color", [](WaterSettings& w) { w.color = glm::vec3(0.3f, 0.3f, 0.1f); }},
+        {"absorption", [](WaterSettings& w) { w.absorption = glm::vec3(0.02f); }},
+        {"distortion", [](WaterSettings& w) { w.distortion = 0.15; }},
+        {"reflection_scale", [](WaterSettings& w) { w.reflectionScale = 0.25; }},
+    };
+    for (const auto& [name, edit] : edits) {
+        Project changed = p;
+        edit(changed.scene.water);
+        r.setProject(changed);
+        const RenderedImage img = r.render(q);
+        size_t waterChanged = 0, landChanged = 0;
+        for (size_t i = 0; i < mask.size(); ++i) {
+            bool differs = false;
+            for (int c = 0; c < 3; ++c) differs |= img.rgba[4 * i + size_t(c)] != base.rgba[4 * i + size_t(c)];
+            if (mask[i]) waterChanged += differs;
+            else if (!nearEdge(mask, kW, kH, uint32_t(i % kW), uint32_t(i / kW), 2)) landChanged += differs;
+        }
+        EXPECT_GT(waterChanged, 50u) << name;
+        EXPECT_EQ(landChanged, 0u) << name;
     }
 }
