@@ -139,6 +139,14 @@ QString formatBytes(double bytes) {
     return QString::number(bytes / (1024.0 * 1024.0), 'f', 1) + " MiB";
 }
 
+// A status line of a dock: plain text that wraps, found by `name` in tests.
+QLabel* statusLabel(const char* name) {
+    auto* label = new QLabel;
+    label->setObjectName(name);
+    label->setWordWrap(true);
+    return label;
+}
+
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectDocument(this)) {
@@ -294,9 +302,7 @@ void MainWindow::buildDocks() {
     // Terrain.
     auto* terrain = new QWidget;
     auto* tv = new QVBoxLayout(terrain);
-    terrainSummary_ = new QLabel;
-    terrainSummary_->setObjectName("terrain.summary");
-    terrainSummary_->setWordWrap(true);
+    terrainSummary_ = statusLabel("terrain.summary");
     tv->addWidget(terrainSummary_);
     auto* importDem = new QPushButton("Import DEM…");
     importDem->setObjectName("terrain.import");
@@ -383,9 +389,7 @@ void MainWindow::buildDocks() {
         QString error;
         if (!doc_->importAlbedoMap(f, &error)) showError("Import albedo map", error);
     });
-    albedoStatus_ = new QLabel;
-    albedoStatus_->setObjectName("surface.albedoStatus");
-    albedoStatus_->setWordWrap(true);
+    albedoStatus_ = statusLabel("surface.albedoStatus");
     uv->addWidget(albedoStatus_);
     uv->addStretch(1);
     auto* surfaceDock = dock("Surface", "dock.surface", surface);
@@ -399,9 +403,7 @@ void MainWindow::buildDocks() {
     aoProgress_->setRange(0, 100);
     aoProgress_->setVisible(false);
     av->addWidget(aoProgress_);
-    aoStatus_ = new QLabel;
-    aoStatus_->setObjectName("ao.status");
-    aoStatus_->setWordWrap(true);
+    aoStatus_ = statusLabel("ao.status");
     av->addWidget(aoStatus_);
     auto* showAo = new QPushButton("Show AO");
     showAo->setObjectName("ao.show");
@@ -437,14 +439,10 @@ void MainWindow::buildDocks() {
     bf->addParameters("export.");
     connectRejected(bf);
     bv->addWidget(bf);
-    outputPath_ = new QLabel;
-    outputPath_->setObjectName("bake.outputPath");
-    outputPath_->setWordWrap(true);
+    outputPath_ = statusLabel("bake.outputPath");
     outputPath_->setTextInteractionFlags(Qt::TextSelectableByMouse);
     bv->addWidget(outputPath_);
-    estimate_ = new QLabel;
-    estimate_->setObjectName("bake.estimate");
-    estimate_->setWordWrap(true);
+    estimate_ = statusLabel("bake.estimate");
     bv->addWidget(estimate_);
     auto* buttons = new QHBoxLayout;
     bakeButton_ = new QPushButton("Bake");
@@ -472,9 +470,7 @@ void MainWindow::buildDocks() {
     report_->setMinimumHeight(120);
     bv->addWidget(report_, 1);
     // What would lower a high interpolation error, with its estimated cost (the report's).
-    suggestions_ = new QLabel;
-    suggestions_->setObjectName("bake.suggestions");
-    suggestions_->setWordWrap(true);
+    suggestions_ = statusLabel("bake.suggestions");
     suggestions_->setTextInteractionFlags(Qt::TextSelectableByMouse);
     suggestions_->hide();
     bv->addWidget(suggestions_);

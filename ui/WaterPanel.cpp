@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include <QComboBox>
-#include <QElapsedTimer>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
@@ -134,19 +133,17 @@ WaterPanel::WaterPanel(ProjectDocument* doc, ViewportWindow* viewport, QWidget* 
 
     // Play advances the time by the wall clock between ticks; paused, nothing ticks.
     clock_.setInterval(33);
-    auto* wall = new QElapsedTimer;
-    connect(this, &QObject::destroyed, this, [wall] { delete wall; });
-    connect(play_, &QPushButton::toggled, this, [this, wall](bool on) {
+    connect(play_, &QPushButton::toggled, this, [this](bool on) {
         play_->setText(on ? "Pause" : "Play");
         if (on) {
-            wall->start();
+            wall_.start();
             clock_.start();
         } else {
             clock_.stop();
         }
     });
-    connect(&clock_, &QTimer::timeout, this, [this, wall] {
-        const double dt = double(wall->restart()) / 1000.0;
+    connect(&clock_, &QTimer::timeout, this, [this] {
+        const double dt = double(wall_.restart()) / 1000.0;
         double t = time() + dt;
         if (t > kSliderSteps * kSliderStep) t = std::fmod(t, kSliderSteps * kSliderStep);
         setTime(t);
@@ -201,6 +198,7 @@ void WaterPanel::refresh() {
 }
 
 void WaterPanel::commitTable(int editedRow, int editedColumn) {
+    const json current = doc_->value("water.waves");
     json waves = json::array();
     for (int i = 0; i < table_->rowCount(); ++i) {
         auto number = [&](int column) {
@@ -211,7 +209,6 @@ void WaterPanel::commitTable(int editedRow, int editedColumn) {
         };
         json w{{"direction_deg", number(kDirection)}, {"wavelength", number(kWavelength)}, {"phase", number(kPhase)}};
         // The edited face of the height wins; elsewhere the face the wave already had.
-        const json current = doc_->value("water.waves");
         const bool hadSteepness = current.is_array() && i < int(current.size()) && current[size_t(i)].contains("steepness");
         const bool bySteepness = i == editedRow ? editedColumn == kSteepness || (editedColumn != kAmplitude && hadSteepness)
                                                 : hadSteepness;

@@ -3,6 +3,7 @@
 // edit in place, presets) and the animation (Play/Pause and the time slider) that the viewport
 // draws. Every edit of the waves is one undoable change of water.waves.
 
+#include <QElapsedTimer>
 #include <QTimer>
 #include <QWidget>
 
@@ -41,6 +42,7 @@ private:
     QSlider* slider_;
     QLabel* timeLabel_;
     QTimer clock_;
+    QElapsedTimer wall_;  // since the last tick of Play
     bool refreshing_ = false;
 };
 

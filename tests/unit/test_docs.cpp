@@ -63,7 +63,9 @@ TEST(Docs, ParameterReferenceIsTheTable) {
 TEST(Docs, WidgetNamesAreTheTable) {
     const std::string generated = uiObjectNamesMarkdown();
     for (const auto& spec : parameterTable())
-        if (spec.uiRow) EXPECT_NE(generated.find(uiObjectName(spec)), std::string::npos) << spec.path;
+        if (spec.uiRow) {
+            EXPECT_NE(generated.find(uiObjectName(spec)), std::string::npos) << spec.path;
+        }
     expectBlock("docs/UI_OBJECT_NAMES.md", "parameters", generated);
 }
 

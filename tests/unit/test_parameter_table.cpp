@@ -46,7 +46,9 @@ TEST(ParameterTable, PathsAreUniqueAndEveryRowIsDeclaredWhole) {
         EXPECT_FALSE(s.label.empty()) << s.path;
         EXPECT_FALSE(s.description.empty()) << s.path;
         EXPECT_TRUE(s.get && s.set) << s.path;
-        if (s.type == ParamType::Choice) EXPECT_GE(s.choices.size(), 2u) << s.path;
+        if (s.type == ParamType::Choice) {
+            EXPECT_GE(s.choices.size(), 2u) << s.path;
+        }
         if (s.type == ParamType::Number || s.type == ParamType::Integer) {
             // Every number the UI edits has finite limits, so the dock shows the table's range.
             EXPECT_TRUE(std::isfinite(s.min) && std::isfinite(s.max)) << s.path;
@@ -157,7 +159,9 @@ TEST(ParameterTable, SchemaDescribesEveryLeafAndAcceptsTheDefaults) {
             EXPECT_EQ(inner[spec.minExclusive ? "exclusiveMinimum" : "minimum"], spec.min) << spec.path;
             EXPECT_EQ(inner["maximum"], spec.max) << spec.path;
         }
-        if (spec.type == ParamType::Choice) EXPECT_EQ(inner["enum"], json(spec.choices)) << spec.path;
+        if (spec.type == ParamType::Choice) {
+            EXPECT_EQ(inner["enum"], json(spec.choices)) << spec.path;
+        }
     }
 }
 
