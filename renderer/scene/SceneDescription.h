@@ -144,13 +144,30 @@ struct ProbeVolumeSettings {
     AdaptiveVolumeSettings adaptive;
 };
 
+// How a reflection probe stores its environment (docs/lighting.md, "Reflection probes").
+enum class ReflectionEncoding {
+    Faces,    // six face colours: the mean radiance over each cube face
+    Cubemap,  // a cube map per probe, GGX-prefiltered into a mip chain by roughness
+};
+
+// Terrain-local reflection probes (seed 000's TV5.3): a (nx, nz) grid placed like a terrain probe
+// volume, each probe baked from the heightfield into `encoding`.
 struct ReflectionProbeSettings {
     bool enabled = false;
-    std::array<int, 2> gridDims{4, 4};
-    double heightOffset = 5.0;
-    int rayCount = 16;
+    std::array<int, 2> gridDims{4, 4};           // product <= kMaxReflectionProbes
+    std::optional<glm::vec2> origin;             // (x, z) of the first probe; unset = auto-span
+    std::optional<glm::vec2> spacing;            // (sx, sz) between probes, > 0; unset = auto-span
+    double heightOffset = 5.0;                   // metres above the traced surface
+    int rayCount = 16;                           // rays per cube texel
+    // The albedo of the ground a probe sees below its horizon where nothing is traced (past the
+    // footprint with the skirt off), lit by the open sky and the sun.
     glm::vec3 groundColor{0.22f, 0.18f, 0.14f};
-    double strength = 1.0;
+    double strength = 1.0;                       // [0, 1]: how far the probes replace the sky's specular
+    std::optional<double> fallbackBlendDistance; // unset = 2 * min(spacing)
+    ReflectionEncoding encoding = ReflectionEncoding::Cubemap;
+    int resolution = 32;                         // cubemap texels a side of mip 0: a power of two, 4..128
+    // Up to 8 probe indices (scene order) the simvx box records carry; empty = the first 8.
+    std::vector<int> simvxSubset;
 };
 
 enum class QualityPreset { Draft, Standard, High, Reference };
