@@ -17,6 +17,7 @@
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
 #include "ProbeDiagnosticsFile.h"
+#include "ReflectionProbeFile.h"
 #include "SceneLighting.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
@@ -25,6 +26,7 @@
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
+#include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 
 #ifndef TERRALUX_VERSION
@@ -100,8 +102,8 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     b.referenceMode = scene.bake.quality == QualityPreset::Reference;
     for (const auto& v : scene.probeVolumes)
         if (v.enabled) b.volumes.push_back(&v);
-    if (b.volumes.empty())
-        throw ProjectError("probe_volumes: no enabled volume; enable one or add one to bake");
+    if (b.volumes.empty() && !scene.reflectionProbes.enabled)
+        throw ProjectError("probe_volumes: no enabled volume; enable one or add one (or reflection probes) to bake");
 }
 
 uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
@@ -284,6 +286,104 @@ uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& la
     return rays;
 }
 
+// The roughnesses the reflection encodings' error is reported at: from the terrain's floor to 1.
+const std::vector<float> kReflectionErrorRoughness{0.25f, 0.5f, 0.75f, 1.0f};
+
+uint64_t reflectionSeed() { return splitmix64(0x2EF1EC7ull); }
+
+// The reflection probes of a bake, baked and encoded for export.
+struct ReflectionOutput {
+    nlohmann::json report;
+    std::vector<std::pair<std::string, std::vector<uint8_t>>> files;
+    nlohmann::json gltf;  // TERRALUX_lighting.reflection_probes
+    std::vector<std::string> warnings;
+};
+
+ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettings& settings,
+                                 const ReflectionLayout& layout, const IrradianceCache* sharedCache,
+                                 int cacheResolution, bool compareReference, const BakeControl& control) {
+    const auto start = Clock::now();
+    const BakeLighting& lighting = b.lighting;
+    // Terrain hits read their light from an irradiance cache: the probes' own when the bake has
+    // one, else one with the bake's bounces less the one the reflection ray makes.
+    std::unique_ptr<IrradianceCache> own;
+    const IrradianceCache* cache = sharedCache;
+    if (!cache) {
+        const BakeQuality standard = qualityPreset(QualityPreset::Standard);
+        own = std::make_unique<IrradianceCache>(
+            lighting, cacheResolution > 0 ? cacheResolution : standard.cacheResolution,
+            b.q.cacheRays > 0 ? b.q.cacheRays : standard.cacheRays, std::max(b.q.sunSamples, 1),
+            std::max(b.q.bounces - 1, 0), BakeControl{nullptr, control.cancel});
+        cache = own.get();
+    }
+    ReflectionLighting light;
+    light.lighting = &lighting;
+    light.cache = cache;
+    light.bounces = std::max(b.q.bounces, 1);
+    light.ground = groundRadiance(lighting, settings.groundColor);
+
+    uint64_t rays = 0;
+    ReflectionProbeSet set = bakeReflectionProbes(light, settings, layout, reflectionSeed(), control, &rays);
+    ReflectionOutput out;
+    nlohmann::json& r = out.report;
+    r = {{"probes", set.probes.size()},
+         {"grid", {set.dims[0], set.dims[1]}},
+         {"origin", {set.origin.x, set.origin.y}},
+         {"spacing", {set.spacing.x, set.spacing.y}},
+         {"cell_size", {set.cellSize.x, set.cellSize.y}},
+         {"fallback_blend_distance", set.blendDistance},
+         {"encoding", settings.encoding == ReflectionEncoding::Cubemap ? "cubemap" : "faces"},
+         {"resolution", settings.resolution},
+         {"rays_per_texel", settings.rayCount},
+         {"rays", rays},
+         {"bounces", light.bounces}};
+    if (compareReference) {
+        const auto refStart = Clock::now();
+        const ReflectionErrorReport e =
+            measureReflectionError(light, settings, set, kReflectionErrorRoughness, reflectionSeed(), control);
+        nlohmann::json rows = nlohmann::json::array();
+        auto spread = [](const Spread& s) { return nlohmann::json{{"mean", s.mean}, {"p95", s.p95}, {"max", s.max}}; };
+        for (const ReflectionError& x : e.byRoughness)
+            rows.push_back({{"roughness", x.roughness}, {"faces", spread(x.faces)}, {"cubemap", spread(x.cubemap)}});
+        r["reference_error"] = {{"metric", "relative RMS of prefiltered radiance luminance over 256 directions"},
+                                {"by_roughness", rows},
+                                {"reference_resolution", e.referenceResolution},
+                                {"reference_rays", e.rays},
+                                {"reference_time_s", secondsSince(refStart)}};
+    }
+    toEncoding(set, settings.encoding);
+
+    std::vector<uint8_t> rprobe = encodeReflectionProbes(set);
+    const ReflectionBoxRecords boxes = encodeBoxRecords(set, settings.simvxSubset);
+    r["bytes"] = rprobe.size();
+    r["simvx"] = {{"exported_ids", boxes.exported}, {"probes", boxes.total}};
+    if (boxes.total > boxes.exported.size())
+        out.warnings.push_back("reflection_probes: " + std::to_string(boxes.total) +
+                               " probes, the simvx box records hold " + std::to_string(kSimvxMaxProbes) +
+                               ": exported ids " + [&] {
+                                   std::string ids;
+                                   for (uint32_t id : boxes.exported) ids += (ids.empty() ? "" : ",") + std::to_string(id);
+                                   return ids;
+                               }() + " (reflection_probes.simvx_subset chooses them)");
+    r["time_s"] = secondsSince(start);
+    const std::string dir = "reflection/";
+    out.gltf = {{"uri", dir + kReflectionProbeFile},
+                {"simvx_desktop_uri", dir + kSimvxDesktopFile},
+                {"simvx_wire_uri", dir + kSimvxWireFile},
+                {"probes", set.probes.size()},
+                {"grid", {set.dims[0], set.dims[1]}},
+                {"encoding", r["encoding"]},
+                {"face_size", set.faceSize},
+                {"mip_count", set.mipCount},
+                {"fallback_blend_distance", set.blendDistance},
+                {"simvx_probes", boxes.exported.size()},
+                {"simvx_ids", boxes.exported}};
+    out.files.push_back({kReflectionProbeFile, std::move(rprobe)});
+    out.files.push_back({kSimvxDesktopFile, boxes.desktop});
+    out.files.push_back({kSimvxWireFile, boxes.wire});
+    return out;
+}
+
 }  // namespace
 
 BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
@@ -323,15 +423,27 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         totalWork += layouts.back().positions.size() + mapPoints.back();
     }
 
+    // Reflection probes are placed before any work, so their settings fail first.
+    std::optional<ReflectionLayout> reflectionLayout;
+    if (scene.reflectionProbes.enabled) {
+        reflectionLayout = placeReflectionProbes(scene.reflectionProbes, hf);
+        simvxProbes(scene.reflectionProbes.simvxSubset, reflectionLayout->count());
+    }
+
     // Phase weights for one progress bar: cache, probes, reference.
     const double cacheShare = (!referenceMode && q.bounces > 0) ? 0.35 : 0.0;
-    const double refShare = request.compareReference && !referenceMode ? 0.45 : 0.0;
-    const double probeShare = 0.97 - 0.02 - cacheShare - refShare;
+    const double refShare = request.compareReference && !referenceMode && !volumes.empty() ? 0.45 : 0.0;
+    const double reflectionShare = !reflectionLayout ? 0.0 : volumes.empty() ? 0.95 - cacheShare : 0.3;
+    const double probeShare = 0.97 - 0.02 - cacheShare - refShare - reflectionShare;
     double base = 0.02;
 
     std::unique_ptr<IrradianceCache> cache;
     const auto cacheStart = Clock::now();
-    const int cacheResolution = cacheResolutionFor(hf, q, plannedProbeRays(setup, layouts, mapPoints));
+    uint64_t plannedRays = plannedProbeRays(setup, layouts, mapPoints);
+    if (reflectionLayout)
+        plannedRays += uint64_t(reflectionLayout->count()) * 6 * uint64_t(scene.reflectionProbes.resolution) *
+                       uint64_t(scene.reflectionProbes.resolution) * uint64_t(scene.reflectionProbes.rayCount);
+    const int cacheResolution = cacheResolutionFor(hf, q, plannedRays);
     if (!referenceMode && q.bounces > 0) {
         BakeControl c{[&](double f) { report("irradiance cache", base + cacheShare * f); }, cancel};
         cache = std::make_unique<IrradianceCache>(lighting, cacheResolution, q.cacheRays,
@@ -526,6 +638,14 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     }
     if (cancelled()) throw BakeCancelled();
 
+    std::optional<ReflectionOutput> reflections;
+    if (reflectionLayout) {
+        const BakeControl rc{[&](double f) { report("reflection probes", 0.97 - reflectionShare * (1.0 - f)); },
+                             cancel};
+        reflections = bakeReflections(setup, scene.reflectionProbes, *reflectionLayout, cache.get(), cacheResolution,
+                                      request.compareReference, rc);
+    }
+
     nlohmann::json bakeInfo = {
         {"shEncoding", scene.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
         {"shConvention", "real SH L2, k = l(l+1)+m, no Condon-Shortley phase, engine frame Y up"},
@@ -583,6 +703,11 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"volumes", volumeReports},
         {"overlaps", overlapReport(grids)},
     };
+    if (reflections) {
+        out.report["reflection_probes"] = reflections->report;
+        out.warnings = reflections->warnings;
+    }
+    out.report["warnings"] = out.warnings;
     {
         // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
         // report: staged together and committed with rollback, so a failed export leaves the
@@ -596,6 +721,10 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         in.volumes = grids;
         in.bake = bakeInfo;
         in.lighting = lightingExtension(project, hf, lighting);
+        if (reflections) {
+            for (const auto& [k, v] : reflections->gltf.items()) in.lighting["reflection_probes"][k] = v;
+            in.reflectionFiles = std::move(reflections->files);
+        }
         if (lighting.water)
             in.water = GltfWater{lighting.water->level, scene.water.color, float(scene.water.roughness)};
         in.generatorVersion = TERRALUX_VERSION;
@@ -640,8 +769,8 @@ void flatten(const nlohmann::json& v, const std::string& path, std::map<std::str
 nlohmann::json bakeInputs(const Project& project) {
     nlohmann::json settings = sceneToJson(project.scene);
     // Not read by a bake: where the camera stands and its exposure, the shadows, fog, ambient
-    // occlusion, specular and micro-detail the renderer draws over the probes, where the files go,
-    // and the reflection-probe settings no bake computes yet.
+    // occlusion, specular and micro-detail the renderer draws over the probes, and where the files
+    // go.
     settings.erase("camera");
     settings.erase("shadows");
     settings.erase("fog");
@@ -649,7 +778,8 @@ nlohmann::json bakeInputs(const Project& project) {
     settings.erase("detail");
     settings["terrain"].erase("roughness");
     settings["terrain"].erase("specular_aa");
-    settings.erase("reflection_probes");
+    // Reflection probes off is the scene before they existed: no key at all.
+    if (!project.scene.reflectionProbes.enabled) settings.erase("reflection_probes");
     settings["export"].erase("out_dir");
     // Files count by what they resolve to (below), not by how the project spells their path.
     settings["terrain"].erase("dem");

@@ -28,6 +28,7 @@ struct BakeOutcome {
     nlohmann::json report;
     std::filesystem::path outDir;
     std::vector<std::filesystem::path> files;
+    std::vector<std::string> warnings;  // one line each, also in the report's "warnings"
 };
 
 // What a bake depends on: every parameter it reads (the project less the camera, the output

@@ -405,6 +405,21 @@ int commandBake(const Args& a) {
             }
         }
     }
+    if (r.contains("reflection_probes")) {
+        const auto& rp = r["reflection_probes"];
+        std::cout << "  reflection probes: " << rp["probes"].get<size_t>() << " (" << rp["grid"][0].get<int>() << " x "
+                  << rp["grid"][1].get<int>() << "), " << rp["encoding"].get<std::string>() << ", "
+                  << rp["bytes"].get<uint64_t>() << " bytes, " << rp["simvx"]["exported_ids"].size()
+                  << " in the simvx records\n";
+        if (rp.contains("reference_error"))
+            for (const auto& e : rp["reference_error"]["by_roughness"])
+                std::cout << "    error vs reference at roughness " << fixed(e["roughness"].get<double>(), 2)
+                          << ": faces mean " << fixed(100.0 * e["faces"]["mean"].get<double>(), 2)
+                          << " % / max " << fixed(100.0 * e["faces"]["max"].get<double>(), 2)
+                          << " %, cubemap mean " << fixed(100.0 * e["cubemap"]["mean"].get<double>(), 2)
+                          << " % / max " << fixed(100.0 * e["cubemap"]["max"].get<double>(), 2) << " %\n";
+    }
+    for (const auto& w : outcome.warnings) std::cerr << "terralux: warning: " << w << "\n";
     std::cout << "wrote " << outcome.outDir.string() << ":\n";
     for (const auto& f : outcome.files)
         std::cout << "  " << f.lexically_relative(outcome.outDir).generic_string() << " ("

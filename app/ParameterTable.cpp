@@ -5,8 +5,10 @@
 
 #include "Project.h"
 #include "bake/PhysicalSky.h"
+#include "bake/ReflectionBake.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -656,12 +658,15 @@ std::vector<ParameterSpec> buildTable() {
         .about("A minimum leaf whose centre is inside the terrain moves its probe up at most this share of its edge")
         .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::maxMoveShare);
 
-    // Reflection probes.
+    // Reflection probes (docs/lighting.md, "Reflection probes"): the preview bakes them again on
+    // every edit but strength's, which the renderer applies live.
+    const auto reflectionOn = [](const SceneDescription& s, size_t) { return s.reflectionProbes.enabled; };
     add(Row("reflection_probes.enabled", T::Boolean)).label("Reflection probes")
-        .about("Terrain-local reflection probes").redoes(kNothing).noUiRow()
-        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::enabled);
+        .about("Bake terrain-local reflection probes, draw them in place of the sky's specular and export them")
+        .redoes(kRebake | kUpload).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::enabled);
     add(Row("reflection_probes.grid_dims", T::IntegerList)).items(2, 2).range(1, kMaxReflectionProbes)
-        .label("Reflection grid").about("[nx, nz] probes, product <= 256").redoes(kNothing).noUiRow()
+        .label("Grid").about("[nx, nz] probes, product <= 256; scene order is row-major, x fastest")
+        .redoes(kRebake).onlyWhen(reflectionOn)
         .custom([](const SceneDescription& s, size_t) {
                     return json{s.reflectionProbes.gridDims[0], s.reflectionProbes.gridDims[1]};
                 },
@@ -669,18 +674,71 @@ std::vector<ParameterSpec> buildTable() {
                     checkProduct({v[0].get<int>(), v[1].get<int>(), 1}, kMaxReflectionProbes);
                     s.reflectionProbes.gridDims = {v[0].get<int>(), v[1].get<int>()};
                 });
+    add(Row("reflection_probes.origin", T::NumberList)).items(2, 2).range(-1.0e7, 1.0e7).unit("m")
+        .autoMeans("auto-span: the grid spans the terrain footprint").label("Origin")
+        .about("(x, z) of the first probe, engine space").redoes(kRebake).onlyWhen(reflectionOn)
+        .custom([](const SceneDescription& s, size_t) {
+                    const auto& o = s.reflectionProbes.origin;
+                    return o ? json{shortest(o->x), shortest(o->y)} : json(nullptr);
+                },
+                [](SceneDescription& s, size_t, const json& v) {
+                    auto& o = s.reflectionProbes.origin;
+                    if (v.is_null()) o.reset();
+                    else o = glm::vec2(v[0].get<float>(), v[1].get<float>());
+                });
+    add(Row("reflection_probes.spacing", T::NumberList)).items(2, 2).above(0.0, 1.0e6).unit("m")
+        .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
+        .about("[sx, sz] between probes").redoes(kRebake).onlyWhen(reflectionOn)
+        .custom([](const SceneDescription& s, size_t) {
+                    const auto& sp = s.reflectionProbes.spacing;
+                    return sp ? json{shortest(sp->x), shortest(sp->y)} : json(nullptr);
+                },
+                [](SceneDescription& s, size_t, const json& v) {
+                    auto& sp = s.reflectionProbes.spacing;
+                    if (v.is_null()) sp.reset();
+                    else sp = glm::vec2(v[0].get<float>(), v[1].get<float>());
+                });
     add(Row("reflection_probes.height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m")
-        .label("Reflection height").about("Probes sit this far above the terrain").redoes(kNothing).noUiRow()
+        .label("Height offset").about("Probes sit this far above the traced terrain surface").redoes(kRebake).onlyWhen(reflectionOn)
         .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::heightOffset);
-    add(Row("reflection_probes.ray_count", T::Integer)).range(1, 1 << 20).label("Reflection rays")
-        .about("Rays per reflection probe").redoes(kNothing).noUiRow()
+    add(Row("reflection_probes.ray_count", T::Integer)).range(1, 1 << 20).label("Rays per texel")
+        .about("Rays traced per cube texel (the reference comparison traces 16× as many)").redoes(kRebake).onlyWhen(reflectionOn)
         .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::rayCount);
-    add(Row("reflection_probes.ground_color", T::Color)).range(0.0, kUnbounded).label("Reflection ground")
-        .about("Colour below the horizon of reflection probes").redoes(kNothing).noUiRow()
-        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::groundColor);
-    add(Row("reflection_probes.strength", T::Number)).range(0.0, 1.0).label("Reflection strength")
-        .about("Weight of the reflection probes").redoes(kNothing).noUiRow()
-        .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::strength);
+    add(Row("reflection_probes.encoding", T::Choice)).choices({"faces", "cubemap"}).label("Encoding")
+        .about("faces: six face colours per probe; cubemap: a GGX-prefiltered cube map per probe")
+        .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::encoding);
+    add(Row("reflection_probes.resolution", T::Integer)).range(8, 128).unit("texels")
+        .label("Cube size").about("Texels a side of each cube face at mip 0: a power of two")
+        .redoes(kRebake).onlyWhen(reflectionOn)
+        .custom([](const SceneDescription& s, size_t) { return json(s.reflectionProbes.resolution); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    const int r = v.get<int>();
+                    if (!std::has_single_bit(unsigned(r))) throw ParameterRejection{"must be a power of two", ""};
+                    s.reflectionProbes.resolution = r;
+                });
+    add(Row("reflection_probes.ground_color", T::Color)).range(0.0, 1.0).label("Ground albedo")
+        .about("Albedo of the ground a probe sees below its horizon where no terrain is traced (past the footprint with the skirt off)")
+        .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::groundColor);
+    add(Row("reflection_probes.strength", T::Number)).range(0.0, 1.0).label("Strength").slider()
+        .about("How far the probes replace the sky's specular where they cover (0: the sky alone)")
+        .redoes(kUpload).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::strength);
+    add(Row("reflection_probes.fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
+        .autoMeans("2 × spacing: twice the smaller probe spacing").label("Fallback blend")
+        .about("Distance outside the grid over which the probes blend to the sky's specular; the box records' blend distance")
+        .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::fallbackBlendDistance);
+    add(Row("reflection_probes.simvx_subset", T::IntegerList)).items(0, kSimvxMaxProbes).range(0, kMaxReflectionProbes - 1)
+        .label("simvx probes")
+        .about("Indices (scene order) of the at most 8 probes the simvx box records carry; empty: the first 8")
+        .redoes(kNothing).onlyWhen(reflectionOn)
+        .custom([](const SceneDescription& s, size_t) { return json(s.reflectionProbes.simvxSubset); },
+                [](SceneDescription& s, size_t, const json& v) {
+                    std::vector<int> idx = v.get<std::vector<int>>();
+                    std::vector<int> sorted = idx;
+                    std::sort(sorted.begin(), sorted.end());
+                    if (const auto d = std::adjacent_find(sorted.begin(), sorted.end()); d != sorted.end())
+                        throw ParameterRejection{"each probe at most once (" + std::to_string(*d) + " appears twice)", ""};
+                    s.reflectionProbes.simvxSubset = idx;
+                });
 
     // Bake.
     add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
@@ -951,6 +1009,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     if (section == "water") return {"dock.water", "Water"};
+    if (section == "reflection_probes") return {"dock.reflectionProbes", "Reflection Probes"};
     return {"", ""};
 }
 

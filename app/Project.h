@@ -22,7 +22,6 @@ public:
 inline constexpr int kProjectVersion = 1;
 inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffuse grid dims
 inline constexpr int kMaxBoxGridProbes = 65536;
-inline constexpr int kMaxReflectionProbes = 256;
 inline constexpr int kMaxBounces = 16;
 inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights
 

@@ -220,6 +220,8 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
             wave["resolved_omega"] = t.omegaDeep;
         }
     }
+    // Reflection probes as authored; the bake adds their files and counts (docs/formats.md).
+    if (scene.reflectionProbes.enabled) ext["reflection_probes"] = authored.at("reflection_probes");
     return ext;
 }
 

@@ -42,6 +42,7 @@ constexpr const char* kGltfName = "scene.gltf";
 constexpr const char* kBinName = "scene.bin";
 constexpr const char* kProbeDir = "sh_coeffs";
 constexpr const char* kProbeExt = ".shprobe";
+constexpr const char* kReflectionDir = "reflection";
 constexpr size_t kMaxVolumeName = 64;
 
 // glTF enumerations (glTF 2.0 specification, section 5).
@@ -476,6 +477,11 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
                              std::vector<uint8_t>(v->diagnostics.begin(), v->diagnostics.end())});
         grids.push_back(probeGridEntry(*v));
     }
+    for (const auto& [name, bytes] : input.reflectionFiles) {
+        if (name.empty() || fs::path(name).has_parent_path())
+            throw std::runtime_error(name + ": not a name for a file of " + kReflectionDir + "/");
+        files.push_back({fs::path(kReflectionDir) / name, bytes});
+    }
     for (const auto& [name, text] : input.extraFiles) {
         if (name.empty() || fs::path(name).has_parent_path() || name == kGltfName || name == kBinName)
             throw std::runtime_error(name + ": not a name for an extra top-level file");
@@ -602,16 +608,25 @@ struct Replaced {
 // back. Throws after the rollback.
 // What an earlier export left that this one owns but does not write: every regular file in
 // sh_coeffs/ and the owned top-level names, less the files being written now.
+// The subdirectories (sh_coeffs/, reflection/) the files go into.
+std::vector<fs::path> subdirectories(const std::vector<PendingFile>& files) {
+    std::set<fs::path> dirs;
+    for (const auto& f : files)
+        if (f.relative.has_parent_path()) dirs.insert(f.relative.parent_path());
+    return {dirs.begin(), dirs.end()};
+}
+
 std::vector<fs::path> staleOwnedFiles(const fs::path& outDir, const std::vector<PendingFile>& files,
                                       const std::vector<std::string>& ownedNames) {
     std::set<fs::path> writing;
     for (const auto& f : files) writing.insert(f.relative);
     std::vector<fs::path> stale;
     std::error_code ec;
-    for (const auto& e : fs::directory_iterator(outDir / kProbeDir, ec)) {
-        const fs::path relative = fs::path(kProbeDir) / e.path().filename();
-        if (e.is_regular_file(ec) && !writing.count(relative)) stale.push_back(relative);
-    }
+    for (const char* dir : {kProbeDir, kReflectionDir})
+        for (const auto& e : fs::directory_iterator(outDir / dir, ec)) {
+            const fs::path relative = fs::path(dir) / e.path().filename();
+            if (e.is_regular_file(ec) && !writing.count(relative)) stale.push_back(relative);
+        }
     for (const auto& name : ownedNames)
         if (!writing.count(name) && fs::is_regular_file(outDir / name, ec)) stale.push_back(name);
     std::sort(stale.begin(), stale.end());
@@ -621,19 +636,16 @@ std::vector<fs::path> staleOwnedFiles(const fs::path& outDir, const std::vector<
 void commit(const fs::path& outDir, const fs::path& staging, const std::vector<PendingFile>& files,
             const std::vector<fs::path>& stale) {
     std::vector<Replaced> done;
-    const fs::path probeDir = outDir / kProbeDir;
-    bool createdProbeDir = false;
+    std::vector<fs::path> createdDirs;
     try {
-        const bool needProbeDir = std::any_of(files.begin(), files.end(), [](const PendingFile& f) {
-            return f.relative.has_parent_path();
-        });
-        if (needProbeDir && !fs::is_directory(probeDir)) {
+        for (const fs::path& dir : subdirectories(files)) {
+            if (fs::is_directory(outDir / dir)) continue;
             std::error_code ec;
-            createdProbeDir = fs::create_directory(probeDir, ec);
-            if (!createdProbeDir) {
-                throw FileWriteError(probeDir.string() + ": cannot create directory (" +
+            if (!fs::create_directory(outDir / dir, ec)) {
+                throw FileWriteError((outDir / dir).string() + ": cannot create directory (" +
                                      (ec ? ec.message() : std::string("exists, not a directory")) + ")");
             }
+            createdDirs.push_back(outDir / dir);
         }
         // Owned files this export does not write go into the staging directory (removed with
         // it), so that engines loading every file of sh_coeffs/ see only this bake.
@@ -680,14 +692,14 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
             else
                 fs::rename(it->backup, it->target, ec);
         }
-        if (createdProbeDir) {
+        for (const fs::path& dir : createdDirs) {
             std::error_code ec;
-            fs::remove(probeDir, ec);
+            fs::remove(dir, ec);
         }
         throw;
     }
-    if (fs::is_directory(probeDir))
-        syncDirectory(probeDir);
+    for (const char* dir : {kProbeDir, kReflectionDir})
+        if (fs::is_directory(outDir / dir)) syncDirectory(outDir / dir);
     syncDirectory(outDir);
 }
 
@@ -700,6 +712,8 @@ std::vector<std::string> exportedFileNames(const GltfSceneInput& input) {
         if (!v->diagnostics.empty())
             names.push_back((fs::path(kProbeDir) / probeDiagnosticsFileName(v->name)).generic_string());
     }
+    for (const auto& f : input.reflectionFiles)
+        names.push_back((fs::path(kReflectionDir) / f.first).generic_string());
     if (input.scene) {
         if (input.heightfield && input.heightfield->width() >= 2 && input.heightfield->depth() >= 2)
             names.push_back(kBinName);
@@ -721,11 +735,10 @@ GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const Gltf
     }
 
     const StagingDirectory staging(outDir);
-    if (std::any_of(files.begin(), files.end(),
-                    [](const PendingFile& f) { return f.relative.has_parent_path(); })) {
-        fs::create_directory(staging.path() / kProbeDir, ec);
+    for (const fs::path& dir : subdirectories(files)) {
+        fs::create_directory(staging.path() / dir, ec);
         if (ec) {
-            throw FileWriteError((outDir / kProbeDir).string() + ": cannot create a staging directory (" +
+            throw FileWriteError((outDir / dir).string() + ": cannot create a staging directory (" +
                                  ec.message() + ")");
         }
     }

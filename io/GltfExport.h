@@ -6,6 +6,7 @@
 //   <outDir>/scene.bin                    only when the terrain has triangles; also holds the
 //                                         terrain's albedo texture (a PNG) when it has one
 //   <outDir>/sh_coeffs/<volume>.shprobe   one file per probe volume
+//   <outDir>/reflection/...               the reflection probes' files, when the caller gives them
 //
 // Engine space is glTF space (Y up, right-handed: X east, Y up, Z south), so nothing is converted.
 // The mesh uses the bake's triangulation (Heightfield.h) wound counter-clockwise seen from +Y, so
@@ -76,6 +77,9 @@ struct GltfSceneInput {
     size_t meshMaxVertices = std::numeric_limits<size_t>::max();
     // false: only the sh_coeffs files (export.gltf off), staged and committed the same way.
     bool scene = true;
+    // Files of reflection/ (the reflection probes' .rprobe and simvx records), committed with the
+    // rest: name within reflection/ and contents.
+    std::vector<std::pair<std::string, std::vector<uint8_t>>> reflectionFiles;
     // More top-level files written with the rest (the bake report): name and contents.
     std::vector<std::pair<std::string, std::string>> extraFiles;
 };
@@ -90,8 +94,8 @@ struct GltfExportResult {
 // into place (the .shprobe files, then scene.bin, then scene.gltf). If any step fails, the files
 // already replaced are restored, the staging directory is removed, and the files in outDir stay
 // byte-identical to what they were before the call.
-// The export owns every file in outDir/sh_coeffs/, scene.gltf, scene.bin and the extra files, and
-// replaces them as a whole: an owned file this export does not write (the .shprobe of a renamed
+// The export owns every file in outDir/sh_coeffs/ and outDir/reflection/, scene.gltf, scene.bin
+// and the extra files, and replaces them as a whole: an owned file this export does not write (the .shprobe of a renamed
 // volume, scene.gltf when the scene is off) is removed in the same commit, and put back if the
 // commit fails. Nothing else in outDir is touched.
 // A heightfield with a single row or column has no triangles: the scene then has no mesh, no buffer

@@ -13,6 +13,8 @@
 #include <random>
 #include <system_error>
 
+#include "LittleEndian.h"
+
 namespace terralux {
 
 namespace {
@@ -137,30 +139,12 @@ void checkOccupancy(const std::string& name, size_t cell, int32_t value, uint64_
     }
 }
 
-// Byte-wise little-endian access, so neither host endianness nor alignment matters.
-
-uint32_t loadU32(const uint8_t* p) {
-    return uint32_t{p[0]} | (uint32_t{p[1]} << 8) | (uint32_t{p[2]} << 16) | (uint32_t{p[3]} << 24);
-}
-float loadF32(const uint8_t* p) {
-    return std::bit_cast<float>(loadU32(p));
-}
-int32_t loadI32(const uint8_t* p) {
-    return std::bit_cast<int32_t>(loadU32(p));
-}
-
-void storeU32(std::vector<uint8_t>& out, uint32_t v) {
-    out.push_back(static_cast<uint8_t>(v));
-    out.push_back(static_cast<uint8_t>(v >> 8));
-    out.push_back(static_cast<uint8_t>(v >> 16));
-    out.push_back(static_cast<uint8_t>(v >> 24));
-}
-void storeF32(std::vector<uint8_t>& out, float v) {
-    storeU32(out, std::bit_cast<uint32_t>(v));
-}
-void storeI32(std::vector<uint8_t>& out, int32_t v) {
-    storeU32(out, std::bit_cast<uint32_t>(v));
-}
+using le::loadF32;
+using le::loadI32;
+using le::loadU32;
+using le::storeF32;
+using le::storeI32;
+using le::storeU32;
 
 struct Header {
     uint32_t count = 0;

@@ -134,7 +134,8 @@ glm::vec3 waterRadiance(const BakeLighting& L, const glm::vec3& at, const glm::v
 
 // probeRayRadiance with the terrain's hit already traced (`hit` null: the ray escapes).
 glm::vec3 rayRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces, const glm::vec3& o,
-                      const glm::vec3& d, const RayHit* hit, float skyAngle, Rng& rng) {
+                      const glm::vec3& d, const RayHit* hit, float skyAngle, Rng& rng,
+                      const glm::vec3* ground = nullptr) {
     glm::vec3 at;
     if (hitsWater(L, o, d, hit ? hit->t : INFINITY, at)) {
         if (bounces <= 0) return glm::vec3(0.0f);
@@ -146,6 +147,7 @@ glm::vec3 rayRadiance(const BakeLighting& L, const IrradianceCache* cache, int b
         });
     }
     if (hit) return terrainRadiance(L, cache, bounces, *hit, rng);
+    if (ground && d.y < 0.0f) return *ground;
     return L.sky.radiance(d, skyAngle);
 }
 
@@ -159,10 +161,11 @@ float waterFresnel(float cosine) {
 }
 
 glm::vec3 probeRayRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces,
-                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng) {
+                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng,
+                           const glm::vec3* ground) {
     RayHit hit;
     const bool terrain = L.tracer->intersect(origin, dir, INFINITY, hit);
-    return rayRadiance(L, cache, bounces, origin, dir, terrain ? &hit : nullptr, skyAngle, rng);
+    return rayRadiance(L, cache, bounces, origin, dir, terrain ? &hit : nullptr, skyAngle, rng, ground);
 }
 
 float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const glm::vec3& p,

@@ -178,8 +178,10 @@ float waterFresnel(float cosine);
 // the terrain, albedo/π × (the cache's indirect irradiance + the sun through one shadow ray),
 // black without bounces or a cache; where it meets the water first, the water's reflection and
 // scatter (black without bounces: 0 bounces is sky visibility only). Shadow rays draw from `rng`.
+// `ground`: the radiance a ray heading down brings back where it escapes (null: the sky's).
 glm::vec3 probeRayRadiance(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
-                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng);
+                           const glm::vec3& origin, const glm::vec3& dir, float skyAngle, Rng& rng,
+                           const glm::vec3* ground = nullptr);
 // Share of the sun's disc visible from surface point p with normal n: `samples` shadow rays,
 // stratified over the disc, against the traced surface (0 where the sun is behind the surface).
 // The bake's sun term is this × cos θ × E_sun; the sun-visibility debug view draws it.

@@ -50,7 +50,10 @@ ReflectionLayout placeReflectionProbes(const ReflectionProbeSettings& settings, 
 
 // Texels a side of cube mip `level` for a mip-0 side of `size`.
 inline int cubeMipSize(int size, int level) { return std::max(1, size >> level); }
-// Mip levels of a cube of side `size` (a power of two): down to 1×1.
+// The smallest mip's side: a GGX lobe at roughness 1 is as wide as the cosine lobe, which 4×4
+// texels a face still follow (a 1×1 face would turn it into six flat colours).
+inline constexpr int kSmallestCubeMip = 4;
+// Mip levels of a cube of side `size` (a power of two, at least 8): down to 4×4, log2(size) − 1.
 int cubeMipCount(int size);
 // The GGX roughness mip `level` of `count` is prefiltered for: level / (count − 1), 0 for one level.
 float cubeMipRoughness(int level, int count);
@@ -133,15 +136,28 @@ ReflectionProbeSet bakeReflectionProbes(const ReflectionLighting& light,
 // Drops the cube texels of a set whose encoding is faces.
 void toEncoding(ReflectionProbeSet& set, ReflectionEncoding encoding);
 
-// Relative RMS of the luminance of prefiltered radiance over 256 fixed directions, per probe:
-// both encodings of a cubemap `set` (its faces and its mip chain) against brute-force
-// prefiltering of `reference` (one cube per probe).
+// How far each encoding is from the truth (docs/lighting.md, "Reflection probes"): per probe, the
+// relative RMS of the luminance of prefiltered radiance over 256 fixed directions, the set's faces
+// and its mip chain against brute-force prefiltering of a reference cube traced at four times the
+// resolution a side with the same rays per texel (16× the rays); mean, p95 and max over probes.
+// `set` must be a cubemap set baked from `layout` with `light`.
 struct ReflectionError {
     float roughness = 0.0f;
-    Spread faces, cubemap;  // over probes
+    Spread faces, cubemap;
 };
-std::vector<ReflectionError> reflectionEncodingError(const ReflectionProbeSet& set,
-                                                     const std::vector<RadianceCube>& reference,
-                                                     const std::vector<float>& roughnesses);
+struct ReflectionErrorReport {
+    std::vector<ReflectionError> byRoughness;
+    int referenceResolution = 0;
+    uint64_t rays = 0;
+};
+ReflectionErrorReport measureReflectionError(const ReflectionLighting& light,
+                                             const ReflectionProbeSettings& settings,
+                                             const ReflectionProbeSet& set,
+                                             const std::vector<float>& roughnesses, uint64_t seed,
+                                             const BakeControl& control);
+// The per-probe term: relative RMS of evaluate(probe, d, roughness) with `encoding` against
+// prefilteredRadiance(reference, d, roughness) over the 256 directions.
+float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
+                           const RadianceCube& reference, float roughness);
 
 }  // namespace terralux

@@ -150,6 +150,9 @@ enum class ReflectionEncoding {
     Cubemap,  // a cube map per probe, GGX-prefiltered into a mip chain by roughness
 };
 
+// Seed 000's limit on a reflection grid's probes.
+inline constexpr int kMaxReflectionProbes = 256;
+
 // Terrain-local reflection probes (seed 000's TV5.3): a (nx, nz) grid placed like a terrain probe
 // volume, each probe baked from the heightfield into `encoding`.
 struct ReflectionProbeSettings {
@@ -165,7 +168,7 @@ struct ReflectionProbeSettings {
     double strength = 1.0;                       // [0, 1]: how far the probes replace the sky's specular
     std::optional<double> fallbackBlendDistance; // unset = 2 * min(spacing)
     ReflectionEncoding encoding = ReflectionEncoding::Cubemap;
-    int resolution = 32;                         // cubemap texels a side of mip 0: a power of two, 4..128
+    int resolution = 32;                         // cubemap texels a side of mip 0: a power of two, 8..128
     // Up to 8 probe indices (scene order) the simvx box records carry; empty = the first 8.
     std::vector<int> simvxSubset;
 };
