@@ -105,15 +105,25 @@ std::vector<glm::vec3> halve(const std::vector<glm::vec3>& texels, int size) {
     return out;
 }
 
-// Bilinear lookup with clamp-to-edge inside one face of a level `size` a side starting at `base`.
-glm::vec3 bilinear(const std::vector<glm::vec3>& texels, size_t base, int size, float s, float t) {
-    const float fx = std::clamp(s * float(size) - 0.5f, 0.0f, float(size - 1));
-    const float fy = std::clamp(t * float(size) - 0.5f, 0.0f, float(size - 1));
-    const int x0 = int(fx), y0 = int(fy);
-    const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
+// Seamless bilinear lookup in one level (`base` its first texel, `size` a side) around (s, t) on
+// `face`, as cube-map hardware filters across face edges (Vulkan spec, "Cube Map Edge Handling"):
+// a tap past the edge reads the texel of the neighbouring face its direction falls on.
+glm::vec3 bilinear(const std::vector<glm::vec3>& texels, size_t base, int size, int face, float s, float t) {
+    const float fx = s * float(size) - 0.5f, fy = t * float(size) - 0.5f;
+    const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
     const float ax = fx - float(x0), ay = fy - float(y0);
-    auto at = [&](int x, int y) { return texels[base + size_t(y) * size + x]; };
-    return (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x1, y0)) + ay * ((1.0f - ax) * at(x0, y1) + ax * at(x1, y1));
+    auto at = [&](int x, int y) {
+        int f = face;
+        if (x < 0 || y < 0 || x >= size || y >= size) {
+            float s2, t2;
+            f = cubeFace(cubeDirection(face, (float(x) + 0.5f) / float(size), (float(y) + 0.5f) / float(size)), s2, t2);
+            x = std::clamp(int(s2 * float(size)), 0, size - 1);
+            y = std::clamp(int(t2 * float(size)), 0, size - 1);
+        }
+        return texels[base + (size_t(f) * size + size_t(y)) * size + size_t(x)];
+    };
+    return (1.0f - ay) * ((1.0f - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+           ay * ((1.0f - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
 }
 
 const std::vector<glm::vec3>& errorDirections() {
@@ -272,9 +282,9 @@ glm::vec3 ReflectionProbeSet::evaluate(size_t i, const glm::vec3& dir, float rou
     const float lod = std::clamp(roughness, 0.0f, 1.0f) * float(mipCount - 1);
     const int m0 = std::min(int(lod), mipCount - 1), m1 = std::min(m0 + 1, mipCount - 1);
     const float f = lod - float(m0);
-    const glm::vec3 a = bilinear(p.texels, texelOffset(m0, face), cubeMipSize(faceSize, m0), s, t);
+    const glm::vec3 a = bilinear(p.texels, texelOffset(m0, 0), cubeMipSize(faceSize, m0), face, s, t);
     if (f <= 0.0f || m1 == m0) return a;
-    const glm::vec3 b = bilinear(p.texels, texelOffset(m1, face), cubeMipSize(faceSize, m1), s, t);
+    const glm::vec3 b = bilinear(p.texels, texelOffset(m1, 0), cubeMipSize(faceSize, m1), face, s, t);
     return (1.0f - f) * a + f * b;
 }
 

@@ -89,7 +89,8 @@ struct ReflectionProbeSet {
     size_t texelOffset(int level, int face) const;
     // The probe's prefiltered radiance toward `dir` for GGX `roughness`, as the renderer reads
     // it: faces, the ambient-cube blend Σ d_i² · face(sign d_i, i) at any roughness; cubemap,
-    // bilinear within the face at the two mips around roughness × (mipCount − 1), blended.
+    // bilinear (seamless across face edges, as cube-map hardware filters) at the two mips around
+    // roughness × (mipCount − 1), blended.
     glm::vec3 evaluate(size_t probe, const glm::vec3& dir, float roughness) const;
 };
 
