@@ -357,7 +357,7 @@ ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettin
     const ReflectionBoxRecords boxes = encodeBoxRecords(set, settings.simvxSubset);
     r["bytes"] = rprobe.size();
     r["simvx"] = {{"exported_ids", boxes.exported}, {"probes", boxes.total}};
-    if (boxes.total > boxes.exported.size())
+    if (settings.simvxSubset.empty() && boxes.total > boxes.exported.size())
         out.warnings.push_back("reflection_probes: " + std::to_string(boxes.total) +
                                " probes, the simvx box records hold " + std::to_string(kSimvxMaxProbes) +
                                ": exported ids " + [&] {

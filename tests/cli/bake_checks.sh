@@ -120,6 +120,69 @@ PY
     [ "$before" = "$after" ] || fail "earlier outputs changed"
     ls -a "$work/out" | grep -q "staging\|\.tmp-" && fail "temporary files left behind"
     ;;
+  reflection)
+    # Reflection probes: the .rprobe and simvx records land beside the probes, 16 probes are
+    # clamped to 8 records with a warning naming both counts, the glTF points at the files, the
+    # bytes do not depend on the thread count, and switching them off removes the files.
+    small=(--quality draft --set reflection_probes.enabled=true --set reflection_probes.resolution=8
+           --set reflection_probes.ray_count=2 --set 'probe_volumes[0].grid_dims=4,4' --set bake.error_map_resolution=0)
+    "$terralux" --bake --out "$work/a" --quiet --threads 1 "${small[@]}" >/dev/null 2>"$work/stderr" || fail "bake exited $?"
+    grep -q "^terralux: warning: reflection_probes: 16 probes, the simvx box records hold 8: exported ids 0,1,2,3,4,5,6,7" \
+      "$work/stderr" || fail "no clamp warning: $(cat "$work/stderr")"
+    [ "$(stat -c %s "$work/a/reflection/probes.simvx.bin")" = 400 ] || fail "probes.simvx.bin is not 400 bytes"
+    [ "$(stat -c %s "$work/a/reflection/probes.simvx.wire")" = 416 ] || fail "probes.simvx.wire is not 8 x 52 bytes"
+    # 64-byte header, 16 probes of 104 bytes and a 8, 4 chain of RGB floats.
+    [ "$(stat -c %s "$work/a/reflection/probes.rprobe")" = $((64 + 16 * (104 + 12 * 6 * (64 + 16)))) ] ||
+      fail "probes.rprobe has the wrong size"
+    python3 - "$work/a" <<'PY' || fail "the glTF or the report does not describe the reflection files"
+import json, sys
+out = sys.argv[1]
+ext = json.load(open(out + "/scene.gltf"))["extensions"]["TERRALUX_lighting"]["reflection_probes"]
+assert ext["uri"] == "reflection/probes.rprobe" and ext["probes"] == 16 and ext["simvx_probes"] == 8, ext
+assert ext["simvx_ids"] == list(range(8)) and ext["encoding"] == "cubemap" and ext["mip_count"] == 2, ext
+assert ext["enabled"] is True and ext["grid_dims"] == [4, 4], ext
+report = json.load(open(out + "/bake_report.json"))
+r = report["reflection_probes"]
+assert r["simvx"]["exported_ids"] == list(range(8)) and r["simvx"]["probes"] == 16, r
+assert "reflection/probes.simvx.wire" in report["files"], report["files"]
+assert report["warnings"] and "16 probes" in report["warnings"][0], report["warnings"]
+PY
+    "$validator" "$work/a/scene.gltf" "$build"
+    rc=$?; [ $rc -eq 0 ] || [ $rc -eq 77 ] || fail "glTF validator reported errors"
+    "$terralux" --bake --out "$work/b" --quiet --threads 2 "${small[@]}" >/dev/null 2>&1 || fail "2-thread bake exited $?"
+    for f in probes.rprobe probes.simvx.bin probes.simvx.wire; do
+      cmp -s "$work/a/reflection/$f" "$work/b/reflection/$f" || fail "reflection/$f differs between 1 and 2 threads"
+    done
+    # A chosen subset, and the encoding that stores face colours only.
+    "$terralux" --bake --out "$work/b" --quiet "${small[@]}" --set reflection_probes.simvx_subset=15,3 \
+      --set reflection_probes.encoding=faces >/dev/null 2>"$work/stderr" || fail "subset bake exited $?"
+    [ -s "$work/stderr" ] && fail "a chosen subset still warned: $(cat "$work/stderr")"
+    [ "$(stat -c %s "$work/b/reflection/probes.simvx.wire")" = 104 ] || fail "the subset's wire is not 2 x 52 bytes"
+    [ "$(stat -c %s "$work/b/reflection/probes.rprobe")" = $((64 + 16 * 104)) ] || fail "the faces file has the wrong size"
+    "$terralux" --bake --out "$work/b" --quiet --quality draft >/dev/null || fail "bake without reflection probes"
+    [ -e "$work/b/reflection/probes.rprobe" ] && fail "the earlier bake's reflection files stayed"
+    grep -q reflection_probes "$work/b/scene.gltf" && fail "the glTF still names reflection probes"
+    ;;
+  reflection_error)
+    # --compare-reference reports each encoding's error against the 16x reference.
+    "$terralux" --bake --out "$work/out" --quiet --quality draft --compare-reference --set 'probe_volumes[0].grid_dims=2,2' \
+      --set bake.error_map_resolution=0 --set reflection_probes.enabled=true --set reflection_probes.grid_dims=2,1 \
+      --set reflection_probes.resolution=8 --set reflection_probes.ray_count=2 >"$work/stdout" || fail "bake exited $?"
+    grep -q "error vs reference at roughness 0.25: faces mean" "$work/stdout" || fail "no error line: $(cat "$work/stdout")"
+    python3 - "$work/out/bake_report.json" <<'PY' || fail "the report's reflection error is not as expected"
+import json, sys
+e = json.load(open(sys.argv[1]))["reflection_probes"]["reference_error"]
+rows = e["by_roughness"]
+assert [r["roughness"] for r in rows] == [0.25, 0.5, 0.75, 1.0], rows
+assert e["reference_resolution"] == 32 and e["reference_rays"] == 2 * 6 * 32 * 32 * 2, e
+for r in rows:
+    for enc in ("faces", "cubemap"):
+        s = r[enc]
+        assert 0 <= s["mean"] <= s["p95"] <= s["max"], r
+# Six face colours cannot follow a glossy reflection that a cube map can.
+assert rows[0]["cubemap"]["mean"] < rows[0]["faces"]["mean"], rows[0]
+PY
+    ;;
   *) echo "unknown case $case_"; exit 2 ;;
 esac
 echo "ok: $case_"
