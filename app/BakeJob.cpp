@@ -704,7 +704,12 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         {"overlaps", overlapReport(grids)},
     };
     if (reflections) {
-        out.report["reflection_probes"] = reflections->report;
+        const nlohmann::json& rr = reflections->report;
+        const uint64_t reflectionRays =
+            rr["rays"].get<uint64_t>() + (rr.contains("reference_error") ? rr["reference_error"]["reference_rays"].get<uint64_t>() : 0);
+        out.report["reflection_rays"] = reflectionRays;
+        out.report["rays"] = out.report["rays"].get<uint64_t>() + reflectionRays;
+        out.report["reflection_probes"] = rr;
         out.warnings = reflections->warnings;
     }
     out.report["warnings"] = out.warnings;

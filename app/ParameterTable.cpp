@@ -728,8 +728,8 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::fallbackBlendDistance);
     add(Row("reflection_probes.simvx_subset", T::IntegerList)).items(0, kSimvxMaxProbes).range(0, kMaxReflectionProbes - 1)
         .label("simvx probes")
-        .about("Indices (scene order) of the at most 8 probes the simvx box records carry; empty: the first 8")
-        .redoes(kNothing).onlyWhen(reflectionOn)
+        .about("Indices (scene order) of the at most 8 probes the simvx box records carry; empty: the first 8. In the window: the probe inspector's check box")
+        .redoes(kNothing).noUiRow().onlyWhen(reflectionOn)
         .custom([](const SceneDescription& s, size_t) { return json(s.reflectionProbes.simvxSubset); },
                 [](SceneDescription& s, size_t, const json& v) {
                     std::vector<int> idx = v.get<std::vector<int>>();
@@ -910,13 +910,13 @@ std::string typeName(const ParameterSpec& s) {
         case ParamType::Choice: return "choice";
         case ParamType::Color: return "RGB";
         case ParamType::NumberList:
-            return s.minItems == s.maxItems ? std::to_string(s.minItems) + " numbers"
+        case ParamType::IntegerList: {
+            const std::string what = s.type == ParamType::NumberList ? " numbers" : " integers";
+            return s.minItems == s.maxItems ? std::to_string(s.minItems) + what
                    : s.maxItems == s.minItems + 1
-                       ? std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " numbers"
-                       : std::to_string(s.minItems) + " to " + std::to_string(s.maxItems) + " numbers";
-        case ParamType::IntegerList:
-            return s.minItems == s.maxItems ? std::to_string(s.minItems) + " integers"
-                                            : std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + " integers";
+                       ? std::to_string(s.minItems) + " or " + std::to_string(s.maxItems) + what
+                       : std::to_string(s.minItems) + " to " + std::to_string(s.maxItems) + what;
+        }
     }
     return "";
 }
