@@ -115,7 +115,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"reflection_probes.grid_dims=[0,1]", "p.json: reflection_probes.grid_dims[0] = 0: must be in [1, 256]"},
         Rule{"reflection_probes.ray_count=0", "p.json: reflection_probes.ray_count = 0: must be in [1, 1048576]"},
         Rule{"reflection_probes.strength=1.5", "p.json: reflection_probes.strength = 1.5: must be in [0, 1]"},
-        Rule{"reflection_probes.ground_color=[1,1,-0.1]", "p.json: reflection_probes.ground_color[2] = -0.1: three components, each in [0, inf]"},
+        Rule{"reflection_probes.ground_color=[1,1,-0.1]", "p.json: reflection_probes.ground_color[2] = -0.1: three components, each in [0, 1]"},
         Rule{"sun.elevation_deg=91", "p.json: sun.elevation_deg = 91: must be in [-90, 90]"},
         Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be in [0, 1000000]"},
         Rule{"sun.angular_radius_deg=50", "p.json: sun.angular_radius_deg = 50: must be in [0, 45]"},
