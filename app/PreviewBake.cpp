@@ -9,6 +9,7 @@
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
+#include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 
 namespace terralux {
@@ -16,10 +17,11 @@ namespace terralux {
 namespace {
 // The draft's error map: enough to see where interpolation fails, at a quarter of the points.
 constexpr int kPreviewErrorMapResolution = 32;
+// Rays per cube texel of the draft reflection probes.
+constexpr int kPreviewReflectionRays = 4;
 }  // namespace
 
-std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
-                                          const std::atomic<bool>* cancel) {
+PreviewBake previewBake(const Project& project, const Heightfield& hf, const std::atomic<bool>* cancel) {
     const SceneDescription& scene = project.scene;
     BakeLighting lighting = lightingOf(project);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
@@ -35,7 +37,8 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
     const BakeControl control{nullptr, cancel};
     const IrradianceCache cache(lighting, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, control);
 
-    std::vector<GpuProbeVolume> out;
+    PreviewBake preview;
+    std::vector<GpuProbeVolume>& out = preview.volumes;
     uint64_t index = 0;
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
@@ -63,7 +66,25 @@ std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfi
         g.diagnostics = std::move(d);
         out.push_back(std::move(g));
     }
-    return out;
+    if (scene.reflectionProbes.enabled) {
+        // The bake's probes at the draft's rays: the same cube size and encoding, so the preview
+        // shows what the encoding keeps.
+        ReflectionProbeSettings s = scene.reflectionProbes;
+        s.rayCount = std::min(s.rayCount, kPreviewReflectionRays);
+        const ReflectionLighting light{&lighting, &cache, q.bounces, groundRadiance(lighting, s.groundColor)};
+        auto set = std::make_shared<ReflectionProbeSet>(
+            bakeReflectionProbes(light, s, placeReflectionProbes(s, hf), splitmix64(0x2EF1EC7ull), control));
+        toEncoding(*set, s.encoding);
+        preview.reflections = std::move(set);
+    }
+    return preview;
+}
+
+std::vector<GpuProbeVolume> previewProbes(const Project& project, const Heightfield& hf,
+                                          const std::atomic<bool>* cancel) {
+    Project volumesOnly = project;
+    volumesOnly.scene.reflectionProbes.enabled = false;
+    return previewBake(volumesOnly, hf, cancel).volumes;
 }
 
 }  // namespace terralux

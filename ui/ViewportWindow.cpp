@@ -120,9 +120,18 @@ void ViewportWindow::zoom(float factor) {
     requestUpdate();
 }
 
-void ViewportWindow::mousePressEvent(QMouseEvent* e) { lastMouse_ = e->position(); }
+void ViewportWindow::mousePressEvent(QMouseEvent* e) {
+    lastMouse_ = pressedAt_ = e->position();
+    dragged_ = false;
+}
+
+void ViewportWindow::mouseReleaseEvent(QMouseEvent* e) {
+    if (e->button() == Qt::LeftButton && !dragged_) emit clicked(e->position());
+}
 
 void ViewportWindow::mouseMoveEvent(QMouseEvent* e) {
+    // A few pixels of jitter in a click are not an orbit.
+    if ((e->position() - pressedAt_).manhattanLength() > 4.0) dragged_ = true;
     const QPointF d = e->position() - lastMouse_;
     lastMouse_ = e->position();
     const bool panning = (e->buttons() & Qt::MiddleButton) ||

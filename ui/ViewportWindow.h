@@ -2,7 +2,7 @@
 // The live viewport: a Vulkan window that presents the renderer's offscreen image (the same
 // draw as `terralux --render`) with frames in flight, never reading pixels back or waiting for
 // the GPU per frame; an orbit camera on the mouse and keys.
-//   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom
+//   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom   left click: pick
 //   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
 
 #include <memory>
@@ -47,12 +47,15 @@ signals:
     // frame slot (which, with every slot busy, is the GPU's frame time).
     void frameRendered(double milliseconds);
     void cameraChanged();
+    // A left click that did not drag: `position` in the window's logical pixels.
+    void clicked(QPointF position);
 
 protected:
     void exposeEvent(QExposeEvent*) override;
     bool event(QEvent* e) override;
     void mousePressEvent(QMouseEvent* e) override;
     void mouseMoveEvent(QMouseEvent* e) override;
+    void mouseReleaseEvent(QMouseEvent* e) override;
     void wheelEvent(QWheelEvent* e) override;
     void keyPressEvent(QKeyEvent* e) override;
 
@@ -66,7 +69,8 @@ private:
     std::unique_ptr<vk::Swapchain> swapchain_;
     OrbitCamera camera_;
     RenderRequest request_;
-    QPointF lastMouse_;
+    QPointF lastMouse_, pressedAt_;
+    bool dragged_ = false;
 };
 
 }  // namespace terralux
