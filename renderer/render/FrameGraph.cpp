@@ -31,6 +31,9 @@ AccessInfo infoOf(Access a) {
         case Access::FragmentSampledRead:
             return {VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, false, false};
+        case Access::FragmentStorageRead:
+            return {VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                    false, false};
         case Access::ColorAttachmentClear:
             return {VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, true, true};
@@ -69,6 +72,7 @@ const char* accessName(Access a) {
         case Access::ComputeStorageRead: return "compute-read";
         case Access::ComputeStorageWrite: return "compute-write";
         case Access::FragmentSampledRead: return "fragment-sampled-read";
+        case Access::FragmentStorageRead: return "fragment-storage-read";
         case Access::ColorAttachmentClear: return "color-clear";
         case Access::ColorAttachmentDraw: return "color-draw";
         case Access::DepthAttachmentClear: return "depth-clear";

@@ -21,6 +21,7 @@ enum class Access {
     ComputeStorageRead,
     ComputeStorageWrite,
     FragmentSampledRead,   // a sampled image in a fragment shader
+    FragmentStorageRead,   // a storage buffer a fragment shader reads
     ColorAttachmentClear,  // the pass clears it: earlier contents are discarded
     ColorAttachmentDraw,   // the pass draws on top of what is there
     DepthAttachmentClear,

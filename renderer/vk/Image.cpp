@@ -56,8 +56,11 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
                                  : desc_.shape == ImageShape::Layers ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
                                                                      : VK_IMAGE_VIEW_TYPE_2D;
     view_ = makeView(device, image, type, desc_.format, aspect_, 0, desc_.layers, std::max(desc_.mipLevels, 1u));
-    for (uint32_t l = 0; l < desc_.layers; ++l)
-        layerViews_.push_back(makeView(device, image, VK_IMAGE_VIEW_TYPE_2D, desc_.format, aspect_, l, 1));
+    // Per-layer views are for framebuffers: a sampled array (reflection probes' faces, thousands of
+    // layers) needs none.
+    if (desc_.usage & (VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT))
+        for (uint32_t l = 0; l < desc_.layers; ++l)
+            layerViews_.push_back(makeView(device, image, VK_IMAGE_VIEW_TYPE_2D, desc_.format, aspect_, l, 1));
 }
 
 namespace {
@@ -93,8 +96,18 @@ Image Image::depthLayers(const VulkanContext& ctx, uint32_t width, uint32_t heig
 }
 
 Image Image::texture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels) {
+    return upload(ctx, ImageShape::Plane, format, 1, levels);
+}
+
+Image Image::textureArray(const VulkanContext& ctx, VkFormat format, uint32_t layers,
+                          const std::vector<MipLevel>& levels) {
+    return upload(ctx, ImageShape::Layers, format, layers, levels);
+}
+
+Image Image::upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
+                    const std::vector<MipLevel>& levels) {
     if (levels.empty()) throw std::invalid_argument("a texture needs at least one level");
-    Image img(ctx, {ImageShape::Plane, format, levels[0].width, levels[0].height, 1,
+    Image img(ctx, {shape, format, levels[0].width, levels[0].height, layers,
                     VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, uint32_t(levels.size())});
     size_t total = 0;
     for (const MipLevel& l : levels) total += (l.bytes.size() + 15) & ~size_t(15);
@@ -106,7 +119,7 @@ Image Image::texture(const VulkanContext& ctx, VkFormat format, const std::vecto
         staging.write(levels[i].bytes.data(), levels[i].bytes.size(), offset);
         VkBufferImageCopy c{};
         c.bufferOffset = offset;
-        c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i, 0, 1};
+        c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i, 0, layers};
         c.imageExtent = {levels[i].width, levels[i].height, 1};
         copies.push_back(c);
         offset += (levels[i].bytes.size() + 15) & ~size_t(15);
@@ -115,7 +128,7 @@ Image Image::texture(const VulkanContext& ctx, VkFormat format, const std::vecto
         VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
         b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         b.image = img.handle();
-        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(levels.size()), 0, 1};
+        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(levels.size()), 0, layers};
         b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
         b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
         b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;

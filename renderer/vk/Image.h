@@ -55,11 +55,15 @@ public:
     // A sampled 2D texture holding `levels` (a full or partial mip chain), uploaded through a
     // staging buffer and left in the shader-read layout.
     static Image texture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels);
+    // The same for a 2D array of `layers` (viewed as an array even for one layer): each level's
+    // bytes hold its layers one after another.
+    static Image textureArray(const VulkanContext& ctx, VkFormat format, uint32_t layers,
+                              const std::vector<MipLevel>& levels);
 
     VkImage handle() const { return image_.get(); }
     // The whole image as shaders see it: 2D, 2D array or cube.
     VkImageView view() const { return view_.get(); }
-    // One layer as a 2D view, for a framebuffer attachment.
+    // One layer as a 2D view, for a framebuffer attachment (attachment images only).
     VkImageView layerView(uint32_t layer) const { return layerViews_[layer].get(); }
     const ImageDesc& desc() const { return desc_; }
     uint32_t width() const { return desc_.width; }
@@ -68,6 +72,8 @@ public:
     VkImageAspectFlags aspect() const { return aspect_; }
 
 private:
+    static Image upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
+                        const std::vector<MipLevel>& levels);
     ImageDesc desc_;
     VkImageAspectFlags aspect_ = VK_IMAGE_ASPECT_COLOR_BIT;
     // Declared in destruction order: views, image, then its memory.
