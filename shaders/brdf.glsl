@@ -17,6 +17,19 @@ vec3 ggxSpecularF0(vec3 n, vec3 v, vec3 l, float roughness, float f0) {
     return vec3(d * g * fres / max(4.0 * ndotl * ndotv, 1e-4)) * ndotl;
 }
 // Dielectric ground: f0 = 0.04.
-vec3 ggxSpecular(vec3 n, vec3 v, vec3 l, float roughness) { return ggxSpecularF0(n, v, l, roughness, 0.04); }
+const float kGroundF0 = 0.04;
+vec3 ggxSpecular(vec3 n, vec3 v, vec3 l, float roughness) { return ggxSpecularF0(n, v, l, roughness, kGroundF0); }
+
+// The split-sum environment BRDF, f0·A + B: the share of the environment's prefiltered radiance
+// a GGX surface of roughness r reflects toward v, in the analytic fit of Karis, "Physically Based
+// Shading on Mobile" (2014), to the same Smith-Schlick GGX as above.
+float envBrdf(float f0, float ndotv, float roughness) {
+    const vec4 c0 = vec4(-1.0, -0.0275, -0.572, 0.022);
+    const vec4 c1 = vec4(1.0, 0.0425, 1.04, -0.04);
+    vec4 r = roughness * c0 + c1;
+    float a004 = min(r.x * r.x, exp2(-9.28 * max(ndotv, 0.0))) * r.x + r.y;
+    vec2 ab = vec2(-1.04, 1.04) * a004 + r.zw;
+    return f0 * ab.x + ab.y;
+}
 
 #endif

@@ -9,6 +9,7 @@
 #include "blocks/sun_sky.h"
 #include "blocks/atmosphere.h"
 #include "sh.glsl"
+#include "sky.glsl"
 #include "tonemap.glsl"
 #include "fog.glsl"
 
@@ -18,10 +19,7 @@ layout(location = 0) out vec4 outColor;
 void main() {
     vec4 far = camera.invViewProj * vec4(ndc, 0.0, 1.0);  // reversed Z: depth 0 is the far plane
     vec3 dir = normalize(far.xyz / far.w - camera.position.xyz);
-    vec3 up = normalize(vec3(dir.x, max(dir.y, 0.0), dir.z) + vec3(0.0, 1e-4, 0.0));
-    vec3 c[9];
-    for (int k = 0; k < 9; ++k) c[k] = sunSky.skySh[k].rgb;
-    vec3 radiance = max(shIrradiance(c, up, true), vec3(0.0));
+    vec3 radiance = skyRadiance(dir);
     // The sun's disc: its illuminance spread over the disc's solid angle π·r².
     float r = sunSky.sunDirection.w;
     vec3 l = normalize(sunSky.sunDirection.xyz);

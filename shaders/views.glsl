@@ -31,7 +31,9 @@ float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDi
 
 // Scene-linear light leaving the point toward the camera: Lambert + GGX sun, sky irradiance
 // (darkened by the AO) with the baked probe irradiance blended over it (absent probes leave the
-// sky term as it is).
+// sky term as it is), and the environment's specular: the sky's radiance in the mirror direction
+// through the split-sum environment BRDF, the AO standing in for specular occlusion (a sky the
+// horizon hides is neither lit from nor reflected).
 vec3 sceneLinear(ShadingPoint s) {
     vec3 n = s.normal;
     vec3 l = normalize(sunSky.sunDirection.xyz);
@@ -41,9 +43,11 @@ vec3 sceneLinear(ShadingPoint s) {
     float weight = s.probe.a;
     vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb * s.aoProbe, weight) : sky;
     vec3 spec = ggxSpecular(n, v, l, s.roughness);
+    vec3 environment = skyRadiance(reflect(-v, n)) * s.ao;
+    vec3 specEnv = envBrdf(kGroundF0, dot(n, v), s.roughness) * environment;
     // Probes hold no direct sun: the sun alone is shadowed by the cascades.
     vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
-    return s.albedo / PI * (sun * ndotl + ambient) + spec * sun;
+    return s.albedo / PI * (sun * ndotl + ambient) + spec * sun + specEnv;
 }
 
 vec3 viewBeauty(ShadingPoint s) { return display(s.linear); }

@@ -44,14 +44,6 @@ vec3 storedToLinear(vec3 stored) {
     return x / max(surface.material.y, 1e-6);
 }
 
-// The sky's radiance toward r (below the horizon, the horizon's), as the sky pass draws it.
-vec3 skyRadiance(vec3 r) {
-    vec3 up = normalize(vec3(r.x, max(r.y, 0.0), r.z) + vec3(0.0, 1e-4, 0.0));
-    vec3 c[9];
-    for (int k = 0; k < 9; ++k) c[k] = sunSky.skySh[k].rgb;
-    return max(shIrradiance(c, up, true), vec3(0.0));
-}
-
 void main() {
     // Map reads and derivatives first, in uniform control flow.
     vec2 field = waterFieldAt(restPos.xz);
