@@ -9,6 +9,9 @@ std::span<const uint32_t> terrainVert();            // without probe light
 std::span<const uint32_t> terrainProbeLightVert();  // with the probe pass's per-vertex light
 std::span<const uint32_t> terrainFrag();        // the sun unshadowed
 std::span<const uint32_t> terrainShadowFrag();  // with the shadow cascades bound
+// The same two with the reflection probes bound in the lights set.
+std::span<const uint32_t> terrainReflectionFrag();
+std::span<const uint32_t> terrainShadowReflectionFrag();
 std::span<const uint32_t> fullscreenVert();
 std::span<const uint32_t> skyBackgroundFrag();
 std::span<const uint32_t> shadowDepthVert();
@@ -19,4 +22,6 @@ std::span<const uint32_t> leavesVert();
 std::span<const uint32_t> waterVert();
 std::span<const uint32_t> waterFrag();        // the sun unshadowed
 std::span<const uint32_t> waterShadowFrag();  // with the shadow cascades bound
+std::span<const uint32_t> waterReflectionFrag();        // the reflection probes bound
+std::span<const uint32_t> waterShadowReflectionFrag();  // both
 }  // namespace terralux::shaders

@@ -1,8 +1,9 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Terrain shading (docs/lighting.md) and the debug views. It binds the view and the lights only: probe
-// light comes in per vertex from the probe pass, when there is one. Built twice: with
-// TLX_SHADOWS the lights include the sun's shadow cascades.
+// light comes in per vertex from the probe pass, when there is one. Built four times: with
+// TLX_SHADOWS the lights include the sun's shadow cascades, with TLX_REFLECTIONS the reflection
+// probes.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"
 #include "blocks/surface.h"
@@ -15,6 +16,7 @@
 #include "tonemap.glsl"
 #include "shadows.glsl"
 #include "fog.glsl"
+#include "reflections.glsl"
 #include "views.glsl"
 
 layout(location = 0) in vec3 worldPos;

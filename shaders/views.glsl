@@ -1,6 +1,6 @@
 // The debug views: kView<Name> constants from debug_views.def, one function per view, and the
-// dispatch over them (include after tonemap.glsl, sky.glsl, brdf.glsl, shadows.glsl and fog.glsl). A view added to the
-// list that has no function here fails the build.
+// dispatch over them (include after tonemap.glsl, sky.glsl, brdf.glsl, shadows.glsl, fog.glsl and
+// reflections.glsl). A view added to the list that has no function here fails the build.
 #ifndef TLX_VIEWS_GLSL
 #define TLX_VIEWS_GLSL
 
@@ -24,6 +24,8 @@ struct ShadingPoint {
     float filled;      // share of filled nodata cells
     float shadow;      // sunShadow(): 1 lit, 0 in shadow
     float fogAmount;   // 1 − the fog's transmittance to the camera
+    vec3 reflection;         // the reflection probes' radiance toward the mirror direction
+    float reflectionWeight;  // their blend weight over the sky's: coverage fade × strength
     vec3 linear;       // sceneLinear(), seen through the fog
 };
 
@@ -33,7 +35,9 @@ float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDi
 // (darkened by the AO) with the baked probe irradiance blended over it (absent probes leave the
 // sky term as it is), and the environment's specular: the sky's radiance in the mirror direction
 // through the split-sum environment BRDF, the AO standing in for specular occlusion (a sky the
-// horizon hides is neither lit from nor reflected).
+// horizon hides is neither lit from nor reflected). Reflection probes replace the sky's radiance
+// by their weight, darkened like the probe light by the AO finer than the probes (a weight of 0
+// leaves the sky's term exactly as it is).
 vec3 sceneLinear(ShadingPoint s) {
     vec3 n = s.normal;
     vec3 l = normalize(sunSky.sunDirection.xyz);
@@ -44,6 +48,7 @@ vec3 sceneLinear(ShadingPoint s) {
     vec3 ambient = weight > 0.0 ? mix(sky, s.probe.rgb * s.aoProbe, weight) : sky;
     vec3 spec = ggxSpecular(n, v, l, s.roughness);
     vec3 environment = skyRadiance(reflect(-v, n)) * s.ao;
+    if (s.reflectionWeight > 0.0) environment = mix(environment, s.reflection * s.aoProbe, s.reflectionWeight);
     vec3 specEnv = envBrdf(kGroundF0, dot(n, v), s.roughness) * environment;
     // Probes hold no direct sun: the sun alone is shadowed by the cascades.
     vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
@@ -57,6 +62,8 @@ vec3 viewNdotL(ShadingPoint s) { return vec3(sunNdotL(s)); }
 vec3 viewLinear(ShadingPoint s) { return linearOutput() ? s.linear : clamp(s.linear, 0.0, 1.0); }
 vec3 viewProbeIrradiance(ShadingPoint s) { return display(s.probe.rgb * s.probe.a / PI); }
 vec3 viewProbeWeight(ShadingPoint s) { return vec3(s.probe.a); }
+vec3 viewReflectionColor(ShadingPoint s) { return display(s.reflection * s.reflectionWeight); }
+vec3 viewReflectionWeight(ShadingPoint s) { return vec3(s.reflectionWeight); }
 
 // Probe validity: grey where probes at their placement light the ground, cyan as moved probes
 // take part, red inside a volume where no valid probe is left, dark outside.
@@ -123,6 +130,9 @@ vec3 shadeView(int view, ShadingPoint s) {
     float distance = length(toPoint);
     vec3 dir = toPoint / max(distance, 1e-6);
     s.fogAmount = 1.0 - fogTransmittance(dir, distance);
+    s.reflectionWeight = reflectionWeight(s.position);
+    s.reflection = s.reflectionWeight > 0.0 ? reflectionProbeRadiance(s.position, reflect(dir, s.normal), s.roughness)
+                                            : vec3(0.0);
     s.linear = applyFog(sceneLinear(s), dir, distance);
     switch (view) {
 #define TLX_VIEW(NAME, NUMBER) case kView##NAME: return view##NAME(s);

@@ -3,7 +3,9 @@
 // The water surface (docs/lighting.md, "Water"): Schlick-Fresnel mix of the reflection (planar
 // or the sky's) and what lies below, the bed seen through the absorbing water plus the light the
 // water body scatters; the sun's highlight on the waves, shadowed by the cascades; fog as on the
-// terrain. Built twice like the terrain: with TLX_SHADOWS the sun is shadowed by the cascades.
+// terrain. Built four times like the terrain: with TLX_SHADOWS the sun is shadowed by the
+// cascades; with TLX_REFLECTIONS the sky's reflection gives way to the nearest reflection probe's
+// where the probes cover the water.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"
 #include "blocks/surface.h"
@@ -16,6 +18,7 @@
 #include "tonemap.glsl"
 #include "shadows.glsl"
 #include "fog.glsl"
+#include "reflections.glsl"
 #include "water.glsl"
 
 #define TLX_VIEW(NAME, NUMBER) const int kView##NAME = NUMBER;
@@ -75,7 +78,15 @@ void main() {
     vec3 v = normalize(camera.position.xyz - worldPos);
     float ndotv = max(dot(n, v), 1e-3);
     float fresnel = kWaterF0 + (1.0 - kWaterF0) * pow(1.0 - ndotv, 5.0);
-    vec3 reflected = water.absorption.w > 0.5 ? planar : skyRadiance(reflect(-v, n));
+    vec3 reflected = planar;
+    if (water.absorption.w <= 0.5) {
+        // The sky's reflection, or where reflection probes cover the water the nearest probe's
+        // (one probe: the water is a mirror, and a blend of probes would double its images).
+        vec3 r = reflect(-v, n);
+        reflected = skyRadiance(r);
+        float w = reflectionWeight(worldPos);
+        if (w > 0.0) reflected = mix(reflected, nearestReflectionProbeRadiance(worldPos, r, water.scatter.w), w);
+    }
 
     vec3 l = normalize(sunSky.sunDirection.xyz);
     float shadowed = sunShadow(worldPos, n);

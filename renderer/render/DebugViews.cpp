@@ -14,8 +14,9 @@ const std::vector<int>& shaderViewNumbers() {
 const std::vector<DebugView>& debugViews() {
     constexpr ViewNeeds none{}, diagnostics{false, true, false}, diagnosticsAndMarkers{false, true, true},
         shadows{false, false, false, true}, visibility{false, false, false, false, true},
-        lit{true, false, false, true, false, true, true, true}, light{true, false, false},
-        waterOnly{false, false, false, false, false, false, true, false};
+        lit{true, false, false, true, false, true, true, true, true}, light{true, false, false},
+        waterOnly{false, false, false, false, false, false, true, false},
+        reflections{false, false, false, false, false, false, false, false, true};
     static const std::vector<DebugView> views = {
         {kViewBeauty, "beauty", "final image", false, ViewBackground::Sky, lit},
         {kViewAlbedo, "albedo", "surface albedo", false, ViewBackground::Black, none},
@@ -48,6 +49,14 @@ const std::vector<DebugView>& debugViews() {
         {kViewProbeIrradiance, "probe-irradiance", "probe irradiance × weight", true,
          ViewBackground::Black, light},
         {kViewProbeWeight, "probe-weight", "probe blend weight", false, ViewBackground::Black, light},
+        {kViewReflectionColor, "reflection-color",
+         "reflection probes' prefiltered radiance toward the mirror direction × their blend weight "
+         "(black without reflection probes)",
+         true, ViewBackground::Black, reflections},
+        {kViewReflectionWeight, "reflection-weight",
+         "reflection-probe blend weight applied over the sky's specular: the coverage fade × "
+         "reflection_probes.strength (black without reflection probes)",
+         false, ViewBackground::Black, reflections},
         {kViewProbeValidity, "probe-validity",
          "invalid / relocated probes: grey lit by probes at their placement, cyan by moved probes, "
          "red inside a volume with no valid probe; markers cyan moved, red rejected (with the probe "
@@ -106,6 +115,7 @@ std::string debugViewsMarkdown() {
         if (v.needs.probeLight) passes = "probe-vertices (light)";
         if (v.needs.probeDiagnostics) passes = "probe-vertices (diagnostics), the bake's sidecar";
         if (v.needs.probeMarkers) passes += ", overlays (probe markers)";
+        if (v.needs.reflectionProbes) passes += (passes.empty() ? "" : ", ") + std::string("reflection probes (when bound)");
         if (v.needs.shadows) passes = "shadow (when shadows are on)" + (passes.empty() ? "" : ", " + passes);
         if (v.needs.sunVisibility) passes = "CPU sun tracing at the vertices (cached per sun)";
         if (v.needs.sky) passes += ", sky";

@@ -33,6 +33,7 @@ struct ViewNeeds {
     bool sky = false;               // the sky pass behind the terrain
     bool water = false;             // the water pass (when the scene has water)
     bool waterShading = false;      // its reflection and the copy of the frame under it
+    bool reflectionProbes = false;  // the reflection probes in the lights set (when a set is bound)
 };
 
 struct DebugView {

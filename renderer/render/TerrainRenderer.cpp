@@ -13,6 +13,7 @@
 
 #include "ShaderBinaries.h"
 #include "bake/DiffuseBake.h"
+#include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "render/DebugViews.h"
 #include "render/UniformBlocks.h"
@@ -53,6 +54,10 @@ const char* const kWaterScene = "water-scene";
 const char* const kWaterVertices = "water-vertices";
 const char* const kWaterIndices = "water-indices";
 const char* const kWaterField = "water-field";
+const char* const kReflectionGrid = "reflection-probe-grid";
+const char* const kReflectionRecords = "reflection-probe-records";
+const char* const kReflectionCubes = "reflection-probe-cubes";
+const char* const kReflectionMarkers = "reflection-probe-markers";
 
 // Vertices along the longer side of the water mesh, at most: the waves longer than two of its
 // cells move it, the shorter ones live in the normal (water.glsl).
@@ -85,7 +90,8 @@ struct ProbeResources {
 };
 
 // What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
-// `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do.
+// `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do (the lights
+// sets with reflection probes belong to ReflectionResources).
 // `reflectionCamera` and `reflectionView`: the view set again with the camera mirrored in the
 // water (the planar reflection pass).
 struct FrameSlot {
@@ -107,6 +113,22 @@ struct WaterResources {
     vk::Framebuffer reflectionFramebuffer;
     std::vector<vk::Buffer> blocks;        // per frame slot: the WaterBlock
     std::vector<vk::DescriptorSet> sets;   // per frame slot: block, reflection, scene, field
+};
+
+// The reflection-probe subsystem: present only while a probe set is bound. The probe records
+// and, for the cubemap encoding, their faces (a 2D array, layer 6·probe + face, with the set's
+// mip chain; a 1×1 placeholder for the faces encoding) are uploaded once per set. The faces are
+// an image rather than texels in the buffer so that the sampler does the filtering the bake's
+// evaluate() describes, bilinear within a face and linear between mips, in one fetch per probe.
+// Per frame slot: the grid block (it holds the live strength) and the lights sets that bind it,
+// without and with the shadow cascades (the latter while the maps exist).
+struct ReflectionResources {
+    blocks::ReflectionBlock grid;
+    vk::Buffer records, markers;
+    vk::Image cubes;
+    uint32_t markerCount = 0;
+    std::vector<vk::Buffer> blocks;
+    std::vector<vk::DescriptorSet> lights, shadowedLights;
 };
 
 // The shadow subsystem: the cascades' depth maps (one layer each) and a framebuffer per layer.
@@ -139,8 +161,8 @@ struct TerrainRenderer::Gpu {
     std::unique_ptr<WaterResources> water;
     vk::Sampler linear;
     vk::UniqueSetLayout waterLayout;
-    vk::PipelineLayout waterPipelineLayout, shadowedWaterPipelineLayout;
-    // By variant: kShadowVariant | kFogVariant.
+    std::array<vk::PipelineLayout, 4> waterLayouts;  // by lights variant
+    // By variant: kShadowVariant | kFogVariant | kReflectionVariant.
     std::map<int, vk::UniquePipeline> waterPipelines;
     // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
     // sun and surface it was traced for.
@@ -153,10 +175,13 @@ struct TerrainRenderer::Gpu {
     std::unique_ptr<RenderTarget> target;
     vk::RenderPass clearPass, drawPass, shadowPass;
     vk::Sampler compareSampler, depthSampler;
-    vk::UniqueSetLayout emptySet, shadowedLightsLayout;
-    vk::PipelineLayout terrainLayout, shadowedTerrainLayout, overlayLayout, probeLayout, shadowDepthLayout;
+    vk::UniqueSetLayout emptySet;
+    std::array<vk::UniqueSetLayout, 4> lightsLayouts;     // by lights variant
+    std::array<vk::PipelineLayout, 4> terrainLayouts;     // view and lights, by lights variant
+    vk::PipelineLayout overlayLayout, probeLayout, shadowDepthLayout;
+    std::unique_ptr<ReflectionResources> reflections;
     // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
-    // variant: kProbeLightVariant | kShadowVariant | kFogVariant.
+    // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant.
     std::map<int, vk::UniquePipeline> terrain;
     vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, probePass;
     FrameGraph graph;
@@ -170,21 +195,35 @@ struct TerrainRenderer::Output {
 
 namespace {
 
-constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4;
+constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8;
+// The lights set's variants, an index into the layouts: the shadow cascades, the reflection probes.
+constexpr int kShadowedLights = 1, kReflectedLights = 2;
 
-// The lights set with the shadow cascades: sun and sky, atmosphere, the cascades' block and their
-// maps (compared, and raw for the PCSS blocker search). `maps` null: the layout alone.
+// The lights set of a variant: sun and sky and the atmosphere; with kShadowedLights the
+// cascades' block and their maps (compared, and raw for the PCSS blocker search); with
+// kReflectedLights the reflection grid of frame slot `slot`, the probe records and their cubes.
+// Null `maps` and `r`: the layout alone.
 template <class Gpu>
-vk::DescriptorSetBuilder shadowedLightsBuilder(const FrameSlot& f, VkImageView maps, const Gpu& g) {
+vk::DescriptorSetBuilder lightsBuilder(int variant, const FrameSlot& f, const Gpu& g, VkImageView maps,
+                                       const ReflectionResources* r, uint32_t slot) {
     constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
-    return vk::DescriptorSetBuilder()
-        .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, frag)
-        .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere, frag)
-        .uniform(blocks::ShadowBlock::kBinding, "shadow", f.shadow, frag)
-        .image(TLX_SHADOW_MAP_COMPARE_BINDING, std::string(kShadowMaps) + "(compare)", maps,
-               g.compareSampler.handle(), frag)
-        .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
-               g.depthSampler.handle(), frag);
+    vk::DescriptorSetBuilder b;
+    b.uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, frag)
+        .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere, frag);
+    if (variant & kShadowedLights)
+        b.uniform(blocks::ShadowBlock::kBinding, "shadow", f.shadow, frag)
+            .image(TLX_SHADOW_MAP_COMPARE_BINDING, std::string(kShadowMaps) + "(compare)", maps,
+                   g.compareSampler.handle(), frag)
+            .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
+                   g.depthSampler.handle(), frag);
+    if (variant & kReflectedLights) {
+        static const vk::Buffer none;
+        b.uniform(blocks::ReflectionBlock::kBinding, kReflectionGrid, r ? r->blocks[slot] : none, frag)
+            .storage(TLX_REFLECTION_PROBES_BINDING, kReflectionRecords, r ? r->records : none, frag)
+            .image(TLX_REFLECTION_CUBES_BINDING, kReflectionCubes, r ? r->cubes.view() : VK_NULL_HANDLE,
+                   g.trilinear.handle(), frag);
+    }
+    return b;
 }
 
 // The view set: camera, surface block and the surface maps. `t` null: the layout alone. The
@@ -292,11 +331,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.atmosphere = ubo(sizeof(blocks::AtmosphereBlock));
         f.shadow = ubo(sizeof(blocks::ShadowBlock));
         f.overlay = ubo(sizeof(blocks::OverlayBlock));
-        f.lights = vk::DescriptorSetBuilder()
-                       .uniform(blocks::SunSkyBlock::kBinding, "sun-sky", f.sunSky, VK_SHADER_STAGE_FRAGMENT_BIT)
-                       .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere,
-                                VK_SHADER_STAGE_FRAGMENT_BIT)
-                       .build(ctx_);
+        f.lights = lightsBuilder(0, f, g, VK_NULL_HANDLE, nullptr, 0).build(ctx_);
         f.overlays = vk::DescriptorSetBuilder()
                          .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
                          .build(ctx_);
@@ -308,8 +343,6 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     setAlbedoMap(0, 0, {});
     g.emptySet = vk::DescriptorSetBuilder().buildLayout(ctx_);
     static_assert(TLX_SET_VIEW == 0 && TLX_SET_LIGHTS == 1 && TLX_SET_SUBSYSTEM == 2);
-    const VkDescriptorSetLayout terrainSets[] = {g.viewLayout.get(), g.slots[0].lights.layout()};
-    g.terrainLayout = vk::PipelineLayout(ctx_, terrainSets);
     const VkDescriptorSetLayout overlaySets[] = {g.viewLayout.get(), g.emptySet.get(),
                                                  g.slots[0].overlays.layout()};
     g.overlayLayout = vk::PipelineLayout(ctx_, overlaySets);
@@ -320,19 +353,19 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     g.shadowPass = vk::RenderPass(ctx_, {{}, vk::kDepthFormat, true, true});
     g.compareSampler = vk::Sampler::depthCompare(ctx_);
     g.depthSampler = vk::Sampler::nearestClamp(ctx_);
-    g.shadowedLightsLayout = shadowedLightsBuilder(g.slots[0], VK_NULL_HANDLE, g).buildLayout(ctx_);
-    const VkDescriptorSetLayout shadowedSets[] = {g.viewLayout.get(), g.shadowedLightsLayout.get()};
-    g.shadowedTerrainLayout = vk::PipelineLayout(ctx_, shadowedSets);
     g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
     g.linear = vk::Sampler::linearClamp(ctx_);
     static const vk::Buffer noBuffer;
     g.waterLayout = waterSetBuilder(noBuffer, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, g.linear.handle())
                         .buildLayout(ctx_);
-    const VkDescriptorSetLayout waterSets[] = {g.viewLayout.get(), g.slots[0].lights.layout(), g.waterLayout.get()};
-    g.waterPipelineLayout = vk::PipelineLayout(ctx_, waterSets);
-    const VkDescriptorSetLayout shadowedWaterSets[] = {g.viewLayout.get(), g.shadowedLightsLayout.get(),
-                                                       g.waterLayout.get()};
-    g.shadowedWaterPipelineLayout = vk::PipelineLayout(ctx_, shadowedWaterSets);
+    for (int variant = 0; variant < 4; ++variant) {
+        g.lightsLayouts[size_t(variant)] = lightsBuilder(variant, g.slots[0], g, VK_NULL_HANDLE, nullptr, 0).buildLayout(ctx_);
+        const VkDescriptorSetLayout terrainSets[] = {g.viewLayout.get(), g.lightsLayouts[size_t(variant)].get()};
+        g.terrainLayouts[size_t(variant)] = vk::PipelineLayout(ctx_, terrainSets);
+        const VkDescriptorSetLayout waterSets[] = {g.viewLayout.get(), g.lightsLayouts[size_t(variant)].get(),
+                                                   g.waterLayout.get()};
+        g.waterLayouts[size_t(variant)] = vk::PipelineLayout(ctx_, waterSets);
+    }
 }
 
 bool TerrainRenderer::hasWaterResources() const { return gpu_->water != nullptr; }
@@ -517,7 +550,7 @@ void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
     g.graph.forget(kShadowMaps);
     for (FrameSlot& f : g.slots) f.shadowedLights = vk::DescriptorSet();
     g.shadows.reset();
-    if (resolution <= 0) return;
+    if (resolution <= 0) return buildReflectionSets();
     auto sh = std::make_unique<ShadowResources>();
     sh->resolution = resolution;
     sh->cascades = cascades;
@@ -527,9 +560,112 @@ void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
         sh->framebuffers.emplace_back(ctx_, g.shadowPass, std::span<const VkImageView>(&view, 1),
                                       uint32_t(resolution), uint32_t(resolution));
     }
-    for (FrameSlot& f : g.slots) f.shadowedLights = shadowedLightsBuilder(f, sh->maps.view(), g).build(ctx_);
+    for (FrameSlot& f : g.slots)
+        f.shadowedLights = lightsBuilder(kShadowedLights, f, g, sh->maps.view(), nullptr, 0).build(ctx_);
     g.graph.importImage(kShadowMaps, sh->maps.handle(), sh->maps.aspect(), uint32_t(cascades));
     g.shadows = std::move(sh);
+    buildReflectionSets();
+}
+
+void TerrainRenderer::buildReflectionSets() {
+    Gpu& g = *gpu_;
+    ReflectionResources* r = g.reflections.get();
+    if (!r) return;
+    r->lights.clear();
+    r->shadowedLights.clear();
+    for (uint32_t i = 0; i < uint32_t(g.slots.size()); ++i) {
+        r->lights.push_back(lightsBuilder(kReflectedLights, g.slots[i], g, VK_NULL_HANDLE, r, i).build(ctx_));
+        if (g.shadows)
+            r->shadowedLights.push_back(
+                lightsBuilder(kShadowedLights | kReflectedLights, g.slots[i], g, g.shadows->maps.view(), r, i).build(ctx_));
+    }
+}
+
+bool TerrainRenderer::hasReflectionResources() const { return gpu_->reflections != nullptr; }
+
+void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
+    Gpu& g = *gpu_;
+    ctx_.waitIdle();  // no frame may still read the old probes
+    for (const char* name : {kReflectionRecords, kReflectionMarkers}) g.graph.forget(name);
+    g.reflections.reset();
+    reflectionBytes_ = 0;
+    if (!set || set->probes.empty()) return;
+    const ReflectionProbeSet& s = *set;
+    const size_t n = s.probes.size();
+    if (s.dims[0] < 1 || s.dims[1] < 1 || size_t(s.dims[0]) * size_t(s.dims[1]) != n)
+        throw std::invalid_argument("reflection probes: a grid of " + std::to_string(s.dims[0]) + " x " +
+                                    std::to_string(s.dims[1]) + " holds " + std::to_string(n) + " probes");
+    const bool cubemap = s.encoding == ReflectionEncoding::Cubemap;
+    uint32_t layers = 1;
+    if (cubemap) {
+        if (s.faceSize < 1 || (s.faceSize & (s.faceSize - 1)) != 0 || s.mipCount != cubeMipCount(s.faceSize))
+            throw std::invalid_argument("reflection probes: cube faces of " + std::to_string(s.faceSize) +
+                                        " texels with " + std::to_string(s.mipCount) + " mip levels");
+        for (const ReflectionProbe& p : s.probes)
+            if (p.texels.size() != s.texelsPerProbe())
+                throw std::invalid_argument("reflection probe " + std::to_string(p.id) + " holds " +
+                                            std::to_string(p.texels.size()) + " texels, not " +
+                                            std::to_string(s.texelsPerProbe()));
+        VkPhysicalDeviceProperties props;
+        vkGetPhysicalDeviceProperties(ctx_.physicalDevice(), &props);
+        if (6 * n > props.limits.maxImageArrayLayers)
+            throw std::invalid_argument("reflection probes: " + std::to_string(n) + " cubes need " +
+                                        std::to_string(6 * n) + " image layers, the device holds " +
+                                        std::to_string(props.limits.maxImageArrayLayers));
+        layers = uint32_t(6 * n);
+    }
+
+    auto r = std::make_unique<ReflectionResources>();
+    std::vector<blocks::ReflectionProbeRecord> records(n);
+    std::vector<glm::vec4> markers(n);
+    for (size_t i = 0; i < n; ++i) {
+        const ReflectionProbe& p = s.probes[i];
+        records[i].position = glm::vec4(p.position, 0.0f);
+        records[i].halfExtent = glm::vec4(p.halfExtent, 0.0f);
+        for (int f = 0; f < 6; ++f) records[i].faces[f] = glm::vec4(p.faces[size_t(f)], 0.0f);
+        markers[i] = glm::vec4(p.position, 3.0f);  // markers.vert: a reflection probe
+    }
+    // Level m holds every probe's six faces, layer 6·probe + face, as the probe's chain holds them
+    // (rows top to bottom, x fastest), in half floats.
+    std::vector<vk::MipLevel> levels;
+    if (cubemap) {
+        for (int m = 0; m < s.mipCount; ++m) {
+            const uint32_t side = uint32_t(cubeMipSize(s.faceSize, m));
+            const size_t faceTexels = size_t(side) * side;
+            vk::MipLevel level{side, side, std::vector<uint8_t>(n * 6 * faceTexels * 8)};
+            tbb::parallel_for(size_t(0), n, [&](size_t i) {
+                const glm::vec3* texels = s.probes[i].texels.data();
+                for (int f = 0; f < 6; ++f) {
+                    const glm::vec3* face = texels + s.texelOffset(m, f);
+                    uint8_t* out = level.bytes.data() + (i * 6 + size_t(f)) * faceTexels * 8;
+                    for (size_t t = 0; t < faceTexels; ++t) {
+                        const uint64_t packed = glm::packHalf4x16(glm::vec4(face[t], 1.0f));
+                        std::memcpy(out + 8 * t, &packed, 8);
+                    }
+                }
+            });
+            reflectionBytes_ += level.bytes.size();
+            levels.push_back(std::move(level));
+        }
+    } else {
+        levels.push_back(vk::MipLevel{1, 1, std::vector<uint8_t>(8, 0)});  // nothing reads it
+    }
+    reflectionBytes_ += records.size() * sizeof(records[0]);
+    r->cubes = vk::Image::textureArray(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, layers, levels);
+    r->records = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(records[0]),
+                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    r->markers = vk::Buffer::deviceLocal(ctx_, markers.data(), markers.size() * sizeof(glm::vec4),
+                                         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    r->markerCount = uint32_t(n);
+    r->grid.grid = glm::ivec4(s.dims[0], s.dims[1], cubemap ? 1 : 0, cubemap ? s.mipCount : 1);
+    r->grid.origin = glm::vec4(s.origin, s.spacing);
+    r->grid.coverage = glm::vec4(s.cellSize, s.blendDistance, 0.0f);
+    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+        r->blocks.push_back(vk::Buffer::hostVisible(ctx_, sizeof(blocks::ReflectionBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
+    g.graph.importBuffer(kReflectionRecords, r->records.handle(), true);
+    g.graph.importBuffer(kReflectionMarkers, r->markers.handle(), true);
+    g.reflections = std::move(r);
+    buildReflectionSets();
 }
 
 void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
@@ -732,7 +868,14 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // reads their light.
     ProbeResources* probes =
         g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
+    // Reflection probes take part only when a set is bound, probes are on and the view reads the
+    // environment's specular. The strength does not decide it: it is a live uniform, and a weight
+    // of 0 leaves the sky's specular as it is.
+    ReflectionResources* reflections =
+        g.reflections && s.probes && view.needs.reflectionProbes ? g.reflections.get() : nullptr;
     const bool drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
+    // The reflection probes' markers, with the probe positions.
+    const bool drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
     const bool drawLeaves = s.showLeaves && leafCount_ > 0;
     // Shadows: the scene has them on, the sun is up and the view draws them.
     const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f;
@@ -762,13 +905,15 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
     // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
     const bool vertexAttribute = probes || sunVisibility;
+    const int lightsVariant = (shadows ? kShadowedLights : 0) | (reflections ? kReflectedLights : 0);
     const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
-                        (fog ? kFogVariant : 0);
+                        (fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0);
     vk::UniquePipeline& terrainPipeline = g.terrain[variant];
     if (!terrainPipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
-        d.frag = shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag();
+        d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
+                             : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
         d.fragConstants = {fog ? 1u : 0u};
         d.bindings = {meshBinding};
         d.attributes = {position, normal};
@@ -776,8 +921,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
             d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
         }
-        terrainPipeline = vk::createGraphicsPipeline(
-            ctx_, g.clearPass.handle(), (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle(), d);
+        terrainPipeline = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(),
+                                                     g.terrainLayouts[size_t(lightsVariant)].handle(), d);
     }
     vk::UniquePipeline& skyPipeline = fog ? g.skyFog : g.skyPlain;
     if ((sky || planarReflection) && !skyPipeline) {
@@ -786,19 +931,21 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         d.frag = shaders::skyBackgroundFrag();
         d.fragConstants = {fog ? 1u : 0u};
         d.depthWrite = false;
-        skyPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.terrainLayout.handle(), d);
+        skyPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.terrainLayouts[0].handle(), d);
     }
-    const int waterVariant = (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0);
+    const int waterVariant = (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0) |
+                             (reflections ? kReflectionVariant : 0);
     vk::UniquePipeline& waterPipeline = g.waterPipelines[waterVariant];
     if (water && !waterPipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::waterVert();
-        d.frag = shadows ? shaders::waterShadowFrag() : shaders::waterFrag();
+        d.frag = reflections ? (shadows ? shaders::waterShadowReflectionFrag() : shaders::waterReflectionFrag())
+                             : (shadows ? shaders::waterShadowFrag() : shaders::waterFrag());
         d.fragConstants = {fog ? 1u : 0u};
         d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
         d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
-        waterPipeline = vk::createGraphicsPipeline(
-            ctx_, g.drawPass.handle(), (shadows ? g.shadowedWaterPipelineLayout : g.waterPipelineLayout).handle(), d);
+        waterPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(),
+                                                   g.waterLayouts[size_t(lightsVariant)].handle(), d);
     }
     if (shadows && !g.shadowDepth) {
         vk::GraphicsPipelineDesc d;
@@ -811,7 +958,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     }
     const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
     const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
-    if (drawMarkers && !g.markerPipeline) {
+    if ((drawMarkers || drawReflectionMarkers) && !g.markerPipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::markersVert();
         d.frag = shaders::markersFrag();
@@ -924,7 +1071,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         mirrored.view = glm::ivec4(kViewBeauty, 1, camera.view.z, 0);
         slot.reflectionCamera.write(&mirrored, sizeof mirrored);
     }
-    if (drawMarkers || drawLeaves) {
+    if (reflections) {
+        blocks::ReflectionBlock block = reflections->grid;
+        block.coverage.w = std::clamp(s.reflectionStrength, 0.0f, 1.0f);
+        reflections->blocks[slotIndex].write(&block, sizeof block);
+    }
+    if (drawMarkers || drawReflectionMarkers || drawLeaves) {
         blocks::OverlayBlock overlay;
         overlay.leaves = glm::vec4(smallestLeaf_, kSmallestLeafPixels, 0.0f, 0.0f);
         overlay.markers = glm::ivec4(s.showProbePositions ? 1 : 0, 1, 0, 0);
@@ -1024,7 +1176,10 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
 
     // The terrain draw, shared by the frame and the planar reflection (which binds the mirrored
     // camera's view set): its uses and bindings beyond the targets, and its recording.
-    vk::DescriptorSet& lights = shadows ? slot.shadowedLights : slot.lights;
+    const vk::DescriptorSet& lights = reflections ? (shadows ? reflections->shadowedLights[slotIndex]
+                                                             : reflections->lights[slotIndex])
+                                    : shadows ? slot.shadowedLights
+                                              : slot.lights;
     VkBuffer attribute = VK_NULL_HANDLE;
     const char* attributeName = nullptr;
     if (probes) {
@@ -1039,7 +1194,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
     const uint32_t indexCount = uint32_t(indexCount_);
     const VkPipeline terrainHandle = terrainPipeline.get();
-    const VkPipelineLayout terrainLayout = (shadows ? g.shadowedTerrainLayout : g.terrainLayout).handle();
+    const VkPipelineLayout terrainLayout = g.terrainLayouts[size_t(lightsVariant)].handle();
     const VkDescriptorSet lightsSet = lights.handle();
     const auto terrainPass = [&](const char* name, std::vector<ResourceUse> targets, const vk::DescriptorSet& viewSet) {
         PassInfo info{name, std::move(targets),
@@ -1048,6 +1203,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         info.uses.push_back({kVertices, Access::VertexAttributeRead});
         info.uses.push_back({kIndices, Access::IndexRead});
         if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
+        if (reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
         if (attributeName) {
             info.uses.push_back({attributeName, Access::VertexAttributeRead});
             info.bindings.push_back(std::string("vertex:") + attributeName);
@@ -1103,7 +1259,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         graph.addPass(std::move(info), [&g, pipeline, sets, beginDrawing](VkCommandBuffer c) {
             beginDrawing(c);
             vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayouts[0].handle(), TLX_SET_VIEW, 2,
                                     sets, 0, nullptr);
             vkCmdDraw(c, 3, 1, 0, 0);
             vkCmdEndRenderPass(c);
@@ -1135,7 +1291,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             setViewport(c, rw, rh);
             vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, skyHandle);
             const VkDescriptorSet sets[] = {viewSet, skyLights};
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayout.handle(), TLX_SET_VIEW, 2,
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayouts[0].handle(), TLX_SET_VIEW, 2,
                                     sets, 0, nullptr);
             vkCmdDraw(c, 3, 1, 0, 0);
             vkCmdEndRenderPass(c);
@@ -1166,9 +1322,10 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                       concat(concat(concat(slot.view.bindingNames(), lights.bindingNames()), waterSet.bindingNames()),
                              {std::string("vertex:") + kWaterVertices, std::string("index:") + kWaterIndices})};
         if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
+        if (reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
         if (fog) info.bindings.push_back("fog");
         const VkPipeline pipeline = waterPipeline.get();
-        const VkPipelineLayout layout = (shadows ? g.shadowedWaterPipelineLayout : g.waterPipelineLayout).handle();
+        const VkPipelineLayout layout = g.waterLayouts[size_t(lightsVariant)].handle();
         const VkDescriptorSet sets[] = {slot.view.handle(), lightsSet, waterSet.handle()};
         const VkBuffer vb = water->vertices.handle(), ib = water->indices.handle();
         const uint32_t waterIndices = water->indexCount;
@@ -1186,7 +1343,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         });
     }
 
-    if (drawMarkers || drawLeaves) {
+    if (drawMarkers || drawReflectionMarkers || drawLeaves) {
         PassInfo info{"overlays",
                       {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
                       concat(slot.view.bindingNames(), slot.overlays.bindingNames())};
@@ -1198,8 +1355,15 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             info.uses.push_back({kMarkers, Access::VertexAttributeRead});
             info.bindings.push_back(std::string("vertex:") + kMarkers);
         }
+        if (drawReflectionMarkers) {
+            info.uses.push_back({kReflectionMarkers, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kReflectionMarkers);
+        }
         const uint32_t leafCount = drawLeaves ? leafCount_ : 0, markerCount = drawMarkers ? markerCount_ : 0;
-        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, beginDrawing](VkCommandBuffer c) {
+        const vk::Buffer* reflectionMarkers = drawReflectionMarkers ? &g.reflections->markers : nullptr;
+        const uint32_t reflectionMarkerCount = drawReflectionMarkers ? g.reflections->markerCount : 0;
+        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, reflectionMarkers, reflectionMarkerCount,
+                                        beginDrawing](VkCommandBuffer c) {
             beginDrawing(c);
             const VkDescriptorSet view = slot.view.handle(), overlay = slot.overlays.handle();
             vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
@@ -1215,6 +1379,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             };
             if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
             if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
+            if (reflectionMarkerCount > 0) draw(g.markerPipeline.get(), *reflectionMarkers, 6, reflectionMarkerCount);
             vkCmdEndRenderPass(c);
         });
     }

@@ -30,6 +30,8 @@
 
 namespace terralux {
 
+struct ReflectionProbeSet;  // bake/ReflectionBake.h
+
 // One baked volume as the GPU reads it: the .shprobe grid (occupancy + coefficients).
 struct GpuProbeVolume {
     std::string name;  // the volume's, for overlays and messages
@@ -75,7 +77,8 @@ struct WaterLook {
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
-    bool probes = true;           // false: exactly the image without probes (no probe pass)
+    bool probes = true;           // false: exactly the image without probes, diffuse or reflection
+                                  // (no probe pass, no reflection probes bound)
     bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
     OrbitCamera camera;
     glm::vec3 albedo{0.3f};       // the constant albedo (when no albedo map is set)
@@ -91,6 +94,9 @@ struct RenderSettings {
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
     WaterLook water;
+    // reflection_probes.strength, [0, 1]: how far bound reflection probes replace the sky's
+    // specular (0 draws the image without them, bit for bit).
+    float reflectionStrength = 1.0f;
 };
 
 struct RenderedImage {
@@ -110,6 +116,15 @@ public:
     // Binds the volumes (none: the probe subsystem and its buffers go away); the next frame that
     // needs probe light runs the probe pass.
     void setProbeVolumes(const std::vector<GpuProbeVolume>& volumes);
+    // Binds a reflection-probe set (null: none; the subsystem and all its GPU resources go away).
+    // Its probes are uploaded here, once; frames whose view reads the environment's specular
+    // bind them with the lights. Throws std::invalid_argument for a set whose probes, grid and
+    // texels disagree, or that holds more faces than the device's image arrays.
+    void setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set);
+    // Whether the reflection subsystem holds GPU resources (a set is bound).
+    bool hasReflectionResources() const;
+    // Bytes of the bound reflection probes on the GPU: their records and cube texels.
+    size_t reflectionBytes() const { return reflectionBytes_; }
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.
     void setProbePositions(const std::vector<glm::vec4>& positions);
     // Octree leaves for the leaf overlay: min corner xyz, w edge (metres).
@@ -162,11 +177,12 @@ private:
     void uploadSurfaceMaps(const std::vector<float>& ao);
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
+    void buildReflectionSets();
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;
     int stride_ = 1;
-    size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0;
+    size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
     int volumeCount_ = 0;
     bool anyErrorMap_ = false;
     uint32_t markerCount_ = 0, leafCount_ = 0;

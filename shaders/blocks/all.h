@@ -10,6 +10,7 @@
 #include "blocks/probes.h"
 #include "blocks/overlay.h"
 #include "blocks/water.h"
+#include "blocks/reflections.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN
