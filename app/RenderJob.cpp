@@ -85,6 +85,7 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.shadows = scene.shadows;
     base_.fog = resolvedFog(scene.fog, lighting.sky, terrain_.heightfield);
     base_.skirt = scene.terrain.skirt;
+    base_.reflectionStrength = float(scene.reflectionProbes.strength);
     // Water: the level and the highest crest decide the field and the mesh (built again only when
     // they change); everything else is uniforms.
     const WaterSettings& ws = scene.water;
@@ -157,6 +158,10 @@ void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
         hasErrorMap_ = hasErrorMap_ || !v.diagnostics->errorMap.empty();
     }
     updateOverlays();
+}
+
+void ProjectRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
+    renderer_->setReflectionProbes(std::move(set));
 }
 
 void ProjectRenderer::updateOverlays() {

@@ -66,6 +66,8 @@ public:
     const std::vector<std::string>& staleBake() const { return staleBake_; }
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes);
+    // Binds a reflection-probe set (null: none) for the renderer to draw with.
+    void setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set);
     // Probes of the bound volumes (what the viewport lights with), whatever the settings say now.
     size_t boundProbeCount() const { return boundProbes_; }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
