@@ -18,6 +18,7 @@
 #include "RenderJob.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
+#include "bake/ReflectionBake.h"
 #include "render/DebugViews.h"
 #include "render/FrameGraph.h"
 #include "vk/Descriptors.h"
@@ -127,6 +128,131 @@ double meanAbsDiff(const RenderedImage& a, const RenderedImage& b) {
     return test::compareImages(a.rgba, b.rgba, a.width, a.height).meanAbs;
 }
 
+// A reflection-probe set built from ReflectionBake.h's types (the tests load no reflection bake):
+// an nx x nz grid whose cells tile `region` (xz min corner and size; default the footprint),
+// probes `above` metres over the surface, boxes half a cell wide and reaching from below the
+// lowest terrain as far above the probe. Each face has a colour of its own, scaled per probe; in
+// the cubemap encoding (8 texels a side, 4 mips) its texels ramp across the face at mip 0 and each
+// coarser mip is the 2x2 mean of the one before, so a lookup that took the wrong face, row, column,
+// mip or probe shows. `uniform`: every face and texel that radiance instead.
+struct ReflectionSetOptions {
+    ReflectionEncoding encoding = ReflectionEncoding::Cubemap;
+    int nx = 2, nz = 2;
+    std::optional<glm::vec3> uniform;
+    std::optional<std::pair<glm::vec2, glm::vec2>> region;
+    float blendDistance = -1.0f;  // < 0: a quarter of the smaller cell side
+    float above = 20.0f;
+};
+
+std::shared_ptr<ReflectionProbeSet> reflectionSet(const Heightfield& hf, const ReflectionSetOptions& o = {}) {
+    auto s = std::make_shared<ReflectionProbeSet>();
+    const bool cubemap = o.encoding == ReflectionEncoding::Cubemap;
+    const int size = 8;
+    s->encoding = o.encoding;
+    s->faceSize = cubemap ? size : 0;
+    s->mipCount = cubemap ? cubeMipCount(size) : 1;
+    s->dims = {o.nx, o.nz};
+    const glm::vec2 lo = o.region ? o.region->first : glm::vec2(hf.minX(), hf.minZ());
+    const glm::vec2 span = o.region ? o.region->second : glm::vec2(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ());
+    s->cellSize = span / glm::vec2(float(o.nx), float(o.nz));
+    s->origin = lo + 0.5f * s->cellSize;
+    s->spacing = glm::vec2(o.nx > 1 ? s->cellSize.x : 0.0f, o.nz > 1 ? s->cellSize.y : 0.0f);
+    s->blendDistance = o.blendDistance >= 0.0f ? o.blendDistance : 0.25f * std::min(s->cellSize.x, s->cellSize.y);
+    const glm::vec3 base[6] = {{0.60f, 0.10f, 0.10f}, {0.10f, 0.60f, 0.10f}, {0.15f, 0.20f, 0.70f},
+                               {0.30f, 0.22f, 0.10f}, {0.55f, 0.50f, 0.10f}, {0.10f, 0.45f, 0.50f}};
+    const int n = o.nx * o.nz;
+    for (int k = 0; k < o.nz; ++k)
+        for (int i = 0; i < o.nx; ++i) {
+            ReflectionProbe p;
+            p.id = uint32_t(k * o.nx + i);
+            const glm::vec2 xz = s->origin + glm::vec2(float(i), float(k)) * s->cellSize;
+            p.position = glm::vec3(xz.x, hf.surfaceHeight(xz.x, xz.y) + o.above, xz.y);
+            p.halfExtent = glm::vec3(0.5f * s->cellSize.x, p.position.y - hf.minHeight() + o.above, 0.5f * s->cellSize.y);
+            const float scale = 1.0f + 0.5f * float(p.id) / float(n);
+            for (int f = 0; f < 6; ++f) p.faces[size_t(f)] = o.uniform ? *o.uniform : base[f] * scale;
+            if (cubemap) {
+                p.texels.resize(s->texelsPerProbe());
+                for (int f = 0; f < 6; ++f)
+                    for (int y = 0; y < size; ++y)
+                        for (int x = 0; x < size; ++x) {
+                            const float sx = (float(x) + 0.5f) / float(size), ty = (float(y) + 0.5f) / float(size);
+                            p.texels[s->texelOffset(0, f) + size_t(y * size + x)] =
+                                o.uniform ? *o.uniform : p.faces[size_t(f)] * (0.5f + sx) * (0.75f + 0.5f * ty);
+                        }
+                for (int m = 1; m < s->mipCount; ++m) {
+                    const int side = cubeMipSize(size, m);
+                    for (int f = 0; f < 6; ++f)
+                        for (int y = 0; y < side; ++y)
+                            for (int x = 0; x < side; ++x) {
+                                const glm::vec3* finer = &p.texels[s->texelOffset(m - 1, f)];
+                                const size_t w = size_t(2 * side);
+                                p.texels[s->texelOffset(m, f) + size_t(y * side + x)] =
+                                    0.25f * (finer[size_t(2 * y) * w + size_t(2 * x)] + finer[size_t(2 * y) * w + size_t(2 * x + 1)] +
+                                             finer[size_t(2 * y + 1) * w + size_t(2 * x)] +
+                                             finer[size_t(2 * y + 1) * w + size_t(2 * x + 1)]);
+                            }
+                }
+            }
+            s->probes.push_back(std::move(p));
+        }
+    return s;
+}
+
+// What the terrain shader reads from `s` at p along r, written from docs/lighting.md with the
+// bake's evaluate(): the blend weight (strength 1) and the probes' radiance, bilinear over the
+// probes around p, each box-projected.
+glm::vec3 referenceReflection(const ReflectionProbeSet& s, glm::vec3 p, glm::vec3 r, float roughness, float& weight) {
+    const glm::vec2 dims(float(s.dims[0]), float(s.dims[1]));
+    const glm::vec2 lo = s.origin - 0.5f * s.cellSize, hi = s.origin + s.spacing * (dims - 1.0f) + 0.5f * s.cellSize;
+    const glm::vec2 xz(p.x, p.z);
+    const float dist = glm::length(xz - glm::clamp(xz, lo, hi));
+    weight = dist <= 0.0f ? 1.0f : s.blendDistance > 0.0f ? std::clamp(1.0f - dist / s.blendDistance, 0.0f, 1.0f) : 0.0f;
+    glm::vec3 sum(0.0f);
+    float g[2], f[2];
+    int i0[2];
+    for (int a = 0; a < 2; ++a) {
+        const float spacing = s.spacing[a], origin = s.origin[a], q = a == 0 ? p.x : p.z;
+        g[a] = std::clamp(spacing > 0.0f ? (q - origin) / spacing : 0.0f, 0.0f, float(s.dims[size_t(a)] - 1));
+        i0[a] = std::min(int(std::floor(g[a])), std::max(s.dims[size_t(a)] - 2, 0));
+        f[a] = g[a] - float(i0[a]);
+    }
+    for (int k = 0; k < 4; ++k) {
+        const int ox = k & 1, oz = k >> 1;
+        const float w = (ox ? f[0] : 1.0f - f[0]) * (oz ? f[1] : 1.0f - f[1]);
+        if (w <= 0.0f) continue;
+        const int cx = std::min(i0[0] + ox, s.dims[0] - 1), cz = std::min(i0[1] + oz, s.dims[1] - 1);
+        const ReflectionProbe& probe = s.probes[size_t(cz * s.dims[0] + cx)];
+        // Box projection: from inside the box, the direction from the capture point to where the
+        // ray leaves it.
+        const glm::vec3 q = p - probe.position;
+        glm::vec3 dir = r;
+        if (std::abs(q.x) <= probe.halfExtent.x && std::abs(q.y) <= probe.halfExtent.y && std::abs(q.z) <= probe.halfExtent.z) {
+            float t = INFINITY;
+            for (int a = 0; a < 3; ++a)
+                if (r[a] != 0.0f) t = std::min(t, ((r[a] > 0.0f ? probe.halfExtent[a] : -probe.halfExtent[a]) - q[a]) / r[a]);
+            dir = q + t * r;
+        }
+        sum += w * s.evaluate(size_t(cz * s.dims[0] + cx), dir, roughness);
+    }
+    return sum;
+}
+
+// The set the golden images of the reflection views show: 2 x 2 cubemap probes over the middle
+// 70 % of the footprint, fading to the sky's over a quarter cell around it.
+std::shared_ptr<ReflectionProbeSet> goldenReflections(const Heightfield& hf) {
+    ReflectionSetOptions o;
+    const glm::vec2 span(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ());
+    o.region = std::make_pair(glm::vec2(hf.minX(), hf.minZ()) + 0.15f * span, 0.7f * span);
+    return reflectionSet(hf, o);
+}
+
+// Draws view `view` with `set` bound (null: none), keeping the set bound afterwards.
+RenderedImage drawWith(ProjectRenderer& r, std::shared_ptr<const ReflectionProbeSet> set, int view,
+                       bool linear = false, bool probes = true) {
+    r.setReflectionProbes(std::move(set));
+    return draw(r, view, probes, linear);
+}
+
 }  // namespace
 
 namespace {
@@ -164,7 +290,14 @@ TEST_F(RenderTest, GoldenImagesOfEveryView) {
     ProjectRenderer r(*ctx_, p);
     addLake(p, r);
     ASSERT_EQ(r.loadProbes(true), 1u);
-    for (const auto& v : debugViews()) checkGolden(std::to_string(v.number) + "-" + v.name, draw(r, v.number));
+    // The reflection views show a synthetic set (no reflection bake is loaded here); every other
+    // view the project as it is, without reflection probes.
+    const auto reflections = goldenReflections(r.heightfield());
+    for (const auto& v : debugViews()) {
+        const bool reflectionView = v.number == kViewReflectionColor || v.number == kViewReflectionWeight;
+        r.setReflectionProbes(reflectionView ? reflections : nullptr);
+        checkGolden(std::to_string(v.number) + "-" + v.name, draw(r, v.number));
+    }
 }
 
 TEST_F(RenderTest, ProbesDisabledEqualsTheUnprobedImage) {
@@ -558,6 +691,7 @@ TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
     ProjectRenderer r(*ctx_, p);
     addLake(p, r);
     ASSERT_EQ(r.loadProbes(true), 1u);
+    r.setReflectionProbes(goldenReflections(r.heightfield()));  // the reflection views have probes to show
     for (const auto& v : debugViews())
         for (bool linear : {false, true}) {
             const RenderedImage img = draw(r, v.number, true, linear);
@@ -1193,4 +1327,263 @@ TEST_F(RenderTest, EveryWaterSettingChangesOnlyTheWater) {
         EXPECT_GT(waterChanged, 50u) << name;
         EXPECT_EQ(landChanged, 0u) << name;
     }
+}
+
+// ---- Reflection probes -------------------------------------------------------------------------
+
+namespace {
+
+// Whether any pass of the frame touches or binds anything of the reflection probes.
+std::string reflectionMention(const std::vector<PassInfo>& passes) {
+    for (const auto& p : passes) {
+        for (const auto& b : p.bindings)
+            if (b.find("reflection-probe") != std::string::npos) return p.name + " binds " + b;
+        for (const auto& u : p.uses)
+            if (u.resource.find("reflection-probe") != std::string::npos) return p.name + " uses " + u.resource;
+    }
+    return "";
+}
+
+Project withStrength(Project p, double strength) {
+    p.scene.reflectionProbes.strength = strength;
+    return p;
+}
+
+}  // namespace
+
+// Strength 0 draws the image without reflection probes (within 1/255), though the probes are
+// bound and read; strength 1 does not.
+TEST_F(RenderTest, ReflectionStrengthZeroEqualsTheProbelessImage) {
+    Project p = sampleProject("reflection_strength", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
+    p.scene.water.reflection = WaterReflection::Sky;  // the water reads the probes too
+    r.setProject(p);
+    const RenderedImage none = drawWith(r, nullptr, kViewBeauty);
+    r.setProject(withStrength(p, 0.0));
+    const RenderedImage zero = drawWith(r, reflectionSet(r.heightfield()), kViewBeauty);
+    EXPECT_TRUE(binds(r.renderer().lastFramePasses(), "terrain", "reflection-probe-records"));
+    EXPECT_TRUE(binds(r.renderer().lastFramePasses(), "water", "reflection-probe-cubes"));
+    const auto d = test::compareImages(zero.rgba, none.rgba, kW, kH);
+    EXPECT_LE(d.maxAbs, 1.0 / 255.0) << "at (" << d.maxX << ", " << d.maxY << ")";
+    r.setProject(withStrength(p, 1.0));
+    EXPECT_GT(meanAbsDiff(draw(r, kViewBeauty), none), 0.5 / 255.0);
+}
+
+// Views 52 and 53 are black without reflection probes; with a set over the footprint the colour
+// view shows them on the terrain and the weight view is the strength there.
+TEST_F(RenderTest, ReflectionViewsAreBlackWithoutProbesAndShowThemWith) {
+    Project p = sampleProject("reflection_views", 2, 2);
+    ProjectRenderer r(*ctx_, p);
+    const std::vector<size_t> terrain = terrainPixels(r);
+    ASSERT_GT(terrain.size(), size_t(kW) * kH / 4);
+    for (int view : {kViewReflectionColor, kViewReflectionWeight})
+        for (bool linear : {false, true}) {
+            const RenderedImage img = drawWith(r, nullptr, view, linear);
+            for (size_t i = 0; i < img.rgba.size(); ++i) {
+                if (i % 4 == 3) continue;  // alpha
+                ASSERT_EQ(img.rgba[i], 0.0f) << "view " << view << " pixel " << i / 4;
+            }
+        }
+    const auto set = reflectionSet(r.heightfield());
+    const RenderedImage color = drawWith(r, set, kViewReflectionColor, true);
+    size_t lit = 0;
+    for (size_t i : terrain) lit += color.rgba[i * 4] > 0.01f && color.rgba[i * 4 + 1] > 0.01f && color.rgba[i * 4 + 2] > 0.01f;
+    EXPECT_GT(lit, terrain.size() * 99 / 100);
+    r.setProject(withStrength(p, 0.5));
+    const RenderedImage weight = draw(r, kViewReflectionWeight);
+    for (size_t i : terrain) ASSERT_NEAR(weight.rgba[i * 4], 0.5f, 1e-3f) << "pixel " << i;
+    // Half the strength, half the colour.
+    const RenderedImage half = draw(r, kViewReflectionColor, true, true);
+    for (size_t i : terrain) ASSERT_NEAR(half.rgba[i * 4 + 1], 0.5f * color.rgba[i * 4 + 1], 2e-3f + 2e-3f * color.rgba[i * 4 + 1]);
+}
+
+// On a flat plane seen from above, view 52 is what the bake's evaluate() gives through the grid's
+// coverage, bilinear blend and box projection (an independent reference), in both encodings.
+TEST_F(RenderTest, ReflectionLookupMatchesTheBakeEvaluateOnAFlatPlane) {
+    Project p = topDown(sampleProject("reflection_flat", 2, 2), writeDem("flat", 65, 10.0, [](int, int) { return 0.0f; }));
+    p.scene.detail.enabled = false;  // the normal is the plane's
+    ProjectRenderer r(*ctx_, p);
+    const Heightfield& hf = r.heightfield();
+    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+    const OrbitCamera& camera = r.defaultCamera();
+    const glm::mat4 inv = glm::inverse(camera.viewProjection(1.0f, extent));
+    const float roughness = float(p.scene.terrain.roughness);  // a plane has no normal variance
+    for (ReflectionEncoding encoding : {ReflectionEncoding::Cubemap, ReflectionEncoding::Faces}) {
+        ReflectionSetOptions o;
+        o.encoding = encoding;
+        o.nx = 3;
+        o.nz = 2;
+        // The middle 70 % of the plane: the fade to the sky's lies on it too.
+        const glm::vec2 span(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ());
+        o.region = std::make_pair(glm::vec2(hf.minX(), hf.minZ()) + 0.15f * span, 0.7f * span);
+        const auto set = reflectionSet(hf, o);
+        r.setReflectionProbes(set);
+        const RenderedImage img = drawSquare(r, kViewReflectionColor, true);
+        size_t checked = 0, off = 0, fading = 0, covered = 0;
+        double worst = 0.0;
+        for (uint32_t y = 0; y < kW; ++y)
+            for (uint32_t x = 0; x < kW; ++x) {
+                const glm::vec2 q = planePoint(inv, kW, kW, x, y, 0.0f);
+                if (!hf.contains(q.x, q.y)) continue;  // the background
+                const glm::vec3 pos(q.x, 0.0f, q.y);
+                const glm::vec3 v = glm::normalize(camera.position() - pos);
+                const glm::vec3 refl(-v.x, v.y, -v.z);  // reflect(−v, up)
+                float w = 0.0f;
+                const glm::vec3 radiance = referenceReflection(*set, pos, refl, roughness, w);
+                const glm::vec3 expected = radiance * w;
+                fading += w > 0.05f && w < 0.95f;
+                covered += w > 0.0f;
+                const float* got = &img.rgba[(size_t(y) * kW + x) * 4];
+                ++checked;
+                double e = 0.0;
+                for (int c = 0; c < 3; ++c) e = std::max(e, double(std::abs(got[c] - expected[c])) / (0.01 + expected[c]));
+                worst = std::max(worst, e);
+                off += e > 0.03;
+            }
+        ASSERT_GT(fading, checked / 20);
+        ASSERT_GT(covered, checked / 2);
+        // A few pixels may fall on the other side of a face seam or a box wall than the reference.
+        EXPECT_LT(off, checked / 100) << (encoding == ReflectionEncoding::Cubemap ? "cubemap" : "faces") << ": worst " << worst;
+    }
+}
+
+// Binding a set is the only way reflection probes take part: the frames that read the
+// environment's specular bind the grid, records and cubes; other views, probes off, and a null set
+// bind nothing of them, and unbinding frees them and gives the image without them back.
+TEST_F(RenderTest, DisablingReflectionProbesFreesThemAndDropsTheBinding) {
+    Project p = sampleProject("reflection_binding", 2, 2);
+    ProjectRenderer r(*ctx_, p);
+    EXPECT_FALSE(r.renderer().hasReflectionResources());
+    EXPECT_EQ(r.renderer().reflectionBytes(), 0u);
+    const RenderedImage before = draw(r, kViewBeauty);
+    EXPECT_EQ(reflectionMention(r.renderer().lastFramePasses()), "");
+
+    const auto set = reflectionSet(r.heightfield());
+    r.setReflectionProbes(set);
+    EXPECT_TRUE(r.renderer().hasReflectionResources());
+    // Per probe a record of 8 vec4, and its chain of 6 faces in RGBA16F.
+    EXPECT_EQ(r.renderer().reflectionBytes(), set->probes.size() * (8 * 16 + set->texelsPerProbe() * 8));
+    const RenderedImage with = draw(r, kViewBeauty);
+    const auto& passes = r.renderer().lastFramePasses();
+    for (const char* b : {"reflection-probe-grid", "reflection-probe-records", "reflection-probe-cubes"})
+        EXPECT_TRUE(binds(passes, "terrain", b)) << b;
+    EXPECT_GT(meanAbsDiff(with, before), 0.5 / 255.0);
+    draw(r, kViewAlbedo);
+    EXPECT_EQ(reflectionMention(r.renderer().lastFramePasses()), "") << "a view without specular";
+    EXPECT_EQ(test::compareImages(draw(r, kViewBeauty, false).rgba, draw(r, kViewBeauty, false).rgba, kW, kH).maxAbs, 0.0);
+    EXPECT_EQ(reflectionMention(r.renderer().lastFramePasses()), "") << "probes off";
+
+    ReflectionSetOptions faces;
+    faces.encoding = ReflectionEncoding::Faces;
+    r.setReflectionProbes(reflectionSet(r.heightfield(), faces));
+    EXPECT_EQ(r.renderer().reflectionBytes(), 4u * 8 * 16) << "the faces encoding uploads records only";
+
+    r.setReflectionProbes(nullptr);
+    EXPECT_FALSE(r.renderer().hasReflectionResources());
+    EXPECT_EQ(r.renderer().reflectionBytes(), 0u);
+    for (const auto& v : debugViews()) {
+        draw(r, v.number);
+        EXPECT_EQ(reflectionMention(r.renderer().lastFramePasses()), "") << v.name;
+    }
+    EXPECT_EQ(test::compareImages(draw(r, kViewBeauty).rgba, before.rgba, kW, kH).maxAbs, 0.0);
+}
+
+// Reflection probes change the image through the specular alone: what they add does not depend
+// on the albedo, it has the sign of the probes' radiance against the sky's, and it is no more
+// than the environment BRDF lets through (under 0.15 of the radiance difference here).
+TEST_F(RenderTest, ReflectionProbesChangeTheImageThroughTheSpecularOnly) {
+    Project p = sampleProject("reflection_specular", 2, 2);
+    p.scene.terrain.albedoMode = AlbedoMode::Constant;
+    ProjectRenderer r(*ctx_, p);
+    const std::vector<size_t> terrain = terrainPixels(r);
+    auto linear = [&](const std::shared_ptr<const ReflectionProbeSet>& set, float albedo, double strength) {
+        Project q = withStrength(p, strength);
+        q.scene.terrain.albedo = glm::vec3(albedo);
+        r.setProject(q);
+        return drawWith(r, set, kViewLinear, true);
+    };
+    const glm::vec3 bright(4.0f), dark(0.0f);
+    for (const glm::vec3& radiance : {bright, dark}) {
+        ReflectionSetOptions o;
+        o.uniform = radiance;
+        const auto set = reflectionSet(r.heightfield(), o);
+        const RenderedImage a0 = linear(set, 0.1f, 0.0), a1 = linear(set, 0.1f, 1.0);
+        const RenderedImage b0 = linear(set, 0.5f, 0.0), b1 = linear(set, 0.5f, 1.0);
+        size_t rightWay = 0, sameForBoth = 0;
+        for (size_t i : terrain) {
+            const float da = a1.rgba[i * 4 + 1] - a0.rgba[i * 4 + 1], db = b1.rgba[i * 4 + 1] - b0.rgba[i * 4 + 1];
+            rightWay += radiance.y > 1.0f ? da > 0.0f && da < 0.15f * radiance.y : da < 0.0f;
+            sameForBoth += std::abs(da - db) <= 2e-3f + 0.01f * std::abs(da);
+        }
+        EXPECT_GT(rightWay, terrain.size() * 99 / 100) << "radiance " << radiance.y;
+        EXPECT_GT(sameForBoth, terrain.size() * 99 / 100) << "radiance " << radiance.y;
+    }
+}
+
+// With the sky's reflection the water reflects the nearest reflection probe where the probes
+// cover it; land the probes do not reach stays as it was, bit for bit.
+TEST_F(RenderTest, WaterInSkyReflectionModeUsesTheProbe) {
+    Project p = sampleProject("reflection_water", 2, 2);
+    p.scene.terrain.dem = writeBasinDem().string();
+    p.scene.camera.elevationDeg = 30.0;
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 20.0, testWaves());
+    p.scene.water.reflection = WaterReflection::Sky;
+    r.setProject(p);
+    const std::vector<uint8_t> mask = waterMask(r.render(unprobed(kViewWaterMask, true)));
+    // One bright probe over the middle 80 % of the basin, no fade: the lake lies under it, the
+    // land around it does not.
+    const Heightfield& hf = r.heightfield();
+    ReflectionSetOptions o;
+    o.nx = o.nz = 1;
+    o.uniform = glm::vec3(3.0f);
+    o.blendDistance = 0.0f;
+    const glm::vec2 span(hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ());
+    o.region = std::make_pair(glm::vec2(hf.minX(), hf.minZ()) + 0.1f * span, 0.8f * span);
+    const auto set = reflectionSet(hf, o);
+    const RenderedImage without = drawWith(r, nullptr, kViewLinear, true);
+    const RenderedImage with = drawWith(r, set, kViewLinear, true);
+    const RenderedImage weight = draw(r, kViewReflectionWeight);
+    size_t water = 0, brighter = 0, farLand = 0, landChanged = 0;
+    for (size_t i = 0; i < mask.size(); ++i) {
+        const float a = without.rgba[4 * i + 1], b = with.rgba[4 * i + 1];
+        if (mask[i]) {
+            ++water;
+            brighter += b > a + 1e-3f;
+        } else if (weight.rgba[4 * i] == 0.0f && !nearEdge(mask, kW, kH, uint32_t(i % kW), uint32_t(i / kW), 2)) {
+            ++farLand;
+            for (int c = 0; c < 3; ++c) landChanged += with.rgba[4 * i + size_t(c)] != without.rgba[4 * i + size_t(c)];
+        }
+    }
+    ASSERT_GT(water, 100u);
+    ASSERT_GT(farLand, 100u);
+    EXPECT_GT(brighter, water * 9 / 10);
+    EXPECT_EQ(landChanged, 0u);
+}
+
+// With the probe positions shown, the reflection probes are marked in their own colour (violet);
+// without a set, no violet marker.
+TEST_F(RenderTest, ReflectionProbeMarkersAreDrawnInTheirOwnColour) {
+    Project p = sampleProject("reflection_markers", 2, 2);
+    ProjectRenderer r(*ctx_, p);
+    RenderRequest q = unprobed(kViewAlbedo, false);
+    q.probePositions = true;
+    auto violet = [](const RenderedImage& img) {
+        size_t n = 0;
+        for (size_t i = 0; i < img.rgba.size(); i += 4)
+            n += std::abs(img.rgba[i] - 0.70f) < 0.02f && std::abs(img.rgba[i + 1] - 0.30f) < 0.02f &&
+                 std::abs(img.rgba[i + 2] - 1.0f) < 0.02f;
+        return n;
+    };
+    EXPECT_EQ(violet(r.render(q)), 0u);
+    ReflectionSetOptions o;
+    o.nx = 3;
+    o.nz = 3;
+    r.setReflectionProbes(reflectionSet(r.heightfield(), o));
+    const RenderedImage marked = r.render(q);
+    EXPECT_TRUE(binds(r.renderer().lastFramePasses(), "overlays", "vertex:reflection-probe-markers"));
+    EXPECT_GT(violet(marked), 9u * 4);  // 6 x 6 pixels each, some hidden behind the terrain
+    q.probePositions = false;
+    EXPECT_EQ(violet(r.render(q)), 0u);
 }
