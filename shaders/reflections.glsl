@@ -11,7 +11,7 @@
 layout(set = TLX_SET_LIGHTS, binding = TLX_REFLECTION_PROBES_BINDING, std430) readonly buffer ReflectionProbes {
     ReflectionProbeRecord p[];
 } reflectionProbes;
-layout(set = TLX_SET_LIGHTS, binding = TLX_REFLECTION_CUBES_BINDING) uniform sampler2DArray reflectionCubes;
+layout(set = TLX_SET_LIGHTS, binding = TLX_REFLECTION_CUBES_BINDING) uniform samplerCubeArray reflectionCubes;
 
 // The blend weight of the grid at p, strength included: 1 over the coverage rectangle (the
 // probes' cells, first probe − cell/2 to last probe + cell/2 in x and z), fading linearly to 0 at
@@ -37,30 +37,10 @@ vec3 boxProjected(ReflectionProbeRecord probe, vec3 p, vec3 r) {
     return q + min(min(exits.x, exits.y), exits.z) * r;
 }
 
-// The face a direction falls on and its (s, t) there: cubeFace() of ReflectionBake.h, the Vulkan
-// cube-map face selection (ties go to x, then y).
-int cubeFace(vec3 d, out vec2 st) {
-    vec3 a = abs(d);
-    int face;
-    vec2 uv;
-    if (a.x >= a.y && a.x >= a.z) {
-        face = d.x >= 0.0 ? 0 : 1;
-        uv = vec2(d.x >= 0.0 ? -d.z : d.z, -d.y) / a.x;
-    } else if (a.y >= a.z) {
-        face = d.y >= 0.0 ? 2 : 3;
-        uv = vec2(d.x, d.y >= 0.0 ? d.z : -d.z) / a.y;
-    } else {
-        face = d.z >= 0.0 ? 4 : 5;
-        uv = vec2(d.z >= 0.0 ? d.x : -d.x, -d.y) / a.z;
-    }
-    st = 0.5 * uv + 0.5;
-    return face;
-}
-
 // Probe i's prefiltered radiance toward d for GGX `roughness`. Faces: the ambient cube
-// Σ d_i² · face(sign d_i, i), the same at every roughness. Cubemap: the face's texels at lod
-// roughness × (mips − 1), bilinear within the face (clamped to its edge: no filtering across a
-// seam) and linear between the two mips, which the sampler does.
+// Σ d_i² · face(sign d_i, i), the same at every roughness. Cubemap: cube i of the array at lod
+// roughness × (mips − 1); the sampler picks the face (Vulkan's cube-face selection, the bake's
+// convention), filters bilinearly across face edges too and linearly between the two mips.
 vec3 probeRadiance(int i, vec3 d, float roughness) {
     d = normalize(d);
     if (reflection.grid.z == 0) {
@@ -69,10 +49,8 @@ vec3 probeRadiance(int i, vec3 d, float roughness) {
                d2.y * reflectionProbes.p[i].faces[d.y < 0.0 ? 3 : 2].rgb +
                d2.z * reflectionProbes.p[i].faces[d.z < 0.0 ? 5 : 4].rgb;
     }
-    vec2 st;
-    int face = cubeFace(d, st);
     float lod = clamp(roughness, 0.0, 1.0) * float(reflection.grid.w - 1);
-    return textureLod(reflectionCubes, vec3(st, float(6 * i + face)), lod).rgb;
+    return textureLod(reflectionCubes, vec4(d, float(i)), lod).rgb;
 }
 
 // Where p lies on the probe lattice, in probes from probe 0 (0 on a one-probe axis).

@@ -116,10 +116,11 @@ struct WaterResources {
 };
 
 // The reflection-probe subsystem: present only while a probe set is bound. The probe records
-// and, for the cubemap encoding, their faces (a 2D array, layer 6·probe + face, with the set's
-// mip chain; a 1×1 placeholder for the faces encoding) are uploaded once per set. The faces are
-// an image rather than texels in the buffer so that the sampler does the filtering the bake's
-// evaluate() describes, bilinear within a face and linear between mips, in one fetch per probe.
+// and, for the cubemap encoding, their cubes (one cube-map array, layer 6·probe + face, with the
+// set's mip chain; a 1×1 placeholder cube for the faces encoding) are uploaded once per set. The
+// cubes are an image rather than texels in the buffer so that the sampler does the filtering the
+// bake's evaluate() describes, bilinear (seamless across face edges, as cube-map hardware
+// filters) and linear between mips, in one fetch per probe.
 // Per frame slot: the grid block (it holds the live strength) and the lights sets that bind it,
 // without and with the shadow cascades (the latter while the maps exist).
 struct ReflectionResources {
@@ -596,7 +597,6 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
         throw std::invalid_argument("reflection probes: a grid of " + std::to_string(s.dims[0]) + " x " +
                                     std::to_string(s.dims[1]) + " holds " + std::to_string(n) + " probes");
     const bool cubemap = s.encoding == ReflectionEncoding::Cubemap;
-    uint32_t layers = 1;
     if (cubemap) {
         if (s.faceSize < 1 || (s.faceSize & (s.faceSize - 1)) != 0 || s.mipCount != cubeMipCount(s.faceSize))
             throw std::invalid_argument("reflection probes: cube faces of " + std::to_string(s.faceSize) +
@@ -612,7 +612,6 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
             throw std::invalid_argument("reflection probes: " + std::to_string(n) + " cubes need " +
                                         std::to_string(6 * n) + " image layers, the device holds " +
                                         std::to_string(props.limits.maxImageArrayLayers));
-        layers = uint32_t(6 * n);
     }
 
     auto r = std::make_unique<ReflectionResources>();
@@ -626,7 +625,7 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
         markers[i] = glm::vec4(p.position, 3.0f);  // markers.vert: a reflection probe
     }
     // Level m holds every probe's six faces, layer 6·probe + face, as the probe's chain holds them
-    // (rows top to bottom, x fastest), in half floats.
+    // (rows top to bottom, x fastest: the bake's faces are Vulkan's), in half floats.
     std::vector<vk::MipLevel> levels;
     if (cubemap) {
         for (int m = 0; m < s.mipCount; ++m) {
@@ -648,10 +647,10 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
             levels.push_back(std::move(level));
         }
     } else {
-        levels.push_back(vk::MipLevel{1, 1, std::vector<uint8_t>(8, 0)});  // nothing reads it
+        levels.push_back(vk::MipLevel{1, 1, std::vector<uint8_t>(6 * 8, 0)});  // nothing reads it
     }
     reflectionBytes_ += records.size() * sizeof(records[0]);
-    r->cubes = vk::Image::textureArray(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, layers, levels);
+    r->cubes = vk::Image::cubeArrayTexture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, cubemap ? uint32_t(n) : 1u, levels);
     r->records = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(records[0]),
                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     r->markers = vk::Buffer::deviceLocal(ctx_, markers.data(), markers.size() * sizeof(glm::vec4),

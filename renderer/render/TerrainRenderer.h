@@ -119,7 +119,8 @@ public:
     // Binds a reflection-probe set (null: none; the subsystem and all its GPU resources go away).
     // Its probes are uploaded here, once; frames whose view reads the environment's specular
     // bind them with the lights. Throws std::invalid_argument for a set whose probes, grid and
-    // texels disagree, or that holds more faces than the device's image arrays.
+    // texels disagree, or that holds more faces than the device's image arrays, and
+    // std::runtime_error for a cubemap set on a device without cube-map arrays.
     void setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set);
     // Whether the reflection subsystem holds GPU resources (a set is bound).
     bool hasReflectionResources() const;

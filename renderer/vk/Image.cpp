@@ -34,7 +34,7 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     aspect_ = isDepthFormat(desc_.format) ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
     VkDevice device = ctx.device();
     VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    ici.flags = desc_.shape == ImageShape::Cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
+    ici.flags = desc_.shape == ImageShape::Cube || desc_.shape == ImageShape::CubeArray ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
     ici.imageType = VK_IMAGE_TYPE_2D;
     ici.format = desc_.format;
     ici.extent = {desc_.width, desc_.height, 1};
@@ -52,9 +52,10 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     memory_ = ctx.allocateMemory(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "image");
     check(vkBindImageMemory(device, image, memory_.get(), 0), "vkBindImageMemory");
 
-    const VkImageViewType type = desc_.shape == ImageShape::Cube     ? VK_IMAGE_VIEW_TYPE_CUBE
-                                 : desc_.shape == ImageShape::Layers ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
-                                                                     : VK_IMAGE_VIEW_TYPE_2D;
+    const VkImageViewType type = desc_.shape == ImageShape::Cube        ? VK_IMAGE_VIEW_TYPE_CUBE
+                                 : desc_.shape == ImageShape::CubeArray ? VK_IMAGE_VIEW_TYPE_CUBE_ARRAY
+                                 : desc_.shape == ImageShape::Layers    ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                                        : VK_IMAGE_VIEW_TYPE_2D;
     view_ = makeView(device, image, type, desc_.format, aspect_, 0, desc_.layers, std::max(desc_.mipLevels, 1u));
     // Per-layer views are for framebuffers: a sampled array (reflection probes' faces, thousands of
     // layers) needs none.
@@ -99,9 +100,10 @@ Image Image::texture(const VulkanContext& ctx, VkFormat format, const std::vecto
     return upload(ctx, ImageShape::Plane, format, 1, levels);
 }
 
-Image Image::textureArray(const VulkanContext& ctx, VkFormat format, uint32_t layers,
-                          const std::vector<MipLevel>& levels) {
-    return upload(ctx, ImageShape::Layers, format, layers, levels);
+Image Image::cubeArrayTexture(const VulkanContext& ctx, VkFormat format, uint32_t cubes,
+                              const std::vector<MipLevel>& levels) {
+    if (!ctx.cubeArrays()) throw std::runtime_error("the Vulkan device " + ctx.deviceName() + " samples no cube-map arrays");
+    return upload(ctx, ImageShape::CubeArray, format, 6 * cubes, levels);
 }
 
 Image Image::upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,

@@ -14,13 +14,13 @@ namespace terralux::vk {
 inline constexpr VkFormat kColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 inline constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 
-enum class ImageShape { Plane, Layers, Cube };
+enum class ImageShape { Plane, Layers, Cube, CubeArray };
 
 struct ImageDesc {
     ImageShape shape = ImageShape::Plane;
     VkFormat format = kColorFormat;
     uint32_t width = 1, height = 1;
-    uint32_t layers = 1;  // Layers: the array size; Cube: 6
+    uint32_t layers = 1;  // Layers: the array size; Cube: 6; CubeArray: 6 × cubes
     VkImageUsageFlags usage = 0;
     uint32_t mipLevels = 1;
 };
@@ -55,10 +55,11 @@ public:
     // A sampled 2D texture holding `levels` (a full or partial mip chain), uploaded through a
     // staging buffer and left in the shader-read layout.
     static Image texture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels);
-    // The same for a 2D array of `layers` (viewed as an array even for one layer): each level's
-    // bytes hold its layers one after another.
-    static Image textureArray(const VulkanContext& ctx, VkFormat format, uint32_t layers,
-                              const std::vector<MipLevel>& levels);
+    // The same for an array of `cubes` cube maps (layer 6·cube + face, faces in Vulkan's order),
+    // sampled as one cube-map array with the hardware's seamless filtering across face edges:
+    // each level's bytes hold its layers one after another. Needs VulkanContext::cubeArrays().
+    static Image cubeArrayTexture(const VulkanContext& ctx, VkFormat format, uint32_t cubes,
+                                  const std::vector<MipLevel>& levels);
 
     VkImage handle() const { return image_.get(); }
     // The whole image as shaders see it: 2D, 2D array or cube.

@@ -149,9 +149,14 @@ void VulkanContext::create(const ContextOptions& options) {
     qci.queueFamilyIndex = queueFamily_;
     qci.queueCount = 1;
     qci.pQueuePriorities = &priority;
+    VkPhysicalDeviceFeatures available{}, features{};
+    vkGetPhysicalDeviceFeatures(physical_, &available);
+    features.imageCubeArray = available.imageCubeArray;
+    cubeArrays_ = available.imageCubeArray == VK_TRUE;
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    dci.pEnabledFeatures = &features;
     const char* swapchainExtension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
     if (options.swapchain) {
         dci.enabledExtensionCount = 1;

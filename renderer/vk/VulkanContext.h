@@ -56,6 +56,9 @@ public:
     uint32_t queueFamily() const { return queueFamily_; }
     VkCommandPool commandPool() const { return pool_; }
     const std::string& deviceName() const { return deviceName_; }
+    // Whether the device samples cube-map arrays (imageCubeArray, enabled when present): the
+    // reflection probes' cubes are one.
+    bool cubeArrays() const { return cubeArrays_; }
     VkPhysicalDeviceType deviceType() const { return deviceType_; }
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
 
@@ -89,6 +92,7 @@ private:
     VkCommandPool pool_ = VK_NULL_HANDLE;
     VkFence fence_ = VK_NULL_HANDLE;
     std::string deviceName_;
+    bool cubeArrays_ = false;
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;

@@ -1,7 +1,7 @@
 // Reflection probes (docs/lighting.md, "Reflection probes in the renderer"): bound in the lights
 // set only while a probe set is, by the pipelines built with TLX_REFLECTIONS. The grid is a
 // uniform block (it carries the live strength, so it is per frame); the probes are a storage
-// buffer of records and, for the cubemap encoding, a 2D array of their faces beside it.
+// buffer of records and, for the cubemap encoding, a cube-map array of their cubes beside it.
 TLX_BLOCK_BEGIN(ReflectionBlock, TLX_SET_LIGHTS, 5)
     TLX_IVEC4(grid)      // x nx, y nz, z encoding (0 faces, 1 cubemap), w mip levels
     TLX_VEC4(origin)     // xy (x, z) of probe 0, zw spacing (x, z), 0 on a one-probe axis
@@ -15,4 +15,4 @@ TLX_STRUCT_BEGIN(ReflectionProbeRecord)
     TLX_VEC4_ARRAY(faces, 6)  // rgb mean radiance of each face, +X, −X, +Y, −Y, +Z, −Z
 TLX_STRUCT_END
 #define TLX_REFLECTION_PROBES_BINDING 6  // storage buffer: ReflectionProbeRecord per probe
-#define TLX_REFLECTION_CUBES_BINDING 7   // sampler2DArray: layer 6·probe + face, mip m at roughness m/(mips − 1)
+#define TLX_REFLECTION_CUBES_BINDING 7   // samplerCubeArray: cube = probe, mip m at roughness m/(mips − 1)
