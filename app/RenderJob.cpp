@@ -9,6 +9,7 @@
 #include "BakeJob.h"
 #include "SceneLighting.h"
 #include "ProbeDiagnosticsFile.h"
+#include "ReflectionProbeFile.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
@@ -161,6 +162,7 @@ void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
 }
 
 void ProjectRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
+    reflections_ = set;
     renderer_->setReflectionProbes(std::move(set));
 }
 
@@ -264,6 +266,20 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
         volumes.push_back(std::move(gv));
     }
     setProbes(volumes);
+    // The reflection probes the bake wrote, while the project has them on.
+    std::shared_ptr<const ReflectionProbeSet> reflections;
+    const auto rprobe = folder / "reflection" / kReflectionProbeFile;
+    if (scene.reflectionProbes.enabled) {
+        try {
+            if (std::filesystem::exists(rprobe))
+                reflections = std::make_shared<const ReflectionProbeSet>(readReflectionProbeFile(rprobe));
+            else if (warnings)
+                warnings->push_back(rprobe.string() + ": missing (bake again with reflection_probes.enabled)");
+        } catch (const ReflectionFileError& e) {
+            if (warnings) warnings->push_back(e.what());
+        }
+    }
+    setReflectionProbes(std::move(reflections));
     return volumes.size();
 }
 

@@ -66,8 +66,10 @@ public:
     const std::vector<std::string>& staleBake() const { return staleBake_; }
     // Binds probe volumes computed elsewhere (the UI's draft preview).
     void setProbes(const std::vector<GpuProbeVolume>& volumes);
-    // Binds a reflection-probe set (null: none) for the renderer to draw with.
+    // Binds a reflection-probe set (null: none) for the renderer to draw with; loadProbes binds
+    // the bake's reflection/probes.rprobe while the project has reflection probes on.
     void setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set);
+    const std::shared_ptr<const ReflectionProbeSet>& reflectionProbes() const { return reflections_; }
     // Probes of the bound volumes (what the viewport lights with), whatever the settings say now.
     size_t boundProbeCount() const { return boundProbes_; }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
@@ -119,6 +121,7 @@ private:
     size_t boundProbes_ = 0;
     bool hasErrorMap_ = false;
     std::vector<std::string> staleBake_;
+    std::shared_ptr<const ReflectionProbeSet> reflections_;
     DemImportResult terrain_;
     std::shared_ptr<const SurfaceAlbedo> albedo_;
     std::string albedoError_;

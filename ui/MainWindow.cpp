@@ -47,6 +47,7 @@
 #include "ParameterTable.h"
 #include "BakeJob.h"
 #include "PreviewBake.h"
+#include "ReflectionPanel.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
@@ -206,6 +207,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateTitle);
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateOutputPath);
     connect(doc_, &ProjectDocument::parametersChanged, this, &MainWindow::updateOutputPath);
+    connect(viewport_, &ViewportWindow::clicked, this, [this](QPointF at) {
+        const int probe = reflectionProbeAt(at);
+        if (probe < 0) return;
+        reflectionPanel_->inspect(probe);
+        findChild<QDockWidget*>("dock.reflectionProbes")->raise();
+        statusBar()->showMessage(QString("reflection probe %1").arg(probe), 4000);
+    });
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
         frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
     });
@@ -242,6 +250,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             probeSource_ = withStaleness(own && *own == bakeOutDir_
                                              ? QString("last bake")
                                              : "export in " + QString::fromStdString(bakeOutDir_.string()));
+            reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
             viewport_->renderNow();
             updateStatus();
         }
@@ -425,6 +434,23 @@ void MainWindow::buildDocks() {
     wv->addStretch(1);
     auto* waterDock = dock("Water", "dock.water", waterPage);
 
+    // Reflection probes: their settings and the probe inspector.
+    auto* reflectionPage = new QWidget;
+    auto* rv = new QVBoxLayout(reflectionPage);
+    rv->addWidget(dockForm("dock.reflectionProbes"));
+    reflectionPanel_ = new ReflectionPanel(doc_);
+    connectRejected(reflectionPanel_);
+    rv->addWidget(reflectionPanel_);
+    auto* showReflection = new QPushButton("Show reflection");
+    showReflection->setObjectName("reflection.show");
+    showReflection->setToolTip("Shows debug view 52, the probes' specular radiance times their blend weight");
+    connect(showReflection, &QPushButton::clicked, this, [this] {
+        viewSelector_->setCurrentIndex(viewSelector_->findData(kViewReflectionColor));
+    });
+    rv->addWidget(showReflection);
+    rv->addStretch(1);
+    auto* reflectionDock = dock("Reflection Probes", "dock.reflectionProbes", reflectionPage);
+
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
@@ -486,7 +512,8 @@ void MainWindow::buildDocks() {
     tabifyDockWidget(atmosphereDock, surfaceDock);
     tabifyDockWidget(surfaceDock, aoDock);
     tabifyDockWidget(aoDock, waterDock);
-    tabifyDockWidget(volumesDock, bakeDock);
+    tabifyDockWidget(volumesDock, reflectionDock);
+    tabifyDockWidget(reflectionDock, bakeDock);
     // Whole tab labels, scrolled when the docks are narrow, rather than "Terr…" and "Wa…".
     for (auto* bar : findChildren<QTabBar*>()) {
         bar->setElideMode(Qt::ElideNone);
@@ -894,6 +921,7 @@ void MainWindow::rebuildRenderer() {
     const auto folder = bakeFolder();
     const size_t baked = folder ? renderer_->loadProbes(false, nullptr, nullptr, *folder) : 0;
     probeSource_ = baked ? withStaleness("last bake") : QString();
+    reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
     viewport_->setRenderer(renderer_.get());
     const Heightfield& hf = doc_->terrain().heightfield;
     const DemSourceInfo& s = doc_->terrain().source;
@@ -1005,12 +1033,13 @@ void MainWindow::startPreview() {
     auto terrain = doc_->terrainShared();
     previewWorker_ = std::thread([this, project, terrain, generation] {
         try {
-            auto volumes = std::make_shared<std::vector<GpuProbeVolume>>(
-                previewProbes(project, terrain->heightfield, &previewCancel_));
-            QMetaObject::invokeMethod(this, [this, volumes, generation] {
+            auto preview = std::make_shared<PreviewBake>(previewBake(project, terrain->heightfield, &previewCancel_));
+            QMetaObject::invokeMethod(this, [this, preview, generation] {
                 if (generation != previewGeneration_ || !renderer_) return;
-                renderer_->setProbes(*volumes);
+                renderer_->setProbes(preview->volumes);
+                renderer_->setReflectionProbes(preview->reflections);
                 probeSource_ = "draft preview";
+                reflectionPanel_->setProbes(preview->reflections, probeSource_);
                 viewport_->renderNow();
                 updateStatus();
             }, Qt::QueuedConnection);
@@ -1020,7 +1049,9 @@ void MainWindow::startPreview() {
             QMetaObject::invokeMethod(this, [this, generation] {
                 if (generation != previewGeneration_ || !renderer_) return;
                 renderer_->setProbes({});
+                renderer_->setReflectionProbes(nullptr);
                 probeSource_ = "no preview: placement failed";
+                reflectionPanel_->setProbes(nullptr, probeSource_);
                 viewport_->renderNow();
                 updateStatus();
             }, Qt::QueuedConnection);
@@ -1091,13 +1122,40 @@ QString MainWindow::withStaleness(const QString& source) const {
            (stale.size() > 1 ? QString(" and %1 more").arg(stale.size() - 1) : QString());
 }
 
+int MainWindow::reflectionProbeAt(QPointF at) const {
+    if (!renderer_ || !renderer_->reflectionProbes() || viewport_->width() <= 0 || viewport_->height() <= 0) return -1;
+    const Heightfield& hf = renderer_->heightfield();
+    // The projection the renderer draws with (TerrainRenderer: the extent is the terrain box's
+    // largest side).
+    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+    const glm::mat4 vp = viewport_->camera().viewProjection(float(viewport_->width()) / float(viewport_->height()), extent);
+    // The nearest marker within 12 pixels of the click.
+    int best = -1;
+    double bestDistance = 12.0;
+    const auto& probes = renderer_->reflectionProbes()->probes;
+    for (size_t i = 0; i < probes.size(); ++i) {
+        const glm::vec4 c = vp * glm::vec4(probes[i].position, 1.0f);
+        if (c.w <= 0.0f) continue;
+        const QPointF screen((c.x / c.w * 0.5 + 0.5) * viewport_->width(), (c.y / c.w * 0.5 + 0.5) * viewport_->height());
+        const double d = std::hypot(screen.x() - at.x(), screen.y() - at.y());
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
 void MainWindow::updateStatus() {
     if (!renderer_) return;
     // What the viewport holds, not what the settings would place (adaptive volumes ignore grids).
-    probeLabel_->setText(QString("%1 probes (%2), %3 on the GPU")
+    const auto& reflections = renderer_->reflectionProbes();
+    probeLabel_->setText(QString("%1 probes%2 (%3), %4 on the GPU")
                              .arg(renderer_->boundProbeCount())
+                             .arg(reflections ? QString(" + %1 reflection").arg(reflections->probes.size()) : QString())
                              .arg(probeSource_.isEmpty() ? "not baked" : probeSource_)
-                             .arg(formatBytes(double(renderer_->renderer().probeBytes()))));
+                             .arg(formatBytes(double(renderer_->renderer().probeBytes() +
+                                                     renderer_->renderer().reflectionBytes()))));
 }
 
 void MainWindow::startBake(const QString& outDir) {

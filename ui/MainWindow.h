@@ -29,6 +29,7 @@ namespace terralux {
 
 class ProbeVolumesPanel;
 class WaterPanel;
+class ReflectionPanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -48,6 +49,9 @@ public:
     // What the viewport's probes come from: "last bake" (the project's output folder),
     // "export in <folder>" (a bake written elsewhere), "draft preview" or "" (none yet).
     const QString& probeSource() const { return probeSource_; }
+    // The reflection probe whose marker is nearest to `at` (viewport pixels), within 12 pixels;
+    // -1 when none (or no reflection probes are bound).
+    int reflectionProbeAt(QPointF at) const;
     // Probes the viewport lights with now (the bound preview or bake).
     size_t boundProbeCount() const;
     // Draft previews started so far: edits that change no probes start none.
@@ -128,6 +132,7 @@ private:
     QLabel* outputPath_ = nullptr;
     ProbeVolumesPanel* volumesPanel_ = nullptr;
     WaterPanel* waterPanel_ = nullptr;
+    ReflectionPanel* reflectionPanel_ = nullptr;
     QProxyStyle* tabStyle_ = nullptr;
     std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;

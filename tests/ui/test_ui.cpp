@@ -12,6 +12,7 @@
 #include <QCheckBox>
 #include <QColorDialog>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFormLayout>
@@ -34,6 +35,8 @@
 #include "CascadeSplitChart.h"
 #include "ImageCompare.h"
 #include "MainWindow.h"
+#include "ReflectionPanel.h"
+#include "bake/ReflectionBake.h"
 #include "ParameterPanels.h"
 #include "ParameterTable.h"
 #include "bake/ProbePlacement.h"
@@ -1168,6 +1171,90 @@ private slots:
         w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(false);
     }
 
+    void reflectionProbesDockPreviewsInspectsAndPicks() {
+        auto* dock = w_->findChild<QDockWidget*>("dock.reflectionProbes");
+        QVERIFY(dock);
+        dock->raise();
+        QString error;
+        // Small cubes keep the preview quick.
+        QVERIFY(w_->document()->setParameter("reflection_probes.resolution", 8, &error));
+        auto* enabled = w_->findChild<QCheckBox*>("param.reflection_probes.enabled");
+        QVERIFY(enabled);
+        auto* selector = w_->findChild<QComboBox*>("viewport.debugView");
+        selector->setCurrentIndex(selector->findData(kViewReflectionWeight));
+        w_->viewport()->renderNow();
+        const RenderedImage off = w_->viewport()->grabImage();
+        double offMean = 0;
+        for (size_t i = 0; i < size_t(off.width) * off.height; ++i) offMean += off.rgba[i * 4];
+        QCOMPARE(offMean, 0.0);  // no probes: no weight anywhere
+
+        enabled->setChecked(true);
+        auto* status = w_->findChild<QLabel*>("reflection.status");
+        QTRY_VERIFY_WITH_TIMEOUT(status->text().startsWith("16 probes (draft preview)"), 30000);
+        QVERIFY(w_->findChild<QSpinBox*>("param.reflection_probes.resolution")->isVisible());
+        // The blend weight covers the terrain once the preview lands.
+        QTRY_VERIFY_WITH_TIMEOUT([&] {
+            const RenderedImage on = w_->viewport()->grabImage();
+            size_t lit = 0;
+            for (size_t i = 0; i < size_t(on.width) * on.height; ++i) lit += on.rgba[i * 4] > 0.99f;
+            return lit > size_t(on.width) * on.height / 10;
+        }(), 10000);
+        // Strength applies live: 0 leaves no weight.
+        auto* strength = w_->findChild<QDoubleSpinBox*>("param.reflection_probes.strength");
+        QVERIFY(strength);
+        strength->setValue(0.0);
+        w_->viewport()->renderNow();
+        const RenderedImage none = w_->viewport()->grabImage();
+        float most = 0;
+        for (size_t i = 0; i < size_t(none.width) * none.height; ++i) most = std::max(most, none.rgba[i * 4]);
+        QCOMPARE(most, 0.0f);
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QCOMPARE(w_->document()->project().scene.reflectionProbes.strength, 1.0);
+
+        // The inspector: probe 9 is past the simvx records' first 8; its cube cross is drawn.
+        auto* probe = w_->findChild<QSpinBox*>("reflection.probe");
+        auto* inSimvx = w_->findChild<QCheckBox*>("reflection.inSimvx");
+        QVERIFY(probe && inSimvx);
+        QCOMPARE(probe->maximum(), 15);
+        probe->setValue(9);
+        QVERIFY(!inSimvx->isChecked());
+        QVERIFY(w_->findChild<QLabel*>("reflection.probeInfo")->text().startsWith("id 9 at ("));
+        auto* panel = w_->findChild<ReflectionPanel*>();
+        QCOMPARE(panel->crossImage().size(), QSize(4 * 48, 3 * 48));
+        // The +Y face (the sky, above) is brighter than the -Y face (the ground, below).
+        const QColor up = panel->crossImage().pixelColor(48 + 24, 24), down = panel->crossImage().pixelColor(48 + 24, 2 * 48 + 24);
+        QVERIFY2(up.lightness() > down.lightness(), qPrintable(QString("%1 vs %2").arg(up.lightness()).arg(down.lightness())));
+        // Swapping probe 0 out of the records and 9 in: two undoable edits of the subset.
+        probe->setValue(0);
+        QVERIFY(inSimvx->isChecked());
+        inSimvx->setChecked(false);
+        QCOMPARE(w_->document()->project().scene.reflectionProbes.simvxSubset, (std::vector<int>{1, 2, 3, 4, 5, 6, 7}));
+        probe->setValue(9);
+        inSimvx->setChecked(true);
+        QCOMPARE(w_->document()->project().scene.reflectionProbes.simvxSubset, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 9}));
+        w_->findChild<QAction*>("action.undo")->trigger();
+        w_->findChild<QAction*>("action.undo")->trigger();
+        QVERIFY(w_->document()->project().scene.reflectionProbes.simvxSubset.empty());
+        QVERIFY(!inSimvx->isChecked());
+
+        // A click on a probe's marker inspects it.
+        const Heightfield& hf = w_->document()->terrain().heightfield;
+        const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+        const OrbitCamera& camera = w_->viewport()->camera();
+        const glm::mat4 vp = camera.viewProjection(float(w_->viewport()->width()) / float(w_->viewport()->height()), extent);
+        ReflectionProbeSettings rs = w_->document()->project().scene.reflectionProbes;
+        const glm::vec3 target = placeReflectionProbes(rs, hf).positions[5];
+        const glm::vec4 c = vp * glm::vec4(target, 1.0f);
+        const QPoint at(int((c.x / c.w * 0.5f + 0.5f) * float(w_->viewport()->width())),
+                        int((c.y / c.w * 0.5f + 0.5f) * float(w_->viewport()->height())));
+        QCOMPARE(w_->reflectionProbeAt(at), 5);
+        QTest::mouseClick(w_->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+        QTRY_COMPARE(probe->value(), 5);
+        selector->setCurrentIndex(selector->findData(kViewBeauty));
+        enabled->setChecked(false);
+        QTRY_VERIFY_WITH_TIMEOUT(status->text() == "Reflection probes are off.", 5000);
+    }
+
     void screenshot() {
         w_->viewport()->renderNow();
         QTest::qWait(500);
@@ -1205,6 +1292,17 @@ private slots:
         QTest::qWait(300);
         const QPixmap waterShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(waterShot.save(QString::fromStdString((kOut / "water_dock.png").string())));
+        // The Reflection Probes dock with the preview's probes, their markers and one inspected.
+        w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(false);
+        w_->findChild<QDockWidget*>("dock.reflectionProbes")->raise();
+        w_->findChild<QCheckBox*>("param.reflection_probes.enabled")->setChecked(true);
+        w_->findChild<QCheckBox*>("viewport.probePositions")->setChecked(true);
+        QTRY_VERIFY_WITH_TIMEOUT(w_->findChild<QLabel*>("reflection.status")->text().startsWith("16 probes"), 60000);
+        w_->findChild<QSpinBox*>("reflection.probe")->setValue(5);
+        w_->viewport()->renderNow();
+        QTest::qWait(300);
+        const QPixmap reflectionShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(reflectionShot.save(QString::fromStdString((kOut / "reflection_dock.png").string())));
     }
 };
 
