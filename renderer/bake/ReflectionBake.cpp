@@ -43,13 +43,8 @@ void parallelIndices(size_t n, const BakeControl& control, Body body) {
 double areaElement(double x, double y) { return std::atan2(x * y, std::sqrt(x * x + y * y + 1.0)); }
 
 // GGX normal distribution D(h) with α = roughness² (Walter et al., "Microfacet Models for
-// Refraction through Rough Surfaces", EGSR 2007), as a function of n·h.
-double ggxD(double ndoth, double roughness) {
-    const double a = std::max(roughness * roughness, 1e-4);
-    const double a2 = a * a;
-    const double d = ndoth * ndoth * (a2 - 1.0) + 1.0;
-    return a2 / (std::numbers::pi * d * d);
-}
+// Refraction through Rough Surfaces", EGSR 2007) is α² / (π ((n·h)² (α² − 1) + 1)²); the
+// prefilter's normalised weights need it only up to its constant.
 
 // Unit texel-centre directions and solid angles of a face `size` a side, all six faces.
 struct CubeGeometry {
@@ -69,15 +64,16 @@ struct CubeGeometry {
 // ∫ L(l) D(h)(n·l) dl / ∫ D(h)(n·l) dl over the texels of one level, for n = v = `dir`.
 glm::vec3 ggxIntegral(const std::vector<glm::vec3>& texels, const CubeGeometry& g, const glm::vec3& n,
                       float roughness) {
+    const double a = std::max(double(roughness) * roughness, 1e-4), a2 = a * a;
     glm::dvec3 sum(0.0);
     double weight = 0.0;
     for (size_t i = 0; i < texels.size(); ++i) {
         const glm::vec3& l = g.dir[i];
         const float ndotl = glm::dot(n, l);
         if (ndotl <= 0.0f) continue;
-        // h = normalize(n + l); n·h = sqrt((1 + n·l) / 2) for unit n and l.
-        const double ndoth = std::sqrt(0.5 * (1.0 + double(ndotl)));
-        const double w = ggxD(ndoth, roughness) * double(ndotl) * double(g.solidAngle[i]);
+        // h = normalize(n + l): n·h² = (1 + n·l) / 2 for unit n and l; D up to its constant 1/π.
+        const double d = 0.5 * (1.0 + double(ndotl)) * (a2 - 1.0) + 1.0;
+        const double w = double(ndotl) * double(g.solidAngle[i]) / (d * d);
         sum += w * glm::dvec3(texels[i]);
         weight += w;
     }
@@ -350,11 +346,14 @@ std::array<glm::vec3, 6> faceMeans(const RadianceCube& cube) {
 std::vector<glm::vec3> prefilterCube(const RadianceCube& cube) {
     const int count = cubeMipCount(cube.size);
     std::vector<glm::vec3> out = cube.texels;
-    // The unfiltered radiance at each level's resolution: mip m integrates level m − 1 of it,
-    // texels at least twice as fine as its own and never a filtered level filtered again.
+    // The unfiltered radiance at each level's resolution: mip m integrates level m of it (its own
+    // resolution, never a filtered level filtered again). A lobe narrower than that level's
+    // texels is a texel the mip cannot hold finer anyway.
     std::vector<glm::vec3> source = cube.texels;
     int sourceSize = cube.size;
     for (int m = 1; m < count; ++m) {
+        source = halve(source, sourceSize);
+        sourceSize = std::max(sourceSize / 2, 1);
         const CubeGeometry g(sourceSize);
         const int size = cubeMipSize(cube.size, m);
         const float roughness = cubeMipRoughness(m, count);
@@ -363,8 +362,6 @@ std::vector<glm::vec3> prefilterCube(const RadianceCube& cube) {
                 for (int x = 0; x < size; ++x)
                     out.push_back(ggxIntegral(source, g, cubeDirection(f, (x + 0.5f) / size, (y + 0.5f) / size),
                                               roughness));
-        source = halve(source, sourceSize);
-        sourceSize = std::max(sourceSize / 2, 1);
     }
     return out;
 }

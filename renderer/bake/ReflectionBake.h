@@ -121,7 +121,8 @@ RadianceCube traceRadianceCube(const ReflectionLighting& light, const glm::vec3&
 std::array<glm::vec3, 6> faceMeans(const RadianceCube& cube);
 // The split-sum prefiltered mip chain (Karis, "Real Shading in Unreal Engine 4", SIGGRAPH 2013,
 // with N = V = R): mip m holds ∫ L(l) D(h) (n·l) dl / ∫ D(h) (n·l) dl at roughness
-// cubeMipRoughness(m), integrated over the texels of the next finer level (mip 0 is the cube).
+// cubeMipRoughness(m), integrated over the unfiltered cube reduced to mip m's resolution (mip 0
+// is the cube).
 std::vector<glm::vec3> prefilterCube(const RadianceCube& cube);
 // The same integral, brute force over every texel of `cube`, for one direction.
 glm::vec3 prefilteredRadiance(const RadianceCube& cube, const glm::vec3& dir, float roughness);
