@@ -891,6 +891,37 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     }
 
     e.seconds = e.secondsMax = e.cacheSeconds;
+    if (scene.reflectionProbes.enabled) {
+        const ReflectionProbeSettings& rs = scene.reflectionProbes;
+        const ReflectionLayout layout = placeReflectionProbes(rs, hf);
+        simvxProbes(rs.simvxSubset, layout.count());
+        // One probe at the bake's cube size and a ray or two per texel, its tracing scaled to the
+        // bake's rays; probes bake in parallel.
+        std::unique_ptr<IrradianceCache> own;
+        if (!cache) own = std::make_unique<IrradianceCache>(setup.lighting, 16, 16, 1, 0, BakeControl{});
+        const ReflectionLighting light{&setup.lighting, cache ? cache.get() : own.get(), std::max(q.bounces, 1),
+                                       groundRadiance(setup.lighting, rs.groundColor)};
+        const int calibrationRays = std::min(rs.rayCount, 2);
+        auto t = Clock::now();
+        const RadianceCube cube = traceRadianceCube(light, layout.positions[layout.count() / 2], rs.resolution,
+                                                    calibrationRays, 1);
+        const double trace = secondsSince(t) * double(rs.rayCount) / double(calibrationRays);
+        t = Clock::now();
+        prefilterCube(cube);
+        const double prefilter = secondsSince(t);
+        ReflectionProbeSet shape;
+        shape.encoding = rs.encoding;
+        shape.faceSize = rs.resolution;
+        shape.mipCount = cubeMipCount(rs.resolution);
+        BakeEstimate::Reflection r;
+        r.probes = layout.count();
+        r.bytes = kRprobeHeaderBytes + r.probes * (kRprobeProbeBytes + 12 * shape.texelsPerProbe());
+        const double waves = std::ceil(double(r.probes) / double(std::min<size_t>(size_t(threads), r.probes)));
+        r.seconds = waves * (trace + prefilter);
+        e.seconds += r.seconds;
+        e.secondsMax += r.seconds;
+        e.reflection = r;
+    }
     for (size_t vi = 0; vi < setup.volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *setup.volumes[vi];
         const ProbeLayout& L = layouts[vi];

@@ -86,6 +86,13 @@ struct BakeEstimate {
     double probeRaysPerSecond = 0.0;  // measured on this terrain, with this lighting
     double seconds = 0.0;             // everything, with error-driven volumes at their minimum
     double secondsMax = 0.0;          // with error-driven volumes at their cap
+    // Reflection probes, when enabled: a probe traced and prefiltered here, scaled by the rays.
+    struct Reflection {
+        size_t probes = 0;
+        uint64_t bytes = 0;           // probes.rprobe
+        double seconds = 0.0;
+    };
+    std::optional<Reflection> reflection;
 };
 
 // Throws the same input errors as runBake.

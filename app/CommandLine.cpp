@@ -291,6 +291,9 @@ int printEstimate(const BakeEstimate& e) {
                       << " %: up to " << v.probesMax << " probes (" << v.cap << "), "
                       << v.bytesMax << " bytes, up to " << duration(v.secondsMax) << "\n";
     }
+    if (e.reflection)
+        std::cout << "  reflection probes: " << e.reflection->probes << " probes, " << e.reflection->bytes
+                  << " bytes, about " << duration(e.reflection->seconds) << "\n";
     if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
     std::cout << "estimated bake time: about " << duration(e.seconds);
     if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
