@@ -1037,8 +1037,9 @@ json projectSchema() {
     auto& props = schema["properties"];
     props["$schema"] = {{"type", "string"}, {"description", "The schema an editor checks this file against"}};
     props["format"] = {{"const", "terralux-project"}, {"description", "Marks the file as a Terralux project"}, {"default", "terralux-project"}};
-    props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", 1},
-                        {"description", "Project format version"}, {"default", 1}};
+    props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", kProjectVersion},
+                        {"description", "Project format version; older versions are migrated on reading"},
+                        {"default", kProjectVersion}};
     json volume = objectSchema(), wave = objectSchema();
     for (const auto& s : parameterTable()) {
         if (s.perVolume()) insert(volume, s.localPath(), leafSchema(s));

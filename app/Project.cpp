@@ -232,18 +232,61 @@ json sceneToJson(const SceneDescription& s) {
 
 json defaultProjectJson() { return sceneToJson(SceneDescription{}); }
 
-SceneDescription sceneFromJson(const json& doc, const std::string& source,
-                               std::vector<std::string>* /*warnings*/) {
+const std::vector<ProjectMigration>& projectMigrations() {
+    static const std::vector<ProjectMigration> steps = {
+        {1,
+         "terrain.albedo_mode's default became the height ramp: a version-1 file without it lit the "
+         "terrain with terrain.albedo alone, so it gets \"constant\"; reflection_probes.ground_color became "
+         "an albedo, so channels above 1 are clamped to 1",
+         [](json& doc, std::vector<std::string>& notes) {
+             if (!doc.contains("terrain") || !doc["terrain"].is_object()) doc["terrain"] = json::object();
+             if (!doc["terrain"].contains("albedo_mode")) {
+                 doc["terrain"]["albedo_mode"] = "constant";
+                 notes.push_back("terrain.albedo_mode set to \"constant\", what version 1 drew without it");
+             }
+             if (doc.contains("reflection_probes") && doc["reflection_probes"].is_object() &&
+                 doc["reflection_probes"].contains("ground_color") && doc["reflection_probes"]["ground_color"].is_array()) {
+                 json& c = doc["reflection_probes"]["ground_color"];
+                 bool clamped = false;
+                 for (auto& x : c)
+                     if (x.is_number() && x.get<double>() > 1.0) {
+                         x = 1.0;
+                         clamped = true;
+                     }
+                 if (clamped) notes.push_back("reflection_probes.ground_color clamped to [0, 1] (it is an albedo since version 2)");
+             }
+         }},
+    };
+    return steps;
+}
+
+json migrateProjectJson(json doc, const std::string& source, std::vector<std::string>* notes) {
     if (!doc.is_object()) throw ProjectError(source + ": the project must be a JSON object");
+    const json* v = lookup(doc, "version");
+    if (!v) return doc;
+    if (!v->is_number_integer() || v->get<long long>() < 1) reject(source, "version", *v, "must be an integer >= 1");
+    if (v->get<long long>() > kProjectVersion)
+        reject(source, "version", *v,
+               "is newer than this Terralux reads (" + std::to_string(kProjectVersion) + "); open it with a newer Terralux");
+    for (int from = int(v->get<long long>()); from < kProjectVersion; ++from) {
+        const auto& steps = projectMigrations();
+        const auto step = std::find_if(steps.begin(), steps.end(), [&](const ProjectMigration& m) { return m.from == from; });
+        std::vector<std::string> stepNotes;
+        step->apply(doc, stepNotes);
+        doc["version"] = from + 1;
+        if (notes)
+            for (const auto& n : stepNotes)
+                notes->push_back(source + ": version " + std::to_string(from) + " migrated to " + std::to_string(from + 1) + ": " + n);
+    }
+    return doc;
+}
+
+SceneDescription sceneFromJson(const json& original, const std::string& source,
+                               std::vector<std::string>* warnings) {
+    const json doc = migrateProjectJson(original, source, warnings);
     checkKeys(doc, "", "", source);
     if (const json* f = lookup(doc, "format"); f && *f != "terralux-project")
         reject(source, "format", *f, "must be \"terralux-project\"");
-    if (const json* v = lookup(doc, "version")) {
-        if (!v->is_number_integer() || v->get<long long>() < 1)
-            reject(source, "version", *v, "must be an integer >= 1");
-        if (v->get<long long>() > kProjectVersion)
-            reject(source, "version", *v, "is newer than this Terralux reads (" + std::to_string(kProjectVersion) + ")");
-    }
 
     SceneDescription s;
     if (const json* volumes = lookup(doc, "probe_volumes")) {

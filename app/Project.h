@@ -19,7 +19,9 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-inline constexpr int kProjectVersion = 1;
+// The project file's version (docs/formats.md, "Project file"): older files are migrated step
+// by step on reading, newer ones refused.
+inline constexpr int kProjectVersion = 2;
 inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffuse grid dims
 inline constexpr int kMaxBoxGridProbes = 65536;
 inline constexpr int kMaxBounces = 16;
@@ -41,9 +43,21 @@ struct Project {
 // Defaults, as JSON: every key the document may hold.
 nlohmann::json defaultProjectJson();
 nlohmann::json sceneToJson(const SceneDescription& scene);
-// Reads and validates every parameter of the table (app/ParameterTable.h); absent keys take
-// their defaults, an unknown key is an error. `source` prefixes messages (a file name, or
-// "--set"); `warnings` is for notes that do not stop a load (none today).
+// One step of the project file's history: what changed from `from` to from + 1, and the edit
+// that keeps an older file meaning what it meant (it may add notes to `notes`).
+struct ProjectMigration {
+    int from = 1;
+    const char* summary = "";
+    void (*apply)(nlohmann::json& doc, std::vector<std::string>& notes) = nullptr;
+};
+const std::vector<ProjectMigration>& projectMigrations();
+// `doc` brought to kProjectVersion, one step at a time, each step's notes prefixed with `source`;
+// a document without a version is taken as current. Throws ProjectError for a version newer
+// than kProjectVersion or one that is not an integer >= 1.
+nlohmann::json migrateProjectJson(nlohmann::json doc, const std::string& source, std::vector<std::string>* notes);
+// Reads and validates every parameter of the table (app/ParameterTable.h) of a document migrated
+// to the current version; absent keys take their defaults, an unknown key is an error. `source`
+// prefixes messages (a file name, or "--set"); `warnings` gets the migration's notes.
 SceneDescription sceneFromJson(const nlohmann::json& doc, const std::string& source,
                                std::vector<std::string>* warnings);
 

@@ -133,7 +133,8 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=2", "p.json: version = 2: is newer than this Terralux reads (1)"}));
+        Rule{"version=3", "p.json: version = 3: is newer than this Terralux reads (2); open it with a newer Terralux"},
+        Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
     EXPECT_EQ(errorFor("probe_volumes[0].placement=box"),
@@ -458,4 +459,67 @@ TEST(Project, AmbientOcclusionSectionDefaultsValidationAndRoundTrip) {
     EXPECT_DOUBLE_EQ(*s.ao.maxDistance, 1500.5);
     EXPECT_DOUBLE_EQ(s.ao.strength, 0.25);
     EXPECT_EQ(sceneToJson(s)["ao"], doc["ao"]);
+}
+
+TEST(ProjectVersions, EveryOlderVersionHasOneMigrationStep) {
+    const auto& steps = projectMigrations();
+    ASSERT_EQ(steps.size(), size_t(kProjectVersion - 1));
+    for (int v = 1; v < kProjectVersion; ++v) EXPECT_EQ(steps[size_t(v - 1)].from, v);
+}
+
+TEST(ProjectVersions, VersionOneWithoutAnAlbedoModeKeepsItsConstantAlbedo) {
+    // A version-1 file from before the albedo modes: its terrain was terrain.albedo everywhere.
+    const json v1 = {{"format", "terralux-project"}, {"version", 1}, {"terrain", {{"albedo", {0.4, 0.35, 0.3}}}}};
+    std::vector<std::string> notes;
+    const json migrated = migrateProjectJson(v1, "old.json", &notes);
+    EXPECT_EQ(migrated["version"], 2);
+    EXPECT_EQ(migrated["terrain"]["albedo_mode"], "constant");
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], "old.json: version 1 migrated to 2: terrain.albedo_mode set to \"constant\", what version 1 drew without it");
+    const SceneDescription s = sceneFromJson(v1, "old.json", nullptr);
+    EXPECT_EQ(s.terrain.albedoMode, AlbedoMode::Constant);
+    // A version-1 file that chose a mode keeps it; a current file without one gets the ramp.
+    json chose = v1;
+    chose["terrain"]["albedo_mode"] = "ramp";
+    EXPECT_EQ(sceneFromJson(chose, "old.json", nullptr).terrain.albedoMode, AlbedoMode::Ramp);
+    json current = v1;
+    current["version"] = 2;
+    EXPECT_EQ(sceneFromJson(current, "new.json", nullptr).terrain.albedoMode, AlbedoMode::Ramp);
+    json unversioned = v1;
+    unversioned.erase("version");
+    EXPECT_EQ(sceneFromJson(unversioned, "new.json", nullptr).terrain.albedoMode, AlbedoMode::Ramp);
+}
+
+TEST(ProjectVersions, VersionOneGroundColourBecomesAnAlbedo) {
+    const json v1 = {{"version", 1},
+                     {"terrain", {{"albedo_mode", "ramp"}}},
+                     {"reflection_probes", {{"ground_color", {2.0, 0.5, 1.5}}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v1, "old.json", &notes);
+    EXPECT_EQ(s.reflectionProbes.groundColor, glm::vec3(1.0f, 0.5f, 1.0f));
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("reflection_probes.ground_color clamped to [0, 1]"), std::string::npos);
+    // The same colour in a version-2 file is refused: there it is an albedo.
+    json v2 = v1;
+    v2["version"] = 2;
+    EXPECT_THROW(sceneFromJson(v2, "new.json", nullptr), ProjectError);
+}
+
+TEST(ProjectVersions, SavingWritesTheCurrentVersion) {
+    const fs::path dir = tempDir("versions");
+    {
+        std::ofstream(dir / "old.json") << R"({"format": "terralux-project", "version": 1, "sun": {"elevation_deg": 20}})";
+    }
+    std::vector<std::string> warnings;
+    Project p = loadProject(dir / "old.json", &warnings);
+    EXPECT_EQ(p.scene.terrain.albedoMode, AlbedoMode::Constant);
+    EXPECT_EQ(warnings.size(), 1u);
+    saveProject(p, dir / "old.json");
+    std::ifstream in(dir / "old.json");
+    const json saved = json::parse(in);
+    EXPECT_EQ(saved["version"], kProjectVersion);
+    EXPECT_EQ(saved["terrain"]["albedo_mode"], "constant");
+    warnings.clear();
+    EXPECT_EQ(loadProject(dir / "old.json", &warnings).scene.terrain.albedoMode, AlbedoMode::Constant);
+    EXPECT_TRUE(warnings.empty());
 }
