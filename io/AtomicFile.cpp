@@ -1,10 +1,12 @@
 #include "AtomicFile.h"
+#include "FaultInjection.h"
 
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <system_error>
 
 #include <unistd.h>
 
@@ -19,20 +21,29 @@ std::filesystem::path temporarySibling(const std::filesystem::path& target) {
 
 void writeFileAtomically(const std::filesystem::path& target, std::span<const uint8_t> bytes) {
     const std::filesystem::path tmp = temporarySibling(target);
+    if (injectedFailure("write", tmp))
+        throw FileWriteError(target.string() + ": cannot write (" + std::strerror(EIO) + ")");
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f)
         throw FileWriteError(target.string() + ": cannot write (" + std::strerror(errno) + ")");
+    errno = 0;
     const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-    const int err = errno;
-    const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+    const int writeErr = errno;
+    errno = 0;
+    const bool flushed = std::fflush(f) == 0 && !injectedFailure("fsync", tmp) && ::fsync(::fileno(f)) == 0;
+    const int flushErr = flushed ? 0 : errno ? errno : EIO;
     const bool closed = std::fclose(f) == 0;
     if (!written || !flushed || !closed) {
+        const int err = !written ? writeErr : !flushed ? flushErr : errno;
         std::error_code ec;
         std::filesystem::remove(tmp, ec);
         throw FileWriteError(target.string() + ": write failed (" + std::strerror(err ? err : EIO) + ")");
     }
     std::error_code ec;
-    std::filesystem::rename(tmp, target, ec);
+    if (injectedFailure("rename", target))
+        ec = std::make_error_code(std::errc::io_error);
+    else
+        std::filesystem::rename(tmp, target, ec);
     if (ec) {
         const std::string reason = ec.message();
         std::filesystem::remove(tmp, ec);

@@ -1,4 +1,5 @@
 #include "GltfExport.h"
+#include "FaultInjection.h"
 #include "ImageFile.h"
 #include "ProbeDiagnosticsFile.h"
 #include "water/Water.h"
@@ -539,14 +540,17 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
 
 // Writes, flushes and syncs one staged file; errors name the final target.
 void writeStaged(const fs::path& staged, const fs::path& target, std::span<const uint8_t> bytes) {
+    if (injectedFailure("write", staged))
+        throw FileWriteError(target.string() + ": cannot write (" + errnoText(EIO) + ")");
     std::FILE* f = std::fopen(staged.c_str(), "wb");
     if (!f)
         throw FileWriteError(target.string() + ": cannot write (" + errnoText(errno) + ")");
     errno = 0;
     const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
     const int writeErr = errno;
-    const bool flushed = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
-    const int flushErr = errno;
+    errno = 0;
+    const bool flushed = std::fflush(f) == 0 && !injectedFailure("fsync", staged) && ::fsync(::fileno(f)) == 0;
+    const int flushErr = flushed ? 0 : errno ? errno : EIO;
     const bool closed = std::fclose(f) == 0;
     if (!written || !flushed || !closed) {
         const int err = !written ? writeErr : !flushed ? flushErr : errno;
@@ -554,12 +558,21 @@ void writeStaged(const fs::path& staged, const fs::path& target, std::span<const
     }
 }
 
+// Makes the renames into `dir` durable. A failure fails the commit, which then rolls back: a
+// bake that reports success has its files on disk.
 void syncDirectory(const fs::path& dir) {
-    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) {
-        ::fsync(fd);
-        ::close(fd);
+    int err = 0;
+    if (injectedFailure("fsync", dir)) {
+        err = EIO;
+    } else {
+        const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        // A file system that cannot open or sync a directory (EINVAL) gives no such guarantee.
+        if (fd >= 0) {
+            if (::fsync(fd) != 0 && errno != EINVAL) err = errno;
+            ::close(fd);
+        }
     }
+    if (err) throw FileWriteError(dir.string() + ": cannot sync the folder (" + errnoText(err) + ")");
 }
 
 // A fresh ".staging-<unique>" directory inside outDir, removed with everything in it on scope exit.
@@ -652,7 +665,10 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
         for (size_t i = 0; i < stale.size(); ++i) {
             const fs::path target = outDir / stale[i], kept = staging / ("stale-" + std::to_string(i));
             std::error_code ec;
-            fs::rename(target, kept, ec);
+            if (injectedFailure("rename", target))
+                ec = std::make_error_code(std::errc::io_error);
+            else
+                fs::rename(target, kept, ec);
             if (ec)
                 throw FileWriteError(target.string() + ": cannot remove the earlier bake's file (" +
                                      ec.message() + ")");
@@ -669,6 +685,11 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
                 if (fs::is_directory(st))
                     throw FileWriteError(target.string() + ": cannot replace (is a directory)");
                 step.backup = staging / ("previous-" + std::to_string(i));
+                if (injectedFailure("link", target)) {
+                    // Fails the link and its copy fallback alike.
+                    throw FileWriteError(target.string() + ": cannot keep the previous file (" +
+                                         errnoText(EIO) + ")");
+                }
                 fs::create_hard_link(target, step.backup, ec);
                 if (ec) {
                     ec.clear();
@@ -679,12 +700,20 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
                                          ec.message() + ")");
                 }
             }
-            fs::rename(staged, target, ec);
+            if (injectedFailure("rename", target))
+                ec = std::make_error_code(std::errc::io_error);
+            else
+                fs::rename(staged, target, ec);
             if (ec)
                 throw FileWriteError(target.string() + ": cannot replace (" + ec.message() + ")");
             done.push_back(std::move(step));
         }
+        for (const char* dir : {kProbeDir, kReflectionDir})
+            if (fs::is_directory(outDir / dir)) syncDirectory(outDir / dir);
+        syncDirectory(outDir);
     } catch (...) {
+        // Rollback undoes the renames above with plain calls (no fault injection): each puts a
+        // file back where this commit moved it from, in the same folder.
         for (auto it = done.rbegin(); it != done.rend(); ++it) {
             std::error_code ec;
             if (it->backup.empty())
@@ -698,9 +727,6 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
         }
         throw;
     }
-    for (const char* dir : {kProbeDir, kReflectionDir})
-        if (fs::is_directory(outDir / dir)) syncDirectory(outDir / dir);
-    syncDirectory(outDir);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 #include "ShProbeFile.h"
+#include "FaultInjection.h"
 
 #include <algorithm>
 #include <atomic>
@@ -6,6 +7,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <ios>
 #include <limits>
@@ -14,6 +16,8 @@
 #include <system_error>
 
 #include "LittleEndian.h"
+
+#include <unistd.h>
 
 namespace terralux {
 
@@ -249,14 +253,15 @@ std::string errnoText(int err) {
     return std::generic_category().message(err);
 }
 
-// Unique per call even if random_device is deterministic on some platform.
+// Unique per call even if random_device is deterministic on some platform. The pid tells a later
+// bake whether the writer of a leftover temporary is still alive.
 std::string tempSuffix() {
     static std::atomic<uint64_t> counter{0};
     std::random_device rd;
     const uint64_t r =
         (uint64_t{rd()} << 32) ^ rd() ^ (counter.fetch_add(1) * 0x9E3779B97F4A7C15ull);
     static constexpr char kDigits[] = "0123456789abcdef";
-    std::string s = ".tmp-";
+    std::string s = ".tmp-" + std::to_string(::getpid()) + "-";
     for (int shift = 60; shift >= 0; shift -= 4)
         s += kDigits[(r >> shift) & 0xFu];
     return s;
@@ -331,23 +336,31 @@ void writeShProbeFile(const std::filesystem::path& path, const ShProbeGrid& grid
     fs::path tmp = path;
     tmp += tempSuffix();
     TempFileGuard guard{tmp};
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) {
-            fail(name, "cannot create temporary file " + tmp.string() + ": " + errnoText(errno));
-        }
-        out.write(reinterpret_cast<const char*>(bytes.data()),
-                  static_cast<std::streamsize>(bytes.size()));
-        out.flush();
-        if (!out)
-            fail(name, "cannot write temporary file " + tmp.string() + ": " + errnoText(errno));
-        out.close();
-        if (out.fail()) {
-            fail(name, "cannot close temporary file " + tmp.string() + ": " + errnoText(errno));
-        }
-    }
+    if (injectedFailure("write", tmp))
+        fail(name, "cannot create temporary file " + tmp.string() + ": " + errnoText(EIO));
+    std::FILE* out = std::fopen(tmp.c_str(), "wb");
+    if (!out)
+        fail(name, "cannot create temporary file " + tmp.string() + ": " + errnoText(errno));
+    errno = 0;
+    const bool written = std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size();
+    const int writeErr = errno ? errno : EIO;
+    errno = 0;
+    // Synced before the rename, so a crash leaves the old file or the whole new one.
+    const bool synced = written && std::fflush(out) == 0 && !injectedFailure("fsync", tmp) &&
+                        ::fsync(::fileno(out)) == 0;
+    const int syncErr = errno ? errno : EIO;
+    const bool closed = std::fclose(out) == 0;
+    if (!written)
+        fail(name, "cannot write temporary file " + tmp.string() + ": " + errnoText(writeErr));
+    if (!synced)
+        fail(name, "cannot write temporary file " + tmp.string() + ": " + errnoText(syncErr));
+    if (!closed)
+        fail(name, "cannot close temporary file " + tmp.string() + ": " + errnoText(errno));
     std::error_code ec;
-    fs::rename(tmp, path, ec);
+    if (injectedFailure("rename", path))
+        ec = std::make_error_code(std::errc::io_error);
+    else
+        fs::rename(tmp, path, ec);
     if (ec)
         fail(name, "cannot rename " + tmp.string() + " over the target: " + ec.message());
     guard.armed = false;

@@ -1,0 +1,211 @@
+// Failures of the file layer (docs/formats.md, "Staged and atomic writes"): an injected failure at
+// every file operation of a save or an export leaves the earlier files byte-identical and nothing
+// temporary behind.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "AtomicFile.h"
+#include "FaultInjection.h"
+#include "GltfExport.h"
+#include "Project.h"
+#include "ShProbeFile.h"
+
+namespace fs = std::filesystem;
+using namespace terralux;
+
+namespace {
+
+std::string readText(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// Every file below `dir` (relative path to contents), and every directory as an empty entry.
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+    std::map<std::string, std::string> out;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::string rel = fs::relative(e.path(), dir).generic_string();
+        out[rel] = e.is_directory() ? std::string("<dir>") : readText(e.path());
+    }
+    return out;
+}
+
+// Staging folders and temporaries left anywhere below `dir`.
+std::vector<std::string> leftovers(const fs::path& dir) {
+    std::vector<std::string> out;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        const std::string name = e.path().filename().string();
+        if (name.find(".tmp-") != std::string::npos || name.rfind(".staging-", 0) == 0)
+            out.push_back(fs::relative(e.path(), dir).generic_string());
+    }
+    return out;
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "";
+}
+
+class Faults : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir = fs::temp_directory_path() /
+              ("terralux_test_faults_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        resetFaultInjection(0);
+    }
+    void TearDown() override {
+        resetFaultInjection(0);
+        fs::remove_all(dir);
+    }
+
+    // The operations `f` does, counted with no failure injected.
+    static uint64_t countOps(const std::function<void()>& f) {
+        resetFaultInjection(0);
+        f();
+        const uint64_t n = fileOperationCount();
+        resetFaultInjection(0);
+        return n;
+    }
+
+    fs::path dir;
+};
+
+TEST_F(Faults, ProjectSaveNeverLeavesATruncatedFile) {
+    const fs::path file = dir / "p.terralux.json";
+    Project before;
+    before.baseDir = dir;
+    saveProject(before, file);
+    const std::string old = readText(file);
+    Project after = before;
+    after.scene.sun.elevationDeg = 12.5;
+
+    // Write the temporary, fsync it, rename it over the project.
+    const uint64_t ops = countOps([&] { saveProject(after, file); });
+    EXPECT_EQ(ops, 3u);
+    const std::string fresh = readText(file);
+    ASSERT_NE(fresh, old);
+
+    for (uint64_t n = 1; n <= ops; ++n) {
+        saveProject(before, file);
+        resetFaultInjection(n);
+        const std::string msg = errorOf([&] { saveProject(after, file); });
+        resetFaultInjection(0);
+        EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << "op " << n << ": " << msg;
+        EXPECT_EQ(readText(file), old) << "op " << n;
+        EXPECT_TRUE(leftovers(dir).empty()) << "op " << n;
+    }
+    resetFaultInjection(ops + 1);
+    saveProject(after, file);
+    EXPECT_EQ(readText(file), fresh);
+}
+
+ShProbeGrid grid(float value) {
+    ShProbeGrid g;
+    g.dims = {2, 1, 1};
+    g.spacing = 1.0f;
+    g.probes.resize(2);
+    for (auto& p : g.probes) p.coeffs[0] = glm::vec3(value);
+    g.occupancy = {0, 1};
+    return g;
+}
+
+TEST_F(Faults, ShProbeWriteLeavesTheOldFileOrTheNew) {
+    const fs::path file = dir / "v.shprobe";
+    writeShProbeFile(file, grid(1.0f));
+    const std::string old = readText(file);
+
+    const uint64_t ops = countOps([&] { writeShProbeFile(file, grid(2.0f)); });
+    EXPECT_EQ(ops, 3u);
+    for (uint64_t n = 1; n <= ops; ++n) {
+        writeShProbeFile(file, grid(1.0f));
+        resetFaultInjection(n);
+        const std::string msg = errorOf([&] { writeShProbeFile(file, grid(2.0f)); });
+        resetFaultInjection(0);
+        EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << "op " << n << ": " << msg;
+        EXPECT_EQ(readText(file), old) << "op " << n;
+        EXPECT_TRUE(leftovers(dir).empty()) << "op " << n;
+    }
+}
+
+Heightfield terrain(float lift) {
+    std::vector<float> h(16);
+    for (size_t i = 0; i < h.size(); ++i) h[i] = lift + float(std::sin(double(i)));
+    return Heightfield(4, 4, 2.0, 2.0, std::move(h));
+}
+
+GltfSceneInput scene(const Heightfield& hf, std::vector<std::string> volumes, float value) {
+    GltfSceneInput in;
+    in.heightfield = &hf;
+    for (const auto& name : volumes) in.volumes.push_back({name, grid(value), "{\"probes\": []}\n"});
+    in.reflectionFiles.push_back({"probes.rprobe", std::vector<uint8_t>(40, uint8_t(value))});
+    in.extraFiles.push_back({"bake_report.json", "{\"value\": " + std::to_string(value) + "}\n"});
+    return in;
+}
+
+// A commit that replaces files, adds one and retires a stale one fails at each of its operations
+// in turn: the folder is byte-identical afterwards, with no staging folder left.
+TEST_F(Faults, ExportFailingAtAnyOperationLeavesTheEarlierFiles) {
+    const Heightfield first = terrain(10.0f), second = terrain(20.0f);
+    exportGltfScene(dir, scene(first, {"a", "b"}, 1.0f));
+    const auto before = snapshot(dir);
+
+    const GltfSceneInput next = scene(second, {"b", "c"}, 2.0f);
+    const fs::path copy = dir.string() + "_count";
+    fs::remove_all(copy);
+    fs::copy(dir, copy, fs::copy_options::recursive);
+    const uint64_t ops = countOps([&] { exportGltfScene(copy, next); });
+    fs::remove_all(copy);
+    // 8 files written and synced, a.shprobe and its sidecar moved aside, 8 files renamed into
+    // place, the 6 that exist before kept for rollback, sh_coeffs/, reflection/ and the folder
+    // synced.
+    EXPECT_EQ(ops, 8u * 2 + 2 + 8 + 6 + 3);
+
+    for (uint64_t n = 1; n <= ops; ++n) {
+        resetFaultInjection(n);
+        const std::string msg = errorOf([&] { exportGltfScene(dir, next); });
+        resetFaultInjection(0);
+        EXPECT_EQ(msg.rfind(dir.string(), 0), 0u) << "op " << n << ": " << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+        EXPECT_TRUE(snapshot(dir) == before) << "op " << n << " (" << msg << ") changed the folder";
+        EXPECT_TRUE(leftovers(dir).empty()) << "op " << n;
+    }
+    resetFaultInjection(ops + 1);
+    exportGltfScene(dir, next);
+    EXPECT_FALSE(snapshot(dir) == before);
+    EXPECT_FALSE(fs::exists(dir / "sh_coeffs/a.shprobe"));
+}
+
+// Into an empty folder: a failure removes the sh_coeffs/ and reflection/ folders it made.
+TEST_F(Faults, FirstExportFailingLeavesAnEmptyFolder) {
+    const Heightfield hf = terrain(10.0f);
+    const GltfSceneInput in = scene(hf, {"a"}, 1.0f);
+    const uint64_t ops = countOps([&] { exportGltfScene(dir, in); });
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    for (uint64_t n = 1; n <= ops; ++n) {
+        resetFaultInjection(n);
+        EXPECT_THROW(exportGltfScene(dir, in), FileWriteError) << "op " << n;
+        resetFaultInjection(0);
+        EXPECT_TRUE(fs::is_empty(dir)) << "op " << n;
+    }
+}
+
+}  // namespace
