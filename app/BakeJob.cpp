@@ -16,6 +16,7 @@
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
+#include "OutputFolder.h"
 #include "ProbeDiagnosticsFile.h"
 #include "ReflectionProbeFile.h"
 #include "SceneLighting.h"
@@ -398,6 +399,11 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         if (progress) progress(phase, std::clamp(f, 0.0, 1.0));
     };
     auto cancelled = [&] { return cancel && cancel->load(); };
+
+    // One bake writes into a folder at a time, for the whole bake, so two never mix their files;
+    // what a killed bake left there (its staging folder, temporaries) goes first.
+    const OutputFolderLock folderLock(project.outDir());
+    removeStaleTemporaries(project.outDir());
 
     BakeSetup setup;
     prepare(project, setup, report, cancelled);

@@ -1,6 +1,6 @@
 // Failures of the file layer (docs/formats.md, "Staged and atomic writes"): an injected failure at
 // every file operation of a save or an export leaves the earlier files byte-identical and nothing
-// temporary behind.
+// temporary behind; a bake's output folder lock; a dead writer's leftovers.
 
 #include <gtest/gtest.h>
 
@@ -13,11 +13,14 @@
 #include <string>
 #include <vector>
 
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "AtomicFile.h"
 #include "FaultInjection.h"
 #include "GltfExport.h"
+#include "OutputFolder.h"
 #include "Project.h"
 #include "ShProbeFile.h"
 
@@ -206,6 +209,80 @@ TEST_F(Faults, FirstExportFailingLeavesAnEmptyFolder) {
         resetFaultInjection(0);
         EXPECT_TRUE(fs::is_empty(dir)) << "op " << n;
     }
+}
+
+TEST_F(Faults, OneBakePerFolder) {
+    const fs::path out = dir / "out";
+    {
+        const OutputFolderLock held(out);
+        ASSERT_TRUE(fs::is_directory(out));
+        EXPECT_EQ(readText(out / ".terralux.lock"), std::to_string(::getpid()) + "\n");
+        // flock locks belong to the open file, so a second lock conflicts within one process too.
+        const std::string msg = errorOf([&] { OutputFolderLock again(out); });
+        EXPECT_EQ(msg, out.string() + ": another bake is writing here (pid " +
+                           std::to_string(::getpid()) + "); wait for it or choose another --out");
+    }
+    // Released: the lock file is gone, and so is the folder the lock made for nothing.
+    EXPECT_FALSE(fs::exists(out));
+    fs::create_directories(out);
+    { const OutputFolderLock again(out); }
+    EXPECT_TRUE(fs::is_directory(out));
+    EXPECT_TRUE(fs::is_empty(out));
+}
+
+TEST_F(Faults, ADeadHoldersLockDoesNotBlock) {
+    const fs::path out = dir / "out";
+    fs::create_directories(out);
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        // Holds the lock until killed: no destructor runs, the lock file stays.
+        new OutputFolderLock(out);
+        (void)!::write(ready[1], "x", 1);
+        for (;;) ::pause();
+    }
+    char c = 0;
+    ASSERT_EQ(::read(ready[0], &c, 1), 1);
+    EXPECT_NE(errorOf([&] { OutputFolderLock busy(out); }).find("(pid " + std::to_string(child) + ")"),
+              std::string::npos);
+    ::kill(child, SIGKILL);
+    ::waitpid(child, nullptr, 0);
+    EXPECT_TRUE(fs::exists(out / ".terralux.lock"));
+    EXPECT_EQ(errorOf([&] { OutputFolderLock mine(out); }), "");
+    ::close(ready[0]);
+    ::close(ready[1]);
+}
+
+TEST_F(Faults, RemovesWhatDeadWritersLeft) {
+    // A pid that is surely free: a child that has exited and been reaped.
+    const pid_t dead = ::fork();
+    if (dead == 0) ::_exit(0);
+    ::waitpid(dead, nullptr, 0);
+    const std::string d = std::to_string(dead), self = std::to_string(::getpid());
+    fs::create_directories(dir / "sh_coeffs");
+    fs::create_directories(dir / (".staging-" + d + "-0-00ff"));
+    std::ofstream(dir / (".staging-" + d + "-0-00ff") / "scene.gltf") << "x";
+    fs::create_directories(dir / (".staging-" + self + "-0-00ff"));  // this process: may be live
+    fs::create_directories(dir / ".staging-1-0-00ff");                // pid 1 lives, started earlier
+    fs::create_directories(dir / ".staging-1-1-00ff");                // pid 1 started after this
+    fs::last_write_time(dir / ".staging-1-1-00ff", fs::file_time_type::clock::now() - std::chrono::hours(24 * 365 * 30));
+    std::ofstream(dir / ("scene.gltf.tmp-" + d + "-3")) << "x";
+    std::ofstream(dir / "sh_coeffs" / ("v.shprobe.tmp-" + d + "-00ab")) << "x";
+    std::ofstream(dir / "notes.tmp-x") << "mine";  // no pid: not ours to judge
+    std::ofstream(dir / "keep.txt") << "mine";
+
+    const auto removed = removeStaleTemporaries(dir);
+    EXPECT_EQ(removed.size(), 4u);
+    EXPECT_FALSE(fs::exists(dir / (".staging-" + d + "-0-00ff")));
+    EXPECT_FALSE(fs::exists(dir / ".staging-1-1-00ff"));
+    EXPECT_FALSE(fs::exists(dir / ("scene.gltf.tmp-" + d + "-3")));
+    EXPECT_FALSE(fs::exists(dir / "sh_coeffs" / ("v.shprobe.tmp-" + d + "-00ab")));
+    EXPECT_TRUE(fs::exists(dir / (".staging-" + self + "-0-00ff")));
+    EXPECT_TRUE(fs::exists(dir / ".staging-1-0-00ff"));
+    EXPECT_TRUE(fs::exists(dir / "notes.tmp-x"));
+    EXPECT_TRUE(fs::exists(dir / "keep.txt"));
 }
 
 }  // namespace
