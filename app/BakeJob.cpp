@@ -400,11 +400,6 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     };
     auto cancelled = [&] { return cancel && cancel->load(); };
 
-    // One bake writes into a folder at a time, for the whole bake, so two never mix their files;
-    // what a killed bake left there (its staging folder, temporaries) goes first.
-    const OutputFolderLock folderLock(project.outDir());
-    removeStaleTemporaries(project.outDir());
-
     BakeSetup setup;
     prepare(project, setup, report, cancelled);
     const Heightfield& hf = setup.terrain.heightfield;
@@ -435,6 +430,12 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         reflectionLayout = placeReflectionProbes(scene.reflectionProbes, hf);
         simvxProbes(scene.reflectionProbes.simvxSubset, reflectionLayout->count());
     }
+
+    // One bake writes into a folder at a time, from here to its end, so two never mix their files.
+    // Taken once the inputs are checked, so that an input error is reported as such, and before
+    // any work. What a killed bake left there (its staging folder, temporaries) goes first.
+    const OutputFolderLock folderLock(project.outDir());
+    removeStaleTemporaries(project.outDir());
 
     // Phase weights for one progress bar: cache, probes, reference.
     const double cacheShare = (!referenceMode && q.bounces > 0) ? 0.35 : 0.0;

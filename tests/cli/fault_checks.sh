@@ -22,14 +22,16 @@ long=(--quality reference --set 'probe_volumes[0].grid_dims=64,64')
 sums() { (cd "$1" && find . -type f -print0 | sort -z | xargs -0 -r sha256sum); }
 # Staging folders, temporaries or a lock file left below $1.
 leftovers() { find "$1" \( -name '.staging-*' -o -name '*.tmp-*' -o -name .terralux.lock \) -print; }
-# Waits until the background bake $1 reports progress into $2 (its work has begun).
-await_progress() {
+# Waits until the background bake $1 holds the folder's lock and reports progress into $2 (its
+# work has begun).
+await_bake() {
   for _ in $(seq 600); do
-    grep -q "%\]" "$2" 2>/dev/null && return 0
+    grep -q "%\]" "$2" 2>/dev/null && [ "$(cat "$out/.terralux.lock" 2>/dev/null)" = "$1" ] && return 0
     kill -0 "$1" 2>/dev/null || fail "the long bake ended early: $(cat "$2")"
     sleep 0.1
   done
-  fail "the long bake reported no progress"
+  kill -9 "$1"
+  fail "the long bake did not start its work"
 }
 
 "$terralux" --bake --out "$out" "${small[@]}" >/dev/null 2>"$work/stderr" || fail "first bake exited $?: $(cat "$work/stderr")"
@@ -74,13 +76,13 @@ case "$case_" in
   kill)
     "$terralux" --bake --out "$out" "${long[@]}" >/dev/null 2>"$work/stderr" &
     pid=$!
-    await_progress "$pid" "$work/stderr"
+    await_bake "$pid" "$work/stderr"
     kill -9 "$pid"
     wait "$pid"
     rc=$?
     [ $rc -eq 137 ] || fail "the killed bake exited $rc"
     (cd "$out" && sha256sum --quiet -c "$work/before") || fail "the killed bake changed the earlier outputs"
-    [ "$(cat "$out/.terralux.lock")" = "$pid" ] || fail "the killed bake held no lock file"
+    [ "$(cat "$out/.terralux.lock")" = "$pid" ] || fail "the killed bake's lock file is gone"
     # What a bake killed while writing leaves (the kill above lands before its export), and a
     # live process's staging folder, which the next bake must keep.
     mkdir "$out/.staging-$pid-0-00000000deadbeef" "$out/.staging-$$-0-00000000feedface"
@@ -96,7 +98,7 @@ case "$case_" in
   concurrent)
     "$terralux" --bake --out "$out" "${long[@]}" >/dev/null 2>"$work/stderr" &
     pid=$!
-    await_progress "$pid" "$work/stderr"
+    await_bake "$pid" "$work/stderr"
     "$terralux" --bake --out "$out" "${changed[@]}" >/dev/null 2>"$work/second"
     rc=$?
     [ $rc -eq 3 ] || { kill -9 "$pid"; fail "the second bake exited $rc, expected 3: $(cat "$work/second")"; }
