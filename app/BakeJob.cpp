@@ -16,6 +16,7 @@
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
+#include "LpvConsoleVariables.h"
 #include "OutputFolder.h"
 #include "ProbeDiagnosticsFile.h"
 #include "ReflectionProbeFile.h"
@@ -29,6 +30,8 @@
 #include "bake/ProbePlacement.h"
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
+#include "lpv/Lpv.h"
+#include "render/OrbitCamera.h"
 
 #ifndef TERRALUX_VERSION
 #define TERRALUX_VERSION "0.0.0"
@@ -109,6 +112,10 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
 
 uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
 
+// estimateBake on a prepared setup: what a suggestion reuses instead of loading the terrain,
+// albedo and tracer a second time (which doubled a bake's peak memory).
+BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads);
+
 // The mean error a suggested terrain grid aims at.
 constexpr double kSuggestTargetMeanError = 0.02;
 
@@ -116,7 +123,8 @@ constexpr double kSuggestTargetMeanError = 0.02;
 // time the dry run's calibration estimates. Bilinear interpolation error falls with the square
 // of the probe spacing, so a terrain grid aiming at the target grows by sqrt(mean / target) a
 // side, within the 4096-probe limit; past that an error-driven adaptive volume is the way.
-nlohmann::json suggestions(const BakeRequest& request, size_t index, double meanError) {
+nlohmann::json suggestions(const BakeRequest& request, size_t index, double meanError, BakeSetup& setup,
+                           int threads) {
     nlohmann::json out = nlohmann::json::array();
     if (!(meanError > kSuggestAboveMeanError)) return out;
     const ProbeVolumeSettings& v = request.project.scene.probeVolumes[index];
@@ -137,8 +145,14 @@ nlohmann::json suggestions(const BakeRequest& request, size_t index, double mean
         nlohmann::json doc = projectToJson(r.project);
         for (const auto& s : sets) applyOverride(doc, s);
         r.project.scene = sceneFromJson(doc, "suggestion", nullptr);
+        // Only the probe volumes differ from the bake's own: its terrain, sky and tracer stand.
+        const std::vector<const ProbeVolumeSettings*> own = setup.volumes;
+        setup.volumes.clear();
+        for (const auto& candidate : r.project.scene.probeVolumes)
+            if (candidate.enabled) setup.volumes.push_back(&candidate);
         try {
-            const BakeEstimate e = estimateBake(r);
+            const BakeEstimate e = estimateWith(r, setup, threads);
+            setup.volumes = own;
             const VolumeEstimate* ve = nullptr;
             for (const auto& x : e.volumes)
                 if (x.name == v.name) ve = &x;
@@ -150,6 +164,7 @@ nlohmann::json suggestions(const BakeRequest& request, size_t index, double mean
                            {"estimated_max_time_s", e.secondsMax}});
         } catch (const std::exception&) {
             // A suggestion the estimate refuses (a placement limit) is not made.
+            setup.volumes = own;
         }
     }
     return out;
@@ -267,6 +282,39 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
     else
         j["refinement"] = nullptr;
     return j;
+}
+
+constexpr const char* kLpvIniName = "lpv.ini";
+
+// The light propagation volumes for the project's camera (what the viewport starts with): the
+// cascades and where each local light went; a light left out is a warning.
+nlohmann::json lpvReport(const SceneDescription& scene, const Heightfield& hf, const BakeLighting& lighting,
+                         std::vector<std::string>& warnings) {
+    const auto start = std::chrono::steady_clock::now();
+    const OrbitCamera camera = OrbitCamera::fromSettings(scene.camera, hf);
+    const glm::vec3 eye = camera.position();
+    const lpv::Volumes volumes(scene.lpv, {&lighting, &scene.lights}, glm::dvec3(eye),
+                               glm::dvec3(camera.target - eye));
+    nlohmann::json cascades = nlohmann::json::array();
+    for (const lpv::Cascade& c : volumes.cascades()) {
+        const glm::dvec3 o = c.layout.origin();
+        cascades.push_back({{"size", c.layout.size},
+                            {"cell_size", c.layout.cellSize},
+                            {"origin", {o.x, o.y, o.z}},
+                            {"sun_surfels", c.sunSurfels},
+                            {"injected_flux", {c.injectedFlux.x, c.injectedFlux.y, c.injectedFlux.z}}});
+    }
+    nlohmann::json lights = nlohmann::json::array();
+    for (const lpv::LightInjection& l : volumes.lightInjections()) {
+        lights.push_back({{"light", l.light}, {"cascade", l.cascade}, {"injected", l.injected},
+                          {"surfels", l.surfels}, {"reason", l.reason}});
+        if (!l.injected && scene.lpv.localLights)
+            warnings.push_back("lights[" + std::to_string(l.light) + "]: not injected into the light propagation volumes: " +
+                               l.reason + " (for the project's camera)");
+    }
+    return {{"cascades", cascades},
+            {"lights", lights},
+            {"time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()}};
 }
 
 // Points at which every adaptive volume measures its interpolation error (docs/lighting.md).
@@ -666,7 +714,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         nlohmann::json& vr = volumeReports[vi];
         if (!vr.contains("error_map") || vr["error_map"]["points"].get<size_t>() == 0) continue;
         const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
-        vr["suggestions"] = suggestions(request, index, vr["error_map"]["mean"].get<double>());
+        vr["suggestions"] = suggestions(request, index, vr["error_map"]["mean"].get<double>(), setup, threads);
     }
     nlohmann::json errorEstimate = nlohmann::json::object();
     for (const auto& vr : volumeReports) {
@@ -719,6 +767,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         out.report["reflection_probes"] = rr;
         out.warnings = reflections->warnings;
     }
+    if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
     out.report["warnings"] = out.warnings;
     {
         // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
@@ -739,6 +788,10 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         }
         if (lighting.water)
             in.water = GltfWater{lighting.water->level, scene.water.color, float(scene.water.roughness)};
+        in.lights = scene.lights;
+        // lpv.ini is the bake's whenever the LPV is on; a bake with it off removes an earlier one.
+        in.ownedFiles.push_back(kLpvIniName);
+        if (scene.lpv.enabled) in.extraFiles.push_back({kLpvIniName, lpvIni(scene.lpv)});
         in.generatorVersion = TERRALUX_VERSION;
         in.scene = scene.exportSettings.gltf;
         // The report lists every file of the bake, itself included, in the order written.
@@ -788,6 +841,12 @@ nlohmann::json bakeInputs(const Project& project) {
     settings.erase("fog");
     settings.erase("ao");
     settings.erase("detail");
+    // Nor the indirect-light choice, the light propagation volumes and the local lights: the
+    // viewport computes the LPV live; lpv.ini and the glTF's lights export them, as the scene
+    // exports the shadows and the fog.
+    settings.erase("lighting");
+    settings.erase("lpv");
+    settings.erase("lights");
     settings["terrain"].erase("roughness");
     settings["terrain"].erase("specular_aa");
     // Reflection probes off is the scene before they existed: no key at all.
@@ -838,12 +897,18 @@ std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const
 }
 
 BakeEstimate estimateBake(const BakeRequest& request) {
-    const Project& project = request.project;
-    const SceneDescription& scene = project.scene;
     const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     BakeSetup setup;
-    prepare(project, setup, [](const std::string&, double) {}, [] { return false; });
+    prepare(request.project, setup, [](const std::string&, double) {}, [] { return false; });
+    return estimateWith(request, setup, threads);
+}
+
+namespace {
+
+BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads) {
+    const Project& project = request.project;
+    const SceneDescription& scene = project.scene;
     const Heightfield& hf = setup.terrain.heightfield;
     const BakeQuality& q = setup.q;
 
@@ -852,6 +917,8 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     e.quality = qualityName(scene.bake.quality);
     e.rays = q.rays;
     e.bounces = q.bounces;
+    e.lpvIni = scene.lpv.enabled;
+    e.lights = scene.lights.size();
 
     std::vector<ProbeLayout> layouts;
     std::vector<size_t> points;
@@ -993,5 +1060,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     }
     return e;
 }
+
+}  // namespace
 
 }  // namespace terralux

@@ -93,6 +93,8 @@ struct BakeEstimate {
         double seconds = 0.0;
     };
     std::optional<Reflection> reflection;
+    bool lpvIni = false;   // lpv.enabled: the bake writes lpv.ini and TERRALUX_lighting.lpv
+    size_t lights = 0;     // local lights: KHR_lights_punctual
 };
 
 // Throws the same input errors as runBake.

@@ -294,6 +294,10 @@ int printEstimate(const BakeEstimate& e) {
     if (e.reflection)
         std::cout << "  reflection probes: " << e.reflection->probes << " probes, " << e.reflection->bytes
                   << " bytes, about " << duration(e.reflection->seconds) << "\n";
+    if (e.lpvIni)
+        std::cout << "  light propagation volumes: lpv.ini (console variables) and TERRALUX_lighting.lpv\n";
+    if (e.lights)
+        std::cout << "  local lights: " << e.lights << " in KHR_lights_punctual\n";
     if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
     std::cout << "estimated bake time: about " << duration(e.seconds);
     if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
@@ -421,6 +425,15 @@ int commandBake(const Args& a) {
                           << " % / max " << fixed(100.0 * e["faces"]["max"].get<double>(), 2)
                           << " %, cubemap mean " << fixed(100.0 * e["cubemap"]["mean"].get<double>(), 2)
                           << " % / max " << fixed(100.0 * e["cubemap"]["max"].get<double>(), 2) << " %\n";
+    }
+    if (r.contains("lpv")) {
+        const auto& lpv = r["lpv"];
+        std::cout << "  light propagation volumes: " << lpv["cascades"].size() << " cascades (";
+        for (size_t i = 0; i < lpv["cascades"].size(); ++i)
+            std::cout << (i ? ", " : "") << fixed(lpv["cascades"][i]["size"].get<double>(), 0);
+        size_t injected = 0;
+        for (const auto& l : lpv["lights"]) injected += l["injected"].get<bool>() ? 1 : 0;
+        std::cout << " m), " << injected << " of " << lpv["lights"].size() << " lights injected\n";
     }
     for (const auto& w : outcome.warnings) std::cerr << "terralux: warning: " << w << "\n";
     std::cout << "wrote " << outcome.outDir.string() << ":\n";

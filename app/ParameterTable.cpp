@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdlib>
 
+#include "LpvConsoleVariables.h"
 #include "Project.h"
 #include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
@@ -79,6 +80,7 @@ public:
     }
     Row& range(double lo, double hi) { s_.min = lo; s_.max = hi; return *this; }
     Row& above(double lo, double hi) { s_.min = lo; s_.minExclusive = true; s_.max = hi; return *this; }
+    Row& openAbove() { s_.maxExclusive = true; return *this; }
     Row& items(int lo, int hi) { s_.minItems = lo; s_.maxItems = hi; return *this; }
     Row& scalarToo() { s_.scalarAllowed = true; return *this; }
     Row& choices(std::vector<std::string> c) { s_.choices = std::move(c); return *this; }
@@ -132,6 +134,16 @@ public:
         s_.get = [=](const SceneDescription& s, size_t i) { return fieldToJson(s.water.waves.at(i).*member, {}); };
         s_.set = [=](SceneDescription& s, size_t i, const json& v) {
             s.water.waves.at(i).*member = fieldFromJson<T>(v, {});
+        };
+        return *this;
+    }
+    template <class T>
+    Row& light(T LocalLight::*member) {
+        s_.get = [=, choices = s_.choices](const SceneDescription& s, size_t i) {
+            return fieldToJson(s.lights.at(i).*member, choices);
+        };
+        s_.set = [=, choices = s_.choices](SceneDescription& s, size_t i, const json& v) {
+            s.lights.at(i).*member = fieldFromJson<T>(v, choices);
         };
         return *this;
     }
@@ -740,6 +752,98 @@ std::vector<ParameterSpec> buildTable() {
                     s.reflectionProbes.simvxSubset = idx;
                 });
 
+    // Indirect light and light propagation volumes (docs/lighting.md, "Light propagation
+    // volumes"). Each lpv row is one console variable of seed 003 (lpv.ini); the LPV dock edits
+    // them, its lights table the lights.
+    add(Row("lighting.indirect", T::Choice)).choices({"probes", "lpv", "both", "none"}).label("Indirect light")
+        .about("Which indirect light the engine adds to the direct sun: the baked probes, the light propagation volumes, both summed, or none; exported in TERRALUX_lighting (the viewport draws the probes)")
+        .redoes(kNothing).field(&SceneDescription::lighting, &LightingSettings::indirect);
+    const auto lpvOn = [](const SceneDescription& s, size_t) { return s.lpv.enabled; };
+    add(Row("lpv.enabled", T::Boolean)).label("Light propagation volumes")
+        .about("rEx.GI.Method: 1 with LPV on, else 0. On: the bake writes lpv.ini and TERRALUX_lighting.lpv")
+        .redoes(kNothing).field(&SceneDescription::lpv, &LpvSettings::enabled);
+    add(Row("lpv.size", T::Number)).above(0.0, 1.0e6).unit("m").decimals(0).label("LPV size")
+        .about("rEx.LPV.Size: edge of the largest cascade (cascade 0), 32 cells across")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::size);
+    add(Row("lpv.fade_range", T::Number)).range(0.0, 16.0).unit("cells").decimals(1).label("Fade range")
+        .about("rEx.LPV.FadeRange: cells at each cascade's boundary over which it fades out (to the next coarser cascade, or to nothing)")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::fadeRange);
+    add(Row("lpv.propagation_weight", T::Number)).range(0.0, 1.0).decimals(3).label("Propagation weight")
+        .about("rEx.LPV.PropagationWeight: per-neighbour propagation strength, compounded over a cascade's 32 cells: each iteration passes on w^(1/32) of the paper's face transfer, so w is the share left after crossing the cascade (1 = energy-conserving, 0.01 = 0.866 per iteration); higher spreads light faster and leaks more")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationWeight);
+    add(Row("lpv.propagation_iterations", T::Integer)).range(0, 64).label("Propagation iterations")
+        .about("rEx.LPV.PropagationIterations: propagation steps per update, each accumulated; 0 = injected light only")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationIterations);
+    add(Row("lpv.update_interval", T::Integer)).range(0, 600).unit("frames").label("Update interval")
+        .about("rEx.LPV.UpdateInterval: frames between the engine's full updates (0 = every frame); exported only, the viewport does not draw the LPV")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::updateInterval);
+    add(Row("lpv.cascades", T::Integer)).range(1, 4).label("Cascades")
+        .about("rEx.LPV.NumCascades: nested 32^3 volumes, each smaller than the last by the cascade ratio")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascades);
+    add(Row("lpv.cascade_ratio", T::Number)).above(1.0, 16.0).decimals(2).label("Cascade ratio")
+        .about("rEx.LPV.CascadeRatio: size of a cascade / size of the next finer one (the least ratio when auto_cascade_min_size is on)")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeRatio);
+    add(Row("lpv.auto_cascade_min_size", T::Number)).range(0.0, 1.0e6).unit("m").decimals(0).zeroMeans("off")
+        .label("Auto min cascade")
+        .about("rEx.LPV.AutoCascadeMinSize: > 0 raises the ratio to max(cascade_ratio, (size / this)^(1/(cascades - 1))), so the smallest cascade is at most this size; 0 = off")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::autoCascadeMinSize);
+    add(Row("lpv.cascade_forward_offset", T::Number)).range(0.0, 1.0).decimals(2).label("Forward offset")
+        .about("rEx.LPV.CascadeForwardOffset: each cascade's centre sits this share of its size ahead of the camera along the view direction (0 = centred on the camera, 0.5 = the camera on its back face)")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeForwardOffset);
+    add(Row("lpv.local_lights", T::Boolean)).label("Local lights")
+        .about("rEx.LPV.EnableLocalLights: inject the point and spot lights of `lights` (each into its best-fitting cascade); off: the sun only")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::localLights);
+    add(Row("lpv.quality", T::Integer)).range(0, 2).label("LPV quality")
+        .about("rEx.LPV.Quality: 0 linear SH diffuse; 1 adds ZH3 reconstruction and directional-derivative leak dampening; 2 adds cone-traced specular")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::quality);
+    add(Row("lpv.cone_trace_samples", T::Integer)).range(1, 64).label("Cone-trace samples")
+        .about("rEx.LPV.ConeTraceSamples: samples along the reflected direction of quality 2's specular (4 short range, 6 balanced, 8 long)")
+        .redoes(kNothing)
+        .onlyWhen([](const SceneDescription& s, size_t) { return s.lpv.enabled && s.lpv.quality == 2; })
+        .field(&SceneDescription::lpv, &LpvSettings::coneTraceSamples);
+    add(Row("lpv.indirect_intensity", T::Number)).range(0.0, 100.0).decimals(2).label("Indirect intensity")
+        .about("The post-process IndirectLightingIntensity: multiplies the LPV's light (not a console variable: in TERRALUX_lighting, and as a comment in lpv.ini)")
+        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::indirectIntensity);
+    // Local lights: a list of objects, read by the LPV only (never by the diffuse bake).
+    const auto spot = [](const SceneDescription& s, size_t i) { return s.lights.at(i).type == LocalLightType::Spot; };
+    add(Row("lights[].type", T::Choice)).choices({"point", "spot"}).label("Light type")
+        .about("point: the same intensity every way; spot: a cone along direction (KHR_lights_punctual's model)")
+        .redoes(kNothing).light(&LocalLight::type);
+    add(Row("lights[].position", T::NumberList)).items(3, 3).range(-1.0e7, 1.0e7).unit("m").label("Position")
+        .about("Engine space (x east, y up, z south)").redoes(kNothing).light(&LocalLight::position);
+    add(Row("lights[].direction", T::NumberList)).items(3, 3).range(-1.0, 1.0).decimals(3).label("Direction")
+        .about("Spot: where the cone points, engine space; normalised, must not be zero")
+        .redoes(kNothing).onlyWhen(spot)
+        .custom([](const SceneDescription& s, size_t i) { return fieldToJson(s.lights.at(i).direction, {}); },
+                [](SceneDescription& s, size_t i, const json& v) {
+                    const glm::vec3 d = fieldFromJson<glm::vec3>(v, {});
+                    if (!(d.x * d.x + d.y * d.y + d.z * d.z > 1e-12f))
+                        throw ParameterRejection{"must not be the zero vector", ""};
+                    s.lights.at(i).direction = d;
+                });
+    add(Row("lights[].color", T::Color)).range(0.0, 1.0).label("Light colour")
+        .about("Linear RGB tint of the intensity").redoes(kNothing).light(&LocalLight::color);
+    add(Row("lights[].intensity", T::Number)).range(0.0, 1.0e12).label("Intensity")
+        .about("Irradiance on a surface facing the light 1 m away, in the sun's scene-linear units (E = intensity / d^2 inside the range); exported as candela, one scene-linear unit of illuminance to one lux")
+        .redoes(kNothing).light(&LocalLight::intensity);
+    add(Row("lights[].range", T::Number)).above(0.0, 1.0e6).unit("m").label("Range")
+        .about("Distance where the light ends: its falloff is windowed by clamp(1 - (d/range)^4, 0, 1) (KHR_lights_punctual)")
+        .redoes(kNothing).light(&LocalLight::range);
+    add(Row("lights[].inner_cone_deg", T::Number)).range(0.0, 90.0).openAbove().unit("°").decimals(1).label("Inner cone")
+        .about("Spot: angle from the axis inside which the light is at full intensity")
+        .redoes(kNothing).onlyWhen(spot).light(&LocalLight::innerConeDeg);
+    add(Row("lights[].outer_cone_deg", T::Number)).above(0.0, 90.0).unit("°").decimals(1).label("Outer cone")
+        .about("Spot: angle from the axis where the light has faded to nothing; above inner_cone_deg")
+        .redoes(kNothing).onlyWhen(spot)
+        .custom([](const SceneDescription& s, size_t i) { return json(s.lights.at(i).outerConeDeg); },
+                [](SceneDescription& s, size_t i, const json& v) {
+                    // Read after inner_cone_deg (table order), so the pair is checked here.
+                    LocalLight& l = s.lights.at(i);
+                    l.outerConeDeg = v.get<double>();
+                    if (l.type == LocalLightType::Spot && !(l.outerConeDeg > l.innerConeDeg))
+                        throw ParameterRejection{"must be above inner_cone_deg (" + number(l.innerConeDeg) + ")", ""};
+                });
+
     // Bake.
     add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
         .about("Preset of rays, bounces and irradiance cache (rays and bounces below override it)")
@@ -795,6 +899,14 @@ std::vector<ParameterSpec> buildTable() {
         .about("Default ambient term written into each .shprobe").redoes(kNothing)
         .field(&SceneDescription::exportSettings, &ExportSettings::defaultAmbient);
 
+    // The console variables in the lpv rows' order (lpv.indirect_intensity is none): the lpv.ini
+    // writer's names, so tooltips and lpv.ini cannot drift apart.
+    const auto cvars = lpvConsoleVariables(LpvSettings{});
+    size_t cvar = 0;
+    for (Row& r : rows)
+        if (r.s_.path.rfind("lpv.", 0) == 0 && r.s_.path != "lpv.indirect_intensity" && cvar < cvars.size())
+            r.s_.consoleVariable = cvars[cvar++].first;
+
     std::vector<ParameterSpec> table;
     table.reserve(rows.size());
     for (Row& r : rows) {
@@ -814,7 +926,7 @@ double shortestDecimal(float f) {
 }
 
 const std::vector<std::string>& objectLists() {
-    static const std::vector<std::string> lists{"probe_volumes", "water.waves"};
+    static const std::vector<std::string> lists{"probe_volumes", "water.waves", "lights"};
     return lists;
 }
 
@@ -837,6 +949,7 @@ bool ParameterSpec::isRead(const SceneDescription& scene, size_t volume) const {
 json ParameterSpec::defaultValue() const {
     SceneDescription scene;  // holds one default probe volume
     if (perWave()) scene.water.waves.emplace_back();
+    if (perLight()) scene.lights.emplace_back();
     return get(scene, 0);
 }
 
@@ -1010,11 +1123,14 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     if (section == "water") return {"dock.water", "Water"};
     if (section == "reflection_probes") return {"dock.reflectionProbes", "Reflection Probes"};
+    if (section == "lpv" || section == "lights" || spec.path == "lighting.indirect") return {"dock.lpv", "LPV"};
     return {"", ""};
 }
 
 std::string uiObjectName(const ParameterSpec& spec) {
-    return "param." + (spec.perVolume() ? "volume." + spec.localPath() : spec.path);
+    if (spec.perVolume()) return "param.volume." + spec.localPath();
+    if (spec.perLight()) return "param.light." + spec.localPath();
+    return "param." + spec.path;
 }
 
 double uiMinimum(const ParameterSpec& spec) {
@@ -1040,10 +1156,11 @@ json projectSchema() {
     props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", kProjectVersion},
                         {"description", "Project format version; older versions are migrated on reading"},
                         {"default", kProjectVersion}};
-    json volume = objectSchema(), wave = objectSchema();
+    json volume = objectSchema(), wave = objectSchema(), light = objectSchema();
     for (const auto& s : parameterTable()) {
         if (s.perVolume()) insert(volume, s.localPath(), leafSchema(s));
         else if (s.perWave()) insert(wave, s.localPath(), leafSchema(s));
+        else if (s.perLight()) insert(light, s.localPath(), leafSchema(s));
         else insert(schema, s.path, leafSchema(s));
     }
     props["probe_volumes"] = {{"type", "array"},
@@ -1056,6 +1173,11 @@ json projectSchema() {
             {"description", "Gerstner waves on the water, each with exactly one of amplitude and steepness; their summed steepness k·A is at most 1"},
             {"items", wave},
             {"default", json::array()}});
+    props["lights"] = {{"type", "array"},
+                       {"maxItems", kMaxLocalLights},
+                       {"description", "Point and spot lights: injected into the light propagation volumes and exported as KHR_lights_punctual; the diffuse bake leaves them out"},
+                       {"items", light},
+                       {"default", json::array()}};
     return schema;
 }
 
@@ -1064,7 +1186,7 @@ std::string parameterReferenceMarkdown() {
     md << "# Project parameters\n\n"
           "Generated from the parameter table (`app/ParameterTable.cpp`) by\n"
           "`terralux --print-reference`; do not edit by hand. Every parameter is reachable by\n"
-          "`--set PATH=VALUE`; rows under `probe_volumes[]` and `water.waves[]` take an index\n"
+          "`--set PATH=VALUE`; rows under `probe_volumes[]`, `water.waves[]` and `lights[]` take an index\n"
           "(`probe_volumes[0].grid_dims`), and a whole list is one JSON array (`--set water.waves=[...]`).\n"
           "`null` means \"auto\" where the last column says what auto does. \"Edit redoes\" is the\n"
           "work an edit in the authoring window costs: redraw < upload < preview bake < re-place <\n"

@@ -64,6 +64,9 @@ struct ParameterSpec {
     bool slider = false;  // UI: a slider beside the spin box (angles)
     bool colorList = false;  // UI: a NumberList of RGB triples, one colour button per triple
     bool uiRow = true;    // shown as a dock row (false: edited elsewhere, or by the viewport)
+    // The engine console variable the row sets ("rEx.LPV.Size"), taken from the lpv.ini writer's
+    // list (io/LpvConsoleVariables.h) so the two never disagree; empty for other rows.
+    std::string consoleVariable;
     // Lists whose length depends on other parameters (a box grid has 3 dims, a terrain grid 2):
     // the exact count for this scene, 0 for one plain number, -1 when the row is not read.
     std::function<int(const SceneDescription&, size_t volume)> items;
@@ -79,6 +82,7 @@ struct ParameterSpec {
 
     bool perVolume() const { return path.rfind("probe_volumes[].", 0) == 0; }
     bool perWave() const { return path.rfind("water.waves[].", 0) == 0; }
+    bool perLight() const { return path.rfind("lights[].", 0) == 0; }
     // The list whose elements hold the row ("probe_volumes", "water.waves"); empty for the rest.
     std::string listPath() const;
     bool inList() const { return !listPath().empty(); }
@@ -103,7 +107,7 @@ struct ParameterRejection {
 
 const std::vector<ParameterSpec>& parameterTable();
 
-// The project's lists of objects, as JSON paths: "probe_volumes" and "water.waves". Each element
+// The project's lists of objects, as JSON paths: "probe_volumes", "water.waves" and "lights". Each element
 // is an object whose keys are the rows "<list>[].<key>".
 const std::vector<std::string>& objectLists();
 
@@ -128,8 +132,8 @@ struct ParameterDock {
 };
 ParameterDock parameterDock(const ParameterSpec& spec);
 // The objectName of a row's editor: "param.sun.elevation_deg"; rows of the selected probe
-// volume are "param.volume.<key>". Lists add ".0", ".1", ...; a slider adds ".slider"; the
-// "auto" box of a nullable list adds ".auto".
+// volume are "param.volume.<key>", of the selected light "param.light.<key>". Lists add ".0",
+// ".1", ...; a slider adds ".slider"; the "auto" box of a nullable list adds ".auto".
 std::string uiObjectName(const ParameterSpec& spec);
 // The smallest value a UI spin box offers: the minimum, or one display step above an excluded one.
 double uiMinimum(const ParameterSpec& spec);

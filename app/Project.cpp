@@ -6,6 +6,7 @@
 #include <limits>
 #include <regex>
 #include <set>
+#include <cstdio>
 #include <sstream>
 
 #include "AtomicFile.h"
@@ -18,9 +19,42 @@ namespace {
 using nlohmann::json;
 
 std::string show(const json& v) {
-    std::string s = v.dump();
+    // replace: a string from the command line may hold bytes that are not UTF-8.
+    std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
     if (s.size() > 60) s = s.substr(0, 57) + "...";
     return s;
+}
+
+// Where s stops being well-formed UTF-8 (RFC 3629: no overlong forms, surrogates or code
+// points past U+10FFFF), or npos.
+size_t firstInvalidUtf8(const std::string& s) {
+    size_t i = 0;
+    while (i < s.size()) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        size_t n = 0;
+        unsigned cp = 0, min = 0;
+        if (c < 0x80) {
+            ++i;
+            continue;
+        } else if ((c & 0xE0) == 0xC0) {
+            n = 1, cp = c & 0x1F, min = 0x80;
+        } else if ((c & 0xF0) == 0xE0) {
+            n = 2, cp = c & 0x0F, min = 0x800;
+        } else if ((c & 0xF8) == 0xF0) {
+            n = 3, cp = c & 0x07, min = 0x10000;
+        } else {
+            return i;
+        }
+        if (i + n >= s.size()) return i;  // truncated sequence
+        for (size_t k = 1; k <= n; ++k) {
+            const auto t = static_cast<unsigned char>(s[i + k]);
+            if ((t & 0xC0) != 0x80) return i;
+            cp = (cp << 6) | (t & 0x3F);
+        }
+        if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
+        i += n + 1;
+    }
+    return std::string::npos;
 }
 
 std::string trim(double d) {
@@ -227,6 +261,7 @@ json sceneToJson(const SceneDescription& s) {
         if (!spec.inList()) place(doc, spec.path, spec.get(s, 0));
     place(doc, "probe_volumes", listToJson(s, "probe_volumes", s.probeVolumes.size()));
     place(doc, "water.waves", listToJson(s, "water.waves", s.water.waves.size()));
+    place(doc, "lights", listToJson(s, "lights", s.lights.size()));
     return doc;
 }
 
@@ -309,12 +344,27 @@ SceneDescription sceneFromJson(const json& original, const std::string& source,
         if (const std::string rule = water::checkWaves(s.water.waves); !rule.empty())
             reject(source, "water.waves", *waves, rule);
     }
+    if (const json* lights = lookup(doc, "lights")) {
+        if (lights->size() > size_t(kMaxLocalLights))
+            reject(source, "lights", *lights,
+                   "must hold at most " + std::to_string(kMaxLocalLights) + " lights (has " +
+                       std::to_string(lights->size()) + ")");
+        s.lights.assign(lights->size(), LocalLight{});
+        readList("lights", *lights, s, source);
+    }
     for (const auto& spec : parameterTable())
         if (!spec.inList()) readRow(spec, doc, "", 0, s, source);
     return s;
 }
 
 void applyOverride(json& doc, const std::string& assignment) {
+    // JSON strings are UTF-8: a value that is not could neither be saved nor reported.
+    if (const size_t bad = firstInvalidUtf8(assignment); bad != std::string::npos) {
+        char byte[8];
+        std::snprintf(byte, sizeof byte, "0x%02X", unsigned(static_cast<unsigned char>(assignment[bad])));
+        throw ProjectError("--set: byte " + std::to_string(bad) + " (" + byte +
+                           ") of the assignment is not UTF-8; parameters and paths must be UTF-8 text");
+    }
     const size_t eq = assignment.find('=');
     if (eq == std::string::npos || eq == 0)
         throw ProjectError("--set " + assignment + ": expected key.path=value");
@@ -333,7 +383,7 @@ void applyOverride(json& doc, const std::string& assignment) {
         if (path[i] == '[') {
             const size_t close = path.find(']', i);
             const std::string idx = close == std::string::npos ? "" : path.substr(i + 1, close - i - 1);
-            if (idx.empty() || idx.find_first_not_of("0123456789") != std::string::npos)
+            if (idx.empty() || idx.size() > 9 || idx.find_first_not_of("0123456789") != std::string::npos)
                 throw ProjectError("--set " + path + ": bad index in '" + path.substr(i) + "'");
             const size_t n = std::stoul(idx);
             walked += "[" + idx + "]";

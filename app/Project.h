@@ -26,6 +26,7 @@ inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffus
 inline constexpr int kMaxBoxGridProbes = 65536;
 inline constexpr int kMaxBounces = 16;
 inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights
+inline constexpr int kMaxLocalLights = 1024;         // lights: what one LPV update injects
 
 struct Project {
     SceneDescription scene;

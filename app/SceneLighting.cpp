@@ -10,6 +10,8 @@
 #include <glm/common.hpp>
 
 #include "EnvironmentImage.h"
+#include "LpvConsoleVariables.h"
+#include "lpv/Lpv.h"
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "render/ShadowCascades.h"
@@ -222,6 +224,16 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     }
     // Reflection probes as authored; the bake adds their files and counts (docs/formats.md).
     if (scene.reflectionProbes.enabled) ext["reflection_probes"] = authored.at("reflection_probes");
+    // Which indirect light the viewport adds; the light propagation volumes as authored, as the
+    // engine's console variables (lpv.ini's values) and with the cascade sizes the rule gives.
+    ext["indirect"] = authored.at("lighting").at("indirect");
+    if (scene.lpv.enabled) {
+        nlohmann::json& lpv = ext["lpv"] = authored.at("lpv");
+        lpv["console_variables"] = lpvConsoleVariablesJson(scene.lpv);
+        lpv["computed_cascade_ratio"] = lpv::cascadeRatio(scene.lpv);
+        lpv["computed_cascade_sizes"] = lpv::cascadeSizes(scene.lpv);
+        lpv["ini_uri"] = "lpv.ini";
+    }
     return ext;
 }
 

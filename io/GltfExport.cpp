@@ -7,13 +7,18 @@
 #include <algorithm>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec4.hpp>
+#include <numbers>
 #include <atomic>
 #include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <random>
 #include <set>
 #include <span>
@@ -37,6 +42,7 @@ constexpr const char* kEngineExtension = "VULKAN_SCHNEE_engine_properties";
 constexpr const char* kGeoExtension = "TERRALUX_geo";
 constexpr const char* kBakeExtension = "TERRALUX_bake";
 constexpr const char* kLightingExtension = "TERRALUX_lighting";
+constexpr const char* kLightsExtension = "KHR_lights_punctual";
 constexpr const char* kTransmissionExtension = "KHR_materials_transmission";
 constexpr const char* kIorExtension = "KHR_materials_ior";
 constexpr const char* kGltfName = "scene.gltf";
@@ -57,10 +63,16 @@ constexpr int kLinear = 9729;
 constexpr int kLinearMipmapLinear = 9987;
 constexpr int kClampToEdge = 33071;
 
-// One file of the layout: where it goes below outDir and what it holds.
+class BinStream;
+
+// One file of the layout: where it goes below outDir and what it holds, either as bytes or, for
+// scene.bin, as a writer that produces its streamBytes bytes when the file is written.
 struct PendingFile {
     fs::path relative;
     std::vector<uint8_t> bytes;
+    std::function<void(BinStream&)> stream = {};
+    size_t streamBytes = 0;
+    size_t size() const { return stream ? streamBytes : bytes.size(); }
 };
 
 std::string errnoText(int err) {
@@ -68,18 +80,54 @@ std::string errnoText(int err) {
 }
 
 // Little-endian appends, independent of the host.
-void putU16(std::vector<uint8_t>& out, uint16_t v) {
+// scene.bin's bytes: only counted (to lay out the glTF document) or written to a file in 1 MiB
+// chunks, so a large DEM's mesh never exists whole in memory (it would be 14x the raster).
+class BinStream {
+public:
+    BinStream() = default;
+    explicit BinStream(std::FILE* file) : file_(file) { chunk_.reserve(kChunk); }
+    void push_back(uint8_t b) {
+        ++size_;
+        if (!file_) return;
+        chunk_.push_back(b);
+        if (chunk_.size() == kChunk) flush();
+    }
+    void append(std::span<const uint8_t> bytes) {
+        for (uint8_t b : bytes) push_back(b);
+    }
+    size_t size() const { return size_; }
+    // False once a write has failed; errno then says why.
+    bool flush() {
+        if (file_ && !chunk_.empty() && ok_)
+            ok_ = std::fwrite(chunk_.data(), 1, chunk_.size(), file_) == chunk_.size();
+        chunk_.clear();
+        return ok_;
+    }
+
+private:
+    static constexpr size_t kChunk = size_t(1) << 20;
+    std::FILE* file_ = nullptr;
+    std::vector<uint8_t> chunk_;
+    size_t size_ = 0;
+    bool ok_ = true;
+};
+
+template <class Out>
+void putU16(Out& out, uint16_t v) {
     out.push_back(static_cast<uint8_t>(v));
     out.push_back(static_cast<uint8_t>(v >> 8));
 }
-void putU32(std::vector<uint8_t>& out, uint32_t v) {
+template <class Out>
+void putU32(Out& out, uint32_t v) {
     for (int shift = 0; shift < 32; shift += 8)
         out.push_back(static_cast<uint8_t>(v >> shift));
 }
-void putF32(std::vector<uint8_t>& out, float v) {
+template <class Out>
+void putF32(Out& out, float v) {
     putU32(out, std::bit_cast<uint32_t>(v));
 }
-void padTo4(std::vector<uint8_t>& out) {
+template <class Out>
+void padTo4(Out& out) {
     while (out.size() % 4 != 0)
         out.push_back(0);
 }
@@ -141,7 +189,7 @@ std::vector<uint8_t> srgbSamples(const SurfaceAlbedo& a) {
 // normals, indices) as node, mesh and material 1, all named `water`. Its material transmits
 // (KHR_materials_transmission) with water's index of refraction (KHR_materials_ior), tinted by
 // the deep-water scatter colour, with the waves' highlight roughness.
-void addWaterPlane(const Heightfield& hf, const GltfWater& w, std::vector<uint8_t>& bin, ojson& doc) {
+void addWaterPlane(const Heightfield& hf, const GltfWater& w, BinStream& bin, ojson& doc) {
     const float x0 = hf.minX(), x1 = hf.maxX(), z0 = hf.minZ(), z1 = hf.maxZ();
     const size_t positionOffset = bin.size();
     // Corners north-west, south-west, south-east, north-east.
@@ -198,15 +246,61 @@ void addWaterPlane(const Heightfield& hf, const GltfWater& w, std::vector<uint8_
     doc["extensionsUsed"].push_back(kIorExtension);
 }
 
-// Builds scene.bin and the mesh part of the glTF document.
+// The local lights as KHR_lights_punctual: one light and one node each. The spec's lights shine
+// along the node's −Z; the node's rotation is the shortest arc from −Z to the spot's direction.
+void addLights(ojson& doc, const std::vector<LocalLight>& lights) {
+    if (!doc.contains("scenes")) {
+        doc["scene"] = 0;
+        doc["scenes"] = ojson::array({ojson{{"name", "terrain"}, {"nodes", ojson::array()}}});
+    }
+    if (!doc.contains("nodes")) doc["nodes"] = ojson::array();
+    ojson list = ojson::array();
+    constexpr double kDeg = std::numbers::pi / 180.0;
+    for (size_t i = 0; i < lights.size(); ++i) {
+        const LocalLight& l = lights[i];
+        const bool spot = l.type == LocalLightType::Spot;
+        ojson light = {{"name", "light " + std::to_string(i)},
+                       {"type", spot ? "spot" : "point"},
+                       {"color", floats({l.color.r, l.color.g, l.color.b})},
+                       {"intensity", l.intensity},
+                       {"range", l.range}};
+        if (spot)
+            light["spot"] = {{"innerConeAngle", l.innerConeDeg * kDeg}, {"outerConeAngle", l.outerConeDeg * kDeg}};
+        list.push_back(std::move(light));
+        ojson node = {{"name", "light " + std::to_string(i)},
+                      {"translation", floats({l.position.x, l.position.y, l.position.z})},
+                      {"extensions", {{kLightsExtension, {{"light", i}}}}}};
+        if (spot) {
+            const glm::dvec3 d = glm::normalize(glm::dvec3(l.direction)), from(0.0, 0.0, -1.0);
+            const double c = glm::dot(from, d);
+            glm::dvec4 q;  // x, y, z, w
+            if (c < -1.0 + 1e-12) {
+                q = glm::dvec4(0.0, 1.0, 0.0, 0.0);  // +Z: half a turn about +Y
+            } else {
+                const glm::dvec3 axis = glm::cross(from, d);
+                q = glm::normalize(glm::dvec4(axis, 1.0 + c));
+            }
+            if (q != glm::dvec4(0.0, 0.0, 0.0, 1.0)) node["rotation"] = {q.x, q.y, q.z, q.w};
+        }
+        const size_t index = doc["nodes"].size();
+        doc["nodes"].push_back(std::move(node));
+        doc["scenes"][0]["nodes"].push_back(index);
+    }
+    doc["extensions"][kLightsExtension] = {{"lights", std::move(list)}};
+    doc["extensionsUsed"].push_back(kLightsExtension);
+}
+
+// scene.bin's layout: the mesh stride, its size, and the albedo texture's PNG, encoded once.
 struct MeshBuild {
-    std::vector<uint8_t> bin;
     size_t stride = 1;
+    size_t bytes = 0;
+    std::vector<uint8_t> png;
 };
 
-MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::path& gltfPath,
-                    ojson& doc) {
-    MeshBuild mesh;
+// Emits scene.bin into bin and the mesh part of the glTF document into doc. Run once counting,
+// to lay out the document, and again when the file is written, with the same bytes.
+void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::path& gltfPath,
+               ojson& doc, BinStream& bin, MeshBuild& mesh) {
     mesh.stride = chooseStride(hf, input.meshMaxVertices, gltfPath);
     const std::vector<int> cols = sampledLines(hf.width(), mesh.stride);
     const std::vector<int> rows = sampledLines(hf.depth(), mesh.stride);
@@ -226,9 +320,6 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
                                  std::to_string(nr) + " vertices needs " + std::to_string(int(binBytes / (1 << 30))) +
                                  " GiB, over the 4 GiB a glTF buffer can address; lower terrain.max_resolution");
     }
-
-    std::vector<uint8_t>& bin = mesh.bin;
-    bin.reserve(vertexCount * 32 + indexCount * (wideIndices ? 4 : 2) + 4);
 
     const size_t positionOffset = bin.size();
     glm::vec3 lo(std::numeric_limits<float>::infinity());
@@ -293,13 +384,15 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
     padTo4(bin);
     const size_t imageOffset = bin.size();
     if (texture) {
-        std::vector<uint8_t> png;
-        try {
-            png = encodePng(uint32_t(texture->width), uint32_t(texture->height), 3, srgbSamples(*texture));
-        } catch (const std::exception& e) {
-            throw std::runtime_error(gltfPath.string() + ": albedo texture: " + e.what());
+        if (mesh.png.empty()) {
+            try {
+                mesh.png = encodePng(uint32_t(texture->width), uint32_t(texture->height), 3,
+                                     srgbSamples(*texture));
+            } catch (const std::exception& e) {
+                throw std::runtime_error(gltfPath.string() + ": albedo texture: " + e.what());
+            }
         }
-        bin.insert(bin.end(), png.begin(), png.end());
+        bin.append(mesh.png);
     }
     const size_t imageBytes = bin.size() - imageOffset;
     padTo4(bin);
@@ -361,7 +454,7 @@ MeshBuild buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs
     if (input.water)
         addWaterPlane(hf, *input.water, bin, doc);
     doc["buffers"] = ojson::array({ojson{{"uri", kBinName}, {"byteLength", bin.size()}}});
-    return mesh;
+    mesh.bytes = bin.size();
 }
 
 ojson probeGridEntry(const GltfProbeVolume& v) {
@@ -505,10 +598,12 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
         doc["extensionsUsed"] = {kEngineExtension, kGeoExtension, kBakeExtension};
         if (input.lighting.is_object())
             doc["extensionsUsed"].push_back(kLightingExtension);
-        MeshBuild mesh;
+        auto mesh = std::make_shared<MeshBuild>();
         const bool hasMesh = hf.width() >= 2 && hf.depth() >= 2;
-        if (hasMesh)
-            mesh = buildMesh(hf, input, gltfPath, doc);
+        if (hasMesh) {
+            BinStream counted;
+            buildMesh(hf, input, gltfPath, doc, counted, *mesh);
+        }
         doc["extensions"] = {
             {kEngineExtension, {{"shProbeGrids", std::move(grids)}}},
             {kGeoExtension,
@@ -521,13 +616,19 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
               {"verticalScale", input.verticalScale},
               {"cellSize", {hf.cellSizeX(), hf.cellSizeZ()}},
               {"gridSize", {hf.width(), hf.depth()}},
-              {"meshStride", mesh.stride}}},
+              {"meshStride", mesh->stride}}},
             {kBakeExtension, ojson(input.bake)},
         };
         if (input.lighting.is_object())
             doc["extensions"][kLightingExtension] = ojson(input.lighting);
-        if (hasMesh)
-            files.push_back({kBinName, std::move(mesh.bin)});
+        if (!input.lights.empty()) addLights(doc, input.lights);
+        if (hasMesh) {
+            auto write = [&hf, &input, gltfPath, mesh](BinStream& bin) {
+                ojson scratch;
+                buildMesh(hf, input, gltfPath, scratch, bin, *mesh);
+            };
+            files.push_back({kBinName, {}, write, mesh->bytes});
+        }
         const std::string text = doc.dump(2) + "\n";
         files.push_back({kGltfName, std::vector<uint8_t>(text.begin(), text.end())});
     } catch (const nlohmann::json::exception& e) {
@@ -539,14 +640,26 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
 }
 
 // Writes, flushes and syncs one staged file; errors name the final target.
-void writeStaged(const fs::path& staged, const fs::path& target, std::span<const uint8_t> bytes) {
+void writeStaged(const fs::path& staged, const fs::path& target, const PendingFile& file) {
     if (injectedFailure("write", staged))
         throw FileWriteError(target.string() + ": cannot write (" + errnoText(EIO) + ")");
     std::FILE* f = std::fopen(staged.c_str(), "wb");
     if (!f)
         throw FileWriteError(target.string() + ": cannot write (" + errnoText(errno) + ")");
     errno = 0;
-    const bool written = bytes.empty() || std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    bool written = true;
+    if (file.stream) {
+        BinStream out(f);
+        try {
+            file.stream(out);
+        } catch (...) {
+            std::fclose(f);
+            throw;
+        }
+        written = out.flush() && out.size() == file.streamBytes;
+    } else {
+        written = file.bytes.empty() || std::fwrite(file.bytes.data(), 1, file.bytes.size(), f) == file.bytes.size();
+    }
     const int writeErr = errno;
     errno = 0;
     const bool flushed = std::fflush(f) == 0 && !injectedFailure("fsync", staged) && ::fsync(::fileno(f)) == 0;
@@ -558,8 +671,6 @@ void writeStaged(const fs::path& staged, const fs::path& target, std::span<const
     }
 }
 
-// Makes the renames into `dir` durable. A failure fails the commit, which then rolls back: a
-// bake that reports success has its files on disk.
 void syncDirectory(const fs::path& dir) {
     int err = 0;
     if (injectedFailure("fsync", dir)) {
@@ -770,12 +881,13 @@ GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const Gltf
     }
     GltfExportResult result;
     for (const PendingFile& f : files) {
-        writeStaged(staging.path() / f.relative, outDir / f.relative, f.bytes);
+        writeStaged(staging.path() / f.relative, outDir / f.relative, f);
         result.files.push_back(outDir / f.relative);
-        result.bytes += f.bytes.size();
+        result.bytes += f.size();
     }
     std::vector<std::string> owned{kGltfName, kBinName};
     for (const auto& extra : input.extraFiles) owned.push_back(extra.first);
+    for (const auto& name : input.ownedFiles) owned.push_back(name);
     commit(outDir, staging.path(), files, staleOwnedFiles(outDir, files, owned));
     return result;
 }

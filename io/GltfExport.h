@@ -19,7 +19,8 @@
 //   TERRALUX_lighting                the caller's JSON object, verbatim, when it gives one
 // With water, a second node and mesh named `water`: a rectangle over the footprint at the water
 // level, whose material uses KHR_materials_transmission and KHR_materials_ior (both used, never
-// required).
+// required). Local lights are KHR_lights_punctual lights (used, never required), one node each
+// ("light <i>") at the light's position, turned so its −Z points along a spot's direction.
 
 #include <cstddef>
 #include <cstdint>
@@ -34,6 +35,7 @@
 
 #include "AtomicFile.h"
 #include "ShProbeFile.h"
+#include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
 #include "terrain/SurfaceAlbedo.h"
 
@@ -70,6 +72,9 @@ struct GltfSceneInput {
     nlohmann::json lighting = nullptr;
     // Unset: no water node (a one-sample-wide heightfield, with no footprint, has none either).
     std::optional<GltfWater> water;
+    // KHR_lights_punctual, in this order. Intensity in candela = LocalLight::intensity (one
+    // scene-linear unit of illuminance is one lux); cone angles in radians.
+    std::vector<LocalLight> lights;
     std::string generatorVersion;                    // asset.generator = "Terralux <version>"
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest
     // k that fits, the last row and column always included); k is TERRALUX_geo.meshStride. The
@@ -82,6 +87,9 @@ struct GltfSceneInput {
     std::vector<std::pair<std::string, std::vector<uint8_t>>> reflectionFiles;
     // More top-level files written with the rest (the bake report): name and contents.
     std::vector<std::pair<std::string, std::string>> extraFiles;
+    // Top-level names the export owns even when it does not write them this time (lpv.ini): an
+    // earlier export's file of that name is removed in the same commit.
+    std::vector<std::string> ownedFiles;
 };
 
 struct GltfExportResult {

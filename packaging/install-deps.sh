@@ -16,6 +16,9 @@ packages=(
   libvulkan-dev glslang-tools glslang-dev spirv-tools
   libglm-dev libgdal-dev gdal-bin libopenimageio-dev openimageio-tools
   libtinygltf-dev nlohmann-json3-dev libtbb-dev
+  # the sanitize/tsan/fuzz presets: clang, and the sanitizer and libFuzzer runtimes (only
+  # recommended by clang-14, and this script installs without recommends)
+  clang libclang-rt-14-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # the project JSON Schema is checked against --print-project with a real validator

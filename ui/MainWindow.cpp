@@ -47,6 +47,7 @@
 #include "ParameterTable.h"
 #include "BakeJob.h"
 #include "PreviewBake.h"
+#include "LpvPanel.h"
 #include "ReflectionPanel.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
@@ -451,6 +452,11 @@ void MainWindow::buildDocks() {
     rv->addStretch(1);
     auto* reflectionDock = dock("Reflection Probes", "dock.reflectionProbes", reflectionPage);
 
+    // Light propagation volumes: their settings, the indirect light selector and the lights.
+    auto* lpvPanel = new LpvPanel(doc_);
+    connectRejected(lpvPanel);
+    auto* lpvDock = dock("LPV", "dock.lpv", lpvPanel);
+
     // Probe Volumes.
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
@@ -512,6 +518,7 @@ void MainWindow::buildDocks() {
     tabifyDockWidget(atmosphereDock, surfaceDock);
     tabifyDockWidget(surfaceDock, aoDock);
     tabifyDockWidget(aoDock, waterDock);
+    tabifyDockWidget(waterDock, lpvDock);
     tabifyDockWidget(volumesDock, reflectionDock);
     tabifyDockWidget(reflectionDock, bakeDock);
     // Whole tab labels, scrolled when the docks are narrow, rather than "Terr…" and "Wa…".

@@ -36,13 +36,13 @@ ParameterForm::ParameterForm(ProjectDocument* doc, QWidget* parent)
     connect(doc_, &ProjectDocument::parametersChanged, this, [this] { refresh(); });
 }
 
-void ParameterForm::setVolume(int volume) {
-    volume_ = volume;
+void ParameterForm::setElement(int index) {
+    element_ = index;
     refresh();
 }
 
 std::string ParameterForm::docPath(const ParameterSpec& spec) const {
-    return spec.perVolume() ? "probe_volumes[" + std::to_string(volume_) + "]." + spec.localPath() : spec.path;
+    return spec.inList() ? spec.listPath() + "[" + std::to_string(element_) + "]." + spec.localPath() : spec.path;
 }
 
 void ParameterForm::set(const std::string& path, const json& value) {
@@ -88,6 +88,12 @@ void ParameterForm::addParameter(const std::string& path) {
 
 void ParameterForm::addRow(const ParameterSpec& spec, QWidget* editor) {
     QString tip = QString::fromStdString(spec.description);
+    if (!spec.consoleVariable.empty()) {
+        // The name from lpv.ini's list heads the tip; the description's own copy of it goes.
+        const QString cvar = QString::fromStdString(spec.consoleVariable);
+        if (tip.startsWith(cvar + ": ")) tip = tip.mid(cvar.size() + 2);
+        tip = "Console variable " + cvar + "\n" + tip;
+    }
     if (spec.type != ParamType::Boolean && spec.type != ParamType::String)
         tip += QString::fromStdString("\nAllowed: " + (spec.type == ParamType::Choice ? spec.rangeText() : "each " + spec.rangeText()) +
                                       (spec.unit.empty() ? "" : " " + spec.unit));
@@ -129,8 +135,9 @@ void ParameterForm::markProblem(const QString& message) {
 
 bool ParameterForm::isRead(const ParameterSpec& spec) const {
     const SceneDescription& scene = doc_->project().scene;
-    if (spec.perVolume() && size_t(volume_) >= scene.probeVolumes.size()) return false;
-    return spec.isRead(scene, spec.perVolume() ? size_t(volume_) : 0);
+    if (spec.perVolume() && size_t(element_) >= scene.probeVolumes.size()) return false;
+    if (spec.perLight() && size_t(element_) >= scene.lights.size()) return false;
+    return spec.isRead(scene, spec.inList() ? size_t(element_) : 0);
 }
 
 void ParameterForm::addNumber(const ParameterSpec& spec) {
@@ -245,7 +252,7 @@ void ParameterForm::addList(const ParameterSpec& spec) {
         if (current.is_array()) return int(current.size());
         if (current.is_number()) return 0;
         if (!isRead(spec)) return spec.maxItems;
-        const int n = spec.items ? spec.items(doc_->project().scene, size_t(volume_)) : spec.maxItems;
+        const int n = spec.items ? spec.items(doc_->project().scene, size_t(element_)) : spec.maxItems;
         return n < 0 ? spec.maxItems : n;
     };
     auto commit = [=, this] {

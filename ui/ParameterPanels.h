@@ -25,8 +25,9 @@ class ParameterForm : public QWidget {
     Q_OBJECT
 public:
     ParameterForm(ProjectDocument* doc, QWidget* parent = nullptr);
-    // Per-volume rows edit probe_volumes[volume].
-    void setVolume(int volume);
+    // Per-volume rows edit probe_volumes[volume], per-light rows lights[index].
+    void setVolume(int volume) { setElement(volume); }
+    void setElement(int index);
 
     // The editor of one row of the parameter table (app/ParameterTable.h): its widget, limits,
     // unit, "auto" text and tooltip all come from the row. `path` is the table's path
@@ -62,14 +63,14 @@ private:
     void addColorList(const ParameterSpec& spec);
     void addText(const ParameterSpec& spec);
     void addRow(const ParameterSpec& spec, QWidget* editor);
-    // The document path a row edits (per-volume rows: of the selected volume).
+    // The document path a row edits (rows of a list's element: of the selected one).
     std::string docPath(const ParameterSpec& spec) const;
-    // Whether the document reads the row now (per-volume rows: for the selected volume).
+    // Whether the document reads the row now (rows of a list's element: for the selected one).
     bool isRead(const ParameterSpec& spec) const;
     void set(const std::string& path, const nlohmann::json& value);
     ProjectDocument* doc_;
     QFormLayout* form_;
-    int volume_ = 0;
+    int element_ = 0;  // the probe volume or light the element rows edit
     std::vector<std::function<void()>> refreshers_;
     struct RowLabel {
         const ParameterSpec* spec;

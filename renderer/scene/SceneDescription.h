@@ -273,6 +273,53 @@ struct WaterSettings {
     static constexpr int kMaxWaves = 8;
 };
 
+// Which indirect light the viewport and --render add to the direct sun (docs/lighting.md,
+// "Light propagation volumes"): the baked probes, the LPV, both summed, or none. The bake exports
+// it in TERRALUX_lighting; it changes no baked file.
+enum class IndirectLighting { Probes, Lpv, Both, None };
+
+struct LightingSettings {
+    IndirectLighting indirect = IndirectLighting::Probes;
+};
+
+// Light propagation volumes (seed 003, docs/lighting.md "Light propagation volumes"): cascaded
+// 32^3 volumes ahead of the camera after Kaplanyan & Dachsbacher, "Cascaded Light Propagation
+// Volumes for Real-Time Indirect Illumination" (I3D 2010). Each field is one of the engine's
+// console variables (lpv.ini); the ranges are ours where the seed gives none.
+struct LpvSettings {
+    bool enabled = false;                 // rEx.GI.Method = 1
+    double size = 5312.0;                 // edge of cascade 0, metres, (0, 1e6]
+    double fadeRange = 6.0;               // cells at each cascade's boundary faded out, [0, 16]
+    double propagationWeight = 0.01;      // share left after crossing a cascade: w^(1/32) per step, [0, 1]
+    int propagationIterations = 4;        // [0, 64]
+    int updateInterval = 2;               // frames between updates (the viewport's), [0, 600]
+    int cascades = 3;                     // 1..4
+    double cascadeRatio = 2.0;            // size divisor between cascades, (1, 16]
+    double autoCascadeMinSize = 768.0;    // metres, 0 = off: the ratio grows until the smallest is this size
+    double cascadeForwardOffset = 0.35;   // centre ahead of the camera, share of each cascade's size, [0, 1]
+    bool localLights = true;              // inject `lights` (point and spot) too
+    int quality = 1;                      // 0 linear SH, 1 + ZH3 and leak dampening, 2 + cone-traced specular
+    int coneTraceSamples = 6;             // quality 2, [1, 64]
+    double indirectIntensity = 1.0;       // final multiplier of the LPV's light, [0, 100]
+};
+
+enum class LocalLightType { Point, Spot };
+
+// A point or spot light (KHR_lights_punctual's model). Lights are read by the LPV only: the
+// diffuse bake leaves them out (docs/lighting.md).
+struct LocalLight {
+    LocalLightType type = LocalLightType::Point;
+    glm::vec3 position{0.0f};                 // engine space, metres
+    glm::vec3 direction{0.0f, -1.0f, 0.0f};   // spot: where the cone points, engine space (normalised on use)
+    glm::vec3 color{1.0f};                    // linear RGB, each in [0, 1]
+    // Intensity I: the irradiance, in the sun's scene-linear units, on a surface facing the
+    // light 1 m away (so E = I / d^2 before the range window); exported as candela 1:1.
+    double intensity = 1000.0;
+    double range = 100.0;                     // metres, > 0: the light reaches nothing beyond
+    double innerConeDeg = 20.0;               // spot: full intensity inside, [0, 90)
+    double outerConeDeg = 30.0;               // spot: nothing outside, (inner, 90]
+};
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -298,6 +345,9 @@ struct SceneDescription {
     DetailSettings detail;
     AoSettings ao;
     WaterSettings water;
+    LightingSettings lighting;
+    LpvSettings lpv;
+    std::vector<LocalLight> lights;
 };
 
 }  // namespace terralux

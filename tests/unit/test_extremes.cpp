@@ -24,7 +24,11 @@
 #include "ImageFile.h"
 #include "bake/ProbePlacement.h"
 #include "ReflectionProbeFile.h"
+#include "SceneLighting.h"
 #include "ShProbeFile.h"
+#include "TerrainLoading.h"
+#include "lpv/Lpv.h"
+#include "render/OrbitCamera.h"
 #include "bake/SphereSampling.h"
 
 using namespace terralux;
@@ -318,6 +322,33 @@ std::vector<Row> rows() {
                      p.scene.reflectionProbes.rayCount = 2;
                      return p;
                  }});
+    // Light propagation volumes at their limits: the bake exports them, and the volumes for the
+    // project's camera give finite, non-negative light everywhere over the terrain.
+    auto lpvRow = [&r](const std::string& name, std::function<void(LpvSettings&)> edit) {
+        r.push_back({name, [=] {
+                         Project p = quick(hills());
+                         p.scene.lpv.enabled = true;
+                         edit(p.scene.lpv);
+                         LocalLight spot;
+                         spot.type = LocalLightType::Spot;
+                         spot.position = glm::vec3(0.0f, 1500.0f, 0.0f);
+                         spot.range = 2000.0;
+                         spot.intensity = 1.0e6;
+                         p.scene.lights = {LocalLight{}, spot};
+                         return p;
+                     }});
+    };
+    lpvRow("lpv_1_cascade_0_iterations", [](LpvSettings& s) { s.cascades = 1; s.propagationIterations = 0; });
+    lpvRow("lpv_4_cascades_64_iterations_weight_1", [](LpvSettings& s) {
+        s.cascades = 4; s.propagationIterations = 64; s.propagationWeight = 1.0; s.quality = 2; s.coneTraceSamples = 64;
+    });
+    lpvRow("lpv_huge_size", [](LpvSettings& s) { s.size = 1.0e6; s.autoCascadeMinSize = 0.0; s.cascadeRatio = 16.0; });
+    lpvRow("lpv_tiny_size_no_fade", [](LpvSettings& s) {
+        s.size = 1.0; s.fadeRange = 0.0; s.cascadeForwardOffset = 1.0; s.quality = 0;
+    });
+    lpvRow("lpv_full_fade_auto_min", [](LpvSettings& s) {
+        s.fadeRange = 16.0; s.autoCascadeMinSize = 1.0e6; s.cascades = 4; s.indirectIntensity = 100.0;
+    });
     return r;
 }
 
@@ -387,6 +418,30 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
             EXPECT_TRUE(std::isfinite(v.get<double>())) << path;
     };
     finite(report, "report");
+    if (p.scene.lpv.enabled) {
+        EXPECT_TRUE(fs::exists(out / "lpv.ini"));
+        EXPECT_TRUE(report.contains("lpv"));
+        const DemImportResult terrain = loadProjectTerrain(request.project);
+        const Heightfield& hf = terrain.heightfield;
+        const HeightfieldTracer tracer(hf);
+        BakeLighting lighting = lightingOf(request.project);
+        lighting.tracer = &tracer;
+        const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, hf);
+        const lpv::Volumes v(request.project.scene.lpv, {&lighting, &request.project.scene.lights},
+                             glm::dvec3(camera.position()), glm::dvec3(camera.target - camera.position()));
+        for (int j = 0; j < 9; ++j)
+            for (int i = 0; i < 9; ++i) {
+                const float x = hf.minX() + (hf.maxX() - hf.minX()) * float(i) / 8.0f;
+                const float z = hf.minZ() + (hf.maxZ() - hf.minZ()) * float(j) / 8.0f;
+                const glm::vec3 n = hf.surfaceNormal(x, z);
+                const lpv::Sample s = v.evaluate(glm::vec3(x, hf.surfaceHeight(x, z), z), n, glm::vec3(0, 1, 0));
+                for (int c = 0; c < 3; ++c) {
+                    ASSERT_TRUE(std::isfinite(s.irradiance[c]) && s.irradiance[c] >= 0.0f) << i << ", " << j;
+                    ASSERT_TRUE(std::isfinite(s.specular[c]) && s.specular[c] >= 0.0f) << i << ", " << j;
+                }
+                ASSERT_TRUE(s.ao >= 0.0f && s.ao <= 1.0f);
+            }
+    }
     fs::remove_all(out);
 }
 

@@ -30,6 +30,10 @@ json baseFor(const ParameterSpec& spec) {
         doc["water"]["waves"] = json::array({wave});
         doc = sceneToJson(sceneFromJson(doc, "base", nullptr));  // every key, as --set finds them
     }
+    if (spec.perLight()) {
+        doc["lights"] = json::array({json::object()});
+        doc = sceneToJson(sceneFromJson(doc, "base", nullptr));
+    }
     return doc;
 }
 
@@ -66,7 +70,7 @@ TEST(ParameterTable, EveryDefaultValidatesAndRoundTrips) {
     for (const auto& spec : parameterTable()) {
         // The default written at its path reads back to the same default.
         EXPECT_EQ(errorFor(spec, spec.defaultValue()), "") << spec.path;
-        if (spec.perWave()) {
+        if (spec.perWave() || spec.perLight()) {
             const SceneDescription w = sceneFromJson(baseFor(spec), "defaults", nullptr);
             EXPECT_EQ(spec.get(w, 0), spec.defaultValue()) << spec.path;
         } else {
@@ -157,7 +161,7 @@ TEST(ParameterTable, SchemaDescribesEveryLeafAndAcceptsTheDefaults) {
         const json& inner = spec.nullable() ? leaf["anyOf"][0] : leaf;
         if (spec.type == ParamType::Number || spec.type == ParamType::Integer) {
             EXPECT_EQ(inner[spec.minExclusive ? "exclusiveMinimum" : "minimum"], spec.min) << spec.path;
-            EXPECT_EQ(inner["maximum"], spec.max) << spec.path;
+            EXPECT_EQ(inner[spec.maxExclusive ? "exclusiveMaximum" : "maximum"], spec.max) << spec.path;
         }
         if (spec.type == ParamType::Choice) {
             EXPECT_EQ(inner["enum"], json(spec.choices)) << spec.path;
@@ -264,4 +268,64 @@ TEST(ParameterTable, WavesAreAListOfObjectsUnderTheSteepnessRule) {
     EXPECT_EQ(test::projectErrorFor("water.waves", json::parse(R"([{"wavelenght": 3, "steepness": 0.1}])"),
                                     defaultProjectJson()),
               "p.json: unknown key 'water.waves[0].wavelenght' (did you mean 'water.waves[].wavelength'?)");
+}
+
+TEST(ParameterTable, LpvRowsAreTheConsoleVariablesWithTheirRules) {
+    // Every lpv row names its console variable (or the post-process setting) in its description.
+    int rows = 0;
+    for (const auto& spec : parameterTable()) {
+        if (spec.path.rfind("lpv.", 0) != 0) continue;
+        EXPECT_TRUE(spec.description.find("rEx.") != std::string::npos ||
+                    spec.path == "lpv.indirect_intensity") << spec.path;
+        // The console variable the tooltips show is lpv.ini's, and the one the description names.
+        if (spec.path != "lpv.indirect_intensity")
+            EXPECT_EQ(spec.description.rfind(spec.consoleVariable + ":", 0), 0u) << spec.path;
+        EXPECT_TRUE(spec.uiRow) << spec.path;
+        EXPECT_EQ(parameterDock(spec).objectName, "dock.lpv") << spec.path;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 14);
+    const json doc = defaultProjectJson();
+    EXPECT_EQ(test::projectErrorFor("lpv.cascades", 5, doc), "p.json: lpv.cascades = 5: must be in [1, 4]");
+    EXPECT_EQ(test::projectErrorFor("lpv.size", 0, doc), "p.json: lpv.size = 0: must be in (0, 1000000]");
+    EXPECT_EQ(test::projectErrorFor("lpv.cascade_ratio", 1, doc), "p.json: lpv.cascade_ratio = 1: must be in (1, 16]");
+    EXPECT_EQ(test::projectErrorFor("lpv.quality", 3, doc), "p.json: lpv.quality = 3: must be in [0, 2]");
+    EXPECT_EQ(test::projectErrorFor("lpv.cone_trace_samples", 0, doc),
+              "p.json: lpv.cone_trace_samples = 0: must be in [1, 64]");
+    EXPECT_EQ(test::projectErrorFor("lpv.propagation_weight", -0.5, doc),
+              "p.json: lpv.propagation_weight = -0.5: must be in [0, 1]");
+    EXPECT_EQ(test::projectErrorFor("lighting.indirect", "all", doc),
+              "p.json: lighting.indirect = \"all\": must be one of probes | lpv | both | none");
+    EXPECT_EQ(test::projectErrorFor("lpv.auto_cascade_min_size", 0, doc), "");  // 0 = off
+    EXPECT_EQ(test::projectErrorFor("lpv.propagation_iterations", 0, doc), "");
+}
+
+TEST(ParameterTable, LightsAreAListOfObjectsWithTheSpotRules) {
+    json doc = defaultProjectJson();
+    EXPECT_EQ(doc["lights"], json::array());
+    doc["lights"] = json::parse(R"([
+        {"position": [10, 900, -20], "intensity": 5000, "range": 150},
+        {"type": "spot", "position": [0, 800, 0], "direction": [0, -1, 0], "color": [1, 0.5, 0.25],
+         "inner_cone_deg": 10, "outer_cone_deg": 25}])");
+    const SceneDescription s = sceneFromJson(doc, "p.json", nullptr);
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_EQ(s.lights[0].type, LocalLightType::Point);
+    EXPECT_EQ(s.lights[0].range, 150.0);
+    EXPECT_EQ(s.lights[1].type, LocalLightType::Spot);
+    EXPECT_EQ(s.lights[1].outerConeDeg, 25.0);
+    const json written = sceneToJson(s);
+    EXPECT_EQ(sceneToJson(sceneFromJson(written, "again", nullptr)), written);
+    EXPECT_EQ(test::projectErrorFor("lights[1].outer_cone_deg", 10, written),
+              "p.json: lights[1].outer_cone_deg = 10: must be above inner_cone_deg (10)");
+    EXPECT_EQ(test::projectErrorFor("lights[1].direction", json::array({0, 0, 0}), written),
+              "p.json: lights[1].direction = [0,0,0]: must not be the zero vector");
+    EXPECT_EQ(test::projectErrorFor("lights[0].range", 0, written), "p.json: lights[0].range = 0: must be in (0, 1000000]");
+    EXPECT_EQ(test::projectErrorFor("lights[1].inner_cone_deg", 90, written),
+              "p.json: lights[1].inner_cone_deg = 90: must be in [0, 90)");
+    EXPECT_EQ(test::projectErrorFor("lights[0].color", json::array({2, 1, 1}), written),
+              "p.json: lights[0].color[0] = 2: three components, each in [0, 1]");
+    // A point light keeps cone angles it does not read, unchecked against each other.
+    EXPECT_EQ(test::projectErrorFor("lights[0].outer_cone_deg", 5, written), "");
+    EXPECT_EQ(test::projectErrorFor("lights", json::parse(R"([{"typ": "spot"}])"), defaultProjectJson()),
+              "p.json: unknown key 'lights[0].typ' (did you mean 'lights[].type'?)");
 }

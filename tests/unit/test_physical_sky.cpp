@@ -4,12 +4,16 @@
 #include "bake/PhysicalSky.h"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <numbers>
 #include <vector>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "EnvironmentImage.h"
 #include "bake/Sky.h"
 
 using namespace terralux;
@@ -181,4 +185,33 @@ TEST(PhysicalSky, EquirectShDcIsTheImageMean) {
     // The lookup reads the model back (no sun disc added, no rotation).
     const glm::vec3 toward = glm::normalize(glm::vec3(0.3f, 0.5f, -0.8f));
     EXPECT_NEAR(luma(sky.radiance(toward)), luma(model.radiance(toward)), 0.05 * luma(model.radiance(toward)));
+}
+
+// Found by fuzz_env_image: an EXR header attribute claiming more bytes than the file holds made
+// OpenEXR allocate and fill all of them (seconds and hundreds of MB for a 1 KB file). It is
+// refused before OpenEXR sees it, naming the attribute; a sane size goes on to OpenImageIO.
+TEST(EnvironmentImage, ExrAttributePastTheEndIsRefused) {
+    auto write = [](const std::filesystem::path& p, uint32_t size) {
+        std::string b = std::string("\x76\x2f\x31\x01\x02\x00\x00\x00", 8) + "comments" + '\0' + "string" + '\0';
+        for (int shift = 0; shift < 32; shift += 8) b.push_back(char((size >> shift) & 0xFF));
+        b += "abcd";
+        b.push_back('\0');
+        std::ofstream(p, std::ios::binary) << b;
+    };
+    const auto dir = std::filesystem::temp_directory_path();
+    write(dir / "terralux_exr_claims.exr", 0x40000000u);
+    try {
+        checkEquirectImage((dir / "terralux_exr_claims.exr").string());
+        FAIL() << "accepted";
+    } catch (const ImageError& e) {
+        EXPECT_NE(std::string(e.what()).find("EXR header attribute 'comments' claims 1073741824 bytes, past the end of the file"),
+                  std::string::npos) << e.what();
+    }
+    write(dir / "terralux_exr_sane.exr", 4);
+    try {
+        checkEquirectImage((dir / "terralux_exr_sane.exr").string());
+        FAIL() << "accepted";
+    } catch (const ImageError& e) {
+        EXPECT_EQ(std::string(e.what()).find("past the end"), std::string::npos) << e.what();
+    }
 }

@@ -231,7 +231,7 @@ TEST(Project, UnknownKeysAreErrorsNamingTheKey) {
     };
     EXPECT_EQ(err({{"sun", {{"elevaton_deg", 20}}}}),
               "p.json: unknown key 'sun.elevaton_deg' (did you mean 'sun.elevation_deg'?)");
-    EXPECT_EQ(err({{"lighting", 1}}), "p.json: unknown key 'lighting' (terralux --print-project lists them)");
+    EXPECT_EQ(err({{"postprocess", 1}}), "p.json: unknown key 'postprocess' (terralux --print-project lists them)");
     EXPECT_EQ(err({{"probe_volumes", {{{"name", "a"}, {"grid_dim", {4, 4}}}}}}),
               "p.json: unknown key 'probe_volumes[0].grid_dim' (did you mean 'probe_volumes[].grid_dims'?)");
     EXPECT_EQ(err({{"probe_volumes", {{{"adaptive", {{"tolerence", 0.1}}}}}}}),
@@ -522,4 +522,16 @@ TEST(ProjectVersions, SavingWritesTheCurrentVersion) {
     warnings.clear();
     EXPECT_EQ(loadProject(dir / "old.json", &warnings).scene.terrain.albedoMode, AlbedoMode::Constant);
     EXPECT_TRUE(warnings.empty());
+}
+
+// Found by fuzz_project: a --set value that is not UTF-8 used to escape as a JSON type error while
+// its refusal was being worded. It is refused up front, naming the byte.
+TEST(Project, OverrideThatIsNotUtf8IsRefused) {
+    EXPECT_EQ(errorFor("probe_volumes[0].name=gr\x9d"),
+              "--set: byte 24 (0x9D) of the assignment is not UTF-8; parameters and paths must be UTF-8 text");
+    EXPECT_NE(errorFor("terrain.dem=\xC0\xAF.tif"), "");         // overlong '/'
+    EXPECT_NE(errorFor("terrain.dem=\xED\xA0\x80.tif"), "");     // a surrogate
+    EXPECT_NE(errorFor("terrain.dem=x\xE2\x82"), "");            // truncated
+    EXPECT_EQ(errorFor("terrain.dem=caf\xC3\xA9.tif").find("not UTF-8"), std::string::npos);
+    EXPECT_NE(errorFor("probe_volumes[99999999999999999999].name=a").find("bad index"), std::string::npos);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -180,19 +181,38 @@ TEST(VoidFill, ValidCellsUnchangedAndTheMaskStillFlagsFilledCells) {
     EXPECT_THROW(fillVoids(grid, 2, 3, mask), DemError);
 }
 
-// A 300-cell hole converges well under a second.
-TEST(VoidFill, LargeHoleIsFast) {
+// A 300-cell hole in a smooth field: the membrane converges to finite heights inside the range
+// of the rim around it (a harmonic fill obeys the maximum principle) and close to the field it
+// replaced. Its cost is measured by bench_tracer's void-fill benchmark, not here.
+TEST(VoidFill, LargeHoleConvergesInsideItsRim) {
     const int n = 500;
     std::vector<float> h(size_t(n) * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) h[size_t(y) * n + x] = float(500 + 200 * std::sin(0.02 * x) * std::cos(0.015 * y));
     const std::vector<uint8_t> mask = punch(n, n, 250, 250, 300, false, 0);
-    const auto t0 = std::chrono::steady_clock::now();
     std::vector<float> g = h;
     fillVoids(g, n, n, mask, VoidFill::GdalMembrane);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    EXPECT_LT(seconds, 2.0);  // a shared 2-core machine; about 0.3 s alone
-    std::printf("300-cell hole: %.2f s\n", seconds);
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (size_t i = 0; i < h.size(); ++i) {
+        if (mask[i]) continue;
+        lo = std::min(lo, h[i]);
+        hi = std::max(hi, h[i]);
+    }
+    size_t filled = 0;
+    double worst = 0;
+    for (size_t i = 0; i < h.size(); ++i) {
+        if (!mask[i]) {
+            ASSERT_EQ(g[i], h[i]);
+            continue;
+        }
+        ++filled;
+        ASSERT_TRUE(std::isfinite(g[i]));
+        EXPECT_GE(g[i], lo - 1e-3f);
+        EXPECT_LE(g[i], hi + 1e-3f);
+        worst = std::max(worst, double(std::abs(g[i] - h[i])));
+    }
+    EXPECT_GT(filled, size_t(50000));
+    EXPECT_LT(worst, 400.0);  // the field's full swing is 400 m
 }
 
 // The table of README.md for the shared SRTM tile.
