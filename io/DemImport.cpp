@@ -296,6 +296,29 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         fail(path, "rotated or south-up geotransform without a CRS cannot be resampled");
     if (!(std::isfinite(gt[1]) && std::isfinite(gt[5])) || gt[1] == 0.0 || gt[5] == 0.0)
         fail(path, "pixel size " + fmt(gt[1]) + " x " + fmt(gt[5]) + " must be finite and non-zero");
+    // A footprint off the globe is a broken file, and handing it to GDAL's transformers can
+    // take seconds per point (a fuzzed GeoTIFF hit 5 s in one Transform), so refuse it first.
+    if (needsMetric) {
+        const bool geographic = srcSrs->IsGeographic();
+        // Degrees per CRS unit for geographic CRSs (radians or gradians are legal); Web
+        // Mercator's square world is 2 x 20 037 508.34 m wide, allowed 1 % over.
+        double degPerUnit = geographic ? srcSrs->GetAngularUnits() * 180.0 / M_PI : 1.0;
+        if (std::abs(degPerUnit - 1.0) < 1e-9) degPerUnit = 1.0;  // degrees, so messages stay exact
+        const double limX = geographic ? 540.0 : 20037508.3428 * 1.01;
+        const double limY = geographic ? 90.5 : 20037508.3428 * 1.01;
+        for (const double i : {0.0, double(info.sourceWidth)}) {
+            for (const double j : {0.0, double(info.sourceHeight)}) {
+                const double x = (gt[0] + gt[1] * i + gt[2] * j) * degPerUnit;
+                const double y = (gt[3] + gt[4] * i + gt[5] * j) * degPerUnit;
+                if (!(std::abs(x) <= limX && std::abs(y) <= limY))
+                    fail(path, "footprint corner (" + fmt(x) + ", " + fmt(y) + ") lies off the globe" +
+                                   (geographic ? "; longitude must be within +-540 and latitude "
+                                                 "within +-90.5 degrees"
+                                               : "; Web Mercator coordinates must be within "
+                                                 "+-20 237 883 m"));
+            }
+        }
+    }
 
     GDALRasterBand* band = ds->GetRasterBand(1);
     int hasNodata = 0;

@@ -1,8 +1,11 @@
 // DEM import against numbers computed independently with GDAL's own tools
 // (tests/data/dem/expected.json, tests/data/dem/SOURCES.md).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <vector>
 
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
@@ -165,6 +168,56 @@ TEST(DemImport, FrameMappingRowZeroIsNorthAtNegativeZ) {
     EXPECT_FLOAT_EQ(hf.surfaceHeight(hf.xOf(0), hf.minZ()), 0.0f);
     EXPECT_DOUBLE_EQ(hf.geo.easting, 500025.0);
     EXPECT_DOUBLE_EQ(hf.geo.northing, 3999970.0);
+}
+
+namespace {
+
+// A 4 x 3 Float32 GeoTIFF in the given CRS and geotransform, every cell 100 m.
+fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6]) {
+    GDALAllRegister();
+    const fs::path tmp = fs::temp_directory_path() / name;
+    GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+    GDALDataset* ds = gtiff->Create(tmp.c_str(), 4, 3, 1, GDT_Float32, nullptr);
+    double g[6];
+    std::copy(std::begin(gt), std::end(gt), g);
+    ds->SetGeoTransform(g);
+    OGRSpatialReference srs;
+    srs.importFromEPSG(epsg);
+    ds->SetSpatialRef(&srs);
+    std::vector<float> v(12, 100.0f);
+    EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 4, 3, v.data(), 4, 3, GDT_Float32, 0,
+                                             0, nullptr),
+              CE_None);
+    GDALClose(ds);
+    return tmp;
+}
+
+}  // namespace
+
+// A footprint off the globe is refused before any reprojection (the fuzzer found one that kept
+// GDAL's transformer busy for seconds), and one on it still imports.
+TEST(DemImport, FootprintOffTheGlobeIsRefused) {
+    const double farLongitude[6] = {1.0e15, 0.001, 0.0, 42.0, 0.0, -0.001};
+    const fs::path geo = writeFlatTiff("terralux_off_globe_geo.tif", 4326, farLongitude);
+    const std::string geoError = importError(geo.string());
+    EXPECT_EQ(geoError, geo.string() + ": footprint corner (1000000000000000, 42) lies off the "
+                                       "globe; longitude must be within +-540 and latitude "
+                                       "within +-90.5 degrees");
+
+    const double pastThePole[6] = {1.0, 0.001, 0.0, 91.0, 0.0, -0.001};
+    const fs::path pole = writeFlatTiff("terralux_off_globe_pole.tif", 4326, pastThePole);
+    EXPECT_NE(importError(pole.string()).find("lies off the globe"), std::string::npos);
+
+    const double mercatorFar[6] = {3.0e7, 30.0, 0.0, 5.0e6, 0.0, -30.0};
+    const fs::path merc = writeFlatTiff("terralux_off_globe_merc.tif", 3857, mercatorFar);
+    EXPECT_NE(importError(merc.string()).find("Web Mercator coordinates must be within"),
+              std::string::npos)
+        << importError(merc.string());
+
+    const double onTheGlobe[6] = {1.0, 0.001, 0.0, 42.0, 0.0, -0.001};
+    const fs::path ok = writeFlatTiff("terralux_on_globe.tif", 4326, onTheGlobe);
+    EXPECT_EQ(importError(ok.string()), "");
+    for (const fs::path& p : {geo, pole, merc, ok}) fs::remove(p);
 }
 
 TEST(DemImport, MaxResolutionAreaAverages) {
