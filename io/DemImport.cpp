@@ -335,8 +335,9 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         rh = h;
         if (options.maxResolution > 0 && std::max(w, h) > options.maxResolution) {
             const double s = double(options.maxResolution) / std::max(w, h);
-            rw = std::max(1, int(std::lround(w * s)));
-            rh = std::max(1, int(std::lround(h * s)));
+            // Two cells each way at least (a surface needs them), however thin the raster.
+            rw = std::min(w, std::max(2, int(std::lround(w * s))));
+            rh = std::min(h, std::max(2, int(std::lround(h * s))));
         }
     };
 
@@ -478,6 +479,10 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         h = ch;
     }
 
+    // A sliver footprint can reproject to a single row or column.
+    if (w < 2 || h < 2)
+        fail(path, "imports as " + std::to_string(w) + " x " + std::to_string(h) +
+                       " cells; a DEM needs at least 2 x 2");
     if (nodataCount == heights.size()) fail(path, "every cell is nodata; nothing to import");
 
     if (nodataCount > 0) {

@@ -234,6 +234,34 @@ TEST(DemImport, MaxResolutionAreaAverages) {
     EXPECT_LT(r.heightfield.maxHeight(), 1589.0f);
 }
 
+// terrain.max_resolution keeps two cells across a thin raster (the fuzzer found a 24 x 23 320
+// strip reduced to one column, a heightfield no surface can be made of).
+TEST(DemImport, MaxResolutionKeepsTwoCellsAcrossAThinStrip) {
+    GDALAllRegister();
+    const fs::path tmp = fs::temp_directory_path() / "terralux_thin_strip.tif";
+    {
+        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+        GDALDataset* ds = gtiff->Create(tmp.c_str(), 4, 2000, 1, GDT_Float32, nullptr);
+        double gt[6] = {500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0};
+        ds->SetGeoTransform(gt);
+        OGRSpatialReference srs;
+        srs.importFromEPSG(32633);
+        ds->SetSpatialRef(&srs);
+        std::vector<float> v(4 * 2000, 50.0f);
+        ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 4, 2000, v.data(), 4, 2000,
+                                                 GDT_Float32, 0, 0, nullptr),
+                  CE_None);
+        GDALClose(ds);
+    }
+    DemImportOptions o;
+    o.maxResolution = 256;
+    const auto r = importDem(tmp.string(), o);
+    fs::remove(tmp);
+    EXPECT_EQ(r.heightfield.width(), 2);
+    EXPECT_EQ(r.heightfield.depth(), 256);
+    EXPECT_FLOAT_EQ(r.heightfield.at(1, 255), 50.0f);
+}
+
 TEST(DemImport, VerticalScaleMultipliesHeights) {
     DemImportOptions o;
     o.verticalScale = 2.0;
