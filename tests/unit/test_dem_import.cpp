@@ -172,20 +172,20 @@ TEST(DemImport, FrameMappingRowZeroIsNorthAtNegativeZ) {
 
 namespace {
 
-// A 4 x 3 Float32 GeoTIFF in the given CRS and geotransform, every cell 100 m.
-fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6]) {
+// A w x h Float32 GeoTIFF in the given CRS and geotransform, every cell 100 m.
+fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6], int w = 4, int h = 3) {
     GDALAllRegister();
     const fs::path tmp = fs::temp_directory_path() / name;
     GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-    GDALDataset* ds = gtiff->Create(tmp.c_str(), 4, 3, 1, GDT_Float32, nullptr);
+    GDALDataset* ds = gtiff->Create(tmp.c_str(), w, h, 1, GDT_Float32, nullptr);
     double g[6];
     std::copy(std::begin(gt), std::end(gt), g);
     ds->SetGeoTransform(g);
     OGRSpatialReference srs;
     srs.importFromEPSG(epsg);
     ds->SetSpatialRef(&srs);
-    std::vector<float> v(12, 100.0f);
-    EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 4, 3, v.data(), 4, 3, GDT_Float32, 0,
+    std::vector<float> v(size_t(w) * h, 100.0f);
+    EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, w, h, v.data(), w, h, GDT_Float32, 0,
                                              0, nullptr),
               CE_None);
     GDALClose(ds);
@@ -237,29 +237,15 @@ TEST(DemImport, MaxResolutionAreaAverages) {
 // terrain.max_resolution keeps two cells across a thin raster (the fuzzer found a 24 x 23 320
 // strip reduced to one column, a heightfield no surface can be made of).
 TEST(DemImport, MaxResolutionKeepsTwoCellsAcrossAThinStrip) {
-    GDALAllRegister();
-    const fs::path tmp = fs::temp_directory_path() / "terralux_thin_strip.tif";
-    {
-        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-        GDALDataset* ds = gtiff->Create(tmp.c_str(), 4, 2000, 1, GDT_Float32, nullptr);
-        double gt[6] = {500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0};
-        ds->SetGeoTransform(gt);
-        OGRSpatialReference srs;
-        srs.importFromEPSG(32633);
-        ds->SetSpatialRef(&srs);
-        std::vector<float> v(4 * 2000, 50.0f);
-        ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 4, 2000, v.data(), 4, 2000,
-                                                 GDT_Float32, 0, 0, nullptr),
-                  CE_None);
-        GDALClose(ds);
-    }
+    const double gt[6] = {500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0};
+    const fs::path tmp = writeFlatTiff("terralux_thin_strip.tif", 32633, gt, 4, 2000);
     DemImportOptions o;
     o.maxResolution = 256;
     const auto r = importDem(tmp.string(), o);
     fs::remove(tmp);
     EXPECT_EQ(r.heightfield.width(), 2);
     EXPECT_EQ(r.heightfield.depth(), 256);
-    EXPECT_FLOAT_EQ(r.heightfield.at(1, 255), 50.0f);
+    EXPECT_FLOAT_EQ(r.heightfield.at(1, 255), 100.0f);
 }
 
 TEST(DemImport, VerticalScaleMultipliesHeights) {
