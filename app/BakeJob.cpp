@@ -292,9 +292,8 @@ nlohmann::json lpvReport(const SceneDescription& scene, const Heightfield& hf, c
                          std::vector<std::string>& warnings) {
     const auto start = std::chrono::steady_clock::now();
     const OrbitCamera camera = OrbitCamera::fromSettings(scene.camera, hf);
-    const glm::vec3 eye = camera.position();
-    const lpv::Volumes volumes(scene.lpv, {&lighting, &scene.lights}, glm::dvec3(eye),
-                               glm::dvec3(camera.target - eye));
+    const lpv::Volumes volumes(scene.lpv, {&lighting, &scene.lights}, glm::dvec3(camera.lpvEye()),
+                               glm::dvec3(camera.lpvViewDirection()));
     nlohmann::json cascades = nlohmann::json::array();
     for (const lpv::Cascade& c : volumes.cascades()) {
         const glm::dvec3 o = c.layout.origin();

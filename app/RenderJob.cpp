@@ -13,6 +13,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
+#include "lpv/Lpv.h"
 #include "render/DebugViews.h"
 #include "render/OrbitCamera.h"
 
@@ -87,6 +88,11 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.fog = resolvedFog(scene.fog, lighting.sky, terrain_.heightfield);
     base_.skirt = scene.terrain.skirt;
     base_.reflectionStrength = float(scene.reflectionProbes.strength);
+    const IndirectLighting indirect = scene.lighting.indirect;
+    base_.lpvLight = scene.lpv.enabled && (indirect == IndirectLighting::Lpv || indirect == IndirectLighting::Both);
+    base_.lights = scene.lights;
+    // Volumes the scene's lighting no longer draws hold no memory (a debug view computes its own).
+    if (!base_.lpvLight) setLpv(nullptr, "");
     // Water: the level and the highest crest decide the field and the mesh (built again only when
     // they change); everything else is uniforms.
     const WaterSettings& ws = scene.water;
@@ -286,7 +292,46 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
 RenderedImage ProjectRenderer::render(const RenderRequest& r) { return render(r, base_.camera); }
 
 RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera& camera) {
+    if (const std::optional<LpvJob> job = lpvJob(r, camera); job && job->key != lpvKey_) setLpv(job->run(), job->key);
     return renderer_->render(settingsOf(r, camera));
+}
+
+std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const OrbitCamera& camera) {
+    const std::optional<DebugView> view = findDebugView(r.debugView);
+    if (!view || !((base_.lpvLight && view->needs.sceneLights) || view->needs.lpvVolumes)) return std::nullopt;
+    const SceneDescription& scene = project_.scene;
+    const bool skirt = scene.terrain.skirt;
+    if (!tracer_ || tracer_->options().skirt != skirt) {
+        HeightfieldTracer::Options o;
+        o.skirt = skirt;
+        tracer_ = std::make_shared<const HeightfieldTracer>(terrain_.heightfield, o);
+    }
+    LpvJob job;
+    job.settings = scene.lpv;
+    job.lights = scene.lights;
+    job.lighting = lightingOf(project_);
+    job.lighting.surface = albedo_;
+    job.tracer = tracer_;
+    job.lighting.tracer = tracer_.get();
+    job.eye = glm::dvec3(camera.lpvEye());
+    job.viewDir = glm::dvec3(camera.lpvViewDirection());
+    const nlohmann::json sceneJson = sceneToJson(scene);
+    nlohmann::json key = {{"albedo", reinterpret_cast<uintptr_t>(albedo_.get())}};
+    for (const char* section : {"lpv", "lights", "sun", "sky", "terrain"}) key[section] = sceneJson.value(section, nlohmann::json());
+    for (const lpv::CascadeLayout& c : lpv::placeCascades(scene.lpv, job.eye, job.viewDir))
+        key["cascades"].push_back({c.originCell[0], c.originCell[1], c.originCell[2]});
+    job.key = key.dump();
+    return job;
+}
+
+std::shared_ptr<const lpv::Volumes> LpvJob::run() const {
+    return std::make_shared<const lpv::Volumes>(settings, lpv::Inputs{&lighting, &lights}, eye, viewDir);
+}
+
+void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const std::string& key) {
+    if (volumes) ++lpvUpdates_;
+    lpvKey_ = volumes ? key : std::string();
+    renderer_->setLpv(std::move(volumes));
 }
 
 bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera, vk::Swapchain& swapchain) {
@@ -299,7 +344,10 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.width = r.width;
     s.height = r.height;
     s.debugView = r.debugView;
-    s.probes = r.probes;
+    // lighting.indirect: the probes light the frame in probes and both, the LPV (base_.lpvLight)
+    // in lpv and both; none draws the frame without either, as with probes off.
+    const IndirectLighting indirect = project_.scene.lighting.indirect;
+    s.probes = r.probes && (indirect == IndirectLighting::Probes || indirect == IndirectLighting::Both);
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;

@@ -10,6 +10,8 @@
 #include <string>
 
 #include "DemImport.h"
+#include "bake/DiffuseBake.h"
+#include "bake/HeightfieldTracer.h"
 #include "Project.h"
 #include "render/TerrainRenderer.h"
 #include "terrain/HorizonAO.h"
@@ -29,6 +31,20 @@ struct RenderRequest {
 };
 
 class ProjectRenderer;
+
+// What one update of the light propagation volumes reads, held by value (the tracer and the albedo
+// field shared), so that a worker can compute it while the project changes on the UI thread.
+struct LpvJob {
+    LpvSettings settings;
+    std::vector<LocalLight> lights;
+    BakeLighting lighting;
+    std::shared_ptr<const HeightfieldTracer> tracer;  // lighting.tracer, kept alive
+    glm::dvec3 eye{0.0}, viewDir{0.0, 0.0, -1.0};
+    // The inputs and the cascades' placement: two jobs with equal keys compute equal volumes, so
+    // a camera move within the cascades' cells computes nothing.
+    std::string key;
+    std::shared_ptr<const lpv::Volumes> run() const;
+};
 
 // How far the shadow maps are from the exact sun visibility: the shadow view (31) and the traced
 // sun-visibility view (29) drawn scene-linear with the same camera, compared on terrain pixels.
@@ -75,11 +91,22 @@ public:
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
+    // A render draws the light propagation volumes when its view does (lighting.indirect lpv or
+    // both with lpv.enabled, or an LPV debug view): render() computes them first for its camera
+    // when the bound ones are not for it; present() draws what is bound (the viewport computes
+    // them on a worker with lpvJob and binds them with setLpv).
     RenderedImage render(const RenderRequest& request);
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
+    // The LPV update a frame of `request` from `camera` wants; nullopt when it draws no LPV.
+    std::optional<LpvJob> lpvJob(const RenderRequest& request, const OrbitCamera& camera);
+    // Binds volumes computed by a job (null: none) and remembers the job's key.
+    void setLpv(std::shared_ptr<const lpv::Volumes> volumes, const std::string& key);
+    const std::string& lpvKey() const { return lpvKey_; }
+    // LPV updates this renderer computed itself (render()) or was handed (setLpv).
+    size_t lpvUpdates() const { return lpvUpdates_; }
     const OrbitCamera& defaultCamera() const { return base_.camera; }
     // How often the probe volumes were placed for the overlays (edits that do not touch them
     // place nothing).
@@ -131,6 +158,9 @@ private:
     std::optional<HorizonAoSettings> boundAo_;  // the settings of the bound AO field
     RenderSettings base_;
     std::unique_ptr<TerrainRenderer> renderer_;
+    std::shared_ptr<const HeightfieldTracer> tracer_;  // for the LPV, made on first use
+    std::string lpvKey_;
+    size_t lpvUpdates_ = 0;
 };
 
 }  // namespace terralux

@@ -12,10 +12,16 @@ std::span<const uint32_t> terrainShadowFrag();  // with the shadow cascades boun
 // The same two with the reflection probes bound in the lights set.
 std::span<const uint32_t> terrainReflectionFrag();
 std::span<const uint32_t> terrainShadowReflectionFrag();
+// The four again with the LPV and local-lights set bound (TLX_LPV).
+std::span<const uint32_t> terrainLpvFrag();
+std::span<const uint32_t> terrainShadowLpvFrag();
+std::span<const uint32_t> terrainReflectionLpvFrag();
+std::span<const uint32_t> terrainShadowReflectionLpvFrag();
 std::span<const uint32_t> fullscreenVert();
 std::span<const uint32_t> skyBackgroundFrag();
 std::span<const uint32_t> shadowDepthVert();
 std::span<const uint32_t> probeVerticesComp();
+std::span<const uint32_t> lpvSampleComp();  // Volumes::evaluate at given points (TerrainRenderer::sampleLpv)
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();
 std::span<const uint32_t> leavesVert();

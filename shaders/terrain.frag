@@ -3,12 +3,16 @@
 // Terrain shading (docs/lighting.md) and the debug views. It binds the view and the lights only: probe
 // light comes in per vertex from the probe pass, when there is one. Built four times: with
 // TLX_SHADOWS the lights include the sun's shadow cascades, with TLX_REFLECTIONS the reflection
-// probes.
+// probes; each of the four again with TLX_LPV binds the set of the LPV and the local lights
+// (lpv.glsl), read as its specialisation constants say.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"
 #include "blocks/surface.h"
 #include "blocks/sun_sky.h"
 #include "blocks/atmosphere.h"
+#ifdef TLX_LPV
+#include "blocks/lpv.h"
+#endif
 #include "sh.glsl"
 #include "sky.glsl"
 #include "brdf.glsl"
@@ -17,6 +21,7 @@
 #include "shadows.glsl"
 #include "fog.glsl"
 #include "reflections.glsl"
+#include "lpv.glsl"
 #include "views.glsl"
 
 layout(location = 0) in vec3 worldPos;

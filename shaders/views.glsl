@@ -1,6 +1,6 @@
 // The debug views: kView<Name> constants from debug_views.def, one function per view, and the
-// dispatch over them (include after tonemap.glsl, sky.glsl, brdf.glsl, shadows.glsl, fog.glsl and
-// reflections.glsl). A view added to the list that has no function here fails the build.
+// dispatch over them (include after tonemap.glsl, sky.glsl, brdf.glsl, shadows.glsl, fog.glsl,
+// reflections.glsl and lpv.glsl). A view added to the list that has no function here fails the build.
 #ifndef TLX_VIEWS_GLSL
 #define TLX_VIEWS_GLSL
 
@@ -27,6 +27,8 @@ struct ShadingPoint {
     vec3 reflection;         // the reflection probes' radiance toward the mirror direction
     float reflectionWeight;  // their blend weight over the sky's: coverage fade × strength
     vec3 linear;       // sceneLinear(), seen through the fog
+    LpvSample lpv;     // the LPV at the point (all cascades; cascade 0 alone in views 61-63)
+    float lpvBlocking; // view 62: cascade 0's geometry, the share of light into the ground it stops
 };
 
 float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
@@ -49,10 +51,22 @@ vec3 sceneLinear(ShadingPoint s) {
     vec3 spec = ggxSpecular(n, v, l, s.roughness);
     vec3 environment = skyRadiance(reflect(-v, n)) * s.ao;
     if (s.reflectionWeight > 0.0) environment = mix(environment, s.reflection * s.aoProbe, s.reflectionWeight);
+    // The LPV's bounce light adds to the sky's (lighting.indirect lpv) or to the probes' (both):
+    // the LPV carries the sun's and the lights' first bounce only, never the sky.
+#ifdef TLX_LPV
+    if (kLpv && lpv.params.z > 0.5) {
+        ambient += s.lpv.irradiance;
+        environment += s.lpv.specular;
+    }
+#endif
     vec3 specEnv = envBrdf(kGroundF0, dot(n, v), s.roughness) * environment;
     // Probes hold no direct sun: the sun alone is shadowed by the cascades.
     vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
-    return s.albedo / PI * (sun * ndotl + ambient) + spec * sun + specEnv;
+    vec3 color = s.albedo / PI * (sun * ndotl + ambient) + spec * sun + specEnv;
+#ifdef TLX_LPV
+    if (kLocalLights) color += localLightsDirect(s.position, n, v, s.albedo, s.roughness);
+#endif
+    return color;
 }
 
 vec3 viewBeauty(ShadingPoint s) { return display(s.linear); }
@@ -122,6 +136,17 @@ vec3 viewWaterMask(ShadingPoint s) {
 vec3 viewShoreDistance(ShadingPoint s) { return linearOutput() ? vec3(0.0, 0.0, 0.0) : vec3(0.0); }
 vec3 viewWaterNormal(ShadingPoint s) { return vec3(0.5) * (0.6 + 0.4 * sunNdotL(s)); }
 
+// The LPV views: the irradiance of cascade 0 alone and of all cascades blended, shown like the
+// probe irradiance (E/π, a white Lambertian surface's radiance); cascade 0's geometry volume and
+// its ambient occlusion as scalars. Black where the frame holds no LPV.
+vec3 viewLpvCascade0(ShadingPoint s) { return display(s.lpv.irradiance / PI); }
+vec3 viewLpvAll(ShadingPoint s) { return display(s.lpv.irradiance / PI); }
+vec3 viewLpvGeometry(ShadingPoint s) {
+    if (linearOutput()) return vec3(s.lpvBlocking, 1.0, 0.0);
+    return heat(0.1 * s.lpvBlocking) * (0.6 + 0.4 * sunNdotL(s));
+}
+vec3 viewLpvAo(ShadingPoint s) { return scalarView(s.lpv.ao); }
+
 vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
     // views that need the full shading share one evaluation.
@@ -133,6 +158,18 @@ vec3 shadeView(int view, ShadingPoint s) {
     s.reflectionWeight = reflectionWeight(s.position);
     s.reflection = s.reflectionWeight > 0.0 ? reflectionProbeRadiance(s.position, reflect(dir, s.normal), s.roughness)
                                             : vec3(0.0);
+    s.lpv.irradiance = vec3(0.0);
+    s.lpv.specular = vec3(0.0);
+    s.lpv.ao = 1.0;
+    s.lpvBlocking = 0.0;
+#ifdef TLX_LPV
+    if (kLpv && lpv.counts.x > 0) {
+        bool firstOnly = view == kViewLpvCascade0 || view == kViewLpvGeometry || view == kViewLpvAo;
+        int last = firstOnly ? 0 : lpv.counts.x - 1;
+        s.lpv = lpvEvaluate(s.position, s.normal, -dir, lpv.counts.y, last);
+        if (view == kViewLpvGeometry) s.lpvBlocking = clamp(lpvShEvaluate(lpvGeometryAt(s.position, 0), s.normal), 0.0, 1.0);
+    }
+#endif
     s.linear = applyFog(sceneLinear(s), dir, distance);
     switch (view) {
 #define TLX_VIEW(NAME, NUMBER) case kView##NAME: return view##NAME(s);

@@ -14,7 +14,8 @@ const std::vector<int>& shaderViewNumbers() {
 const std::vector<DebugView>& debugViews() {
     constexpr ViewNeeds none{}, diagnostics{false, true, false}, diagnosticsAndMarkers{false, true, true},
         shadows{false, false, false, true}, visibility{false, false, false, false, true},
-        lit{true, false, false, true, false, true, true, true, true}, light{true, false, false},
+        lit{true, false, false, true, false, true, true, true, true, true}, light{true, false, false},
+        lpvOnly{false, false, false, false, false, false, false, false, false, false, true},
         waterOnly{false, false, false, false, false, false, true, false},
         reflections{false, false, false, false, false, false, false, false, true};
     static const std::vector<DebugView> views = {
@@ -66,6 +67,19 @@ const std::vector<DebugView>& debugViews() {
          "interpolation error heat map: blue 0 %, cyan 2.5 %, green 5 %, yellow 7.5 %, red 10 % and "
          "above, grey unmeasured (EXR: error in red, 1 in green where measured)",
          true, ViewBackground::Black, diagnostics},
+        {kViewLpvCascade0, "lpv-cascade0",
+         "irradiance of the LPV's cascade 0 alone, as E/π (what a white Lambertian surface reflects), "
+         "black outside it",
+         true, ViewBackground::Black, lpvOnly},
+        {kViewLpvGeometry, "lpv-geometry",
+         "cascade 0's geometry volume at the surface: the share of the light flowing into the ground "
+         "it stops, heat ramp from blue (none) to red (all) (EXR: share in red, 1 in green on terrain)",
+         true, ViewBackground::Black, lpvOnly},
+        {kViewLpvAo, "lpv-ao",
+         "ambient occlusion from cascade 0's geometry volume, 1 open (EXR: value in red, 1 in green on terrain)",
+         true, ViewBackground::Black, lpvOnly},
+        {kViewLpvAll, "lpv-all", "LPV irradiance of all cascades blended, as E/π, black outside them", true,
+         ViewBackground::Black, lpvOnly},
         {kViewWaterMask, "water-mask",
          "water / land: blue where the water surface is in view, brown land (EXR: 1 in red on water, 1 in green everywhere)",
          true, ViewBackground::Black, waterOnly},
@@ -118,6 +132,8 @@ std::string debugViewsMarkdown() {
         if (v.needs.reflectionProbes) passes += (passes.empty() ? "" : ", ") + std::string("reflection probes (when bound)");
         if (v.needs.shadows) passes = "shadow (when shadows are on)" + (passes.empty() ? "" : ", " + passes);
         if (v.needs.sunVisibility) passes = "CPU sun tracing at the vertices (cached per sun)";
+        if (v.needs.sceneLights) passes += ", LPV (when lighting.indirect uses it) and local lights";
+        if (v.needs.lpvVolumes) passes = "LPV volumes (computed on the CPU for the camera)";
         if (v.needs.sky) passes += ", sky";
         if (v.needs.waterShading) passes += ", water reflection and water (when the scene has water)";
         else if (v.needs.water) passes += (passes.empty() ? "" : ", ") + std::string("water (when the scene has water)");

@@ -34,6 +34,9 @@ struct ViewNeeds {
     bool water = false;             // the water pass (when the scene has water)
     bool waterShading = false;      // its reflection and the copy of the frame under it
     bool reflectionProbes = false;  // the reflection probes in the lights set (when a set is bound)
+    // The scene's LPV light (when lighting.indirect uses it) and its point and spot lights.
+    bool sceneLights = false;
+    bool lpvVolumes = false;        // the LPV's volumes whatever lighting.indirect says
 };
 
 struct DebugView {

@@ -21,6 +21,11 @@ struct OrbitCamera {
     // mean height, radius framing the whole footprint.
     static OrbitCamera fromSettings(const CameraSettings& s, const Heightfield& hf);
     glm::vec3 position() const;
+    // Where the light propagation volumes are placed from (docs/lighting.md, "Cascades"): a viewer
+    // standing at the target, looking along this camera's view direction. The orbit camera hovers
+    // far above the ground, where cascades around it would hold only air.
+    glm::vec3 lpvEye() const { return target; }
+    glm::vec3 lpvViewDirection() const { return target - position(); }
     // Near and far planes fitted to the radius and the scene's `extent` (its largest side).
     struct Planes {
         float nearPlane = 0.05f, farPlane = 1.0f;

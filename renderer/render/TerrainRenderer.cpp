@@ -15,6 +15,7 @@
 #include "bake/DiffuseBake.h"
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
+#include "lpv/Lpv.h"
 #include "render/DebugViews.h"
 #include "render/UniformBlocks.h"
 #include "terrain/SurfaceMaps.h"
@@ -58,6 +59,8 @@ const char* const kReflectionGrid = "reflection-probe-grid";
 const char* const kReflectionRecords = "reflection-probe-records";
 const char* const kReflectionCubes = "reflection-probe-cubes";
 const char* const kReflectionMarkers = "reflection-probe-markers";
+const char* const kLpvLight = "lpv-light";
+const char* const kLpvGeometry = "lpv-geometry";
 
 // Vertices along the longer side of the water mesh, at most: the waves longer than two of its
 // cells move it, the shorter ones live in the normal (water.glsl).
@@ -97,6 +100,21 @@ struct ProbeResources {
 struct FrameSlot {
     vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay, reflectionCamera;
     vk::DescriptorSet view, lights, shadowedLights, overlays, reflectionView;
+    // The terrain pass's LPV and local-lights set: its block, the lights (grown as needed), and
+    // the set, written again when the bound volumes or the lights buffer change (`lpvSetKey`).
+    vk::Buffer lpvBlock, localLights;
+    size_t localLightCapacity = 0;
+    vk::DescriptorSet lpvSet;
+    uint64_t lpvSetKey = 0;
+};
+
+// The LPV subsystem: present only while volumes are bound. Every cascade's light volume (its
+// three channels one after another, Lpv.h's layout) and geometry volume, uploaded once per
+// update; the block's cascade records come with them.
+struct LpvResources {
+    std::shared_ptr<const lpv::Volumes> volumes;
+    vk::Buffer light, geometry;
+    blocks::LpvBlock block;
 };
 
 // The water subsystem: present only while the scene has water. The field and mesh follow the
@@ -181,6 +199,13 @@ struct TerrainRenderer::Gpu {
     std::array<vk::PipelineLayout, 4> terrainLayouts;     // view and lights, by lights variant
     vk::PipelineLayout overlayLayout, probeLayout, shadowDepthLayout;
     std::unique_ptr<ReflectionResources> reflections;
+    std::unique_ptr<LpvResources> lpv;
+    uint64_t lpvGeneration = 1;  // counts setLpv calls: a slot's LPV set is written for one
+    vk::Buffer lpvDummy;  // one vec4 standing in for the volumes where none are bound
+    vk::UniqueSetLayout lpvLayout;
+    std::array<vk::PipelineLayout, 4> terrainLpvLayouts;  // view, lights and the LPV set, by lights variant
+    vk::PipelineLayout lpvSampleLayout;
+    vk::UniquePipeline lpvSample;
     // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
     // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant.
     std::map<int, vk::UniquePipeline> terrain;
@@ -196,7 +221,8 @@ struct TerrainRenderer::Output {
 
 namespace {
 
-constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8;
+constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8,
+              kLpvVariant = 16, kLocalLightsVariant = 32;
 // The lights set's variants, an index into the layouts: the shadow cascades, the reflection probes.
 constexpr int kShadowedLights = 1, kReflectedLights = 2;
 
@@ -250,6 +276,17 @@ vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView re
         .image(TLX_WATER_REFLECTION_BINDING, kWaterReflection, reflection, sampler, frag)
         .image(TLX_WATER_SCENE_BINDING, kWaterScene, scene, sampler, frag)
         .image(TLX_WATER_FIELD_BINDING, kWaterField, field, sampler, kVertexFragment);
+}
+
+// The terrain pass's LPV set: the block, the volumes (or the placeholder) and the lights. Null
+// buffers: the layout alone.
+vk::DescriptorSetBuilder lpvSetBuilder(const vk::Buffer& block, const vk::Buffer& light, const vk::Buffer& geometry,
+                                       const vk::Buffer& lights, VkShaderStageFlags stages = VK_SHADER_STAGE_FRAGMENT_BIT) {
+    return vk::DescriptorSetBuilder()
+        .uniform(blocks::LpvBlock::kBinding, "lpv", block, stages)
+        .storage(TLX_LPV_LIGHT_BINDING, kLpvLight, light, stages)
+        .storage(TLX_LPV_GEOMETRY_BINDING, kLpvGeometry, geometry, stages)
+        .storage(TLX_LOCAL_LIGHTS_BINDING, "local-lights", lights, stages);
 }
 
 // Bilinear sample of a row-major DEM-grid array at fractional (col, row).
@@ -332,6 +369,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.atmosphere = ubo(sizeof(blocks::AtmosphereBlock));
         f.shadow = ubo(sizeof(blocks::ShadowBlock));
         f.overlay = ubo(sizeof(blocks::OverlayBlock));
+        f.lpvBlock = ubo(sizeof(blocks::LpvBlock));
         f.lights = lightsBuilder(0, f, g, VK_NULL_HANDLE, nullptr, 0).build(ctx_);
         f.overlays = vk::DescriptorSetBuilder()
                          .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
@@ -359,8 +397,14 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     static const vk::Buffer noBuffer;
     g.waterLayout = waterSetBuilder(noBuffer, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, g.linear.handle())
                         .buildLayout(ctx_);
+    const glm::vec4 zero(0.0f);
+    g.lpvDummy = vk::Buffer::deviceLocal(ctx_, &zero, sizeof zero, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    g.lpvLayout = lpvSetBuilder(noBuffer, noBuffer, noBuffer, noBuffer).buildLayout(ctx_);
     for (int variant = 0; variant < 4; ++variant) {
         g.lightsLayouts[size_t(variant)] = lightsBuilder(variant, g.slots[0], g, VK_NULL_HANDLE, nullptr, 0).buildLayout(ctx_);
+        const VkDescriptorSetLayout lpvSets[] = {g.viewLayout.get(), g.lightsLayouts[size_t(variant)].get(),
+                                                 g.lpvLayout.get()};
+        g.terrainLpvLayouts[size_t(variant)] = vk::PipelineLayout(ctx_, lpvSets);
         const VkDescriptorSetLayout terrainSets[] = {g.viewLayout.get(), g.lightsLayouts[size_t(variant)].get()};
         g.terrainLayouts[size_t(variant)] = vk::PipelineLayout(ctx_, terrainSets);
         const VkDescriptorSetLayout waterSets[] = {g.viewLayout.get(), g.lightsLayouts[size_t(variant)].get(),
@@ -583,6 +627,102 @@ void TerrainRenderer::buildReflectionSets() {
 }
 
 bool TerrainRenderer::hasReflectionResources() const { return gpu_->reflections != nullptr; }
+
+bool TerrainRenderer::hasLpvResources() const { return gpu_->lpv != nullptr; }
+
+const std::shared_ptr<const lpv::Volumes>& TerrainRenderer::lpv() const {
+    static const std::shared_ptr<const lpv::Volumes> none;
+    return gpu_->lpv ? gpu_->lpv->volumes : none;
+}
+
+void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
+    Gpu& g = *gpu_;
+    if (g.lpv ? g.lpv->volumes == volumes : !volumes) return;
+    std::unique_ptr<LpvResources> r;
+    if (volumes && !volumes->cascades().empty()) {
+        r = std::make_unique<LpvResources>();
+        const auto& cascades = volumes->cascades();
+        const size_t n = std::min<size_t>(cascades.size(), 4);
+        std::vector<float> light, geometry;
+        light.reserve(n * cascades[0].accumulated.size());
+        geometry.reserve(n * cascades[0].geometry.size());
+        const LpvSettings& ls = volumes->settings();
+        r->block.counts = glm::ivec4(int(n), ls.quality, ls.coneTraceSamples, 0);
+        r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f, 0.0f);
+        for (size_t c = 0; c < n; ++c) {
+            light.insert(light.end(), cascades[c].accumulated.begin(), cascades[c].accumulated.end());
+            geometry.insert(geometry.end(), cascades[c].geometry.begin(), cascades[c].geometry.end());
+            r->block.cascades[c] = glm::vec4(glm::vec3(cascades[c].layout.origin()), float(cascades[c].layout.cellSize));
+        }
+        r->light = vk::Buffer::deviceLocal(ctx_, light.data(), light.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        r->geometry = vk::Buffer::deviceLocal(ctx_, geometry.data(), geometry.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        r->volumes = std::move(volumes);
+    }
+    ctx_.waitIdle();  // no frame may still read the old volumes
+    g.graph.forget(kLpvLight);
+    g.graph.forget(kLpvGeometry);
+    g.lpv = std::move(r);
+    ++g.lpvGeneration;
+    if (!g.lpv) return;
+    g.graph.importBuffer(kLpvLight, g.lpv->light.handle(), true);
+    g.graph.importBuffer(kLpvGeometry, g.lpv->geometry.handle(), true);
+}
+
+std::vector<lpv::Sample> TerrainRenderer::sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
+                                                    int lastCascade) {
+    Gpu& g = *gpu_;
+    if (!g.lpv || queries.empty()) return {};
+    const int cascades = g.lpv->block.counts.x;
+    const int last = lastCascade < 0 ? cascades - 1 : std::min(lastCascade, cascades - 1);
+    std::vector<glm::vec4> packed;
+    for (const auto& q : queries)
+        for (const glm::vec3& v : q) packed.emplace_back(v, 0.0f);
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    const vk::Buffer input = vk::Buffer::deviceLocal(ctx_, packed.data(), packed.size() * sizeof(glm::vec4),
+                                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::Buffer results = vk::Buffer::hostVisible(ctx_, queries.size() * 2 * sizeof(glm::vec4),
+                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::Buffer block = vk::Buffer::hostVisible(ctx_, sizeof(blocks::LpvBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    block.write(&g.lpv->block, sizeof(blocks::LpvBlock));
+    const vk::DescriptorSet set = lpvSetBuilder(block, g.lpv->light, g.lpv->geometry, g.lpvDummy, compute)
+                                      .storage(4, "lpv-queries", input, compute)
+                                      .storage(5, "lpv-results", results, compute)
+                                      .build(ctx_);
+    if (!g.lpvSample) {
+        const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), set.layout()};
+        g.lpvSampleLayout = vk::PipelineLayout(ctx_, sets, sizeof(glm::ivec4), compute);
+        g.lpvSample = vk::createComputePipeline(ctx_, g.lpvSampleLayout.handle(), shaders::lpvSampleComp());
+    }
+    const glm::ivec4 push(int(queries.size()), last, 0, 0);
+    ctx_.waitIdle();
+    ctx_.submitAndWait([&](VkCommandBuffer cb) {
+        // The volumes and the queries were filled by transfers.
+        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
+                             0, nullptr, 0, nullptr);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSample.get());
+        const VkDescriptorSet handle = set.handle();
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSampleLayout.handle(), TLX_SET_SUBSYSTEM, 1,
+                                &handle, 0, nullptr);
+        vkCmdPushConstants(cb, g.lpvSampleLayout.handle(), compute, 0, sizeof push, &push);
+        vkCmdDispatch(cb, uint32_t(queries.size() + 63) / 64, 1, 1);
+        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        after.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+        after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &after, 0,
+                             nullptr, 0, nullptr);
+    });
+    const auto* values = static_cast<const glm::vec4*>(results.map());
+    std::vector<lpv::Sample> out(queries.size());
+    for (size_t i = 0; i < queries.size(); ++i) {
+        out[i].irradiance = glm::vec3(values[2 * i]);
+        out[i].ao = values[2 * i].w;
+        out[i].specular = glm::vec3(values[2 * i + 1]);
+    }
+    return out;
+}
 
 void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
     Gpu& g = *gpu_;
@@ -872,6 +1012,13 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // of 0 leaves the sky's specular as it is.
     ReflectionResources* reflections =
         g.reflections && s.probes && view.needs.reflectionProbes ? g.reflections.get() : nullptr;
+    // The LPV takes part when volumes are bound and either the view lights with them and
+    // lighting.indirect asks for them, or the view shows them; the local lights in the lit views
+    // whenever the scene has some. Either binds the terrain's LPV set.
+    LpvResources* lpvVolumes =
+        g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes) ? g.lpv.get() : nullptr;
+    const bool localLights = !s.lights.empty() && view.needs.sceneLights;
+    const bool lpvSet = lpvVolumes || localLights;
     const bool drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
     // The reflection probes' markers, with the probe positions.
     const bool drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
@@ -906,22 +1053,29 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const bool vertexAttribute = probes || sunVisibility;
     const int lightsVariant = (shadows ? kShadowedLights : 0) | (reflections ? kReflectedLights : 0);
     const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
-                        (fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0);
+                        (fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0) |
+                        (lpvVolumes ? kLpvVariant : 0) | (localLights ? kLocalLightsVariant : 0);
+    const VkPipelineLayout terrainLayout = lpvSet ? g.terrainLpvLayouts[size_t(lightsVariant)].handle()
+                                                  : g.terrainLayouts[size_t(lightsVariant)].handle();
     vk::UniquePipeline& terrainPipeline = g.terrain[variant];
     if (!terrainPipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
-        d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
-                             : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
+        if (lpvSet)
+            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionLpvFrag() : shaders::terrainReflectionLpvFrag())
+                                 : (shadows ? shaders::terrainShadowLpvFrag() : shaders::terrainLpvFrag());
+        else
+            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
+                                 : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
         d.fragConstants = {fog ? 1u : 0u};
+        if (lpvSet) d.fragConstants.insert(d.fragConstants.end(), {lpvVolumes ? 1u : 0u, localLights ? 1u : 0u});
         d.bindings = {meshBinding};
         d.attributes = {position, normal};
         if (vertexAttribute) {
             d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
             d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
         }
-        terrainPipeline = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(),
-                                                     g.terrainLayouts[size_t(lightsVariant)].handle(), d);
+        terrainPipeline = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), terrainLayout, d);
     }
     vk::UniquePipeline& skyPipeline = fog ? g.skyFog : g.skyPlain;
     if ((sky || planarReflection) && !skyPipeline) {
@@ -1075,6 +1229,40 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         block.coverage.w = std::clamp(s.reflectionStrength, 0.0f, 1.0f);
         reflections->blocks[slotIndex].write(&block, sizeof block);
     }
+    if (lpvSet) {
+        const size_t wanted = std::max<size_t>(localLights ? s.lights.size() : 0, 1);
+        if (slot.localLightCapacity < wanted) {
+            slot.localLights = vk::Buffer::hostVisible(ctx_, wanted * sizeof(blocks::LocalLightRecord),
+                                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+            slot.localLightCapacity = wanted;
+            slot.lpvSetKey = 0;
+        }
+        std::vector<blocks::LocalLightRecord> records(wanted);
+        for (size_t i = 0; localLights && i < s.lights.size(); ++i) {
+            const LocalLight& l = s.lights[i];
+            blocks::LocalLightRecord& r = records[i];
+            const bool spot = l.type == LocalLightType::Spot;
+            r.positionRange = glm::vec4(l.position, float(l.range));
+            r.emitted = glm::vec4(l.color * float(l.intensity), spot ? 1.0f : 0.0f);
+            const float len = glm::length(l.direction);
+            r.direction = glm::vec4(len > 0.0f ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f), 0.0f);
+            const float cosOuter = std::cos(glm::radians(float(l.outerConeDeg)));
+            const float cosInner = std::cos(glm::radians(float(l.innerConeDeg)));
+            r.cone = glm::vec4(cosOuter, 1.0f / std::max(0.001f, cosInner - cosOuter), 0.0f, 0.0f);
+        }
+        slot.localLights.write(records.data(), records.size() * sizeof(records[0]));
+        blocks::LpvBlock block = lpvVolumes ? lpvVolumes->block : blocks::LpvBlock{};
+        block.counts.w = localLights ? int(s.lights.size()) : 0;
+        block.params.z = lpvVolumes && s.lpvLight && view.needs.sceneLights ? 1.0f : 0.0f;
+        slot.lpvBlock.write(&block, sizeof block);
+        const uint64_t key = lpvVolumes ? g.lpvGeneration : 1;
+        if (slot.lpvSetKey != key) {
+            slot.lpvSet = lpvSetBuilder(slot.lpvBlock, lpvVolumes ? lpvVolumes->light : g.lpvDummy,
+                                        lpvVolumes ? lpvVolumes->geometry : g.lpvDummy, slot.localLights)
+                              .build(ctx_);
+            slot.lpvSetKey = key;
+        }
+    }
     if (drawMarkers || drawReflectionMarkers || drawLeaves) {
         blocks::OverlayBlock overlay;
         overlay.leaves = glm::vec4(smallestLeaf_, kSmallestLeafPixels, 0.0f, 0.0f);
@@ -1193,8 +1381,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
     const uint32_t indexCount = uint32_t(indexCount_);
     const VkPipeline terrainHandle = terrainPipeline.get();
-    const VkPipelineLayout terrainLayout = g.terrainLayouts[size_t(lightsVariant)].handle();
     const VkDescriptorSet lightsSet = lights.handle();
+    const VkDescriptorSet lpvSetHandle = lpvSet ? slot.lpvSet.handle() : VK_NULL_HANDLE;
     const auto terrainPass = [&](const char* name, std::vector<ResourceUse> targets, const vk::DescriptorSet& viewSet) {
         PassInfo info{name, std::move(targets),
                       concat(concat(viewSet.bindingNames(), lights.bindingNames()),
@@ -1203,6 +1391,11 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         info.uses.push_back({kIndices, Access::IndexRead});
         if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
         if (reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
+        if (lpvVolumes) {
+            info.uses.push_back({kLpvLight, Access::FragmentStorageRead});
+            info.uses.push_back({kLpvGeometry, Access::FragmentStorageRead});
+        }
+        if (lpvSet) info.bindings = concat(info.bindings, slot.lpvSet.bindingNames());
         if (attributeName) {
             info.uses.push_back({attributeName, Access::VertexAttributeRead});
             info.bindings.push_back(std::string("vertex:") + attributeName);
@@ -1210,12 +1403,13 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         if (fog) info.bindings.push_back("fog");
         return info;
     };
-    const auto drawTerrain = [&g, terrainHandle, terrainLayout, lightsSet, attribute, attributeOffset,
+    const auto drawTerrain = [&g, terrainHandle, terrainLayout, lightsSet, lpvSetHandle, attribute, attributeOffset,
                               indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {
         if (indexCount == 0) return;
         vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainHandle);
-        const VkDescriptorSet sets[] = {viewSet, lightsSet};
-        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainLayout, TLX_SET_VIEW, 2, sets, 0, nullptr);
+        const VkDescriptorSet sets[] = {viewSet, lightsSet, lpvSetHandle};
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainLayout, TLX_SET_VIEW,
+                                lpvSetHandle != VK_NULL_HANDLE ? 3 : 2, sets, 0, nullptr);
         const VkBuffer vb[2] = {g.vertices.handle(), attribute};
         const VkDeviceSize offsets[2] = {0, attributeOffset};
         vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);

@@ -31,6 +31,10 @@
 namespace terralux {
 
 struct ReflectionProbeSet;  // bake/ReflectionBake.h
+namespace lpv {
+class Volumes;  // lpv/Lpv.h
+struct Sample;
+}  // namespace lpv
 
 // One baked volume as the GPU reads it: the .shprobe grid (occupancy + coefficients).
 struct GpuProbeVolume {
@@ -97,6 +101,11 @@ struct RenderSettings {
     // reflection_probes.strength, [0, 1]: how far bound reflection probes replace the sky's
     // specular (0 draws the image without them, bit for bit).
     float reflectionStrength = 1.0f;
+    // lighting.indirect is lpv or both: the bound LPV's irradiance (and at quality 2 its specular)
+    // adds to the ambient in the lit views. The LPV views draw a bound LPV whatever this says.
+    bool lpvLight = false;
+    // Point and spot lights: their direct light, unshadowed (none: no lights code runs).
+    std::vector<LocalLight> lights;
 };
 
 struct RenderedImage {
@@ -124,6 +133,16 @@ public:
     void setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set);
     // Whether the reflection subsystem holds GPU resources (a set is bound).
     bool hasReflectionResources() const;
+    // Binds light propagation volumes (null: none; their GPU buffers go away). Their cascades,
+    // quality, cone samples and intensity are the volumes' own settings.
+    void setLpv(std::shared_ptr<const lpv::Volumes> volumes);
+    const std::shared_ptr<const lpv::Volumes>& lpv() const;
+    bool hasLpvResources() const;
+    // Volumes::evaluate of the bound LPV on the GPU, by the terrain shader's own code, at each
+    // query (position, unit normal, unit direction toward the eye), over cascades `lastCascade`
+    // down to 0 (-1: all), at the volumes' quality; waits for the GPU. Empty without an LPV.
+    std::vector<lpv::Sample> sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
+                                       int lastCascade = -1);
     // Bytes of the bound reflection probes on the GPU: their records and cube texels.
     size_t reflectionBytes() const { return reflectionBytes_; }
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.

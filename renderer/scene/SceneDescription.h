@@ -305,8 +305,8 @@ struct LpvSettings {
 
 enum class LocalLightType { Point, Spot };
 
-// A point or spot light (KHR_lights_punctual's model). Lights are read by the LPV only: the
-// diffuse bake leaves them out (docs/lighting.md).
+// A point or spot light (KHR_lights_punctual's model). The renderer draws its direct light
+// (unshadowed) and the LPV its bounce; the diffuse bake leaves lights out (docs/lighting.md).
 struct LocalLight {
     LocalLightType type = LocalLightType::Point;
     glm::vec3 position{0.0f};                 // engine space, metres

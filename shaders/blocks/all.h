@@ -11,6 +11,7 @@
 #include "blocks/overlay.h"
 #include "blocks/water.h"
 #include "blocks/reflections.h"
+#include "blocks/lpv.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN

@@ -19,6 +19,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ReflectionBake.h"
+#include "lpv/Lpv.h"
 #include "render/DebugViews.h"
 #include "render/FrameGraph.h"
 #include "vk/Descriptors.h"
@@ -288,6 +289,10 @@ void checkGolden(const std::string& stem, const RenderedImage& img) {
 
 TEST_F(RenderTest, GoldenImagesOfEveryView) {
     Project p = sampleProject("golden", 8, 8);
+    // The LPV views draw the volumes whatever lpv.enabled says; light carried across the cascades
+    // and four times as strong reads in 8 bits (no other view reads these settings).
+    p.scene.lpv.propagationWeight = 1.0;
+    p.scene.lpv.indirectIntensity = 4.0;
     ProjectRenderer r(*ctx_, p);
     addLake(p, r);
     ASSERT_EQ(r.loadProbes(true), 1u);
@@ -1592,4 +1597,197 @@ TEST_F(RenderTest, ReflectionProbeMarkersAreDrawnInTheirOwnColour) {
     EXPECT_GT(violet(marked), 9u * 4);  // 6 x 6 pixels each, some hidden behind the terrain
     q.probePositions = false;
     EXPECT_EQ(violet(r.render(q)), 0u);
+}
+
+namespace {
+
+// The sample with the LPV on and lighting.indirect `indirect`, quality `quality`.
+Project lpvProject(Project p, IndirectLighting indirect, int quality = 1) {
+    p.scene.lpv.enabled = true;
+    p.scene.lpv.quality = quality;
+    p.scene.lighting.indirect = indirect;
+    return p;
+}
+
+double linearSum(const RenderedImage& img) {
+    double sum = 0;
+    for (size_t i = 0; i < img.rgba.size(); ++i)
+        if (i % 4 != 3) sum += img.rgba[i];
+    return sum;
+}
+
+}  // namespace
+
+TEST_F(RenderTest, LpvViewsDifferFromEachOtherAndShowTheVolumes) {
+    Project p = sampleProject("lpv_views", 8, 8);
+    // Light that carries across the cascades and shows in the display encoding, seen from close
+    // enough that the finer cascades fill much of the frame.
+    p.scene.lpv.propagationWeight = 1.0;
+    p.scene.lpv.indirectIntensity = 4.0;
+    p.scene.camera.radius = 3000.0;
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    const std::vector<int> views = {kViewLpvCascade0, kViewLpvGeometry, kViewLpvAo, kViewLpvAll};
+    std::vector<RenderedImage> images;
+    for (int v : views) images.push_back(draw(r, v));
+    // The LPV views draw volumes even with lpv.enabled off, computed for the camera once.
+    EXPECT_FALSE(p.scene.lpv.enabled);
+    EXPECT_TRUE(r.renderer().hasLpvResources());
+    EXPECT_EQ(r.lpvUpdates(), 1u);
+    for (size_t a = 0; a < views.size(); ++a)
+        for (size_t b = a + 1; b < views.size(); ++b)
+            EXPECT_GT(meanAbsDiff(images[a], images[b]), 1.0 / 255.0) << views[a] << " and " << views[b] << ": "
+                                                                       << meanAbsDiff(images[a], images[b]) * 255.0;
+    // Lit views do not bind the LPV while lighting.indirect leaves it out.
+    draw(r, kViewBeauty);
+    for (const PassInfo& pass : r.renderer().lastFramePasses())
+        for (const std::string& b : pass.bindings) EXPECT_NE(b, "lpv-light") << pass.name;
+}
+
+TEST_F(RenderTest, IndirectNoneEqualsTheImageWithoutIndirectLight) {
+    Project p = sampleProject("indirect_none", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    const RenderedImage unlit = draw(r, kViewLinear, false, true);
+    for (bool lpvOn : {false, true}) {
+        p.scene.lighting.indirect = IndirectLighting::None;
+        p.scene.lpv.enabled = lpvOn;
+        r.setProject(p);
+        const RenderedImage none = draw(r, kViewLinear, true, true);
+        EXPECT_EQ(none.rgba, unlit.rgba) << "lpv.enabled " << lpvOn;
+        EXPECT_FALSE(r.renderer().hasLpvResources());
+    }
+}
+
+TEST_F(RenderTest, LpvIndirectDiffersFromProbesAndBothSumsThem) {
+    Project p = sampleProject("indirect_lpv", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    // The LPV carries light across its cascades, ten times as strong as physical: the first
+    // bounce is a few percent of the sunlit terrain's light, and this makes it plain.
+    p.scene.lpv.propagationWeight = 1.0;
+    p.scene.lpv.indirectIntensity = 10.0;
+    r.setProject(p);
+    const std::vector<size_t> terrain = terrainPixels(r);
+    const RenderedImage probes = draw(r, kViewLinear, true, true);
+    const RenderedImage unlit = draw(r, kViewLinear, false, true);
+    r.setProject(lpvProject(p, IndirectLighting::Lpv));
+    const RenderedImage lpvImage = draw(r, kViewLinear, true, true);
+    EXPECT_TRUE(r.renderer().hasLpvResources());
+    r.setProject(lpvProject(p, IndirectLighting::Both));
+    const RenderedImage both = draw(r, kViewLinear, true, true);
+    EXPECT_EQ(r.lpvUpdates(), 1u) << "the same volumes serve lpv and both";
+    double differs = 0, probeLit = 0;
+    for (size_t p : terrain)
+        for (size_t c = 0; c < 3; ++c) {
+            differs += std::abs(lpvImage.rgba[4 * p + c] - probes.rgba[4 * p + c]);
+            probeLit += probes.rgba[4 * p + c];
+        }
+    EXPECT_GT(differs / probeLit, 0.02) << "lpv against probes, share of the probe-lit terrain";
+    // lpv adds the LPV's bounce to the sky-lit image; both adds the same to the probe-lit one.
+    const double bounce = linearSum(lpvImage) - linearSum(unlit);
+    EXPECT_GT(bounce, 0.0);
+    EXPECT_NEAR(linearSum(both) - linearSum(probes), bounce, 1e-3 * linearSum(probes));
+}
+
+TEST_F(RenderTest, APointLightBrightensTheGroundUnderIt) {
+    Project p = sampleProject("point_light", 8, 8);
+    ProjectRenderer r(*ctx_, p);
+    const OrbitCamera camera = r.defaultCamera();
+    const Heightfield& hf = r.heightfield();
+    const glm::vec3 ground(camera.target.x, hf.surfaceHeight(camera.target.x, camera.target.z), camera.target.z);
+    const RenderedImage dark = draw(r, kViewLinear, false, true);
+    LocalLight light;
+    light.position = ground + glm::vec3(0.0f, 150.0f, 0.0f);
+    light.range = 800.0;
+    light.intensity = 6.0e4;  // 2.7 under it, about the sun's 3
+    p.scene.lights = {light};
+    r.setProject(p);
+    const RenderedImage lit = draw(r, kViewLinear, false, true);
+    EXPECT_FALSE(r.renderer().hasLpvResources()) << "direct light needs no LPV";
+    // The target projects to the image's centre: the light brightens the ground there, and the
+    // ground beyond its range not at all.
+    const glm::mat4 vp = camera.viewProjection(float(kW) / float(kH), std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(),
+                                                                               hf.maxHeight() - hf.minHeight()}));
+    const glm::vec4 clip = vp * glm::vec4(ground, 1.0f);
+    const int cx = int((clip.x / clip.w * 0.5f + 0.5f) * kW), cy = int((clip.y / clip.w * 0.5f + 0.5f) * kH);
+    ASSERT_TRUE(cx > 2 && cx < int(kW) - 3 && cy > 2 && cy < int(kH) - 3);
+    double near = 0, before = 0;
+    for (int y = cy - 2; y <= cy + 2; ++y)
+        for (int x = cx - 2; x <= cx + 2; ++x) {
+            const size_t i = (size_t(y) * kW + size_t(x)) * 4;
+            near += lit.rgba[i] - dark.rgba[i];
+            before += dark.rgba[i];
+        }
+    EXPECT_GT(near, 0.25 * before) << "the ground under the light";
+    const size_t corner = (size_t(4) * kW + 4) * 4;
+    EXPECT_EQ(lit.rgba[corner], dark.rgba[corner]);
+    // A spot pointing away lights nothing.
+    light.type = LocalLightType::Spot;
+    light.direction = glm::vec3(0.0f, 1.0f, 0.0f);
+    p.scene.lights = {light};
+    r.setProject(p);
+    const RenderedImage away = draw(r, kViewLinear, false, true);
+    EXPECT_EQ(away.rgba, dark.rgba);
+}
+
+// The terrain shader's LPV code against Volumes::evaluate at the same points: the compute pass
+// runs lpv.glsl's lpvEvaluate, the function the terrain pass calls.
+TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
+    Project p = sampleProject("lpv_agreement", 8, 8);
+    p.scene.lpv.enabled = true;
+    p.scene.lpv.propagationWeight = 0.25;
+    p.scene.lighting.indirect = IndirectLighting::Lpv;
+    LocalLight light;
+    light.position = glm::vec3(300.0f, 1700.0f, -200.0f);
+    light.range = 900.0;
+    light.intensity = 5.0e5;
+    p.scene.lights = {light};
+    ProjectRenderer r(*ctx_, p);
+    const Heightfield& hf = r.heightfield();
+    for (int quality : {0, 1, 2}) {
+        p.scene.lpv.quality = quality;
+        r.setProject(p);
+        draw(r, kViewLpvAll);
+        const auto volumes = r.renderer().lpv();
+        ASSERT_TRUE(volumes);
+        // Ground points on a grid over the footprint (inside and outside the cascades), and a few
+        // above it, each with the terrain's normal and a view from the south-west above.
+        std::vector<std::array<glm::vec3, 3>> queries;
+        for (int k = 0; k < 24; ++k)
+            for (int i = 0; i < 24; ++i) {
+                const float x = hf.minX() + (float(i) + 0.5f) / 24.0f * (hf.maxX() - hf.minX());
+                const float z = hf.minZ() + (float(k) + 0.5f) / 24.0f * (hf.maxZ() - hf.minZ());
+                const float lift = (i + k) % 5 == 0 ? 40.0f : 0.0f;
+                const glm::vec3 n = hf.surfaceNormal(x, z);
+                queries.push_back({glm::vec3(x, hf.surfaceHeight(x, z) + lift, z), n,
+                                   glm::normalize(glm::vec3(-0.5f, 0.6f, 0.6f))});
+            }
+        const std::vector<lpv::Sample> gpu = r.renderer().sampleLpv(queries);
+        ASSERT_EQ(gpu.size(), queries.size());
+        double largest = 0, largestSpec = 0, worst = 0, worstSpec = 0, worstAo = 0;
+        size_t lit = 0;
+        std::vector<lpv::Sample> cpu;
+        for (const auto& q : queries) cpu.push_back(volumes->evaluate(q[0], q[1], q[2]));
+        for (size_t i = 0; i < cpu.size(); ++i) {
+            largest = std::max(largest, double(glm::length(cpu[i].irradiance)));
+            largestSpec = std::max(largestSpec, double(glm::length(cpu[i].specular)));
+            lit += glm::length(cpu[i].irradiance) > 0.0f;
+        }
+        for (size_t i = 0; i < cpu.size(); ++i) {
+            worst = std::max(worst, double(glm::length(gpu[i].irradiance - cpu[i].irradiance)) / largest);
+            if (largestSpec > 0) worstSpec = std::max(worstSpec, double(glm::length(gpu[i].specular - cpu[i].specular)) / largestSpec);
+            worstAo = std::max(worstAo, double(std::abs(gpu[i].ao - cpu[i].ao)));
+        }
+        std::cout << "quality " << quality << ": " << lit << " of " << cpu.size() << " points lit, largest irradiance "
+                  << largest << "; worst |GPU - CPU| / largest: irradiance " << worst << ", specular " << worstSpec
+                  << "; AO " << worstAo << "\n";
+        EXPECT_GT(lit, cpu.size() / 4);
+        EXPECT_LT(worst, 1e-4) << quality;
+        EXPECT_LT(worstAo, 1e-4) << quality;
+        if (quality == 2) {
+            EXPECT_GT(largestSpec, 0.0);
+            EXPECT_LT(worstSpec, 1e-4);
+        }
+    }
 }
