@@ -756,64 +756,64 @@ std::vector<ParameterSpec> buildTable() {
     // volumes"). Each lpv row is one console variable of seed 003 (lpv.ini); the LPV dock edits
     // them, its lights table the lights.
     add(Row("lighting.indirect", T::Choice)).choices({"probes", "lpv", "both", "none"}).label("Indirect light")
-        .about("Which indirect light the engine adds to the direct sun: the baked probes, the light propagation volumes, both summed, or none; exported in TERRALUX_lighting (the viewport draws the probes)")
-        .redoes(kNothing).field(&SceneDescription::lighting, &LightingSettings::indirect);
+        .about("Which indirect light the engine, the viewport and --render add to the direct sun and sky: the baked probes (diffuse and reflection), the light propagation volumes (with lpv.enabled), both summed, or none; exported in TERRALUX_lighting")
+        .redoes(kUpload).field(&SceneDescription::lighting, &LightingSettings::indirect);
     const auto lpvOn = [](const SceneDescription& s, size_t) { return s.lpv.enabled; };
     add(Row("lpv.enabled", T::Boolean)).label("Light propagation volumes")
-        .about("rEx.GI.Method: 1 with LPV on, else 0. On: the bake writes lpv.ini and TERRALUX_lighting.lpv")
-        .redoes(kNothing).field(&SceneDescription::lpv, &LpvSettings::enabled);
+        .about("rEx.GI.Method: 1 with LPV on, else 0. On: the bake writes lpv.ini and TERRALUX_lighting.lpv, and the viewport draws the LPV when lighting.indirect is lpv or both")
+        .redoes(kUpload).field(&SceneDescription::lpv, &LpvSettings::enabled);
     add(Row("lpv.size", T::Number)).above(0.0, 1.0e6).unit("m").decimals(0).label("LPV size")
         .about("rEx.LPV.Size: edge of the largest cascade (cascade 0), 32 cells across")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::size);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::size);
     add(Row("lpv.fade_range", T::Number)).range(0.0, 16.0).unit("cells").decimals(1).label("Fade range")
         .about("rEx.LPV.FadeRange: cells at each cascade's boundary over which it fades out (to the next coarser cascade, or to nothing)")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::fadeRange);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::fadeRange);
     add(Row("lpv.propagation_weight", T::Number)).range(0.0, 1.0).decimals(3).label("Propagation weight")
         .about("rEx.LPV.PropagationWeight: per-neighbour propagation strength, compounded over a cascade's 32 cells: each iteration passes on w^(1/32) of the paper's face transfer, so w is the share left after crossing the cascade (1 = energy-conserving, 0.01 = 0.866 per iteration); higher spreads light faster and leaks more")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationWeight);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationWeight);
     add(Row("lpv.propagation_iterations", T::Integer)).range(0, 64).label("Propagation iterations")
         .about("rEx.LPV.PropagationIterations: propagation steps per update, each accumulated; 0 = injected light only")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationIterations);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::propagationIterations);
     add(Row("lpv.update_interval", T::Integer)).range(0, 600).unit("frames").label("Update interval")
-        .about("rEx.LPV.UpdateInterval: frames between the engine's full updates (0 = every frame); exported only, the viewport does not draw the LPV")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::updateInterval);
+        .about("rEx.LPV.UpdateInterval: frames without an update between two full updates (0 = every frame); the viewport counts its own frames, and updates only after a camera or settings change")
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::updateInterval);
     add(Row("lpv.cascades", T::Integer)).range(1, 4).label("Cascades")
         .about("rEx.LPV.NumCascades: nested 32^3 volumes, each smaller than the last by the cascade ratio")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascades);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascades);
     add(Row("lpv.cascade_ratio", T::Number)).above(1.0, 16.0).decimals(2).label("Cascade ratio")
         .about("rEx.LPV.CascadeRatio: size of a cascade / size of the next finer one (the least ratio when auto_cascade_min_size is on)")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeRatio);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeRatio);
     add(Row("lpv.auto_cascade_min_size", T::Number)).range(0.0, 1.0e6).unit("m").decimals(0).zeroMeans("off")
         .label("Auto min cascade")
         .about("rEx.LPV.AutoCascadeMinSize: > 0 raises the ratio to max(cascade_ratio, (size / this)^(1/(cascades - 1))), so the smallest cascade is at most this size; 0 = off")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::autoCascadeMinSize);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::autoCascadeMinSize);
     add(Row("lpv.cascade_forward_offset", T::Number)).range(0.0, 1.0).decimals(2).label("Forward offset")
-        .about("rEx.LPV.CascadeForwardOffset: each cascade's centre sits this share of its size ahead of the camera along the view direction (0 = centred on the camera, 0.5 = the camera on its back face)")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeForwardOffset);
+        .about("rEx.LPV.CascadeForwardOffset: each cascade's centre sits this share of its size ahead of the camera along the view direction (0 = centred on the camera, 0.5 = the camera on its back face); the viewport places them for a viewer at its orbit target")
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::cascadeForwardOffset);
     add(Row("lpv.local_lights", T::Boolean)).label("Local lights")
         .about("rEx.LPV.EnableLocalLights: inject the point and spot lights of `lights` (each into its best-fitting cascade); off: the sun only")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::localLights);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::localLights);
     add(Row("lpv.quality", T::Integer)).range(0, 2).label("LPV quality")
         .about("rEx.LPV.Quality: 0 linear SH diffuse; 1 adds ZH3 reconstruction and directional-derivative leak dampening; 2 adds cone-traced specular")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::quality);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::quality);
     add(Row("lpv.cone_trace_samples", T::Integer)).range(1, 64).label("Cone-trace samples")
         .about("rEx.LPV.ConeTraceSamples: samples along the reflected direction of quality 2's specular (4 short range, 6 balanced, 8 long)")
-        .redoes(kNothing)
+        .redoes(kUpload)
         .onlyWhen([](const SceneDescription& s, size_t) { return s.lpv.enabled && s.lpv.quality == 2; })
         .field(&SceneDescription::lpv, &LpvSettings::coneTraceSamples);
     add(Row("lpv.indirect_intensity", T::Number)).range(0.0, 100.0).decimals(2).label("Indirect intensity")
         .about("The post-process IndirectLightingIntensity: multiplies the LPV's light (not a console variable: in TERRALUX_lighting, and as a comment in lpv.ini)")
-        .redoes(kNothing).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::indirectIntensity);
+        .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::indirectIntensity);
     // Local lights: a list of objects, read by the LPV only (never by the diffuse bake).
     const auto spot = [](const SceneDescription& s, size_t i) { return s.lights.at(i).type == LocalLightType::Spot; };
     add(Row("lights[].type", T::Choice)).choices({"point", "spot"}).label("Light type")
         .about("point: the same intensity every way; spot: a cone along direction (KHR_lights_punctual's model)")
-        .redoes(kNothing).light(&LocalLight::type);
+        .redoes(kUpload).light(&LocalLight::type);
     add(Row("lights[].position", T::NumberList)).items(3, 3).range(-1.0e7, 1.0e7).unit("m").label("Position")
-        .about("Engine space (x east, y up, z south)").redoes(kNothing).light(&LocalLight::position);
+        .about("Engine space (x east, y up, z south)").redoes(kUpload).light(&LocalLight::position);
     add(Row("lights[].direction", T::NumberList)).items(3, 3).range(-1.0, 1.0).decimals(3).label("Direction")
         .about("Spot: where the cone points, engine space; normalised, must not be zero")
-        .redoes(kNothing).onlyWhen(spot)
+        .redoes(kUpload).onlyWhen(spot)
         .custom([](const SceneDescription& s, size_t i) { return fieldToJson(s.lights.at(i).direction, {}); },
                 [](SceneDescription& s, size_t i, const json& v) {
                     const glm::vec3 d = fieldFromJson<glm::vec3>(v, {});
@@ -822,19 +822,19 @@ std::vector<ParameterSpec> buildTable() {
                     s.lights.at(i).direction = d;
                 });
     add(Row("lights[].color", T::Color)).range(0.0, 1.0).label("Light colour")
-        .about("Linear RGB tint of the intensity").redoes(kNothing).light(&LocalLight::color);
+        .about("Linear RGB tint of the intensity").redoes(kUpload).light(&LocalLight::color);
     add(Row("lights[].intensity", T::Number)).range(0.0, 1.0e12).label("Intensity")
         .about("Irradiance on a surface facing the light 1 m away, in the sun's scene-linear units (E = intensity / d^2 inside the range); exported as candela, one scene-linear unit of illuminance to one lux")
-        .redoes(kNothing).light(&LocalLight::intensity);
+        .redoes(kUpload).light(&LocalLight::intensity);
     add(Row("lights[].range", T::Number)).above(0.0, 1.0e6).unit("m").label("Range")
         .about("Distance where the light ends: its falloff is windowed by clamp(1 - (d/range)^4, 0, 1) (KHR_lights_punctual)")
-        .redoes(kNothing).light(&LocalLight::range);
+        .redoes(kUpload).light(&LocalLight::range);
     add(Row("lights[].inner_cone_deg", T::Number)).range(0.0, 90.0).openAbove().unit("°").decimals(1).label("Inner cone")
         .about("Spot: angle from the axis inside which the light is at full intensity")
-        .redoes(kNothing).onlyWhen(spot).light(&LocalLight::innerConeDeg);
+        .redoes(kUpload).onlyWhen(spot).light(&LocalLight::innerConeDeg);
     add(Row("lights[].outer_cone_deg", T::Number)).above(0.0, 90.0).unit("°").decimals(1).label("Outer cone")
         .about("Spot: angle from the axis where the light has faded to nothing; above inner_cone_deg")
-        .redoes(kNothing).onlyWhen(spot)
+        .redoes(kUpload).onlyWhen(spot)
         .custom([](const SceneDescription& s, size_t i) { return json(s.lights.at(i).outerConeDeg); },
                 [](SceneDescription& s, size_t i, const json& v) {
                     // Read after inner_cone_deg (table order), so the pair is checked here.

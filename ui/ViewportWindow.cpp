@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include <QExposeEvent>
+#include <QMetaObject>
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QVulkanInstance>
@@ -13,6 +14,8 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "lpv/Lpv.h"
+
 namespace terralux {
 
 ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance) : ctx_(ctx) {
@@ -20,9 +23,13 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
     setVulkanInstance(instance);
 }
 
-ViewportWindow::~ViewportWindow() { swapchain_.reset(); }
+ViewportWindow::~ViewportWindow() {
+    stopLpv();
+    swapchain_.reset();
+}
 
 void ViewportWindow::setRenderer(ProjectRenderer* renderer) {
+    stopLpv();  // the worker reads the old renderer's terrain
     renderer_ = renderer;
     requestUpdate();
 }
@@ -76,8 +83,57 @@ void ViewportWindow::updateSize() {
     request_.height = uint32_t(std::max(1, int(height() * dpr)));
 }
 
+void ViewportWindow::stopLpv() {
+    ++lpvGeneration_;
+    if (lpvWorker_.joinable()) lpvWorker_.join();
+    lpvBusy_ = false;
+    lpvSchedule_.reset();
+}
+
+bool ViewportWindow::lpvCurrent() {
+    if (!renderer_) return true;
+    const std::optional<LpvJob> job = renderer_->lpvJob(request_, camera_);
+    return !job || job->key == renderer_->lpvKey();
+}
+
+void ViewportWindow::scheduleLpv() {
+    std::optional<LpvJob> job = renderer_->lpvJob(request_, camera_);
+    if (!job) return;
+    // Volumes started for this key that are not bound now were dropped (the LPV was off for a
+    // while): they are wanted again.
+    if (!lpvBusy_ && lpvSchedule_.startedFor(job->key) && renderer_->lpvKey() != job->key) lpvSchedule_.reset();
+    lpvSchedule_.setInterval(job->settings.updateInterval);
+    if (!lpvSchedule_.frame(job->key, lpvBusy_)) {
+        // A change waiting for its frame needs frames to come.
+        if (lpvSchedule_.pending() && !lpvBusy_) requestUpdate();
+        return;
+    }
+    if (lpvWorker_.joinable()) lpvWorker_.join();  // finished: its result has landed
+    lpvBusy_ = true;
+    const unsigned generation = lpvGeneration_;
+    lpvWorker_ = std::thread([this, job = std::move(*job), generation] {
+        const auto start = std::chrono::steady_clock::now();
+        std::shared_ptr<const lpv::Volumes> volumes;
+        try {
+            volumes = job.run();
+        } catch (const std::exception&) {
+            // Settings the volumes refuse draw none; the next change tries again.
+        }
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        QMetaObject::invokeMethod(this, [this, volumes, key = job.key, generation, ms] {
+            if (generation != lpvGeneration_) return;
+            lpvBusy_ = false;
+            if (!renderer_) return;
+            renderer_->setLpv(volumes, key);
+            emit lpvUpdated(ms);
+            requestUpdate();
+        }, Qt::QueuedConnection);
+    });
+}
+
 void ViewportWindow::renderNow() {
     if (!renderer_ || !isExposed()) return;
+    scheduleLpv();
     const auto start = std::chrono::steady_clock::now();
     updateSize();
     if (!swapchain_) {

@@ -5,12 +5,15 @@
 //   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom   left click: pick
 //   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
 
+#include <atomic>
 #include <memory>
 #include <optional>
+#include <thread>
 
 #include <QWindow>
 
 #include "RenderJob.h"
+#include "lpv/UpdateSchedule.h"
 #include "render/OrbitCamera.h"
 #include "vk/Swapchain.h"
 
@@ -41,6 +44,16 @@ public:
     RenderedImage grabImage();
     // Records and submits a frame now instead of at the next update.
     void renderNow();
+    // The light propagation volumes: each frame that draws them asks the schedule
+    // (lpv.update_interval in frames) whether to start an update for its camera and settings; the
+    // update runs on a worker and lands on this thread, and frames draw the last volumes bound.
+    const lpv::UpdateSchedule& lpvSchedule() const { return lpvSchedule_; }
+    bool lpvUpdating() const { return lpvBusy_; }
+    // Whether the bound volumes are those the current view and camera want (or none are wanted).
+    bool lpvCurrent();
+    ProjectRenderer* renderer() const { return renderer_; }
+    // Waits for the update under way and drops its result.
+    void stopLpv();
 
 signals:
     // Wall time the frame took on this thread: recording, submitting and any wait for a free
@@ -49,6 +62,8 @@ signals:
     void cameraChanged();
     // A left click that did not drag: `position` in the window's logical pixels.
     void clicked(QPointF position);
+    // An LPV update landed: the volumes took `milliseconds` on the worker.
+    void lpvUpdated(double milliseconds);
 
 protected:
     void exposeEvent(QExposeEvent*) override;
@@ -61,6 +76,7 @@ protected:
 
 private:
     void updateSize();
+    void scheduleLpv();
     void orbit(float dAzimuth, float dElevation);
     void pan(float dx, float dy);
     void zoom(float factor);
@@ -71,6 +87,10 @@ private:
     RenderRequest request_;
     QPointF lastMouse_, pressedAt_;
     bool dragged_ = false;
+    lpv::UpdateSchedule lpvSchedule_;
+    std::thread lpvWorker_;
+    bool lpvBusy_ = false;  // UI thread only: set when a worker starts, cleared when its result lands
+    unsigned lpvGeneration_ = 0;  // a result of an older generation (another renderer) is dropped
 };
 
 }  // namespace terralux

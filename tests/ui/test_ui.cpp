@@ -1428,6 +1428,39 @@ private slots:
         QCOMPARE(doc->project().scene.lighting.indirect, IndirectLighting::Probes);
     }
 
+    // lighting.indirect lpv in the window: the volumes are computed on a worker, a still camera
+    // computes nothing more, and a moving one at most every lpv.update_interval + 1 frames, the
+    // last position's volumes landing once it stops.
+    void viewportUpdatesTheLpvOnAWorkerAtItsInterval() {
+        ViewportWindow* v = w_->viewport();
+        ProjectDocument* doc = w_->document();
+        QString error;
+        QVERIFY(doc->setParameter("lpv.update_interval", 3, &error));
+        QVERIFY(doc->setParameter("lighting.indirect", "lpv", &error));
+        QSignalSpy landed(v, &ViewportWindow::lpvUpdated);
+        QVERIFY(!v->renderer()->renderer().hasLpvResources());
+        QVERIFY(doc->setParameter("lpv.enabled", true, &error));
+        v->renderNow();
+        QTRY_VERIFY_WITH_TIMEOUT(!landed.isEmpty(), 20000);
+        QVERIFY(v->renderer()->renderer().hasLpvResources());
+        QVERIFY(v->lpvCurrent());
+        const uint64_t updates = v->lpvSchedule().updates(), frames = v->lpvSchedule().frames();
+        for (int i = 0; i < 6; ++i) v->renderNow();
+        QCOMPARE(v->lpvSchedule().updates(), updates);
+        QCOMPARE(v->lpvSchedule().frames(), frames + 6);
+        // Each pan moves the finest cascade by several of its cells.
+        for (int i = 0; i < 12; ++i) {
+            QTest::keyClick(v, Qt::Key_D);
+            v->renderNow();
+        }
+        const uint64_t f = v->lpvSchedule().frames() - frames - 6, u = v->lpvSchedule().updates() - updates;
+        QVERIFY2(u >= 1 && u <= (f + 3) / 4, qPrintable(QString("%1 updates in %2 frames").arg(u).arg(f)));
+        QTRY_VERIFY_WITH_TIMEOUT(!v->lpvUpdating() && v->lpvCurrent(), 20000);
+        // Off: the volumes go.
+        QVERIFY(doc->setParameter("lpv.enabled", false, &error));
+        QVERIFY(!v->renderer()->renderer().hasLpvResources());
+    }
+
     void aThousandEditsThroughTheDocks() {
         auto rss = [] {
             std::ifstream in("/proc/self/status");

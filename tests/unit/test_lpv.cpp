@@ -14,6 +14,7 @@
 #include "bake/SphereSampling.h"
 #include "bake/SphericalHarmonics.h"
 #include "lpv/Lpv.h"
+#include "lpv/UpdateSchedule.h"
 
 using namespace terralux;
 using namespace terralux::lpv;
@@ -571,4 +572,54 @@ TEST(Lpv, SettingsAndLightsRoundTripThroughTheProject) {
     EXPECT_EQ(back.lights[1].type, LocalLightType::Spot);
     EXPECT_EQ(back.lights[1].position, spot.position);
     EXPECT_EQ(back.lighting.indirect, IndirectLighting::Both);
+}
+
+// lpv.update_interval in the viewport: N frames without an update between two updates, and only
+// for a change; a change waits for its frame, and none starts while one runs.
+TEST(LpvSchedule, UpdatesEveryIntervalPlusOneFramesWhileTheCameraMoves) {
+    for (int interval : {0, 1, 2, 5}) {
+        UpdateSchedule s(interval);
+        std::vector<int> started;
+        for (int f = 0; f < 24; ++f)
+            if (s.frame("camera " + std::to_string(f), false)) started.push_back(f);
+        ASSERT_FALSE(started.empty());
+        EXPECT_EQ(started.front(), 0) << interval;
+        for (size_t i = 1; i < started.size(); ++i) EXPECT_EQ(started[i] - started[i - 1], interval + 1) << interval;
+        EXPECT_EQ(s.updates(), started.size());
+        EXPECT_EQ(s.frames(), 24u);
+    }
+}
+
+TEST(LpvSchedule, AStillCameraUpdatesOnceAndAChangeWaitsForItsTurn) {
+    UpdateSchedule s(3);
+    EXPECT_TRUE(s.frame("a", false));
+    for (int f = 0; f < 10; ++f) EXPECT_FALSE(s.frame("a", false));
+    EXPECT_FALSE(s.pending());
+    // Ten frames have passed: a change starts at once.
+    EXPECT_TRUE(s.frame("b", false));
+    // The next change waits three frames, pending meanwhile.
+    EXPECT_FALSE(s.frame("c", false));
+    EXPECT_TRUE(s.pending());
+    EXPECT_FALSE(s.frame("c", false));
+    EXPECT_FALSE(s.frame("c", false));
+    EXPECT_TRUE(s.frame("c", false));
+    EXPECT_FALSE(s.pending());
+    // Going back to what the last update computed is no change.
+    EXPECT_FALSE(s.frame("c", false));
+    EXPECT_EQ(s.updates(), 3u);
+}
+
+TEST(LpvSchedule, NoUpdateStartsWhileOneRunsAndResetForgetsTheLast) {
+    UpdateSchedule s(0);
+    EXPECT_TRUE(s.frame("a", false));
+    EXPECT_FALSE(s.frame("b", true));
+    EXPECT_FALSE(s.frame("b", true));
+    EXPECT_TRUE(s.pending());
+    EXPECT_TRUE(s.frame("b", false));
+    EXPECT_TRUE(s.startedFor("b"));
+    s.reset();
+    EXPECT_FALSE(s.startedFor("b"));
+    EXPECT_TRUE(s.frame("b", false));
+    s.setInterval(-4);
+    EXPECT_EQ(s.interval(), 0);
 }
