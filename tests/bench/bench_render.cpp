@@ -6,6 +6,7 @@
 // the share of terrain pixels where the shadow map (view 31) and the traced sun visibility (view 29)
 // disagree by more than 0.5, beside the frame time of beauty with those shadows; and beauty with
 // shadows and fog each on and off.
+#include <chrono>
 #include <filesystem>
 #include <memory>
 
@@ -14,6 +15,7 @@
 #include "PreviewBake.h"
 #include "RenderJob.h"
 #include "TerrainLoading.h"
+#include "lpv/Lpv.h"
 #include "render/DebugViews.h"
 
 using namespace terralux;
@@ -281,6 +283,65 @@ void BM_ReflectionProbes(benchmark::State& state) {
     f.renderer->setReflectionProbes(nullptr);
 }
 BENCHMARK(BM_ReflectionProbes)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
+// The LPV over N42E001 at 1280 x 720, the camera 4 km from the tile's centre so that the default
+// cascades (5312 m and finer) fill most of the frame: beauty lit by the probes (the LPV off), by
+// the LPV at quality 0, 1 and 2 (lighting.indirect lpv), and by the probes with four point lights
+// in view (their direct light). Beside each LPV frame, its update: the volumes computed on the
+// CPU for the camera (what the viewport's worker does) and their upload.
+void BM_Lpv(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    const int mode = int(state.range(0));
+    Project p = fixtureProject();
+    p.scene.camera.radius = 4000.0;
+    if (mode >= 1 && mode <= 3) {
+        p.scene.lpv.enabled = true;
+        p.scene.lighting.indirect = IndirectLighting::Lpv;
+        p.scene.lpv.quality = mode - 1;
+    }
+    if (mode == 4) {
+        const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, f.renderer->heightfield());
+        const Heightfield& hf = f.renderer->heightfield();
+        for (int i = 0; i < 4; ++i) {
+            LocalLight light;
+            const float x = camera.target.x + 500.0f * float(i - 2), z = camera.target.z;
+            light.position = glm::vec3(x, hf.surfaceHeight(x, z) + 100.0f, z);
+            light.range = 600.0;
+            light.intensity = 3.0e4;
+            p.scene.lights.push_back(light);
+        }
+    }
+    f.renderer->setProject(p);
+    RenderRequest q;
+    q.width = 1280;
+    q.height = 720;
+    double updateMs = 0, uploadMs = 0;
+    if (const auto job = f.renderer->lpvJob(q, f.renderer->defaultCamera())) {  // the project's camera
+        using Clock = std::chrono::steady_clock;
+        const auto t0 = Clock::now();
+        auto volumes = job->run();
+        const auto t1 = Clock::now();
+        f.renderer->setLpv(std::move(volumes), job->key);
+        const auto t2 = Clock::now();
+        updateMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
+        uploadMs = std::chrono::duration<double, std::milli>(t2 - t1).count();
+    }
+    f.renderer->render(q);  // this variant's pipeline
+    double ms = 0;
+    for (auto _ : state) ms += f.renderer->render(q).milliseconds;
+    static const char* labels[] = {"probes, LPV off", "LPV quality 0", "LPV quality 1", "LPV quality 2",
+                                   "probes and 4 point lights"};
+    state.SetLabel(std::string(labels[mode]) + " on " + f.ctx->deviceName());
+    state.counters["frame_ms"] = ms / double(state.iterations());
+    state.counters["update_ms"] = updateMs;
+    state.counters["upload_ms"] = uploadMs;
+    f.renderer->setProject(fixtureProject());
+}
+BENCHMARK(BM_Lpv)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
 }  // namespace
 
