@@ -286,8 +286,8 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
 
 constexpr const char* kLpvIniName = "lpv.ini";
 
-// The light propagation volumes for the project's camera (what the viewport starts with): the
-// cascades and where each local light went; a light left out is a warning.
+// The light propagation volumes for the project's camera, placed as the viewport places them (what
+// it starts with): the cascades and where each local light went; a light left out is a warning.
 nlohmann::json lpvReport(const SceneDescription& scene, const Heightfield& hf, const BakeLighting& lighting,
                          std::vector<std::string>& warnings) {
     const auto start = std::chrono::steady_clock::now();
