@@ -91,8 +91,6 @@ void ProjectRenderer::setProject(const Project& project) {
     const IndirectLighting indirect = scene.lighting.indirect;
     base_.lpvLight = scene.lpv.enabled && (indirect == IndirectLighting::Lpv || indirect == IndirectLighting::Both);
     base_.lights = scene.lights;
-    // Volumes the scene's lighting no longer draws hold no memory (a debug view computes its own).
-    if (!base_.lpvLight) setLpv(nullptr, "");
     // Water: the level and the highest crest decide the field and the mesh (built again only when
     // they change); everything else is uniforms.
     const WaterSettings& ws = scene.water;
@@ -292,13 +290,18 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
 RenderedImage ProjectRenderer::render(const RenderRequest& r) { return render(r, base_.camera); }
 
 RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera& camera) {
-    if (const std::optional<LpvJob> job = lpvJob(r, camera); job && job->key != lpvKey_) setLpv(job->run(), job->key);
+    if (!drawsLpv(r)) setLpv(nullptr, "");
+    else if (const std::optional<LpvJob> job = lpvJob(r, camera); job && job->key != lpvKey_) setLpv(job->run(), job->key);
     return renderer_->render(settingsOf(r, camera));
 }
 
-std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const OrbitCamera& camera) {
+bool ProjectRenderer::drawsLpv(const RenderRequest& r) const {
     const std::optional<DebugView> view = findDebugView(r.debugView);
-    if (!view || !((base_.lpvLight && view->needs.sceneLights) || view->needs.lpvVolumes)) return std::nullopt;
+    return view && ((base_.lpvLight && view->needs.sceneLights) || view->needs.lpvVolumes);
+}
+
+std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const OrbitCamera& camera) {
+    if (!drawsLpv(r)) return std::nullopt;
     const SceneDescription& scene = project_.scene;
     const bool skirt = scene.terrain.skirt;
     if (!tracer_ || tracer_->options().skirt != skirt) {
@@ -335,6 +338,7 @@ void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const 
 }
 
 bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera, vk::Swapchain& swapchain) {
+    if (!drawsLpv(r)) setLpv(nullptr, "");  // volumes no frame draws hold no memory
     return renderer_->present(settingsOf(r, camera), swapchain);
 }
 

@@ -100,6 +100,8 @@ public:
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
+    // Whether a frame of `request` draws the LPV; a frame that does not frees bound volumes.
+    bool drawsLpv(const RenderRequest& request) const;
     // The LPV update a frame of `request` from `camera` wants; nullopt when it draws no LPV.
     std::optional<LpvJob> lpvJob(const RenderRequest& request, const OrbitCamera& camera);
     // Binds volumes computed by a job (null: none) and remembers the job's key.

@@ -1656,6 +1656,11 @@ TEST_F(RenderTest, IndirectNoneEqualsTheImageWithoutIndirectLight) {
         const RenderedImage none = draw(r, kViewLinear, true, true);
         EXPECT_EQ(none.rgba, unlit.rgba) << "lpv.enabled " << lpvOn;
         EXPECT_FALSE(r.renderer().hasLpvResources());
+        // An LPV view computes volumes; the next frame that draws none frees them.
+        draw(r, kViewLpvAll);
+        EXPECT_TRUE(r.renderer().hasLpvResources());
+        EXPECT_EQ(draw(r, kViewLinear, true, true).rgba, unlit.rgba);
+        EXPECT_FALSE(r.renderer().hasLpvResources());
     }
 }
 
@@ -1751,21 +1756,22 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
         draw(r, kViewLpvAll);
         const auto volumes = r.renderer().lpv();
         ASSERT_TRUE(volumes);
-        // Ground points on a grid over the footprint (inside and outside the cascades), and a few
-        // above it, each with the terrain's normal and a view from the south-west above.
+        // Ground points on a grid over the footprint (inside and outside the cascades), some
+        // above it, each with the terrain's normal, every third facing the ground instead (there
+        // the geometry volume occludes), and a view from the south-west above.
         std::vector<std::array<glm::vec3, 3>> queries;
         for (int k = 0; k < 24; ++k)
             for (int i = 0; i < 24; ++i) {
                 const float x = hf.minX() + (float(i) + 0.5f) / 24.0f * (hf.maxX() - hf.minX());
                 const float z = hf.minZ() + (float(k) + 0.5f) / 24.0f * (hf.maxZ() - hf.minZ());
                 const float lift = (i + k) % 5 == 0 ? 40.0f : 0.0f;
-                const glm::vec3 n = hf.surfaceNormal(x, z);
+                const glm::vec3 n = hf.surfaceNormal(x, z) * ((i + 2 * k) % 3 == 0 ? -1.0f : 1.0f);
                 queries.push_back({glm::vec3(x, hf.surfaceHeight(x, z) + lift, z), n,
                                    glm::normalize(glm::vec3(-0.5f, 0.6f, 0.6f))});
             }
         const std::vector<lpv::Sample> gpu = r.renderer().sampleLpv(queries);
         ASSERT_EQ(gpu.size(), queries.size());
-        double largest = 0, largestSpec = 0, worst = 0, worstSpec = 0, worstAo = 0;
+        double largest = 0, largestSpec = 0, worst = 0, worstSpec = 0, worstAo = 0, leastAo = 1;
         size_t lit = 0;
         std::vector<lpv::Sample> cpu;
         for (const auto& q : queries) cpu.push_back(volumes->evaluate(q[0], q[1], q[2]));
@@ -1773,6 +1779,7 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
             largest = std::max(largest, double(glm::length(cpu[i].irradiance)));
             largestSpec = std::max(largestSpec, double(glm::length(cpu[i].specular)));
             lit += glm::length(cpu[i].irradiance) > 0.0f;
+            leastAo = std::min(leastAo, double(cpu[i].ao));
         }
         for (size_t i = 0; i < cpu.size(); ++i) {
             worst = std::max(worst, double(glm::length(gpu[i].irradiance - cpu[i].irradiance)) / largest);
@@ -1781,8 +1788,9 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
         }
         std::cout << "quality " << quality << ": " << lit << " of " << cpu.size() << " points lit, largest irradiance "
                   << largest << "; worst |GPU - CPU| / largest: irradiance " << worst << ", specular " << worstSpec
-                  << "; AO " << worstAo << "\n";
+                  << "; AO " << worstAo << " (least AO " << leastAo << ")\n";
         EXPECT_GT(lit, cpu.size() / 4);
+        EXPECT_LT(leastAo, 0.5);
         EXPECT_LT(worst, 1e-4) << quality;
         EXPECT_LT(worstAo, 1e-4) << quality;
         if (quality == 2) {

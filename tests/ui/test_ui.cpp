@@ -1456,8 +1456,9 @@ private slots:
         const uint64_t f = v->lpvSchedule().frames() - frames - 6, u = v->lpvSchedule().updates() - updates;
         QVERIFY2(u >= 1 && u <= (f + 3) / 4, qPrintable(QString("%1 updates in %2 frames").arg(u).arg(f)));
         QTRY_VERIFY_WITH_TIMEOUT(!v->lpvUpdating() && v->lpvCurrent(), 20000);
-        // Off: the volumes go.
+        // Off: the next frame frees the volumes.
         QVERIFY(doc->setParameter("lpv.enabled", false, &error));
+        v->renderNow();
         QVERIFY(!v->renderer()->renderer().hasLpvResources());
     }
 
