@@ -207,7 +207,8 @@ struct TerrainRenderer::Gpu {
     vk::PipelineLayout lpvSampleLayout;
     vk::UniquePipeline lpvSample;
     // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
-    // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant.
+    // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant |
+    // kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV shaders and layout).
     std::map<int, vk::UniquePipeline> terrain;
     vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, probePass;
     FrameGraph graph;
