@@ -218,6 +218,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
         frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
     });
+    connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {
+        statusBar()->showMessage(QString("light propagation volumes updated in %1 ms").arg(ms, 0, 'f', 0), 3000);
+    });
     // The practical cascade splits the Shadows dock shows and writes depend on the view's shape.
     auto updateAspect = [this] {
         if (viewport_->width() > 0 && viewport_->height() > 0)
