@@ -1,6 +1,6 @@
 #pragma once
 // Light propagation volumes on the CPU (docs/lighting.md, "Light propagation volumes"): the
-// engine-independent core the viewport's compute passes will mirror. After Kaplanyan &
+// engine-independent core; the renderer's shaders/lpv.glsl mirrors evaluate(). After Kaplanyan &
 // Dachsbacher, "Cascaded Light Propagation Volumes for Real-Time Indirect Illumination" (I3D 2010):
 //
 //   1. cascades: 1-4 volumes of 32^3 cells ahead of the camera, each snapped to its own cells;
@@ -15,7 +15,8 @@
 //   5. apply: irradiance at a point and normal (linear L1, or ZH3 with leak dampening), cone-traced
 //      specular at quality 2, and the geometry volume's ambient occlusion.
 //
-// Memory layout, as a later upload wants it (one 3-D image per array, x fastest):
+// Memory layout, as the renderer uploads it (a storage buffer per array, cascades one after
+// another; as 3-D images it would be one per array), x fastest:
 //   light volume    3 x RGBA32F 32^3 per cascade: float[channel][cell][4], channel R, G, B,
 //                   cell = x + 32·(y + 32·z), the 4 values the L1 SH coefficients k = 0..3 of the
 //                   cell's intensity I(ω) in W/sr (SphericalHarmonics.h's order: 1, y, z, x)
