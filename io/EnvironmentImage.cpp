@@ -15,9 +15,12 @@ namespace terralux {
 namespace {
 
 // An OpenEXR header is a list of attributes (name, type, 32-bit size, value; the OpenEXR file
-// layout, "Header Attributes"). OpenEXR 3.1 allocates and fills whatever size an attribute claims
-// before it reads the value, so a 1 KB file claiming a 500 MB string takes seconds and the
-// memory: refuse a size past the end of the file before handing the file over.
+// layout, "Header Attributes"). OpenEXR 3.1 allocates whatever an attribute's value claims before
+// it reads it (a string or an unknown type: its size; a preview: width x height x 4; a string
+// vector: each string's length), so a 1 KB file can make it allocate and fill gigabytes. Walk the
+// header as OpenEXR's Header::readFrom does (names and types read up to 255 bytes; fixed-size
+// types and channel lists read by their own layout, whatever size they declare) and refuse any
+// claim past the end of the file before handing the file over.
 void checkExrHeader(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     unsigned char magic[8] = {};
@@ -30,23 +33,59 @@ void checkExrHeader(const std::string& path) {
     auto readName = [&](std::string& out) {
         out.clear();
         char c;
-        while (in.get(c) && c != '\0') {
-            if (out.size() >= 255) return false;
-            out.push_back(c);
-        }
+        while (out.size() < 255 && in.get(c) && c != '\0') out.push_back(c);
         return bool(in);
     };
-    std::string name, type;
+    auto readU32 = [&](uint32_t& v) {
+        unsigned char b[4];
+        if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+        v = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+        return true;
+    };
+    auto remaining = [&] {
+        const std::streamoff at = in.tellg();
+        return at < 0 ? uint64_t(0) : fileBytes - std::min(uint64_t(at), fileBytes);
+    };
+    auto refuse = [&](const std::string& name, uint64_t bytes) {
+        throw ImageError(path + ": EXR header attribute '" + name + "' claims " + std::to_string(bytes) +
+                         " bytes, past the end of the file (" + std::to_string(fileBytes) + " bytes)");
+    };
+    // Bytes OpenEXR reads for a fixed-size type, whatever the attribute's size field says.
+    static const std::pair<const char*, int> kFixed[] = {
+        {"box2i", 16}, {"box2f", 16}, {"compression", 1}, {"chromaticities", 32},
+        {"deepImageState", 1}, {"double", 8}, {"envmap", 1}, {"float", 4}, {"int", 4},
+        {"keycode", 28}, {"lineOrder", 1}, {"m33d", 72}, {"m33f", 36}, {"m44d", 128},
+        {"m44f", 64}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2d", 16},
+        {"v2f", 8}, {"v2i", 8}, {"v3d", 24}, {"v3f", 12}, {"v3i", 12}};
+    std::string name, type, channel;
     while (readName(name) && !name.empty()) {
-        unsigned char size[4];
-        if (!readName(type) || !in.read(reinterpret_cast<char*>(size), 4)) return;
-        const uint32_t bytes = uint32_t(size[0]) | uint32_t(size[1]) << 8 | uint32_t(size[2]) << 16 |
-                               uint32_t(size[3]) << 24;
-        const uint64_t at = uint64_t(in.tellg());
-        if (uint64_t(bytes) > fileBytes - std::min(at, fileBytes))
-            throw ImageError(path + ": EXR header attribute '" + name + "' claims " + std::to_string(bytes) +
-                             " bytes, past the end of the file (" + std::to_string(fileBytes) + " bytes)");
-        in.seekg(std::streamoff(bytes), std::ios::cur);
+        uint32_t size = 0;
+        if (!readName(type) || !readU32(size) || int32_t(size) < 0) return;
+        if (const auto* f = std::find_if(std::begin(kFixed), std::end(kFixed),
+                                         [&](const auto& t) { return type == t.first; });
+            f != std::end(kFixed)) {
+            in.seekg(f->second, std::ios::cur);
+        } else if (type == "chlist") {
+            // Channels until an empty name: each a name and 16 bytes of layout.
+            while (readName(channel) && !channel.empty()) in.seekg(16, std::ios::cur);
+        } else if (type == "preview") {
+            uint32_t w = 0, h = 0;
+            if (!readU32(w) || !readU32(h)) return;
+            if (uint64_t(w) * h * 4 > remaining()) refuse(name, uint64_t(w) * h * 4);
+            in.seekg(std::streamoff(uint64_t(w) * h * 4), std::ios::cur);
+        } else if (type == "stringvector") {
+            if (uint64_t(size) > remaining()) refuse(name, size);
+            const std::streamoff end = in.tellg() + std::streamoff(size);
+            for (uint32_t len = 0; in.tellg() < end && readU32(len);) {
+                if (uint64_t(len) > remaining()) refuse(name, len);
+                in.seekg(std::streamoff(len), std::ios::cur);
+            }
+        } else {
+            // string, floatvector, bytes, idmanifest and unknown (opaque) types: `size` bytes.
+            if (uint64_t(size) > remaining()) refuse(name, size);
+            in.seekg(std::streamoff(size), std::ios::cur);
+        }
+        if (!in) return;
     }
 }
 

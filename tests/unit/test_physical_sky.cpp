@@ -215,3 +215,40 @@ TEST(EnvironmentImage, ExrAttributePastTheEndIsRefused) {
         EXPECT_EQ(std::string(e.what()).find("past the end"), std::string::npos) << e.what();
     }
 }
+
+// Found by fuzz_env_image too: a channel list whose declared size is not where OpenEXR stops
+// reading it (OpenEXR reads channels up to an empty name) hid the next attribute's claim from a
+// walk that skipped by declared sizes. The walk reads each type as OpenEXR does: channel lists
+// by their entries, a preview by its width x height x 4.
+TEST(EnvironmentImage, ExrClaimsAfterAChannelListAndInAPreviewAreRefused) {
+    auto u32 = [](uint32_t v) {
+        std::string b;
+        for (int shift = 0; shift < 32; shift += 8) b.push_back(char((v >> shift) & 0xFF));
+        return b;
+    };
+    const std::string head("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+    // One channel "R" (16 bytes of layout) and the list's end, declared as 2 bytes.
+    const std::string chlist = std::string("channels") + '\0' + "chlist" + '\0' + u32(2) + "R" + '\0' +
+                               std::string(16, '\0') + '\0';
+    const auto dir = std::filesystem::temp_directory_path();
+    auto refusal = [&](const std::string& name, const std::string& bytes) {
+        const auto p = dir / name;
+        std::ofstream(p, std::ios::binary) << bytes;
+        try {
+            checkEquirectImage(p.string());
+        } catch (const ImageError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string afterList = refusal(
+        "terralux_exr_after_chlist.exr",
+        head + chlist + "Software" + '\0' + "string" + '\0' + u32(0x6863008au) + "abc" + '\0');
+    EXPECT_NE(afterList.find("attribute 'Software' claims 1751318666 bytes, past the end"), std::string::npos)
+        << afterList;
+    const std::string preview = refusal(
+        "terralux_exr_preview.exr",
+        head + "preview" + '\0' + "preview" + '\0' + u32(8) + u32(60000) + u32(60000) + '\0');
+    EXPECT_NE(preview.find("attribute 'preview' claims 14400000000 bytes, past the end"), std::string::npos)
+        << preview;
+}
