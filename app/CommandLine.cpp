@@ -21,6 +21,7 @@
 #include "BakeJob.h"
 #include "ImageFile.h"
 #include "RenderJob.h"
+#include "Study.h"
 #include "render/DebugViews.h"
 #include "DemImport.h"
 #include "EnvironmentImage.h"
@@ -51,6 +52,12 @@ Commands:
                                 output folder (baking first when there is none or it is stale)
                                 into --out IMAGE (.png display-encoded, .exr scene-linear), on
                                 the Vulkan device.
+  --study [PROJECT]             Sweep the settings that trade bake time for accuracy (quality,
+                                rays, bounces, probe spacing or adaptive tolerance, error-map
+                                resolution, AO directions, LPV quality and cascades), measure
+                                each against the exact answer on the same points, and write
+                                study.json, study.csv, study.png and study.html into --out DIR
+                                (default: "study" beside the project or in the current folder).
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
@@ -64,7 +71,10 @@ Commands:
 Options:
   --dem FILE                    Use FILE as the terrain instead of the project's (or the sample).
   --out DIR | IMAGE             --bake: the output folder (default: export.out_dir, "bake" beside
-                                the project or in the current folder); --render: the image.
+                                the project or in the current folder); --study: its folder;
+                                --render: the image.
+  --budget SECONDS              --study: the time it may take (default 120); settings that
+                                would not fit are skipped and listed with their estimate.
   --quality PRESET              draft | standard | high | reference (bake.quality).
   --compare-reference           Also run the brute-force reference and report the error of
                                 every probe against it (slow).
@@ -151,12 +161,14 @@ struct Args {
     QCommandLineOption dryRun{"dry-run", "Estimate the bake only."};
     QCommandLineOption overlay{"overlay", "Overlays.", "LIST"};
     QCommandLineOption time{"time", "Seconds.", "T"};
+    QCommandLineOption study{"study", "Study."};
+    QCommandLineOption budget{"budget", "Seconds.", "SECONDS"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time});
+                           device, dryRun, overlay, time, study, budget});
     }
 };
 
@@ -567,7 +579,53 @@ int commandPrintProject(const Args& a) {
 
 }  // namespace
 
-int runCommandLine(int argc, char** argv) {
+int commandStudy(const Args& a, const StudyPlotWriter& writePlot) {
+    const QStringList positional = a.parser.positionalArguments();
+    if (positional.size() > 1) throw UsageError("--study takes one PROJECT");
+    StudyOptions options;
+    if (a.parser.isSet(a.budget)) {
+        bool ok = false;
+        options.budgetSeconds = a.parser.value(a.budget).toDouble(&ok);
+        if (!ok || !(options.budgetSeconds >= kMinStudyBudget && options.budgetSeconds <= kMaxStudyBudget))
+            throw UsageError("--budget " + str(a.parser.value(a.budget)) + ": must be a number of seconds in [" +
+                             fixed(kMinStudyBudget, 0) + ", " + fixed(kMaxStudyBudget, 0) + "]");
+    }
+    options.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
+    std::vector<std::string> sets, warnings;
+    for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
+    const Project project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
+                                                 a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "", &warnings);
+    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
+    std::filesystem::path outDir;
+    if (a.parser.isSet(a.out)) {
+        const std::string dir = str(a.parser.value(a.out));
+        if (dir.empty()) throw UsageError("--out: must name a folder");
+        outDir = std::filesystem::absolute(dir).lexically_normal();
+    } else {
+        outDir = project.resolve("study");
+    }
+    std::error_code ec;
+    if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec))
+        throw UsageError("--out " + outDir.string() + ": exists and is not a folder");
+
+    std::signal(SIGINT, onInterrupt);
+    std::signal(SIGTERM, onInterrupt);
+    ProgressPrinter printer(a.parser.isSet(a.quiet));
+    StudyResult result;
+    try {
+        result = runStudy(project, options, std::ref(printer), &gInterrupted);
+    } catch (const BakeCancelled&) {
+        std::cerr << "\nterralux: interrupted; nothing written\n";
+        return kExitInterrupted;
+    }
+    const auto files = writeStudy(result, outDir, writePlot);
+    std::cout << studySummary(result);
+    std::cout << "wrote " << outDir.string() << ":\n";
+    for (const auto& f : files) std::cout << "  " << f.filename().string() << "\n";
+    return kExitOk;
+}
+
+int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot) {
     Args a;
     QStringList arguments;
     for (int i = 0; i < argc; ++i) arguments << QString::fromLocal8Bit(argv[i]);
@@ -583,9 +641,10 @@ int runCommandLine(int argc, char** argv) {
         }
         const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
                              int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render)) +
-                             int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference));
+                             int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference)) +
+                             int(a.parser.isSet(a.study));
         if (commands > 1)
-            throw UsageError("choose one command: --bake, --render, --info, --print-project, "
+            throw UsageError("choose one command: --bake, --study, --render, --info, --print-project, "
                              "--print-schema or --print-reference");
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
@@ -604,7 +663,10 @@ int runCommandLine(int argc, char** argv) {
             throw UsageError("--no-rebake: only with --render");
         if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))
             throw UsageError("--quality: only with --bake (elsewhere: --set bake.quality=PRESET)");
+        if (a.parser.isSet(a.budget) && !a.parser.isSet(a.study))
+            throw UsageError("--budget: only with --study");
         if (a.parser.isSet(a.info)) return commandInfo(a);
+        if (a.parser.isSet(a.study)) return commandStudy(a, writeStudyPlot);
         if (a.parser.isSet(a.bake)) return commandBake(a);
         if (a.parser.isSet(a.render)) return commandRender(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);

@@ -1,6 +1,8 @@
 #pragma once
 // `terralux` on the command line: argument handling, the commands and their exit codes.
 
+#include "Study.h"
+
 namespace terralux {
 
 enum ExitCode : int {
@@ -10,6 +12,8 @@ enum ExitCode : int {
     kExitInterrupted = 130,
 };
 
-int runCommandLine(int argc, char** argv);
+// `writeStudyPlot` draws study.png for --study (the chart lives with the widgets, above this layer);
+// without it the study writes its JSON, CSV and HTML only.
+int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot = {});
 
 }  // namespace terralux

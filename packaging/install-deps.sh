@@ -13,6 +13,8 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config git
   # libraries fixed by the product card
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev
+  # the study's error-against-time plot (study.png, the Trade-off panel)
+  qt6-charts-dev
   libvulkan-dev glslang-tools glslang-dev spirv-tools
   libglm-dev libgdal-dev gdal-bin libopenimageio-dev openimageio-tools
   libtinygltf-dev nlohmann-json3-dev libtbb-dev

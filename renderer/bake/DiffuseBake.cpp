@@ -182,6 +182,33 @@ float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const 
     return float(visible) / float(samples);
 }
 
+float tracedSkyVisibility(const HeightfieldTracer& tracer, const glm::vec3& p, const glm::vec3& n,
+                          uint32_t rays, uint64_t seed) {
+    const glm::vec3 o = liftOff(p, n);
+    const float offset = hashToUnit(splitmix64(seed));
+    uint32_t open = 0;
+    for (uint32_t i = 0; i < rays; ++i)
+        open += !tracer.occluded(o, cosineHemisphere(i, rays, offset, n), INFINITY);
+    return rays ? float(open) / float(rays) : 0.0f;
+}
+
+glm::vec3 sunFirstBounce(const BakeLighting& lighting, const glm::vec3& p, const glm::vec3& n, uint32_t rays,
+                         uint64_t seed) {
+    const glm::vec3 o = liftOff(p, n);
+    Rng rng(seed);
+    const float offset = rng.next();
+    glm::vec3 sum(0.0f);
+    for (uint32_t i = 0; i < rays; ++i) {
+        RayHit hit;
+        if (!lighting.tracer->intersect(o, cosineHemisphere(i, rays, offset, n), INFINITY, hit)) continue;
+        const float cosine = glm::dot(hit.normal, lighting.sun.direction);
+        if (cosine <= 0.0f) continue;
+        const float v = sunVisibility(*lighting.tracer, lighting.sun, hit.position, hit.normal, 4, rng);
+        sum += lighting.albedoAt(hit) * lighting.sun.illuminance * (cosine * v);
+    }
+    return rays ? sum / float(rays) : sum;
+}
+
 float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 const char* qualityName(QualityPreset preset) {

@@ -187,6 +187,17 @@ glm::vec3 probeRayRadiance(const BakeLighting& lighting, const IrradianceCache* 
 // The bake's sun term is this × cos θ × E_sun; the sun-visibility debug view draws it.
 float sunVisibility(const HeightfieldTracer& tracer, const SunLight& sun, const glm::vec3& p,
                     const glm::vec3& n, int samples, Rng& rng);
+// Cosine-weighted sky visibility at surface point p (normal n): the share of `rays` stratified
+// cosine-weighted rays that escape the traced surface. What horizon AO approximates (the AO
+// benchmark and the study measure it against this).
+float tracedSkyVisibility(const HeightfieldTracer& tracer, const glm::vec3& p, const glm::vec3& n,
+                          uint32_t rays, uint64_t seed);
+// The sun's light reflected once by the terrain onto surface point p (normal n), the sky black:
+// the cosine-weighted estimator of ∫ (ρE/π)·cos dω over `rays` rays, at each terrain hit
+// albedo × E_sun·cos θ·V with V from 4 shadow rays over the sun's disc. What a light propagation
+// volume carries, so the LPV's exact counterpart.
+glm::vec3 sunFirstBounce(const BakeLighting& lighting, const glm::vec3& p, const glm::vec3& n, uint32_t rays,
+                         uint64_t seed);
 // The per-probe term of that metric: relative RMS of irradiance luminance over the 256 fixed
 // normals of `value` against `reference` (0 when the reference is black).
 float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference);

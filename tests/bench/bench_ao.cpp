@@ -22,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include "DemImport.h"
+#include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/SphereSampling.h"
 #include "terrain/HorizonAO.h"
@@ -36,17 +37,6 @@ constexpr double kMargin = 2000.0;  // metres between the points and the border
 
 double seconds(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-float tracedVisibility(const HeightfieldTracer& tracer, const glm::vec3& p, const glm::vec3& n, uint32_t rays,
-                       uint32_t seed) {
-    const float m = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    const glm::vec3 origin = p + n * (1e-5f * m + 1e-3f);
-    const float offset = hashToUnit(splitmix64(seed));
-    uint32_t open = 0;
-    for (uint32_t i = 0; i < rays; ++i)
-        open += !tracer.occluded(origin, cosineHemisphere(i, rays, offset, n), std::numeric_limits<float>::infinity());
-    return float(open) / float(rays);
 }
 
 struct Sample {
@@ -98,10 +88,10 @@ int main() {
     std::vector<float> refPoints(kPoints), refVertices(kPoints);
     tbb::parallel_for(0, kPoints, [&](int i) {
         const Sample& p = points[size_t(i)];
-        refPoints[size_t(i)] = tracedVisibility(tracer, {p.x, hf.surfaceHeight(p.x, p.z), p.z},
+        refPoints[size_t(i)] = tracedSkyVisibility(tracer, {p.x, hf.surfaceHeight(p.x, p.z), p.z},
                                                 hf.surfaceNormal(p.x, p.z), kRays, uint32_t(i));
         const Sample& v = vertices[size_t(i)];
-        refVertices[size_t(i)] = tracedVisibility(tracer, hf.vertex(v.col, v.row), hf.vertexNormal(v.col, v.row),
+        refVertices[size_t(i)] = tracedSkyVisibility(tracer, hf.vertex(v.col, v.row), hf.vertexNormal(v.col, v.row),
                                                   kRays, uint32_t(i + kPoints));
     });
     const double refSeconds = seconds(t0);
@@ -111,7 +101,7 @@ int main() {
     std::vector<float> fine(kNoisePoints);
     tbb::parallel_for(0, kNoisePoints, [&](int i) {
         const Sample& p = points[size_t(i)];
-        fine[size_t(i)] = tracedVisibility(tracer, {p.x, hf.surfaceHeight(p.x, p.z), p.z},
+        fine[size_t(i)] = tracedSkyVisibility(tracer, {p.x, hf.surfaceHeight(p.x, p.z), p.z},
                                            hf.surfaceNormal(p.x, p.z), 4 * kRays, uint32_t(i) + 77777u);
     });
     for (int i = 0; i < kNoisePoints; ++i) refNoise += std::fabs(fine[size_t(i)] - refPoints[size_t(i)]);

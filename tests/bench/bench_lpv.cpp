@@ -57,24 +57,6 @@ struct Terrain {
     double meanReference = 0, referenceSeconds = 0;
 };
 
-// The sun's one-bounce irradiance at p (normal n), the sky black.
-glm::vec3 oneBounce(const BakeLighting& L, const glm::vec3& p, const glm::vec3& n, uint64_t seed) {
-    const float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-    const glm::vec3 origin = p + n * (1e-5f * m + 1e-2f);
-    Rng rng(seed);
-    const float offset = rng.next();
-    glm::vec3 sum(0.0f);
-    for (uint32_t i = 0; i < kReferenceRays; ++i) {
-        RayHit hit;
-        if (!L.tracer->intersect(origin, cosineHemisphere(i, kReferenceRays, offset, n), 1e30f, hit)) continue;
-        const float cosine = glm::dot(hit.normal, L.sun.direction);
-        if (cosine <= 0.0f) continue;
-        const float v = sunVisibility(*L.tracer, L.sun, hit.position, hit.normal, 4, rng);
-        sum += L.albedoAt(hit) * L.sun.illuminance * (cosine * v);
-    }
-    return sum / float(kReferenceRays);
-}
-
 std::unique_ptr<Terrain> load(int which) {
     auto t = std::make_unique<Terrain>();
     if (which == 0) {
@@ -109,7 +91,7 @@ std::unique_ptr<Terrain> load(int which) {
     const auto start = std::chrono::steady_clock::now();
     t->reference.resize(kPoints);
     tbb::parallel_for(0, kPoints, [&](int i) {
-        t->reference[size_t(i)] = luminance(oneBounce(t->lighting, t->p[size_t(i)], t->n[size_t(i)], uint64_t(i) * 7919u + 17u));
+        t->reference[size_t(i)] = luminance(sunFirstBounce(t->lighting, t->p[size_t(i)], t->n[size_t(i)], kReferenceRays, uint64_t(i) * 7919u + 17u));
     });
     t->referenceSeconds = secondsSince(start);
     for (float r : t->reference) t->meanReference += r;
