@@ -644,7 +644,7 @@ int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot)
                              int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference)) +
                              int(a.parser.isSet(a.study));
         if (commands > 1)
-            throw UsageError("choose one command: --bake, --study, --render, --info, --print-project, "
+            throw UsageError("choose one command: --bake, --render, --study, --info, --print-project, "
                              "--print-schema or --print-reference");
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
