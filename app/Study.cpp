@@ -138,8 +138,17 @@ struct Study {
     std::vector<glm::vec3> points;      // study points above the ground
     std::vector<sh::ShRgb> reference;   // path-traced at each point
 
-    // Seconds per unit of work, per kind, from what ran (the largest seen, to stay inside).
+    // Seconds per unit of work, per kind, from the largest piece of work of that kind measured so
+    // far: small settings are dominated by fixed costs (placement, threads starting) that would
+    // make every larger setting look dearer than it is. Settings run cheapest first, so the rate
+    // follows the sizes about to be estimated.
     std::map<std::string, double> rate;
+    std::map<std::string, double> rateWork;
+    void learn(const std::string& kind, double work, double seconds) {
+        if (work <= 0.0 || (rateWork.count(kind) && work < rateWork[kind])) return;
+        rateWork[kind] = work;
+        rate[kind] = seconds / work;
+    }
 
     Study(const Project& p, const StudyOptions& o, const StudyProgress& pr, const std::atomic<bool>* c)
         : project(p), options(o), progress(pr), cancel(c) {}
@@ -322,6 +331,24 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
         }
     }
 
+    // Spacing and sampling together: the densest placements with a cheaper and a dearer preset,
+    // so the front can show where fewer rays on more probes beat more rays on fewer. The
+    // candidates are the costliest, so they run last, with what the budget has left.
+    {
+        std::vector<Candidate> placements;
+        for (const Candidate& c : out)
+            if (c.knob == "spacing" || c.knob == "tolerance") placements.push_back(c);
+        const size_t keep = std::min<size_t>(placements.size(), 4);
+        for (size_t k = placements.size() - keep; k < placements.size(); ++k)
+            for (QualityPreset p : {QualityPreset::Draft, QualityPreset::High})
+                if (p != s.bake.quality || s.bake.rays || s.bake.bounces) {
+                    std::vector<std::string> sets = placements[k].sets;
+                    sets.insert(sets.end(), {std::string("bake.quality=") + qualityName(p), "bake.rays=null",
+                                             "bake.bounces=null"});
+                    add("placement_quality", placements[k].label + ", " + qualityName(p), sets);
+                }
+    }
+
     const int res = s.bake.errorMapResolution;
     for (int r : {8, 16, 32, 64, 128})
         if (r < denseMapResolution) add("error_map", "error map " + std::to_string(r), {"bake.error_map_resolution=" + std::to_string(r)},
@@ -450,7 +477,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     p.points = covered.size();
     const Spread sp = spreadOfErrors(std::move(covered));
     p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
-    rate["rays"] = std::max(rate.count("rays") ? rate["rays"] : 0.0, p.seconds / double(std::max<uint64_t>(traced, 1)));
+    learn("rays", double(traced), p.seconds);
     if (c.knob == "current") {
         baked->layout = std::move(layout);
         baked->sh = std::move(bake.sh);
@@ -533,7 +560,7 @@ StudyPoint Study::measureAo(const Candidate& c) {
     p.points = err.size();
     const Spread sp = spreadOfErrors(std::move(err));
     p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
-    rate["ao"] = std::max(rate.count("ao") ? rate["ao"] : 0.0, p.seconds / c.work);
+    learn("ao", c.work, p.seconds);
     return p;
 }
 
@@ -581,7 +608,7 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     p.points = err.size();
     const Spread sp = spreadOfErrors(std::move(err));
     p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
-    rate["lpv"] = std::max(rate.count("lpv") ? rate["lpv"] : 0.0, p.seconds / c.work);
+    learn("lpv", c.work, p.seconds);
     return p;
 }
 

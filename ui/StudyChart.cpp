@@ -34,6 +34,7 @@ QString seriesName(const std::string& knob, StudyMetric m) {
     static const std::map<std::string, QString> names = {
         {"quality", "quality preset"}, {"rays", "rays"}, {"bounces", "bounces"},
         {"spacing", "probe spacing"}, {"tolerance", "adaptive tolerance"},
+        {"placement_quality", "dense placements at draft / high"},
         {"error_map", "error-map resolution (its p95's error)"},
         {"ao_directions", "AO directions (AO error)"},
         {"lpv_quality", "LPV quality (LPV error)"}, {"lpv_cascades", "LPV cascades (LPV error)"}};
@@ -102,8 +103,24 @@ StudyChart makeStudyChart(const StudyResult& r) {
         for (size_t i = 0; i < r.points.size(); ++i)
             if (r.points[i].knob == knob) idx.push_back(i);
         const StudyMetric metric = r.points[idx.front()].metric;
-        if (metric == StudyMetric::Irradiance && current) idx.push_back(size_t(current - r.points.data()));
+        // Combinations of two knobs are not a line through the current point: drawn as points.
+        const bool combined = knob == "placement_quality";
+        if (metric == StudyMetric::Irradiance && current && !combined) idx.push_back(size_t(current - r.points.data()));
         std::sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return r.points[a].seconds < r.points[b].seconds; });
+        if (combined) {
+            auto* s = new QScatterSeries();
+            s->setName(seriesName(knob, metric));
+            s->setMarkerSize(9.0);
+            for (size_t i : idx) {
+                s->append(at(r.points[i]));
+                extend(at(r.points[i]));
+            }
+            attach(s);
+            s->setColor(kPalette[out.series.size() % std::size(kPalette)]);
+            s->setBorderColor(Qt::transparent);
+            out.series.emplace_back(s, idx);
+            continue;
+        }
         auto* s = new QLineSeries();
         s->setName(seriesName(knob, metric));
         s->setPointsVisible(true);
