@@ -91,7 +91,7 @@ TradeoffPanel::TradeoffPanel(ProjectDocument* doc, QWidget* parent) : QWidget(pa
     view_ = new QChartView;
     view_->setObjectName("tradeoff.chart");
     view_->setRenderHint(QPainter::Antialiasing);
-    view_->setMinimumHeight(320);
+    view_->setMinimumHeight(420);
     view_->setToolTip("Click a point to select its setting; double-click to apply it");
     v->addWidget(view_, 3);
 
@@ -277,7 +277,10 @@ void TradeoffPanel::showResult() {
         setting->setToolTip(sets.isEmpty() ? "the project's settings" : "--set " + sets.join(" --set "));
         table_->setItem(i, kSetting, setting);
         table_->setItem(i, kTime, cell(QString("%1 s").arg(p.seconds, 0, 'f', 2), true));
-        table_->setItem(i, kMemory, cell(locale.formattedDataSize(qint64(p.peakMemoryBytes)), true));
+        // Below the page granularity of the resident-memory mark a setting reads 0: no measurable growth.
+        auto* memory = cell(p.peakMemoryBytes ? locale.formattedDataSize(qint64(p.peakMemoryBytes)) : "—", true);
+        memory->setToolTip("Resident memory above what was resident when the setting began");
+        table_->setItem(i, kMemory, memory);
         table_->setItem(i, kOutput, cell(p.outputBytes ? locale.formattedDataSize(qint64(p.outputBytes)) : "—", true));
         const QString meaning = studyMetricMeaning(p.metric);
         for (auto [c, value] : {std::pair{kMean, p.errorMean}, {kP95, p.errorP95}, {kMax, p.errorMax}}) {
@@ -344,9 +347,13 @@ void TradeoffPanel::updateMarks() {
                 if (int(indices[i]) == index && int(i) < s->count()) return s->at(int(i));
         return std::nullopt;
     };
+    // The chart's star marks the settings the study measured from; the square, another point
+    // the project has been set to since.
+    const bool moved = result_ && projectPoint_ >= 0 && !result_->points[size_t(projectPoint_)].current;
     if (projectMark_) {
         projectMark_->clear();
-        if (auto p = place(projectPoint_)) projectMark_->append(*p);
+        if (auto p = place(projectPoint_); p && moved) projectMark_->append(*p);
+        for (QLegendMarker* m : chart_.chart->legend()->markers(projectMark_)) m->setVisible(moved);
     }
     if (selectedMark_) {
         selectedMark_->clear();

@@ -1754,6 +1754,19 @@ private slots:
         QVERIFY(w_->findChild<LpvPanel*>()->grab().save(QString::fromStdString((kOut / "lpv_panel.png").string())));
         const QPixmap lpvShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(lpvShot.save(QString::fromStdString((kOut / "lpv_dock.png").string())));
+        // The Trade-off dock after a short study, a rays point selected.
+        w_->findChild<QDockWidget*>("dock.tradeoff")->raise();
+        auto* tradeoff = w_->findChild<TradeoffPanel*>();
+        w_->findChild<QSpinBox*>("tradeoff.budget")->setValue(5);
+        w_->findChild<QPushButton*>("tradeoff.run")->click();
+        QTRY_VERIFY_WITH_TIMEOUT(!tradeoff->running(), 120000);
+        QVERIFY(tradeoff->result().has_value());
+        for (size_t i = 0; i < tradeoff->result()->points.size(); ++i)
+            if (tradeoff->result()->points[i].knob == "rays") tradeoff->selectPoint(int(i));
+        QTest::qWait(300);
+        QVERIFY(tradeoff->grab().save(QString::fromStdString((kOut / "tradeoff_panel.png").string())));
+        const QPixmap tradeoffShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(tradeoffShot.save(QString::fromStdString((kOut / "tradeoff_dock.png").string())));
     }
 };
 
