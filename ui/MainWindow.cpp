@@ -49,6 +49,7 @@
 #include "PreviewBake.h"
 #include "LpvPanel.h"
 #include "ReflectionPanel.h"
+#include "TradeoffPanel.h"
 #include "ShProbeFile.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
@@ -513,6 +514,11 @@ void MainWindow::buildDocks() {
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
     auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
 
+    // Trade-off: the speed/accuracy study of the bake's knobs, its points applied as edits.
+    auto* tradeoff = new TradeoffPanel(doc_);
+    connectRejected(tradeoff);
+    auto* tradeoffDock = dock("Trade-off", "dock.tradeoff", tradeoff);
+
     for (auto* f : {sky, sf, atmosphere, bf}) f->refresh();
     // The lighting docks share the upper tab group with the terrain.
     tabifyDockWidget(terrainDock, skyDock);
@@ -524,6 +530,7 @@ void MainWindow::buildDocks() {
     tabifyDockWidget(waterDock, lpvDock);
     tabifyDockWidget(volumesDock, reflectionDock);
     tabifyDockWidget(reflectionDock, bakeDock);
+    tabifyDockWidget(bakeDock, tradeoffDock);
     // Whole tab labels, scrolled when the docks are narrow, rather than "Terr…" and "Wa…".
     for (auto* bar : findChildren<QTabBar*>()) {
         bar->setElideMode(Qt::ElideNone);

@@ -1,5 +1,7 @@
 #include "ProjectDocument.h"
 
+#include <algorithm>
+
 #include <QFileInfo>
 #include <QUndoCommand>
 
@@ -47,6 +49,20 @@ private:
     std::string path_;
     nlohmann::json before_, after_;
     std::shared_ptr<DemImportResult> terrainBefore_, terrainAfter_;
+};
+
+// Several parameters in one step (setParameters): applied together, undone together.
+class SetParametersCommand : public QUndoCommand {
+public:
+    using Values = std::vector<std::pair<std::string, nlohmann::json>>;
+    SetParametersCommand(ProjectDocument* doc, const QString& text, Values before, Values after)
+        : QUndoCommand(text), doc_(doc), before_(std::move(before)), after_(std::move(after)) {}
+    void undo() override { doc_->apply(before_); }
+    void redo() override { doc_->apply(after_); }
+
+private:
+    ProjectDocument* doc_;
+    Values before_, after_;
 };
 
 // Edits the parameter table marks as re-importing the DEM (or a whole section holding one).
@@ -167,6 +183,63 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
     }
 }
 
+bool ProjectDocument::setParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values,
+                                    QString* error) {
+    try {
+        nlohmann::json next = json_;
+        std::vector<std::string> edited;
+        for (const auto& [path, value] : values) {
+            applyOverride(next, path + "=" + value.dump());
+            const std::string e = fitSplits(path, next) ? std::string("shadows") : path;
+            if (touchesTerrain(e))
+                throw ProjectError(e + ": a terrain edit re-imports the DEM and is made on its own");
+            if (std::find(edited.begin(), edited.end(), e) == edited.end()) edited.push_back(e);
+        }
+        Project candidate = project_;
+        candidate.scene = sceneFromJson(next, "project", nullptr);
+        SetParametersCommand::Values before, after;
+        QStringList names;
+        for (const std::string& e : edited) {
+            if (at(json_, e) == at(next, e)) continue;
+            before.emplace_back(e, at(json_, e));
+            after.emplace_back(e, at(next, e));
+            names << QString::fromStdString(e);
+        }
+        if (after.empty()) return true;
+        // Undo restores in reverse, so a section and a path inside it land as they were.
+        std::reverse(before.begin(), before.end());
+        undo_.push(new SetParametersCommand(this, "Set " + names.join(", "), std::move(before), std::move(after)));
+        return true;
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+std::pair<std::string, nlohmann::json> ProjectDocument::assignmentValue(const nlohmann::json& base,
+                                                                         const std::string& assignment) {
+    nlohmann::json next = base;
+    applyOverride(next, assignment);  // throws on a malformed assignment, so '=' is there
+    const std::string path = assignment.substr(0, assignment.find('='));
+    return {path, at(next, path)};
+}
+
+bool ProjectDocument::setAssignments(const std::vector<std::string>& assignments, QString* error) {
+    std::vector<std::pair<std::string, nlohmann::json>> values;
+    try {
+        // Each against the values before it, as `--set` applies them in order.
+        nlohmann::json next = json_;
+        for (const std::string& a : assignments) {
+            values.push_back(assignmentValue(next, a));
+            applyOverride(next, a);
+        }
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+    return setParameters(values, error);
+}
+
 ProjectDocument::~ProjectDocument() {
     if (loader_.joinable()) loader_.join();
 }
@@ -221,6 +294,12 @@ void ProjectDocument::apply(const std::string& path, const nlohmann::json& value
         emit terrainChanged();
     }
     emit parametersChanged(QString::fromStdString(path));
+}
+
+void ProjectDocument::apply(const std::vector<std::pair<std::string, nlohmann::json>>& values) {
+    for (const auto& [path, value] : values) applyOverride(json_, path + "=" + value.dump());
+    project_.scene = sceneFromJson(json_, "project", nullptr);
+    for (const auto& v : values) emit parametersChanged(QString::fromStdString(v.first));
 }
 
 void ProjectDocument::setCameraQuietly(const nlohmann::json& camera) {

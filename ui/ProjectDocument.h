@@ -6,6 +6,8 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <QObject>
 #include <QString>
@@ -42,6 +44,15 @@ public:
     // (fitManualSplits, filled from the practical splits of the current view): one edit of the
     // whole shadows section.
     bool setParameter(const std::string& path, const nlohmann::json& value, QString* error);
+    // Several values as one undoable edit, all validated together first: a rejected value (or
+    // one that would re-import the terrain, which setParameter does on its own) changes nothing.
+    bool setParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values, QString* error);
+    // `--set` assignments ("bake.rays=128", "probe_volumes[0].grid_dims=16,16") as one edit.
+    bool setAssignments(const std::vector<std::string>& assignments, QString* error);
+    // The path and JSON value an assignment gives, parsed as `--set` parses it against `base`.
+    // Throws ProjectError on a bad assignment.
+    static std::pair<std::string, nlohmann::json> assignmentValue(const nlohmann::json& base,
+                                                                   const std::string& assignment);
     bool terrainLoading() const { return loadGeneration_ != landedGeneration_; }
     // Blocks (processing events) until no terrain import is running; for tests and shutdown.
     void waitForTerrain();
@@ -74,6 +85,8 @@ public:
     // for it, for terrain edits).
     void apply(const std::string& path, const nlohmann::json& value,
                std::shared_ptr<DemImportResult> terrain = nullptr);
+    // Applies validated values together (an intermediate state may break a rule the whole keeps).
+    void apply(const std::vector<std::pair<std::string, nlohmann::json>>& values);
 
 signals:
     void parametersChanged(const QString& path);  // "" = everything

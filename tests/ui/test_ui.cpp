@@ -14,6 +14,7 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QDockWidget>
+#include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFormLayout>
 #include <QStatusBar>
@@ -33,6 +34,7 @@
 #include <QTimer>
 #include <QUndoStack>
 #include <QtTest>
+#include <QtCharts/QXYSeries>
 
 #include "CascadeSplitChart.h"
 #include "ImageCompare.h"
@@ -40,6 +42,7 @@
 #include "LpvPanel.h"
 #include "MainWindow.h"
 #include "ReflectionPanel.h"
+#include "TradeoffPanel.h"
 #include "bake/ReflectionBake.h"
 #include "ParameterPanels.h"
 #include "ParameterTable.h"
@@ -1532,6 +1535,158 @@ private slots:
         QCOMPARE(sceneToJson(w_->document()->project().scene), start);
     }
 
+    void tradeoffStudyAppliesAPointAsOneUndoableEdit() {
+        auto* panel = w_->findChild<TradeoffPanel*>();
+        QVERIFY(panel);
+        QVERIFY(w_->findChild<QDockWidget*>("dock.tradeoff"));
+        auto* budget = w_->findChild<QSpinBox*>("tradeoff.budget");
+        auto* run = w_->findChild<QPushButton*>("tradeoff.run");
+        auto* table = w_->findChild<QTableWidget*>("tradeoff.table");
+        auto* apply = w_->findChild<QPushButton*>("tradeoff.apply");
+        auto* status = w_->findChild<QLabel*>("tradeoff.status");
+        QVERIFY(budget && run && table && apply && status && w_->findChild<QWidget*>("tradeoff.chart"));
+        QCOMPARE(budget->value(), 60);
+        QCOMPARE(budget->minimum(), 5);
+        QCOMPARE(budget->maximum(), 3600);
+        budget->setValue(5);
+        run->click();
+        QVERIFY(panel->running());
+        QVERIFY(!run->isEnabled());
+        QTRY_VERIFY_WITH_TIMEOUT(!panel->running(), 120000);
+        QVERIFY2(panel->result().has_value(), qPrintable(status->text()));
+        const StudyResult& r = *panel->result();
+        QVERIFY(!r.points.empty());
+        QCOMPARE(table->rowCount(), int(r.points.size()));
+        QVERIFY(!panel->chart().series.empty());
+        QVERIFY(status->text().contains(QString("%1 settings in").arg(r.points.size())));
+        QVERIFY(run->isEnabled());
+
+        // The project's own settings are the study's current point.
+        int current = -1, target = -1;
+        for (size_t i = 0; i < r.points.size(); ++i) {
+            const StudyPoint& p = r.points[i];
+            if (p.current) current = int(i);
+            // The rays or probe spacing knobs: a number or a grid the project can be read back for.
+            if (!p.current && target < 0 && (p.knob == "rays" || p.knob == "spacing"))
+                for (const std::string& set : p.sets)
+                    if (set.rfind("bake.rays=", 0) == 0 || set.rfind("probe_volumes[0].grid_dims=", 0) == 0) target = int(i);
+        }
+        QVERIFY(current >= 0);
+        QVERIFY2(target >= 0, "no rays or spacing point in a 5 s study");
+        QCOMPARE(panel->projectPoint(), current);
+        const StudyPoint& point = r.points[size_t(target)];
+
+        // A click on the plot near the point selects it, in the table too.
+        bool clicked = false;
+        for (const auto& [series, indices] : panel->chart().series)
+            for (size_t i = 0; i < indices.size() && !clicked; ++i)
+                if (int(indices[i]) == target) {
+                    emit series->clicked(series->at(int(i)) * 1.01);
+                    clicked = true;
+                }
+        QVERIFY(clicked);
+        QCOMPARE(panel->selectedPoint(), target);
+        QCOMPARE(table->selectionModel()->selectedRows().size(), 1);
+        QCOMPARE(table->selectionModel()->selectedRows().front().row(), target);
+        QVERIFY(apply->isEnabled());
+
+        // The values each assignment gives, and the ones they replace.
+        ProjectDocument* doc = w_->document();
+        std::vector<std::pair<std::string, nlohmann::json>> before, after;
+        for (const std::string& set : point.sets) {
+            const std::string path = set.substr(0, set.find('='));
+            after.emplace_back(path, ProjectDocument::assignmentValue(doc->json(), set).second);
+            before.emplace_back(path, doc->value(path));
+        }
+        QVERIFY(before != after);
+        bool typedChecks = false;
+        const int undoDepth = doc->undoStack()->index();
+        const auto raysBefore = doc->project().scene.bake.rays;
+        const auto dimsBefore = doc->project().scene.probeVolumes[0].gridDims;
+        apply->click();
+        QCOMPARE(doc->undoStack()->index(), undoDepth + 1);  // one edit
+        for (const auto& [path, value] : after) QCOMPARE(doc->value(path).dump(), value.dump());
+        // The typed project has them, read back independently of the JSON.
+        for (const std::string& set : point.sets) {
+            const std::string text = set.substr(set.find('=') + 1);
+            if (set.rfind("bake.rays=", 0) == 0) {
+                QVERIFY(doc->project().scene.bake.rays.has_value());
+                QCOMPARE(*doc->project().scene.bake.rays, std::stoi(text));
+                typedChecks = true;
+            } else if (set.rfind("probe_volumes[0].grid_dims=", 0) == 0) {
+                const auto& dims = doc->project().scene.probeVolumes[0].gridDims;
+                const QStringList parts = QString::fromStdString(text).split(',');
+                QCOMPARE(parts.first().toInt(), dims[0]);
+                QCOMPARE(parts.last().toInt(), dims[2]);  // nx,nz or nx,ny,nz
+                typedChecks = true;
+            }
+        }
+        QVERIFY(typedChecks);
+        QCOMPARE(panel->projectPoint(), target);
+        QVERIFY(!apply->isEnabled());  // it is the project's now
+        QVERIFY2(status->text().contains("measured before the edit") &&
+                     status->text().contains(QString::fromStdString(point.label)),
+                 qPrintable(status->text()));
+        QVERIFY(table->item(target, table->columnCount() - 1)->text().contains("now"));
+
+        // Undo restores every value in one step.
+        doc->undoStack()->undo();
+        QCOMPARE(doc->undoStack()->index(), undoDepth);
+        for (const auto& [path, value] : before) QCOMPARE(doc->value(path).dump(), value.dump());
+        QCOMPARE(doc->project().scene.bake.rays, raysBefore);
+        QCOMPARE(doc->project().scene.probeVolumes[0].gridDims, dimsBefore);
+        QCOMPARE(panel->projectPoint(), current);
+        QVERIFY(!status->text().contains("measured before the edit"));
+
+        // Double-clicking the row applies it too.
+        emit table->cellDoubleClicked(target, 0);
+        QCOMPARE(doc->undoStack()->index(), undoDepth + 1);
+        for (const auto& [path, value] : after) QCOMPARE(doc->value(path).dump(), value.dump());
+        doc->undoStack()->undo();
+    }
+
+    void tradeoffStudyCancelsAndKeepsTheLastResult() {
+        auto* panel = w_->findChild<TradeoffPanel*>();
+        QVERIFY(panel);
+        auto* budget = w_->findChild<QSpinBox*>("tradeoff.budget");
+        auto* run = w_->findChild<QPushButton*>("tradeoff.run");
+        auto* cancel = w_->findChild<QPushButton*>("tradeoff.cancel");
+        auto* progress = w_->findChild<QProgressBar*>("tradeoff.progress");
+        auto* status = w_->findChild<QLabel*>("tradeoff.status");
+        QVERIFY(!cancel->isEnabled());
+        budget->setValue(3600);
+        run->click();
+        QVERIFY(panel->running());
+        QVERIFY(cancel->isEnabled());
+        QTest::qWait(1500);
+        QVERIFY(panel->running());
+        QElapsedTimer timer;
+        timer.start();
+        cancel->click();
+        QTRY_VERIFY_WITH_TIMEOUT(!panel->running(), 10000);
+        QVERIFY2(timer.elapsed() < 5000, qPrintable(QString("cancel took %1 ms").arg(timer.elapsed())));
+        QVERIFY(run->isEnabled());
+        QVERIFY(!cancel->isEnabled());
+        QCOMPARE(progress->value(), 0);
+        QVERIFY(!panel->result().has_value());
+        QVERIFY2(status->text().contains("Cancelled"), qPrintable(status->text()));
+        // A finished study stays shown through a cancelled one.
+        budget->setValue(5);
+        run->click();
+        QTRY_VERIFY_WITH_TIMEOUT(!panel->running(), 120000);
+        QVERIFY(panel->result().has_value());
+        const size_t points = panel->result()->points.size();
+        budget->setValue(3600);
+        run->click();
+        QTest::qWait(500);
+        cancel->click();
+        QTRY_VERIFY_WITH_TIMEOUT(!panel->running(), 10000);
+        QVERIFY(panel->result().has_value());
+        QCOMPARE(panel->result()->points.size(), points);
+        QCOMPARE(w_->findChild<QTableWidget*>("tradeoff.table")->rowCount(), int(points));
+        QVERIFY2(status->text().contains("last study is still shown"), qPrintable(status->text()));
+    }
+
     void screenshot() {
         w_->viewport()->renderNow();
         QTest::qWait(500);
@@ -1599,6 +1754,19 @@ private slots:
         QVERIFY(w_->findChild<LpvPanel*>()->grab().save(QString::fromStdString((kOut / "lpv_panel.png").string())));
         const QPixmap lpvShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(lpvShot.save(QString::fromStdString((kOut / "lpv_dock.png").string())));
+        // The Trade-off dock after a short study, a rays point selected.
+        w_->findChild<QDockWidget*>("dock.tradeoff")->raise();
+        auto* tradeoff = w_->findChild<TradeoffPanel*>();
+        w_->findChild<QSpinBox*>("tradeoff.budget")->setValue(5);
+        w_->findChild<QPushButton*>("tradeoff.run")->click();
+        QTRY_VERIFY_WITH_TIMEOUT(!tradeoff->running(), 120000);
+        QVERIFY(tradeoff->result().has_value());
+        for (size_t i = 0; i < tradeoff->result()->points.size(); ++i)
+            if (tradeoff->result()->points[i].knob == "rays") tradeoff->selectPoint(int(i));
+        QTest::qWait(300);
+        QVERIFY(tradeoff->grab().save(QString::fromStdString((kOut / "tradeoff_panel.png").string())));
+        const QPixmap tradeoffShot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
+        QVERIFY(tradeoffShot.save(QString::fromStdString((kOut / "tradeoff_dock.png").string())));
     }
 };
 
