@@ -36,7 +36,11 @@ expect(s["elapsed_s"] <= 24, "elapsed_s over the budget + 20 %")
 expect(s["reference"]["points"] >= 36 and s["reference"]["rays_per_point"] >= 1024, "reference too small")
 expect(pts and pts[0]["knob"] == "current" and pts[0]["current"], "the project's settings are not the first point")
 knobs = {p["knob"] for p in pts}
+# Every knob is measured, or skipped or left out with its reason (a slow machine, a sanitizer build).
+accounted = knobs | {k["knob"] for k in s["skipped"]} | {n.split(":")[0] for n in s["not_studied"]}
 for k in ("quality", "rays", "bounces", "spacing", "error_map", "ao_directions"):
+    expect(k in accounted, "knob %s neither studied nor said to be left out" % k)
+for k in ("rays", "spacing"):
     expect(k in knobs, "knob %s not studied" % k)
 for p in pts:
     for key in ("time_s", "peak_memory_bytes", "output_bytes", "probes", "error", "set", "metric", "points"):
