@@ -665,6 +665,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].adaptive.max_bytes", T::Integer)).range(1, double(1ll << 53)).unit("bytes")
         .autoMeans("no limit").label("Adaptive: max bytes").about(".shprobe size budget of the error-driven refinement")
         .redoes(kReplace | kRebake).noUiRow().adaptive(&AdaptiveVolumeSettings::maxBytes);
+    add(Row("probe_volumes[].target_error", T::Number)).above(0.0, 1.0).openAbove().decimals(3)
+        .autoMeans("none: grid_dims or adaptive.tolerance stand").label("Target error")
+        .about("Relative interpolation error to meet at the error map's 95th percentile: chooses grid_dims (terrain) or adaptive.tolerance (adaptive), replacing them; box volumes refuse it")
+        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::targetError);
     add(Row("probe_volumes[].adaptive.max_move_share", T::Number)).range(0.0, 0.5).unit("of a cell")
         .label("Adaptive: max move")
         .about("A minimum leaf whose centre is inside the terrain moves its probe up at most this share of its edge")
@@ -853,6 +857,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("preset: the quality preset decides").label("Bounces")
         .about("Light bounces off the terrain; 0 = sky visibility only").redoes(kNothing)
         .field(&SceneDescription::bake, &BakeSettings::bounces);
+    add(Row("bake.target_error", T::Number)).above(0.0, 1.0).openAbove().decimals(3)
+        .autoMeans("none: rays and bounces (or the preset) stand").label("Target bake error")
+        .about("Relative error to aim at: rays from the probes' Monte Carlo standard error, bounces until the next one changes irradiance by less; replaces rays and bounces")
+        .redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::targetError);
     add(Row("bake.sh_encoding", T::Choice)).choices({"radiance", "irradiance"}).label("SH encoding")
         .about("radiance: SH projection of what the probe sees; irradiance: pre-convolved with the cosine lobe")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::encoding);
