@@ -79,6 +79,21 @@ PlacementSearch searchTerrainGrid(const Heightfield& hf, double target, int maxP
     return s;
 }
 
+void confirmTerrainGrid(const Heightfield& hf, double target, int maxProbes, PlacementSearch& s,
+                        const GridTrialFn& fine) {
+    const int top = maxPerSide(hf, maxProbes);
+    int n = std::max(s.chosen.dims[0], s.chosen.dims[2]);
+    PlacementTrial t = fine(terrainDimsFor(hf, n));
+    s.trials.push_back(t);
+    while (t.p95 > target && n < top) {
+        t = fine(terrainDimsFor(hf, ++n));
+        s.trials.push_back(t);
+    }
+    s.chosen = t;
+    s.met = t.p95 <= target;
+    s.capped = !s.met;
+}
+
 PlacementSearch searchAdaptiveTolerance(double target, const ToleranceTrialFn& trial) {
     PlacementSearch s;
     constexpr int kFinest = -12, kCoarsest = 4;

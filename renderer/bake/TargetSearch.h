@@ -52,6 +52,12 @@ using GridTrialFn = std::function<PlacementTrial(const std::array<int, 3>& dims)
 PlacementSearch searchTerrainGrid(const Heightfield& hf, double target, int maxProbes, int startPerSide,
                                   const GridTrialFn& trial);
 
+// Confirms a search's choice on a finer map (`fine`: the bake's own resolution): while the chosen
+// grid misses there, one more probe a side, up to `maxProbes`. The confirmed trial replaces the
+// choice and joins the trials.
+void confirmTerrainGrid(const Heightfield& hf, double target, int maxProbes, PlacementSearch& search,
+                        const GridTrialFn& fine);
+
 using ToleranceTrialFn = std::function<PlacementTrial(double tolerance)>;
 // The largest adaptive tolerance on the ladder target·2^(k/2), k in [-12, 4], whose trial meets
 // `target`, bisecting on k from k = 0.
