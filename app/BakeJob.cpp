@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 #include <cmath>
+#include <iomanip>
 #include <thread>
 
 #include <glm/vector_relational.hpp>
@@ -30,6 +31,7 @@
 #include "bake/ProbePlacement.h"
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
+#include "bake/TargetSearch.h"
 #include "lpv/Lpv.h"
 #include "render/OrbitCamera.h"
 
@@ -188,6 +190,169 @@ void requireProbes(const SceneDescription& scene, const ProbeVolumeSettings& v, 
 ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed,
                       const BakeControl& control) {
     return seededBaker(b.lighting, cache, b.q.bounces, rays, seed, control, b.referenceMode);
+}
+
+int raysOf(const BakeSetup& b, const ProbeVolumeSettings& v);
+
+// Probes in groups of three digits: "3 914".
+std::string grouped(uint64_t n) {
+    std::string d = std::to_string(n), out;
+    for (size_t i = 0; i < d.size(); ++i) {
+        if (i && (d.size() - i) % 3 == 0) out += ' ';
+        out += d[i];
+    }
+    return out;
+}
+
+std::string percent(double x) {
+    std::ostringstream o;
+    o.setf(std::ios::fixed);
+    o.precision(1);
+    o << 100.0 * x << " %";
+    return o.str();
+}
+
+// Map points a side for the search's trials: coarse, since a trial only has to rank layouts.
+int searchMapResolution(const BakeSettings& b) {
+    constexpr int kSearchMap = 32;
+    return b.errorMapResolution > 0 ? std::min(b.errorMapResolution, kSearchMap) : kSearchMap;
+}
+
+// The trials' baker: seeded like the bake's, windowed like its probes, so a trial's map measures
+// the probes the bake writes.
+ProbeBaker trialBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed, bool dering) {
+    const ProbeBaker keyed = seededBaker(b.lighting, cache, b.q.bounces, rays, seed, BakeControl{}, b.referenceMode);
+    return [keyed, dering](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+        ProbeBake t = keyed(p, k);
+        if (dering)
+            for (auto& s : t.sh) sh::deringIrradiance(s);
+        return t;
+    };
+}
+
+// The small irradiance cache the search bakes with (the bake's own is sized by its probes, which
+// the search decides).
+std::unique_ptr<IrradianceCache> searchCache(const BakeSetup& b) {
+    if (b.referenceMode || b.q.bounces <= 0) return nullptr;
+    constexpr int kSearchCacheResolution = 32;
+    return std::make_unique<IrradianceCache>(b.lighting, kSearchCacheResolution, b.q.cacheRays, b.q.sunSamples,
+                                             b.q.bounces - 1, BakeControl{});
+}
+
+constexpr int kOfferMaxProbes = kMaxBoxGridProbes;
+
+// Chooses grid_dims or adaptive.tolerance for every enabled volume with a target_error, in place
+// in `scene` (whose volumes `setup` points at). The project's terrain, lighting and tracer are
+// the setup's; nothing is loaded again.
+std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup& setup,
+                                             const std::function<void(const std::string&)>& phase) {
+    std::map<size_t, TargetChoice> out;
+    const Heightfield& hf = setup.terrain.heightfield;
+    std::unique_ptr<IrradianceCache> cache;
+    for (size_t vi = 0; vi < setup.volumes.size(); ++vi) {
+        const size_t index = size_t(setup.volumes[vi] - scene.probeVolumes.data());
+        ProbeVolumeSettings& v = scene.probeVolumes[index];
+        if (!v.targetError) continue;
+        const std::string at = "probe_volumes[" + std::to_string(index) + "]";
+        if (v.placement == ProbePlacement::Box)
+            throw ProjectError(at + ".target_error = " + nlohmann::json(*v.targetError).dump() +
+                               ": applies to terrain and adaptive placements; a box volume takes " + at +
+                               ".grid_dims (or set " + at + ".placement=adaptive)");
+        phase("choosing placement '" + v.name + "'");
+        const auto start = Clock::now();
+        if (!cache) cache = searchCache(setup);
+        TargetChoice c;
+        c.target = *v.targetError;
+        c.mapResolution = searchMapResolution(scene.bake);
+        const uint64_t seed = volumeSeed(vi);
+        const ProbeBaker baker = trialBaker(setup, cache.get(), raysOf(setup, v), seed, scene.bake.deringing);
+        PlacementSearch search;
+        std::ostringstream value;
+        if (v.placement == ProbePlacement::Terrain) {
+            c.setting = "grid_dims";
+            c.replaced = std::to_string(v.gridDims[0]) + "," + std::to_string(v.gridDims[2]);
+            search = searchTerrainGrid(hf, c.target, kMaxTerrainGridProbes, std::max(v.gridDims[0], v.gridDims[2]),
+                                       [&](const std::array<int, 3>& d) {
+                                           return measureGridTrial(v, hf, d, baker, c.mapResolution, seed);
+                                       });
+            // The bake judges its own, finer map: confirm there, a probe a side more while it misses.
+            const int fine = scene.bake.errorMapResolution;
+            if (fine > c.mapResolution) {
+                confirmTerrainGrid(hf, c.target, kMaxTerrainGridProbes, search, [&](const std::array<int, 3>& d) {
+                    return measureGridTrial(v, hf, d, baker, fine, seed);
+                });
+                c.mapResolution = fine;
+            }
+            v.gridDims = search.chosen.dims;
+            v.spacing.reset();
+            value << v.gridDims[0] << "," << v.gridDims[2];
+        } else {
+            c.setting = "adaptive.tolerance";
+            if (v.adaptive.tolerance) c.replaced = nlohmann::json(*v.adaptive.tolerance).dump();
+            search = searchAdaptiveTolerance(c.target, [&](double tolerance) {
+                return measureAdaptiveTrial(v, hf, tolerance, baker, c.mapResolution, seed);
+            });
+            v.adaptive.tolerance = search.chosen.tolerance;
+            value << std::setprecision(3) << search.chosen.tolerance;
+        }
+        c.value = value.str();
+        c.probes = search.chosen.probes;
+        c.bytes = search.chosen.bytes;
+        c.spacing = search.chosen.spacing;
+        c.p95 = search.chosen.p95;
+        c.met = search.met;
+        c.capped = search.capped;
+        c.trials = search.trials.size();
+        std::ostringstream sum;
+        sum << (v.placement == ProbePlacement::Terrain ? "spacing " : "min cell ") << std::lround(c.spacing) << " m";
+        if (v.placement == ProbePlacement::Adaptive) sum << ", tolerance " << percent(search.chosen.tolerance);
+        sum << ", " << grouped(c.probes) << " probes, p95 " << percent(c.p95);
+        c.summary = sum.str();
+        if (v.placement == ProbePlacement::Terrain && c.capped) {
+            // Past the cap: what meets the target instead, at the adaptive volume's cost.
+            ProbeVolumeSettings a = v;
+            a.placement = ProbePlacement::Adaptive;
+            // Within a box grid's limit: the largest volume an engine allocates for.
+            if (!a.adaptive.maxProbes) a.adaptive.maxProbes = kOfferMaxProbes;
+            const auto offerStart = Clock::now();
+            PlacementSearch as;
+            try {
+                as = searchAdaptiveTolerance(c.target, [&](double tolerance) {
+                    return measureAdaptiveTrial(a, hf, tolerance, baker, c.mapResolution, seed);
+                });
+            } catch (const PlacementError&) {
+                // Its geometry alone is past the budget: no offer.
+                as.chosen.p95 = NAN;
+            }
+            const double offerSeconds = secondsSince(offerStart) / double(std::max<size_t>(as.trials.size(), 1));
+            std::ostringstream tol;
+            tol << std::setprecision(3) << as.chosen.tolerance;
+            std::ostringstream w;
+            w << at << ".target_error " << percent(c.target) << " needs more than the " << kMaxTerrainGridProbes
+              << " probes a terrain grid may hold: baking the densest allowed, grid_dims " << c.value << " (p95 "
+              << percent(c.p95) << ")";
+            if (as.met) {
+                c.offer = {{"set", {at + ".placement=adaptive", at + ".target_error=" + nlohmann::json(c.target).dump()}},
+                           {"tolerance", as.chosen.tolerance},
+                           {"probes", as.chosen.probes},
+                           {"bytes", as.chosen.bytes},
+                           {"p95", as.chosen.p95},
+                           {"estimated_time_s", offerSeconds}};
+                w << "; an adaptive volume meets it: --set " << at << ".placement=adaptive (tolerance "
+                  << tol.str() << ", " << grouped(as.chosen.probes) << " probes, " << grouped(as.chosen.bytes)
+                  << " bytes, about " << std::setprecision(2) << offerSeconds << " s, p95 " << percent(as.chosen.p95)
+                  << ")";
+            } else {
+                w << "; no adaptive volume within " << *a.adaptive.maxProbes << " probes meets it either";
+                if (std::isfinite(as.chosen.p95)) w << " (best p95 " << percent(as.chosen.p95) << ")";
+                w << ": raise the target or split the terrain into several volumes";
+            }
+            c.warning = w.str();
+        }
+        c.seconds = secondsSince(start);
+        out[index] = c;
+    }
+    return out;
 }
 
 // Where two volumes' grids overlap, the engine reads the one whose file name sorts first
@@ -434,9 +599,12 @@ ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettin
 
 }  // namespace
 
-BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
+BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                     const std::atomic<bool>* cancel) {
     const auto start = Clock::now();
+    // The project as baked: target_error rewrites the volumes' grid_dims or tolerance here, while
+    // bake_report.json's inputs stay the project's own (so the bake is current for it).
+    BakeRequest request = original;
     const Project& project = request.project;
     const SceneDescription& scene = project.scene;
     const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
@@ -449,6 +617,9 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
 
     BakeSetup setup;
     prepare(project, setup, report, cancelled);
+    const std::map<size_t, TargetChoice> targets =
+        chooseTargets(request.project.scene, setup, [&](const std::string& p) { report(p, 0.02); });
+    if (cancelled()) throw BakeCancelled();
     const Heightfield& hf = setup.terrain.heightfield;
     const DemImportResult& terrain = setup.terrain;
     const BakeLighting& lighting = setup.lighting;
@@ -569,6 +740,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
             {"borrowed_cells", layout.octree ? layout.octree->borrowed : layout.borrowedCells},
             {"split_for_inside", layout.octree ? layout.octree->splitForInside : size_t(0)},
         };
+        const size_t volumeIndex = size_t(volumes[vi] - scene.probeVolumes.data());
+        if (targets.count(volumeIndex)) vr["target"] = targetChoiceReport(targets.at(volumeIndex));
         if (layout.octree) {
             vr["adaptive"] = adaptiveReport(*layout.octree, refinement);
             vr["interpolation_error"] =
@@ -667,6 +840,14 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
                                {"max", ms.max},
                                {"rays", mapRays},
                                {"time_s", secondsSince(mapStart)}};
+            // The target is judged on this map, the bake's own, not the search's coarser one.
+            if (vr.contains("target") && ms.points > 0) {
+                nlohmann::json& t = vr["target"];
+                const std::string summary = t["summary"].get<std::string>();
+                t["p95"] = ms.p95;
+                t["met"] = ms.p95 <= t["target"].get<double>();
+                t["summary"] = summary.substr(0, summary.rfind(", p95 ")) + ", p95 " + percent(ms.p95);
+            }
         }
 
         // Pre-convolved irradiance (Â_l L_k) when asked for.
@@ -712,6 +893,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         nlohmann::json& vr = volumeReports[vi];
         if (!vr.contains("error_map") || vr["error_map"]["points"].get<size_t>() == 0) continue;
+        // A volume with a target_error has its placement from the target.
+        if (vr.contains("target")) continue;
         const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
         vr["suggestions"] = suggestions(request, index, vr["error_map"]["mean"].get<double>(), setup, threads);
     }
@@ -747,7 +930,7 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
           {"cache_rays", cache ? q.cacheRays : 0},
           {"cache_time_s", cacheSeconds}}},
         {"sh_encoding", scene.bake.encoding == ShEncoding::Irradiance ? "irradiance" : "radiance"},
-        {"inputs", bakeInputs(project)},
+        {"inputs", bakeInputs(original.project)},
         {"threads", threads},
         {"rays", totalRays + cacheRays + referenceRays},
         {"probe_rays", totalRays},
@@ -767,6 +950,8 @@ BakeOutcome runBake(const BakeRequest& request, const BakeProgress& progress,
         out.warnings = reflections->warnings;
     }
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
+    for (const auto& [index, c] : targets)
+        if (!c.warning.empty()) out.warnings.push_back(c.warning);
     out.report["warnings"] = out.warnings;
     {
         // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
@@ -829,6 +1014,24 @@ void flatten(const nlohmann::json& v, const std::string& path, std::map<std::str
 }
 
 }  // namespace
+
+nlohmann::json targetChoiceReport(const TargetChoice& c) {
+    return {{"target", c.target},
+            {"setting", c.setting},
+            {"value", c.value},
+            {"replaced", c.replaced.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.replaced)},
+            {"probes", c.probes},
+            {"bytes", c.bytes},
+            {"spacing_m", c.spacing},
+            {"search_p95", c.p95},
+            {"search_map_resolution", c.mapResolution},
+            {"met", c.met},
+            {"capped", c.capped},
+            {"trials", c.trials},
+            {"time_s", c.seconds},
+            {"summary", c.summary},
+            {"offer", c.offer}};
+}
 
 nlohmann::json bakeInputs(const Project& project) {
     nlohmann::json settings = sceneToJson(project.scene);
@@ -899,8 +1102,17 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     const int threads = request.threads > 0 ? request.threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     BakeSetup setup;
-    prepare(request.project, setup, [](const std::string&, double) {}, [] { return false; });
-    return estimateWith(request, setup, threads);
+    BakeRequest chosen = request;
+    prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; });
+    const std::map<size_t, TargetChoice> targets = chooseTargets(chosen.project.scene, setup, [](const std::string&) {});
+    BakeEstimate e = estimateWith(chosen, setup, threads);
+    for (auto& ve : e.volumes)
+        for (const auto& [index, c] : targets)
+            if (chosen.project.scene.probeVolumes[index].name == ve.name) {
+                ve.target = c;
+                if (!c.warning.empty()) e.warnings.push_back(c.warning);
+            }
+    return e;
 }
 
 namespace {

@@ -43,6 +43,31 @@ std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const
 // Above this mean interpolation error a bake's report suggests denser probes ("suggestions").
 inline constexpr double kSuggestAboveMeanError = 0.05;
 
+// What a volume's target_error chose (docs/lighting.md, "Asking for an accuracy"): the search's
+// trials bake with a small irradiance cache and a coarse error map; the bake then measures its
+// own map of the chosen layout.
+struct TargetChoice {
+    double target = 0.0;
+    std::string setting;        // "grid_dims" or "adaptive.tolerance"
+    std::string value;          // what it was set to: "48,32", "0.0150"
+    std::string replaced;       // the project's own value it replaced ("8,8"); empty when unset
+    size_t probes = 0;
+    uint64_t bytes = 0;
+    float spacing = 0.0f;       // terrain: probe spacing; adaptive: min cell, metres
+    double p95 = 0.0;           // of the search's map
+    int mapResolution = 0;      // of the search's map
+    bool met = false;
+    bool capped = false;        // terrain: the target needs more than kMaxTerrainGridProbes
+    size_t trials = 0;
+    double seconds = 0.0;       // the search
+    std::string summary;        // "spacing 240 m, 3 914 probes, p95 2.8 %"
+    // Terrain grids past the cap: the adaptive volume that meets the target instead, with its
+    // cost ({"set": [...], "probes", "bytes", "estimated_time_s", "p95"}); null when none does.
+    nlohmann::json offer;
+    std::string warning;        // one line when capped
+};
+nlohmann::json targetChoiceReport(const TargetChoice& c);
+
 // Phase name and progress in [0, 1] of the whole bake.
 using BakeProgress = std::function<void(const std::string& phase, double fraction)>;
 
@@ -75,6 +100,7 @@ struct VolumeEstimate {
     uint64_t bytesMax = 0;
     double secondsMax = 0.0;
     std::string cap;
+    std::optional<TargetChoice> target;     // target_error chose the placement
 };
 
 struct BakeEstimate {
@@ -95,6 +121,7 @@ struct BakeEstimate {
     std::optional<Reflection> reflection;
     bool lpvIni = false;   // lpv.enabled: the bake writes lpv.ini and TERRALUX_lighting.lpv
     size_t lights = 0;     // local lights: KHR_lights_punctual
+    std::vector<std::string> warnings;  // one line each (a target past the terrain-grid limit)
 };
 
 // Throws the same input errors as runBake.

@@ -298,6 +298,14 @@ int printEstimate(const BakeEstimate& e) {
         std::cout << ", " << v.bytes << " bytes";
         if (v.errorMapPoints) std::cout << ", " << v.errorMapPoints << " error-map points";
         std::cout << ", about " << duration(v.seconds) << "\n";
+        if (v.target) {
+            const TargetChoice& t = *v.target;
+            std::cout << "    target_error " << fixed(100.0 * t.target, 1) << " %: " << t.setting << " " << t.value;
+            if (!t.replaced.empty()) std::cout << " (replaces " << t.replaced << ")";
+            std::cout << ": " << t.summary << " on a " << t.mapResolution << "-point map ("
+                      << (t.met ? "meets it" : "misses it") << "; " << t.trials << " trials, "
+                      << duration(t.seconds) << ")\n";
+        }
         if (v.refines)
             std::cout << "    error-driven refinement to " << fixed(100.0 * v.tolerance, 2)
                       << " %: up to " << v.probesMax << " probes (" << v.cap << "), "
@@ -314,6 +322,7 @@ int printEstimate(const BakeEstimate& e) {
     std::cout << "estimated bake time: about " << duration(e.seconds);
     if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
     std::cout << " (" << fixed(e.probeRaysPerSecond / 1e6, 2) << " M probe rays/s measured here)\n";
+    for (const auto& w : e.warnings) std::cerr << "terralux: warning: " << w << "\n";
     return kExitOk;
 }
 
@@ -395,6 +404,14 @@ int commandBake(const Args& a) {
                       << fixed(100.0 * v["reference_error"]["p95"].get<double>(), 2) << " % / max "
                       << fixed(100.0 * v["reference_error"]["max"].get<double>(), 2) << " %";
         std::cout << "\n";
+        if (v.contains("target")) {
+            const auto& t = v["target"];
+            std::cout << "    target_error " << fixed(100.0 * t["target"].get<double>(), 1) << " %: "
+                      << t["setting"].get<std::string>() << " " << t["value"].get<std::string>();
+            if (!t["replaced"].is_null()) std::cout << " (replaces " << t["replaced"].get<std::string>() << ")";
+            std::cout << ": " << t["summary"].get<std::string>() << " ("
+                      << (t["met"].get<bool>() ? "meets it" : "misses it") << ")\n";
+        }
         if (v.contains("error_map") && v["error_map"]["size"][0].get<int>() == 0) {
             std::cout << "    no interpolation-error map: the volume's grid is not over the terrain\n";
         } else if (v.contains("error_map") && v["error_map"]["points"].get<int>() == 0) {

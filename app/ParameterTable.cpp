@@ -665,6 +665,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].adaptive.max_bytes", T::Integer)).range(1, double(1ll << 53)).unit("bytes")
         .autoMeans("no limit").label("Adaptive: max bytes").about(".shprobe size budget of the error-driven refinement")
         .redoes(kReplace | kRebake).noUiRow().adaptive(&AdaptiveVolumeSettings::maxBytes);
+    add(Row("probe_volumes[].target_error", T::Number)).above(0.0, 1.0).openAbove().decimals(3)
+        .autoMeans("none: grid_dims or adaptive.tolerance stand").label("Target error")
+        .about("Relative interpolation error to meet at the error map's 95th percentile: chooses grid_dims (terrain) or adaptive.tolerance (adaptive), replacing them; box volumes refuse it")
+        .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::targetError);
     add(Row("probe_volumes[].adaptive.max_move_share", T::Number)).range(0.0, 0.5).unit("of a cell")
         .label("Adaptive: max move")
         .about("A minimum leaf whose centre is inside the terrain moves its probe up at most this share of its edge")

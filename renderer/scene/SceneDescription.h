@@ -142,6 +142,10 @@ struct ProbeVolumeSettings {
     std::optional<int> rayCount;     // unset = the bake quality preset decides
     std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
     AdaptiveVolumeSettings adaptive;
+    // Relative interpolation error the bake meets at the 95th percentile of the error map
+    // (docs/lighting.md, "Asking for an accuracy"): it chooses grid_dims (terrain) or
+    // adaptive.tolerance (adaptive) and replaces what they say. Unset = they stand.
+    std::optional<double> targetError;
 };
 
 // How a reflection probe stores its environment (docs/lighting.md, "Reflection probes").

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# target_checks.sh CASE TERRALUX WORKDIR DEM
+# probe_volumes[].target_error end to end on a committed DEM crop: the bake meets the target on
+# its own error map and says why it chose what it did; the dry run says the same and writes
+# nothing; a target past the terrain-grid limit is one plain warning.
+set -u
+case_=$1 terralux=$2 work=$3 dem=$4
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+p95() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['volumes'][0]['$1']['p95'])" "$work/out/bake_report.json"; }
+case "$case_" in
+  meets)
+    "$terralux" --bake --quiet --quality draft --dem "$dem" --out "$work/out" \
+      --set 'probe_volumes[0].target_error=0.1' >"$work/stdout" 2>"$work/stderr" || fail "bake exited $?"
+    python3 - "$work/out/bake_report.json" <<'PY' || fail "bake_report.json"
+import json, sys
+v = json.load(open(sys.argv[1]))["volumes"][0]
+t, m = v["target"], v["error_map"]
+assert m["points"] > 1000, m
+assert m["p95"] <= 0.1, f"error map p95 {m['p95']} above the target 0.1"
+assert t["target"] == 0.1 and t["met"] is True and t["capped"] is False, t
+assert t["setting"] == "grid_dims" and t["replaced"] == "8,8", t
+nx, nz = (int(x) for x in t["value"].split(","))
+assert v["probe_grid"] == [nx, 1, nz] and v["probes"] == t["probes"] == nx * nz, (v["probe_grid"], t)
+assert nx * nz <= 4096 and nx * nz > 64, t
+assert abs(t["p95"] - m["p95"]) < 1e-9, (t, m)
+assert t["summary"].startswith("spacing ") and "probes, p95 " in t["summary"], t
+PY
+    grep -Eq "^    target_error 10.0 %: grid_dims [0-9]+,[0-9]+ \(replaces 8,8\): spacing [0-9]+ m, [0-9 ]+ probes, p95 [0-9.]+ % \(meets it\)$" \
+      "$work/stdout" || fail "stdout does not explain the choice"
+    [ -s "$work/stderr" ] && fail "stderr not empty: $(cat "$work/stderr")"
+    ;;
+  dry_run)
+    "$terralux" --bake --dry-run --quiet --quality draft --dem "$dem" --out "$work/out" \
+      --set 'probe_volumes[0].target_error=0.1' >"$work/stdout" 2>"$work/stderr" || fail "dry run exited $?"
+    grep -q "^dry run: nothing baked, nothing written" "$work/stdout" || fail "no dry-run header"
+    grep -Eq "^    target_error 10.0 %: grid_dims [0-9]+,[0-9]+ \(replaces 8,8\): spacing [0-9]+ m, [0-9 ]+ probes, p95 [0-9.]+ % on a 64-point map \(meets it; [0-9]+ trials" \
+      "$work/stdout" || fail "no choice in the dry run"
+    grep -Eq "^  probes: terrain grid, .*: [0-9]+ probes, [0-9]+ bytes, .* about" "$work/stdout" || fail "no cost"
+    [ -e "$work/out" ] && fail "the dry run created $work/out"
+    [ -s "$work/stderr" ] && fail "stderr not empty"
+    ;;
+  capped)
+    # 5 % on this crop needs more than 4096 probes: the densest grid, one warning line.
+    "$terralux" --bake --quiet --quality draft --dem "$dem" --out "$work/out" \
+      --set 'probe_volumes[0].target_error=0.05' >"$work/stdout" 2>"$work/stderr" || fail "bake exited $?"
+    [ "$(wc -l <"$work/stderr")" = 1 ] || fail "want one stderr line, got: $(cat "$work/stderr")"
+    grep -Eq "^terralux: warning: probe_volumes\[0\].target_error 5.0 % needs more than the 4096 probes a terrain grid may hold: baking the densest allowed, grid_dims [0-9]+,[0-9]+ \(p95 [0-9.]+ %\); (an adaptive volume meets it: --set probe_volumes\[0\].placement=adaptive \(tolerance [0-9.e-]+, [0-9 ]+ probes, [0-9 ]+ bytes, about [0-9.]+ s|no adaptive volume within 65536 probes meets it)" \
+      "$work/stderr" || fail "no plain warning: $(cat "$work/stderr")"
+    python3 - "$work/out/bake_report.json" <<'PY' || fail "bake_report.json"
+import json, sys
+r = json.load(open(sys.argv[1]))
+v = r["volumes"][0]
+assert v["probes"] <= 4096 and v["probes"] > 3500, v["probes"]
+assert v["target"]["capped"] is True and v["target"]["met"] is False, v["target"]
+assert len(r["warnings"]) == 1 and "4096 probes" in r["warnings"][0], r["warnings"]
+PY
+    ;;
+  *) echo "unknown case $case_"; exit 2 ;;
+esac
+echo "ok: $case_"
