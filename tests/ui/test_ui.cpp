@@ -1565,7 +1565,8 @@ private slots:
         int current = -1, target = -1;
         for (size_t i = 0; i < r.points.size(); ++i) {
             const StudyPoint& p = r.points[i];
-            if (p.current) current = int(i);
+            // The error-map knob marks the project's map resolution too: the settings are the first.
+            if (p.current && current < 0) current = int(i);
             // The rays or probe spacing knobs: a number or a grid the project can be read back for.
             if (!p.current && target < 0 && (p.knob == "rays" || p.knob == "spacing"))
                 for (const std::string& set : p.sets)
