@@ -111,7 +111,21 @@ std::string fmt(const char* f, double v) {
     return b;
 }
 
-Spread spreadOfErrors(std::vector<float> e) { return spreadOf(std::move(e)); }
+// The peak resident memory a setting adds: started before it, read after.
+struct PeakMemory {
+    uint64_t before = statusBytes("VmRSS");
+    PeakMemory() { resetPeakMemory(); }
+    uint64_t added() const {
+        const uint64_t peak = statusBytes("VmHWM");
+        return peak > before ? peak - before : 0;
+    }
+};
+
+void setErrors(StudyPoint& p, std::vector<float> errors) {
+    p.points = errors.size();
+    const Spread s = spreadOf(std::move(errors));
+    p.errorMean = s.mean, p.errorP95 = s.p95, p.errorMax = s.max;
+}
 
 // A setting to try: its overrides, and how to measure it.
 struct Candidate {
@@ -431,8 +445,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     if (s.bake.bounces) q.bounces = *s.bake.bounces;
     const int rays = v.rayCount.value_or(q.rays);
     StudyPoint p;
-    const uint64_t before = statusBytes("VmRSS");
-    resetPeakMemory();
+    const PeakMemory memory;
     const auto t0 = Clock::now();
     auto baked = std::make_unique<Baked>();
     baked->q = q;
@@ -461,8 +474,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
         for (size_t i = 0; i < bake.sh.size(); ++i)
             if (layout.valid[i]) sh::deringIrradiance(bake.sh[i]);
     p.seconds = secondsSince(t0);
-    const uint64_t peak = statusBytes("VmHWM");
-    p.peakMemoryBytes = peak > before ? peak - before : 0;
+    p.peakMemoryBytes = memory.added();
     p.outputBytes = layout.fileBytes();
     p.probes = layout.validCount();
 
@@ -474,9 +486,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     std::vector<float> covered;
     for (float e : err)
         if (std::isfinite(e)) covered.push_back(e);
-    p.points = covered.size();
-    const Spread sp = spreadOfErrors(std::move(covered));
-    p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
+    setErrors(p, std::move(covered));
     learn("rays", double(traced), p.seconds);
     if (c.knob == "current") {
         baked->layout = std::move(layout);
@@ -504,14 +514,12 @@ ErrorMapStats mapStats(const Study& st, int resolution, uint64_t* rays) {
 
 StudyPoint Study::measureErrorMap(const Candidate& c) {
     StudyPoint p;
-    const uint64_t before = statusBytes("VmRSS");
-    resetPeakMemory();
+    const PeakMemory memory;
     const auto t0 = Clock::now();
     uint64_t rays = 0;
     const ErrorMapStats m = mapStats(*this, c.param, &rays);
     p.seconds = secondsSince(t0);
-    const uint64_t peak = statusBytes("VmHWM");
-    p.peakMemoryBytes = peak > before ? peak - before : 0;
+    p.peakMemoryBytes = memory.added();
     p.points = m.points;
     p.probes = current->layout.validCount();
     p.outputBytes = current->layout.fileBytes();
@@ -544,22 +552,18 @@ StudyPoint Study::measureAo(const Candidate& c) {
     HorizonAoSettings settings;
     settings.directions = c.param;
     settings.maxDistance = project.scene.ao.maxDistance.value_or(0.0);
-    const uint64_t before = statusBytes("VmRSS");
-    resetPeakMemory();
+    const PeakMemory memory;
     const auto t0 = Clock::now();
     const std::vector<float> field = horizonSkyVisibility(hf(), settings, [&](double) { return !cancelled(); });
     if (field.empty()) throw BakeCancelled();
     p.seconds = secondsSince(t0);
-    const uint64_t peak = statusBytes("VmHWM");
-    p.peakMemoryBytes = peak > before ? peak - before : 0;
+    p.peakMemoryBytes = memory.added();
     std::vector<float> err;
     for (size_t i = 0; i < aoVertices.size(); ++i) {
         const auto [col, row] = aoVertices[i];
         err.push_back(std::abs(field[size_t(row) * size_t(hf().width()) + size_t(col)] - aoTruth[i]));
     }
-    p.points = err.size();
-    const Spread sp = spreadOfErrors(std::move(err));
-    p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
+    setErrors(p, std::move(err));
     learn("ao", c.work, p.seconds);
     return p;
 }
@@ -592,22 +596,18 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     }
     StudyPoint p;
     p.metric = StudyMetric::Lpv;
-    const uint64_t before = statusBytes("VmRSS");
-    resetPeakMemory();
+    const PeakMemory memory;
     const auto t0 = Clock::now();
     const lpv::Volumes volumes(s.lpv, {&lighting, &s.lights}, eye, view);
     p.seconds = secondsSince(t0);
-    const uint64_t peak = statusBytes("VmHWM");
-    p.peakMemoryBytes = peak > before ? peak - before : 0;
+    p.peakMemoryBytes = memory.added();
     std::vector<float> err;
     for (size_t i = 0; i < lpvP.size(); ++i) {
         const glm::vec3 toEye = glm::normalize(glm::vec3(eye) - lpvP[i]);
         const float value = luminance(volumes.evaluate(lpvP[i], lpvN[i], toEye).irradiance);
         err.push_back(std::abs(value - lpvTruth[i]) / std::max(lpvTruth[i], std::max(lpvFloor, 1e-12f)));
     }
-    p.points = err.size();
-    const Spread sp = spreadOfErrors(std::move(err));
-    p.errorMean = sp.mean, p.errorP95 = sp.p95, p.errorMax = sp.max;
+    setErrors(p, std::move(err));
     learn("lpv", c.work, p.seconds);
     return p;
 }
