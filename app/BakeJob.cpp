@@ -102,9 +102,7 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     report("loading albedo", 0.015);
     b.lighting.surface = surfaceAlbedoOf(project, b.terrain.heightfield);
     if (cancelled()) throw BakeCancelled();
-    b.q = qualityPreset(scene.bake.quality);
-    if (scene.bake.rays) b.q.rays = *scene.bake.rays;
-    if (scene.bake.bounces) b.q.bounces = *scene.bake.bounces;
+    b.q = qualityOf(scene.bake);
     b.referenceMode = scene.bake.quality == QualityPreset::Reference;
     for (const auto& v : scene.probeVolumes)
         if (v.enabled) b.volumes.push_back(&v);

@@ -286,9 +286,7 @@ void Study::bakeReference() {
 std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
     const SceneDescription& s = project.scene;
     const ProbeVolumeSettings& v = volumeOf(s);
-    BakeQuality q = qualityPreset(s.bake.quality);
-    if (s.bake.rays) q.rays = *s.bake.rays;
-    if (s.bake.bounces) q.bounces = *s.bake.bounces;
+    const BakeQuality q = qualityOf(s.bake);
     std::vector<Candidate> out;
     auto add = [&](std::string knob, std::string label, std::vector<std::string> sets, StudyMetric m = StudyMetric::Irradiance,
                    int param = 0) {
@@ -391,9 +389,7 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
         switch (c.metric) {
             case StudyMetric::Irradiance: {
                 const ProbeVolumeSettings& cv = volumeOf(cs);
-                BakeQuality cq = qualityPreset(cs.bake.quality);
-                if (cs.bake.rays) cq.rays = *cs.bake.rays;
-                if (cs.bake.bounces) cq.bounces = *cs.bake.bounces;
+                const BakeQuality cq = qualityOf(cs.bake);
                 const int rays = cv.rayCount.value_or(cq.rays);
                 double probes;
                 if (cv.placement == ProbePlacement::Adaptive) {
@@ -440,9 +436,7 @@ double Study::estimate(const Candidate& c) const {
 StudyPoint Study::measureProbes(const Candidate& c) {
     const SceneDescription s = sceneWith(c.sets);
     const ProbeVolumeSettings& v = volumeOf(s);
-    BakeQuality q = qualityPreset(s.bake.quality);
-    if (s.bake.rays) q.rays = *s.bake.rays;
-    if (s.bake.bounces) q.bounces = *s.bake.bounces;
+    const BakeQuality q = qualityOf(s.bake);
     const int rays = v.rayCount.value_or(q.rays);
     StudyPoint p;
     const PeakMemory memory;

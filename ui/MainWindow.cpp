@@ -1083,8 +1083,7 @@ void MainWindow::updateEstimate() {
     size_t probes = 0, invalid = 0, mapPoints = 0;
     uint64_t bytes = 0;
     double rays = 0;
-    BakeQuality q = qualityPreset(p.scene.bake.quality);
-    if (p.scene.bake.rays) q.rays = *p.scene.bake.rays;
+    const BakeQuality q = qualityOf(p.scene.bake);
     // Placement errors go next to the settings they name (Probe Volumes dock) and to the status
     // bar; the estimate says it has none.
     std::vector<QString> errors(p.scene.probeVolumes.size());

@@ -221,6 +221,13 @@ const char* qualityName(QualityPreset preset) {
     return "standard";
 }
 
+BakeQuality qualityOf(const BakeSettings& bake) {
+    BakeQuality q = qualityPreset(bake.quality);
+    if (bake.rays) q.rays = *bake.rays;
+    if (bake.bounces) q.bounces = *bake.bounces;
+    return q;
+}
+
 BakeQuality qualityPreset(QualityPreset preset) {
     switch (preset) {
         case QualityPreset::Draft: return {64, 1, 64, 32, 2};

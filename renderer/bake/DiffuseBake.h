@@ -34,6 +34,8 @@ struct BakeQuality {
     int sunSamples = 4;        // shadow rays per cache point across the sun's disk
 };
 BakeQuality qualityPreset(QualityPreset preset);
+// The preset of bake.quality with bake.rays and bake.bounces applied where set.
+BakeQuality qualityOf(const BakeSettings& bake);
 const char* qualityName(QualityPreset preset);
 
 // The irradiance-cache resolution a bake uses (docs/lighting.md "Irradiance cache"): the
