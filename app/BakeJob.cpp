@@ -219,13 +219,8 @@ int searchMapResolution(const BakeSettings& b) {
 // The trials' baker: seeded like the bake's, windowed like its probes, so a trial's map measures
 // the probes the bake writes.
 ProbeBaker trialBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed, bool dering) {
-    const ProbeBaker keyed = seededBaker(b.lighting, cache, b.q.bounces, rays, seed, BakeControl{}, b.referenceMode);
-    return [keyed, dering](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        ProbeBake t = keyed(p, k);
-        if (dering)
-            for (auto& s : t.sh) sh::deringIrradiance(s);
-        return t;
-    };
+    return deringedBaker(seededBaker(b.lighting, cache, b.q.bounces, rays, seed, BakeControl{}, b.referenceMode),
+                         dering);
 }
 
 // The small irradiance cache the search bakes with (the bake's own is sized by its probes, which
@@ -814,15 +809,9 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                                               double(std::max<size_t>(totalWork, 1)));
                                  },
                                  cancel};
-            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, mc);
             // The truth gets the same window as the probes, so the map shows interpolation alone.
-            const ProbeBaker counted = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-                ProbeBake t = baker(p, k);
-                mapRays += t.rays;
-                if (scene.bake.deringing)
-                    for (auto& s : t.sh) sh::deringIrradiance(s);
-                return t;
-            };
+            const ProbeBaker counted =
+                deringedBaker(keyedBaker(setup, cache.get(), rays, seed, mc), scene.bake.deringing, &mapRays);
             diagnostics.errorMap = measureErrorMap(layout, bake.sh, hf, counted,
                                                    scene.bake.errorMapResolution,
                                                    errorMapHeight(v, layout), seed);

@@ -361,11 +361,9 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                 }
     }
 
-    const int res = s.bake.errorMapResolution;
     for (int r : {8, 16, 32, 64, 128})
         if (r < denseMapResolution) add("error_map", "error map " + std::to_string(r), {"bake.error_map_resolution=" + std::to_string(r)},
                                         StudyMetric::ErrorMapP95, r);
-    (void)res;
 
     if (s.ao.enabled)
         for (int d : {8, 16, 32, 64})
@@ -492,15 +490,9 @@ StudyPoint Study::measureProbes(const Candidate& c) {
 
 ErrorMapStats mapStats(const Study& st, int resolution, uint64_t* rays) {
     const Study::Baked& b = *st.current;
-    const ProbeBaker baker = seededBaker(st.lighting, b.cache.get(), b.q.bounces, b.rays, kStudySeed, st.control());
-    const bool dering = st.project.scene.bake.deringing;
-    const ProbeBaker counted = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-        ProbeBake t = baker(p, k);
-        *rays += t.rays;
-        if (dering)
-            for (auto& s : t.sh) sh::deringIrradiance(s);
-        return t;
-    };
+    const ProbeBaker counted = deringedBaker(
+        seededBaker(st.lighting, b.cache.get(), b.q.bounces, b.rays, kStudySeed, st.control()),
+        st.project.scene.bake.deringing, rays);
     const ProbeVolumeSettings& v = st.volumeOf(st.project.scene);
     return errorMapStats(measureErrorMap(b.layout, b.sh, st.hf(), counted, resolution,
                                          errorMapHeight(v, b.layout), kStudySeed));

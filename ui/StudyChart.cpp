@@ -30,7 +30,7 @@ QPointF at(const StudyPoint& p) {
     return {std::max(p.seconds, kTimeFloor), std::max(p.errorP95, kErrorFloor)};
 }
 
-QString seriesName(const std::string& knob, StudyMetric m) {
+QString seriesName(const std::string& knob) {
     static const std::map<std::string, QString> names = {
         {"quality", "quality preset"}, {"rays", "rays"}, {"bounces", "bounces"},
         {"spacing", "probe spacing"}, {"tolerance", "adaptive tolerance"},
@@ -39,9 +39,7 @@ QString seriesName(const std::string& knob, StudyMetric m) {
         {"ao_directions", "AO directions (AO error)"},
         {"lpv_quality", "LPV quality (LPV error)"}, {"lpv_cascades", "LPV cascades (LPV error)"}};
     auto it = names.find(knob);
-    QString n = it != names.end() ? it->second : QString::fromStdString(knob);
-    (void)m;
-    return n;
+    return it != names.end() ? it->second : QString::fromStdString(knob);
 }
 
 // A qualitative palette (Tableau 10): the chart theme's five colours repeat past five series.
@@ -109,7 +107,7 @@ StudyChart makeStudyChart(const StudyResult& r) {
         std::sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return r.points[a].seconds < r.points[b].seconds; });
         if (combined) {
             auto* s = new QScatterSeries();
-            s->setName(seriesName(knob, metric));
+            s->setName(seriesName(knob));
             s->setMarkerSize(9.0);
             for (size_t i : idx) {
                 s->append(at(r.points[i]));
@@ -122,7 +120,7 @@ StudyChart makeStudyChart(const StudyResult& r) {
             continue;
         }
         auto* s = new QLineSeries();
-        s->setName(seriesName(knob, metric));
+        s->setName(seriesName(knob));
         s->setPointsVisible(true);
         for (size_t i : idx) {
             s->append(at(r.points[i]));

@@ -368,6 +368,16 @@ ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cach
     };
 }
 
+ProbeBaker deringedBaker(ProbeBaker baker, bool dering, uint64_t* rays) {
+    return [baker = std::move(baker), dering, rays](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+        ProbeBake t = baker(p, k);
+        if (rays) *rays += t.rays;
+        if (dering)
+            for (auto& s : t.sh) sh::deringIrradiance(s);
+        return t;
+    };
+}
+
 uint64_t octreeLeafKey(const OctreeLeaf& l) {
     uint64_t k = splitmix64(0x0C7EE1EAFull ^ l.x);
     k = splitmix64(k ^ l.y);

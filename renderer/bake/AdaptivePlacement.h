@@ -74,6 +74,11 @@ using ProbeBaker = std::function<ProbeBake(const std::vector<glm::vec3>& positio
 ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                        int rays, uint64_t seed, const BakeControl& control, bool reference = false);
 
+// `baker` whose probes get the deringing window when `dering` (bake.deringing), as the probes a
+// bake writes do: a truth baked with it differs from those probes by interpolation alone. `rays`
+// (optional) accumulates the rays it traced.
+ProbeBaker deringedBaker(ProbeBaker baker, bool dering, uint64_t* rays = nullptr);
+
 struct AdaptiveRefinement {
     double tolerance = 0.0;
     int rounds = 0;
