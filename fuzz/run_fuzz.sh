@@ -9,6 +9,12 @@
 # only a real hang fails them. Smoke runs use a fixed seed, so a change is judged on the same
 # mutations every time and CI does not fail on what one random draw happened to reach; the long
 # runs draw a new seed each time.
+#
+# libFuzzer's log goes to WORKDIR/fuzz.log. A CI log keeps only the end of a failed test's output,
+# so on failure this prints the lines that say why (the sanitizer or libFuzzer report), the log's
+# last lines and every finding's input in base64, enough to commit it as a regression input
+# without the build tree. A run that ended on a signal from outside (no report, no finding: the
+# machine's OOM killer, say) says so and runs once more; a finding never does.
 set -eu
 fuzzer=$1 seconds=$2 work=$3 dict=$4 corpus=$5
 regressions=${6:-}
@@ -25,4 +31,39 @@ set -- -seed="$seed" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_m
   -print_final_stats=1 -artifact_prefix="$work/artifacts/" "$work/corpus" "$corpus"
 [ -n "$dict" ] && set -- -dict="$dict" "$@"
 [ -n "$regressions" ] && [ -d "$regressions" ] && set -- "$@" "$regressions"
-exec "$fuzzer" "$@"
+log=$work/fuzz.log
+name=$(basename "$fuzzer")
+
+marker=$work/.started
+findings() { find "$work/artifacts" -type f -newer "$marker" | sort; }
+
+attempt=1
+while :; do
+  touch "$marker"
+  status=0
+  "$fuzzer" "$@" > "$log" 2>&1 || status=$?
+  if [ "$status" -eq 0 ]; then
+    grep -E '^(Done|stat::)' "$log" || true
+    echo "$name: no finding in ${seconds} s (log: $log)"
+    exit 0
+  fi
+  new=$(findings | wc -l)
+  report=$(grep -E 'ERROR: |ALARM: |SUMMARY: |runtime error: |Test unit written|deadly signal|out-of-memory|==[0-9]+==' "$log" | head -n 20 || true)
+  if [ "$status" -gt 128 ] && [ "$new" -eq 0 ] && [ -z "$report" ] && [ "$attempt" -eq 1 ]; then
+    echo "$name: stopped by signal $((status - 128)) with no report and no finding; running it once more"
+    tail -n 5 "$log"
+    attempt=2
+    continue
+  fi
+  break
+done
+
+echo "$name: FAILED, exit status $status (log: $log)"
+[ -n "$report" ] && { echo "--- why"; echo "$report"; }
+echo "--- last lines"
+tail -n 25 "$log"
+for f in $(findings); do
+  echo "--- finding $(basename "$f"), $(wc -c < "$f") bytes, base64 (decode with: base64 -d > input):"
+  head -c 8192 "$f" | base64
+done
+exit "$status"
