@@ -234,6 +234,110 @@ std::unique_ptr<IrradianceCache> searchCache(const BakeSetup& b) {
 
 constexpr int kOfferMaxProbes = kMaxBoxGridProbes;
 
+// bake.target_error's trials: at most this many of the volumes' own probes, rays in
+// [kMinTargetRays, kMaxTargetRays] (the top is the standard-error factors' calibration count), the
+// bounce trials at kBounceTrialRays each (the same rays for b and b + 1, so their difference has
+// little noise) over a cache of at most kBounceTrialCache points a side.
+constexpr size_t kPilotProbes = 64;
+constexpr int kMinTargetRays = 16, kMaxTargetRays = 16384;
+constexpr int kBounceTrialRays = 512;
+constexpr int kBounceTrialCache = 48;
+
+// Chooses rays and bounces from bake.target_error, into setup.q, and clears the volumes' own
+// ray_count, which the target replaces (in `scene`, whose volumes `setup` points at).
+std::optional<SamplingChoice> chooseSampling(SceneDescription& scene, BakeSetup& setup,
+                                             const std::function<void(const std::string&)>& phase) {
+    if (!scene.bake.targetError) return std::nullopt;
+    const double target = *scene.bake.targetError;
+    const std::string at = "bake.target_error = " + nlohmann::json(target).dump();
+    if (setup.referenceMode)
+        throw ProjectError(at + ": the reference preset path-traces every bounce to convergence; use draft, "
+                                "standard or high with a target, or unset bake.target_error");
+    if (setup.volumes.empty())
+        throw ProjectError(at + ": it measures the probes of a probe volume, and none is enabled");
+    phase("choosing rays and bounces");
+    const auto start = Clock::now();
+    const Heightfield& hf = setup.terrain.heightfield;
+    SamplingChoice c;
+    c.target = target;
+
+    // What the target replaces, for the report.
+    std::ostringstream replaced;
+    const BakeQuality preset = qualityPreset(scene.bake.quality);
+    replaced << (scene.bake.rays ? "bake.rays " + std::to_string(*scene.bake.rays)
+                                 : "the " + std::string(qualityName(scene.bake.quality)) + " preset's " +
+                                       std::to_string(preset.rays) + " rays")
+             << " and "
+             << (scene.bake.bounces ? "bake.bounces " + std::to_string(*scene.bake.bounces)
+                                    : std::to_string(preset.bounces) + " bounces");
+    for (const auto* v : setup.volumes) {
+        const size_t index = size_t(v - scene.probeVolumes.data());
+        if (!v->rayCount) continue;
+        replaced << "; probe_volumes[" << index << "].ray_count " << *v->rayCount;
+        scene.probeVolumes[index].rayCount.reset();
+    }
+    c.replaced = replaced.str();
+
+    // The pilot probes: spread evenly over every enabled volume's valid probes as placed now.
+    std::vector<glm::vec3> all;
+    for (const auto* v : setup.volumes) {
+        const ProbeLayout layout = placeProbes(*v, hf);
+        for (size_t i = 0; i < layout.positions.size(); ++i)
+            if (layout.valid[i]) all.push_back(layout.positions[i]);
+    }
+    std::vector<glm::vec3> pilot;
+    for (size_t k = 0; k < std::min(all.size(), kPilotProbes); ++k)
+        pilot.push_back(all[k * all.size() / std::min(all.size(), kPilotProbes)]);
+    const std::vector<uint8_t> valid(pilot.size(), 1);
+    c.pilotProbes = pilot.size();
+    c.pilotRays = kBounceTrialRays;
+    constexpr uint64_t kPilotSeed = 0x9170AB5Eull;
+
+    // Bounces: caches after 0..kMaxBounces-1 gathers from one set of rays; b bounces read the
+    // cache after b - 1 gathers (0 bounces: sky visibility, no cache).
+    const std::vector<IrradianceCache> caches = IrradianceCache::byGathers(
+        setup.lighting, std::min(setup.q.cacheResolution, kBounceTrialCache), setup.q.cacheRays, setup.q.sunSamples,
+        kMaxBounces - 1, BakeControl{});
+    auto cacheFor = [&](int bounces) { return bounces > 0 ? &caches[size_t(bounces - 1)] : nullptr; };
+    std::map<int, ProbeBake> byBounces;
+    auto bakedAt = [&](int bounces) -> const ProbeBake& {
+        auto it = byBounces.find(bounces);
+        if (it == byBounces.end())
+            it = byBounces.emplace(bounces, bakeProbes(setup.lighting, cacheFor(bounces), bounces, pilot, valid,
+                                                       kBounceTrialRays, kPilotSeed, BakeControl{})).first;
+        return it->second;
+    };
+    c.bounceSearch = searchBounces(target, kMaxBounces, [&](int b) {
+        const double change = compareToReference(bakedAt(b).sh, bakedAt(b + 1).sh, valid).p95;
+        byBounces.erase(b);
+        return change;
+    });
+    c.bounces = c.bounceSearch.chosen;
+
+    // Rays, at those bounces.
+    c.raySearch = searchRays(target, kMinTargetRays, kMaxTargetRays, setup.q.rays, [&](int rays) {
+        const ProbeBake b = bakeProbes(setup.lighting, cacheFor(c.bounces), c.bounces, pilot, valid, rays,
+                                       kPilotSeed, BakeControl{});
+        return spreadOf(b.standardError).p95;
+    });
+    c.rays = c.raySearch.chosen;
+    c.met = c.raySearch.met && c.bounceSearch.met;
+    c.seconds = secondsSince(start);
+
+    std::ostringstream sum;
+    sum << grouped(uint64_t(c.rays)) << " rays (p95 standard error " << percent(c.raySearch.error) << "), "
+        << c.bounces << " bounce" << (c.bounces == 1 ? "" : "s");
+    if (c.bounceSearch.met)
+        sum << " (one more adds " << percent(c.bounceSearch.error) << ")";
+    else
+        sum << " (the most allowed; one more still adds " << percent(c.bounceSearch.error) << ")";
+    c.summary = sum.str();
+
+    setup.q.rays = c.rays;
+    setup.q.bounces = c.bounces;
+    return c;
+}
+
 // Chooses grid_dims or adaptive.tolerance for every enabled volume with a target_error, in place
 // in `scene` (whose volumes `setup` points at). The project's terrain, lighting and tracer are
 // the setup's; nothing is loaded again.
@@ -610,6 +714,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
 
     BakeSetup setup;
     prepare(project, setup, report, cancelled);
+    const std::optional<SamplingChoice> sampling =
+        chooseSampling(request.project.scene, setup, [&](const std::string& p) { report(p, 0.02); });
     const std::map<size_t, TargetChoice> targets =
         chooseTargets(request.project.scene, setup, [&](const std::string& p) { report(p, 0.02); });
     if (cancelled()) throw BakeCancelled();
@@ -939,6 +1045,27 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
     for (const auto& [index, c] : targets)
         if (!c.warning.empty()) out.warnings.push_back(c.warning);
+    if (sampling) {
+        // Judged on the bake's own probes, every volume's, not only the pilot's.
+        double baked = 0.0;
+        for (const auto& vr : volumeReports) baked = std::max(baked, vr["standard_error"]["p95"].get<double>());
+        nlohmann::json t = samplingChoiceReport(*sampling);
+        t["pilot_met"] = t["met"];
+        t["baked_standard_error_p95"] = baked;
+        t["met"] = sampling->bounceSearch.met && baked <= sampling->target;
+        if (!t["met"].get<bool>()) {
+            std::ostringstream w;
+            w << "bake.target_error " << percent(sampling->target) << " is not met: ";
+            if (!sampling->bounceSearch.met)
+                w << "after " << kMaxBounces << " bounces one more still adds " << percent(sampling->bounceSearch.error);
+            else
+                w << grouped(uint64_t(sampling->rays)) << " rays leave a p95 standard error of " << percent(baked);
+            w << "; raise the target"
+              << (sampling->rays >= kMaxTargetRays ? "" : " or set bake.rays above " + std::to_string(sampling->rays));
+            out.warnings.push_back(w.str());
+        }
+        out.report["sampling_target"] = t;
+    }
     out.report["warnings"] = out.warnings;
     {
         // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
@@ -1001,6 +1128,27 @@ void flatten(const nlohmann::json& v, const std::string& path, std::map<std::str
 }
 
 }  // namespace
+
+nlohmann::json samplingChoiceReport(const SamplingChoice& c) {
+    auto trials = [](const SamplingSearch& s, const char* key) {
+        nlohmann::json out = nlohmann::json::array();
+        for (const auto& t : s.trials) out.push_back({{key, t.value}, {"p95", t.error}});
+        return out;
+    };
+    return {{"target", c.target},
+            {"rays", c.rays},
+            {"bounces", c.bounces},
+            {"replaced", c.replaced},
+            {"pilot_probes", c.pilotProbes},
+            {"bounce_trial_rays", c.pilotRays},
+            {"standard_error_p95", c.raySearch.error},
+            {"next_bounce_change_p95", c.bounceSearch.error},
+            {"met", c.met},
+            {"ray_trials", trials(c.raySearch, "rays")},
+            {"bounce_trials", trials(c.bounceSearch, "bounces")},
+            {"seconds", c.seconds},
+            {"summary", c.summary}};
+}
 
 nlohmann::json targetChoiceReport(const TargetChoice& c) {
     return {{"target", c.target},
@@ -1091,8 +1239,10 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     BakeSetup setup;
     BakeRequest chosen = request;
     prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; });
+    const std::optional<SamplingChoice> sampling = chooseSampling(chosen.project.scene, setup, [](const std::string&) {});
     const std::map<size_t, TargetChoice> targets = chooseTargets(chosen.project.scene, setup, [](const std::string&) {});
     BakeEstimate e = estimateWith(chosen, setup, threads);
+    e.sampling = sampling;
     for (auto& ve : e.volumes)
         for (const auto& [index, c] : targets)
             if (chosen.project.scene.probeVolumes[index].name == ve.name) {
@@ -1100,6 +1250,25 @@ BakeEstimate estimateBake(const BakeRequest& request) {
                 if (!c.warning.empty()) e.warnings.push_back(c.warning);
             }
     return e;
+}
+
+Project resolveTargets(const Project& project, int threads) {
+    bool any = bool(project.scene.bake.targetError);
+    for (const auto& v : project.scene.probeVolumes) any = any || (v.enabled && v.targetError);
+    if (!any) return project;
+    threads = threads > 0 ? threads : tbb::info::default_concurrency();
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    Project resolved = project;
+    BakeSetup setup;
+    prepare(resolved, setup, [](const std::string&, double) {}, [] { return false; });
+    if (chooseSampling(resolved.scene, setup, [](const std::string&) {})) {
+        resolved.scene.bake.rays = setup.q.rays;
+        resolved.scene.bake.bounces = setup.q.bounces;
+        resolved.scene.bake.targetError.reset();
+    }
+    chooseTargets(resolved.scene, setup, [](const std::string&) {});
+    for (auto& v : resolved.scene.probeVolumes) v.targetError.reset();
+    return resolved;
 }
 
 namespace {

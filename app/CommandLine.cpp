@@ -280,6 +280,14 @@ std::string duration(double seconds) {
 int printEstimate(const BakeEstimate& e) {
     std::cout << "dry run: nothing baked, nothing written (" << e.quality << ", " << e.rays
               << " rays, " << e.bounces << " bounces, " << e.threads << " threads)\n";
+    if (e.sampling) {
+        const SamplingChoice& t = *e.sampling;
+        std::cout << "  bake.target_error " << fixed(100.0 * t.target, 1) << " %: " << t.summary << " on "
+                  << t.pilotProbes << " probes (replaces " << t.replaced << "; "
+                  << (t.met ? "meets it" : "misses it") << "; "
+                  << t.raySearch.trials.size() + t.bounceSearch.trials.size() << " trials, " << duration(t.seconds)
+                  << ")\n";
+    }
     for (const VolumeEstimate& v : e.volumes) {
         std::cout << "  " << v.name << ": ";
         if (v.placement == ProbePlacement::Adaptive)
@@ -391,6 +399,14 @@ int commandBake(const Args& a) {
               << " s (" << r["quality"]["preset"].get<std::string>() << ", "
               << r["quality"]["rays"].get<int>() << " rays, " << r["quality"]["bounces"].get<int>()
               << " bounces, " << r["threads"].get<int>() << " threads)\n";
+    if (r.contains("sampling_target")) {
+        const auto& t = r["sampling_target"];
+        std::cout << "  bake.target_error " << fixed(100.0 * t["target"].get<double>(), 1) << " %: "
+                  << t["summary"].get<std::string>() << " (replaces " << t["replaced"].get<std::string>()
+                  << "); the baked probes' p95 standard error is "
+                  << fixed(100.0 * t["baked_standard_error_p95"].get<double>(), 2) << " % ("
+                  << (t["met"].get<bool>() ? "meets it" : "misses it") << ")\n";
+    }
     for (const auto& v : r["volumes"]) {
         std::cout << "  " << v["name"].get<std::string>() << ": " << v["probes"].get<size_t>()
                   << " probes (" << v["invalid_probes"].get<size_t>() << " inside the terrain), "

@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include "AtomicFile.h"
+#include "BakeJob.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
@@ -137,6 +138,42 @@ struct Candidate {
     double estimate = 0.0;    // seconds
 };
 
+// A point's settings as they apply to the user's project, not to the resolved one the study
+// measures. Where the project asks for an accuracy (bake.target_error, a volume's target_error),
+// a point that sets what the target chooses clears that target and pins the rest of the target's
+// choice, so that the applied project bakes what was measured.
+std::vector<std::string> pinTargets(std::vector<std::string> sets, const Project& original, const Project& resolved,
+                                    size_t volumeIndex) {
+    auto keyOf = [](const std::string& set) { return set.substr(0, set.find('=')); };
+    auto sets_ = [&](const std::string& key) {
+        return std::any_of(sets.begin(), sets.end(), [&](const std::string& x) { return keyOf(x) == key; });
+    };
+    auto touches = [&](const std::vector<std::string>& keys) {
+        return std::any_of(keys.begin(), keys.end(), [&](const std::string& k) {
+            return std::any_of(sets.begin(), sets.end(), [&](const std::string& x) { return keyOf(x).rfind(k, 0) == 0; });
+        });
+    };
+    std::vector<std::string> pins;
+    const BakeSettings& rb = resolved.scene.bake;
+    if (original.scene.bake.targetError && touches({"bake.rays", "bake.bounces", "bake.quality"})) {
+        pins.push_back("bake.target_error=null");
+        if (!sets_("bake.rays") && rb.rays) pins.push_back("bake.rays=" + std::to_string(*rb.rays));
+        if (!sets_("bake.bounces") && rb.bounces) pins.push_back("bake.bounces=" + std::to_string(*rb.bounces));
+    }
+    const std::string at = "probe_volumes[" + std::to_string(volumeIndex) + "].";
+    if (volumeIndex < original.scene.probeVolumes.size() && original.scene.probeVolumes[volumeIndex].targetError &&
+        touches({at + "grid_dims", at + "placement", at + "spacing", at + "adaptive."})) {
+        const ProbeVolumeSettings& rv = resolved.scene.probeVolumes[volumeIndex];
+        pins.push_back(at + "target_error=null");
+        if (!sets_(at + "grid_dims"))
+            pins.push_back(at + "grid_dims=" + std::to_string(rv.gridDims[0]) + "," + std::to_string(rv.gridDims[2]));
+        if (!sets_(at + "adaptive.tolerance") && rv.adaptive.tolerance)
+            pins.push_back(at + "adaptive.tolerance=" + fmt("%.6g", *rv.adaptive.tolerance));
+    }
+    sets.insert(sets.end(), pins.begin(), pins.end());
+    return sets;
+}
+
 struct Study {
     const Project& project;
     const StudyOptions& options;
@@ -163,6 +200,10 @@ struct Study {
         rateWork[kind] = work;
         rate[kind] = seconds / work;
     }
+
+    // The project as the user has it: `project` is its resolution (resolveTargets), what the
+    // study measures, which differs where it asks for an accuracy.
+    const Project* original = nullptr;
 
     Study(const Project& p, const StudyOptions& o, const StudyProgress& pr, const std::atomic<bool>* c)
         : project(p), options(o), progress(pr), cancel(c) {}
@@ -636,6 +677,8 @@ void Study::run() {
     // The error map's truth: a map twice as dense as the project's (at least 32, at most 256).
     denseMapResolution = std::clamp(2 * std::max(s.bake.errorMapResolution, 16), 32, 256);
     std::vector<Candidate> todo = candidates(current->layout);
+    if (original)
+        for (Candidate& c : todo) c.sets = pinTargets(c.sets, *original, project, volumeIndex);
     {
         const double work = double(denseMapResolution) * denseMapResolution * current->rays;
         const double est = kSafety * work * rate["rays"];
@@ -768,7 +811,10 @@ StudyResult runStudy(const Project& project, const StudyOptions& options, const 
                            fmt("%g", kMinStudyBudget) + ", " + fmt("%g", kMaxStudyBudget) + "] seconds");
     const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    Study st(project, options, progress, cancel);
+    // Targets are resolved first, so the study measures what the bake would bake.
+    const Project resolved = resolveTargets(project, threads);
+    Study st(resolved, options, progress, cancel);
+    st.original = &project;
     st.result.budgetSeconds = options.budgetSeconds;
     st.result.threads = threads;
     st.run();

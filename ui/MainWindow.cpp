@@ -1120,9 +1120,15 @@ void MainWindow::updateEstimate() {
     const double cacheRays =
         cached ? double(cachePoints[0]) * cachePoints[1] * (q.cacheRays + q.sunSamples) : 0.0;
     const double seconds = (rays * (p.scene.bake.quality == QualityPreset::Reference ? 8.0 : 1.5) + cacheRays) / 3.0e6;
-    estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, %4 error-map points, about %5 s")
+    // Targets are chosen by trial bakes, too slow for every edit: say the figures are the settings'.
+    bool targets = bool(p.scene.bake.targetError);
+    for (const auto& v : p.scene.probeVolumes) targets = targets || (v.enabled && v.targetError);
+    estimate_->setText(QString("Estimate: %1 probes (%2 inside the terrain), %3, %4 error-map points, about %5 s%6")
                            .arg(probes).arg(invalid).arg(formatBytes(double(bytes))).arg(mapPoints)
-                           .arg(seconds, 0, 'f', 1));
+                           .arg(seconds, 0, 'f', 1)
+                           .arg(targets ? QString(" at the settings as they stand; the bake's targets choose "
+                                                  "their own (terralux --bake --dry-run shows what)")
+                                        : QString()));
 }
 
 void MainWindow::updateTitle() {

@@ -263,6 +263,23 @@ int cacheResolutionFor(const Heightfield& hf, const BakeQuality& q, uint64_t pro
 
 IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays, int sunSamples,
                                  int bounces, const BakeControl& control)
+    : IrradianceCache(L, resolution, rays, sunSamples, bounces, control, nullptr) {}
+
+std::vector<IrradianceCache> IrradianceCache::byGathers(const BakeLighting& L, int resolution, int rays,
+                                                        int sunSamples, int gathers, const BakeControl& control) {
+    std::vector<std::vector<glm::vec3>> levels;
+    IrradianceCache last(L, resolution, rays, sunSamples, gathers, control, &levels);
+    std::vector<IrradianceCache> out;
+    for (auto& level : levels) {
+        out.push_back(last);
+        out.back().irradiance_ = std::move(level);
+    }
+    return out;
+}
+
+IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays, int sunSamples,
+                                 int bounces, const BakeControl& control,
+                                 std::vector<std::vector<glm::vec3>>* levels)
     : lighting_(&L) {
     const Heightfield& hf = L.tracer->heightfield();
     skirt_ = L.sky.openIrradianceUp() + L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
@@ -328,6 +345,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
     irradiance_ = direct;
     std::vector<glm::vec3> next(points);
     for (int b = 0; b < bounces; ++b) {
+        if (levels) levels->push_back(irradiance_);
         BakeControl gather = control;
         gather.progress = control.progress
                               ? [&](double f) { control.progress(0.8 + 0.2 * (b + f) / bounces); }
@@ -357,6 +375,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
         });
         irradiance_.swap(next);
     }
+    if (levels) levels->push_back(irradiance_);
 }
 
 glm::vec3 IrradianceCache::interpolate(const std::vector<glm::vec3>& e, float x, float z) const {

@@ -91,6 +91,10 @@ class IrradianceCache {
 public:
     IrradianceCache(const BakeLighting& lighting, int resolution, int rays, int sunSamples,
                     int bounces, const BakeControl& control);
+    // The caches after 0, 1, ..., `gathers` gathers, from one set of traced rays: what a search
+    // over bounces compares (only the gathers differ, so their differences carry no ray noise).
+    static std::vector<IrradianceCache> byGathers(const BakeLighting& lighting, int resolution, int rays,
+                                                  int sunSamples, int gathers, const BakeControl& control);
     // Irradiance arriving at a hit point: bilinear over the cache on the terrain; on the skirt,
     // the open sky and the unshadowed sun (docs/lighting.md).
     glm::vec3 at(const RayHit& hit) const;
@@ -105,6 +109,9 @@ public:
     static std::array<int, 2> gridPoints(const Heightfield& hf, int resolution);
 
 private:
+    // `levels`, when given, receives the irradiance after each gather count, 0 to `bounces`.
+    IrradianceCache(const BakeLighting& lighting, int resolution, int rays, int sunSamples, int bounces,
+                    const BakeControl& control, std::vector<std::vector<glm::vec3>>* levels);
     glm::vec3 interpolate(const std::vector<glm::vec3>& e, float x, float z) const;
     const BakeLighting* lighting_;
     int nx_ = 0, nz_ = 0, rays_ = 0;

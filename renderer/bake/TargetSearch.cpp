@@ -55,6 +55,49 @@ int bisect(int lo, int hi, int start, double target, const std::function<double(
 
 }  // namespace
 
+SamplingSearch searchRays(double target, int minRays, int maxRays, int startRays,
+                          const std::function<double(int)>& p95At) {
+    const auto log2Of = [](int n) { return int(std::ceil(std::log2(double(std::max(n, 1))) - 1e-9)); };
+    const int lo = log2Of(minRays), hi = std::max(lo, int(std::floor(std::log2(double(std::max(maxRays, 1))))));
+    SamplingSearch s;
+    std::map<int, double> seen;
+    auto error = [&](int k) {
+        const double e = p95At(1 << k);
+        seen[k] = e;
+        s.trials.push_back({1 << k, e});
+        return e;
+    };
+    // error ∝ N^(-3/4): N·(e/target)^(4/3) rays meet it, log2 of that is k + (4/3)·log2(e/target).
+    const auto guess = [&](int k, double e) {
+        if (!(e > 0.0)) return lo;
+        return int(std::ceil(double(k) + (4.0 / 3.0) * std::log2(e / target) - 1e-9));
+    };
+    const int pass = bisect(lo, hi, log2Of(startRays), target, error, guess);
+    const int k = std::min(pass, hi);
+    if (!seen.count(k)) error(k);
+    s.chosen = 1 << k;
+    s.error = seen[k];
+    s.met = pass <= hi;
+    return s;
+}
+
+SamplingSearch searchBounces(double target, int maxBounces, const std::function<double(int)>& changeAfter) {
+    SamplingSearch s;
+    for (int b = 0; b < maxBounces; ++b) {
+        const double change = changeAfter(b);
+        s.trials.push_back({b, change});
+        if (change < target) {
+            s.chosen = b;
+            s.error = change;
+            s.met = true;
+            return s;
+        }
+    }
+    s.chosen = std::max(maxBounces, 0);
+    s.error = s.trials.empty() ? 0.0 : s.trials.back().error;
+    return s;
+}
+
 PlacementSearch searchTerrainGrid(const Heightfield& hf, double target, int maxProbes, int startPerSide,
                                   const GridTrialFn& trial) {
     PlacementSearch s;

@@ -63,6 +63,29 @@ using ToleranceTrialFn = std::function<PlacementTrial(double tolerance)>;
 // `target`, bisecting on k from k = 0.
 PlacementSearch searchAdaptiveTolerance(double target, const ToleranceTrialFn& trial);
 
+// Rays and bounces from an accuracy (bake.target_error; docs/lighting.md, "Asking for an accuracy").
+struct SamplingTrial {
+    int value = 0;       // rays per probe, or bounces
+    double error = 0.0;  // rays: p95 of the probes' relative standard error; bounces: p95 of the
+                         // relative change of irradiance that one more bounce makes
+};
+struct SamplingSearch {
+    int chosen = 0;
+    double error = 0.0;  // of the chosen value
+    bool met = false;
+    std::vector<SamplingTrial> trials;  // in the order measured
+};
+// The fewest rays per probe, a power of two in [minRays, maxRays], whose measured p95 standard
+// error meets `target`, from `startRays`. Steps follow the quasi-Monte Carlo model error ∝ N^(-3/4)
+// of a spherical Fibonacci lattice (docs/lighting.md, "Monte Carlo standard error"), alternating
+// with plain bisection of the bracket. When even maxRays misses, maxRays, not met.
+SamplingSearch searchRays(double target, int minRays, int maxRays, int startRays,
+                          const std::function<double(int rays)>& p95At);
+// The fewest bounces b in [0, maxBounces) after which one more changes irradiance by less than
+// `target` (`changeAfter(b)` measures b against b + 1), tried in order since the change falls
+// with each bounce. When none does, maxBounces, not met, with the last change measured.
+SamplingSearch searchBounces(double target, int maxBounces, const std::function<double(int bounces)>& changeAfter);
+
 // The trial of a terrain grid: `volume` placed with `dims`, its probes baked with `baker`, its
 // error map measured at `resolution` (the truth baked by the same baker).
 PlacementTrial measureGridTrial(ProbeVolumeSettings volume, const Heightfield& hf, const std::array<int, 3>& dims,

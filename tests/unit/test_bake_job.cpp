@@ -117,6 +117,120 @@ TEST(StandardError, MatchesTheMeasuredSamplingErrorOfEachPreset) {
     }
 }
 
+// bake.target_error: the rays and bounces it chooses meet it on the bake's own probes, measured
+// against what the estimate stands for: the same probes at 16 384 rays (sampling) and at many
+// more bounces (truncation).
+TEST(BakeTargetError, ChosenRaysAndBouncesMeetItAgainstAFineBake) {
+    const fs::path dir = tempDir("sampling_target");
+    Project p = cropProject(dir, 8);
+    p.scene.bake.targetError = 0.01;
+    const nlohmann::json r = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+    ASSERT_TRUE(r.contains("sampling_target")) << r.dump(1);
+    const nlohmann::json& t = r["sampling_target"];
+    const int rays = t["rays"].get<int>(), bounces = t["bounces"].get<int>();
+    EXPECT_EQ(r["quality"]["rays"].get<int>(), rays);
+    EXPECT_EQ(r["quality"]["bounces"].get<int>(), bounces);
+    EXPECT_TRUE(t["met"].get<bool>()) << t.dump(1);
+    EXPECT_LE(t["baked_standard_error_p95"].get<double>(), 0.01);
+    EXPECT_EQ(t["replaced"].get<std::string>(), "the standard preset's 256 rays and 2 bounces");
+
+    const DemImportResult dem = importDem(kCrop.string());
+    const HeightfieldTracer tracer(dem.heightfield);
+    const BakeLighting L = test::skyAndSun(tracer);
+    const ProbeLayout layout = placeProbes(p.scene.probeVolumes[0], dem.heightfield);
+    const BakeQuality q = qualityPreset(QualityPreset::Standard);
+    // b bounces read the cache after b - 1 gathers.
+    const std::vector<IrradianceCache> caches =
+        IrradianceCache::byGathers(L, q.cacheResolution, q.cacheRays, q.sunSamples, 12, {});
+    auto cacheFor = [&](int b) { return b > 0 ? &caches[size_t(b - 1)] : nullptr; };
+    // Sampling: E(up) at the chosen rays against 16 384 rays, same bounces.
+    const ProbeBake atChosen = bakeProbes(L, cacheFor(bounces), bounces, layout.positions, layout.valid, rays, 5, {});
+    const ProbeBake fine = bakeProbes(L, cacheFor(bounces), bounces, layout.positions, layout.valid, 16384, 6, {});
+    auto up = [](const sh::ShRgb& s) { return double(luminance(sh::evalIrradiance(s, glm::vec3(0, 1, 0)))); };
+    std::vector<float> sampling;
+    for (size_t i = 0; i < layout.positions.size(); ++i)
+        if (layout.valid[i])
+            sampling.push_back(float(std::abs(up(atChosen.sh[i]) - up(fine.sh[i])) / up(fine.sh[i])));
+    const double samplingP95 = spreadOf(sampling).p95;
+    std::printf("target 1 %%: %d rays, %d bounces; sampling error p95 %.3f %%\n", rays, bounces, 100 * samplingP95);
+    // A p95 of an estimate over 64 probes: within 1.5x, as the estimate itself is checked.
+    EXPECT_LT(samplingP95, 1.5 * 0.01);
+    // Truncation: the chosen bounces against 13, on the same rays.
+    const ProbeBake more = bakeProbes(L, cacheFor(13), 13, layout.positions, layout.valid, 1024, 7, {});
+    const ProbeBake chosenBounces = bakeProbes(L, cacheFor(bounces), bounces, layout.positions, layout.valid, 1024, 7, {});
+    const double truncation = compareToReference(chosenBounces.sh, more.sh, layout.valid).p95;
+    std::printf("truncation error p95 %.3f %%\n", 100 * truncation);
+    EXPECT_LT(truncation, 0.01);
+    // Fewer bounces would not have met it: the choice is the fewest.
+    if (bounces > 0) {
+        const ProbeBake fewer =
+            bakeProbes(L, cacheFor(bounces - 1), bounces - 1, layout.positions, layout.valid, 1024, 7, {});
+        EXPECT_GT(compareToReference(fewer.sh, more.sh, layout.valid).p95, 0.01);
+    }
+    fs::remove_all(dir);
+}
+
+// The bounce search's caches are the caches a bake of each bounce count builds.
+TEST(BakeTargetError, CachesByGathersAreTheCachesOfEachGatherCount) {
+    const DemImportResult dem = importDem(kCrop.string());
+    const HeightfieldTracer tracer(dem.heightfield);
+    const BakeLighting L = test::skyAndSun(tracer);
+    const std::vector<IrradianceCache> levels = IrradianceCache::byGathers(L, 12, 16, 2, 3, {});
+    ASSERT_EQ(levels.size(), 4u);
+    const Heightfield& hf = dem.heightfield;
+    for (int g = 0; g <= 3; ++g) {
+        const IrradianceCache own(L, 12, 16, 2, g, {});
+        for (float fx : {0.1f, 0.37f, 0.8f}) {
+            RayHit hit;
+            hit.onTerrain = true;
+            hit.position = glm::vec3(hf.minX() + fx * (hf.maxX() - hf.minX()), 0.0f,
+                                     hf.minZ() + (1.0f - fx) * (hf.maxZ() - hf.minZ()));
+            const glm::vec3 a = levels[size_t(g)].at(hit), b = own.at(hit);
+            EXPECT_EQ(a.x, b.x) << g;
+            EXPECT_EQ(a.y, b.y) << g;
+            EXPECT_EQ(a.z, b.z) << g;
+        }
+    }
+    // Bounce light adds up: each gather count holds more light than the last.
+    RayHit hit;
+    hit.onTerrain = true;
+    hit.position = glm::vec3(0.5f * (hf.minX() + hf.maxX()), 0.0f, 0.5f * (hf.minZ() + hf.maxZ()));
+    EXPECT_GT(levels[3].at(hit).y, levels[0].at(hit).y);
+}
+
+TEST(BakeTargetError, TighterTargetsTraceMoreAndTheReferencePresetRefusesIt) {
+    const fs::path dir = tempDir("sampling_target_order");
+    Project p = cropProject(dir, 8);
+    p.scene.bake.rays = 100;
+    p.scene.probeVolumes[0].rayCount = 300;
+    int last = 0;
+    for (double target : {0.04, 0.01, 0.0025}) {
+        p.scene.bake.targetError = target;
+        const BakeEstimate e = estimateBake(BakeRequest{p, 0, false});
+        ASSERT_TRUE(e.sampling);
+        EXPECT_EQ(e.rays, e.sampling->rays);
+        EXPECT_EQ(e.volumes[0].raysPerProbe, e.sampling->rays) << "the target replaces the volume's ray_count";
+        EXPECT_GT(e.rays, last) << target;
+        EXPECT_EQ(e.sampling->replaced, "bake.rays 100 and 2 bounces; probe_volumes[0].ray_count 300");
+        last = e.rays;
+        // What the study measures for the same project.
+        const Project resolved = resolveTargets(p);
+        EXPECT_EQ(resolved.scene.bake.rays, std::optional<int>(e.rays));
+        EXPECT_EQ(resolved.scene.bake.bounces, std::optional<int>(e.bounces));
+        EXPECT_FALSE(resolved.scene.bake.targetError);
+        EXPECT_FALSE(resolved.scene.probeVolumes[0].rayCount);
+    }
+    p.scene.bake.quality = QualityPreset::Reference;
+    try {
+        estimateBake(BakeRequest{p, 0, false});
+        ADD_FAILURE() << "the reference preset took a target";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("bake.target_error = 0.0025: the reference preset"), std::string::npos)
+            << e.what();
+    }
+    fs::remove_all(dir);
+}
+
 // The report counts every ray: the irradiance cache's as well as the probes'.
 TEST(BakeReport, RaysCountTheCacheAndTheProbes) {
     const fs::path dir = tempDir("rays");

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "BakeJob.h"
 #include "Project.h"
 #include "Study.h"
 #include "bake/DiffuseBake.h"
@@ -124,6 +125,47 @@ TEST(Study, ShortBudgetSkipsWhatDoesNotFitAndSaysSo) {
         EXPECT_FALSE(s.reason.empty()) << s.label;
         EXPECT_EQ(find(r, s.label), nullptr) << s.label << " both skipped and measured";
     }
+}
+
+// A project that asks for accuracies is studied as its bake would bake it, and a point applied
+// to it clears the target that would override the point, pinning the rest of the target's choice.
+TEST(Study, TargetsAreResolvedAndAPointClearsTheTargetItOverrides) {
+    StudyOptions o;
+    o.budgetSeconds = 5.0;
+    const Project project = sampleProject({"bake.target_error=0.02", "probe_volumes[0].target_error=0.3"});
+    const Project resolved = resolveTargets(project);
+    ASSERT_TRUE(resolved.scene.bake.rays && resolved.scene.bake.bounces);
+    const StudyResult r = runStudy(project, o, {}, nullptr);
+    ASSERT_GT(r.points.size(), 3u);
+    size_t raysPoints = 0, spacingPoints = 0;
+    for (const StudyPoint& p : r.points) {
+        auto has = [&](const std::string& set) { return std::find(p.sets.begin(), p.sets.end(), set) != p.sets.end(); };
+        auto setsKey = [&](const std::string& key) {
+            return std::any_of(p.sets.begin(), p.sets.end(), [&](const std::string& x) { return x.rfind(key + "=", 0) == 0; });
+        };
+        if (p.knob == "rays") {
+            ++raysPoints;
+            EXPECT_TRUE(has("bake.target_error=null")) << p.label;
+            EXPECT_TRUE(has("bake.bounces=" + std::to_string(*resolved.scene.bake.bounces))) << p.label;
+        }
+        if (p.knob == "spacing") {
+            ++spacingPoints;
+            EXPECT_TRUE(has("probe_volumes[0].target_error=null")) << p.label;
+        }
+        if (p.knob == "error_map") {
+            EXPECT_FALSE(setsKey("bake.target_error")) << p.label;
+        }
+        // Applied to the user's project, the point is the project the study measured.
+        nlohmann::json doc = projectToJson(project);
+        for (const auto& x : p.sets) applyOverride(doc, x);
+        const SceneDescription applied = sceneFromJson(doc, "test", nullptr);
+        if (p.knob == "rays" || p.knob == "bounces") {
+            EXPECT_FALSE(applied.bake.targetError) << p.label;
+            EXPECT_TRUE(applied.bake.rays && applied.bake.bounces) << p.label;
+        }
+    }
+    EXPECT_GT(raysPoints, 0u);
+    EXPECT_GT(spacingPoints, 0u);
 }
 
 TEST(Study, CancelStopsTheStudy) {

@@ -1,5 +1,5 @@
 // Placement from an accuracy (bake/TargetSearch.h): the search against a field whose
-// interpolation error is known in closed form, and the validation of target_error.
+// interpolation error is known in closed form, and the validation of both target_error settings.
 
 #include <algorithm>
 #include <cmath>
@@ -136,8 +136,53 @@ TEST(TargetSearch, AdaptiveToleranceIsTheLargestOnTheLadderThatMeets) {
     EXPECT_NEAR(never.chosen.tolerance, target * std::exp2(-6.0), 1e-12);
 }
 
+TEST(TargetSearch, RaysAreTheFewestPowerOfTwoThatMeets) {
+    // The lattice's model, error = 0.4·N^(-3/4): 0.01 needs N >= 40^(4/3) = 137, so 256.
+    size_t calls = 0;
+    const auto lattice = [&](int n) {
+        ++calls;
+        return 0.4 * std::pow(double(n), -0.75);
+    };
+    SamplingSearch s = searchRays(0.01, 16, 16384, 1024, lattice);
+    EXPECT_TRUE(s.met);
+    EXPECT_EQ(s.chosen, 256);
+    EXPECT_LE(s.error, 0.01);
+    EXPECT_LE(calls, 4u);
+    EXPECT_EQ(calls, s.trials.size());
+    // Where the model is wrong (independent samples, N^(-1/2): 0.01 needs 1 600), the bisection
+    // still lands on the fewest that meet.
+    s = searchRays(0.01, 16, 16384, 256, [](int n) { return 0.4 / std::sqrt(double(n)); });
+    EXPECT_TRUE(s.met);
+    EXPECT_EQ(s.chosen, 2048);
+    // Met at the floor, and never met: the most allowed, not met.
+    s = searchRays(0.5, 16, 16384, 256, lattice);
+    EXPECT_EQ(s.chosen, 16);
+    EXPECT_TRUE(s.met);
+    s = searchRays(1e-5, 16, 16384, 256, lattice);
+    EXPECT_EQ(s.chosen, 16384);
+    EXPECT_FALSE(s.met);
+    EXPECT_NEAR(s.error, lattice(16384), 1e-12);
+}
+
+TEST(TargetSearch, BouncesStopWhereTheNextAddsLessThanTheTarget) {
+    // Each bounce adds 0.3 of the last (an albedo-0.3 valley): 0.5·0.3^b < 0.01 from b = 4.
+    std::vector<int> asked;
+    const SamplingSearch s = searchBounces(0.01, 16, [&](int b) {
+        asked.push_back(b);
+        return 0.5 * std::pow(0.3, b);
+    });
+    EXPECT_TRUE(s.met);
+    EXPECT_EQ(s.chosen, 4);
+    EXPECT_EQ(asked, (std::vector<int>{0, 1, 2, 3, 4}));
+    EXPECT_LT(s.error, 0.01);
+    const SamplingSearch never = searchBounces(0.01, 16, [](int) { return 0.2; });
+    EXPECT_FALSE(never.met);
+    EXPECT_EQ(never.chosen, 16);
+    EXPECT_EQ(never.trials.size(), 16u);
+}
+
 TEST(TargetSearch, TargetErrorSettingsAreValidated) {
-    for (const char* path : {"probe_volumes[0].target_error"}) {
+    for (const char* path : {"probe_volumes[0].target_error", "bake.target_error"}) {
         EXPECT_EQ(projectErrorFor(path, 0.03), "") << path;
         EXPECT_EQ(projectErrorFor(path, nullptr), "") << path;
         for (const nlohmann::json& bad : {nlohmann::json(-0.1), nlohmann::json(0.0), nlohmann::json(1.0),
