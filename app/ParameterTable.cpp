@@ -857,6 +857,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("preset: the quality preset decides").label("Bounces")
         .about("Light bounces off the terrain; 0 = sky visibility only").redoes(kNothing)
         .field(&SceneDescription::bake, &BakeSettings::bounces);
+    add(Row("bake.target_error", T::Number)).above(0.0, 1.0).openAbove().decimals(3)
+        .autoMeans("none: rays and bounces (or the preset) stand").label("Target bake error")
+        .about("Relative error to aim at: rays from the probes' Monte Carlo standard error, bounces until the next one changes irradiance by less; replaces rays and bounces")
+        .redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::targetError);
     add(Row("bake.sh_encoding", T::Choice)).choices({"radiance", "irradiance"}).label("SH encoding")
         .about("radiance: SH projection of what the probe sees; irradiance: pre-convolved with the cosine lobe")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::encoding);

@@ -194,6 +194,9 @@ struct BakeSettings {
     // Points along the longer side of each volume's interpolation-error map (the interpolation-error debug view);
     // 0 = no map. Each point costs one probe bake.
     int errorMapResolution = 64;
+    // Relative Monte Carlo and truncation error the bake aims at: chooses rays and bounces and
+    // replaces what rays, bounces and the preset say (docs/lighting.md). Unset = they stand.
+    std::optional<double> targetError;
 };
 
 struct ExportSettings {

@@ -1,5 +1,5 @@
 // Placement from an accuracy (bake/TargetSearch.h): the search against a field whose
-// interpolation error is known in closed form, and the validation of target_error.
+// interpolation error is known in closed form, and the validation of both target_error settings.
 
 #include <algorithm>
 #include <cmath>
@@ -137,7 +137,7 @@ TEST(TargetSearch, AdaptiveToleranceIsTheLargestOnTheLadderThatMeets) {
 }
 
 TEST(TargetSearch, TargetErrorSettingsAreValidated) {
-    for (const char* path : {"probe_volumes[0].target_error"}) {
+    for (const char* path : {"probe_volumes[0].target_error", "bake.target_error"}) {
         EXPECT_EQ(projectErrorFor(path, 0.03), "") << path;
         EXPECT_EQ(projectErrorFor(path, nullptr), "") << path;
         for (const nlohmann::json& bad : {nlohmann::json(-0.1), nlohmann::json(0.0), nlohmann::json(1.0),
