@@ -191,7 +191,8 @@ void benchDem(const Dem& dem, const std::filesystem::path& out) {
                     (unsigned long long)a.bytes, a.seconds, 100.0 * a.p95,
                     at["met"].get<bool>() ? "met" : "missed", t.probes, 100.0 * t.p95,
                     t.volume["target"]["capped"].get<bool>() ? "capped" : t.volume["target"]["met"].get<bool>() ? "met" : "missed",
-                    dimsOf(s.chosen.dims).c_str(), u.probes, s.met ? "" : " (not reached)", (unsigned long long)u.bytes,
+                    dimsOf(s.chosen.dims).c_str(), u.probes,
+                    !s.met ? " (not reached)" : u.probes > size_t(kMaxTerrainGridProbes) ? " (past the limit)" : "", (unsigned long long)u.bytes,
                     u.seconds, 100.0 * u.p95, double(u.probes) / double(a.probes), double(u.bytes) / double(a.bytes));
         std::fflush(stdout);
         if (a.uncovered + t.uncovered + u.uncovered > 0)
