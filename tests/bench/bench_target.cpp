@@ -12,11 +12,13 @@
 // The uniform grid is the coarsest terrain grid (probes per side bisected by searchTerrainGrid)
 // whose p95 on those points is at or below the adaptive volume's; it may go past the 4096-probe
 // terrain-grid limit, which only the comparison lifts.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -139,8 +141,10 @@ Baked bake(Project project, const CommonPoints& c) {
     b.volume = o.report["volumes"][0];
     b.probes = b.volume["probes"].get<size_t>();
     b.bytes = b.volume["bytes"].get<uint64_t>();
-    for (const auto& f : o.files)
-        if (f.extension() == ".shprobe") measure(f, c, b);
+    const auto shprobe = std::find_if(o.files.begin(), o.files.end(),
+                                      [](const std::filesystem::path& f) { return f.extension() == ".shprobe"; });
+    if (shprobe == o.files.end()) throw std::runtime_error("the bake wrote no .shprobe");
+    measure(*shprobe, c, b);
     return b;
 }
 
