@@ -2,7 +2,8 @@
 # target_checks.sh CASE TERRALUX WORKDIR DEM
 # probe_volumes[].target_error end to end on a committed DEM crop: the bake meets the target on
 # its own error map and says why it chose what it did; the dry run says the same and writes
-# nothing; a target past the terrain-grid limit is one plain warning.
+# nothing; a target past the terrain-grid limit is one plain warning; an adaptive volume's target
+# chooses its tolerance the same way.
 set -u
 case_=$1 terralux=$2 work=$3 dem=$4
 rm -rf "$work" && mkdir -p "$work"
@@ -54,6 +55,31 @@ v = r["volumes"][0]
 assert v["probes"] <= 4096 and v["probes"] > 3500, v["probes"]
 assert v["target"]["capped"] is True and v["target"]["met"] is False, v["target"]
 assert len(r["warnings"]) == 1 and "4096 probes" in r["warnings"][0], r["warnings"]
+PY
+    ;;
+  adaptive)
+    # An adaptive volume's target sets adaptive.tolerance; the dry run names the same choice.
+    set -- --quality draft --dem "$dem" --set 'probe_volumes[0].placement=adaptive' \
+      --set 'probe_volumes[0].target_error=0.2'
+    "$terralux" --bake --dry-run --quiet --out "$work/dry" "$@" >"$work/dry_stdout" 2>"$work/dry_stderr" \
+      || fail "dry run exited $?"
+    grep -q "^dry run: nothing baked, nothing written" "$work/dry_stdout" || fail "no dry-run header"
+    choice='^    target_error 20.0 %: adaptive.tolerance ([0-9.e-]+): min cell [0-9]+ m, tolerance [0-9.]+ %, [0-9 ]+ probes, p95 [0-9.]+ %'
+    grep -Eq "$choice on a [0-9]+-point map \(meets it; [0-9]+ trials" "$work/dry_stdout" \
+      || fail "no choice in the dry run: $(cat "$work/dry_stdout")"
+    [ -e "$work/dry" ] && fail "the dry run created $work/dry"
+    [ -s "$work/dry_stderr" ] && fail "dry-run stderr not empty: $(cat "$work/dry_stderr")"
+    "$terralux" --bake --quiet --out "$work/out" "$@" >"$work/stdout" 2>"$work/stderr" || fail "bake exited $?"
+    grep -Eq "$choice \(meets it\)$" "$work/stdout" || fail "stdout does not explain the choice: $(cat "$work/stdout")"
+    [ -s "$work/stderr" ] && fail "stderr not empty: $(cat "$work/stderr")"
+    python3 - "$work/out/bake_report.json" <<'PY' || fail "bake_report.json"
+import json, sys
+v = json.load(open(sys.argv[1]))["volumes"][0]
+t, m = v["target"], v["error_map"]
+assert t["setting"] == "adaptive.tolerance" and t["replaced"] is None, t
+assert t["target"] == 0.2 and t["met"] is True and t["capped"] is False, t
+assert m["points"] > 100 and m["p95"] <= 0.2 and abs(t["p95"] - m["p95"]) < 1e-9, (t, m)
+assert v["probes"] > 0 and t["summary"].startswith("min cell "), (v["probes"], t)
 PY
     ;;
   *) echo "unknown case $case_"; exit 2 ;;
