@@ -1,14 +1,18 @@
 #!/bin/sh
 # run_fuzz.sh FUZZER SECONDS WORKDIR DICT CORPUS [REGRESSIONS]
-# Runs one libFuzzer target for SECONDS ("env": $TERRALUX_FUZZ_SECONDS, default 300; "smoke": 20) over its
+# Runs one libFuzzer target for SECONDS ("env": $TERRALUX_FUZZ_SECONDS, default 300; "smoke": see
+# below) over its
 # committed corpus and regression inputs. New inputs go to WORKDIR/corpus (libFuzzer writes to
 # its first corpus folder), crash, leak, timeout and OOM inputs to WORKDIR/artifacts. Limits:
 # 1 s per input ($TERRALUX_FUZZ_INPUT_SECONDS where a target sets more), 2 GiB resident and per
-# allocation. The 20-second smoke runs of the sanitize preset share two cores with the rest of the
-# suite, where an input that takes 0.8 s alone can take twice that: they allow at least 5 s, so
-# only a real hang fails them. Smoke runs use a fixed seed, so a change is judged on the same
-# mutations every time and CI does not fail on what one random draw happened to reach; the long
-# runs draw a new seed each time.
+# allocation. The smoke runs of the sanitize preset share two cores with the rest of the suite,
+# where an input that takes 0.8 s alone can take twice that: they allow at least 5 s, so only a
+# real hang fails them. A smoke run tries $TERRALUX_FUZZ_SMOKE_RUNS inputs (set per target by
+# fuzz/CMakeLists.txt) from a fixed seed, starting from the committed corpus alone (the previous
+# run's finds are cleared): every machine tries the same inputs in the same order, so what CI
+# finds, a local `ctest --preset sanitize` finds first. $TERRALUX_FUZZ_SMOKE_SECONDS (default 120)
+# only caps a machine too slow to finish them. The long runs keep their finds and draw a new seed
+# each time.
 #
 # libFuzzer's log goes to WORKDIR/fuzz.log. A CI log keeps only the end of a failed test's output,
 # so on failure this prints the lines that say why (the sanitizer or libFuzzer report), the log's
@@ -21,13 +25,16 @@ regressions=${6:-}
 timeout=${TERRALUX_FUZZ_INPUT_SECONDS:-1}
 [ "$seconds" = env ] && seconds=${TERRALUX_FUZZ_SECONDS:-300}
 seed=0
+runs=-1
 if [ "$seconds" = smoke ]; then
-  seconds=20
+  seconds=${TERRALUX_FUZZ_SMOKE_SECONDS:-120}
+  runs=${TERRALUX_FUZZ_SMOKE_RUNS:--1}
   seed=1
   [ "$timeout" -lt 5 ] && timeout=5
+  rm -rf "$work/corpus"
 fi
 mkdir -p "$work/corpus" "$work/artifacts"
-set -- -seed="$seed" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+set -- -seed="$seed" -runs="$runs" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=2048 \
   -print_final_stats=1 -artifact_prefix="$work/artifacts/" "$work/corpus" "$corpus"
 [ -n "$dict" ] && set -- -dict="$dict" "$@"
 [ -n "$regressions" ] && [ -d "$regressions" ] && set -- "$@" "$regressions"
@@ -44,7 +51,7 @@ while :; do
   "$fuzzer" "$@" > "$log" 2>&1 || status=$?
   if [ "$status" -eq 0 ]; then
     grep -E '^(Done|stat::)' "$log" || true
-    echo "$name: no finding in ${seconds} s (log: $log)"
+    echo "$name: no finding (log: $log)"
     exit 0
   fi
   new=$(findings | wc -l)

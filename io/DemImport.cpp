@@ -330,6 +330,23 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     GDALDatasetH readFrom = src.get();
     const double maxCells = options.maxCells;
 
+    // GDAL averages one output cell from one buffer of the source cells it covers, so a raster
+    // that declares far more cells than it can hold (a 90-byte ASCII grid that claims
+    // 240000 x 9940000) would ask for gigabytes before the first row is read. Refuse a
+    // reduction whose buffer per output cell passes 256 MiB of 4-byte samples.
+    auto checkReduction = [&](int outW, int outH) {
+        const double perCell =
+            (double(info.sourceWidth) / outW) * (double(info.sourceHeight) / outH);
+        constexpr double kMaxCellsPerOutput = 256.0 * 1024 * 1024 / 4;
+        if (perCell > kMaxCellsPerOutput)
+            fail(path, "raster " + std::to_string(info.sourceWidth) + "x" +
+                           std::to_string(info.sourceHeight) + " is too large to average down to " +
+                           std::to_string(outW) + "x" + std::to_string(outH) + " (" +
+                           fmt(std::round(perCell)) + " source cells per output cell, at most " +
+                           fmt(kMaxCellsPerOutput) +
+                           "); raise terrain.max_resolution or crop the DEM");
+    };
+
     auto reducedSize = [&](int w, int h, int& rw, int& rh) {
         rw = w;
         rh = h;
@@ -373,6 +390,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         if (double(outW) * outH > maxCells)
             fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
+        checkReduction(outW, outH);
 
         // -wm: GDAL's warp buffers (64 MB by default) at 8 MB, so a bake's peak memory stays a
         // few rasters (bench_bake_memory); chunking costs no accuracy.
@@ -389,11 +407,18 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         work = warpTo(path, src.get(), args);
         info.reprojected = needsMetric;
 
-        // Same warp of an all-ones raster: where the output has no source at all.
+        // Same warp of an all-ones raster: where the output has no source at all. Coverage
+        // depends only on the footprint, so the ones raster spans it at no more than twice the
+        // output's resolution instead of the source's (a large source would cost a byte a cell).
+        const int onesW = std::min(info.sourceWidth, 2 * outW + 2);
+        const int onesH = std::min(info.sourceHeight, 2 * outH + 2);
+        const double sx = double(info.sourceWidth) / onesW, sy = double(info.sourceHeight) / onesH;
+        double onesGt[6] = {gt[0], gt[1] * sx, gt[2] * sy, gt[3], gt[4] * sx, gt[5] * sy};
         GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-        DatasetPtr ones(mem->Create("", info.sourceWidth, info.sourceHeight, 1, GDT_Byte, nullptr));
+        DatasetPtr ones(mem->Create("", onesW, onesH, 1, GDT_Byte, nullptr));
+        if (!ones) fail(path, withGdalReason("cannot allocate the coverage raster"));
         auto* onesDs = static_cast<GDALDataset*>(ones.get());
-        onesDs->SetGeoTransform(gt);
+        onesDs->SetGeoTransform(onesGt);
         onesDs->SetSpatialRef(srcSrs);
         onesDs->GetRasterBand(1)->Fill(1.0);
         coverage = warpTo(path, ones.get(),
@@ -406,6 +431,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         if (double(outW) * outH > maxCells)
             fail(path, "raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
+        checkReduction(outW, outH);
         if (outW != info.sourceWidth || outH != info.sourceHeight) {
             work = translateTo(path, src.get(),
                                {"-of", "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),

@@ -292,8 +292,21 @@ TEST(DemImport, BadInputNamesTheFileAndTheProblem) {
     EXPECT_NE(importError(big, tiny).find("too large to hold in memory; set terrain.max_resolution"),
               std::string::npos);
 
+    // A grid that declares far more cells than it holds is refused before GDAL's averaging asks
+    // for gigabytes: 240000 x 9940000 cells in a few bytes, reduced to 256 on its long side.
+    const fs::path huge = fs::temp_directory_path() / "terralux_declares_huge.asc";
+    std::ofstream(huge) << "ncols 240000\nnrows 9940000\nxllcorner 0\nyllcorner 0\ncellsize 9\n1 2 3\n";
+    DemImportOptions reduced;
+    reduced.maxResolution = 256;
+    const std::string hugeError = importError(huge.string(), reduced);
+    EXPECT_EQ(hugeError, huge.string() +
+                             ": raster 240000x9940000 is too large to average down to 6x256 "
+                             "(1553125000 source cells per output cell, at most 67108864); raise "
+                             "terrain.max_resolution or crop the DEM");
+    fs::remove(huge);
+
     // Messages are one line.
-    for (const auto& m : {importError(text), importError(nan), importError(allNodata)})
+    for (const auto& m : {importError(text), importError(nan), importError(allNodata), hugeError})
         EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
 
