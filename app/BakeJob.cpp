@@ -90,6 +90,10 @@ struct BakeSetup {
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
              const std::function<bool()>& cancelled) {
     const SceneDescription& scene = project.scene;
+    // A scene built in code has not met the parameter table's rules, as a file or --set has:
+    // take it through them, so a bake refuses what loading the project would (a grid past
+    // its probe limit, a value out of range) instead of baking it.
+    (void)sceneFromJson(sceneToJson(scene), "project", nullptr);
     report("loading terrain", 0.0);
     b.terrain = loadProjectTerrain(project);
     if (cancelled()) throw BakeCancelled();

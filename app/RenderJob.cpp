@@ -70,7 +70,7 @@ void ProjectRenderer::setProject(const Project& project) {
     if (albedo_.get() != uploadedAlbedo_) {
         uploadedAlbedo_ = albedo_.get();
         if (albedo_)
-            renderer_->setAlbedoMap(albedo_->width, albedo_->height, albedo_->linear);
+            renderer_->setAlbedoMap(albedo_->width, albedo_->height, albedo_->srgb);
         else
             renderer_->setAlbedoMap(0, 0, {});
     }

@@ -161,10 +161,8 @@ SurfaceAlbedo importAlbedoMap(const std::string& path, const Heightfield& terrai
     for (int v = 0; v < levels; ++v) decode[size_t(v)] = srgbToLinear(float(v) / float(levels - 1));
 
     SurfaceAlbedo field;
-    field.width = width;
-    field.height = height;
+    field.resize(width, height);
     field.fallback = fallback;
-    field.linear.resize(n);
     size_t covered = 0;
     for (size_t i = 0; i < n; ++i) {
         const float a = std::min(float(samples[3][i]) / float(levels - 1), 1.0f);
@@ -172,7 +170,7 @@ SurfaceAlbedo importAlbedoMap(const std::string& path, const Heightfield& terrai
         const glm::vec3 map(decode[std::min<size_t>(samples[0][i], size_t(levels - 1))],
                             decode[std::min<size_t>(samples[1][i], size_t(levels - 1))],
                             decode[std::min<size_t>(samples[2][i], size_t(levels - 1))]);
-        field.linear[i] = a >= 1.0f ? map : a * map + (1.0f - a) * fallback;
+        field.setTexel(i, a >= 1.0f ? map : a * map + (1.0f - a) * fallback);
     }
     if (covered == 0)
         fail(path, "does not overlap the DEM " + demName + " (or holds only nodata there)");

@@ -176,14 +176,6 @@ ojson floats(std::initializer_list<float> values) {
     return a;
 }
 
-// The albedo texture's samples: linear albedo to sRGB-encoded 8 bits, RGB.
-std::vector<uint8_t> srgbSamples(const SurfaceAlbedo& a) {
-    std::vector<uint8_t> out(a.linear.size() * 3);
-    for (size_t i = 0; i < a.linear.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-            out[3 * i + size_t(c)] = uint8_t(std::lround(linearToSrgb(a.linear[i][c]) * 255.0f));
-    return out;
-}
 
 // The water plane: the footprint's rectangle at the level, appended to scene.bin (positions,
 // normals, indices) as node, mesh and material 1, all named `water`. Its material transmits
@@ -387,7 +379,7 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
         if (mesh.png.empty()) {
             try {
                 mesh.png = encodePng(uint32_t(texture->width), uint32_t(texture->height), 3,
-                                     srgbSamples(*texture));
+                                     texture->srgb);
             } catch (const std::exception& e) {
                 throw std::runtime_error(gltfPath.string() + ": albedo texture: " + e.what());
             }
@@ -501,9 +493,9 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
         throw std::runtime_error(gltfPath.string() + ": roughness = " + std::to_string(input.roughness) +
                                  " must be in [0, 1]");
     if (const SurfaceAlbedo* t = input.albedoTexture; t && !t->empty() &&
-        t->linear.size() != size_t(t->width) * size_t(t->height))
+        t->texels() != size_t(t->width) * size_t(t->height))
         throw std::runtime_error(gltfPath.string() + ": albedo texture of " + std::to_string(t->width) + " x " +
-                                 std::to_string(t->height) + " texels holds " + std::to_string(t->linear.size()));
+                                 std::to_string(t->height) + " texels holds " + std::to_string(t->texels()));
     const GeoOrigin& geo = hf->geo;
     if (!std::isfinite(input.verticalScale) || !std::isfinite(geo.easting) ||
         !std::isfinite(geo.northing) || !std::isfinite(geo.height)) {

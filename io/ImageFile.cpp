@@ -72,7 +72,7 @@ std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, int channels,
         std::replace(why.begin(), why.end(), '\n', ' ');
         throw ImageError("PNG encoding failed (" + why + ")");
     }
-    return std::vector<uint8_t>(bytes.begin(), bytes.end());
+    return bytes;
 }
 
 std::vector<float> readImageRgba(const std::filesystem::path& path, uint32_t& width,

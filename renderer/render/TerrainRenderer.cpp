@@ -18,6 +18,7 @@
 #include "lpv/Lpv.h"
 #include "render/DebugViews.h"
 #include "render/UniformBlocks.h"
+#include "terrain/SurfaceAlbedo.h"
 #include "terrain/SurfaceMaps.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
@@ -311,11 +312,6 @@ vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
     return l;
 }
 
-uint8_t srgbByte(float linear) {
-    const float c = std::clamp(linear, 0.0f, 1.0f);
-    const float e = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-    return uint8_t(std::lround(e * 255.0f));
-}
 
 }  // namespace
 
@@ -544,17 +540,21 @@ void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) {
     uploadSurfaceMaps(perVertex);
 }
 
-void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<glm::vec3>& linear) {
+void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb) {
     Gpu& g = *gpu_;
-    const bool map = width > 0 && height > 0 && linear.size() == size_t(width) * size_t(height);
-    // A full mip chain of box means in linear light, stored sRGB-encoded (the hardware decodes).
+    const bool map = width > 0 && height > 0 && srgb.size() == size_t(width) * size_t(height) * 3;
+    // A full mip chain of box means in linear light, stored sRGB-encoded (the hardware decodes);
+    // level 0 holds the field's own codes.
     std::vector<vk::MipLevel> levels;
-    std::vector<glm::vec3> level = map ? linear : std::vector<glm::vec3>{glm::vec3(1.0f)};
+    std::vector<glm::vec3> level(map ? srgb.size() / 3 : 1, glm::vec3(1.0f));
+    if (map)
+        for (size_t i = 0; i < level.size(); ++i)
+            level[i] = {linearOfSrgb8(srgb[3 * i]), linearOfSrgb8(srgb[3 * i + 1]), linearOfSrgb8(srgb[3 * i + 2])};
     int w = map ? width : 1, h = map ? height : 1;
     while (true) {
         vk::MipLevel l{uint32_t(w), uint32_t(h), std::vector<uint8_t>(level.size() * 4)};
         for (size_t i = 0; i < level.size(); ++i)
-            for (int c = 0; c < 3; ++c) l.bytes[4 * i + size_t(c)] = srgbByte(level[i][c]);
+            for (int c = 0; c < 3; ++c) l.bytes[4 * i + size_t(c)] = srgb8(level[i][c]);
         for (size_t i = 0; i < level.size(); ++i) l.bytes[4 * i + 3] = 255;
         levels.push_back(std::move(l));
         if (w == 1 && h == 1) break;

@@ -152,9 +152,9 @@ public:
     // The sky visibility per DEM vertex (horizonSkyVisibility's layout), or empty for none: the
     // surface maps are built and uploaded again.
     void setAmbientOcclusion(const std::vector<float>& perVertex);
-    // An albedo map over the footprint (texel centres corner to corner, row 0 north, linear RGB),
-    // or width 0 for the constant albedo of RenderSettings.
-    void setAlbedoMap(int width, int height, const std::vector<glm::vec3>& linear);
+    // An albedo map over the footprint (texel centres corner to corner, row 0 north, 8-bit sRGB,
+    // 3 bytes a texel: SurfaceAlbedo::srgb), or width 0 for the constant albedo of RenderSettings.
+    void setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb);
     bool hasAmbientOcclusion() const { return hasAo_; }
     // The water plane at `level` (engine y): the field of depth below the level and distance to
     // shore, and the mesh over every cell whose bed lies below level + `margin` (the highest a

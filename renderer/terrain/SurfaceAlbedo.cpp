@@ -1,12 +1,44 @@
 #include "terrain/SurfaceAlbedo.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
 #include <glm/common.hpp>
 
 namespace terralux {
+
+namespace {
+// Every 8-bit code decoded once.
+const std::array<float, 256>& srgb8Table() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int v = 0; v < 256; ++v) t[size_t(v)] = srgbToLinear(float(v) / 255.0f);
+        return t;
+    }();
+    return table;
+}
+}  // namespace
+
+uint8_t srgb8(float linear) { return uint8_t(std::lround(linearToSrgb(linear) * 255.0f)); }
+
+float linearOfSrgb8(uint8_t code) { return srgb8Table()[code]; }
+
+void SurfaceAlbedo::resize(int w, int h) {
+    width = w;
+    height = h;
+    srgb.assign(size_t(std::max(w, 0)) * size_t(std::max(h, 0)) * 3, 0);
+}
+
+glm::vec3 SurfaceAlbedo::texel(size_t i) const {
+    const auto& t = srgb8Table();
+    return {t[srgb[3 * i]], t[srgb[3 * i + 1]], t[srgb[3 * i + 2]]};
+}
+
+void SurfaceAlbedo::setTexel(size_t i, glm::vec3 linear) {
+    for (int c = 0; c < 3; ++c) srgb[3 * i + size_t(c)] = srgb8(linear[c]);
+}
 
 glm::vec3 SurfaceAlbedo::at(const Heightfield& terrain, float x, float z) const {
     if (empty()) return fallback;
@@ -22,15 +54,15 @@ glm::vec3 SurfaceAlbedo::at(const Heightfield& terrain, float x, float z) const 
     const int ix1 = std::min(ix + 1, width - 1), iz1 = std::min(iz + 1, height - 1);
     const float tx = fx - float(ix), tz = fz - float(iz);
     const size_t row0 = size_t(iz) * size_t(width), row1 = size_t(iz1) * size_t(width);
-    return (1.0f - tz) * ((1.0f - tx) * linear[row0 + ix] + tx * linear[row0 + ix1]) +
-           tz * ((1.0f - tx) * linear[row1 + ix] + tx * linear[row1 + ix1]);
+    return (1.0f - tz) * ((1.0f - tx) * texel(row0 + ix) + tx * texel(row0 + ix1)) +
+           tz * ((1.0f - tx) * texel(row1 + ix) + tx * texel(row1 + ix1));
 }
 
 glm::vec3 SurfaceAlbedo::maximum() const {
     if (empty()) return fallback;
-    glm::vec3 m(0.0f);
-    for (const glm::vec3& a : linear) m = glm::max(m, a);
-    return m;
+    uint8_t m[3] = {0, 0, 0};
+    for (size_t i = 0; i < srgb.size(); ++i) m[i % 3] = std::max(m[i % 3], srgb[i]);
+    return {linearOfSrgb8(m[0]), linearOfSrgb8(m[1]), linearOfSrgb8(m[2])};
 }
 
 glm::vec3 rampColor(const AlbedoRampSettings& ramp, double elevation, double slopeDeg) {
@@ -63,7 +95,7 @@ SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& r
     const double shrink = std::min(1.0, double(kMaxSurfaceAlbedoSide) / double(std::max(w, d)));
     out.width = shrink < 1.0 ? std::max(2, int(std::lround(w * shrink))) : w;
     out.height = shrink < 1.0 ? std::max(2, int(std::lround(d * shrink))) : d;
-    out.linear.resize(size_t(out.width) * size_t(out.height));
+    out.resize(out.width, out.height);
     const double scale = verticalScale > 0.0 ? verticalScale : 1.0;
     // Texel i's centre lies at vertex i (w − 1)/(width − 1): the vertex itself at full size.
     auto vertexOf = [](int i, int texels, int vertices) {
@@ -75,7 +107,7 @@ SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& r
             const double elevation = (double(terrain.at(c, r)) + terrain.geo.height) / scale;
             const double slope = std::acos(std::clamp(double(terrain.vertexNormal(c, r).y), -1.0, 1.0)) *
                                  180.0 / std::numbers::pi;
-            out.linear[size_t(j) * size_t(out.width) + size_t(i)] = rampColor(ramp, elevation, slope);
+            out.setTexel(size_t(j) * size_t(out.width) + size_t(i), rampColor(ramp, elevation, slope));
         }
     return out;
 }

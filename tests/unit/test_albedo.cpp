@@ -72,7 +72,16 @@ size_t checkBands(const Heightfield& hf, const SurfaceAlbedo& a, int ring) {
     return checked;
 }
 
-bool isFallback(const glm::vec3& v, const glm::vec3& f) { return v == f; }
+// A colour as the field stores it: its nearest 8-bit sRGB code, decoded.
+glm::vec3 stored(const glm::vec3& f) {
+    return {linearOfSrgb8(srgb8(f.x)), linearOfSrgb8(srgb8(f.y)), linearOfSrgb8(srgb8(f.z))};
+}
+bool isFallback(const glm::vec3& v, const glm::vec3& f) { return v == stored(f); }
+std::vector<glm::vec3> texels(const SurfaceAlbedo& a) {
+    std::vector<glm::vec3> out;
+    for (size_t i = 0; i < a.texels(); ++i) out.push_back(a.texel(i));
+    return out;
+}
 
 // A fallback no map holds.
 const glm::vec3 kMagenta(1.0f, 0.0f, 1.0f);
@@ -84,7 +93,7 @@ SurfaceAlbedo drapeCovering(const std::string& map, const Heightfield& hf, int w
     EXPECT_EQ(a.width, width);
     EXPECT_EQ(a.height, height);
     size_t fallbacks = 0;
-    for (const glm::vec3& v : a.linear) fallbacks += isFallback(v, kMagenta);
+    for (const glm::vec3& v : texels(a)) fallbacks += isFallback(v, kMagenta);
     EXPECT_EQ(fallbacks, 0u);
     return a;
 }
@@ -101,9 +110,11 @@ TEST(Srgb, DecodingIsTheExactEotf) {
     EXPECT_FLOAT_EQ(srgbToLinear(0.5f), 0.21404114f);
     EXPECT_FLOAT_EQ(srgbToLinear(128.0f / 255.0f), 0.21586050f);
     EXPECT_FLOAT_EQ(srgbToLinear(188.0f / 255.0f), 0.50288646f);
-    // Encoding inverts it: every 8-bit level survives the round trip.
-    for (int v = 0; v < 256; ++v)
+    // Encoding inverts it: every 8-bit level survives the round trip, as the field stores it too.
+    for (int v = 0; v < 256; ++v) {
         EXPECT_EQ(std::lround(linearToSrgb(srgbToLinear(v / 255.0f)) * 255.0f), v) << v;
+        EXPECT_EQ(srgb8(linearOfSrgb8(uint8_t(v))), v) << v;
+    }
 }
 
 TEST(Ramp, SnowAboveTheLineRockOnSteepSlopesGroundBelow) {
@@ -134,9 +145,9 @@ TEST(Ramp, SnowAboveTheLineRockOnSteepSlopesGroundBelow) {
         const SurfaceAlbedo a = rampAlbedo(hf, ramp, scale, fallback);
         ASSERT_EQ(a.width, n);
         ASSERT_EQ(a.height, n);
-        EXPECT_EQ(a.at(hf, hf.xOf(2), hf.zOf(5)), ramp.colors.back()) << "scale " << scale;
+        EXPECT_EQ(a.at(hf, hf.xOf(2), hf.zOf(5)), stored(ramp.colors.back())) << "scale " << scale;
         // Slope is as lit: at 2x, the 60-degree face is steeper still, and rock either way.
-        EXPECT_EQ(a.at(hf, hf.xOf(12), hf.zOf(5)), ramp.rockColor) << "scale " << scale;
+        EXPECT_EQ(a.at(hf, hf.xOf(12), hf.zOf(5)), stored(ramp.rockColor)) << "scale " << scale;
     }
 }
 
@@ -152,21 +163,27 @@ TEST(Ramp, LargeTerrainsGetAtMostTheLargestFieldSide) {
     const SurfaceAlbedo a = rampAlbedo(hf, ramp, 1.0, glm::vec3(0.3f));
     EXPECT_EQ(a.width, kMaxSurfaceAlbedoSide);
     EXPECT_EQ(a.height, 2);
-    EXPECT_EQ(a.at(hf, hf.minX(), hf.minZ()), ramp.colors.front());
-    EXPECT_EQ(a.at(hf, hf.maxX(), hf.maxZ()), ramp.colors.back());
+    EXPECT_EQ(a.at(hf, hf.minX(), hf.minZ()), stored(ramp.colors.front()));
+    EXPECT_EQ(a.at(hf, hf.maxX(), hf.maxZ()), stored(ramp.colors.back()));
 }
 
 TEST(SurfaceAlbedo, TexelCentresSpanTheFootprintCornerToCorner) {
     const Heightfield hf = test::flat(5, 10.0, 0.0f);  // x, z in [-20, 20]
     SurfaceAlbedo a;
-    a.width = 3;
-    a.height = 2;
-    a.linear = {glm::vec3(0.0f), glm::vec3(0.5f), glm::vec3(1.0f), glm::vec3(0.2f), glm::vec3(0.2f), glm::vec3(0.2f)};
-    EXPECT_EQ(a.at(hf, -20.0f, -20.0f), glm::vec3(0.0f));  // texel (0, 0): north-west corner
-    EXPECT_EQ(a.at(hf, 0.0f, -20.0f), glm::vec3(0.5f));    // texel (1, 0)
-    EXPECT_EQ(a.at(hf, 20.0f, -20.0f), glm::vec3(1.0f));   // texel (2, 0): north-east corner
-    EXPECT_EQ(a.at(hf, 20.0f, 20.0f), glm::vec3(0.2f));    // texel (2, 1): south-east corner
-    EXPECT_NEAR(a.at(hf, 10.0f, -20.0f).x, 0.75f, 1e-6f);  // between texels: bilinear
+    a.resize(3, 2);
+    // Code 128 (0.21586) is stored exactly; 0.2 is stored as its nearest code.
+    const float c128 = linearOfSrgb8(128);
+    EXPECT_NEAR(c128, 0.21586050f, 1e-7f);
+    const glm::vec3 texels[] = {glm::vec3(0.0f), glm::vec3(c128), glm::vec3(1.0f),
+                                glm::vec3(0.2f), glm::vec3(0.2f), glm::vec3(0.2f)};
+    for (size_t i = 0; i < 6; ++i) a.setTexel(i, texels[i]);
+    EXPECT_EQ(a.srgb[3], 128);
+    EXPECT_EQ(a.at(hf, -20.0f, -20.0f), glm::vec3(0.0f));         // texel (0, 0): north-west corner
+    EXPECT_EQ(a.at(hf, 0.0f, -20.0f), glm::vec3(c128));           // texel (1, 0)
+    EXPECT_EQ(a.at(hf, 20.0f, -20.0f), glm::vec3(1.0f));          // texel (2, 0): north-east corner
+    EXPECT_EQ(a.at(hf, 20.0f, 20.0f), stored(glm::vec3(0.2f)));   // texel (2, 1): south-east corner
+    EXPECT_NEAR(stored(glm::vec3(0.2f)).x, 0.2f, 0.0021f);        // within the encoding's step
+    EXPECT_NEAR(a.at(hf, 10.0f, -20.0f).x, (c128 + 1.0f) / 2.0f, 1e-6f);  // between texels: bilinear
     EXPECT_EQ(a.at(hf, 500.0f, -500.0f), glm::vec3(1.0f)); // beyond: clamped to the border
     EXPECT_EQ(a.maximum(), glm::vec3(1.0f));
     EXPECT_EQ(SurfaceAlbedo{}.at(hf, 0.0f, 0.0f), glm::vec3(0.3f));  // empty: the fallback
@@ -215,9 +232,9 @@ TEST(AlbedoMap, PartialOverlapFallsBackWhereTheMapEnds) {
     for (int b = 0; b < 4; ++b) isBand = isBand || glm::all(glm::lessThan(glm::abs(west - linearOf(b)), glm::vec3(1e-5f)));
     EXPECT_TRUE(isBand) << west.x << ", " << west.y << ", " << west.z;
     size_t fallbacks = 0;
-    for (const glm::vec3& v : a.linear) fallbacks += isFallback(v, fallback);
-    EXPECT_GT(fallbacks, a.linear.size() * 3 / 4);
-    EXPECT_LT(fallbacks, a.linear.size() * 9 / 10);
+    for (const glm::vec3& v : texels(a)) fallbacks += isFallback(v, fallback);
+    EXPECT_GT(fallbacks, a.texels() * 3 / 4);
+    EXPECT_LT(fallbacks, a.texels() * 9 / 10);
 }
 
 TEST(AlbedoMap, NoOverlapNamesBothFiles) {
@@ -371,12 +388,13 @@ TEST(AlbedoBake, BrightGroundNearAProbeRaisesItsBounceLight) {
 
     // Snow-bright (0.85) within 40 m of the first probe, the constant grey elsewhere.
     auto field = std::make_shared<SurfaceAlbedo>();
-    field->width = field->height = 64;
+    field->resize(64, 64);
     field->fallback = scene.L.albedo;
     for (int r = 0; r < 64; ++r)
         for (int c = 0; c < 64; ++c)
-            field->linear.push_back(std::hypot(scene.hf.xOf(c), scene.hf.zOf(r)) < 40.0f ? glm::vec3(0.85f)
-                                                                                        : scene.L.albedo);
+            field->setTexel(size_t(r) * 64 + size_t(c), std::hypot(scene.hf.xOf(c), scene.hf.zOf(r)) < 40.0f
+                                                            ? glm::vec3(0.85f)
+                                                            : scene.L.albedo);
     scene.L.surface = field;
     const ProbeBake bright = scene.bake();
     const ProbeBake brightReference = scene.reference();
@@ -387,7 +405,7 @@ TEST(AlbedoBake, BrightGroundNearAProbeRaisesItsBounceLight) {
     EXPECT_GT(fromBelow(brightReference.sh[0]), 2.5f * fromBelow(greyReference.sh[0]));
     EXPECT_LT(fromBelow(bright.sh[1]), 1.05f * fromBelow(grey.sh[1]));
     // The reference follows the brightest albedo for its path length.
-    EXPECT_EQ(scene.L.maxAlbedo(), glm::vec3(0.85f));
+    EXPECT_EQ(scene.L.maxAlbedo(), stored(glm::vec3(0.85f)));
 }
 
 TEST(AlbedoBake, ConstantModeIsBitIdenticalToTheBakeBeforeAlbedoFields) {

@@ -231,6 +231,25 @@ TEST(BakeTargetError, TighterTargetsTraceMoreAndTheReferencePresetRefusesIt) {
     fs::remove_all(dir);
 }
 
+// A scene built in code meets the parameter table's rules as a loaded one does: a terrain grid
+// past 4096 probes is refused, naming the setting and the rule, and nothing is written.
+TEST(BakeJob, ASceneBuiltInCodeMeetsTheTableRules) {
+    const fs::path dir = tempDir("table_rules");
+    const Project p = cropProject(dir, 65);
+    try {
+        runBake(BakeRequest{p, 0, false}, {}, nullptr);
+        ADD_FAILURE() << "a 65 x 65 terrain grid was baked";
+    } catch (const ProjectError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("probe_volumes[0].grid_dims"), std::string::npos) << m;
+        EXPECT_NE(m.find("product <= 4096 (is 4225)"), std::string::npos) << m;
+    }
+    EXPECT_FALSE(fs::exists(dir));
+    // At the limit it bakes.
+    const Project atLimit = cropProject(dir, 64);
+    EXPECT_NO_THROW(estimateBake(BakeRequest{atLimit, 0, false}));
+}
+
 // The report counts every ray: the irradiance cache's as well as the probes'.
 TEST(BakeReport, RaysCountTheCacheAndTheProbes) {
     const fs::path dir = tempDir("rays");

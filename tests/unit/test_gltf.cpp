@@ -613,10 +613,10 @@ TEST_F(GltfExport, TheMeshIsTheTracedSurfaceAboveAMillionVertices) {
 TEST_F(GltfExport, AnAlbedoFieldIsAnEmbeddedSrgbPngWithUvsOnItsTexelCentres) {
     const Heightfield hf = makeHeightfield(5, 4);
     SurfaceAlbedo field;
-    field.width = 3;
-    field.height = 2;
-    field.linear = {glm::vec3(0.0f), glm::vec3(0.5f, 0.2f, 0.1f), glm::vec3(1.0f),
-                    glm::vec3(0.21586050f), glm::vec3(0.8f, 0.82f, 0.85f), glm::vec3(0.0031308f)};
+    field.resize(3, 2);
+    const glm::vec3 linear[] = {glm::vec3(0.0f), glm::vec3(0.5f, 0.2f, 0.1f), glm::vec3(1.0f),
+                                glm::vec3(0.21586050f), glm::vec3(0.8f, 0.82f, 0.85f), glm::vec3(0.0031308f)};
+    for (size_t i = 0; i < 6; ++i) field.setTexel(i, linear[i]);
     GltfSceneInput in = sampleInput(hf);
     in.albedoTexture = &field;
     const GltfExportResult res = exportGltfScene(dir, in);
@@ -637,10 +637,10 @@ TEST_F(GltfExport, AnAlbedoFieldIsAnEmbeddedSrgbPngWithUvsOnItsTexelCentres) {
     ASSERT_EQ(image.height, 2);
     ASSERT_GE(image.component, 3);
     // Each texel is the sRGB encoding of its linear albedo, row 0 (north) first.
-    for (size_t i = 0; i < field.linear.size(); ++i)
+    for (size_t i = 0; i < 6; ++i)
         for (int c = 0; c < 3; ++c)
             EXPECT_EQ(int(image.image.at(i * size_t(image.component) + size_t(c))),
-                      int(std::lround(linearToSrgb(field.linear[i][c]) * 255.0f)))
+                      int(std::lround(linearToSrgb(linear[i][c]) * 255.0f)))
                 << "texel " << i << " channel " << c;
     EXPECT_EQ(int(image.image[3 * size_t(image.component)]), 128);  // 0.21586050 is sRGB 128/255
 
