@@ -41,6 +41,20 @@ using QuietGdalErrors = gdal::QuietErrors;
 
 std::string withGdalReason(const std::string& what) { return gdal::withReason(what); }
 
+// A one-band MEM dataset over `data` (w × h samples of `type`, row-major), which must outlive it;
+// null when GDAL refuses it.
+DatasetPtr memOver(void* data, int w, int h, GDALDataType type) {
+    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+    DatasetPtr ds(mem ? mem->Create("", w, h, 0, type, nullptr) : nullptr);
+    if (!ds) return ds;
+    char pointer[64] = {};
+    CPLPrintPointer(pointer, data, sizeof pointer - 1);
+    const std::string option = std::string("DATAPOINTER=") + pointer;
+    char* options[] = {const_cast<char*>(option.c_str()), nullptr};
+    if (static_cast<GDALDataset*>(ds.get())->AddBand(type, options) != CE_None) return {};
+    return ds;
+}
+
 DatasetPtr warpTo(const std::string& path, GDALDatasetH src, const std::vector<std::string>& args) {
     std::string why;
     DatasetPtr out = gdal::warp(src, args, why);
@@ -212,18 +226,19 @@ void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint
     // GDALFillNodata interpolates by inverse distance weighting over a search in four directions,
     // then runs 3x3 smoothing passes over the filled cells only. The search reaches the whole
     // grid, so every hole is filled.
-    GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-    DatasetPtr fillDs(mem->Create("", w, h, 1, GDT_Float32, nullptr));
-    DatasetPtr maskDs(mem->Create("", w, h, 1, GDT_Byte, nullptr));
-    auto* fb = static_cast<GDALDataset*>(fillDs.get())->GetRasterBand(1);
-    auto* mb = static_cast<GDALDataset*>(maskDs.get())->GetRasterBand(1);
+    // The MEM datasets read and write our own buffers: no copy of the grid for GDAL.
     std::vector<uint8_t> valid(nodata.size());
     for (size_t i = 0; i < nodata.size(); ++i) valid[i] = nodata[i] ? 0 : 1;
-    if (fb->RasterIO(GF_Write, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) != CE_None ||
-        mb->RasterIO(GF_Write, 0, 0, w, h, valid.data(), w, h, GDT_Byte, 0, 0, nullptr) != CE_None ||
-        GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr, nullptr) != CE_None ||
-        fb->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) != CE_None)
+    DatasetPtr fillDs = memOver(heights.data(), w, h, GDT_Float32);
+    DatasetPtr maskDs = memOver(valid.data(), w, h, GDT_Byte);
+    if (!fillDs || !maskDs) throw DemError(withGdalReason("filling nodata cells failed"));
+    auto* fb = static_cast<GDALDataset*>(fillDs.get())->GetRasterBand(1);
+    auto* mb = static_cast<GDALDataset*>(maskDs.get())->GetRasterBand(1);
+    if (GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr, nullptr) != CE_None)
         throw DemError(withGdalReason("filling nodata cells failed"));
+    static_cast<GDALDataset*>(fillDs.get())->FlushCache();
+    fillDs.reset();
+    maskDs.reset();
     if (method == VoidFill::GdalMembrane) membraneFill(heights, w, h, nodata);
 }
 
@@ -440,6 +455,20 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
             info.resampled = true;
         }
     }
+    // Each GDAL dataset goes as soon as it has been read, so the import holds at most one grid
+    // of GDAL's beside its own: the source (and its cached blocks) once a working copy exists,
+    // the coverage once read.
+    if (work) src.reset();
+    std::vector<uint8_t> cov;
+    if (coverage) {
+        auto* c = static_cast<GDALDataset*>(coverage.get());
+        const int cw = c->GetRasterXSize(), chh = c->GetRasterYSize();
+        cov.resize(size_t(cw) * size_t(chh));
+        if (c->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, cw, chh, cov.data(), cw, chh, GDT_Byte, 0, 0,
+                                          nullptr) != CE_None)
+            fail(path, withGdalReason("cannot read the reprojected coverage"));
+        coverage.reset();
+    }
 
     auto* rd = static_cast<GDALDataset*>(readFrom);
     int w = rd->GetRasterXSize();
@@ -461,6 +490,26 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         CE_None)
         fail(path, withGdalReason("cannot read band 1"));
 
+    // Metric units and the CRS of the grid read.
+    double unit = 1.0;
+    std::string crsWkt, crsName;
+    int epsg = 0;
+    if (const OGRSpatialReference* outSrs = rd->GetSpatialRef(); outSrs && !outSrs->IsEmpty()) {
+        unit = outSrs->GetLinearUnits();
+        if (!(unit > 0.0)) unit = 1.0;
+        char* wkt = nullptr;
+        outSrs->exportToWkt(&wkt);
+        crsWkt = wkt ? wkt : "";
+        CPLFree(wkt);
+        crsName = srsName(*outSrs);
+        epsg = srsEpsg(*outSrs);
+    }
+    // Everything is read: the last dataset goes before the trim and the void fill.
+    rd = nullptr;
+    rband = nullptr;
+    work.reset();
+    src.reset();
+
     std::vector<uint8_t> nodata(heights.size(), 0);
     const bool nodataIsNan = rHasNodata && std::isnan(rNodata);
     const float nodataF = float(rNodata);
@@ -478,27 +527,26 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
 
     // Trim a reprojected grid to the window that lies wholly inside the source footprint.
     int x0 = 0, y0 = 0;
-    if (coverage) {
-        std::vector<uint8_t> cov(size_t(w) * h);
-        if (static_cast<GDALDataset*>(coverage.get())
-                ->GetRasterBand(1)
-                ->RasterIO(GF_Read, 0, 0, w, h, cov.data(), w, h, GDT_Byte, 0, 0, nullptr) != CE_None)
-            fail(path, withGdalReason("cannot read the reprojected coverage"));
+    if (!cov.empty()) {
+        if (cov.size() != heights.size()) fail(path, "reprojected coverage does not match the grid");
         const Window win = coveredWindow(cov, w, h);
+        cov = {};
         if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");
         const int cw = win.x1 - win.x0 + 1, ch = win.y1 - win.y0 + 1;
-        std::vector<float> ch_h(size_t(cw) * ch);
-        std::vector<uint8_t> ch_n(size_t(cw) * ch);
+        // In place: a cell's index in the window is never past its index in the grid, and both
+        // rise together, so no cell is overwritten before it is moved.
         nodataCount = 0;
         for (int y = 0; y < ch; ++y)
             for (int x = 0; x < cw; ++x) {
                 const size_t s = size_t(y + win.y0) * w + (x + win.x0), d = size_t(y) * cw + x;
-                ch_h[d] = heights[s];
-                ch_n[d] = nodata[s];
-                nodataCount += nodata[s];
+                heights[d] = heights[s];
+                nodata[d] = nodata[s];
+                nodataCount += nodata[d];
             }
-        heights.swap(ch_h);
-        nodata.swap(ch_n);
+        heights.resize(size_t(cw) * ch);
+        nodata.resize(size_t(cw) * ch);
+        heights.shrink_to_fit();
+        nodata.shrink_to_fit();
         x0 = win.x0;
         y0 = win.y0;
         w = cw;
@@ -519,20 +567,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         }
     }
 
-    // Metric units and the geographic origin of the footprint centre.
-    double unit = 1.0;
-    std::string crsWkt, crsName;
-    int epsg = 0;
-    if (const OGRSpatialReference* outSrs = rd->GetSpatialRef(); outSrs && !outSrs->IsEmpty()) {
-        unit = outSrs->GetLinearUnits();
-        if (!(unit > 0.0)) unit = 1.0;
-        char* wkt = nullptr;
-        outSrs->exportToWkt(&wkt);
-        crsWkt = wkt ? wkt : "";
-        CPLFree(wkt);
-        crsName = srsName(*outSrs);
-        epsg = srsEpsg(*outSrs);
-    }
+    // Metric cell sizes and the geographic origin of the footprint centre.
     const double cellX = std::abs(rgt[1]) * unit;
     const double cellZ = std::abs(rgt[5]) * unit;
 
