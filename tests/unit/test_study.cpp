@@ -58,7 +58,10 @@ TEST(Study, BudgetOutsideItsRangeIsRefused) {
 
 TEST(Study, SampleStudyMeasuresEveryKnobWithinItsBudget) {
     StudyOptions o;
-    o.budgetSeconds = 10.0;
+    // Enough for every sweep under the sanitizers on a loaded 2-core machine (about 8 s in a
+    // release build, where the fixed sweeps end the study early; a 10 s budget cut the spacing
+    // sweep short under AddressSanitizer).
+    o.budgetSeconds = 60.0;
     const auto t0 = std::chrono::steady_clock::now();
     const StudyResult r = runStudy(sampleProject(), o, {}, nullptr);
     const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
