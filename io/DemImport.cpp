@@ -436,9 +436,16 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         onesDs->SetGeoTransform(onesGt);
         onesDs->SetSpatialRef(srcSrs);
         onesDs->GetRasterBand(1)->Fill(1.0);
+        // On the heights' own grid: the same extent and size, so coverage cell (i, j) is
+        // heights cell (i, j) by construction, not because both warps chose alike.
+        double wgt[6];
+        static_cast<GDALDataset*>(work.get())->GetGeoTransform(wgt);
+        const int ww = static_cast<GDALDataset*>(work.get())->GetRasterXSize();
+        const int wh = static_cast<GDALDataset*>(work.get())->GetRasterYSize();
         coverage = warpTo(path, ones.get(),
-                          {"-of", "MEM", "-t_srs", dstWkt, "-ts", std::to_string(outW),
-                           std::to_string(outH), "-r", "near", "-dstnodata", "0", "-wm", "8"});
+                          {"-of", "MEM", "-t_srs", dstWkt, "-te", fmt(wgt[0]), fmt(wgt[3] + wgt[5] * wh),
+                           fmt(wgt[0] + wgt[1] * ww), fmt(wgt[3]), "-ts", std::to_string(ww),
+                           std::to_string(wh), "-r", "near", "-dstnodata", "0", "-wm", "8"});
         readFrom = work.get();
     } else {
         int outW, outH;
@@ -528,7 +535,9 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     // Trim a reprojected grid to the window that lies wholly inside the source footprint.
     int x0 = 0, y0 = 0;
     if (!cov.empty()) {
-        if (cov.size() != heights.size()) fail(path, "reprojected coverage does not match the grid");
+        if (cov.size() != heights.size())
+            fail(path, "reprojected coverage of " + std::to_string(cov.size()) + " cells does not match the " +
+                           std::to_string(w) + "x" + std::to_string(h) + " grid");
         const Window win = coveredWindow(cov, w, h);
         cov = {};
         if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");

@@ -248,6 +248,35 @@ TEST(DemImport, MaxResolutionKeepsTwoCellsAcrossAThinStrip) {
     EXPECT_FLOAT_EQ(r.heightfield.at(1, 255), 100.0f);
 }
 
+// A reprojected, reduced import trims to the same footprint as the full-size one: the coverage
+// raster that finds the footprint is built at twice the output's resolution, not the source's,
+// and must still span the whole source.
+TEST(DemImport, ReducedReprojectionKeepsTheFullFootprint) {
+    // 1200 x 900 cells of about 80 m, 2.3 degrees east of UTM 31's central meridian: the grid
+    // turns by 1.5 degrees, so the reprojected raster has wedges outside the source to trim.
+    const double gt[6] = {4.7, 0.001, 0.0, 43.0, 0.0, -0.001};
+    const fs::path tmp = writeFlatTiff("terralux_geo_reduced.tif", 4326, gt, 1200, 900);
+    const auto full = importDem(tmp.string());
+    DemImportOptions o;
+    o.maxResolution = 128;
+    const auto reduced = importDem(tmp.string(), o);
+    fs::remove(tmp);
+    ASSERT_TRUE(full.source.reprojected);
+    ASSERT_TRUE(reduced.source.resampled);
+    const Heightfield& f = full.heightfield;
+    const Heightfield& r = reduced.heightfield;
+    EXPECT_LE(std::max(r.width(), r.depth()), 128);
+    // Nothing outside the source was kept (it would be nodata, filled).
+    EXPECT_EQ(f.nodataCount(), 0u);
+    EXPECT_EQ(r.nodataCount(), 0u);
+    // The same footprint, to within the trim of one reduced cell a side.
+    const double spanX = double(r.width()) * r.cellSizeX(), spanZ = double(r.depth()) * r.cellSizeZ();
+    EXPECT_NEAR(spanX, double(f.width()) * f.cellSizeX(), 2.0 * r.cellSizeX());
+    EXPECT_NEAR(spanZ, double(f.depth()) * f.cellSizeZ(), 2.0 * r.cellSizeZ());
+    EXPECT_NEAR(r.geo.easting, f.geo.easting, r.cellSizeX());
+    EXPECT_NEAR(r.geo.northing, f.geo.northing, r.cellSizeZ());
+}
+
 TEST(DemImport, VerticalScaleMultipliesHeights) {
     DemImportOptions o;
     o.verticalScale = 2.0;
