@@ -176,7 +176,6 @@ ojson floats(std::initializer_list<float> values) {
     return a;
 }
 
-
 // The water plane: the footprint's rectangle at the level, appended to scene.bin (positions,
 // normals, indices) as node, mesh and material 1, all named `water`. Its material transmits
 // (KHR_materials_transmission) with water's index of refraction (KHR_materials_ior), tinted by

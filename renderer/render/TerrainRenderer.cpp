@@ -312,7 +312,6 @@ vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
     return l;
 }
 
-
 }  // namespace
 
 TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget)
