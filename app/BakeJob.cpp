@@ -528,6 +528,7 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
     nlohmann::json j = {{"min_cell_size", t.minCell},
                         {"max_cell_size", t.maxCell},
                         {"surface_band", t.surfaceBand},
+                        {"surface_cell_size", t.surfaceCell},
                         {"leaves", t.leaves.size()},
                         {"leaves_by_edge_m", byEdge},
                         {"uniform_grid_probes", t.uniformProbes},

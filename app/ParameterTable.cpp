@@ -655,6 +655,10 @@ std::vector<ParameterSpec> buildTable() {
         .autoMeans("one min cell").label("Adaptive: surface band")
         .about("A cell this close above the surface goes down to the minimum size").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::surfaceBand);
+    add(Row("probe_volumes[].adaptive.surface_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
+        .autoMeans("min cell: the band is all minimum cells").label("Adaptive: surface cell")
+        .about("The size the surface band forces cells down to; below it the error tolerance alone splits them. At least min_cell_size; the largest min_cell_size × 2^k at or below it applies (max_cell_size at most)")
+        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::surfaceCellSize);
     add(Row("probe_volumes[].adaptive.tolerance", T::Number)).above(0.0, 1.0).decimals(3)
         .autoMeans("none: geometric refinement only").label("Adaptive: error tolerance")
         .about("Relative interpolation error that splits a leaf (error-driven refinement)")

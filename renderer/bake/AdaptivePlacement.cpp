@@ -83,6 +83,16 @@ public:
                                  (a.minCellSize ? "" : ", the auto size") + ") times 2^k, k in [0, " +
                                  std::to_string(kMaxLevels) + "]");
         levels_ = int(k);
+        if (a.surfaceCellSize) {
+            // The largest octree cell size at or below it: a size set in metres stays valid when
+            // an auto min cell moves with the box. 1e-5 forgives a size written to 6 digits.
+            const double sr = *a.surfaceCellSize / m_;
+            if (!(sr >= 1.0 - 1e-5))
+                throw PlacementError(where + ": adaptive.surface_cell_size = " + num(*a.surfaceCellSize) +
+                                     " must be at least min_cell_size (" + num(m_) +
+                                     (a.minCellSize ? "" : ", the auto size") + ")");
+            surfaceLevel_ = std::clamp(int(std::floor(std::log2(sr) + 1e-5)), 0, levels_);
+        }
         band_ = a.surfaceBand ? *a.surfaceBand : m_;
         share_ = a.maxMoveShare;
 
@@ -112,10 +122,8 @@ public:
         return glm::vec3(origin_) +
                float(m_) * glm::vec3(float(n.x) + h, float(n.y) + h, float(n.z) + h);
     }
-    bool centreInside(const OctreeLeaf& n) const {
-        const glm::vec3 c = centre(n);
-        return !(c.y > hf_.surfaceHeight(c.x, c.z));
-    }
+    bool aboveSurface(const glm::vec3& p) const { return p.y > hf_.surfaceHeight(p.x, p.z); }
+    bool centreInside(const OctreeLeaf& n) const { return !aboveSurface(centre(n)); }
     std::array<OctreeLeaf, 8> children(const OctreeLeaf& n) const {
         std::array<OctreeLeaf, 8> c;
         const uint32_t h = n.edge() / 2;
@@ -139,7 +147,7 @@ public:
         if (y1 <= r.lo) return;  // wholly inside the terrain
         if (n.level > 0) {
             const bool inside = centreInside(n);
-            if (inside || y0 < double(r.hi) + band_) {
+            if (inside || (n.level > surfaceLevel_ && y0 < double(r.hi) + band_)) {
                 splitForInside += inside;
                 for (const OctreeLeaf& c : children(n)) visit(c, out, splitForInside);
                 return;
@@ -203,6 +211,7 @@ public:
         t.minCell = m_;
         t.maxCell = maxCell();
         t.surfaceBand = band_;
+        t.surfaceCell = m_ * std::exp2(surfaceLevel_);
         t.levels = levels_;
         t.splitForInside = splitForInside;
         const size_t n = leaves.size();
@@ -273,12 +282,12 @@ public:
             throw PlacementError(where + ": " + what + " needs " + std::to_string(L.validCount()) +
                                  " probes, more than adaptive.max_probes = " +
                                  std::to_string(*a.maxProbes) +
-                                 "; raise it or adaptive.min_cell_size");
+                                 "; raise it, adaptive.min_cell_size or adaptive.surface_cell_size");
         if (a.maxBytes && L.fileBytes() > uint64_t(*a.maxBytes))
             throw PlacementError(where + ": " + what + " needs " + std::to_string(L.fileBytes()) +
                                  " bytes, more than adaptive.max_bytes = " +
                                  std::to_string(*a.maxBytes) +
-                                 "; raise it or adaptive.min_cell_size");
+                                 "; raise it, adaptive.min_cell_size or adaptive.surface_cell_size");
     }
 
 private:
@@ -320,7 +329,7 @@ private:
     const Heightfield& hf_;
     const ProbeVolumeSettings& v_;
     double m_ = 1.0, band_ = 0.0, share_ = 0.25;
-    int levels_ = 0;
+    int levels_ = 0, surfaceLevel_ = 0;
     glm::dvec3 origin_{0.0};
     double dimsD_[3] = {1, 1, 1};
     std::array<uint32_t, 3> dims_{1, 1, 1};
@@ -444,8 +453,11 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
                 const size_t i = candidates[k];
                 const sh::ShRgb& own = store.at(out.layout.probeKeys[i]).sh;
                 double error = 0.0;
+                // An octant whose centre is in the terrain sees it from inside: no light an
+                // interpolated point above the surface receives, so it is not a test of the leaf.
                 for (size_t o = 0; o < 8; ++o)
-                    error = std::max(error, double(relativeIrradianceError(own, octants.sh[8 * k + o])));
+                    if (tree.aboveSurface(positions[8 * k + o]))
+                        error = std::max(error, double(relativeIrradianceError(own, octants.sh[8 * k + o])));
                 if (error > ref.tolerance) {
                     failing.push_back({k, error});
                 } else {

@@ -7,9 +7,10 @@
 // + height_range) is made of whole minimum cells and tiled by root cells of max_cell_size. A cell
 //   - is dropped when it lies wholly inside the terrain (its top at or below the lowest surface
 //     point over its footprint): its grid cells hold -1;
-//   - splits when it is larger than the minimum and sticks out of the box, reaches into the
-//     surface band (its bottom below the highest surface point over its footprint plus
-//     surface_band), or has its centre inside the terrain;
+//   - splits when it is larger than the minimum and sticks out of the box, or has its centre
+//     inside the terrain, or is larger than surface_cell_size (default: the minimum) and reaches
+//     into the surface band (its bottom below the highest surface point over its footprint plus
+//     surface_band);
 //   - otherwise is a leaf with one probe at its centre. A minimum-size leaf whose centre is inside
 //     the terrain, or above it by less than 2 % of the cell, moves its probe up to 2 % of the
 //     cell above the surface when that move is at most max_move_share of the cell; otherwise it
@@ -29,7 +30,8 @@
 // Error-driven refinement (tolerance set). Each leaf larger than the minimum bakes probes at the
 // centres of its 8 octants, where its children's probes would go. The model gives the leaf's own
 // probe there, so the leaf's error is the largest relative irradiance error (docs/lighting.md probe
-// error: RMS over 256 normals) of its probe against those 8 bakes; above the tolerance it splits
+// error: RMS over 256 normals) of its probe against those 8 bakes (octants whose centre is in the
+// terrain left out: no point above the surface is lit as they are); above the tolerance it splits
 // and its children keep the octant bakes (same position, same seed). Rounds go one level down at
 // a time; in each round the worst leaves split first, and a budget (max_probes, max_bytes) stops
 // the refinement at the first split that no longer fits.

@@ -44,6 +44,7 @@ enum class LeafProbe : uint8_t {
 // The adaptive octree behind a layout, with its resolved settings.
 struct AdaptiveOctree {
     double minCell = 1.0, maxCell = 1.0, surfaceBand = 0.0;
+    double surfaceCell = 1.0;          // the size the surface band forces cells down to
     int levels = 0;                    // maxCell = minCell * 2^levels
     std::vector<OctreeLeaf> leaves;    // leaves[i] holds ProbeLayout::positions[i]
     std::vector<LeafProbe> probe;      // per leaf

@@ -117,6 +117,10 @@ struct AdaptiveVolumeSettings {
     // A cell overlaps the surface when it reaches within this height above it; unset = one
     // min cell.
     std::optional<double> surfaceBand;
+    // The size the surface band forces cells down to; below it only the error tolerance splits
+    // them. Unset = min_cell_size (the band is all minimum cells). At least min_cell_size; taken
+    // as the largest min_cell_size x 2^k at or below it, at most max_cell_size.
+    std::optional<double> surfaceCellSize;
     // Relative interpolation error that splits a leaf (docs/lighting.md); unset = geometric only.
     std::optional<double> tolerance;
     std::optional<int> maxProbes;            // budget for the refinement; unset = none

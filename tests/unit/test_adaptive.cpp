@@ -367,16 +367,21 @@ TEST(AdaptivePlacement, SettingsTheTerrainDecidesAreChecked) {
     v.adaptive.maxProbes = 10;
     EXPECT_EQ(message(v), "probe_volumes 'tight': the surface band alone needs " +
                               std::to_string(unlimited.validCount()) +
-                              " probes, more than adaptive.max_probes = 10; raise it or "
-                              "adaptive.min_cell_size");
+                              " probes, more than adaptive.max_probes = 10; raise it, "
+                              "adaptive.min_cell_size or adaptive.surface_cell_size");
     v.adaptive.maxProbes = int(unlimited.validCount());
     EXPECT_EQ(message(v), "");
     v.adaptive.maxProbes.reset();
     v.adaptive.maxBytes = 1000;
     EXPECT_EQ(message(v), "probe_volumes 'tight': the surface band alone needs " +
                               std::to_string(unlimited.fileBytes()) +
-                              " bytes, more than adaptive.max_bytes = 1000; raise it or "
-                              "adaptive.min_cell_size");
+                              " bytes, more than adaptive.max_bytes = 1000; raise it, "
+                              "adaptive.min_cell_size or adaptive.surface_cell_size");
+    v = adaptive(30.0, 120.0);
+    v.name = "band";
+    v.adaptive.surfaceCellSize = 20.0;
+    EXPECT_EQ(message(v), "probe_volumes 'band': adaptive.surface_cell_size = 20 must be at least "
+                          "min_cell_size (30)");
     // An explicit box grows to whole minimum cells.
     v = adaptive(30.0, 120.0);
     v.origin = glm::vec3(-100.0f, -50.0f, -100.0f);
@@ -411,6 +416,34 @@ TEST(Interpolation, TrilinearOverCellCentresLeavesOutEmptyCells) {
 }
 
 namespace {
+
+TEST(AdaptivePlacement, SurfaceCellSizeStopsTheBandAtItsSize) {
+    // The band test's scene: flat ground at 100 m, cells of 10 m to 80 m from y = 0 to 400.
+    const Heightfield hf = flat(41, 10.0, 100.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 80.0);
+    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
+    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    const size_t allMinimum = placeProbes(v, hf).validCount();
+    v.adaptive.surfaceCellSize = 10.0;
+    EXPECT_EQ(placeProbes(v, hf).validCount(), allMinimum);
+    // 30 m stands for the 20 m cells below it. Per 80 m column: the root [80, 160) reaches the
+    // band and is larger than 20 m; its 40 m child [80, 120) has its centre on the ground and
+    // splits, into the buried [80, 100) and the 20 m leaves [100, 120) (2 x 2 each, 16 in all);
+    // the 40 m cells [120, 160) (4) and the 80 m roots above (3) stay.
+    v.adaptive.surfaceCellSize = 30.0;
+    const ProbeLayout L = placeProbes(v, hf);
+    EXPECT_DOUBLE_EQ(L.octree->surfaceCell, 20.0);
+    EXPECT_EQ(allMinimum, 25u * (128 + 4 + 3));
+    EXPECT_EQ(L.validCount(), 25u * (16 + 4 + 3));
+    for (const OctreeLeaf& l : L.octree->leaves) EXPECT_GE(l.level, 1);
+    expectPlacementRules(L, hf, v.adaptive.maxMoveShare);
+    // Past max_cell_size it is max_cell_size: the band forces nothing, and the roots [80, 160),
+    // whose centres are above the ground, stay whole under the 3 above them.
+    v.adaptive.surfaceCellSize = 1000.0;
+    const ProbeLayout open = placeProbes(v, hf);
+    EXPECT_DOUBLE_EQ(open.octree->surfaceCell, 80.0);
+    EXPECT_EQ(open.validCount(), 25u * (1 + 3));
+}
 
 float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
     const glm::vec3 d = (p - c) / radius;
@@ -513,6 +546,65 @@ TEST(Refinement, BudgetStopsItWorstLeavesFirst) {
     const AdaptiveBake b = bakeAdaptive(v, hf, fieldBaker(field));
     EXPECT_EQ(b.layout.validCount(), before + 7);
     EXPECT_EQ(b.layout.fileBytes(), uint64_t(*v.adaptive.maxBytes));
+}
+
+TEST(Refinement, CoarseSurfaceCellsSplitOnlyWhereTheGroundsLightVaries) {
+    // Flat ground at 0; the light varies in one spot 30 m above it. With the band's cells as
+    // large as the largest, the error alone decides where the ground gets small cells.
+    const Heightfield hf = flat(41, 10.0, 0.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 160.0);
+    v.origin = glm::vec3(-240.0f, 0.0f, -240.0f);
+    v.adaptive.size = glm::vec3(480.0f, 480.0f, 480.0f);
+    v.adaptive.surfaceCellSize = 160.0;
+    v.adaptive.tolerance = 0.05;
+    const glm::vec3 hot(-100.0f, 30.0f, 100.0f);
+    auto field = [&](const glm::vec3& p) { return 1.0f + 2.0f * bump(p, hot, 40.0f); };
+    const AdaptiveBake a = bakeAdaptive(v, hf, fieldBaker(field));
+    v.adaptive.surfaceCellSize.reset();
+    const size_t allMinimum = placeProbes(v, hf).validCount();
+    ASSERT_TRUE(a.refinement.has_value());
+    EXPECT_GT(a.refinement->leavesSplit, 0u);
+    EXPECT_LT(a.layout.validCount(), allMinimum / 4);
+    expectPlacementRules(a.layout, hf, v.adaptive.maxMoveShare);
+    // Minimum cells only near the bright spot; the ground far from it keeps 160 m cells.
+    size_t nearMinimum = 0, farCoarse = 0;
+    for (size_t i = 0; i < a.layout.positions.size(); ++i) {
+        const OctreeLeaf& l = a.layout.octree->leaves[i];
+        const float d = glm::length(a.layout.positions[i] - hot);
+        if (l.level == 0) {
+            EXPECT_LT(d, 160.0f);
+            ++nearMinimum;
+        }
+        farCoarse += l.level == 4 && l.y == 0 && d > 250.0f;
+    }
+    EXPECT_GT(nearMinimum, 0u);
+    EXPECT_GT(farCoarse, 0u);
+    // A budget the band of minimum cells alone exceeds: the coarse band fits it, and the
+    // refinement spends it on the worst leaves, those around the spot.
+    v.adaptive.maxProbes = int(allMinimum / 8);
+    EXPECT_THROW(placeProbes(v, hf), PlacementError);
+    v.adaptive.surfaceCellSize = 160.0;
+    const AdaptiveBake budgeted = bakeAdaptive(v, hf, fieldBaker(field));
+    EXPECT_TRUE(budgeted.refinement->budgetReached || budgeted.layout.validCount() == a.layout.validCount());
+    EXPECT_LE(budgeted.layout.validCount(), size_t(*v.adaptive.maxProbes));
+}
+
+TEST(Refinement, OctantsInsideTheTerrainDoNotSplitALeaf) {
+    // Flat ground at 100 m; the 80 m leaves [80, 160) of a 80 m band have their lower octants'
+    // centres on the ground, where a probe would see the terrain from inside (a fifth of the
+    // light here). Above the ground the light is uniform, so nothing should split.
+    const Heightfield hf = flat(41, 10.0, 100.0f);
+    ProbeVolumeSettings v = adaptive(10.0, 80.0);
+    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
+    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    v.adaptive.surfaceCellSize = 80.0;
+    v.adaptive.tolerance = 0.05;
+    auto field = [&](const glm::vec3& p) { return p.y > hf.surfaceHeight(p.x, p.z) ? 1.0f : 0.2f; };
+    const AdaptiveBake a = bakeAdaptive(v, hf, fieldBaker(field));
+    ASSERT_TRUE(a.refinement.has_value());
+    EXPECT_GT(a.refinement->leavesTested, 0u);
+    EXPECT_EQ(a.refinement->leavesSplit, 0u);
+    EXPECT_EQ(a.layout.validCount(), placeProbes(v, hf).validCount());
 }
 
 TEST(Refinement, SameResultWithOneAndTwoThreads) {
