@@ -294,7 +294,6 @@ std::optional<SamplingChoice> chooseSampling(SceneDescription& scene, BakeSetup&
         pilot.push_back(all[k * all.size() / std::min(all.size(), kPilotProbes)]);
     const std::vector<uint8_t> valid(pilot.size(), 1);
     c.pilotProbes = pilot.size();
-    c.pilotRays = kBounceTrialRays;
     constexpr uint64_t kPilotSeed = 0x9170AB5Eull;
 
     // Bounces: caches after 0..kMaxBounces-1 gathers from one set of rays; b bounces read the
@@ -404,11 +403,7 @@ std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup&
         c.met = search.met;
         c.capped = search.capped;
         c.trials = search.trials.size();
-        std::ostringstream sum;
-        sum << (v.placement == ProbePlacement::Terrain ? "spacing " : "min cell ") << std::lround(c.spacing) << " m";
-        if (v.placement == ProbePlacement::Adaptive) sum << ", tolerance " << percent(search.chosen.tolerance);
-        sum << ", " << grouped(c.probes) << " probes, p95 " << percent(c.p95);
-        c.summary = sum.str();
+        if (v.placement == ProbePlacement::Adaptive) c.tolerance = search.chosen.tolerance;
         if (v.placement == ProbePlacement::Terrain && c.capped) {
             // Past the cap: what meets the target instead, at the adaptive volume's cost.
             ProbeVolumeSettings a = v;
@@ -939,12 +934,10 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                {"rays", mapRays},
                                {"time_s", secondsSince(mapStart)}};
             // The target is judged on this map, the bake's own, not the search's coarser one.
-            if (vr.contains("target") && ms.points > 0) {
-                nlohmann::json& t = vr["target"];
-                const std::string summary = t["summary"].get<std::string>();
-                t["p95"] = ms.p95;
-                t["met"] = ms.p95 <= t["target"].get<double>();
-                t["summary"] = summary.substr(0, summary.rfind(", p95 ")) + ", p95 " + percent(ms.p95);
+            if (targets.count(volumeIndex) && ms.points > 0) {
+                TargetChoice judged = targets.at(volumeIndex);
+                judged.bakeP95 = ms.p95;
+                vr["target"] = targetChoiceReport(judged);
             }
         }
 
@@ -1145,7 +1138,7 @@ nlohmann::json samplingChoiceReport(const SamplingChoice& c) {
             {"bounces", c.bounces},
             {"replaced", c.replaced},
             {"pilot_probes", c.pilotProbes},
-            {"bounce_trial_rays", c.pilotRays},
+            {"bounce_trial_rays", kBounceTrialRays},
             {"standard_error_p95", c.raySearch.error},
             {"next_bounce_change_p95", c.bounceSearch.error},
             {"met", c.met},
@@ -1155,8 +1148,16 @@ nlohmann::json samplingChoiceReport(const SamplingChoice& c) {
             {"summary", c.summary}};
 }
 
+std::string targetSummary(const TargetChoice& c) {
+    std::ostringstream sum;
+    sum << (c.tolerance ? "min cell " : "spacing ") << std::lround(c.spacing) << " m";
+    if (c.tolerance) sum << ", tolerance " << percent(*c.tolerance);
+    sum << ", " << grouped(c.probes) << " probes, p95 " << percent(c.bakeP95.value_or(c.p95));
+    return sum.str();
+}
+
 nlohmann::json targetChoiceReport(const TargetChoice& c) {
-    return {{"target", c.target},
+    nlohmann::json j = {{"target", c.target},
             {"setting", c.setting},
             {"value", c.value},
             {"replaced", c.replaced.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.replaced)},
@@ -1165,12 +1166,14 @@ nlohmann::json targetChoiceReport(const TargetChoice& c) {
             {"spacing_m", c.spacing},
             {"search_p95", c.p95},
             {"search_map_resolution", c.mapResolution},
-            {"met", c.met},
+            {"met", c.bakeP95 ? *c.bakeP95 <= c.target : c.met},
             {"capped", c.capped},
             {"trials", c.trials},
             {"time_s", c.seconds},
-            {"summary", c.summary},
+            {"summary", targetSummary(c)},
             {"offer", c.offer}};
+    if (c.bakeP95) j["p95"] = *c.bakeP95;
+    return j;
 }
 
 nlohmann::json bakeInputs(const Project& project) {

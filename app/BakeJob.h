@@ -55,18 +55,22 @@ struct TargetChoice {
     size_t probes = 0;
     uint64_t bytes = 0;
     float spacing = 0.0f;       // terrain: probe spacing; adaptive: min cell, metres
+    std::optional<double> tolerance;  // adaptive: the chosen adaptive.tolerance
     double p95 = 0.0;           // of the search's map
     int mapResolution = 0;      // of the search's map
-    bool met = false;
+    std::optional<double> bakeP95;    // of the bake's own map, once measured: the target's judge
+    bool met = false;           // of the search's map
     bool capped = false;        // terrain: the target needs more than kMaxTerrainGridProbes
     size_t trials = 0;
     double seconds = 0.0;       // the search
-    std::string summary;        // "spacing 240 m, 3 914 probes, p95 2.8 %"
     // Terrain grids past the cap: the adaptive volume that meets the target instead, with its
     // cost ({"set": [...], "probes", "bytes", "estimated_time_s", "p95"}); null when none does.
     nlohmann::json offer;
     std::string warning;        // one line when capped
 };
+// "spacing 240 m, 3 914 probes, p95 2.8 %", the p95 of the bake's map once measured.
+std::string targetSummary(const TargetChoice& c);
+// met and p95 judged on the bake's map once measured, on the search's until then.
 nlohmann::json targetChoiceReport(const TargetChoice& c);
 
 // What bake.target_error chose (docs/lighting.md, "Asking for an accuracy"): bounces until one
@@ -78,7 +82,6 @@ struct SamplingChoice {
     int rays = 0, bounces = 0;
     std::string replaced;            // what it overrides: "the standard preset's 256 rays and 2 bounces"
     size_t pilotProbes = 0;          // probes the trials bake
-    int pilotRays = 0;               // rays of the bounce trials
     SamplingSearch raySearch, bounceSearch;
     bool met = false;                // both searches met it on the pilot probes
     double seconds = 0.0;

@@ -310,7 +310,7 @@ int printEstimate(const BakeEstimate& e) {
             const TargetChoice& t = *v.target;
             std::cout << "    target_error " << fixed(100.0 * t.target, 1) << " %: " << t.setting << " " << t.value;
             if (!t.replaced.empty()) std::cout << " (replaces " << t.replaced << ")";
-            std::cout << ": " << t.summary << " on a " << t.mapResolution << "-point map ("
+            std::cout << ": " << targetSummary(t) << " on a " << t.mapResolution << "-point map ("
                       << (t.met ? "meets it" : "misses it") << "; " << t.trials << " trials, "
                       << duration(t.seconds) << ")\n";
         }

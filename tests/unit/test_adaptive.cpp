@@ -41,6 +41,14 @@ ProbeVolumeSettings adaptive(std::optional<double> minCell = std::nullopt,
     return v;
 }
 
+// An adaptive volume over the cube of edge `edge` centred on the origin in x and z, from y = 0.
+ProbeVolumeSettings adaptiveCube(double minCell, double maxCell, float edge) {
+    ProbeVolumeSettings v = adaptive(minCell, maxCell);
+    v.origin = glm::vec3(-0.5f * edge, 0.0f, -0.5f * edge);
+    v.adaptive.size = glm::vec3(edge);
+    return v;
+}
+
 size_t cellIndex(const ProbeLayout& L, uint32_t x, uint32_t y, uint32_t z) {
     return x + size_t(y) * L.cellDims[0] + size_t(z) * L.cellDims[0] * L.cellDims[1];
 }
@@ -219,9 +227,7 @@ TEST(AdaptivePlacement, FullSharedDemFollowsTheRules) {
 TEST(AdaptivePlacement, SurfaceBandGoesToTheMinimumAndOpenAirStaysCoarse) {
     // Flat ground at 100 m; cells of 10 m to 80 m from y = 0 to 400: the band reaches 110 m.
     const Heightfield hf = flat(41, 10.0, 100.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 80.0);
-    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
-    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 80.0, 400.0f);
     const ProbeLayout L = placeProbes(v, hf);
     ASSERT_EQ(L.cellDims, (std::array<uint32_t, 3>{40, 40, 40}));
     for (const OctreeLeaf& l : L.octree->leaves) {
@@ -420,9 +426,7 @@ namespace {
 TEST(AdaptivePlacement, SurfaceCellSizeStopsTheBandAtItsSize) {
     // The band test's scene: flat ground at 100 m, cells of 10 m to 80 m from y = 0 to 400.
     const Heightfield hf = flat(41, 10.0, 100.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 80.0);
-    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
-    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 80.0, 400.0f);
     const size_t allMinimum = placeProbes(v, hf).validCount();
     v.adaptive.surfaceCellSize = 10.0;
     EXPECT_EQ(placeProbes(v, hf).validCount(), allMinimum);
@@ -454,9 +458,7 @@ float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
 
 TEST(Refinement, SplitsWhereLightingVariesAndReusesTheOctantBakes) {
     const Heightfield hf = flat(41, 10.0, 0.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 160.0);
-    v.origin = glm::vec3(-240.0f, 0.0f, -240.0f);
-    v.adaptive.size = glm::vec3(480.0f, 480.0f, 480.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 160.0, 480.0f);
     v.adaptive.tolerance = 0.05;
     const glm::vec3 hot(-100.0f, 300.0f, 100.0f);
     auto field = [&](const glm::vec3& p) { return 1.0f + 2.0f * bump(p, hot, 60.0f); };
@@ -510,9 +512,7 @@ TEST(Refinement, SplitsWhereLightingVariesAndReusesTheOctantBakes) {
 
 TEST(Refinement, BudgetStopsItWorstLeavesFirst) {
     const Heightfield hf = flat(33, 10.0, 0.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 80.0);
-    v.origin = glm::vec3(-160.0f, 0.0f, -160.0f);
-    v.adaptive.size = glm::vec3(320.0f, 320.0f, 320.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 80.0, 320.0f);
     v.adaptive.tolerance = 0.01;
     // Two bumps in the air, the stronger in the leaf [0, 80)^2 x [240, 320).
     const glm::vec3 strong(40.0f, 280.0f, 40.0f), weak(-120.0f, 280.0f, -120.0f);
@@ -552,9 +552,7 @@ TEST(Refinement, CoarseSurfaceCellsSplitOnlyWhereTheGroundsLightVaries) {
     // Flat ground at 0; the light varies in one spot 30 m above it. With the band's cells as
     // large as the largest, the error alone decides where the ground gets small cells.
     const Heightfield hf = flat(41, 10.0, 0.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 160.0);
-    v.origin = glm::vec3(-240.0f, 0.0f, -240.0f);
-    v.adaptive.size = glm::vec3(480.0f, 480.0f, 480.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 160.0, 480.0f);
     v.adaptive.surfaceCellSize = 160.0;
     v.adaptive.tolerance = 0.05;
     const glm::vec3 hot(-100.0f, 30.0f, 100.0f);
@@ -579,14 +577,21 @@ TEST(Refinement, CoarseSurfaceCellsSplitOnlyWhereTheGroundsLightVaries) {
     }
     EXPECT_GT(nearMinimum, 0u);
     EXPECT_GT(farCoarse, 0u);
-    // A budget the band of minimum cells alone exceeds: the coarse band fits it, and the
-    // refinement spends it on the worst leaves, those around the spot.
-    v.adaptive.maxProbes = int(allMinimum / 8);
-    EXPECT_THROW(placeProbes(v, hf), PlacementError);
+    // A budget the band of minimum cells alone exceeds, halfway between the coarse geometry and
+    // the unbudgeted refinement: the coarse band fits it, and the refinement stops within it,
+    // having split the worst leaves, those around the spot.
     v.adaptive.surfaceCellSize = 160.0;
+    const size_t coarse = placeProbes(v, hf).validCount();
+    v.adaptive.maxProbes = int((coarse + a.layout.validCount()) / 2);
     const AdaptiveBake budgeted = bakeAdaptive(v, hf, fieldBaker(field));
-    EXPECT_TRUE(budgeted.refinement->budgetReached || budgeted.layout.validCount() == a.layout.validCount());
+    EXPECT_TRUE(budgeted.refinement->budgetReached);
+    EXPECT_GT(budgeted.layout.validCount(), coarse);
     EXPECT_LE(budgeted.layout.validCount(), size_t(*v.adaptive.maxProbes));
+    for (size_t i = 0; i < budgeted.layout.positions.size(); ++i)
+        if (budgeted.layout.octree->leaves[i].level < 4)
+            EXPECT_LT(glm::length(budgeted.layout.positions[i] - hot), 250.0f);
+    v.adaptive.surfaceCellSize.reset();
+    EXPECT_THROW(placeProbes(v, hf), PlacementError);
 }
 
 TEST(Refinement, OctantsInsideTheTerrainDoNotSplitALeaf) {
@@ -594,9 +599,7 @@ TEST(Refinement, OctantsInsideTheTerrainDoNotSplitALeaf) {
     // centres on the ground, where a probe would see the terrain from inside (a fifth of the
     // light here). Above the ground the light is uniform, so nothing should split.
     const Heightfield hf = flat(41, 10.0, 100.0f);
-    ProbeVolumeSettings v = adaptive(10.0, 80.0);
-    v.origin = glm::vec3(-200.0f, 0.0f, -200.0f);
-    v.adaptive.size = glm::vec3(400.0f, 400.0f, 400.0f);
+    ProbeVolumeSettings v = adaptiveCube(10.0, 80.0, 400.0f);
     v.adaptive.surfaceCellSize = 80.0;
     v.adaptive.tolerance = 0.05;
     auto field = [&](const glm::vec3& p) { return p.y > hf.surfaceHeight(p.x, p.z) ? 1.0f : 0.2f; };
