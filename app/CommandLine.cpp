@@ -54,8 +54,9 @@ Commands:
                                 the Vulkan device.
   --study [PROJECT]             Sweep the settings that trade bake time for accuracy (quality,
                                 rays, bounces, probe spacing or adaptive tolerance, error-map
-                                resolution, AO directions, LPV quality and cascades), measure
-                                each against the exact answer on the same points, and write
+                                resolution, AO directions, LPV quality and cascades, reflection
+                                cube size, rays and encoding), measure each against the exact
+                                answer on the same points, and write
                                 study.json, study.csv, study.png and study.html into --out DIR
                                 (default: "study" beside the project or in the current folder).
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:

@@ -17,12 +17,14 @@
 
 #include "AtomicFile.h"
 #include "BakeJob.h"
+#include "ReflectionProbeFile.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
+#include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
 #include "render/OrbitCamera.h"
@@ -40,6 +42,7 @@ const char* studyMetricName(StudyMetric m) {
         case StudyMetric::ErrorMapP95: return "error_map_p95";
         case StudyMetric::AmbientOcclusion: return "ambient_occlusion";
         case StudyMetric::Lpv: return "lpv";
+        case StudyMetric::Reflection: return "reflection";
     }
     return "irradiance";
 }
@@ -54,6 +57,8 @@ const char* studyMetricMeaning(StudyMetric m) {
             return "absolute error of horizon AO against traced sky visibility";
         case StudyMetric::Lpv:
             return "relative error of the LPV against the traced one-bounce sun irradiance";
+        case StudyMetric::Reflection:
+            return "relative RMS of prefiltered reflection luminance against a reference cube twice as fine";
     }
     return "";
 }
@@ -104,6 +109,11 @@ constexpr int kAoRays = 512;
 constexpr int kAoVertices = 512;
 constexpr int kLpvPoints = 256;
 constexpr int kLpvRays = 512;
+// Reflection truth: per probe, a cube twice as fine a side as the finest swept or set, with 4 rays
+// a texel, read at the roughnesses the bake's own comparison uses.
+constexpr int kReflectionSweep[] = {8, 16, 32};
+constexpr int kReflectionReferenceRays = 4;
+const std::vector<float> kReflectionRoughness{0.25f, 0.5f, 0.75f, 1.0f};
 constexpr double kSafety = 1.25;            // estimates are scaled up by this before they are trusted
 
 std::string fmt(const char* f, double v) {
@@ -234,6 +244,7 @@ struct Study {
     StudyPoint measureErrorMap(const Candidate& c);
     StudyPoint measureAo(const Candidate& c);
     StudyPoint measureLpv(const Candidate& c);
+    StudyPoint measureReflection(const Candidate& c);
     StudyPoint measure(const Candidate& c);
     void run();
 
@@ -256,6 +267,13 @@ struct Study {
     std::vector<glm::vec3> lpvP, lpvN;
     std::vector<float> lpvTruth;
     float lpvFloor = 0.0f;
+    // Reflection truth: the project's layout, the cache its rays read, per probe and roughness the
+    // reference luminance over the 256 error directions.
+    std::unique_ptr<IrradianceCache> reflectionCache;
+    std::optional<ReflectionLighting> reflectionLight;
+    ReflectionLayout reflectionLayout;
+    std::vector<std::vector<double>> reflectionTruth;
+    int reflectionReferenceSize = 0;
 };
 
 void Study::prepare() {
@@ -421,6 +439,22 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                 add("lpv_cascades", "LPV " + std::to_string(c) + " cascades", {"lpv.cascades=" + std::to_string(c)},
                     StudyMetric::Lpv);
     }
+    if (s.reflectionProbes.enabled) {
+        const ReflectionProbeSettings& r = s.reflectionProbes;
+        const std::string enc = r.encoding == ReflectionEncoding::Cubemap ? "cubemap" : "faces";
+        add("reflection_resolution", "reflection " + std::to_string(r.resolution) + "² " + enc + " (current)",
+            {"reflection_probes.resolution=" + std::to_string(r.resolution)}, StudyMetric::Reflection);
+        for (int res : kReflectionSweep)
+            if (res != r.resolution)
+                add("reflection_resolution", "reflection " + std::to_string(res) + "² " + enc,
+                    {"reflection_probes.resolution=" + std::to_string(res)}, StudyMetric::Reflection);
+        for (int rays : {2, 4, 16, 64})
+            if (rays != r.rayCount)
+                add("reflection_rays", "reflection " + std::to_string(rays) + " rays/texel",
+                    {"reflection_probes.ray_count=" + std::to_string(rays)}, StudyMetric::Reflection);
+        const std::string other = r.encoding == ReflectionEncoding::Cubemap ? "faces" : "cubemap";
+        add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
+    }
 
     // Work, in each kind's unit, for the estimates.
     for (Candidate& c : out) {
@@ -450,6 +484,12 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
             case StudyMetric::ErrorMapP95: c.work = double(c.param) * c.param * double(current ? current->rays : q.rays); break;
             case StudyMetric::AmbientOcclusion: c.work = double(hf().width()) * hf().depth() * c.param; break;
             case StudyMetric::Lpv: c.work = double(cs.lpv.cascades) * (cs.lpv.quality == 2 ? 1.3 : 1.0); break;
+            case StudyMetric::Reflection: {
+                // Traced texels; a faces set is baked as a cube too.
+                const ReflectionProbeSettings& r = cs.reflectionProbes;
+                c.work = double(r.gridDims[0]) * r.gridDims[1] * 6.0 * r.resolution * r.resolution * r.rayCount;
+                break;
+            }
         }
     }
     return out;
@@ -461,6 +501,7 @@ const char* rateKey(StudyMetric m) {
         case StudyMetric::ErrorMapP95: return "rays";
         case StudyMetric::AmbientOcclusion: return "ao";
         case StudyMetric::Lpv: return "lpv";
+        case StudyMetric::Reflection: return "reflection";
     }
     return "rays";
 }
@@ -639,6 +680,55 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     return p;
 }
 
+StudyPoint Study::measureReflection(const Candidate& c) {
+    const SceneDescription s = sceneWith(c.sets);
+    if (!reflectionLight) {
+        // Terrain hits read their light from a cache with the bake's bounces less the one the
+        // reflection ray makes, as the bake's own reflection pass does without probes.
+        const BakeQuality q = qualityOf(project.scene.bake), standard = qualityPreset(QualityPreset::Standard);
+        reflectionCache = std::make_unique<IrradianceCache>(lighting, standard.cacheResolution, standard.cacheRays,
+                                                            std::max(q.sunSamples, 1), std::max(q.bounces - 1, 0),
+                                                            control());
+        const ReflectionProbeSettings& r = project.scene.reflectionProbes;
+        reflectionLight = ReflectionLighting{&lighting, reflectionCache.get(), std::max(q.bounces, 1),
+                                             groundRadiance(lighting, r.groundColor)};
+        reflectionLayout = placeReflectionProbes(r, hf());
+        reflectionReferenceSize = 2 * std::max(kReflectionSweep[std::size(kReflectionSweep) - 1], r.resolution);
+        const size_t n = reflectionLayout.count(), nr = kReflectionRoughness.size();
+        reflectionTruth.assign(n * nr, {});
+        tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            if (cancelled()) return;
+            const RadianceCube ref = traceRadianceCube(*reflectionLight, reflectionLayout.positions[i],
+                                                       reflectionReferenceSize, kReflectionReferenceRays,
+                                                       splitmix64(kStudySeed ^ 0x2EF) + i);
+            for (size_t k = 0; k < nr; ++k) reflectionTruth[i * nr + k] = referenceLuminance(ref, kReflectionRoughness[k]);
+        });
+        if (cancelled()) throw BakeCancelled();
+    }
+    StudyPoint p;
+    p.metric = StudyMetric::Reflection;
+    const PeakMemory memory;
+    const auto t0 = Clock::now();
+    ReflectionProbeSet set = bakeReflectionProbes(*reflectionLight, s.reflectionProbes, reflectionLayout, kStudySeed,
+                                                  control());
+    toEncoding(set, s.reflectionProbes.encoding);
+    p.seconds = secondsSince(t0);
+    p.peakMemoryBytes = memory.added();
+    p.outputBytes = encodeReflectionProbes(set).size();
+    p.probes = set.probes.size();
+    std::vector<float> err;
+    const size_t nr = kReflectionRoughness.size();
+    for (size_t i = 0; i < set.probes.size(); ++i)
+        for (size_t k = 0; k < nr; ++k)
+            err.push_back(reflectionProbeError(set, i, set.encoding, reflectionTruth[i * nr + k], kReflectionRoughness[k]));
+    setErrors(p, std::move(err));
+    learn("reflection", c.work, p.seconds);
+    const ReflectionProbeSettings& own = project.scene.reflectionProbes;
+    p.current = s.reflectionProbes.resolution == own.resolution && s.reflectionProbes.rayCount == own.rayCount &&
+                s.reflectionProbes.encoding == own.encoding;
+    return p;
+}
+
 StudyPoint Study::measure(const Candidate& c) {
     StudyPoint p;
     switch (c.metric) {
@@ -646,6 +736,7 @@ StudyPoint Study::measure(const Candidate& c) {
         case StudyMetric::ErrorMapP95: p = measureErrorMap(c); break;
         case StudyMetric::AmbientOcclusion: p = measureAo(c); break;
         case StudyMetric::Lpv: p = measureLpv(c); break;
+        case StudyMetric::Reflection: p = measureReflection(c); break;
     }
     p.knob = c.knob;
     p.label = c.label;
@@ -710,9 +801,6 @@ void Study::run() {
     if (s.shadows.enabled)
         result.notStudied.push_back("shadows: cascades and filters are measured by the Vulkan renderer against traced sun "
                                     "visibility (bench_render, README), not by the CPU study");
-    if (s.reflectionProbes.enabled)
-        result.notStudied.push_back("reflection_probes: encodings are measured against brute force by bench_reflection "
-                                    "(README), not by the study");
 
     // Cheapest first within each knob, knobs in turn, so a short budget still sees every knob.
     std::map<std::string, std::vector<Candidate>> byKnob;

@@ -9,7 +9,8 @@
 // Monte Carlo noise, missing bounces and interpolation add up in one number. The error map's
 // resolution is measured by how far its p95 is from the p95 of a map twice as dense; AO directions
 // by the horizon AO's error against traced sky visibility; LPV quality and cascades by their
-// error against the traced one-bounce sun irradiance.
+// error against the traced one-bounce sun irradiance; reflection cube size, rays and encoding by
+// the prefiltered luminance's error against a reference cube twice as fine per probe.
 //
 // The study keeps to a time budget: every setting's cost is estimated from the throughput
 // measured so far, the cheapest settings of every knob run first, and a setting that no longer
@@ -35,6 +36,7 @@ enum class StudyMetric {
     ErrorMapP95,     // |p95 of the map − p95 of the map twice as dense| / the latter
     AmbientOcclusion,// mean |horizon AO − traced sky visibility| at terrain vertices
     Lpv,             // LPV irradiance against the traced one-bounce sun irradiance
+    Reflection,      // prefiltered reflection luminance against a finer reference cube per probe
 };
 const char* studyMetricName(StudyMetric m);
 // One line: what the metric's error means, for the table and the plot's legend.

@@ -418,8 +418,6 @@ void toEncoding(ReflectionProbeSet& set, ReflectionEncoding encoding) {
     }
 }
 
-namespace {
-
 // The reference's prefiltered luminance toward each of the 256 directions.
 std::vector<double> referenceLuminance(const RadianceCube& reference, float roughness) {
     const CubeGeometry g(reference.size);
@@ -428,8 +426,8 @@ std::vector<double> referenceLuminance(const RadianceCube& reference, float roug
     return out;
 }
 
-float errorAgainst(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
-                   const std::vector<double>& reference, float roughness) {
+float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
+                           const std::vector<double>& reference, float roughness) {
     ReflectionProbeSet view;
     const ReflectionProbeSet* s = &set;
     if (encoding != set.encoding) {
@@ -450,11 +448,9 @@ float errorAgainst(const ReflectionProbeSet& set, size_t probe, ReflectionEncodi
     return den > 0 ? float(std::sqrt(num / den)) : 0.0f;
 }
 
-}  // namespace
-
 float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
                            const RadianceCube& reference, float roughness) {
-    return errorAgainst(set, probe, encoding, referenceLuminance(reference, roughness), roughness);
+    return reflectionProbeError(set, probe, encoding, referenceLuminance(reference, roughness), roughness);
 }
 
 ReflectionErrorReport measureReflectionError(const ReflectionLighting& light,
@@ -472,8 +468,8 @@ ReflectionErrorReport measureReflectionError(const ReflectionLighting& light,
                                                    settings.rayCount, splitmix64(seed ^ 0x5EF1EC7ull) + i, &traced[i]);
         for (size_t r = 0; r < nr; ++r) {
             const std::vector<double> truth = referenceLuminance(ref, roughnesses[r]);
-            faces[i * nr + r] = errorAgainst(set, i, ReflectionEncoding::Faces, truth, roughnesses[r]);
-            cubemap[i * nr + r] = errorAgainst(set, i, ReflectionEncoding::Cubemap, truth, roughnesses[r]);
+            faces[i * nr + r] = reflectionProbeError(set, i, ReflectionEncoding::Faces, truth, roughnesses[r]);
+            cubemap[i * nr + r] = reflectionProbeError(set, i, ReflectionEncoding::Cubemap, truth, roughnesses[r]);
         }
     });
     for (size_t r = 0; r < nr; ++r) {

@@ -161,5 +161,10 @@ ReflectionErrorReport measureReflectionError(const ReflectionLighting& light,
 // prefilteredRadiance(reference, d, roughness) over the 256 directions.
 float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
                            const RadianceCube& reference, float roughness);
+// The same against the luminance of that reference over the 256 directions (referenceLuminance),
+// for a truth measured once and read by many sets.
+float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, ReflectionEncoding encoding,
+                           const std::vector<double>& reference, float roughness);
+std::vector<double> referenceLuminance(const RadianceCube& reference, float roughness);
 
 }  // namespace terralux
