@@ -596,9 +596,6 @@ uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& la
     return rays;
 }
 
-// The roughnesses the reflection encodings' error is reported at: from the terrain's floor to 1.
-const std::vector<float> kReflectionErrorRoughness{0.25f, 0.5f, 0.75f, 1.0f};
-
 uint64_t reflectionSeed() { return splitmix64(0x2EF1EC7ull); }
 
 // The reflection probes of a bake, baked and encoded for export.
@@ -609,28 +606,32 @@ struct ReflectionOutput {
     std::vector<std::string> warnings;
 };
 
-ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettings& settings,
-                                 const ReflectionLayout& layout, const IrradianceCache* sharedCache,
-                                 int cacheResolution, bool compareReference, const BakeControl& control) {
-    const auto start = Clock::now();
-    const BakeLighting& lighting = b.lighting;
-    // Terrain hits read their light from an irradiance cache: the probes' own when the bake has
-    // one, else one with the bake's bounces less the one the reflection ray makes.
-    std::unique_ptr<IrradianceCache> own;
+}  // namespace
+
+ReflectionLighting reflectionLightingOf(const BakeLighting& lighting, const BakeQuality& q, const glm::vec3& groundColor,
+                                        const IrradianceCache* sharedCache, int cacheResolution,
+                                        std::unique_ptr<IrradianceCache>& own, const BakeControl& control) {
     const IrradianceCache* cache = sharedCache;
     if (!cache) {
         const BakeQuality standard = qualityPreset(QualityPreset::Standard);
         own = std::make_unique<IrradianceCache>(
             lighting, cacheResolution > 0 ? cacheResolution : standard.cacheResolution,
-            b.q.cacheRays > 0 ? b.q.cacheRays : standard.cacheRays, std::max(b.q.sunSamples, 1),
-            std::max(b.q.bounces - 1, 0), BakeControl{nullptr, control.cancel});
+            q.cacheRays > 0 ? q.cacheRays : standard.cacheRays, std::max(q.sunSamples, 1),
+            std::max(q.bounces - 1, 0), BakeControl{nullptr, control.cancel});
         cache = own.get();
     }
-    ReflectionLighting light;
-    light.lighting = &lighting;
-    light.cache = cache;
-    light.bounces = std::max(b.q.bounces, 1);
-    light.ground = groundRadiance(lighting, settings.groundColor);
+    return ReflectionLighting{&lighting, cache, std::max(q.bounces, 1), groundRadiance(lighting, groundColor)};
+}
+
+namespace {
+
+ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettings& settings,
+                                 const ReflectionLayout& layout, const IrradianceCache* sharedCache,
+                                 int cacheResolution, bool compareReference, const BakeControl& control) {
+    const auto start = Clock::now();
+    std::unique_ptr<IrradianceCache> own;
+    const ReflectionLighting light =
+        reflectionLightingOf(b.lighting, b.q, settings.groundColor, sharedCache, cacheResolution, own, control);
 
     uint64_t rays = 0;
     ReflectionProbeSet set = bakeReflectionProbes(light, settings, layout, reflectionSeed(), control, &rays);
@@ -642,7 +643,7 @@ ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettin
          {"spacing", {set.spacing.x, set.spacing.y}},
          {"cell_size", {set.cellSize.x, set.cellSize.y}},
          {"fallback_blend_distance", set.blendDistance},
-         {"encoding", settings.encoding == ReflectionEncoding::Cubemap ? "cubemap" : "faces"},
+         {"encoding", reflectionEncodingName(settings.encoding)},
          {"resolution", settings.resolution},
          {"rays_per_texel", settings.rayCount},
          {"rays", rays},

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "Project.h"
+#include "bake/ReflectionBake.h"
 #include "bake/TargetSearch.h"
 
 namespace terralux {
@@ -72,6 +73,14 @@ struct TargetChoice {
 std::string targetSummary(const TargetChoice& c);
 // met and p95 judged on the bake's map once measured, on the search's until then.
 nlohmann::json targetChoiceReport(const TargetChoice& c);
+
+// The light a bake's reflection rays read: terrain hits from `sharedCache` (the probes' own) when
+// given, else from a cache built into `own` with the bake's bounces less the one the reflection ray
+// makes (at `cacheResolution`, or the standard preset's when 0); the ground beyond the terrain
+// has albedo `groundColor`.
+ReflectionLighting reflectionLightingOf(const BakeLighting& lighting, const BakeQuality& q, const glm::vec3& groundColor,
+                                        const IrradianceCache* sharedCache, int cacheResolution,
+                                        std::unique_ptr<IrradianceCache>& own, const BakeControl& control);
 
 // What bake.target_error chose (docs/lighting.md, "Asking for an accuracy"): bounces until one
 // more changes the irradiance of a few of the volumes' own probes by less than the target, then

@@ -110,10 +110,9 @@ constexpr int kAoVertices = 512;
 constexpr int kLpvPoints = 256;
 constexpr int kLpvRays = 512;
 // Reflection truth: per probe, a cube twice as fine a side as the finest swept or set, with 4 rays
-// a texel, read at the roughnesses the bake's own comparison uses.
+// a texel, read at the roughnesses the bake's own comparison uses (kReflectionErrorRoughness).
 constexpr int kReflectionSweep[] = {8, 16, 32};
 constexpr int kReflectionReferenceRays = 4;
-const std::vector<float> kReflectionRoughness{0.25f, 0.5f, 0.75f, 1.0f};
 constexpr double kSafety = 1.25;            // estimates are scaled up by this before they are trusted
 
 std::string fmt(const char* f, double v) {
@@ -441,7 +440,7 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
     }
     if (s.reflectionProbes.enabled) {
         const ReflectionProbeSettings& r = s.reflectionProbes;
-        const std::string enc = r.encoding == ReflectionEncoding::Cubemap ? "cubemap" : "faces";
+        const std::string enc = reflectionEncodingName(r.encoding);
         add("reflection_resolution", "reflection " + std::to_string(r.resolution) + "² " + enc + " (current)",
             {"reflection_probes.resolution=" + std::to_string(r.resolution)}, StudyMetric::Reflection);
         for (int res : kReflectionSweep)
@@ -452,7 +451,8 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
             if (rays != r.rayCount)
                 add("reflection_rays", "reflection " + std::to_string(rays) + " rays/texel",
                     {"reflection_probes.ray_count=" + std::to_string(rays)}, StudyMetric::Reflection);
-        const std::string other = r.encoding == ReflectionEncoding::Cubemap ? "faces" : "cubemap";
+        const std::string other = reflectionEncodingName(r.encoding == ReflectionEncoding::Cubemap ? ReflectionEncoding::Faces
+                                                                                                  : ReflectionEncoding::Cubemap);
         add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
     }
 
@@ -683,25 +683,20 @@ StudyPoint Study::measureLpv(const Candidate& c) {
 StudyPoint Study::measureReflection(const Candidate& c) {
     const SceneDescription s = sceneWith(c.sets);
     if (!reflectionLight) {
-        // Terrain hits read their light from a cache with the bake's bounces less the one the
-        // reflection ray makes, as the bake's own reflection pass does without probes.
-        const BakeQuality q = qualityOf(project.scene.bake), standard = qualityPreset(QualityPreset::Standard);
-        reflectionCache = std::make_unique<IrradianceCache>(lighting, standard.cacheResolution, standard.cacheRays,
-                                                            std::max(q.sunSamples, 1), std::max(q.bounces - 1, 0),
-                                                            control());
+        // The light the bake's own reflection pass reads when it has no probes' cache.
         const ReflectionProbeSettings& r = project.scene.reflectionProbes;
-        reflectionLight = ReflectionLighting{&lighting, reflectionCache.get(), std::max(q.bounces, 1),
-                                             groundRadiance(lighting, r.groundColor)};
+        reflectionLight = reflectionLightingOf(lighting, qualityOf(project.scene.bake), r.groundColor, nullptr, 0,
+                                               reflectionCache, control());
         reflectionLayout = placeReflectionProbes(r, hf());
         reflectionReferenceSize = 2 * std::max(kReflectionSweep[std::size(kReflectionSweep) - 1], r.resolution);
-        const size_t n = reflectionLayout.count(), nr = kReflectionRoughness.size();
+        const size_t n = reflectionLayout.count(), nr = kReflectionErrorRoughness.size();
         reflectionTruth.assign(n * nr, {});
         tbb::parallel_for(size_t(0), n, [&](size_t i) {
             if (cancelled()) return;
             const RadianceCube ref = traceRadianceCube(*reflectionLight, reflectionLayout.positions[i],
                                                        reflectionReferenceSize, kReflectionReferenceRays,
                                                        splitmix64(kStudySeed ^ 0x2EF) + i);
-            for (size_t k = 0; k < nr; ++k) reflectionTruth[i * nr + k] = referenceLuminance(ref, kReflectionRoughness[k]);
+            for (size_t k = 0; k < nr; ++k) reflectionTruth[i * nr + k] = referenceLuminance(ref, kReflectionErrorRoughness[k]);
         });
         if (cancelled()) throw BakeCancelled();
     }
@@ -717,10 +712,10 @@ StudyPoint Study::measureReflection(const Candidate& c) {
     p.outputBytes = encodeReflectionProbes(set).size();
     p.probes = set.probes.size();
     std::vector<float> err;
-    const size_t nr = kReflectionRoughness.size();
+    const size_t nr = kReflectionErrorRoughness.size();
     for (size_t i = 0; i < set.probes.size(); ++i)
         for (size_t k = 0; k < nr; ++k)
-            err.push_back(reflectionProbeError(set, i, set.encoding, reflectionTruth[i * nr + k], kReflectionRoughness[k]));
+            err.push_back(reflectionProbeError(set, i, set.encoding, reflectionTruth[i * nr + k], kReflectionErrorRoughness[k]));
     setErrors(p, std::move(err));
     learn("reflection", c.work, p.seconds);
     const ReflectionProbeSettings& own = project.scene.reflectionProbes;

@@ -143,6 +143,8 @@ void toEncoding(ReflectionProbeSet& set, ReflectionEncoding encoding);
 // and its mip chain against brute-force prefiltering of a reference cube traced at four times the
 // resolution a side with the same rays per texel (16× the rays); mean, p95 and max over probes.
 // `set` must be a cubemap set baked from `layout` with `light`.
+// The roughnesses the encodings' error is reported at: from the terrain's floor to 1.
+inline const std::vector<float> kReflectionErrorRoughness{0.25f, 0.5f, 0.75f, 1.0f};
 struct ReflectionError {
     float roughness = 0.0f;
     Spread faces, cubemap;

@@ -158,6 +158,11 @@ enum class ReflectionEncoding {
     Cubemap,  // a cube map per probe, GGX-prefiltered into a mip chain by roughness
 };
 
+// The project-file spelling of an encoding.
+inline const char* reflectionEncodingName(ReflectionEncoding e) {
+    return e == ReflectionEncoding::Cubemap ? "cubemap" : "faces";
+}
+
 // Seed 000's limit on a reflection grid's probes.
 inline constexpr int kMaxReflectionProbes = 256;
 
