@@ -721,6 +721,8 @@ TEST(AdaptiveBake, SameBytesWithOneAndTwoThreadsAndAReportThatSaysWhatHappened) 
     EXPECT_EQ(v["moved_probes"], v["adaptive"]["moved_probes"]);
     EXPECT_TRUE(v["split_for_inside"].is_number_unsigned());
     EXPECT_EQ(v["adaptive"]["refinement"]["tolerance"], 0.05);
+    // Unset, the surface band goes down to the minimum cell, and the report says so.
+    EXPECT_EQ(v["adaptive"]["surface_cell_size"], v["adaptive"]["min_cell_size"]);
     EXPECT_EQ(v["interpolation_error"]["points"], 256);
     EXPECT_EQ(v["interpolation_error"]["uncovered_points"], 0);
     EXPECT_TRUE(v["interpolation_error"]["within_tolerance"].is_number());
