@@ -55,10 +55,11 @@ Commands:
   --study [PROJECT]             Sweep the settings that trade bake time for accuracy (quality,
                                 rays, bounces, probe spacing or adaptive tolerance, error-map
                                 resolution, AO directions, LPV quality and cascades, reflection
-                                cube size, rays and encoding), measure each against the exact
-                                answer on the same points, and write
-                                study.json, study.csv, study.png and study.html into --out DIR
-                                (default: "study" beside the project or in the current folder).
+                                cube size, rays and encoding; shadow cascades, map size and
+                                filter on the Vulkan device), measure each against the exact
+                                answer on the same points, and write study.json, study.csv,
+                                study.png and study.html into --out DIR (default: "study"
+                                beside the project or in the current folder).
   --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
                                 the embedded sample terrain.
   --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
@@ -92,8 +93,8 @@ Options:
                                 stale (its recorded settings or input files differ from the
                                 project's), saying what differs; without it such a bake is
                                 baked again first.
-  --device NAME                 Vulkan device: cpu, gpu, or part of its name
-                                (default: discrete GPU, integrated, then CPU).
+  --device NAME                 --render, --study: the Vulkan device: cpu, gpu, or part of its
+                                name (default: discrete GPU, integrated, then CPU).
   --dry-run                     With --bake: place the probes and print, per volume, the probe
                                 count, the .shprobe bytes and the estimated bake time; bake and
                                 write nothing.
@@ -625,6 +626,7 @@ int commandStudy(const Args& a, const StudyPlotWriter& writePlot) {
                              fixed(kMinStudyBudget, 0) + ", " + fixed(kMaxStudyBudget, 0) + "]");
     }
     options.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
+    if (a.parser.isSet(a.device)) options.device = str(a.parser.value(a.device));
     std::vector<std::string> sets, warnings;
     for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
     const Project project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
@@ -699,6 +701,8 @@ int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot)
             throw UsageError("--quality: only with --bake (elsewhere: --set bake.quality=PRESET)");
         if (a.parser.isSet(a.budget) && !a.parser.isSet(a.study))
             throw UsageError("--budget: only with --study");
+        if (a.parser.isSet(a.device) && !a.parser.isSet(a.render) && !a.parser.isSet(a.study))
+            throw UsageError("--device: only with --render or --study");
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.study)) return commandStudy(a, writeStudyPlot);
         if (a.parser.isSet(a.bake)) return commandBake(a);

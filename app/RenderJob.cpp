@@ -369,23 +369,33 @@ ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width
     const RenderedImage traced = renderer.render(q);
     q.debugView = kViewShadow;
     renderer.render(q);  // the first frame of a new view may build its pipeline: not its time
+    renderer.renderer().redrawShadowMaps();
     const RenderedImage mapped = renderer.render(q);
     ShadowAgreement a;
     a.shadowMilliseconds = mapped.milliseconds;
+    const uint32_t tilesX = (width + kShadowTile - 1) / kShadowTile, tilesY = (height + kShadowTile - 1) / kShadowTile;
+    std::vector<uint32_t> tileTerrain(size_t(tilesX) * tilesY, 0), tileOff(tileTerrain.size(), 0);
     size_t off = 0;
     double sum = 0.0;
     // Both views write the value in red and 1 in green on terrain.
-    for (size_t i = 0; i + 3 < traced.rgba.size(); i += 4) {
-        if (traced.rgba[i + 1] < 0.5f || mapped.rgba[i + 1] < 0.5f) continue;
-        ++a.terrainPixels;
-        const double d = std::abs(double(traced.rgba[i]) - double(mapped.rgba[i]));
-        sum += d;
-        if (d > 0.5) ++off;
-    }
+    for (uint32_t y = 0; y < height; ++y)
+        for (uint32_t x = 0; x < width; ++x) {
+            const size_t i = (size_t(y) * width + x) * 4;
+            if (i + 3 >= traced.rgba.size() || traced.rgba[i + 1] < 0.5f || mapped.rgba[i + 1] < 0.5f) continue;
+            ++a.terrainPixels;
+            const double d = std::abs(double(traced.rgba[i]) - double(mapped.rgba[i]));
+            sum += d;
+            const size_t t = size_t(y / kShadowTile) * tilesX + x / kShadowTile;
+            ++tileTerrain[t];
+            if (d > 0.5) ++off, ++tileOff[t];
+        }
     if (a.terrainPixels > 0) {
         a.disagreeing = double(off) / double(a.terrainPixels);
         a.meanAbsDifference = sum / double(a.terrainPixels);
     }
+    for (size_t t = 0; t < tileTerrain.size(); ++t)
+        if (tileTerrain[t] >= kShadowTile * kShadowTile / 4)
+            a.tileDisagreeing.push_back(float(tileOff[t]) / float(tileTerrain[t]));
     return a;
 }
 

@@ -52,8 +52,13 @@ struct ShadowAgreement {
     size_t terrainPixels = 0;
     double disagreeing = 0.0;     // share of terrain pixels where the two differ by more than 0.5
     double meanAbsDifference = 0.0;
-    double shadowMilliseconds = 0.0;  // the frame time of view 31
+    // The frame time of view 31 with its maps drawn in that frame (as a moving camera draws them).
+    double shadowMilliseconds = 0.0;
+    // Per screen tile of kShadowTile² pixels at least a quarter terrain: its share of disagreeing
+    // terrain pixels (where the shadows go wrong, not only how often).
+    std::vector<float> tileDisagreeing;
 };
+inline constexpr uint32_t kShadowTile = 32;
 ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width, uint32_t height);
 
 class ProjectRenderer {

@@ -18,6 +18,7 @@
 #include "AtomicFile.h"
 #include "BakeJob.h"
 #include "ReflectionProbeFile.h"
+#include "RenderJob.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
@@ -43,6 +44,7 @@ const char* studyMetricName(StudyMetric m) {
         case StudyMetric::AmbientOcclusion: return "ambient_occlusion";
         case StudyMetric::Lpv: return "lpv";
         case StudyMetric::Reflection: return "reflection";
+        case StudyMetric::Shadow: return "shadow";
     }
     return "irradiance";
 }
@@ -59,6 +61,9 @@ const char* studyMetricMeaning(StudyMetric m) {
             return "relative error of the LPV against the traced one-bounce sun irradiance";
         case StudyMetric::Reflection:
             return "relative RMS of prefiltered reflection luminance against a reference cube twice as fine";
+        case StudyMetric::Shadow:
+            return "share of terrain pixels per screen tile where the shadow maps and the traced sun visibility "
+                   "differ by more than half";
     }
     return "";
 }
@@ -114,6 +119,11 @@ constexpr int kLpvRays = 512;
 constexpr int kReflectionSweep[] = {8, 16, 32};
 constexpr int kReflectionReferenceRays = 4;
 constexpr double kSafety = 1.25;            // estimates are scaled up by this before they are trusted
+// Shadows: frames of this size from the project's camera; the first shadow setting also starts
+// the Vulkan device, uploads the terrain and traces the sun at its vertices, which this many
+// seconds cover on a 2-core CPU rasteriser.
+constexpr uint32_t kShadowWidth = 960, kShadowHeight = 540;
+constexpr double kShadowSetupSeconds = 4.0;
 
 std::string fmt(const char* f, double v) {
     char b[64];
@@ -244,6 +254,7 @@ struct Study {
     StudyPoint measureAo(const Candidate& c);
     StudyPoint measureLpv(const Candidate& c);
     StudyPoint measureReflection(const Candidate& c);
+    StudyPoint measureShadow(const Candidate& c);
     StudyPoint measure(const Candidate& c);
     void run();
 
@@ -273,6 +284,19 @@ struct Study {
     ReflectionLayout reflectionLayout;
     std::vector<std::vector<double>> reflectionTruth;
     int reflectionReferenceSize = 0;
+    // Shadows: the device and the renderer, made for the first shadow setting; why not, when the
+    // device could not be had.
+    std::unique_ptr<vk::VulkanContext> vulkan;
+    std::unique_ptr<ProjectRenderer> shadowRenderer;
+    std::string shadowsUnavailable;
+    // No device, or one that failed: the bake's knobs are still studied; the shadows are not, and
+    // the outputs say why.
+    void shadowsWithout(const std::string& why) {
+        shadowsUnavailable = why;
+        shadowRenderer.reset();
+        vulkan.reset();
+        result.notStudied.push_back("shadows: " + why + "; the shadow maps are measured on a Vulkan device (--device)");
+    }
 };
 
 void Study::prepare() {
@@ -455,6 +479,31 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                                                                                                   : ReflectionEncoding::Cubemap);
         add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
     }
+    if (s.shadows.enabled) {
+        const ShadowSettings& sh = s.shadows;
+        const std::string filter = shadowFilterName(sh.filter);
+        const std::string res = std::to_string(sh.mapResolution) + "²";
+        auto shadowLabel = [&](int cascades, const std::string& map, const std::string& f) {
+            return "shadows " + std::to_string(cascades) + " x " + map + " " + f;
+        };
+        add("shadow_cascades", shadowLabel(sh.cascades, res, filter) + " (current)",
+            {"shadows.cascades=" + std::to_string(sh.cascades)}, StudyMetric::Shadow);
+        for (int n = 1; n <= 4; ++n)
+            if (n != sh.cascades) {
+                // Manual splits are one fewer than the cascades: another count takes the practical scheme.
+                std::vector<std::string> sets{"shadows.cascades=" + std::to_string(n)};
+                if (sh.splitMode == SplitMode::Manual) sets.insert(sets.end(), {"shadows.split_mode=practical", "shadows.splits=null"});
+                add("shadow_cascades", shadowLabel(n, res, filter), sets, StudyMetric::Shadow);
+            }
+        for (int m : {1024, 2048, 4096})
+            if (m != sh.mapResolution)
+                add("shadow_resolution", shadowLabel(sh.cascades, std::to_string(m) + "²", filter),
+                    {"shadows.map_resolution=" + std::to_string(m)}, StudyMetric::Shadow);
+        for (ShadowFilter f : {ShadowFilter::Hard, ShadowFilter::Pcf, ShadowFilter::Pcss})
+            if (f != sh.filter)
+                add("shadow_filter", shadowLabel(sh.cascades, res, shadowFilterName(f)),
+                    {std::string("shadows.filter=") + shadowFilterName(f)}, StudyMetric::Shadow);
+    }
 
     // Work, in each kind's unit, for the estimates.
     for (Candidate& c : out) {
@@ -490,6 +539,11 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                 c.work = double(r.gridDims[0]) * r.gridDims[1] * 6.0 * r.resolution * r.resolution * r.rayCount;
                 break;
             }
+            case StudyMetric::Shadow:
+                // The maps' texels drawn, and the frame's pixels (a map texel costs about a pixel).
+                c.work = double(cs.shadows.cascades) * cs.shadows.mapResolution * cs.shadows.mapResolution +
+                         double(kShadowWidth) * kShadowHeight;
+                break;
         }
     }
     return out;
@@ -502,12 +556,14 @@ const char* rateKey(StudyMetric m) {
         case StudyMetric::AmbientOcclusion: return "ao";
         case StudyMetric::Lpv: return "lpv";
         case StudyMetric::Reflection: return "reflection";
+        case StudyMetric::Shadow: return "shadow";
     }
     return "rays";
 }
 
 double Study::estimate(const Candidate& c) const {
     auto it = rate.find(rateKey(c.metric));
+    if (it == rate.end() && c.metric == StudyMetric::Shadow && !shadowRenderer) return kShadowSetupSeconds;
     if (it == rate.end()) return -1.0;  // nothing of its kind ran yet
     return kSafety * c.work * it->second;
 }
@@ -724,6 +780,38 @@ StudyPoint Study::measureReflection(const Candidate& c) {
     return p;
 }
 
+// Where the shadow maps of the candidate's settings disagree with the sun's visibility traced at
+// the terrain's vertices, from the project's camera (measureShadowAgreement), and what the frame
+// that draws the maps costs.
+StudyPoint Study::measureShadow(const Candidate& c) {
+    const SceneDescription s = sceneWith(c.sets);
+    if (!shadowRenderer) {
+        vk::ContextOptions o;
+        o.device = options.device;
+        vulkan = std::make_unique<vk::VulkanContext>(o);
+        // The terrain as the study imported it; no horizon AO, which no shadow view reads.
+        shadowRenderer = std::make_unique<ProjectRenderer>(*vulkan, project, terrain, false);
+    }
+    const auto t0 = Clock::now();
+    Project candidate = project;
+    candidate.scene = s;
+    shadowRenderer->setProject(candidate);
+    const ShadowAgreement a = measureShadowAgreement(*shadowRenderer, kShadowWidth, kShadowHeight);
+    StudyPoint p;
+    p.metric = StudyMetric::Shadow;
+    p.seconds = a.shadowMilliseconds / 1000.0;
+    // Depth maps of 32-bit texels, one layer a cascade.
+    p.peakMemoryBytes = uint64_t(s.shadows.cascades) * uint64_t(s.shadows.mapResolution) * uint64_t(s.shadows.mapResolution) * 4u;
+    setErrors(p, a.tileDisagreeing);
+    // The budget pays for the whole measurement (the traced view and a warm-up frame besides the
+    // timed one), not the frame alone.
+    learn("shadow", c.work, secondsSince(t0));
+    const ShadowSettings& own = project.scene.shadows;
+    p.current = s.shadows.cascades == own.cascades && s.shadows.mapResolution == own.mapResolution &&
+                s.shadows.filter == own.filter;
+    return p;
+}
+
 StudyPoint Study::measure(const Candidate& c) {
     StudyPoint p;
     switch (c.metric) {
@@ -732,6 +820,7 @@ StudyPoint Study::measure(const Candidate& c) {
         case StudyMetric::AmbientOcclusion: p = measureAo(c); break;
         case StudyMetric::Lpv: p = measureLpv(c); break;
         case StudyMetric::Reflection: p = measureReflection(c); break;
+        case StudyMetric::Shadow: p = measureShadow(c); break;
     }
     p.knob = c.knob;
     p.label = c.label;
@@ -793,10 +882,6 @@ void Study::run() {
             todo.push_back(c);
         }
     }
-    if (s.shadows.enabled)
-        result.notStudied.push_back("shadows: cascades and filters are measured by the Vulkan renderer against traced sun "
-                                    "visibility (bench_render, README), not by the CPU study");
-
     // Cheapest first within each knob, knobs in turn, so a short budget still sees every knob.
     std::map<std::string, std::vector<Candidate>> byKnob;
     std::vector<std::string> knobs;
@@ -817,6 +902,7 @@ void Study::run() {
             any = true;
             Candidate& c = list[i++];
             if (cancelled()) throw BakeCancelled();
+            if (c.metric == StudyMetric::Shadow && !shadowsUnavailable.empty()) continue;
             c.estimate = estimate(c);
             // A kind that has not run yet gets its first (cheapest) point whenever time is left.
             if (c.estimate < 0.0 ? left() <= 0.05 * options.budgetSeconds : c.estimate > left()) {
@@ -829,6 +915,10 @@ void Study::run() {
             report(c.label);
             try {
                 result.points.push_back(measure(c));
+            } catch (const vk::VulkanUnavailable& e) {
+                shadowsWithout(e.what());
+            } catch (const vk::VulkanError& e) {
+                shadowsWithout(e.what());
             } catch (const PlacementError& e) {
                 result.skipped.push_back({c.knob, c.label, c.sets, c.estimate, e.what()});
             } catch (const ProjectError& e) {
@@ -925,8 +1015,7 @@ nlohmann::json studyToJson(const StudyResult& r) {
         skipped.push_back({{"knob", s.knob}, {"label", s.label}, {"set", s.sets},
                            {"estimated_time_s", s.estimatedSeconds}, {"reason", s.reason}});
     nlohmann::json metrics = nlohmann::json::object();
-    for (StudyMetric m : {StudyMetric::Irradiance, StudyMetric::ErrorMapP95, StudyMetric::AmbientOcclusion, StudyMetric::Lpv})
-        metrics[studyMetricName(m)] = studyMetricMeaning(m);
+    for (StudyMetric m : kStudyMetrics) metrics[studyMetricName(m)] = studyMetricMeaning(m);
     return {{"generator", std::string("Terralux ") + TERRALUX_VERSION},
             {"project", r.project},
             {"terrain", r.terrain},
@@ -975,7 +1064,7 @@ std::string studyHtml(const StudyResult& r, const std::string& plotFile) {
     o << "<p>Error (p95) against time. Green rows lie on the Pareto front of the probe settings: nothing "
          "else is both faster and more accurate. Bold: the project's settings. Each setting changes only "
          "what its <code>--set</code> says.</p>\n<ul>\n";
-    for (StudyMetric m : {StudyMetric::Irradiance, StudyMetric::ErrorMapP95, StudyMetric::AmbientOcclusion, StudyMetric::Lpv})
+    for (StudyMetric m : kStudyMetrics)
         o << "<li><code>" << studyMetricName(m) << "</code>: " << htmlEscape(studyMetricMeaning(m)) << "</li>\n";
     o << "</ul>\n<table><tr><th class=l>knob</th><th class=l>setting</th><th>time s</th><th>peak memory</th>"
          "<th>output</th><th>probes</th><th class=l>metric</th><th>error mean</th><th>p95</th><th>max</th>"
@@ -1009,15 +1098,21 @@ std::string studySummary(const StudyResult& r) {
     o << "study of '" << r.volume << "' on " << r.terrain << ": " << r.points.size() << " settings in "
       << fmt("%.1f", r.elapsedSeconds) << " s (budget " << fmt("%.0f", r.budgetSeconds) << " s), reference "
       << r.reference.points << " points x " << r.reference.raysPerPoint << " rays\n";
+    // Columns as wide as their longest entry, counted in characters (a label may hold a '²').
+    auto width = [](const std::string& t) {
+        return size_t(std::count_if(t.begin(), t.end(), [](char ch) { return (static_cast<unsigned char>(ch) & 0xC0) != 0x80; }));
+    };
+    auto pad = [&](const std::string& t, size_t w) { return t + std::string(w > width(t) ? w - width(t) : 0, ' '); };
+    size_t knobW = 4, labelW = 7;
+    for (const StudyPoint& p : r.points) knobW = std::max(knobW, width(p.knob)), labelW = std::max(labelW, width(p.label));
     char line[256];
-    std::snprintf(line, sizeof line, "  %-16s %-26s %9s %10s %10s %9s %9s\n", "knob", "setting", "time s", "memory",
-                  "output", "err mean", "err p95");
-    o << line;
+    std::snprintf(line, sizeof line, " %9s %10s %10s %9s %9s\n", "time s", "memory", "output", "err mean", "err p95");
+    o << "  " << pad("knob", knobW) << " " << pad("setting", labelW) << line;
     for (const StudyPoint& p : r.points) {
-        std::snprintf(line, sizeof line, "%s %-16s %-26s %9.3f %10s %10s %8.2f%% %8.2f%%%s\n", p.current ? "*" : " ",
-                      p.knob.c_str(), p.label.c_str(), p.seconds, bytesText(p.peakMemoryBytes).c_str(),
-                      bytesText(p.outputBytes).c_str(), 100 * p.errorMean, 100 * p.errorP95, p.pareto ? "  front" : "");
-        o << line;
+        std::snprintf(line, sizeof line, " %9.3f %10s %10s %8.2f%% %8.2f%%%s\n", p.seconds,
+                      bytesText(p.peakMemoryBytes).c_str(), bytesText(p.outputBytes).c_str(), 100 * p.errorMean,
+                      100 * p.errorP95, p.pareto ? "  front" : "");
+        o << (p.current ? "* " : "  ") << pad(p.knob, knobW) << " " << pad(p.label, labelW) << line;
     }
     for (const StudySkip& s : r.skipped) o << "  skipped " << s.label << ": " << s.reason << "\n";
     for (const std::string& s : r.notStudied) o << "  not studied: " << s << "\n";

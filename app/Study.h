@@ -10,7 +10,9 @@
 // resolution is measured by how far its p95 is from the p95 of a map twice as dense; AO directions
 // by the horizon AO's error against traced sky visibility; LPV quality and cascades by their
 // error against the traced one-bounce sun irradiance; reflection cube size, rays and encoding by
-// the prefiltered luminance's error against a reference cube twice as fine per probe.
+// the prefiltered luminance's error against a reference cube twice as fine per probe; shadow
+// cascades, map size and filter, on the Vulkan device, by where the shadow maps disagree with the
+// sun's visibility traced at the terrain's vertices, seen from the project's camera.
 //
 // The study keeps to a time budget: every setting's cost is estimated from the throughput
 // measured so far, the cheapest settings of every knob run first, and a setting that no longer
@@ -37,7 +39,13 @@ enum class StudyMetric {
     AmbientOcclusion,// mean |horizon AO − traced sky visibility| at terrain vertices
     Lpv,             // LPV irradiance against the traced one-bounce sun irradiance
     Reflection,      // prefiltered reflection luminance against a finer reference cube per probe
+    Shadow,          // per screen tile, the share of terrain pixels where the shadow maps and the
+                     // traced sun visibility differ by more than half
 };
+// Every metric, in the order the outputs explain them.
+inline constexpr StudyMetric kStudyMetrics[] = {StudyMetric::Irradiance, StudyMetric::ErrorMapP95,
+                                                StudyMetric::AmbientOcclusion, StudyMetric::Lpv,
+                                                StudyMetric::Reflection, StudyMetric::Shadow};
 const char* studyMetricName(StudyMetric m);
 // One line: what the metric's error means, for the table and the plot's legend.
 const char* studyMetricMeaning(StudyMetric m);
@@ -48,8 +56,10 @@ struct StudyPoint {
     std::vector<std::string> sets;    // --set assignments that make this setting from the project
     bool current = false;             // the project's own settings
     StudyMetric metric = StudyMetric::Irradiance;
-    double seconds = 0.0;             // what the setting costs: the bake (or the map, AO, LPV)
-    uint64_t peakMemoryBytes = 0;     // resident memory above what was resident when it began
+    double seconds = 0.0;             // what the setting costs: the bake (or the map, AO, LPV; for
+                                      // shadows the frame that draws the maps and their view)
+    uint64_t peakMemoryBytes = 0;     // resident memory above what was resident when it began;
+                                      // for shadows the maps' device memory
     uint64_t outputBytes = 0;         // .shprobe bytes (probe knobs)
     size_t probes = 0;
     double errorMean = 0.0, errorP95 = 0.0, errorMax = 0.0;
@@ -88,6 +98,7 @@ struct StudyResult {
 struct StudyOptions {
     double budgetSeconds = 120.0;
     int threads = 0;                  // 0 = all cores
+    std::string device;               // Vulkan device for the shadow sweeps (vk::ContextOptions::device)
 };
 
 inline constexpr double kMinStudyBudget = 5.0;

@@ -37,7 +37,13 @@ QString seriesName(const std::string& knob) {
         {"placement_quality", "dense placements at draft / high"},
         {"error_map", "error-map resolution (its p95's error)"},
         {"ao_directions", "AO directions (AO error)"},
-        {"lpv_quality", "LPV quality (LPV error)"}, {"lpv_cascades", "LPV cascades (LPV error)"}};
+        {"lpv_quality", "LPV quality (LPV error)"}, {"lpv_cascades", "LPV cascades (LPV error)"},
+        {"reflection_resolution", "reflection cube size (reflection error)"},
+        {"reflection_rays", "reflection rays per texel (reflection error)"},
+        {"reflection_encoding", "reflection encoding (reflection error)"},
+        {"shadow_cascades", "shadow cascades (shadow error)"},
+        {"shadow_resolution", "shadow map size (shadow error)"},
+        {"shadow_filter", "shadow filter (shadow error)"}};
     auto it = names.find(knob);
     return it != names.end() ? it->second : QString::fromStdString(knob);
 }

@@ -511,6 +511,10 @@ void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float 
 
 bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
 
+void TerrainRenderer::redrawShadowMaps() {
+    if (gpu_->shadows) gpu_->shadows->drawn.clear();
+}
+
 void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
     Gpu& g = *gpu_;
     const SurfaceMaps maps = buildSurfaceMaps(hf_, ao);

@@ -177,6 +177,9 @@ public:
     // Whether the shadow subsystem holds GPU resources (a frame drew shadows and the scene's
     // shadows are still on).
     bool hasShadowResources() const;
+    // The next frame that draws shadows draws its maps again, as every frame of a moving camera
+    // does (a still camera keeps the maps it drew): what a measurement of their cost times.
+    void redrawShadowMaps();
     // The cascades of the last frame that drew shadows (empty when none).
     const std::vector<Cascade>& lastCascades() const { return cascades_; }
     // How often the sun's visibility was traced at the vertices (cached per sun and surface).

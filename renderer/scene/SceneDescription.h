@@ -217,6 +217,10 @@ struct ExportSettings {
 
 enum class SplitMode { Practical, Manual };
 enum class ShadowFilter { Pcss, Pcf, Hard };
+// A filter's project-file name.
+inline const char* shadowFilterName(ShadowFilter f) {
+    return f == ShadowFilter::Pcss ? "pcss" : f == ShadowFilter::Pcf ? "pcf" : "hard";
+}
 
 // Cascaded sun shadows (docs/lighting.md, "Shadows"). Cascades cover the view from the near plane
 // to the shadow distance; each is a square orthographic depth map fitted to its slice of the view

@@ -38,7 +38,8 @@ expect(pts and pts[0]["knob"] == "current" and pts[0]["current"], "the project's
 knobs = {p["knob"] for p in pts}
 # Every knob is measured, or skipped or left out with its reason (a slow machine, a sanitizer build).
 accounted = knobs | {k["knob"] for k in s["skipped"]} | {n.split(":")[0] for n in s["not_studied"]}
-for k in ("quality", "rays", "bounces", "spacing", "error_map", "ao_directions"):
+for k in ("quality", "rays", "bounces", "spacing", "error_map", "ao_directions", "shadow_cascades", "shadow_resolution",
+          "shadow_filter"):
     expect(k in accounted, "knob %s neither studied nor said to be left out" % k)
 for k in ("rays", "spacing"):
     expect(k in knobs, "knob %s not studied" % k)
