@@ -587,9 +587,11 @@ TEST(Refinement, CoarseSurfaceCellsSplitOnlyWhereTheGroundsLightVaries) {
     EXPECT_TRUE(budgeted.refinement->budgetReached);
     EXPECT_GT(budgeted.layout.validCount(), coarse);
     EXPECT_LE(budgeted.layout.validCount(), size_t(*v.adaptive.maxProbes));
-    for (size_t i = 0; i < budgeted.layout.positions.size(); ++i)
-        if (budgeted.layout.octree->leaves[i].level < 4)
+    for (size_t i = 0; i < budgeted.layout.positions.size(); ++i) {
+        if (budgeted.layout.octree->leaves[i].level < 4) {
             EXPECT_LT(glm::length(budgeted.layout.positions[i] - hot), 250.0f);
+        }
+    }
     v.adaptive.surfaceCellSize.reset();
     EXPECT_THROW(placeProbes(v, hf), PlacementError);
 }

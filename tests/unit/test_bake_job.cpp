@@ -303,8 +303,9 @@ TEST(BakeCost, PresetsAreOrderedByRaysTracedOnSmallAndLargeGrids) {
             EXPECT_GT(rays, previous) << grid << " " << qualityName(preset);
             previous = rays;
             // At 28 x 28 the probes trace more rays than high's whole cache: it is not cut.
-            if (grid == 28 && preset == QualityPreset::High)
+            if (grid == 28 && preset == QualityPreset::High) {
                 EXPECT_EQ(r["quality"]["cache_resolution"].get<int>(), qualityPreset(preset).cacheResolution);
+            }
         }
     }
     fs::remove_all(dir);

@@ -212,10 +212,11 @@ TEST(ProbeDiagnosticsFile, ReadsBackWhatItWrites) {
     EXPECT_FLOAT_EQ(back.errorMap.step, 2.5f);
     EXPECT_FLOAT_EQ(back.errorMap.height, 5.0f);
     for (size_t i = 0; i < 6; ++i) {
-        if (std::isnan(d.errorMap.error[i]))
+        if (std::isnan(d.errorMap.error[i])) {
             EXPECT_TRUE(std::isnan(back.errorMap.error[i]));
-        else
+        } else {
             EXPECT_FLOAT_EQ(back.errorMap.error[i], d.errorMap.error[i]);
+        }
     }
 
     const fs::path file = fs::temp_directory_path() / probeDiagnosticsFileName("terralux_diag_test");

@@ -119,7 +119,7 @@ struct Expected {
 struct Row {
     std::string name;
     std::function<Project()> project;
-    std::string refusal;  // empty: the bake succeeds; else a regex its message matches
+    std::string refusal = {};  // empty: the bake succeeds; else a regex its message matches
     std::vector<Expected> analytic = {};
 };
 
@@ -420,8 +420,9 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
             for (const auto& [k, x] : v.items()) finite(x, path + "." + k);
         else if (v.is_array())
             for (size_t i = 0; i < v.size(); ++i) finite(v[i], path + "[" + std::to_string(i) + "]");
-        else if (v.is_number_float())
+        else if (v.is_number_float()) {
             EXPECT_TRUE(std::isfinite(v.get<double>())) << path;
+        }
     };
     finite(report, "report");
     if (p.scene.lpv.enabled) {

@@ -278,8 +278,9 @@ TEST(ParameterTable, LpvRowsAreTheConsoleVariablesWithTheirRules) {
         EXPECT_TRUE(spec.description.find("rEx.") != std::string::npos ||
                     spec.path == "lpv.indirect_intensity") << spec.path;
         // The console variable the tooltips show is lpv.ini's, and the one the description names.
-        if (spec.path != "lpv.indirect_intensity")
+        if (spec.path != "lpv.indirect_intensity") {
             EXPECT_EQ(spec.description.rfind(spec.consoleVariable + ":", 0), 0u) << spec.path;
+        }
         EXPECT_TRUE(spec.uiRow) << spec.path;
         EXPECT_EQ(parameterDock(spec).objectName, "dock.lpv") << spec.path;
         ++rows;
