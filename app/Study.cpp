@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
@@ -479,7 +480,12 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                                                                                                   : ReflectionEncoding::Cubemap);
         add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
     }
-    if (s.shadows.enabled) {
+    // The renderer draws no shadow maps once the sun is more than about 3° below the horizon.
+    const bool sunUp = std::sin(glm::radians(s.sun.elevationDeg)) > -0.05;
+    if (s.shadows.enabled && !sunUp)
+        result.notStudied.push_back("shadows: the sun is below the horizon (sun.elevation_deg = " +
+                                    fmt("%g", s.sun.elevationDeg) + "), so no shadow maps are drawn");
+    if (s.shadows.enabled && sunUp) {
         const ShadowSettings& sh = s.shadows;
         const std::string filter = shadowFilterName(sh.filter);
         const std::string res = std::to_string(sh.mapResolution) + "²";
@@ -797,6 +803,9 @@ StudyPoint Study::measureShadow(const Candidate& c) {
     candidate.scene = s;
     shadowRenderer->setProject(candidate);
     const ShadowAgreement a = measureShadowAgreement(*shadowRenderer, kShadowWidth, kShadowHeight);
+    if (a.tileDisagreeing.empty())
+        throw ProjectError("camera: no screen tile of the project's view is a quarter terrain; the shadows are "
+                           "compared on the terrain the camera sees");
     StudyPoint p;
     p.metric = StudyMetric::Shadow;
     p.seconds = a.shadowMilliseconds / 1000.0;

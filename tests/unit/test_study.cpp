@@ -185,6 +185,17 @@ TEST(Study, WithoutAVulkanDeviceTheShadowsAreNotStudiedAndItSaysWhy) {
     EXPECT_TRUE(std::any_of(r.points.begin(), r.points.end(), [](const StudyPoint& p) { return p.knob == "rays"; }));
 }
 
+TEST(Study, ASunBelowTheHorizonLeavesTheShadowsOutAndSaysWhy) {
+    StudyOptions o;
+    o.budgetSeconds = 5.0;
+    const StudyResult r = runStudy(sampleProject({"sun.elevation_deg=-10", "ao.enabled=false"}), o, {}, nullptr);
+    EXPECT_NE(std::find(r.notStudied.begin(), r.notStudied.end(),
+                        "shadows: the sun is below the horizon (sun.elevation_deg = -10), so no shadow maps are drawn"),
+              r.notStudied.end());
+    for (const StudyPoint& p : r.points) EXPECT_NE(p.metric, StudyMetric::Shadow) << p.label;
+    for (const StudySkip& s : r.skipped) EXPECT_EQ(s.knob.rfind("shadow", 0), std::string::npos) << s.label;
+}
+
 TEST(Study, ShortBudgetSkipsWhatDoesNotFitAndSaysSo) {
     // A 64 x 64 grid at 2048 rays costs far more than 5 s allow after the reference and the
     // current point: the expensive settings are skipped with their estimates.
