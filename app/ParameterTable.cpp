@@ -399,7 +399,8 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("shadows.normal_bias", T::Number)).range(0.0, 100.0).unit("texels").label("Normal bias")
         .about("Moves the receiver along its normal by this many cascade texels: removes acne on slopes facing away")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::normalBias);
-    add(Row("shadows.filter", T::Choice)).choices({"pcss", "pcf", "hard"}).label("Filter")
+    add(Row("shadows.filter", T::Choice))
+        .choices({shadowFilterName(ShadowFilter::Pcss), shadowFilterName(ShadowFilter::Pcf), shadowFilterName(ShadowFilter::Hard)}).label("Filter")
         .about("pcss: penumbrae from the sun's size that harden at contact (Fernando 2005); pcf: a fixed soft edge; hard: one comparison")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::filter);
 
@@ -724,7 +725,8 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("reflection_probes.ray_count", T::Integer)).range(1, 1 << 20).label("Rays per texel")
         .about("Rays traced per cube texel (the reference comparison traces 16× as many)").redoes(kRebake).onlyWhen(reflectionOn)
         .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::rayCount);
-    add(Row("reflection_probes.encoding", T::Choice)).choices({"faces", "cubemap"}).label("Encoding")
+    add(Row("reflection_probes.encoding", T::Choice))
+        .choices({reflectionEncodingName(ReflectionEncoding::Faces), reflectionEncodingName(ReflectionEncoding::Cubemap)}).label("Encoding")
         .about("faces: six face colours per probe; cubemap: a GGX-prefiltered cube map per probe")
         .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::encoding);
     add(Row("reflection_probes.resolution", T::Integer)).range(8, 128).unit("texels")

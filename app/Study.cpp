@@ -804,8 +804,10 @@ StudyPoint Study::measureShadow(const Candidate& c) {
     shadowRenderer->setProject(candidate);
     const ShadowAgreement a = measureShadowAgreement(*shadowRenderer, kShadowWidth, kShadowHeight);
     if (a.tileDisagreeing.empty())
-        throw ProjectError("camera: no screen tile of the project's view is a quarter terrain; the shadows are "
-                           "compared on the terrain the camera sees");
+        throw ProjectError("camera (azimuth_deg " + fmt("%g", s.camera.azimuthDeg) + ", elevation_deg " +
+                           fmt("%g", s.camera.elevationDeg) + "): no 32-pixel tile of its " + std::to_string(kShadowWidth) +
+                           " x " + std::to_string(kShadowHeight) + " view is a quarter terrain; the shadows are compared "
+                           "on the terrain the camera sees");
     StudyPoint p;
     p.metric = StudyMetric::Shadow;
     p.seconds = a.shadowMilliseconds / 1000.0;

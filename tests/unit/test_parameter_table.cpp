@@ -175,6 +175,21 @@ TEST(ParameterTable, ReferenceListsEveryRow) {
         EXPECT_NE(md.find("| `" + spec.path + "` |"), std::string::npos) << spec.path;
 }
 
+// The names the study and the report write for a shadow filter and a reflection encoding are the
+// ones a project file reads back as that value.
+TEST(ParameterTable, EnumNamesReadBackAsTheirValues) {
+    for (ShadowFilter f : {ShadowFilter::Pcss, ShadowFilter::Pcf, ShadowFilter::Hard}) {
+        json doc = defaultProjectJson();
+        applyOverride(doc, std::string("shadows.filter=") + shadowFilterName(f));
+        EXPECT_EQ(sceneFromJson(doc, "test", nullptr).shadows.filter, f) << shadowFilterName(f);
+    }
+    for (ReflectionEncoding e : {ReflectionEncoding::Faces, ReflectionEncoding::Cubemap}) {
+        json doc = defaultProjectJson();
+        applyOverride(doc, std::string("reflection_probes.encoding=") + reflectionEncodingName(e));
+        EXPECT_EQ(sceneFromJson(doc, "test", nullptr).reflectionProbes.encoding, e) << reflectionEncodingName(e);
+    }
+}
+
 TEST(ParameterTable, SunAndSkyRowsAreReadByTheirSkyMode) {
     auto read = [](const SceneDescription& s, const char* path) { return findParameter(path)->isRead(s, 0); };
     SceneDescription s;  // uniform
