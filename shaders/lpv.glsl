@@ -10,7 +10,6 @@
 struct LpvSample {
     vec3 irradiance;  // × indirect_intensity
     vec3 specular;    // quality 2: radiance along the mirror direction, × indirect_intensity
-    float ao;         // the geometry volume's ambient occlusion, 1 open
 };
 
 // Without TLX_LPV the shader declares none of the set: the pipelines of frames without the LPV
@@ -35,6 +34,10 @@ const int kLpvCornerCount = kLpvCorners * kLpvCorners * kLpvCorners;
 const float kLpvY0 = 0.28209479177387814;   // 1/(2√π)
 const float kLpvY1 = 0.4886025119029199;    // √(3/4π)
 const float kLpvY20 = 0.31539156525252005;  // √(5/16π)
+// Lpv.h kAoDirections, kAoSteps, kAoCutoff.
+const int kLpvAoDirections = 16;
+const int kLpvAoSteps = 48;
+const float kLpvAoCutoff = 1e-3;
 
 // L1 SH in SphericalHarmonics.h's order (1, y, z, x) evaluated toward d (Lpv.cpp evaluate()).
 float lpvShEvaluate(vec4 sh, vec3 d) { return sh.x * kLpvY0 + kLpvY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
@@ -121,6 +124,20 @@ float lpvWeight(vec3 p, int last, out float cellSize) {
     return 1.0 - remaining;
 }
 
+// The cascades' cells blended by their weights at p, 0 outside all (Lpv.cpp blendedCellSize()).
+float lpvBlendedCell(vec3 p, int last) {
+    float remaining = 1.0, sum = 0.0;
+    for (int c = last; c >= 0; --c) {
+        float fade = lpvFade(c, p);
+        float w = fade * remaining;
+        if (w <= 0.0) continue;
+        sum += w * lpv.cascades[c].w;
+        remaining *= 1.0 - fade;
+    }
+    float total = 1.0 - remaining;
+    return total > 0.0 ? sum / total : 0.0;
+}
+
 // The blended blocking SH at p, on the corner texels (Lpv.cpp geometryAt()).
 vec4 lpvGeometryAt(vec3 p, int last) {
     vec4 sum = vec4(0.0);
@@ -186,7 +203,6 @@ LpvSample lpvEvaluate(vec3 p, vec3 n, vec3 toEye, int quality, int last) {
     LpvSample s;
     s.irradiance = vec3(0.0);
     s.specular = vec3(0.0);
-    s.ao = 1.0;
     float h;
     if (lpvWeight(p, last, h) <= 0.0) return s;
     // Half a cell out along the normal, so a surface does not read its own cell's light.
@@ -200,7 +216,6 @@ LpvSample lpvEvaluate(vec3 p, vec3 n, vec3 toEye, int quality, int last) {
         float centre = lpvLuminance(e);
         if (centre > 0.0) e *= clamp(1.0 + min(0.0, front - back) / centre, 0.0, 1.0);
     }
-    s.ao = 1.0 - clamp(lpvIrradianceLinear(lpvGeometryAt(q, last), -n) / PI, 0.0, 1.0);
     if (quality >= 2) {
         // Cone-traced specular: every cell along the mirror direction, each sample dimmed by the
         // geometry passed before it, averaged.
@@ -220,6 +235,50 @@ LpvSample lpvEvaluate(vec3 p, vec3 n, vec3 toEye, int quality, int last) {
     }
     s.irradiance = e * lpv.params.x;
     return s;
+}
+
+// Orthonormal basis around a unit normal (Duff et al. 2017; SphereSampling.h basisAround()).
+void lpvBasisAround(vec3 n, out vec3 t, out vec3 b) {
+    float sign_ = (floatBitsToUint(n.z) & 0x80000000u) != 0u ? -1.0 : 1.0;  // copysign: −0 counts as negative
+    float a = -1.0 / (sign_ + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0 + sign_ * n.x * n.x * a, sign_ * c, -sign_ * n.x);
+    b = vec3(c, sign_ + n.y * n.y * a, -n.y);
+}
+
+// Cosine-weighted direction i of `count` about n with its basis t, b: a Fibonacci spiral on the
+// disk lifted to the hemisphere (SphereSampling.h cosineHemisphere(), azimuth offset 0).
+vec3 lpvCosineHemisphere(int i, int count, vec3 n, vec3 t, vec3 b) {
+    float r2 = (float(i) + 0.5) / float(count);
+    float phi = 2.0 * PI * fract(float(i) * 0.6180339887498949);
+    float r = sqrt(r2);
+    return normalize(r * cos(phi) * t + sqrt(max(0.0, 1.0 - r2)) * n + r * sin(phi) * b);
+}
+
+// The geometry volume's sky visibility at p facing n, 1 open (Lpv.cpp Volumes::ambientOcclusion):
+// along each direction, from half a cell above p, a blended cell a step until the volumes end,
+// keeping 1 − the blocking of the surfaces facing back toward p. Only view 63 calls it: a CPU
+// driver that runs it under a mask for the other views leaves each loop after one pass.
+float lpvAmbientOcclusion(vec3 p, vec3 n, int last) {
+    float h;
+    if (lpvWeight(p, last, h) <= 0.0) return 1.0;
+    vec3 q = p + 0.5 * h * n;
+    vec3 t, b;
+    lpvBasisAround(n, t, b);
+    float open = 0.0;
+    for (int k = 0; k < kLpvAoDirections; ++k) {
+        vec3 w = lpvCosineHemisphere(k, kLpvAoDirections, n, t, b);
+        float transmit = 1.0;
+        float dist = 0.0;
+        for (int j = 0; j < kLpvAoSteps && transmit > kLpvAoCutoff; ++j) {
+            float hx = lpvBlendedCell(q + dist * w, last);
+            if (hx <= 0.0) break;
+            transmit *= 1.0 - clamp(lpvShEvaluate(lpvGeometryAt(q + (dist + 0.5 * hx) * w, last), -w), 0.0, 1.0);
+            dist += hx;
+        }
+        open += transmit;
+    }
+    return open / float(kLpvAoDirections);
 }
 
 // KHR_lights_punctual's range window clamp(1 − (d/range)⁴, 0, 1)/d² and, for a spot, the squared

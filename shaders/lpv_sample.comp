@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Volumes::evaluate on the GPU at given points (TerrainRenderer::sampleLpv): the terrain pass's
+// Volumes::evaluate and Volumes::ambientOcclusion on the GPU at given points (TerrainRenderer::sampleLpv): the terrain pass's
 // own LPV code, read back so the tests can hold it against the CPU's at the same points.
 layout(local_size_x = 64) in;
 #define TLX_LPV
@@ -12,7 +12,7 @@ layout(local_size_x = 64) in;
 
 // Per query: position, normal, toward the eye (xyz each, w unused).
 layout(set = TLX_SET_SUBSYSTEM, binding = 4, std430) readonly buffer Queries { vec4 v[]; } queries;
-// Per query: (irradiance, ao), (specular, 0).
+// Per query: (irradiance, ambient occlusion), (specular, 0).
 layout(set = TLX_SET_SUBSYSTEM, binding = 5, std430) writeonly buffer Results { vec4 v[]; } results;
 layout(push_constant) uniform Push { ivec4 countLast; } push;  // x queries, y last cascade
 
@@ -21,6 +21,6 @@ void main() {
     if (i >= push.countLast.x) return;
     vec3 p = queries.v[3 * i].xyz, n = queries.v[3 * i + 1].xyz, toEye = queries.v[3 * i + 2].xyz;
     LpvSample s = lpvEvaluate(p, n, toEye, lpv.counts.y, push.countLast.y);
-    results.v[2 * i] = vec4(s.irradiance, s.ao);
+    results.v[2 * i] = vec4(s.irradiance, lpvAmbientOcclusion(p, n, push.countLast.y));
     results.v[2 * i + 1] = vec4(s.specular, 0.0);
 }

@@ -28,6 +28,8 @@ struct ShadingPoint {
     float reflectionWeight;  // their blend weight over the sky's: coverage fade × strength
     vec3 linear;       // sceneLinear(), seen through the fog
     LpvSample lpv;     // the LPV at the point (all cascades; cascade 0 alone in views 61-63)
+    float lpvAo;       // view 63: cascade 0's geometry volume's ambient occlusion, 1 open
+    float lpvCover;    // view 63: cascade 0's fade weight at the point, 0 outside it
     float lpvBlocking; // view 62: cascade 0's geometry, the share of light into the ground it stops
 };
 
@@ -145,7 +147,10 @@ vec3 viewLpvGeometry(ShadingPoint s) {
     if (linearOutput()) return vec3(s.lpvBlocking, 1.0, 0.0);
     return heat(0.1 * s.lpvBlocking) * (0.6 + 0.4 * sunNdotL(s));
 }
-vec3 viewLpvAo(ShadingPoint s) { return scalarView(s.lpv.ao); }
+vec3 viewLpvAo(ShadingPoint s) {
+    if (linearOutput()) return vec3(s.lpvAo, s.lpvCover > 0.0 ? 1.0 : 0.0, 0.0);
+    return vec3(clamp(s.lpvAo, 0.0, 1.0) * s.lpvCover);  // fading to black with the cascade, as view 61
+}
 
 vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
@@ -160,7 +165,8 @@ vec3 shadeView(int view, ShadingPoint s) {
                                             : vec3(0.0);
     s.lpv.irradiance = vec3(0.0);
     s.lpv.specular = vec3(0.0);
-    s.lpv.ao = 1.0;
+    s.lpvAo = 1.0;
+    s.lpvCover = 0.0;
     s.lpvBlocking = 0.0;
 #ifdef TLX_LPV
     if (kLpv && lpv.counts.x > 0) {
@@ -168,6 +174,11 @@ vec3 shadeView(int view, ShadingPoint s) {
         int last = firstOnly ? 0 : lpv.counts.x - 1;
         s.lpv = lpvEvaluate(s.position, s.normal, -dir, lpv.counts.y, last);
         if (view == kViewLpvGeometry) s.lpvBlocking = clamp(lpvShEvaluate(lpvGeometryAt(s.position, 0), s.normal), 0.0, 1.0);
+        if (view == kViewLpvAo) {
+            float cell;
+            s.lpvCover = lpvWeight(s.position, 0, cell);
+            s.lpvAo = lpvAmbientOcclusion(s.position, s.normal, 0);
+        }
     }
 #endif
     s.linear = applyFog(sceneLinear(s), dir, distance);

@@ -625,17 +625,15 @@ Trilinear trilinear(const glm::dvec3& u, int n) {
 
 }  // namespace
 
-std::array<Sh4, 3> Volumes::blendedRadiance(const glm::vec3& p, float* weight, double* cellSize) const {
+std::array<Sh4, 3> Volumes::radianceAt(const glm::vec3& p, float* weight) const {
     std::array<Sh4, 3> out{};
-    float remaining = 1.0f, best = 0.0f;
-    double finest = cascades_.empty() ? 1.0 : cascades_.front().layout.cellSize;
+    float remaining = 1.0f;
     // Finest first: each cascade takes its fade weight of what the finer ones left.
     for (int c = int(cascades_.size()) - 1; c >= 0; --c) {
         const float w = fadeWeight(c, p) * remaining;
         if (w <= 0.0f) continue;
         const Cascade& cas = cascades_[size_t(c)];
         const double h = cas.layout.cellSize;
-        if (w > best) best = w, finest = h;
         const Trilinear t = trilinear((glm::dvec3(p) - cas.layout.origin()) / h - 0.5, kGrid);
         const float toRadiance = float(1.0 / (h * h));
         for (int dz = 0; dz < 2; ++dz)
@@ -651,12 +649,21 @@ std::array<Sh4, 3> Volumes::blendedRadiance(const glm::vec3& p, float* weight, d
         remaining *= 1.0f - fadeWeight(c, p);
     }
     if (weight) *weight = 1.0f - remaining;
-    if (cellSize) *cellSize = finest;
     return out;
 }
 
-std::array<Sh4, 3> Volumes::radianceAt(const glm::vec3& p, float* weight) const {
-    return blendedRadiance(p, weight, nullptr);
+float Volumes::weightAt(const glm::vec3& p, double* cellSize) const {
+    float remaining = 1.0f, best = 0.0f;
+    double dominant = cascades_.empty() ? 1.0 : cascades_.front().layout.cellSize;
+    for (int c = int(cascades_.size()) - 1; c >= 0; --c) {
+        const float fade = fadeWeight(c, p);
+        const float w = fade * remaining;
+        if (w <= 0.0f) continue;
+        if (w > best) best = w, dominant = cascades_[size_t(c)].layout.cellSize;
+        remaining *= 1.0f - fade;
+    }
+    if (cellSize) *cellSize = dominant;
+    return 1.0f - remaining;
 }
 
 Sh4 Volumes::geometryAt(const glm::vec3& p) const {
@@ -692,10 +699,8 @@ glm::vec3 Volumes::irradianceAt(const glm::vec3& q, const glm::vec3& n, int qual
 
 Sample Volumes::evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3& toEye, int quality) const {
     Sample out;
-    float weight = 0.0f;
     double h = 1.0;
-    blendedRadiance(p, &weight, &h);
-    if (weight <= 0.0f) return out;
+    if (weightAt(p, &h) <= 0.0f) return out;
     // Half a cell out along the normal, as the paper samples, so a surface does not read the
     // light its own cell holds behind it.
     const float half = float(0.5 * h);
@@ -710,9 +715,6 @@ Sample Volumes::evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3
         const float centre = luminanceOf(e);
         if (centre > 0.0f) e *= std::clamp(1.0f + std::min(0.0f, front - back) / centre, 0.0f, 1.0f);
     }
-    // Ambient occlusion: the cosine-weighted share of the hemisphere the geometry volume blocks,
-    // counting surfaces that face the receiver (what it sees), 1 − ∫ B(−ω)·max(0, n·ω) dω / π.
-    out.ao = 1.0f - std::clamp(irradianceLinear(geometryAt(q), -n) / kPi, 0.0f, 1.0f);
     if (quality >= 2) {
         // Cone-traced specular: the radiance flowing back toward the surface along the mirror
         // direction, sampled every cell (the blended cascades coarsen with distance from the
@@ -731,6 +733,44 @@ Sample Volumes::evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3
     }
     out.irradiance = e * float(settings_.indirectIntensity);
     return out;
+}
+
+double Volumes::blendedCellSize(const glm::vec3& p) const {
+    float remaining = 1.0f;
+    double sum = 0.0;
+    for (int c = int(cascades_.size()) - 1; c >= 0; --c) {
+        const float fade = fadeWeight(c, p);
+        const float w = fade * remaining;
+        if (w <= 0.0f) continue;
+        sum += w * cascades_[size_t(c)].layout.cellSize;
+        remaining *= 1.0f - fade;
+    }
+    const float total = 1.0f - remaining;
+    return total > 0.0f ? sum / total : 0.0;
+}
+
+float Volumes::ambientOcclusion(const glm::vec3& p, const glm::vec3& n) const {
+    double h = 1.0;
+    if (weightAt(p, &h) <= 0.0f) return 1.0f;
+    const glm::vec3 q = p + float(0.5 * h) * n;
+    float open = 0.0f;
+    for (int k = 0; k < kAoDirections; ++k) {
+        const glm::vec3 w = cosineHemisphere(uint32_t(k), uint32_t(kAoDirections), 0.0f, n);
+        // Each step samples the middle of a stretch one cell long, so a texel's blocking (the share
+        // of a cell's cross-section its surfaces cover) is counted once per cell crossed.
+        float transmit = 1.0f;
+        float t = 0.0f;
+        for (int j = 0; j < kAoSteps && transmit > kAoCutoff; ++j) {
+            const float hx = float(blendedCellSize(q + t * w));
+            if (hx <= 0.0f) break;
+            const glm::vec3 x = q + (t + 0.5f * hx) * w;
+            // What p sees along w: the surfaces facing back toward it (blocking light flowing along w).
+            transmit *= 1.0f - blocking(geometryAt(x), w);
+            t += hx;
+        }
+        open += transmit;
+    }
+    return open / float(kAoDirections);
 }
 
 GroundComparison compareWithOneBounce(const Volumes& volumes, const BakeLighting& lighting,

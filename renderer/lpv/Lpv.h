@@ -13,7 +13,8 @@
 //      propagation weight w (propagationStepWeight), blocked
 //      by the geometry volume, accumulated over the iterations;
 //   5. apply: irradiance at a point and normal (linear L1, or ZH3 with leak dampening), cone-traced
-//      specular at quality 2, and the geometry volume's ambient occlusion.
+//      specular at quality 2, and (view 63 only) an ambient occlusion marched through the geometry
+//      volume.
 //
 // Memory layout, as the renderer uploads it (a storage buffer per array, cascades one after
 // another; as 3-D images it would be one per array), x fastest:
@@ -50,6 +51,12 @@ inline constexpr int kCornerCount = kCorners * kCorners * kCorners;
 inline constexpr int kSurfelsPerCell = 4;
 // Shadow rays per surfel across the sun's disc.
 inline constexpr int kSunSamples = 4;
+// The geometry volume's ambient occlusion: cosine-weighted directions, and the most steps along
+// each (a step is the local cell; 48 cross a cascade's diagonal from its centre, and the march
+// ends sooner where it leaves the volumes or the light left is below kAoCutoff).
+inline constexpr int kAoDirections = 16;
+inline constexpr int kAoSteps = 48;
+inline constexpr float kAoCutoff = 1e-3f;
 
 // ---- L1 spherical harmonics (the 4 coefficients of SphericalHarmonics.h's first two bands) --
 
@@ -177,7 +184,6 @@ struct Inputs {
 struct Sample {
     glm::vec3 irradiance{0.0f};  // W/m², × indirect_intensity
     glm::vec3 specular{0.0f};    // quality 2: radiance toward the eye along the mirror direction, × indirect_intensity
-    float ao = 1.0f;             // the geometry volume's ambient occlusion, 1 = open
 };
 
 class Volumes {
@@ -202,6 +208,18 @@ public:
     std::array<Sh4, 3> radianceAt(const glm::vec3& p, float* weight = nullptr) const;
     // The blended blocking SH at p.
     Sh4 geometryAt(const glm::vec3& p) const;
+    // The cascades' total weight at p (0 outside all) and the cell of the one that weighs most
+    // (ties: the finer).
+    float weightAt(const glm::vec3& p, double* cellSize = nullptr) const;
+    // The cascades' cells blended by their weights at p, 0 outside all: ambientOcclusion's step,
+    // which unlike the dominant cell does not jump where one cascade takes over from another.
+    double blendedCellSize(const glm::vec3& p) const;
+    // The sky visibility the geometry volume gives a surface at p facing n (1 open): over
+    // kAoDirections cosine-weighted directions ω, the light left after marching from half a cell
+    // above p out of the volumes, a blended cell a step, each step keeping 1 − blocking by the
+    // surfaces there that face p. Against the heightfield's traced visibility in
+    // docs/lighting.md.
+    float ambientOcclusion(const glm::vec3& p, const glm::vec3& n) const;
     // A cascade's fade weight at p: 1 inside, falling to 0 over fade_range cells at its faces.
     float fadeWeight(int cascade, const glm::vec3& p) const;
 
@@ -210,8 +228,6 @@ private:
     void injectSun(Cascade& c, int cascade) const;
     void injectLights();
     void propagate(Cascade& c) const;
-    // The blended radiance SH and the finest contributing cell size.
-    std::array<Sh4, 3> blendedRadiance(const glm::vec3& p, float* weight, double* cellSize) const;
     glm::vec3 irradianceAt(const glm::vec3& q, const glm::vec3& n, int quality) const;
 
     LpvSettings settings_;

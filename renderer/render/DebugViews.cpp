@@ -76,7 +76,8 @@ const std::vector<DebugView>& debugViews() {
          "it stops, heat ramp from blue (none) to red (all) (EXR: share in red, 1 in green on terrain)",
          true, ViewBackground::Black, lpvOnly},
         {kViewLpvAo, "lpv-ao",
-         "ambient occlusion from cascade 0's geometry volume, 1 open (EXR: value in red, 1 in green on terrain)",
+         "sky visibility marched through cascade 0's geometry volume, 1 open, fading to black at the "
+         "cascade's edge as view 61 (EXR: value in red, 1 in green on terrain inside cascade 0)",
          true, ViewBackground::Black, lpvOnly},
         {kViewLpvAll, "lpv-all", "LPV irradiance of all cascades blended, as E/π, black outside them", true,
          ViewBackground::Black, lpvOnly},

@@ -672,7 +672,7 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     g.graph.importBuffer(kLpvGeometry, g.lpv->geometry.handle(), true);
 }
 
-std::vector<lpv::Sample> TerrainRenderer::sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
+std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
                                                     int lastCascade) {
     Gpu& g = *gpu_;
     if (!g.lpv || queries.empty()) return {};
@@ -719,11 +719,11 @@ std::vector<lpv::Sample> TerrainRenderer::sampleLpv(const std::vector<std::array
                              nullptr, 0, nullptr);
     });
     const auto* values = static_cast<const glm::vec4*>(results.map());
-    std::vector<lpv::Sample> out(queries.size());
+    std::vector<LpvSample> out(queries.size());
     for (size_t i = 0; i < queries.size(); ++i) {
         out[i].irradiance = glm::vec3(values[2 * i]);
-        out[i].ao = values[2 * i].w;
         out[i].specular = glm::vec3(values[2 * i + 1]);
+        out[i].ao = values[2 * i].w;
     }
     return out;
 }

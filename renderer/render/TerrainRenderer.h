@@ -138,11 +138,15 @@ public:
     void setLpv(std::shared_ptr<const lpv::Volumes> volumes);
     const std::shared_ptr<const lpv::Volumes>& lpv() const;
     bool hasLpvResources() const;
-    // Volumes::evaluate of the bound LPV on the GPU, by the terrain shader's own code, at each
-    // query (position, unit normal, unit direction toward the eye), over cascades `lastCascade`
-    // down to 0 (-1: all), at the volumes' quality; waits for the GPU. Empty without an LPV.
-    std::vector<lpv::Sample> sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
-                                       int lastCascade = -1);
+    // Volumes::evaluate and Volumes::ambientOcclusion of the bound LPV on the GPU, by the terrain
+    // shader's own code, at each query (position, unit normal, unit direction toward the eye),
+    // over cascades `lastCascade` down to 0 (-1: all), at the volumes' quality; waits for the GPU.
+    // Empty without an LPV.
+    struct LpvSample {
+        glm::vec3 irradiance{0.0f}, specular{0.0f};  // lpv::Sample's
+        float ao = 1.0f;
+    };
+    std::vector<LpvSample> sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries, int lastCascade = -1);
     // Bytes of the bound reflection probes on the GPU: their records and cube texels.
     size_t reflectionBytes() const { return reflectionBytes_; }
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.

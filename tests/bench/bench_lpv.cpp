@@ -14,7 +14,8 @@
 // Error per point: |value − reference| / max(reference, 5 % of the mean reference) on luminance;
 // the floor keeps points the one-bounce light barely reaches (reference near 0) from dominating.
 // Counters: mean, 95th percentile and max of that, bias (mean value / mean reference), the update's
-// wall time and the apply's time per point.
+// wall time and the apply's time per point. BM_LpvAo holds view 63's ambient occlusion against the
+// sky visibility traced at the same points.
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -172,6 +173,69 @@ void lpvArgs(benchmark::internal::Benchmark* b) {
     }
 }
 BENCHMARK(BM_Lpv)->Apply(lpvArgs)->Unit(benchmark::kMillisecond)->Iterations(1)->UseManualTime();
+
+// The geometry volume's ambient occlusion (view 63, Volumes::ambientOcclusion) against the sky
+// visibility traced on the heightfield at the same points (256 cosine-weighted rays, no distance
+// limit), and the estimate that reads only the texels at the point (what view 63 showed before the
+// march) beside it. Error: |AO − traced| in visibility units; bias: mean AO − mean traced;
+// correlation: Pearson's r over the points. Args: terrain, cascades.
+void BM_LpvAo(benchmark::State& state) {
+    Terrain* t = terrain(int(state.range(0)));
+    if (!t) {
+        state.SkipWithError("shared DEM N42E001.hgt not present");
+        return;
+    }
+    LpvSettings s;
+    s.enabled = true;
+    s.cascades = int(state.range(1));
+    s.propagationIterations = 0;  // the geometry volume alone matters
+    const lpv::Volumes v(s, {&t->lighting, nullptr}, t->camera, t->view);
+    std::vector<float> traced(kPoints), marched(kPoints), local(kPoints);
+    tbb::parallel_for(0, kPoints, [&](int i) {
+        traced[size_t(i)] = tracedSkyVisibility(*t->tracer, t->p[size_t(i)], t->n[size_t(i)], 256, uint64_t(i) + 5u);
+    });
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < kPoints; ++i) marched[size_t(i)] = v.ambientOcclusion(t->p[size_t(i)], t->n[size_t(i)]);
+        state.SetIterationTime(secondsSince(start));
+    }
+    for (int i = 0; i < kPoints; ++i) {
+        double h = 1.0;
+        v.weightAt(t->p[size_t(i)], &h);
+        const glm::vec3 q = t->p[size_t(i)] + float(0.5 * h) * t->n[size_t(i)];
+        local[size_t(i)] = 1.0f - std::clamp(lpv::irradianceLinear(v.geometryAt(q), -t->n[size_t(i)]) / 3.14159265f, 0.0f, 1.0f);
+    }
+    const auto stats = [&](const std::vector<float>& ao, const char* prefix) {
+        std::vector<float> err(kPoints);
+        double ma = 0, mt = 0;
+        for (int i = 0; i < kPoints; ++i) {
+            err[size_t(i)] = std::abs(ao[size_t(i)] - traced[size_t(i)]);
+            ma += ao[size_t(i)], mt += traced[size_t(i)];
+        }
+        ma /= kPoints, mt /= kPoints;
+        double sab = 0, saa = 0, sbb = 0;
+        for (int i = 0; i < kPoints; ++i) {
+            const double a = ao[size_t(i)] - ma, b = traced[size_t(i)] - mt;
+            sab += a * b, saa += a * a, sbb += b * b;
+        }
+        const Spread sp = spreadOf(err);
+        const std::string p(prefix);
+        state.counters[p + "err_mean"] = sp.mean;
+        state.counters[p + "err_p95"] = sp.p95;
+        state.counters[p + "bias"] = ma - mt;
+        state.counters[p + "r"] = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+        state.counters[p + "mean"] = ma;
+    };
+    stats(marched, "");
+    stats(local, "local_");
+    double mt = 0;
+    for (float x : traced) mt += x;
+    state.counters["traced_mean"] = mt / kPoints;
+    char label[64];
+    std::snprintf(label, sizeof label, "%s c%d", t->name.c_str(), s.cascades);
+    state.SetLabel(label);
+}
+BENCHMARK(BM_LpvAo)->Args({0, 1})->Args({0, 3})->Args({1, 1})->Args({1, 3})->Unit(benchmark::kMillisecond)->Iterations(1)->UseManualTime();
 
 // The bake on the same points: a 32 x 32 terrain grid over the points' square, standard-preset
 // rays, one bounce, the sky black. Arg: terrain.

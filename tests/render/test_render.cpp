@@ -1638,6 +1638,26 @@ TEST_F(RenderTest, LpvViewsDifferFromEachOtherAndShowTheVolumes) {
         for (size_t b = a + 1; b < views.size(); ++b)
             EXPECT_GT(meanAbsDiff(images[a], images[b]), 1.0 / 255.0) << views[a] << " and " << views[b] << ": "
                                                                        << meanAbsDiff(images[a], images[b]) * 255.0;
+    // View 63 marches the geometry volume: valleys are darker than the open ridges (reading the
+    // texels at the point alone, it was 0.9999 nearly everywhere).
+    {
+        const RenderedImage ao = draw(r, kViewLpvAo, true, true);
+        size_t covered = 0, shaded = 0;
+        double sum = 0, least = 1;
+        for (size_t i = 0; i < ao.rgba.size(); i += 4) {
+            if (ao.rgba[i + 1] != 1.0f) continue;
+            ++covered;
+            sum += ao.rgba[i];
+            least = std::min(least, double(ao.rgba[i]));
+            shaded += ao.rgba[i] < 0.9f;
+        }
+        ASSERT_GT(covered, ao.rgba.size() / 4 / 10);
+        std::cout << "lpv-ao: " << covered << " pixels in cascade 0, mean " << sum / double(covered) << ", least "
+                  << least << ", " << shaded << " below 0.9\n";
+        EXPECT_GT(double(shaded), 0.03 * double(covered));
+        EXPECT_LT(least, 0.8);
+        EXPECT_GT(sum / double(covered), 0.75);
+    }
     // Lit views do not bind the LPV while lighting.indirect leaves it out.
     draw(r, kViewBeauty);
     for (const PassInfo& pass : r.renderer().lastFramePasses())
@@ -1769,12 +1789,15 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
                 queries.push_back({glm::vec3(x, hf.surfaceHeight(x, z) + lift, z), n,
                                    glm::normalize(glm::vec3(-0.5f, 0.6f, 0.6f))});
             }
-        const std::vector<lpv::Sample> gpu = r.renderer().sampleLpv(queries);
+        const std::vector<TerrainRenderer::LpvSample> gpu = r.renderer().sampleLpv(queries);
         ASSERT_EQ(gpu.size(), queries.size());
         double largest = 0, largestSpec = 0, worst = 0, worstSpec = 0, worstAo = 0, leastAo = 1;
         size_t lit = 0;
-        std::vector<lpv::Sample> cpu;
-        for (const auto& q : queries) cpu.push_back(volumes->evaluate(q[0], q[1], q[2]));
+        std::vector<TerrainRenderer::LpvSample> cpu;
+        for (const auto& q : queries) {
+            const lpv::Sample c = volumes->evaluate(q[0], q[1], q[2]);
+            cpu.push_back({c.irradiance, c.specular, volumes->ambientOcclusion(q[0], q[1])});
+        }
         for (size_t i = 0; i < cpu.size(); ++i) {
             largest = std::max(largest, double(glm::length(cpu[i].irradiance)));
             largestSpec = std::max(largestSpec, double(glm::length(cpu[i].specular)));
