@@ -112,6 +112,13 @@ Terrain* terrain(int which) {
     return cache[which].get();
 }
 
+// The terrain of the benchmark's first argument; null, the benchmark skipped, when it is absent.
+Terrain* terrainOrSkip(benchmark::State& state) {
+    Terrain* t = terrain(int(state.range(0)));
+    if (!t) state.SkipWithError("shared DEM N42E001.hgt not present");
+    return t;
+}
+
 void report(benchmark::State& state, const Terrain& t, const std::vector<float>& values) {
     const float floor = 0.05f * float(t.meanReference);
     std::vector<float> err(values.size());
@@ -129,11 +136,8 @@ void report(benchmark::State& state, const Terrain& t, const std::vector<float>&
 
 // Args: terrain (0 N42E001, 1 sample), cascades, iterations, quality, propagation weight × 1000.
 void BM_Lpv(benchmark::State& state) {
-    Terrain* t = terrain(int(state.range(0)));
-    if (!t) {
-        state.SkipWithError("shared DEM N42E001.hgt not present");
-        return;
-    }
+    Terrain* t = terrainOrSkip(state);
+    if (!t) return;
     LpvSettings s;
     s.enabled = true;
     s.cascades = int(state.range(1));
@@ -180,11 +184,8 @@ BENCHMARK(BM_Lpv)->Apply(lpvArgs)->Unit(benchmark::kMillisecond)->Iterations(1)-
 // march) beside it. Error: |AO − traced| in visibility units; bias: mean AO − mean traced;
 // correlation: Pearson's r over the points. Args: terrain, cascades.
 void BM_LpvAo(benchmark::State& state) {
-    Terrain* t = terrain(int(state.range(0)));
-    if (!t) {
-        state.SkipWithError("shared DEM N42E001.hgt not present");
-        return;
-    }
+    Terrain* t = terrainOrSkip(state);
+    if (!t) return;
     LpvSettings s;
     s.enabled = true;
     s.cascades = int(state.range(1));
@@ -240,11 +241,8 @@ BENCHMARK(BM_LpvAo)->Args({0, 1})->Args({0, 3})->Args({1, 1})->Args({1, 3})->Uni
 // The bake on the same points: a 32 x 32 terrain grid over the points' square, standard-preset
 // rays, one bounce, the sky black. Arg: terrain.
 void BM_Probes(benchmark::State& state) {
-    Terrain* t = terrain(int(state.range(0)));
-    if (!t) {
-        state.SkipWithError("shared DEM N42E001.hgt not present");
-        return;
-    }
+    Terrain* t = terrainOrSkip(state);
+    if (!t) return;
     glm::vec3 lo(1e30f), hi(-1e30f);
     for (const glm::vec3& p : t->p) lo = glm::min(lo, p), hi = glm::max(hi, p);
     ProbeVolumeSettings volume;
