@@ -275,6 +275,11 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     info.sourceWidth = ds->GetRasterXSize();
     info.sourceHeight = ds->GetRasterYSize();
     if (ds->GetRasterCount() < 1) fail(path, "has no raster band");
+    // The heights are the first band. The others (a mask, colours, or thousands in a crafted file)
+    // would each get their own copy in a reprojection or a reduction, so those read a one-band view.
+    DatasetPtr firstBand;
+    if (ds->GetRasterCount() > 1) firstBand = translateTo(path, src.get(), {"-of", "VRT", "-b", "1"});
+    GDALDatasetH heightBand = firstBand ? firstBand.get() : src.get();
     // A surface needs two samples each way: fewer make a footprint of no width and no mesh.
     if (info.sourceWidth < 2 || info.sourceHeight < 2)
         fail(path, "raster is " + std::to_string(info.sourceWidth) + " x " +
@@ -342,7 +347,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     // Pick the output grid: metric CRS, north up, optionally reduced.
     DatasetPtr work;        // the grid we finally read (may be src itself)
     DatasetPtr coverage;    // 1 where the warped output lies inside the source footprint
-    GDALDatasetH readFrom = src.get();
+    GDALDatasetH readFrom = heightBand;
     const double maxCells = options.maxCells;
 
     // GDAL averages one output cell from one buffer of the source cells it covers, so a raster
@@ -398,7 +403,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         CPLFree(wktRaw);
 
         int fullW = 0, fullH = 0;
-        if (!suggestedWarpSize(src.get(), dstWkt, fullW, fullH))
+        if (!suggestedWarpSize(heightBand, dstWkt, fullW, fullH))
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
@@ -419,7 +424,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
             args.insert(args.end(), {"-r", "bilinear"});
         }
         if (hasNodata) args.insert(args.end(), {"-srcnodata", fmt(srcNodata)});
-        work = warpTo(path, src.get(), args);
+        work = warpTo(path, heightBand, args);
         info.reprojected = needsMetric;
 
         // Same warp of an all-ones raster: where the output has no source at all. Coverage
@@ -455,7 +460,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
         if (outW != info.sourceWidth || outH != info.sourceHeight) {
-            work = translateTo(path, src.get(),
+            work = translateTo(path, heightBand,
                                {"-of", "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),
                                 std::to_string(outH), "-r", "average"});
             readFrom = work.get();
@@ -465,7 +470,10 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     // Each GDAL dataset goes as soon as it has been read, so the import holds at most one grid
     // of GDAL's beside its own: the source (and its cached blocks) once a working copy exists,
     // the coverage once read.
-    if (work) src.reset();
+    if (work) {
+        firstBand.reset();  // the view reads the source: it goes first
+        src.reset();
+    }
     std::vector<uint8_t> cov;
     if (coverage) {
         auto* c = static_cast<GDALDataset*>(coverage.get());
@@ -515,6 +523,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     rd = nullptr;
     rband = nullptr;
     work.reset();
+    firstBand.reset();
     src.reset();
 
     std::vector<uint8_t> nodata(heights.size(), 0);

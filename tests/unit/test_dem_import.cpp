@@ -194,6 +194,47 @@ fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6],
 
 }  // namespace
 
+// The heights are the first band, whichever way the import goes: read as it is, reduced, or
+// reprojected (the fuzzer found a GeoTIFF of 34 737 bands whose reduction copied every one).
+TEST(DemImport, OnlyTheFirstBandIsRead) {
+    GDALAllRegister();
+    const auto write = [](const std::string& name, int epsg, const double (&gt)[6]) {
+        const fs::path tmp = fs::temp_directory_path() / name;
+        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+        GDALDataset* ds = gtiff->Create(tmp.c_str(), 64, 48, 3, GDT_Float32, nullptr);
+        double g[6];
+        std::copy(std::begin(gt), std::end(gt), g);
+        ds->SetGeoTransform(g);
+        OGRSpatialReference srs;
+        srs.importFromEPSG(epsg);
+        ds->SetSpatialRef(&srs);
+        std::vector<float> heights(64 * 48), other(64 * 48, 9999.0f);
+        for (int i = 0; i < 64 * 48; ++i) heights[size_t(i)] = 100.0f + float(i % 64);
+        for (int b = 1; b <= 3; ++b)
+            EXPECT_EQ(ds->GetRasterBand(b)->RasterIO(GF_Write, 0, 0, 64, 48, b == 1 ? heights.data() : other.data(),
+                                                     64, 48, GDT_Float32, 0, 0, nullptr),
+                      CE_None);
+        GDALClose(ds);
+        return tmp;
+    };
+    const double utm[6] = {500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0};
+    const double geographic[6] = {1.0, 0.0003, 0.0, 42.0, 0.0, -0.0003};
+    const fs::path projected = write("terralux_bands_utm.tif", 32633, utm);
+    const fs::path lonLat = write("terralux_bands_geo.tif", 4326, geographic);
+    DemImportOptions reduced;
+    reduced.maxResolution = 16;
+    for (const auto& [path, options, what] : {std::tuple{projected, DemImportOptions{}, "as it is"},
+                                              std::tuple{projected, reduced, "reduced"},
+                                              std::tuple{lonLat, DemImportOptions{}, "reprojected"}}) {
+        const auto r = importDem(path.string(), options);
+        EXPECT_GE(r.heightfield.minHeight(), 99.9f) << what;
+        EXPECT_LE(r.heightfield.maxHeight(), 163.1f) << what;
+        EXPECT_GT(r.heightfield.maxHeight() - r.heightfield.minHeight(), 30.0f) << what;
+    }
+    fs::remove(projected);
+    fs::remove(lonLat);
+}
+
 // A footprint off the globe is refused before any reprojection (the fuzzer found one that kept
 // GDAL's transformer busy for seconds), and one on it still imports.
 TEST(DemImport, FootprintOffTheGlobeIsRefused) {
