@@ -14,6 +14,10 @@ namespace terralux {
 
 namespace {
 
+// The widest sky read: 32 768 x 16 384, beyond the largest published equirectangular skies (24K),
+// whose RGBA floats alone would take 8 GiB.
+constexpr int64_t kMaxEquirectWidth = 32768;
+
 // An OpenEXR header is a list of attributes (name, type, 32-bit size, value; the OpenEXR file
 // layout, "Header Attributes"). OpenEXR 3.1 allocates whatever an attribute's value claims before
 // it reads it (a string or an unknown type: its size; a preview: width x height x 4; a string
@@ -61,9 +65,22 @@ void checkExrHeader(const std::string& path) {
     while (readName(name) && !name.empty()) {
         uint32_t size = 0;
         if (!readName(type) || !readU32(size) || int32_t(size) < 0) return;
-        if (const auto* f = std::find_if(std::begin(kFixed), std::end(kFixed),
-                                         [&](const auto& t) { return type == t.first; });
-            f != std::end(kFixed)) {
+        if (name == "dataWindow" && type == "box2i") {
+            // OpenEXR sizes its line buffers by the window's width before it reads a pixel: refuse
+            // a window no equirectangular sky has (the rule openEquirect applies once it is open)
+            // while the width is still only a number.
+            uint32_t box[4];
+            for (uint32_t& v : box)
+                if (!readU32(v)) return;
+            const int64_t w = int64_t(int32_t(box[2])) - int32_t(box[0]) + 1;
+            const int64_t h = int64_t(int32_t(box[3])) - int32_t(box[1]) + 1;
+            if (w < 2 || h < 1 || w != 2 * h || w > kMaxEquirectWidth)
+                throw ImageError(path + ": EXR data window " + std::to_string(w) + "x" + std::to_string(h) +
+                                 " is not an equirectangular image (width twice the height, at most " +
+                                 std::to_string(kMaxEquirectWidth) + ")");
+        } else if (const auto* f = std::find_if(std::begin(kFixed), std::end(kFixed),
+                                                [&](const auto& t) { return type == t.first; });
+                   f != std::end(kFixed)) {
             in.seekg(f->second, std::ios::cur);
         } else if (type == "chlist") {
             // Channels until an empty name: each a name and 16 bytes of layout.
@@ -102,10 +119,10 @@ std::unique_ptr<OIIO::ImageInput> openEquirect(const std::string& path) {
         throw ImageError(path + ": not an image OpenImageIO can read (" + why + ")");
     }
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width < 2 || spec.height < 1 || spec.width != 2 * spec.height)
-        throw ImageError(path + ": " + std::to_string(spec.width) + "x" +
-                         std::to_string(spec.height) +
-                         " is not an equirectangular image (width must be twice the height)");
+    if (spec.width < 2 || spec.height < 1 || spec.width != 2 * spec.height || spec.width > kMaxEquirectWidth)
+        throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                         " is not an equirectangular image (width twice the height, at most " +
+                         std::to_string(kMaxEquirectWidth) + ")");
     return in;
 }
 

@@ -252,3 +252,33 @@ TEST(EnvironmentImage, ExrClaimsAfterAChannelListAndInAPreviewAreRefused) {
     EXPECT_NE(preview.find("attribute 'preview' claims 14400000000 bytes, past the end"), std::string::npos)
         << preview;
 }
+
+// Found by the 30-minute fuzz_env_image run: a 748-byte EXR whose data window is 7 340 036 x 257
+// made OpenEXR size its line buffers by that width (440 MB, 3 s under AddressSanitizer) before
+// OpenImageIO's open returned and the equirectangular rule could refuse it. The header walk
+// applies the rule to the data window first; a 2:1 window goes on.
+TEST(EnvironmentImage, ExrDataWindowThatIsNoSkyIsRefusedBeforeOpenExrSizesItsBuffers) {
+    auto u32 = [](uint32_t v) {
+        std::string b;
+        for (int shift = 0; shift < 32; shift += 8) b.push_back(char((v >> shift) & 0xFF));
+        return b;
+    };
+    const auto dir = std::filesystem::temp_directory_path();
+    auto refusal = [&](uint32_t xMax, uint32_t yMax) {
+        const auto p = dir / "terralux_exr_window.exr";
+        std::ofstream(p, std::ios::binary) << std::string("\x76\x2f\x31\x01\x02\x00\x00\x00", 8) + "dataWindow" + '\0' +
+                                                  "box2i" + '\0' + u32(16) + u32(0) + u32(0) + u32(xMax) + u32(yMax) + '\0';
+        try {
+            checkEquirectImage(p.string());
+        } catch (const ImageError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(refusal(7340035, 256).find("EXR data window 7340036x257 is not an equirectangular image"), std::string::npos);
+    EXPECT_NE(refusal(65535, 32767).find("EXR data window 65536x32768 is not an equirectangular image (width twice "
+                                         "the height, at most 32768)"),
+              std::string::npos);
+    const std::string sky = refusal(7, 3);  // 8 x 4: the header walk lets it through to OpenImageIO
+    EXPECT_EQ(sky.find("data window"), std::string::npos) << sky;
+}
