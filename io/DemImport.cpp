@@ -279,7 +279,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     // would each get their own copy in a reprojection or a reduction, so those read a one-band view.
     DatasetPtr firstBand;
     if (ds->GetRasterCount() > 1) firstBand = translateTo(path, src.get(), {"-of", "VRT", "-b", "1"});
-    GDALDatasetH heightBand = firstBand ? firstBand.get() : src.get();
+    GDALDatasetH heightSource = firstBand ? firstBand.get() : src.get();
     // A surface needs two samples each way: fewer make a footprint of no width and no mesh.
     if (info.sourceWidth < 2 || info.sourceHeight < 2)
         fail(path, "raster is " + std::to_string(info.sourceWidth) + " x " +
@@ -347,7 +347,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     // Pick the output grid: metric CRS, north up, optionally reduced.
     DatasetPtr work;        // the grid we finally read (may be src itself)
     DatasetPtr coverage;    // 1 where the warped output lies inside the source footprint
-    GDALDatasetH readFrom = heightBand;
+    GDALDatasetH readFrom = heightSource;
     const double maxCells = options.maxCells;
 
     // GDAL averages one output cell from one buffer of the source cells it covers, so a raster
@@ -403,7 +403,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         CPLFree(wktRaw);
 
         int fullW = 0, fullH = 0;
-        if (!suggestedWarpSize(heightBand, dstWkt, fullW, fullH))
+        if (!suggestedWarpSize(heightSource, dstWkt, fullW, fullH))
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
@@ -424,7 +424,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
             args.insert(args.end(), {"-r", "bilinear"});
         }
         if (hasNodata) args.insert(args.end(), {"-srcnodata", fmt(srcNodata)});
-        work = warpTo(path, heightBand, args);
+        work = warpTo(path, heightSource, args);
         info.reprojected = needsMetric;
 
         // Same warp of an all-ones raster: where the output has no source at all. Coverage
@@ -460,7 +460,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
         if (outW != info.sourceWidth || outH != info.sourceHeight) {
-            work = translateTo(path, heightBand,
+            work = translateTo(path, heightSource,
                                {"-of", "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),
                                 std::to_string(outH), "-r", "average"});
             readFrom = work.get();

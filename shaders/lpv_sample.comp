@@ -1,7 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// Volumes::evaluate and Volumes::ambientOcclusion on the GPU at given points (TerrainRenderer::sampleLpv): the terrain pass's
-// own LPV code, read back so the tests can hold it against the CPU's at the same points.
+// Volumes::evaluate and Volumes::ambientOcclusion on the GPU at given points
+// (TerrainRenderer::sampleLpv): the terrain pass's own LPV code, read back so the tests can hold
+// it against the CPU's at the same points.
 layout(local_size_x = 64) in;
 #define TLX_LPV
 #include "blocks/glsl.h"

@@ -52,7 +52,7 @@ inline constexpr int kSurfelsPerCell = 4;
 // Shadow rays per surfel across the sun's disc.
 inline constexpr int kSunSamples = 4;
 // The geometry volume's ambient occlusion: cosine-weighted directions, and the most steps along
-// each (a step is the local cell; 48 cross a cascade's diagonal from its centre, and the march
+// each (a step is the blended cell; 48 cross a cascade's diagonal from its centre, and the march
 // ends sooner where it leaves the volumes or the light left is below kAoCutoff).
 inline constexpr int kAoDirections = 16;
 inline constexpr int kAoSteps = 48;

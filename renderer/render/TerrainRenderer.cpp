@@ -672,8 +672,8 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     g.graph.importBuffer(kLpvGeometry, g.lpv->geometry.handle(), true);
 }
 
-std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries,
-                                                    int lastCascade) {
+std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
+    const std::vector<std::array<glm::vec3, 3>>& queries, int lastCascade) {
     Gpu& g = *gpu_;
     if (!g.lpv || queries.empty()) return {};
     const int cascades = g.lpv->block.counts.x;

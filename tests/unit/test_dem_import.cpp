@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <vector>
 
@@ -172,24 +173,34 @@ TEST(DemImport, FrameMappingRowZeroIsNorthAtNegativeZ) {
 
 namespace {
 
-// A w x h Float32 GeoTIFF in the given CRS and geotransform, every cell 100 m.
-fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6], int w = 4, int h = 3) {
+// A w x h Float32 GeoTIFF of `bands` bands in the given CRS and geotransform, band b's cell
+// (col, row) holding value(b, col, row) (bands from 1).
+fs::path writeTiff(const std::string& name, int epsg, const double (&gt)[6], int w, int h, int bands,
+                   const std::function<float(int, int, int)>& value) {
     GDALAllRegister();
     const fs::path tmp = fs::temp_directory_path() / name;
     GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-    GDALDataset* ds = gtiff->Create(tmp.c_str(), w, h, 1, GDT_Float32, nullptr);
+    GDALDataset* ds = gtiff->Create(tmp.c_str(), w, h, bands, GDT_Float32, nullptr);
     double g[6];
     std::copy(std::begin(gt), std::end(gt), g);
     ds->SetGeoTransform(g);
     OGRSpatialReference srs;
     srs.importFromEPSG(epsg);
     ds->SetSpatialRef(&srs);
-    std::vector<float> v(size_t(w) * h, 100.0f);
-    EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, w, h, v.data(), w, h, GDT_Float32, 0,
-                                             0, nullptr),
-              CE_None);
+    std::vector<float> v(size_t(w) * h);
+    for (int b = 1; b <= bands; ++b) {
+        for (int r = 0; r < h; ++r)
+            for (int c = 0; c < w; ++c) v[size_t(r) * w + c] = value(b, c, r);
+        EXPECT_EQ(ds->GetRasterBand(b)->RasterIO(GF_Write, 0, 0, w, h, v.data(), w, h, GDT_Float32, 0, 0, nullptr),
+                  CE_None);
+    }
     GDALClose(ds);
     return tmp;
+}
+
+// The same with one band, every cell 100 m.
+fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6], int w = 4, int h = 3) {
+    return writeTiff(name, epsg, gt, w, h, 1, [](int, int, int) { return 100.0f; });
 }
 
 }  // namespace
@@ -197,30 +208,12 @@ fs::path writeFlatTiff(const std::string& name, int epsg, const double (&gt)[6],
 // The heights are the first band, whichever way the import goes: read as it is, reduced, or
 // reprojected (the fuzzer found a GeoTIFF of 34 737 bands whose reduction copied every one).
 TEST(DemImport, OnlyTheFirstBandIsRead) {
-    GDALAllRegister();
-    const auto write = [](const std::string& name, int epsg, const double (&gt)[6]) {
-        const fs::path tmp = fs::temp_directory_path() / name;
-        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-        GDALDataset* ds = gtiff->Create(tmp.c_str(), 64, 48, 3, GDT_Float32, nullptr);
-        double g[6];
-        std::copy(std::begin(gt), std::end(gt), g);
-        ds->SetGeoTransform(g);
-        OGRSpatialReference srs;
-        srs.importFromEPSG(epsg);
-        ds->SetSpatialRef(&srs);
-        std::vector<float> heights(64 * 48), other(64 * 48, 9999.0f);
-        for (int i = 0; i < 64 * 48; ++i) heights[size_t(i)] = 100.0f + float(i % 64);
-        for (int b = 1; b <= 3; ++b)
-            EXPECT_EQ(ds->GetRasterBand(b)->RasterIO(GF_Write, 0, 0, 64, 48, b == 1 ? heights.data() : other.data(),
-                                                     64, 48, GDT_Float32, 0, 0, nullptr),
-                      CE_None);
-        GDALClose(ds);
-        return tmp;
-    };
     const double utm[6] = {500000.0, 30.0, 0.0, 4000000.0, 0.0, -30.0};
     const double geographic[6] = {1.0, 0.0003, 0.0, 42.0, 0.0, -0.0003};
-    const fs::path projected = write("terralux_bands_utm.tif", 32633, utm);
-    const fs::path lonLat = write("terralux_bands_geo.tif", 4326, geographic);
+    // Band 1 rises 1 m a column from 100 m; the others are 9999 m everywhere.
+    const auto value = [](int band, int col, int) { return band == 1 ? 100.0f + float(col) : 9999.0f; };
+    const fs::path projected = writeTiff("terralux_bands_utm.tif", 32633, utm, 64, 48, 3, value);
+    const fs::path lonLat = writeTiff("terralux_bands_geo.tif", 4326, geographic, 64, 48, 3, value);
     DemImportOptions reduced;
     reduced.maxResolution = 16;
     for (const auto& [path, options, what] : {std::tuple{projected, DemImportOptions{}, "as it is"},
