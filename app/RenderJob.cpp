@@ -318,6 +318,7 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     job.lighting.tracer = tracer_.get();
     job.eye = glm::dvec3(camera.lpvEye());
     job.viewDir = glm::dvec3(camera.lpvViewDirection());
+    job.propagation = renderer_->propagatesLpv() ? lpv::Propagation::Renderer : lpv::Propagation::Cpu;
     const nlohmann::json sceneJson = sceneToJson(scene);
     nlohmann::json key = {{"albedo", reinterpret_cast<uintptr_t>(albedo_.get())}};
     for (const char* section : {"lpv", "lights", "sun", "sky", "terrain"}) key[section] = sceneJson.value(section, nlohmann::json());
@@ -327,8 +328,8 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     return job;
 }
 
-std::shared_ptr<const lpv::Volumes> LpvJob::run() const {
-    return std::make_shared<const lpv::Volumes>(settings, lpv::Inputs{&lighting, &lights}, eye, viewDir);
+std::shared_ptr<const lpv::Volumes> LpvJob::run(lpv::Propagation where) const {
+    return std::make_shared<const lpv::Volumes>(settings, lpv::Inputs{&lighting, &lights}, eye, viewDir, where);
 }
 
 void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const std::string& key) {

@@ -12,6 +12,7 @@
 #include "DemImport.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
+#include "lpv/Lpv.h"
 #include "Project.h"
 #include "render/TerrainRenderer.h"
 #include "terrain/HorizonAO.h"
@@ -43,7 +44,12 @@ struct LpvJob {
     // The inputs and the cascades' placement: two jobs with equal keys compute equal volumes, so
     // a camera move within the cascades' cells computes nothing.
     std::string key;
-    std::shared_ptr<const lpv::Volumes> run() const;
+    // Where the steps are taken: by the renderer that binds the volumes (Renderer), or here with
+    // the geometry and the injection (Cpu). ProjectRenderer::lpvJob picks what its device does
+    // faster (TerrainRenderer::propagatesLpv).
+    lpv::Propagation propagation = lpv::Propagation::Cpu;
+    std::shared_ptr<const lpv::Volumes> run() const { return run(propagation); }
+    std::shared_ptr<const lpv::Volumes> run(lpv::Propagation where) const;
 };
 
 // How far the shadow maps are from the exact sun visibility: the shadow view (31) and the traced

@@ -22,6 +22,7 @@ std::span<const uint32_t> skyBackgroundFrag();
 std::span<const uint32_t> shadowDepthVert();
 std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> lpvSampleComp();  // Volumes::evaluate at given points (TerrainRenderer::sampleLpv)
+std::span<const uint32_t> lpvPropagateComp();  // propagation steps of the bound LPV (TerrainRenderer::setLpv)
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();
 std::span<const uint32_t> leavesVert();

@@ -29,45 +29,9 @@ constexpr int kHalf = kGrid / 2;
 
 float luminanceOf(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
 
-// The thirty faces: for neighbour direction a (source → destination), face f's centre direction
-// from the source's centre, its outward normal at the destination, and its solid angle.
-struct Face {
-    glm::vec3 dir, normal;
-    float solidAngle;
-};
-struct Neighbour {
-    glm::ivec3 offset;
-    int axis, sign;
-    std::array<Face, 5> faces;
-};
-
-const std::array<Neighbour, 6>& neighbours() {
-    static const std::array<Neighbour, 6> table = [] {
-        std::array<Neighbour, 6> t{};
-        int n = 0;
-        for (int axis = 0; axis < 3; ++axis)
-            for (int sign : {1, -1}) {
-                Neighbour& nb = t[n++];
-                nb.offset = glm::ivec3(0);
-                nb.offset[axis] = sign;
-                nb.axis = axis;
-                nb.sign = sign;
-                const glm::vec3 a(nb.offset);
-                nb.faces[0] = {a, a, kFarFace};
-                int f = 1;
-                for (int other = 0; other < 3; ++other) {
-                    if (other == axis) continue;
-                    for (int s : {1, -1}) {
-                        glm::vec3 b(0.0f);
-                        b[other] = float(s);
-                        nb.faces[f++] = {glm::normalize(a + 0.5f * b), b, kSideFace};
-                    }
-                }
-            }
-        return t;
-    }();
-    return table;
-}
+using Face = PropagationFace;
+using Neighbour = PropagationNeighbour;
+const std::array<Neighbour, 6>& neighbours() { return propagationNeighbours(); }
 
 Sh4 cellSh(const LightVolume& v, int channel, size_t cell) {
     const float* c = &v[lightOffset(channel, cell, 0)];
@@ -83,7 +47,7 @@ Sh4 cornerSh(const GeometryVolume& g, size_t corner) {
 // four corner texels (the face centre, bilinearly).
 Sh4 faceGeometry(const GeometryVolume& g, const glm::ivec3& s, const Neighbour& nb) {
     glm::ivec3 base = s;
-    if (nb.sign > 0) base[nb.axis] += 1;
+    if (nb.offset[nb.axis] > 0) base[nb.axis] += 1;
     const int o1 = (nb.axis + 1) % 3, o2 = (nb.axis + 2) % 3;
     Sh4 sum{};
     for (int i = 0; i < 2; ++i)
@@ -175,6 +139,35 @@ glm::vec3 irradianceZh3Hallucinated(const std::array<Sh4, 3>& rgb, const glm::ve
     return out;
 }
 
+// ---- Propagation's faces -----------------------------------------------------------------------
+
+const std::array<PropagationNeighbour, 6>& propagationNeighbours() {
+    static const std::array<PropagationNeighbour, 6> table = [] {
+        std::array<PropagationNeighbour, 6> t{};
+        int n = 0;
+        for (int axis = 0; axis < 3; ++axis)
+            for (int sign : {1, -1}) {
+                PropagationNeighbour& nb = t[size_t(n++)];
+                nb.offset = glm::ivec3(0);
+                nb.offset[axis] = sign;
+                nb.axis = axis;
+                const glm::vec3 a(nb.offset);
+                nb.faces[0] = {a, kFarFace, clampedCosine(a, 1.0f / kPi)};
+                int f = 1;
+                for (int other = 0; other < 3; ++other) {
+                    if (other == axis) continue;
+                    for (int s : {1, -1}) {
+                        glm::vec3 b(0.0f);
+                        b[other] = float(s);
+                        nb.faces[size_t(f++)] = {glm::normalize(a + 0.5f * b), kSideFace, clampedCosine(b, 1.0f / kPi)};
+                    }
+                }
+            }
+        return t;
+    }();
+    return table;
+}
+
 // ---- Cascades ---------------------------------------------------------------------------------
 
 double cascadeRatio(const LpvSettings& s) {
@@ -263,13 +256,12 @@ void propagationStep(const GeometryVolume& geometry, const LightVolume& src, Lig
                     const Sh4 g = occlude ? faceGeometry(geometry, s, nb) : Sh4{};
                     for (const Face& f : nb.faces) {
                         const float transmit = occlude ? 1.0f - blocking(g, f.dir) : 1.0f;
-                        const Sh4 unit = clampedCosine(f.normal, 1.0f / kPi);
                         for (int ch = 0; ch < 3; ++ch) {
                             const float k = scale[size_t(ch) * kCells + sc];
                             if (k == 0.0f) continue;
                             const float flux = k * std::max(0.0f, evaluate(cellSh(src, ch, sc), f.dir)) *
                                                f.solidAngle * weight * transmit;
-                            for (int c = 0; c < 4; ++c) dst[lightOffset(ch, tc, c)] += flux * unit[c];
+                            for (int c = 0; c < 4; ++c) dst[lightOffset(ch, tc, c)] += flux * f.lobe[c];
                         }
                     }
                 }
@@ -391,8 +383,8 @@ float lightAttenuation(const LocalLight& l, const glm::vec3& toSurfel, float d) 
 }  // namespace
 
 Volumes::Volumes(const LpvSettings& settings, const Inputs& inputs, const glm::dvec3& camera,
-                 const glm::dvec3& viewDir)
-    : settings_(settings), inputs_(inputs) {
+                 const glm::dvec3& viewDir, Propagation propagation)
+    : settings_(settings), inputs_(inputs), propagated_(propagation == Propagation::Cpu) {
     if (!inputs.lighting || !inputs.lighting->tracer)
         throw std::invalid_argument("light propagation volumes need the terrain's tracer");
     const HeightfieldTracer& tracer = *inputs.lighting->tracer;
@@ -408,7 +400,7 @@ Volumes::Volumes(const LpvSettings& settings, const Inputs& inputs, const glm::d
     if (inputs.lights) injectLights();
     for (Cascade& c : cascades_) {
         c.injectedFlux = totalFlux(c.injected);
-        propagate(c);
+        if (propagated_) propagate(c);
     }
 }
 
@@ -626,6 +618,8 @@ Trilinear trilinear(const glm::dvec3& u, int n) {
 }  // namespace
 
 std::array<Sh4, 3> Volumes::radianceAt(const glm::vec3& p, float* weight) const {
+    if (!propagated_)
+        throw std::logic_error("these light propagation volumes were left to the renderer to propagate");
     std::array<Sh4, 3> out{};
     float remaining = 1.0f;
     // Finest first: each cascade takes its fade weight of what the finer ones left.

@@ -10,8 +10,9 @@
 //      visibility from the bake's tracer) and point and spot lights, each a clamped-cosine lobe of
 //      its reflected flux, half a cell along its normal;
 //   4. propagation: six-neighbour, five-face transfer, scaled per step by w^(1/32) for the
-//      propagation weight w (propagationStepWeight), blocked
-//      by the geometry volume, accumulated over the iterations;
+//      propagation weight w (propagationStepWeight), blocked by the geometry volume, accumulated
+//      over the iterations; here, or by the renderer's compute pass (shaders/lpv_propagate.comp,
+//      Propagation::Renderer), which steps exactly as propagationStep does;
 //   5. apply: irradiance at a point and normal (linear L1, or ZH3 with leak dampening), cone-traced
 //      specular at quality 2, and (view 63 only) an ambient occlusion marched through the geometry
 //      volume.
@@ -146,6 +147,22 @@ struct PropagationStats {
 // geometry's transmission at the shared face (skipped with `occlude` false).
 void propagationStep(const GeometryVolume& geometry, const LightVolume& src, LightVolume& dst,
                      float weight, bool occlude, PropagationStats* stats = nullptr);
+// propagationStep's six neighbours (offset from source to destination, in this order) and each
+// one's five faces (the far face first): the direction of the face's centre from the source's
+// centre, its solid angle, and the unit lobe a face's flux becomes at the destination
+// (clampedCosine(face normal, 1/π)). The renderer's propagation pass reads this table, so both
+// step through the same values in the same order.
+struct PropagationFace {
+    glm::vec3 dir{0.0f};
+    float solidAngle = 0.0f;
+    Sh4 lobe{};
+};
+struct PropagationNeighbour {
+    glm::ivec3 offset{0};
+    int axis = 0;
+    std::array<PropagationFace, 5> faces{};
+};
+const std::array<PropagationNeighbour, 6>& propagationNeighbours();
 // The `weight` each step of Volumes::propagate passes to propagationStep for lpv.propagation_weight
 // w: w^(1/32). The seed calls w a per-neighbour propagation strength (default 0.01) without a
 // scale; as a per-step factor 0.01 would leave only the injected light. Read per neighbour step
@@ -160,7 +177,7 @@ struct Cascade {
     CascadeLayout layout;
     GeometryVolume geometry;
     LightVolume injected;     // sun and local lights
-    LightVolume accumulated;  // injected + every propagation step
+    LightVolume accumulated;  // injected + every propagation step; empty when the renderer propagates
     glm::dvec3 injectedFlux{0.0};
     size_t sunSurfels = 0;    // surfels the sun lights (at least partly visible)
 };
@@ -186,16 +203,25 @@ struct Sample {
     glm::vec3 specular{0.0f};    // quality 2: radiance toward the eye along the mirror direction, × indirect_intensity
 };
 
+// Where the injected light is propagated: here (Cpu: `accumulated` filled, evaluate() works), or
+// by the renderer's compute pass when it binds the volumes (Renderer: `accumulated` left empty;
+// TerrainRenderer::setLpv). The CPU's propagation is the reference the renderer's is tested
+// against.
+enum class Propagation { Cpu, Renderer };
+
 class Volumes {
 public:
     // Places the cascades for the camera, builds their geometry, injects the sun and (with
-    // local_lights) the lights, and propagates.
+    // local_lights) the lights, and (Propagation::Cpu) propagates.
     Volumes(const LpvSettings& settings, const Inputs& inputs, const glm::dvec3& camera,
-            const glm::dvec3& viewDir);
+            const glm::dvec3& viewDir, Propagation propagation = Propagation::Cpu);
 
     const LpvSettings& settings() const { return settings_; }
     const std::vector<Cascade>& cascades() const { return cascades_; }
     const std::vector<LightInjection>& lightInjections() const { return lights_; }
+    // False when the renderer propagates: then only the geometry, the injection and
+    // ambientOcclusion() are here, and evaluate() and radianceAt() throw std::logic_error.
+    bool propagated() const { return propagated_; }
 
     // At position p with unit normal n; `toEye` (unit, toward the viewer) is read by quality 2.
     Sample evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3& toEye, int quality) const;
@@ -232,6 +258,7 @@ private:
 
     LpvSettings settings_;
     Inputs inputs_;
+    bool propagated_ = true;
     std::vector<Cascade> cascades_;
     std::vector<LightInjection> lights_;
 };

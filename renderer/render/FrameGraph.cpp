@@ -28,6 +28,9 @@ AccessInfo infoOf(Access a) {
         case Access::ComputeStorageWrite:
             return {VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                     VK_IMAGE_LAYOUT_GENERAL, true, false};
+        case Access::ComputeStorageReadWrite:
+            return {VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                    VK_IMAGE_LAYOUT_GENERAL, true, false};
         case Access::FragmentSampledRead:
             return {VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT,
                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, false, false};
@@ -71,6 +74,7 @@ const char* accessName(Access a) {
         case Access::IndexRead: return "index-read";
         case Access::ComputeStorageRead: return "compute-read";
         case Access::ComputeStorageWrite: return "compute-write";
+        case Access::ComputeStorageReadWrite: return "compute-read-write";
         case Access::FragmentSampledRead: return "fragment-sampled-read";
         case Access::FragmentStorageRead: return "fragment-storage-read";
         case Access::ColorAttachmentClear: return "color-clear";

@@ -20,6 +20,7 @@ enum class Access {
     IndexRead,             // an index buffer
     ComputeStorageRead,
     ComputeStorageWrite,
+    ComputeStorageReadWrite,  // reads what it or an earlier pass wrote, and writes
     FragmentSampledRead,   // a sampled image in a fragment shader
     FragmentStorageRead,   // a storage buffer a fragment shader reads
     ColorAttachmentClear,  // the pass clears it: earlier contents are discarded

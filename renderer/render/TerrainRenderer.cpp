@@ -62,6 +62,8 @@ const char* const kReflectionCubes = "reflection-probe-cubes";
 const char* const kReflectionMarkers = "reflection-probe-markers";
 const char* const kLpvLight = "lpv-light";
 const char* const kLpvGeometry = "lpv-geometry";
+const char* const kLpvWork = "lpv-work";
+const char* const kLpvScales = "lpv-scales";
 
 // Vertices along the longer side of the water mesh, at most: the waves longer than two of its
 // cells move it, the shorter ones live in the normal (water.glsl).
@@ -111,11 +113,17 @@ struct FrameSlot {
 
 // The LPV subsystem: present only while volumes are bound. Every cascade's light volume (its
 // three channels one after another, Lpv.h's layout) and geometry volume, uploaded once per
-// update; the block's cascade records come with them.
+// update; the block's cascade records come with them. Volumes left to the renderer to propagate
+// upload their injected light instead (region 0 of `work`), and the first frame or sample that
+// reads `light` runs the propagation pass into it (`steps` > 0 until then).
 struct LpvResources {
     std::shared_ptr<const lpv::Volumes> volumes;
     vk::Buffer light, geometry;
     blocks::LpvBlock block;
+    vk::Buffer work, scales, propagationBlock;
+    vk::DescriptorSet propagationSet;
+    int steps = 0;
+    uint32_t cells = 0;  // cascades x 32^3
 };
 
 // The water subsystem: present only while the scene has water. The field and mesh follow the
@@ -205,8 +213,11 @@ struct TerrainRenderer::Gpu {
     vk::Buffer lpvDummy;  // one vec4 standing in for the volumes where none are bound
     vk::UniqueSetLayout lpvLayout;
     std::array<vk::PipelineLayout, 4> terrainLpvLayouts;  // view, lights and the LPV set, by lights variant
-    vk::PipelineLayout lpvSampleLayout;
-    vk::UniquePipeline lpvSample;
+    vk::PipelineLayout lpvSampleLayout, lpvPropagateLayout;
+    vk::UniquePipeline lpvSample, lpvPropagate;
+    // Timestamps around the last propagation pass (devices that write them).
+    vk::UniqueQueryPool lpvQueries;
+    bool lpvTimed = false;
     // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
     // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant |
     // kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV shaders and layout).
@@ -634,10 +645,44 @@ bool TerrainRenderer::hasReflectionResources() const { return gpu_->reflections 
 
 bool TerrainRenderer::hasLpvResources() const { return gpu_->lpv != nullptr; }
 
+bool TerrainRenderer::propagatesLpv() const { return ctx_.deviceType() != VK_PHYSICAL_DEVICE_TYPE_CPU; }
+
 const std::shared_ptr<const lpv::Volumes>& TerrainRenderer::lpv() const {
     static const std::shared_ptr<const lpv::Volumes> none;
     return gpu_->lpv ? gpu_->lpv->volumes : none;
 }
+
+namespace {
+
+// The propagation pass's set: its block, the work regions, the send scales, the geometry and the
+// light it accumulates into.
+vk::DescriptorSetBuilder lpvPropagationSetBuilder(const LpvResources& r) {
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    vk::DescriptorSetBuilder b;
+    b.uniform(blocks::LpvPropagationBlock::kBinding, "lpv-propagation", r.propagationBlock, compute)
+        .storage(TLX_LPV_WORK_BINDING, kLpvWork, r.work, compute)
+        .storage(TLX_LPV_SCALES_BINDING, kLpvScales, r.scales, compute)
+        .storage(TLX_LPV_PROPAGATE_GEOMETRY_BINDING, kLpvGeometry, r.geometry, compute)
+        .storage(TLX_LPV_ACCUMULATED_BINDING, kLpvLight, r.light, compute);
+    return b;
+}
+
+blocks::LpvPropagationBlock propagationBlock(float stepWeight, int cascades) {
+    blocks::LpvPropagationBlock b;
+    const auto& table = lpv::propagationNeighbours();
+    for (size_t n = 0; n < table.size(); ++n) {
+        b.neighbours[n] = glm::vec4(glm::vec3(table[n].offset), float(table[n].axis));
+        for (size_t f = 0; f < table[n].faces.size(); ++f) {
+            const lpv::PropagationFace& face = table[n].faces[f];
+            b.faceDirs[5 * n + f] = glm::vec4(face.dir, face.solidAngle);
+            b.faceLobes[5 * n + f] = glm::vec4(face.lobe[0], face.lobe[1], face.lobe[2], face.lobe[3]);
+        }
+    }
+    b.params = glm::vec4(stepWeight, float(cascades), 0.0f, 0.0f);
+    return b;
+}
+
+}  // namespace
 
 void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     Gpu& g = *gpu_;
@@ -647,29 +692,154 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
         r = std::make_unique<LpvResources>();
         const auto& cascades = volumes->cascades();
         const size_t n = std::min<size_t>(cascades.size(), 4);
-        std::vector<float> light, geometry;
-        light.reserve(n * cascades[0].accumulated.size());
-        geometry.reserve(n * cascades[0].geometry.size());
         const LpvSettings& ls = volumes->settings();
+        // Propagated here unless the volumes already are, or have no step to take.
+        const bool propagate = !volumes->propagated() && ls.propagationIterations > 0;
+        std::vector<float> light, geometry;
+        light.reserve((propagate ? 3 : 1) * n * cascades[0].injected.size());
+        geometry.reserve(n * cascades[0].geometry.size());
         r->block.counts = glm::ivec4(int(n), ls.quality, ls.coneTraceSamples, 0);
         r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f, 0.0f);
         for (size_t c = 0; c < n; ++c) {
-            light.insert(light.end(), cascades[c].accumulated.begin(), cascades[c].accumulated.end());
+            const lpv::LightVolume& v = volumes->propagated() ? cascades[c].accumulated : cascades[c].injected;
+            light.insert(light.end(), v.begin(), v.end());
             geometry.insert(geometry.end(), cascades[c].geometry.begin(), cascades[c].geometry.end());
             r->block.cascades[c] = glm::vec4(glm::vec3(cascades[c].layout.origin()), float(cascades[c].layout.cellSize));
         }
-        r->light = vk::Buffer::deviceLocal(ctx_, light.data(), light.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-        r->geometry = vk::Buffer::deviceLocal(ctx_, geometry.data(), geometry.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+        constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+        const VkDeviceSize lightBytes = VkDeviceSize(n) * cascades[0].injected.size() * 4;
+        r->geometry = vk::Buffer::deviceLocal(ctx_, geometry.data(), geometry.size() * 4, storage);
+        if (!propagate) {
+            r->light = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage);
+        } else {
+            // Region 0 the injected light; regions 1 and 2 the steps' outputs, written before read.
+            light.resize(3 * light.size(), 0.0f);
+            r->work = vk::Buffer::deviceLocal(ctx_, light.data(), light.size() * 4, storage);
+            r->light = vk::Buffer(ctx_, lightBytes, storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+            r->cells = uint32_t(n) * uint32_t(lpv::kCells);
+            r->scales = vk::Buffer(ctx_, VkDeviceSize(2 * 3) * r->cells * 4, storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+            const blocks::LpvPropagationBlock block =
+                propagationBlock(lpv::propagationStepWeight(ls.propagationWeight), int(n));
+            r->propagationBlock = vk::Buffer::deviceLocal(ctx_, &block, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+            r->propagationSet = lpvPropagationSetBuilder(*r).build(ctx_);
+            r->steps = ls.propagationIterations;
+            if (!g.lpvPropagate) {
+                constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+                const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), r->propagationSet.layout()};
+                g.lpvPropagateLayout = vk::PipelineLayout(ctx_, sets, sizeof(glm::ivec4), compute);
+                g.lpvPropagate = vk::createComputePipeline(ctx_, g.lpvPropagateLayout.handle(), shaders::lpvPropagateComp());
+            }
+            if (!g.lpvQueries && ctx_.timestampPeriod() > 0.0) {
+                VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+                qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+                qci.queryCount = 2;
+                VkQueryPool pool = VK_NULL_HANDLE;
+                vk::check(vkCreateQueryPool(ctx_.device(), &qci, nullptr, &pool), "vkCreateQueryPool");
+                g.lpvQueries = vk::UniqueQueryPool(ctx_.device(), pool);
+            }
+        }
         r->volumes = std::move(volumes);
     }
     ctx_.waitIdle();  // no frame may still read the old volumes
-    g.graph.forget(kLpvLight);
-    g.graph.forget(kLpvGeometry);
+    for (const char* name : {kLpvLight, kLpvGeometry, kLpvWork, kLpvScales}) g.graph.forget(name);
     g.lpv = std::move(r);
     ++g.lpvGeneration;
+    g.lpvTimed = false;  // the last pass's time was the old volumes'
     if (!g.lpv) return;
-    g.graph.importBuffer(kLpvLight, g.lpv->light.handle(), true);
+    g.graph.importBuffer(kLpvLight, g.lpv->light.handle(), g.lpv->steps == 0);
     g.graph.importBuffer(kLpvGeometry, g.lpv->geometry.handle(), true);
+    if (g.lpv->steps == 0) return;
+    g.graph.importBuffer(kLpvWork, g.lpv->work.handle(), true);
+    g.graph.importBuffer(kLpvScales, g.lpv->scales.handle());
+}
+
+void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
+    Gpu& g = *gpu_;
+    LpvResources& r = *g.lpv;
+    if (g.lpvQueries) {
+        vkCmdResetQueryPool(cb, g.lpvQueries.get(), 0, 2);
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, g.lpvQueries.get(), 0);
+    }
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagate.get());
+    const VkDescriptorSet set = r.propagationSet.handle();
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagateLayout.handle(), TLX_SET_SUBSYSTEM, 1,
+                            &set, 0, nullptr);
+    // Each dispatch reads what the one before it wrote.
+    VkMemoryBarrier between{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    between.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    between.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    const uint32_t groups = (r.cells + 255) / 256;
+    const auto dispatch = [&](const glm::ivec4& push) {
+        vkCmdPushConstants(cb, g.lpvPropagateLayout.handle(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatch(cb, groups, 1, 1);
+    };
+    dispatch(glm::ivec4(0, 0, 0, 0));  // the injected light's send scales
+    for (int step = 0; step < r.steps; ++step) {
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                             &between, 0, nullptr, 0, nullptr);
+        // Step 0 reads the injected light (region 0); then the regions 1 and 2 alternate.
+        const int source = step == 0 ? 0 : 1 + (step - 1) % 2, destination = 1 + step % 2;
+        dispatch(glm::ivec4(1, source, destination, step + 1 < r.steps ? 1 : 0));
+    }
+    if (g.lpvQueries) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, g.lpvQueries.get(), 1);
+    g.lpvTimed = bool(g.lpvQueries);
+    r.steps = 0;
+}
+
+void TerrainRenderer::propagateLpvNow() {
+    Gpu& g = *gpu_;
+    if (!g.lpv || g.lpv->steps == 0) return;
+    ctx_.waitIdle();
+    ctx_.submitAndWait([&](VkCommandBuffer cb) {
+        // The injected light and the geometry were filled by transfers.
+        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
+                             0, nullptr, 0, nullptr);
+        recordLpvPropagation(cb);
+        // Whatever reads the light later, in this submission's successors, sees it written.
+        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        after.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+        after.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after,
+                             0, nullptr, 0, nullptr);
+    });
+}
+
+std::optional<double> TerrainRenderer::lpvPropagationMilliseconds() {
+    Gpu& g = *gpu_;
+    if (!g.lpvTimed) return std::nullopt;
+    ctx_.waitIdle();
+    uint64_t ticks[2] = {0, 0};
+    if (vkGetQueryPoolResults(ctx_.device(), g.lpvQueries.get(), 0, 2, sizeof ticks, ticks, sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT) != VK_SUCCESS)
+        return std::nullopt;
+    return double(ticks[1] - ticks[0]) * ctx_.timestampPeriod() * 1e-6;
+}
+
+std::vector<float> TerrainRenderer::readLpvLight() {
+    Gpu& g = *gpu_;
+    if (!g.lpv) return {};
+    propagateLpvNow();
+    vk::Buffer host = vk::Buffer::hostVisible(ctx_, g.lpv->light.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    ctx_.waitIdle();
+    ctx_.submitAndWait([&](VkCommandBuffer cb) {
+        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        before.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+        before.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+        const VkBufferCopy region{0, 0, g.lpv->light.size()};
+        vkCmdCopyBuffer(cb, g.lpv->light.handle(), host.handle(), 1, &region);
+        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+        after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &after, 0, nullptr,
+                             0, nullptr);
+    });
+    const auto* values = static_cast<const float*>(host.map());
+    return std::vector<float>(values, values + g.lpv->light.size() / 4);
 }
 
 std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
@@ -698,13 +868,16 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
         g.lpvSample = vk::createComputePipeline(ctx_, g.lpvSampleLayout.handle(), shaders::lpvSampleComp());
     }
     const glm::ivec4 push(int(queries.size()), last, 0, 0);
+    propagateLpvNow();
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
-        // The volumes and the queries were filled by transfers.
+        // The volumes and the queries were filled by transfers (the light perhaps by the
+        // propagation pass).
         VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
         before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
                              0, nullptr, 0, nullptr);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSample.get());
         const VkDescriptorSet handle = set.handle();
@@ -1326,6 +1499,17 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                                     TLX_SET_SUBSYSTEM, 1, &set, 0, nullptr);
             vkCmdDispatch(c, (n + 63) / 64, 1, 1);
         });
+    }
+
+    // Volumes bound for the renderer to propagate: their steps, once, before anything reads them.
+    if (lpvVolumes && lpvVolumes->steps > 0) {
+        PassInfo info{"lpv-propagate",
+                      {{kLpvWork, Access::ComputeStorageReadWrite},
+                       {kLpvScales, Access::ComputeStorageReadWrite},
+                       {kLpvGeometry, Access::ComputeStorageRead},
+                       {kLpvLight, Access::ComputeStorageReadWrite}},
+                      lpvVolumes->propagationSet.bindingNames()};
+        graph.addPass(std::move(info), [this](VkCommandBuffer c) { recordLpvPropagation(c); });
     }
 
     // The cascades, drawn again only when their light projections moved (the camera, the sun or

@@ -134,8 +134,14 @@ public:
     // Whether the reflection subsystem holds GPU resources (a set is bound).
     bool hasReflectionResources() const;
     // Binds light propagation volumes (null: none; their GPU buffers go away). Their cascades,
-    // quality, cone samples and intensity are the volumes' own settings.
+    // quality, cone samples and intensity are the volumes' own settings. Volumes made with
+    // lpv::Propagation::Renderer are propagated here, by a compute pass (shaders/
+    // lpv_propagate.comp) that the first frame reading them runs ("lpv-propagate").
     void setLpv(std::shared_ptr<const lpv::Volumes> volumes);
+    // Whether volumes for this renderer are best propagated by it: on a GPU, yes; on a CPU device
+    // (lavapipe) the CPU's own propagation is about 3x faster than the pass on the same cores
+    // (bench_render BM_LpvUpdate) and runs on the update's worker rather than in a frame.
+    bool propagatesLpv() const;
     const std::shared_ptr<const lpv::Volumes>& lpv() const;
     bool hasLpvResources() const;
     // Volumes::evaluate and Volumes::ambientOcclusion of the bound LPV on the GPU, by the terrain
@@ -147,6 +153,13 @@ public:
         float ao = 1.0f;
     };
     std::vector<LpvSample> sampleLpv(const std::vector<std::array<glm::vec3, 3>>& queries, int lastCascade = -1);
+    // The bound LPV's light as the terrain reads it (Lpv.h's layout, cascades one after another),
+    // propagated first if that is still owed: Volumes' `accumulated` for volumes it propagated.
+    // Waits for the GPU. Empty without an LPV.
+    std::vector<float> readLpvLight();
+    // The GPU time of the last propagation pass, milliseconds, from timestamps; none before the
+    // first, or where the device writes no timestamps. Waits for the GPU.
+    std::optional<double> lpvPropagationMilliseconds();
     // Bytes of the bound reflection probes on the GPU: their records and cube texels.
     size_t reflectionBytes() const { return reflectionBytes_; }
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.
@@ -205,6 +218,8 @@ private:
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
     void buildReflectionSets();
+    void recordLpvPropagation(VkCommandBuffer cb);
+    void propagateLpvNow();  // runs the owed propagation in a submission of its own
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;

@@ -17,6 +17,7 @@ void destroyHandle(VkDevice d, VkDescriptorPool h) { vkDestroyDescriptorPool(d, 
 void destroyHandle(VkDevice d, VkFence h) { vkDestroyFence(d, h, nullptr); }
 void destroyHandle(VkDevice d, VkSemaphore h) { vkDestroySemaphore(d, h, nullptr); }
 void destroyHandle(VkDevice d, VkSwapchainKHR h) { vkDestroySwapchainKHR(d, h, nullptr); }
+void destroyHandle(VkDevice d, VkQueryPool h) { vkDestroyQueryPool(d, h, nullptr); }
 void freeCommandBuffer(VkDevice d, VkCommandPool pool, VkCommandBuffer cb) {
     vkFreeCommandBuffers(d, pool, 1, &cb);
 }

@@ -25,6 +25,7 @@ void destroyHandle(VkDevice device, VkDescriptorPool h);
 void destroyHandle(VkDevice device, VkFence h);
 void destroyHandle(VkDevice device, VkSemaphore h);
 void destroyHandle(VkDevice device, VkSwapchainKHR h);
+void destroyHandle(VkDevice device, VkQueryPool h);
 void freeCommandBuffer(VkDevice device, VkCommandPool pool, VkCommandBuffer cb);
 
 template <typename T>
@@ -76,6 +77,7 @@ using UniqueDescriptorPool = DeviceHandle<VkDescriptorPool>;
 using UniqueFence = DeviceHandle<VkFence>;
 using UniqueSemaphore = DeviceHandle<VkSemaphore>;
 using UniqueSwapchain = DeviceHandle<VkSwapchainKHR>;
+using UniqueQueryPool = DeviceHandle<VkQueryPool>;
 
 // Command buffers go back to the pool they came from.
 class UniqueCommandBuffer {

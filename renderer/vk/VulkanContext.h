@@ -60,6 +60,8 @@ public:
     // reflection probes' cubes are one.
     bool cubeArrays() const { return cubeArrays_; }
     VkPhysicalDeviceType deviceType() const { return deviceType_; }
+    // Nanoseconds a timestamp tick, 0 where the queue writes no timestamps.
+    double timestampPeriod() const { return timestampPeriod_; }
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
 
     // Validation messages seen so far (warnings and errors), for tests that must see none.
@@ -93,6 +95,7 @@ private:
     VkFence fence_ = VK_NULL_HANDLE;
     std::string deviceName_;
     bool cubeArrays_ = false;
+    double timestampPeriod_ = 0.0;
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;

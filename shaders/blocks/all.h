@@ -12,6 +12,7 @@
 #include "blocks/water.h"
 #include "blocks/reflections.h"
 #include "blocks/lpv.h"
+#include "blocks/lpv_propagation.h"
 #undef TLX_BLOCK_BEGIN
 #undef TLX_BLOCK_END
 #undef TLX_STRUCT_BEGIN

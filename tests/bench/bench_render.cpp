@@ -287,8 +287,10 @@ BENCHMARK(BM_ReflectionProbes)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillise
 // The LPV over N42E001 at 1280 x 720, the camera 4 km from the tile's centre so that the default
 // cascades (5312 m and finer) fill most of the frame: beauty lit by the probes (the LPV off), by
 // the LPV at quality 0, 1 and 2 (lighting.indirect lpv), and by the probes with four point lights
-// in view (their direct light). Beside each LPV frame, its update: the volumes computed on the
-// CPU for the camera (what the viewport's worker does) and their upload.
+// in view (their direct light). Beside each LPV frame, its update: the volumes computed on the CPU
+// for the camera (what the viewport's worker does: geometry, injection and, on a CPU device, the
+// propagation), their upload, and on a GPU the propagation pass the first frame runs
+// (timestamps).
 void BM_Lpv(benchmark::State& state) {
     Fixture& f = fixture();
     if (!f.renderer) {
@@ -330,7 +332,8 @@ void BM_Lpv(benchmark::State& state) {
         updateMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
         uploadMs = std::chrono::duration<double, std::milli>(t2 - t1).count();
     }
-    f.renderer->render(q);  // this variant's pipeline
+    f.renderer->render(q);  // this variant's pipeline, and the propagation
+    const double propagationMs = f.renderer->renderer().lpvPropagationMilliseconds().value_or(0.0);
     double ms = 0;
     for (auto _ : state) ms += f.renderer->render(q).milliseconds;
     static const char* labels[] = {"probes, LPV off", "LPV quality 0", "LPV quality 1", "LPV quality 2",
@@ -339,9 +342,80 @@ void BM_Lpv(benchmark::State& state) {
     state.counters["frame_ms"] = ms / double(state.iterations());
     state.counters["update_ms"] = updateMs;
     state.counters["upload_ms"] = uploadMs;
+    state.counters["propagation_ms"] = propagationMs;
     f.renderer->setProject(fixtureProject());
 }
 BENCHMARK(BM_Lpv)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
+// One LPV update for BM_Lpv's camera, by its parts: the geometry and the injection on the CPU
+// (update_cpu_ms), the upload (upload_ms) and the propagation pass on the GPU (the benchmark's
+// time, from timestamps), against the same steps on the CPU (cpu_propagation_ms:
+// lpv::propagationStep as Volumes::propagate takes them, oneTBB on this machine's cores). Args: cascades, iterations; quality and weight
+// change no step's cost.
+void BM_LpvUpdate(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    if (!(f.ctx->timestampPeriod() > 0.0)) {
+        state.SkipWithError("the device writes no timestamps");
+        return;
+    }
+    Project p = fixtureProject();
+    p.scene.camera.radius = 4000.0;
+    p.scene.lpv.enabled = true;
+    p.scene.lighting.indirect = IndirectLighting::Lpv;
+    p.scene.lpv.cascades = int(state.range(0));
+    p.scene.lpv.propagationIterations = int(state.range(1));
+    f.renderer->setProject(p);
+    RenderRequest q;
+    q.width = 1280;
+    q.height = 720;
+    const auto job = f.renderer->lpvJob(q, f.renderer->defaultCamera());
+    if (!job) {
+        state.SkipWithError("no LPV job");
+        return;
+    }
+    using Clock = std::chrono::steady_clock;
+    const auto ms = [](Clock::time_point a, Clock::time_point b) {
+        return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    const float weight = lpv::propagationStepWeight(p.scene.lpv.propagationWeight);
+    double cpuPart = 0, upload = 0, cpuSteps = 0;
+    for (auto _ : state) {
+        const auto t0 = Clock::now();
+        const std::shared_ptr<const lpv::Volumes> volumes = job->run(lpv::Propagation::Renderer);
+        const auto t1 = Clock::now();
+        f.renderer->setLpv(nullptr, "");
+        f.renderer->setLpv(volumes, job->key);
+        const auto t2 = Clock::now();
+        f.renderer->render(q);
+        const std::optional<double> gpu = f.renderer->renderer().lpvPropagationMilliseconds();
+        state.SetIterationTime(gpu.value_or(0.0) * 1e-3);
+        const auto t3 = Clock::now();
+        for (const lpv::Cascade& c : volumes->cascades()) {
+            lpv::LightVolume current = c.injected, next;
+            for (int it = 0; it < p.scene.lpv.propagationIterations; ++it) {
+                lpv::propagationStep(c.geometry, current, next, weight, it > 0);
+                current.swap(next);
+            }
+        }
+        cpuSteps += ms(t3, Clock::now());
+        cpuPart += ms(t0, t1);
+        upload += ms(t1, t2);
+    }
+    const double n = double(state.iterations());
+    state.SetLabel("c" + std::to_string(state.range(0)) + " it" + std::to_string(state.range(1)) + " on " +
+                   f.ctx->deviceName());
+    state.counters["update_cpu_ms"] = cpuPart / n;
+    state.counters["upload_ms"] = upload / n;
+    state.counters["cpu_propagation_ms"] = cpuSteps / n;
+    f.renderer->setProject(fixtureProject());
+}
+BENCHMARK(BM_LpvUpdate)
+    ->Args({3, 4})->Args({1, 4})->Args({2, 4})->Args({4, 4})->Args({3, 2})->Args({3, 8})->Args({3, 16})
+    ->Unit(benchmark::kMillisecond)->Iterations(3)->UseManualTime();
 
 }  // namespace
 

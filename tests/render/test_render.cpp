@@ -1774,8 +1774,11 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
         p.scene.lpv.quality = quality;
         r.setProject(p);
         draw(r, kViewLpvAll);
-        const auto volumes = r.renderer().lpv();
-        ASSERT_TRUE(volumes);
+        ASSERT_TRUE(r.renderer().lpv());
+        // The renderer propagated the volumes it drew; the CPU reference propagates its own.
+        const std::optional<LpvJob> job = r.lpvJob(unprobed(kViewLpvAll, false), r.defaultCamera());
+        ASSERT_TRUE(job);
+        const auto volumes = job->run(lpv::Propagation::Cpu);
         // Ground points on a grid over the footprint (inside and outside the cascades), some
         // above it, each with the terrain's normal, every third facing the ground instead (there
         // the geometry volume occludes), and a view from the south-west above.
@@ -1820,5 +1823,76 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
             EXPECT_GT(largestSpec, 0.0);
             EXPECT_LT(worstSpec, 1e-4);
         }
+    }
+}
+
+// The propagation pass against Volumes::propagate: the light the terrain reads, cell by cell, for
+// volumes the renderer propagated and the same volumes propagated on the CPU. The pass runs once,
+// on the first frame that reads them.
+TEST_F(RenderTest, LpvPropagatedOnTheGpuMatchesTheCpu) {
+    Project p = sampleProject("lpv_propagation", 8, 8);
+    p.scene.lpv.enabled = true;
+    p.scene.lighting.indirect = IndirectLighting::Lpv;
+    LocalLight light;
+    light.position = glm::vec3(300.0f, 1700.0f, -200.0f);
+    light.range = 900.0;
+    light.intensity = 5.0e5;
+    p.scene.lights = {light};
+    struct Case {
+        int cascades, iterations;
+        double weight;
+    };
+    for (const Case c : {Case{3, 4, 0.01}, Case{1, 0, 0.01}, Case{4, 1, 1.0}, Case{2, 7, 0.3}}) {
+        p.scene.lpv.cascades = c.cascades;
+        p.scene.lpv.propagationIterations = c.iterations;
+        p.scene.lpv.propagationWeight = c.weight;
+        ProjectRenderer r(*ctx_, p);
+        const RenderRequest q = unprobed(kViewLinear, true);
+        const std::optional<LpvJob> job = r.lpvJob(q, r.defaultCamera());
+        ASSERT_TRUE(job);
+        EXPECT_EQ(job->propagation, r.renderer().propagatesLpv() ? lpv::Propagation::Renderer : lpv::Propagation::Cpu);
+        const auto gpuVolumes = job->run(lpv::Propagation::Renderer);
+        EXPECT_FALSE(gpuVolumes->propagated());
+        EXPECT_THROW(gpuVolumes->evaluate(glm::vec3(0.0f), glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f)),
+                     std::logic_error);
+        r.setLpv(gpuVolumes, job->key);
+        r.render(q);
+        const auto passesOf = [&] {
+            std::vector<std::string> names;
+            for (const PassInfo& pass : r.renderer().lastFramePasses()) names.push_back(pass.name);
+            return names;
+        };
+        const std::vector<std::string> first = passesOf();
+        EXPECT_EQ(std::count(first.begin(), first.end(), "lpv-propagate"), c.iterations > 0 ? 1 : 0);
+        r.render(q);
+        const std::vector<std::string> second = passesOf();
+        EXPECT_EQ(std::count(second.begin(), second.end(), "lpv-propagate"), 0) << "propagated once";
+        if (c.iterations > 0 && ctx_->timestampPeriod() > 0.0) {
+            const std::optional<double> ms = r.renderer().lpvPropagationMilliseconds();
+            ASSERT_TRUE(ms);
+            EXPECT_GT(*ms, 0.0);
+        }
+
+        const auto cpu = job->run(lpv::Propagation::Cpu);
+        std::vector<float> expected;
+        for (const lpv::Cascade& cas : cpu->cascades())
+            expected.insert(expected.end(), cas.accumulated.begin(), cas.accumulated.end());
+        const std::vector<float> got = r.renderer().readLpvLight();
+        ASSERT_EQ(got.size(), expected.size());
+        double largest = 0, worst = 0, injected = 0, total = 0;
+        for (size_t i = 0; i < got.size(); ++i) largest = std::max(largest, double(std::abs(expected[i])));
+        for (size_t i = 0; i < got.size(); ++i) worst = std::max(worst, double(std::abs(got[i] - expected[i])));
+        for (const lpv::Cascade& cas : cpu->cascades()) {
+            injected += lpv::totalFlux(cas.injected).y;
+            total += lpv::totalFlux(cas.accumulated).y;
+        }
+        std::cout << c.cascades << " cascades, " << c.iterations << " steps, weight " << c.weight
+                  << ": largest coefficient " << largest << ", worst |GPU - CPU| / largest " << worst / largest
+                  << ", flux accumulated / injected " << total / injected << "\n";
+        ASSERT_GT(largest, 0.0);
+        EXPECT_LT(worst / largest, 1e-5);
+        // The steps moved light (or, with none, the light is the injected light exactly).
+        if (c.iterations > 0) EXPECT_GT(total / injected, 1.2);
+        else EXPECT_EQ(got, expected);
     }
 }

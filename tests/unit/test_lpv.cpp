@@ -189,6 +189,54 @@ TEST(Lpv, PropagationConservesFluxInEmptySpace) {
     EXPECT_NEAR(totalFlux(next).x, 0.25, 1e-4);
 }
 
+// The face table the renderer's propagation pass reads: six axis neighbours, each with its far
+// face first; the thirty solid angles cover the sphere, every face lies on the neighbour's side,
+// and each face's lobe carries unit flux along its face's outward normal.
+TEST(Lpv, ThePropagationFacesCoverTheSphereAndCarryUnitLobes) {
+    double solidAngle = 0;
+    for (const PropagationNeighbour& nb : propagationNeighbours()) {
+        EXPECT_EQ(std::abs(nb.offset.x) + std::abs(nb.offset.y) + std::abs(nb.offset.z), 1);
+        EXPECT_EQ(std::abs(nb.offset[nb.axis]), 1);
+        EXPECT_EQ(nb.faces[0].dir, glm::vec3(nb.offset));
+        for (const PropagationFace& f : nb.faces) {
+            solidAngle += f.solidAngle;
+            EXPECT_NEAR(glm::length(f.dir), 1.0f, 1e-6f);
+            EXPECT_GT(glm::dot(f.dir, glm::vec3(nb.offset)), 0.8f);
+            // Unit flux: 2√π·c0 = 1, and the lobe's direction is a face normal (an axis).
+            EXPECT_NEAR(2.0 * std::sqrt(kPi) * f.lobe[0], 1.0, 1e-6);
+            const glm::vec3 axis(f.lobe[3], f.lobe[1], f.lobe[2]);
+            EXPECT_NEAR(std::max({std::abs(axis.x), std::abs(axis.y), std::abs(axis.z)}), glm::length(axis), 1e-7);
+        }
+    }
+    // To the paper's constants' 2 x 10^-5 (the send scales make each cell send its flux exactly).
+    EXPECT_NEAR(solidAngle, 4.0 * kPi, 4.0 * kPi * 5e-5);
+}
+
+// Volumes left to the renderer to propagate hold the same geometry and injection as those
+// propagated here, no accumulated light, and refuse to be evaluated.
+TEST(Lpv, VolumesForTheRendererAreInjectedButNotPropagated) {
+    const Heightfield hf = valley();
+    const HeightfieldTracer tracer(hf);
+    const BakeLighting lighting = sunLighting(tracer);
+    const LpvSettings s = smallLpv();
+    const glm::dvec3 eye(10.0, 220.0, -30.0), view(0.2, -0.7, 0.7);
+    const Volumes cpu(s, {&lighting, nullptr}, eye, view, Propagation::Cpu);
+    const Volumes gpu(s, {&lighting, nullptr}, eye, view, Propagation::Renderer);
+    EXPECT_TRUE(cpu.propagated());
+    EXPECT_FALSE(gpu.propagated());
+    ASSERT_EQ(cpu.cascades().size(), gpu.cascades().size());
+    for (size_t c = 0; c < cpu.cascades().size(); ++c) {
+        EXPECT_EQ(cpu.cascades()[c].injected, gpu.cascades()[c].injected);
+        EXPECT_EQ(cpu.cascades()[c].geometry, gpu.cascades()[c].geometry);
+        EXPECT_FALSE(cpu.cascades()[c].accumulated.empty());
+        EXPECT_TRUE(gpu.cascades()[c].accumulated.empty());
+    }
+    EXPECT_GT(cpu.cascades()[0].injectedFlux.x, 0.0);
+    const glm::vec3 p(0.0f, hf.surfaceHeight(0.0f, 0.0f), 0.0f), up(0.0f, 1.0f, 0.0f);
+    EXPECT_THROW(gpu.evaluate(p, up, up), std::logic_error);
+    EXPECT_EQ(gpu.ambientOcclusion(p, up), cpu.ambientOcclusion(p, up));
+}
+
 TEST(Lpv, ALambertianPatchLightsAReceiverFacingItByTheInverseSquareLaw) {
     // A patch of flux Φ = 1 radiates I(ω) = Φ/π·cos; a receiver facing it at distance r along a
     // direction at θ from its normal gets E = Φ·cos θ/(π r²) (h = 1 here, so radiance = I). The
