@@ -654,6 +654,16 @@ const std::shared_ptr<const lpv::Volumes>& TerrainRenderer::lpv() const {
 
 namespace {
 
+// One global memory dependency: what `srcStages` wrote through `srcAccess` is visible to
+// `dstAccess` in `dstStages`.
+void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cb, srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
 // The propagation pass's set: its block, the work regions, the send scales, the geometry and the
 // light it accumulates into.
 vk::DescriptorSetBuilder lpvPropagationSetBuilder(const LpvResources& r) {
@@ -764,10 +774,6 @@ void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
     const VkDescriptorSet set = r.propagationSet.handle();
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagateLayout.handle(), TLX_SET_SUBSYSTEM, 1,
                             &set, 0, nullptr);
-    // Each dispatch reads what the one before it wrote.
-    VkMemoryBarrier between{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    between.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    between.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
     const uint32_t groups = (r.cells + 255) / 256;
     const auto dispatch = [&](const glm::ivec4& push) {
         vkCmdPushConstants(cb, g.lpvPropagateLayout.handle(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
@@ -775,8 +781,9 @@ void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
     };
     dispatch(glm::ivec4(0, 0, 0, 0));  // the injected light's send scales
     for (int step = 0; step < r.steps; ++step) {
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                             &between, 0, nullptr, 0, nullptr);
+        // Each dispatch reads what the one before it wrote.
+        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
         // Step 0 reads the injected light (region 0); then the regions 1 and 2 alternate.
         const int source = step == 0 ? 0 : 1 + (step - 1) % 2, destination = 1 + step % 2;
         dispatch(glm::ivec4(1, source, destination, step + 1 < r.steps ? 1 : 0));
@@ -792,18 +799,12 @@ void TerrainRenderer::propagateLpvNow() {
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         // The injected light and the geometry were filled by transfers.
-        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
-                             0, nullptr, 0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
         recordLpvPropagation(cb);
         // Whatever reads the light later, in this submission's successors, sees it written.
-        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        after.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-        after.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &after,
-                             0, nullptr, 0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     });
 }
 
@@ -825,18 +826,13 @@ std::vector<float> TerrainRenderer::readLpvLight() {
     vk::Buffer host = vk::Buffer::hostVisible(ctx_, g.lpv->light.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
-        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        before.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-        before.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                             VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &before, 0, nullptr, 0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_ACCESS_TRANSFER_READ_BIT);
         const VkBufferCopy region{0, 0, g.lpv->light.size()};
         vkCmdCopyBuffer(cb, g.lpv->light.handle(), host.handle(), 1, &region);
-        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        after.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &after, 0, nullptr,
-                             0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                      VK_ACCESS_HOST_READ_BIT);
     });
     const auto* values = static_cast<const float*>(host.map());
     return std::vector<float>(values, values + g.lpv->light.size() / 4);
@@ -873,23 +869,17 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         // The volumes and the queries were filled by transfers (the light perhaps by the
         // propagation pass).
-        VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-        before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &before,
-                             0, nullptr, 0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSample.get());
         const VkDescriptorSet handle = set.handle();
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSampleLayout.handle(), TLX_SET_SUBSYSTEM, 1,
                                 &handle, 0, nullptr);
         vkCmdPushConstants(cb, g.lpvSampleLayout.handle(), compute, 0, sizeof push, &push);
         vkCmdDispatch(cb, uint32_t(queries.size() + 63) / 64, 1, 1);
-        VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-        after.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-        after.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &after, 0,
-                             nullptr, 0, nullptr);
+        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                      VK_ACCESS_HOST_READ_BIT);
     });
     const auto* values = static_cast<const glm::vec4*>(results.map());
     std::vector<LpvSample> out(queries.size());

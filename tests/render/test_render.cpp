@@ -1758,16 +1758,21 @@ TEST_F(RenderTest, APointLightBrightensTheGroundUnderIt) {
 
 // The terrain shader's LPV code against Volumes::evaluate at the same points: the compute pass
 // runs lpv.glsl's lpvEvaluate, the function the terrain pass calls.
-TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
-    Project p = sampleProject("lpv_agreement", 8, 8);
+// A project with the LPV lighting it (lighting.indirect lpv) and a point light above the sample.
+Project lpvLit(Project p) {
     p.scene.lpv.enabled = true;
-    p.scene.lpv.propagationWeight = 0.25;
     p.scene.lighting.indirect = IndirectLighting::Lpv;
     LocalLight light;
     light.position = glm::vec3(300.0f, 1700.0f, -200.0f);
     light.range = 900.0;
     light.intensity = 5.0e5;
     p.scene.lights = {light};
+    return p;
+}
+
+TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
+    Project p = lpvLit(sampleProject("lpv_agreement", 8, 8));
+    p.scene.lpv.propagationWeight = 0.25;
     ProjectRenderer r(*ctx_, p);
     const Heightfield& hf = r.heightfield();
     for (int quality : {0, 1, 2}) {
@@ -1830,14 +1835,7 @@ TEST_F(RenderTest, LpvOnTheGpuMatchesVolumesEvaluate) {
 // volumes the renderer propagated and the same volumes propagated on the CPU. The pass runs once,
 // on the first frame that reads them.
 TEST_F(RenderTest, LpvPropagatedOnTheGpuMatchesTheCpu) {
-    Project p = sampleProject("lpv_propagation", 8, 8);
-    p.scene.lpv.enabled = true;
-    p.scene.lighting.indirect = IndirectLighting::Lpv;
-    LocalLight light;
-    light.position = glm::vec3(300.0f, 1700.0f, -200.0f);
-    light.range = 900.0;
-    light.intensity = 5.0e5;
-    p.scene.lights = {light};
+    Project p = lpvLit(sampleProject("lpv_propagation", 8, 8));
     struct Case {
         int cascades, iterations;
         double weight;
