@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 // The LPV's propagation on the GPU: lpv::propagationStep and Volumes::propagate's accumulation,
-// step for step (renderer/lpv/Lpv.cpp; Kaplanyan & Dachsbacher 2010, Sec. 5). One invocation a
+// the same operations in the same order (renderer/lpv/Lpv.cpp; Kaplanyan & Dachsbacher 2010, Sec. 5). One invocation a
 // cell of every cascade:
 //   pass 0 (once, before the first step): each injected cell's send scale per channel, the factor
 //           that makes its non-negative face fluxes sum to its flux (Lpv.cpp sendScales());
@@ -11,8 +11,8 @@
 //           step on, writes it as the step's output, adds it to the accumulated light (the first
 //           step to the injected) and, but for the last step, computes its own send scales for
 //           the next.
-// The loops over neighbours, faces and channels are unrolled: the face table's indices become
-// constants and the channels' sums stay in registers (lavapipe otherwise spills them, 4x slower).
+// The loops over channels and send-scale faces are unrolled, so the channels' sums stay in
+// registers.
 layout(local_size_x = 256) in;
 #include "blocks/glsl.h"
 #include "blocks/lpv_propagation.h"

@@ -692,6 +692,8 @@ glm::vec3 Volumes::irradianceAt(const glm::vec3& q, const glm::vec3& n, int qual
 }
 
 Sample Volumes::evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3& toEye, int quality) const {
+    if (!propagated_)
+        throw std::logic_error("these light propagation volumes were left to the renderer to propagate");
     Sample out;
     double h = 1.0;
     if (weightAt(p, &h) <= 0.0f) return out;

@@ -12,7 +12,7 @@
 //   4. propagation: six-neighbour, five-face transfer, scaled per step by w^(1/32) for the
 //      propagation weight w (propagationStepWeight), blocked by the geometry volume, accumulated
 //      over the iterations; here, or by the renderer's compute pass (shaders/lpv_propagate.comp,
-//      Propagation::Renderer), which steps exactly as propagationStep does;
+//      Propagation::Renderer), which takes propagationStep's operations in the same order;
 //   5. apply: irradiance at a point and normal (linear L1, or ZH3 with leak dampening), cone-traced
 //      specular at quality 2, and (view 63 only) an ambient occlusion marched through the geometry
 //      volume.

@@ -95,8 +95,8 @@ void FrameGraph::importBuffer(const std::string& name, VkBuffer buffer, bool upl
     r = Resource{};
     r.buffer = buffer;
     if (uploaded) {
-        r.stages = VK_PIPELINE_STAGE_TRANSFER_BIT;
-        r.writes = VK_ACCESS_TRANSFER_WRITE_BIT;
+        r.stages = r.writeStages = VK_PIPELINE_STAGE_TRANSFER_BIT;
+        r.writes = r.writeAccess = VK_ACCESS_TRANSFER_WRITE_BIT;
     }
 }
 
@@ -132,15 +132,18 @@ void FrameGraph::barrier(VkCommandBuffer cb, const ResourceUse& use) {
     const AccessInfo a = infoOf(use.access);
     const bool layoutChange = r.image && r.layout != a.layout;
     // Read after write, write after write, write after read; a read after a read of the same
-    // layout needs nothing.
-    const bool hazard = r.writes != 0 || (a.write && r.readSinceWrite) || layoutChange;
+    // layout needs nothing unless it reads in a stage or way the last write was not yet made
+    // visible to.
+    const bool unseen = !a.write && r.writeAccess != 0 &&
+                        ((a.stage & ~r.visibleStages) != 0 || (a.access & ~r.visibleAccess) != 0);
+    const bool hazard = r.writes != 0 || (a.write && r.readSinceWrite) || layoutChange || unseen;
     if (hazard) {
-        const VkPipelineStageFlags src =
-            r.stages ? r.stages : VkPipelineStageFlags(VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
+        const VkPipelineStageFlags stages = r.stages | (unseen ? r.writeStages : 0);
+        const VkPipelineStageFlags src = stages ? stages : VkPipelineStageFlags(VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT);
         // A host read waits for the submission's fence; the barrier makes the writes available.
         if (r.image) {
             VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-            b.srcAccessMask = r.writes;
+            b.srcAccessMask = r.writes | (unseen ? r.writeAccess : 0);
             b.dstAccessMask = a.access;
             b.oldLayout = a.discard ? VK_IMAGE_LAYOUT_UNDEFINED : r.layout;
             b.newLayout = a.layout;
@@ -150,7 +153,7 @@ void FrameGraph::barrier(VkCommandBuffer cb, const ResourceUse& use) {
             vkCmdPipelineBarrier(cb, src, a.stage, 0, 0, nullptr, 0, nullptr, 1, &b);
         } else {
             VkBufferMemoryBarrier b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-            b.srcAccessMask = r.writes;
+            b.srcAccessMask = r.writes | (unseen ? r.writeAccess : 0);
             b.dstAccessMask = a.access;
             b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
             b.buffer = r.buffer;
@@ -164,10 +167,20 @@ void FrameGraph::barrier(VkCommandBuffer cb, const ResourceUse& use) {
     if (r.image) r.layout = a.layout;
     r.stages |= a.stage;
     if (a.write) {
-        r.writes |= a.access & (VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
-                                VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
+        const VkAccessFlags written =
+            a.access & (VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT |
+                        VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT);
+        r.writes |= written;
+        r.writeStages = a.stage;
+        r.writeAccess = written;
+        r.visibleStages = 0;
+        r.visibleAccess = 0;
     } else {
         r.readSinceWrite = true;
+        if (hazard) {
+            r.visibleStages |= a.stage;
+            r.visibleAccess |= a.access;
+        }
     }
 }
 

@@ -85,6 +85,13 @@ private:
         VkPipelineStageFlags stages = 0;   // stages of the accesses since the last barrier
         VkAccessFlags writes = 0;          // unflushed writes
         bool readSinceWrite = false;
+        // The last write, and the stages and accesses a barrier has made it visible to since: a
+        // read from another stage (a buffer a compute pass read and a fragment shader reads next)
+        // needs its own dependency on that write.
+        VkPipelineStageFlags writeStages = 0;
+        VkAccessFlags writeAccess = 0;
+        VkPipelineStageFlags visibleStages = 0;
+        VkAccessFlags visibleAccess = 0;
     };
     struct Pass {
         PassInfo info;

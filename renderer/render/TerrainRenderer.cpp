@@ -114,8 +114,8 @@ struct FrameSlot {
 // The LPV subsystem: present only while volumes are bound. Every cascade's light volume (its
 // three channels one after another, Lpv.h's layout) and geometry volume, uploaded once per
 // update; the block's cascade records come with them. Volumes left to the renderer to propagate
-// upload their injected light instead (region 0 of `work`), and the first frame or sample that
-// reads `light` runs the propagation pass into it (`steps` > 0 until then).
+// upload their injected light instead (to `light`, and to region 0 of `work`), and the first frame
+// or sample that reads `light` runs the propagation pass into it (`steps` > 0 until then).
 struct LpvResources {
     std::shared_ptr<const lpv::Volumes> volumes;
     vk::Buffer light, geometry;
@@ -719,18 +719,17 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
         constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
         const VkDeviceSize lightBytes = VkDeviceSize(n) * cascades[0].injected.size() * 4;
         r->geometry = vk::Buffer::deviceLocal(ctx_, geometry.data(), geometry.size() * 4, storage);
-        if (!propagate) {
-            r->light = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage);
-        } else {
+        // The injected light until the pass has run, should a frame read it before.
+        r->light = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage);
+        if (propagate) {
             // Region 0 the injected light; regions 1 and 2 the steps' outputs, written before read.
-            light.resize(3 * light.size(), 0.0f);
-            r->work = vk::Buffer::deviceLocal(ctx_, light.data(), light.size() * 4, storage);
-            r->light = vk::Buffer(ctx_, lightBytes, storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+            r->work = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage, 3 * lightBytes);
             r->cells = uint32_t(n) * uint32_t(lpv::kCells);
             r->scales = vk::Buffer(ctx_, VkDeviceSize(2 * 3) * r->cells * 4, storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
             const blocks::LpvPropagationBlock block =
                 propagationBlock(lpv::propagationStepWeight(ls.propagationWeight), int(n));
-            r->propagationBlock = vk::Buffer::deviceLocal(ctx_, &block, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+            r->propagationBlock = vk::Buffer::hostVisible(ctx_, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+            r->propagationBlock.write(&block, sizeof block);
             r->propagationSet = lpvPropagationSetBuilder(*r).build(ctx_);
             r->steps = ls.propagationIterations;
             if (!g.lpvPropagate) {
@@ -756,7 +755,7 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     ++g.lpvGeneration;
     g.lpvTimed = false;  // the last pass's time was the old volumes'
     if (!g.lpv) return;
-    g.graph.importBuffer(kLpvLight, g.lpv->light.handle(), g.lpv->steps == 0);
+    g.graph.importBuffer(kLpvLight, g.lpv->light.handle(), true);
     g.graph.importBuffer(kLpvGeometry, g.lpv->geometry.handle(), true);
     if (g.lpv->steps == 0) return;
     g.graph.importBuffer(kLpvWork, g.lpv->work.handle(), true);
@@ -767,8 +766,9 @@ void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
     Gpu& g = *gpu_;
     LpvResources& r = *g.lpv;
     if (g.lpvQueries) {
+        // The first once everything before has finished, so an earlier pass's tail is not counted.
         vkCmdResetQueryPool(cb, g.lpvQueries.get(), 0, 2);
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, g.lpvQueries.get(), 0);
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, g.lpvQueries.get(), 0);
     }
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagate.get());
     const VkDescriptorSet set = r.propagationSet.handle();
@@ -800,7 +800,7 @@ void TerrainRenderer::propagateLpvNow() {
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         // The injected light and the geometry were filled by transfers.
         memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
         recordLpvPropagation(cb);
         // Whatever reads the light later, in this submission's successors, sees it written.
         memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
@@ -816,7 +816,9 @@ std::optional<double> TerrainRenderer::lpvPropagationMilliseconds() {
     if (vkGetQueryPoolResults(ctx_.device(), g.lpvQueries.get(), 0, 2, sizeof ticks, ticks, sizeof(uint64_t),
                               VK_QUERY_RESULT_64_BIT) != VK_SUCCESS)
         return std::nullopt;
-    return double(ticks[1] - ticks[0]) * ctx_.timestampPeriod() * 1e-6;
+    const uint32_t bits = ctx_.timestampBits();
+    const uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+    return double(((ticks[1] & mask) - (ticks[0] & mask)) & mask) * ctx_.timestampPeriod() * 1e-6;
 }
 
 std::vector<float> TerrainRenderer::readLpvLight() {

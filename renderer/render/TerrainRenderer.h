@@ -139,7 +139,7 @@ public:
     // lpv_propagate.comp) that the first frame reading them runs ("lpv-propagate").
     void setLpv(std::shared_ptr<const lpv::Volumes> volumes);
     // Whether volumes for this renderer are best propagated by it: on a GPU, yes; on a CPU device
-    // (lavapipe) the CPU's own propagation is about 3x faster than the pass on the same cores
+    // (lavapipe) the CPU's own propagation is 2-4x faster than the pass on the same cores
     // (bench_render BM_LpvUpdate) and runs on the update's worker rather than in a frame.
     bool propagatesLpv() const;
     const std::shared_ptr<const lpv::Volumes>& lpv() const;

@@ -1,5 +1,6 @@
 #include "vk/Buffer.h"
 
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -38,10 +39,10 @@ Buffer Buffer::hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBuffer
 }
 
 Buffer Buffer::deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
-                           VkBufferUsageFlags usage) {
+                           VkBufferUsageFlags usage, VkDeviceSize capacity) {
     Buffer staging = hostVisible(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     if (size > 0) staging.write(bytes, size);
-    Buffer b(ctx, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    Buffer b(ctx, std::max(size, capacity), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     if (size > 0)
         ctx.submitAndWait([&](VkCommandBuffer cb) {
             VkBufferCopy copy{0, 0, size};

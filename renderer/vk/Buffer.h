@@ -28,9 +28,10 @@ public:
         return *this;
     }
 
-    // A device-local buffer holding `bytes`, uploaded through a host-visible staging buffer.
+    // A device-local buffer holding `bytes`, uploaded through a host-visible staging buffer;
+    // `capacity` bytes long where that is more (the rest undefined until written).
     static Buffer deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
-                              VkBufferUsageFlags usage);
+                              VkBufferUsageFlags usage, VkDeviceSize capacity = 0);
     // A host-visible, coherent buffer (uniforms, readback).
     static Buffer hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
 

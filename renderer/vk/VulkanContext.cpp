@@ -134,7 +134,8 @@ void VulkanContext::create(const ContextOptions& options) {
             queueFamily_ = uint32_t(family);
             deviceName_ = p.deviceName;
             deviceType_ = p.deviceType;
-            timestampPeriod_ = qf[size_t(family)].timestampValidBits > 0 ? double(p.limits.timestampPeriod) : 0.0;
+            timestampBits_ = qf[size_t(family)].timestampValidBits;
+            timestampPeriod_ = timestampBits_ > 0 ? double(p.limits.timestampPeriod) : 0.0;
         }
     }
     if (physical_ == VK_NULL_HANDLE) {

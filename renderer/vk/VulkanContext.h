@@ -60,8 +60,10 @@ public:
     // reflection probes' cubes are one.
     bool cubeArrays() const { return cubeArrays_; }
     VkPhysicalDeviceType deviceType() const { return deviceType_; }
-    // Nanoseconds a timestamp tick, 0 where the queue writes no timestamps.
+    // Nanoseconds a timestamp tick, 0 where the queue writes no timestamps; the bits a timestamp
+    // holds (the rest are undefined).
     double timestampPeriod() const { return timestampPeriod_; }
+    uint32_t timestampBits() const { return timestampBits_; }
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
 
     // Validation messages seen so far (warnings and errors), for tests that must see none.
@@ -96,6 +98,7 @@ private:
     std::string deviceName_;
     bool cubeArrays_ = false;
     double timestampPeriod_ = 0.0;
+    uint32_t timestampBits_ = 0;
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;
