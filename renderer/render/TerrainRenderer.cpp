@@ -706,7 +706,7 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
         // Propagated here unless the volumes already are, or have no step to take.
         const bool propagate = !volumes->propagated() && ls.propagationIterations > 0;
         std::vector<float> light, geometry;
-        light.reserve((propagate ? 3 : 1) * n * cascades[0].injected.size());
+        light.reserve(n * cascades[0].injected.size());
         geometry.reserve(n * cascades[0].geometry.size());
         r->block.counts = glm::ivec4(int(n), ls.quality, ls.coneTraceSamples, 0);
         r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f, 0.0f);

@@ -1852,7 +1852,9 @@ TEST_F(RenderTest, LpvPropagatedOnTheGpuMatchesTheCpu) {
         const RenderRequest q = unprobed(kViewLinear, true);
         const std::optional<LpvJob> job = r.lpvJob(q, r.defaultCamera());
         ASSERT_TRUE(job);
-        EXPECT_EQ(job->propagation, r.renderer().propagatesLpv() ? lpv::Propagation::Renderer : lpv::Propagation::Cpu);
+        // The product propagates on the CPU's worker on a CPU device, in the pass on a GPU.
+        EXPECT_EQ(r.renderer().propagatesLpv(), !cpuDevice);
+        EXPECT_EQ(job->propagation, cpuDevice ? lpv::Propagation::Cpu : lpv::Propagation::Renderer);
         const auto gpuVolumes = job->run(lpv::Propagation::Renderer);
         const auto cpuVolumes = job->run(lpv::Propagation::Cpu);
         EXPECT_FALSE(gpuVolumes->propagated());
