@@ -45,6 +45,7 @@ DatasetPtr openMap(const std::string& path, bool& sixteenBit) {
         fail(path, std::string("has ") + GDALGetDataTypeName(type) +
                        " samples; an albedo map must be 8 or 16 bits (Byte or UInt16)");
     if (ds->GetRasterXSize() < 1 || ds->GetRasterYSize() < 1) fail(path, "has no pixels");
+    if (const std::string block = gdal::oversizedBlock(src.get()); !block.empty()) fail(path, block);
     sixteenBit = type == GDT_UInt16;
     return src;
 }

@@ -1,8 +1,6 @@
 #include "DemImport.h"
 
 #include <algorithm>
-#include <array>
-#include <numbers>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -19,9 +17,9 @@
 #include <gdal_utils.h>
 #include <gdalwarper.h>
 #include <ogr_spatialref.h>
-#include <tbb/parallel_for.h>
 
 #include "GdalSupport.h"
+#include "Membrane.h"
 
 namespace terralux {
 namespace {
@@ -137,89 +135,16 @@ Window coveredWindow(const std::vector<uint8_t>& cov, int w, int h) {
     return win;
 }
 
-// Membrane (Laplace) fill of the holes, from the current values: successive over-relaxation
-// (Young 1954) of the 5-point Laplacian, each hole (4-connected) on its own with the optimal
-// factor for a square of its larger side L, ω = 2 / (1 + sin(π / (L + 1))), which converges in
-// O(L) sweeps where Gauss–Seidel needs O(L²). Cells on the grid's edge use the neighbours they
-// have (a zero-slope boundary there).
-void membraneFill(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata) {
-    std::vector<int> label(heights.size(), -1);
-    std::vector<std::vector<uint32_t>> holes;
-    for (size_t start = 0; start < heights.size(); ++start) {
-        if (!nodata[start] || label[start] >= 0) continue;
-        const int id = int(holes.size());
-        std::vector<uint32_t> cells{uint32_t(start)};
-        label[start] = id;
-        for (size_t k = 0; k < cells.size(); ++k) {
-            const int x = int(cells[k] % uint32_t(w)), y = int(cells[k] / uint32_t(w));
-            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-            for (int j = 0; j < 4; ++j) {
-                if (nx[j] < 0 || ny[j] < 0 || nx[j] >= w || ny[j] >= h) continue;
-                const size_t n = size_t(ny[j]) * size_t(w) + size_t(nx[j]);
-                if (nodata[n] && label[n] < 0) {
-                    label[n] = id;
-                    cells.push_back(uint32_t(n));
-                }
-            }
-        }
-        std::sort(cells.begin(), cells.end());  // sweep in raster order
-        holes.push_back(std::move(cells));
-    }
-    tbb::parallel_for(size_t(0), holes.size(), [&](size_t id) {
-        const std::vector<uint32_t>& cells = holes[id];
-        const size_t n = cells.size();
-        // Per cell: the sum of its valid neighbours, how many neighbours it has, and which of
-        // them are hole cells (indices into `cells`).
-        std::vector<double> value(n), fixedSum(n, 0.0);
-        std::vector<float> invCount(n);
-        std::vector<std::array<int32_t, 4>> free(n);
-        int x0 = w, x1 = 0, y0 = h, y1 = 0;
-        for (size_t k = 0; k < n; ++k) {
-            const int x = int(cells[k] % uint32_t(w)), y = int(cells[k] / uint32_t(w));
-            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-            value[k] = heights[cells[k]];
-            const int nx[4] = {x - 1, x + 1, x, x}, ny[4] = {y, y, y - 1, y + 1};
-            int count = 0;
-            for (int j = 0; j < 4; ++j) {
-                free[k][size_t(j)] = -1;
-                if (nx[j] < 0 || ny[j] < 0 || nx[j] >= w || ny[j] >= h) continue;
-                ++count;
-                const uint32_t c = uint32_t(ny[j]) * uint32_t(w) + uint32_t(nx[j]);
-                if (nodata[c])
-                    free[k][size_t(j)] = int32_t(std::lower_bound(cells.begin(), cells.end(), c) - cells.begin());
-                else
-                    fixedSum[k] += heights[c];
-            }
-            invCount[k] = count > 0 ? 1.0f / float(count) : 0.0f;
-        }
-        const int side = std::max(x1 - x0, y1 - y0) + 1;
-        const double omega = 2.0 / (1.0 + std::sin(std::numbers::pi / (side + 1)));
-        const int maxSweeps = 20 * side + 100;
-        for (int sweep = 0; sweep < maxSweeps; ++sweep) {
-            double largest = 0.0;
-            for (size_t k = 0; k < n; ++k) {
-                double sum = fixedSum[k];
-                for (const int32_t j : free[k])
-                    if (j >= 0) sum += value[size_t(j)];
-                const double delta = omega * (sum * invCount[k] - value[k]);
-                value[k] += delta;
-                largest = std::max(largest, std::fabs(delta));
-            }
-            if (largest < 1e-3) break;
-        }
-        for (size_t k = 0; k < n; ++k) heights[cells[k]] = float(value[k]);
-    });
-}
-
 }  // namespace
 
-void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata, VoidFill method) {
+MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
+                         VoidFill method) {
     if (w < 1 || h < 1 || heights.size() != size_t(w) * size_t(h) || nodata.size() != heights.size())
         throw DemError("filling nodata cells: grid " + std::to_string(w) + " x " + std::to_string(h) + " has " +
                        std::to_string(heights.size()) + " heights and " + std::to_string(nodata.size()) +
                        " mask cells; both must be w x h");
     const size_t holes = size_t(std::count_if(nodata.begin(), nodata.end(), [](uint8_t v) { return v != 0; }));
-    if (holes == 0) return;
+    if (holes == 0) return {};
     if (holes == nodata.size()) throw DemError("filling nodata cells: every cell is nodata; nothing to fill from");
     registerDriversOnce();
     QuietGdalErrors quiet;
@@ -239,7 +164,13 @@ void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint
     static_cast<GDALDataset*>(fillDs.get())->FlushCache();
     fillDs.reset();
     maskDs.reset();
-    if (method == VoidFill::GdalMembrane) membraneFill(heights, w, h, nodata);
+    if (method != VoidFill::GdalMembrane) return {};
+    try {
+        return membraneFill(heights, w, h, nodata);
+    } catch (const std::bad_alloc&) {
+        throw DemError("filling nodata cells: not enough memory for the membrane over " + std::to_string(holes) +
+                       " cells; set terrain.max_resolution");
+    }
 }
 
 int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
@@ -275,6 +206,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     info.sourceWidth = ds->GetRasterXSize();
     info.sourceHeight = ds->GetRasterYSize();
     if (ds->GetRasterCount() < 1) fail(path, "has no raster band");
+    if (const std::string block = gdal::oversizedBlock(src.get()); !block.empty()) fail(path, block);
     // The heights are the first band. The others (a mask, colours, or thousands in a crafted file)
     // would each get their own copy in a reprojection or a reduction, so those read a one-band view.
     DatasetPtr firstBand;
@@ -287,8 +219,20 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
 
     double gt[6] = {0, 1, 0, 0, 0, -1};
     const bool hasGeoTransform = ds->GetGeoTransform(gt) == CE_None;
-    if (!hasGeoTransform)
+    if (!hasGeoTransform) {
+        // Control points alone place the raster only through a warp we do not make, and a CRS
+        // without a geotransform places nothing.
+        if (ds->GetGCPCount() > 0)
+            fail(path, "is georeferenced by " + std::to_string(ds->GetGCPCount()) +
+                           " control points, not a geotransform; warp it first (gdalwarp)");
+        const OGRSpatialReference* crs = ds->GetSpatialRef();
+        if (crs && !crs->IsEmpty())
+            fail(path, "has a CRS but no geotransform: its cells cannot be placed in it");
+        // GDAL fills in its own default on failure, south-up (a positive row step); rows go south.
+        const double northUp[6] = {0, 1, 0, 0, 0, -1};
+        std::copy(std::begin(northUp), std::end(northUp), gt);
         info.warnings.push_back("no georeferencing: cells taken as 1 m, origin at 0");
+    }
     info.sourcePixelX = gt[1];
     info.sourcePixelY = gt[5];
 
@@ -489,7 +433,12 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     int w = rd->GetRasterXSize();
     int h = rd->GetRasterYSize();
     double rgt[6] = {0, 1, 0, 0, 0, -1};
-    if (hasGeoTransform || work) rd->GetGeoTransform(rgt);
+    if (hasGeoTransform) {
+        rd->GetGeoTransform(rgt);
+    } else {  // 1 m source cells, widened by any reduction (GDAL keeps no geotransform for it)
+        rgt[1] = double(info.sourceWidth) / w;
+        rgt[5] = -double(info.sourceHeight) / h;
+    }
     GDALRasterBand* rband = rd->GetRasterBand(1);
     int rHasNodata = 0;
     const double rNodata = rband->GetNoDataValue(&rHasNodata);
@@ -579,7 +528,11 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
 
     if (nodataCount > 0) {
         try {
-            fillVoids(heights, w, h, nodata);
+            const MembraneReport fill = fillVoids(heights, w, h, nodata);
+            if (!fill.converged)
+                info.warnings.push_back("nodata fill: the membrane solve stopped at its " +
+                                        std::to_string(kMembraneMaxIterations) +
+                                        "-iteration cap before reaching 0.1 mm in some hole");
         } catch (const DemError& e) {
             fail(path, e.what());
         }

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "Membrane.h"
+
 #include "terrain/Heightfield.h"
 
 namespace terralux {
@@ -55,8 +57,8 @@ enum class VoidFill {
     // GDALFillNodata: inverse distance weighting over a search in four directions, then 3x3
     // smoothing passes over the filled cells.
     Gdal,
-    // Gdal, then the membrane (Laplace) surface over the holes: SOR sweeps over the filled cells
-    // with the valid cells as fixed boundary, until no cell moves by more than 1 mm.
+    // Gdal, then the membrane (Laplace) surface over the holes, the valid cells around each hole
+    // fixed: conjugate gradients with a multigrid preconditioner, from GDAL's fill (Membrane.h).
     GdalMembrane,
 };
 // What importDem uses: the better of the two in the measurements of README.md.
@@ -64,8 +66,9 @@ inline constexpr VoidFill kImportVoidFill = VoidFill::GdalMembrane;
 
 // Fills the cells where nodata[i] != 0 of a row-major w x h grid from the others; cells with
 // nodata[i] == 0 are left unchanged. Every hole is filled if at least one cell is valid. Throws
-// DemError when GDAL fails.
-void fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
+// DemError when GDAL fails or memory runs out. Returns how the membrane solve went (nothing
+// for VoidFill::Gdal).
+MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
                VoidFill method = kImportVoidFill);
 
 // Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.

@@ -65,6 +65,15 @@ inline std::string fmt(double v) {
     return s.str();
 }
 
+// GDAL decodes a raster a block at a time, and a pixel-interleaved block holds every band's
+// samples, so reading one band allocates block width x block height x the bytes of all bands at
+// once. A block of band 1, of its overviews, or of a mask stored for the dataset may take at most
+// what the largest height grid the DEM import accepts takes (256 Mi cells of 4 bytes). Empty when
+// all are within that; otherwise what the first too large one would take and the rule, for the
+// caller to prefix with the file. Reads no pixel.
+inline constexpr double kMaxBlockBytes = 1024.0 * 1024 * 1024;
+std::string oversizedBlock(GDALDatasetH ds);
+
 // gdalwarp / gdal_translate (their library form) on `src`, with command-line `args`; the result
 // is what `-of` names (MEM in memory). Null on failure, with `why` saying what failed and GDAL's
 // reason.

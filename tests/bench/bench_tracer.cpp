@@ -26,6 +26,7 @@
 #include <glm/geometric.hpp>
 
 #include "DemImport.h"
+#include "Membrane.h"
 #include "bake/HeightfieldTracer.h"
 #include "terrain/Heightfield.h"
 
@@ -334,25 +335,56 @@ void BM_CompareBruteForce(benchmark::State& state) {
 }
 BENCHMARK(BM_CompareBruteForce)->Arg(256)->Iterations(1)->Unit(benchmark::kMillisecond);
 
-// The membrane void fill of DEM import on a 500 x 500 smooth field with a round 300-cell hole
-// (the case test_void_fill checks for correctness): about 0.3 s on one idle core.
+// A smooth field with a round hole of `size` cells across in a grid of 5/3 that side.
+struct HoleCase {
+    int n = 0;
+    std::vector<float> field;
+    std::vector<uint8_t> mask;
+};
+HoleCase roundHole(int size) {
+    HoleCase hole;
+    const int n = hole.n = size * 5 / 3, c = n / 2, r = size / 2;
+    hole.field.resize(size_t(n) * n);
+    hole.mask.assign(hole.field.size(), 0);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            hole.field[size_t(y) * n + x] = float(500 + 200 * std::sin(0.02 * x) * std::cos(0.015 * y));
+            hole.mask[size_t(y) * n + x] = (x - c) * (x - c) + (y - c) * (y - c) <= r * r;
+        }
+    return hole;
+}
+
+// The void fill of DEM import, by GDAL alone (range(1) == 0) or by GDAL and the membrane (1).
 void BM_VoidFillLargeHole(benchmark::State& state) {
-    const int n = 500;
-    std::vector<float> field(size_t(n) * n);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x)
-            field[size_t(y) * n + x] = float(500 + 200 * std::sin(0.02 * x) * std::cos(0.015 * y));
-    std::vector<uint8_t> mask(field.size(), 0);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x)
-            if ((x - 250) * (x - 250) + (y - 250) * (y - 250) <= 150 * 150) mask[size_t(y) * n + x] = 1;
+    const HoleCase hole = roundHole(int(state.range(0)));
+    const VoidFill method = state.range(1) ? VoidFill::GdalMembrane : VoidFill::Gdal;
     for (auto _ : state) {
-        std::vector<float> g = field;
-        terralux::fillVoids(g, n, n, mask, VoidFill::GdalMembrane);
+        std::vector<float> g = hole.field;
+        terralux::fillVoids(g, hole.n, hole.n, hole.mask, method);
         benchmark::DoNotOptimize(g.data());
     }
+    state.counters["hole_cells"] = double(std::count(hole.mask.begin(), hole.mask.end(), uint8_t(1)));
 }
-BENCHMARK(BM_VoidFillLargeHole)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_VoidFillLargeHole)
+    ->ArgsProduct({{300, 1000}, {0, 1}})
+    ->ArgNames({"hole", "membrane"})
+    ->Iterations(2)
+    ->Unit(benchmark::kMillisecond);
+
+// The membrane solve alone on the same holes, from GDAL's fill.
+void BM_MembraneSolve(benchmark::State& state) {
+    const HoleCase hole = roundHole(int(state.range(0)));
+    std::vector<float> start = hole.field;
+    terralux::fillVoids(start, hole.n, hole.n, hole.mask, VoidFill::Gdal);
+    MembraneReport report;
+    for (auto _ : state) {
+        std::vector<float> g = start;
+        report = terralux::membraneFill(g, hole.n, hole.n, hole.mask);
+        benchmark::DoNotOptimize(g.data());
+    }
+    state.counters["iterations"] = double(report.iterations);
+}
+BENCHMARK(BM_MembraneSolve)->Arg(300)->Arg(1000)->Arg(2000)->Iterations(2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace terralux

@@ -228,6 +228,120 @@ TEST(DemImport, OnlyTheFirstBandIsRead) {
     fs::remove(lonLat);
 }
 
+// One block of band 1 may decode to at most 1 GiB, counting every band a pixel-interleaved block
+// carries; the fuzzer found a 367-byte GeoTIFF of 49 153 interleaved bands in 29 008 x 51 strips
+// for which GDAL asked for 145 GB. The files here are sparse: no block is written or read.
+TEST(DemImport, OversizedBlockIsRefusedBeforeAnyRead) {
+    GDALAllRegister();
+    GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+    const auto sparse = [&](const std::string& name, int w, int h, int bands, GDALDataType type,
+                            std::vector<std::string> options) {
+        const fs::path path = fs::temp_directory_path() / name;
+        options.insert(options.end(), {"SPARSE_OK=TRUE", "COMPRESS=DEFLATE"});
+        CPLStringList list;
+        for (const std::string& o : options) list.AddString(o.c_str());
+        GDALDataset* ds = gtiff->Create(path.c_str(), w, h, bands, type, list.List());
+        EXPECT_NE(ds, nullptr) << name;
+        GDALClose(ds);
+        return path;
+    };
+    // 20 000 x 64 cells x 500 bands x 2 bytes = 1 221 MiB a strip.
+    const fs::path pixel =
+        sparse("terralux_block_pixel.tif", 20000, 64, 500, GDT_Int16, {"INTERLEAVE=PIXEL", "BLOCKYSIZE=64"});
+    EXPECT_EQ(importError(pixel.string()),
+              pixel.string() + ": one block of band 1 decodes to 1221 MiB (20000 x 64 cells x 1000 bytes: 500 "
+                               "bands interleaved by pixel); at most 1024 MiB; rewrite it tiled (gdal_translate "
+                               "-co TILED=YES -co INTERLEAVE=BAND)");
+    // The same bands each in their own strips: 2.4 MiB a block, and the import goes on.
+    const fs::path band =
+        sparse("terralux_block_band.tif", 20000, 64, 500, GDT_Int16, {"INTERLEAVE=BAND", "BLOCKYSIZE=64"});
+    EXPECT_EQ(importError(band.string()), "");
+    // One band in one strip of 17 000 x 16 000 Float32 cells: 1 038 MiB.
+    const fs::path strip = sparse("terralux_block_strip.tif", 17000, 16000, 1, GDT_Float32, {"BLOCKYSIZE=16000"});
+    EXPECT_EQ(importError(strip.string()),
+              strip.string() + ": one block of band 1 decodes to 1038 MiB (17000 x 16000 cells x 4 bytes); at "
+                               "most 1024 MiB; rewrite it tiled (gdal_translate -co TILED=YES)");
+    // A tiled raster whose overview (a GDAL .ovr beside it) is one strip of 20 000 x 15 000 Float32
+    // cells: a reduction may read the overview, so it counts too.
+    const fs::path tiled = sparse("terralux_block_overview.tif", 40000, 30000, 1, GDT_Float32, {"TILED=YES"});
+    const fs::path overview = fs::path(tiled.string() + ".ovr");
+    CPLStringList overviewOptions;
+    for (const char* o : {"SPARSE_OK=TRUE", "COMPRESS=DEFLATE", "BLOCKYSIZE=15000"}) overviewOptions.AddString(o);
+    GDALClose(gtiff->Create(overview.c_str(), 20000, 15000, 1, GDT_Float32, overviewOptions.List()));
+    EXPECT_EQ(importError(tiled.string()),
+              tiled.string() + ": one block of band 1's overview 1 decodes to 1144 MiB (20000 x 15000 cells x 4 "
+                               "bytes); at most 1024 MiB; rewrite it tiled (gdal_translate -co TILED=YES)");
+    // The fuzzer's file itself.
+    const std::string found = std::string(TERRALUX_FUZZ_REGRESSIONS) + "/dem_tiff/interleaved_block_of_145_gb.tif";
+    EXPECT_NE(importError(found).find("decodes to 138697 MiB (29008 x 51 cells x 98306 bytes: 49153 bands"),
+              std::string::npos)
+        << importError(found);
+    for (const fs::path& p : {pixel, band, strip, tiled, overview}) fs::remove(p);
+}
+
+// A raster without a geotransform (a plain TIFF heightmap) is read as 1 m cells, north up, with a
+// warning; GDAL's own default on failure is south-up, which the import must not take as rotated.
+// Reduced, its cells widen with the reduction. Control points alone, or a CRS alone, place
+// nothing and are refused.
+TEST(DemImport, NoGeoTransformIsOneMetreCells) {
+    GDALAllRegister();
+    const fs::path path = fs::temp_directory_path() / "terralux_no_geotransform.tif";
+    const auto write = [&](const std::function<void(GDALDataset&)>& georeference) {
+        GDALDataset* ds =
+            GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), 40, 20, 1, GDT_Float32, nullptr);
+        std::vector<float> v(800);
+        for (int i = 0; i < 800; ++i) v[size_t(i)] = float(10 * (i / 40));  // rises 10 m a row
+        EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, 40, 20, v.data(), 40, 20, GDT_Float32, 0, 0, nullptr),
+                  CE_None);
+        georeference(*ds);
+        GDALClose(ds);
+    };
+    write([](GDALDataset&) {});
+    const DemImportResult r = importDem(path.string());
+    EXPECT_EQ(r.heightfield.width(), 40);
+    EXPECT_EQ(r.heightfield.depth(), 20);
+    EXPECT_DOUBLE_EQ(r.heightfield.cellSizeX(), 1.0);
+    EXPECT_DOUBLE_EQ(r.heightfield.cellSizeZ(), 1.0);
+    EXPECT_FLOAT_EQ(r.heightfield.at(0, 0), 0.0f);  // row 0 stays the first row
+    EXPECT_FLOAT_EQ(r.heightfield.at(0, 19), 190.0f);
+    EXPECT_NE(std::find(r.source.warnings.begin(), r.source.warnings.end(),
+                        "no georeferencing: cells taken as 1 m, origin at 0"),
+              r.source.warnings.end());
+    DemImportOptions reduced;
+    reduced.maxResolution = 10;
+    const DemImportResult small = importDem(path.string(), reduced);
+    EXPECT_EQ(small.heightfield.width(), 10);
+    EXPECT_EQ(small.heightfield.depth(), 5);
+    EXPECT_DOUBLE_EQ(small.heightfield.cellSizeX(), 4.0);
+    EXPECT_DOUBLE_EQ(small.heightfield.cellSizeZ(), 4.0);
+
+    write([](GDALDataset& ds) {
+        OGRSpatialReference utm;
+        utm.importFromEPSG(32631);
+        GDAL_GCP gcps[3];
+        GDALInitGCPs(3, gcps);
+        const double at[3][4] = {{0, 0, 400000, 4700000}, {40, 0, 400040, 4700000}, {0, 20, 400000, 4699980}};
+        for (int i = 0; i < 3; ++i) {
+            gcps[i].dfGCPPixel = at[i][0];
+            gcps[i].dfGCPLine = at[i][1];
+            gcps[i].dfGCPX = at[i][2];
+            gcps[i].dfGCPY = at[i][3];
+        }
+        ds.SetGCPs(3, gcps, &utm);
+        GDALDeinitGCPs(3, gcps);
+    });
+    EXPECT_EQ(importError(path.string()),
+              path.string() + ": is georeferenced by 3 control points, not a geotransform; warp it first (gdalwarp)");
+    write([](GDALDataset& ds) {
+        OGRSpatialReference utm;
+        utm.importFromEPSG(32631);
+        ds.SetSpatialRef(&utm);
+    });
+    EXPECT_EQ(importError(path.string()),
+              path.string() + ": has a CRS but no geotransform: its cells cannot be placed in it");
+    fs::remove(path);
+}
+
 // A footprint off the globe is refused before any reprojection (the fuzzer found one that kept
 // GDAL's transformer busy for seconds), and one on it still imports.
 TEST(DemImport, FootprintOffTheGlobeIsRefused) {
