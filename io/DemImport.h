@@ -69,7 +69,7 @@ inline constexpr VoidFill kImportVoidFill = VoidFill::GdalMembrane;
 // DemError when GDAL fails or memory runs out. Returns how the membrane solve went (nothing
 // for VoidFill::Gdal).
 MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
-               VoidFill method = kImportVoidFill);
+                         VoidFill method = kImportVoidFill);
 
 // Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.
 DemImportResult importDem(const std::string& path, const DemImportOptions& options = {});

@@ -47,7 +47,7 @@ std::string oversizedBlock(GDALDatasetH ds) {
         if (bytes <= kMaxBlockBytes) return {};
         return "one block of " + what + " decodes to " + fmt(std::round(bytes / (1024.0 * 1024.0))) + " MiB (" +
                std::to_string(bw) + " x " + std::to_string(bh) + " cells x " + std::to_string(bytesPerCell) +
-               " bytes" + (interleaved ? ": " + std::to_string(count) + " bands interleaved by pixel" : "") +
+               (bytesPerCell == 1 ? " byte" : " bytes") + (interleaved ? ": " + std::to_string(count) + " bands interleaved by pixel" : "") +
                "); at most " + fmt(kMaxBlockBytes / (1024.0 * 1024.0)) +
                " MiB; rewrite it tiled (gdal_translate -co TILED=YES" +
                (interleaved ? " -co INTERLEAVE=BAND)" : ")");

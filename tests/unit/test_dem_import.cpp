@@ -271,12 +271,25 @@ TEST(DemImport, OversizedBlockIsRefusedBeforeAnyRead) {
     EXPECT_EQ(importError(tiled.string()),
               tiled.string() + ": one block of band 1's overview 1 decodes to 1144 MiB (20000 x 15000 cells x 4 "
                                "bytes); at most 1024 MiB; rewrite it tiled (gdal_translate -co TILED=YES)");
+    // A tiled raster whose mask (a GDAL .msk beside it, for the whole dataset) is in strips of
+    // 40 000 x 28 000 bytes: resampling reads the mask beside the heights.
+    const fs::path masked = sparse("terralux_block_mask.tif", 40000, 30000, 1, GDT_Float32, {"TILED=YES"});
+    const fs::path mask = fs::path(masked.string() + ".msk");
+    CPLStringList maskOptions;
+    for (const char* o : {"SPARSE_OK=TRUE", "COMPRESS=DEFLATE", "BLOCKYSIZE=28000"}) maskOptions.AddString(o);
+    GDALDataset* maskDs = gtiff->Create(mask.c_str(), 40000, 30000, 1, GDT_Byte, maskOptions.List());
+    ASSERT_NE(maskDs, nullptr);
+    maskDs->SetMetadataItem("INTERNAL_MASK_FLAGS_1", "2");  // GMF_PER_DATASET
+    GDALClose(maskDs);
+    EXPECT_EQ(importError(masked.string()),
+              masked.string() + ": one block of the mask decodes to 1068 MiB (40000 x 28000 cells x 1 byte); at "
+                                "most 1024 MiB; rewrite it tiled (gdal_translate -co TILED=YES)");
     // The fuzzer's file itself.
     const std::string found = std::string(TERRALUX_FUZZ_REGRESSIONS) + "/dem_tiff/interleaved_block_of_145_gb.tif";
     EXPECT_NE(importError(found).find("decodes to 138697 MiB (29008 x 51 cells x 98306 bytes: 49153 bands"),
               std::string::npos)
         << importError(found);
-    for (const fs::path& p : {pixel, band, strip, tiled, overview}) fs::remove(p);
+    for (const fs::path& p : {pixel, band, strip, tiled, overview, masked, mask}) fs::remove(p);
 }
 
 // A raster without a geotransform (a plain TIFF heightmap) is read as 1 m cells, north up, with a
