@@ -14,6 +14,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <sys/stat.h>
+
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
@@ -34,6 +36,7 @@
 #include "bake/TargetSearch.h"
 #include "lpv/Lpv.h"
 #include "render/OrbitCamera.h"
+#include "water/Water.h"
 
 #ifndef TERRALUX_VERSION
 #define TERRALUX_VERSION "0.0.0"
@@ -1042,6 +1045,9 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         out.warnings = reflections->warnings;
     }
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
+    if (scene.water.enabled && !lighting.water)
+        out.warnings.push_back("water.level auto: " + water::autoLevel(hf).summary +
+                               "; no water is baked or exported; set water.level to place it");
     for (const auto& [index, c] : targets)
         if (!c.warning.empty()) out.warnings.push_back(c.warning);
     if (sampling) {
@@ -1110,8 +1116,10 @@ nlohmann::json fileIdentity(const std::filesystem::path& path) {
     nlohmann::json id = {{"path", path.lexically_normal().generic_string()}};
     const auto size = std::filesystem::file_size(path, ec);
     if (!ec) id["bytes"] = size;
-    const auto time = std::filesystem::last_write_time(path, ec);
-    if (!ec) id["modified_ns"] = std::chrono::duration_cast<std::chrono::nanoseconds>(time.time_since_epoch()).count();
+    // Unix time in nanoseconds, as stat(2) gives it (std::filesystem's file clock has its own epoch).
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0)
+        id["modified_ns"] = int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
     return id;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 
@@ -595,6 +596,15 @@ int commandRender(const Args& a) {
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    // The LPV views' own exposure, printed with the view so the image can be read as numbers.
+    if (view->number == kViewLpvCascade0 || view->number == kViewLpvAll) {
+        if (const std::optional<double> range = renderer.renderer().lpvViewRange())
+            std::cout << "LPV view scale: E/pi / " << std::setprecision(4) << *range
+                      << " W/(m2 sr) through the display curve ("
+                      << (request.linearOutput ? "this EXR holds E/pi unscaled" : "1.0 shows as 0.9") << ")\n";
+        else
+            std::cout << "LPV view scale: the light propagation volumes hold no light here\n";
+    }
     return kExitOk;
 }
 

@@ -412,9 +412,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("fog.density", T::Number)).range(0.0, 1.0).unit("1/m").decimals(6).label("Density")
         .about("Extinction coefficient at the base height")
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::density);
-    add(Row("fog.height_falloff", T::Number)).range(0.0, 1.0).unit("1/m").decimals(6).label("Height falloff")
-        .about("Density falls by e for every 1/falloff metres above the base height; 0 = the same at every height")
-        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::heightFalloff);
+    add(Row("fog.scale_height", T::Number)).range(0.0, 1.0e6).unit("m").decimals(0)
+        .zeroMeans("the same at every height").label("Scale height")
+        .about("Height above the base height over which the density falls by e (a haze layer is about 1200 m); 0 = the same at every height")
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::scaleHeight);
     add(Row("fog.base_height", T::Number)).range(-1.0e5, 1.0e5).unit("m").decimals(1)
         .autoMeans("the lowest terrain").label("Base height")
         .about("Height where the density is fog.density, engine space")
@@ -473,7 +474,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("A lake or sea: a level plane at water.level with Gerstner waves over the terrain below it; the viewport and --render draw it, the bake's probe rays see it, the glTF exports it")
         .redoes(kUpload | kRebake).field(&SceneDescription::water, &WaterSettings::enabled);
     add(Row("water.level", T::Number)).range(-1.0e5, 1.0e5).unit("m").decimals(1)
-        .autoMeans("the DEM's lowest decile: the 10th percentile of its heights").label("Water level")
+        .autoMeans("the water the DEM shows: its largest flat, lowest surface (none when it shows none)").label("Water level")
         .about("Height of the water at rest, engine space (DEM elevation × terrain.vertical_scale); the water covers the terrain below it")
         .redoes(kUpload | kRebake).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::level);
     add(Row("water.color", T::Color)).range(0.0, 1.0).label("Scatter colour")
@@ -664,8 +665,9 @@ std::vector<ParameterSpec> buildTable() {
         .autoMeans("none: geometric refinement only").label("Adaptive: error tolerance")
         .about("Relative interpolation error that splits a leaf (error-driven refinement)")
         .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::tolerance);
-    add(Row("probe_volumes[].adaptive.max_probes", T::Integer)).range(1, std::numeric_limits<int>::max())
-        .autoMeans("no limit").label("Adaptive: max probes").about("Probe budget of the error-driven refinement")
+    add(Row("probe_volumes[].adaptive.max_probes", T::Integer)).range(1, kMaxVolumeProbes)
+        .autoMeans("the limit of 65536").label("Adaptive: max probes")
+        .about("Probe budget of the error-driven refinement; no adaptive volume holds more than 65536 valid probes")
         .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::maxProbes);
     add(Row("probe_volumes[].adaptive.max_bytes", T::Integer)).range(1, double(1ll << 53)).unit("bytes")
         .autoMeans("no limit").label("Adaptive: max bytes").about(".shprobe size budget of the error-driven refinement")

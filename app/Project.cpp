@@ -291,6 +291,22 @@ const std::vector<ProjectMigration>& projectMigrations() {
                  if (clamped) notes.push_back("reflection_probes.ground_color clamped to [0, 1] (it is an albedo since version 2)");
              }
          }},
+        {2,
+         "fog.height_falloff (1/m) became fog.scale_height (m), its reciprocal: the same fog",
+         [](json& doc, std::vector<std::string>& notes) {
+             if (!doc.contains("fog") || !doc["fog"].is_object() || !doc["fog"].contains("height_falloff")) return;
+             json& fog = doc["fog"];
+             const json falloff = fog["height_falloff"];
+             fog.erase("height_falloff");
+             // Anything but a number is left for the check to name under its new key.
+             if (!falloff.is_number()) {
+                 fog["scale_height"] = falloff;
+                 return;
+             }
+             const double f = falloff.get<double>();
+             fog["scale_height"] = f > 0.0 ? 1.0 / f : f;
+             notes.push_back("fog.height_falloff " + falloff.dump() + " is fog.scale_height " + fog["scale_height"].dump() + " m");
+         }},
     };
     return steps;
 }

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bake/ProbePlacement.h"
 #include "scene/SceneDescription.h"
 
 namespace terralux {
@@ -21,9 +22,8 @@ public:
 
 // The project file's version (docs/formats.md, "Project file"): older files are migrated step
 // by step on reading, newer ones refused.
-inline constexpr int kProjectVersion = 2;
-inline constexpr int kMaxTerrainGridProbes = 4096;   // docs/lighting.md, diffuse grid dims
-inline constexpr int kMaxBoxGridProbes = 65536;
+inline constexpr int kProjectVersion = 3;
+inline constexpr int kMaxBoxGridProbes = kMaxVolumeProbes;  // cells; docs/lighting.md, "Probe limits"
 inline constexpr int kMaxBounces = 16;
 inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights
 inline constexpr int kMaxLocalLights = 1024;         // lights: what one LPV update injects

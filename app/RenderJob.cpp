@@ -103,7 +103,9 @@ void ProjectRenderer::setProject(const Project& project) {
             w.waves.push_back(water::waveTerms(wave));
             crest += w.waves.back().amplitude;
         }
-        renderer_->setWater(float(water::waterLevel(ws, terrain_.heightfield)), float(crest));
+        const std::optional<double> level = water::waterLevel(ws, terrain_.heightfield);
+        if (level) renderer_->setWater(float(*level), float(crest));
+        else w.enabled = false;  // "auto" found no water in the DEM: none is drawn
         w.scatter = ws.color;
         w.absorption = ws.absorption;
         w.roughness = float(ws.roughness);
@@ -199,6 +201,16 @@ nlohmann::json readReport(const std::filesystem::path& file) {
     return report.is_object() ? report : nlohmann::json(nullptr);
 }
 
+// The fallback blend distance the bake resolved for a volume, when its report names the volume.
+std::optional<float> reportedBlendDistance(const nlohmann::json& report, const std::string& volume) {
+    if (!report.is_object() || !report.contains("volumes") || !report["volumes"].is_array()) return std::nullopt;
+    for (const auto& v : report["volumes"])
+        if (v.is_object() && v.value("name", std::string()) == volume && v.contains("fallback_blend_distance") &&
+            v["fallback_blend_distance"].is_number())
+            return v["fallback_blend_distance"].get<float>();
+    return std::nullopt;
+}
+
 // Why the bake in the folder is not the project's: its differences, or what is missing.
 std::vector<std::string> staleness(const Project& project, const std::filesystem::path& dir,
                                    const nlohmann::json& report) {
@@ -254,9 +266,10 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
         gv.occupancy = g.occupancy;
         gv.scale = g.defaultScale;
         gv.irradianceEncoded = irradiance;
-        // docs/lighting.md default: twice the smallest probe spacing, which is the cell edge here.
+        // The distance the bake resolved (defaultFallbackBlendDistance), from its report; a folder
+        // without one falls back to twice the file's cell edge, the grid's smallest spacing.
         gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
-                                                           : 2.0f * g.spacing;
+                                                           : reportedBlendDistance(report, v.name).value_or(2.0f * g.spacing);
         for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);
         const auto sidecar = dir / probeDiagnosticsFileName(v.name);
         try {

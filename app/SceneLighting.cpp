@@ -139,7 +139,9 @@ BakeLighting lightingOf(const Project& p) {
 std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
     const WaterSettings& w = p.scene.water;
     if (!w.enabled) return std::nullopt;
-    return BakeWater{float(water::waterLevel(w, hf)), w.color};
+    const std::optional<double> level = water::waterLevel(w, hf);
+    if (!level) return std::nullopt;  // "auto" found no water in the DEM
+    return BakeWater{float(*level), w.color};
 }
 
 namespace {
@@ -211,8 +213,11 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     // before water existed.
     if (scene.water.enabled) {
         nlohmann::json& w = ext["water"] = authored.at("water");
+        // null when "auto" finds no water surface in the DEM (then no water node either).
+        const std::optional<double> level = water::waterLevel(scene.water, hf);
         w["resolved_level"] = scene.water.level ? w.at("level")
-                                                : nlohmann::json(shortestDecimal(float(water::autoLevel(hf))));
+                              : level           ? nlohmann::json(shortestDecimal(float(*level)))
+                                                : nlohmann::json(nullptr);
         for (size_t i = 0; i < scene.water.waves.size(); ++i) {
             const water::WaveTerms t = water::waveTerms(scene.water.waves[i]);
             nlohmann::json& wave = w.at("waves").at(i);

@@ -28,8 +28,9 @@ SunLight sunOf(const SunSettings& sun);
 // Sun, sky and albedo; the caller sets the tracer.
 BakeLighting lightingOf(const Project& project);
 
-// The water the bake's probe rays see (BakeWater): unset while water.enabled is off; the level
-// resolved on `hf` (unset = the DEM's lowest decile, water::autoLevel).
+// The water the bake's probe rays see (BakeWater): unset while water.enabled is off, or when the
+// level is "auto" and the DEM shows no water surface (water::autoLevel); else the level resolved
+// on `hf`.
 std::optional<BakeWater> bakeWaterOf(const Project& project, const Heightfield& hf);
 
 // The aspect ratio TERRALUX_lighting's cascade splits are computed for (shadows.computed_for_aspect).

@@ -595,7 +595,14 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
             BinStream counted;
             buildMesh(hf, input, gltfPath, doc, counted, *mesh);
         }
-        doc["extensions"] = {
+        // Seed 001's extension and ours are scene-level: an engine reads them from the scene it
+        // loads (scenes[0].extensions), not from the asset's root.
+        if (!doc.contains("scenes")) {
+            doc["scene"] = 0;
+            doc["scenes"] = ojson::array({ojson{{"name", "terrain"}}});
+        }
+        ojson& sceneExtensions = doc["scenes"][0]["extensions"];
+        sceneExtensions = {
             {kEngineExtension, {{"shProbeGrids", std::move(grids)}}},
             {kGeoExtension,
              {{"crs", hf.geo.crsWkt},
@@ -610,8 +617,7 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
               {"meshStride", mesh->stride}}},
             {kBakeExtension, ojson(input.bake)},
         };
-        if (input.lighting.is_object())
-            doc["extensions"][kLightingExtension] = ojson(input.lighting);
+        if (input.lighting.is_object()) sceneExtensions[kLightingExtension] = ojson(input.lighting);
         if (!input.lights.empty()) addLights(doc, input.lights);
         if (hasMesh) {
             auto write = [&hf, &input, gltfPath, mesh](BinStream& bin) {
@@ -895,9 +901,13 @@ nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile) {
         throw std::runtime_error(name + ": cannot load as glTF (" +
                                  (reason.empty() ? std::string("unknown error") : reason) + ")");
     }
+    // Seed 001's extension belongs to the scene an engine loads: the default scene, else the first.
+    const int scene = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (size_t(scene) >= model.scenes.size())
+        throw std::runtime_error(name + ": no scene to hold " + kEngineExtension);
     nlohmann::json extensions;
     try {
-        extensions = nlohmann::json::parse(model.extensions_json_string);
+        extensions = nlohmann::json::parse(model.scenes[size_t(scene)].extensions_json_string);
     } catch (const nlohmann::json::exception&) {
         extensions = nullptr;
     }
@@ -905,7 +915,8 @@ nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile) {
         !extensions[kEngineExtension].is_object() ||
         !extensions[kEngineExtension].contains("shProbeGrids") ||
         !extensions[kEngineExtension]["shProbeGrids"].is_array()) {
-        throw std::runtime_error(name + ": no " + kEngineExtension + ".shProbeGrids array");
+        throw std::runtime_error(name + ": no " + kEngineExtension +
+                                 ".shProbeGrids array in the scene's extensions");
     }
     return extensions[kEngineExtension]["shProbeGrids"];
 }

@@ -114,9 +114,9 @@ GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const Gltf
 // The files exportGltfScene writes for `input`, relative to outDir, in the order it commits them.
 std::vector<std::string> exportedFileNames(const GltfSceneInput& input);
 
-// Reads scene.gltf back with tinygltf and returns the VULKAN_SCHNEE_engine_properties.shProbeGrids
-// array as written (for tests and tools). Throws std::runtime_error naming the file if it does not
-// load or has no such array.
+// Reads scene.gltf back with tinygltf and returns the default scene's
+// VULKAN_SCHNEE_engine_properties.shProbeGrids array as written (for tests and tools). Throws
+// std::runtime_error naming the file if it does not load or its scene has no such array.
 nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile);
 
 }  // namespace terralux

@@ -31,6 +31,9 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
                          OIIO::geterror() + "); use .png or .exr");
     const bool linear = encodingFor(path) == ImageEncoding::LinearFloat;
     OIIO::ImageSpec spec(int(width), int(height), 4, linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    // OpenImageIO stamps an EXR with the time of writing unless DateTime is given; an empty one
+    // keeps the file the same bytes on every run, like every other output.
+    if (linear) spec.attribute("DateTime", "");
     std::vector<uint8_t> bytes;
     const void* data = rgba.data();
     if (!linear) {

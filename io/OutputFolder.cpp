@@ -2,20 +2,20 @@
 
 #include <cerrno>
 #include <charconv>
-#include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
-#include <thread>
 
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include "AtomicFile.h"
@@ -26,19 +26,31 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kLockName = ".terralux.lock";
+constexpr const char* kLegacyLockName = ".terralux.lock";
 
 std::string errnoText(int err) { return std::generic_category().message(err); }
 
-// The pid a lock file names, if it names one yet.
-std::optional<long> readPid(int fd) {
-    char buf[32] = {};
-    const ssize_t n = ::pread(fd, buf, sizeof buf - 1, 0);
-    long pid = 0;
-    if (n <= 0) return std::nullopt;
-    const auto [end, ec] = std::from_chars(buf, buf + n, pid);
-    if (ec != std::errc() || pid <= 0) return std::nullopt;
-    return pid;
+// The process holding a flock lock on the file `fd` is open on, from the kernel's table of locks
+// (/proc/locks: "1: FLOCK ADVISORY WRITE <pid> <major>:<minor>:<inode> 0 EOF", device numbers in
+// hex), if it is listed there.
+std::optional<long> flockHolder(int fd) {
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) return std::nullopt;
+    std::ifstream locks("/proc/locks");
+    std::string line;
+    while (std::getline(locks, line)) {
+        std::istringstream fields(line);
+        std::string index, kind, mode, access, id;
+        long pid = 0;
+        if (!(fields >> index >> kind) || kind != "FLOCK") continue;
+        if (!(fields >> mode >> access >> pid >> id)) continue;
+        unsigned major = 0, minor = 0;
+        unsigned long long inode = 0;
+        if (std::sscanf(id.c_str(), "%x:%x:%llu", &major, &minor, &inode) != 3) continue;
+        if (inode == st.st_ino && major == ::major(st.st_dev) && minor == ::minor(st.st_dev) && pid > 0)
+            return pid;
+    }
+    return std::nullopt;
 }
 
 // The pid in a leftover's name: the digits after `marker`, up to a '-'.
@@ -96,7 +108,7 @@ double modifiedSeconds(const fs::path& p) {
 
 }  // namespace
 
-OutputFolderLock::OutputFolderLock(const fs::path& dir) : dir_(dir), file_(dir / kLockName) {
+OutputFolderLock::OutputFolderLock(const fs::path& dir) : dir_(dir) {
     std::error_code ec;
     const bool existed = fs::exists(dir_, ec);
     fs::create_directories(dir_, ec);
@@ -114,51 +126,38 @@ OutputFolderLock::OutputFolderLock(const fs::path& dir) : dir_(dir), file_(dir /
 }
 
 void OutputFolderLock::acquire() {
-    // The holder removes the file before it lets go, so a lock taken on a file that is no longer
-    // the one at the path is retried on the new file.
-    for (int attempt = 0; attempt < 100; ++attempt) {
-        const int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-        if (fd < 0)
-            throw FileWriteError(file_.string() + ": cannot create the lock file (" + errnoText(errno) + ")");
-        if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-            const int err = errno;
-            if (err != EWOULDBLOCK) {
-                ::close(fd);
-                throw FileWriteError(file_.string() + ": cannot lock (" + errnoText(err) + ")");
-            }
-            // The holder writes its pid right after it locks; give it that moment.
-            std::optional<long> pid = readPid(fd);
-            for (int i = 0; i < 20 && !pid; ++i) {
-                std::this_thread::sleep_for(std::chrono::milliseconds(5));
-                pid = readPid(fd);
-            }
+    // The lock is on the folder itself, so nothing lands in it: an engine's importer watching the
+    // export folder never sees a lock file, and a killed bake leaves none behind.
+    const int fd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0)
+        throw FileWriteError(dir_.string() + ": cannot open the output folder (" + errnoText(errno) + ")");
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        const int err = errno;
+        if (err != EWOULDBLOCK) {
             ::close(fd);
-            throw FileWriteError(dir_.string() + ": another bake is writing here (pid " +
-                                 (pid ? std::to_string(*pid) : std::string("unknown")) +
-                                 "); wait for it or choose another --out");
+            throw FileWriteError(dir_.string() + ": cannot lock the output folder (" + errnoText(err) + ")");
         }
-        struct stat held {}, named {};
-        if (::fstat(fd, &held) != 0 || ::stat(file_.c_str(), &named) != 0 ||
-            held.st_ino != named.st_ino || held.st_dev != named.st_dev) {
-            ::close(fd);
-            continue;
-        }
-        const std::string pid = std::to_string(::getpid()) + "\n";
-        if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) != ssize_t(pid.size())) {
-            const int err = errno;
-            ::unlink(file_.c_str());
-            ::close(fd);
-            throw FileWriteError(file_.string() + ": cannot write the lock file (" + errnoText(err) + ")");
-        }
-        fd_ = fd;
-        return;
+        const std::optional<long> pid = flockHolder(fd);
+        ::close(fd);
+        throw FileWriteError(dir_.string() + ": another bake is writing here (pid " +
+                             (pid ? std::to_string(*pid) : std::string("unknown")) +
+                             "); wait for it or choose another --out");
     }
-    throw FileWriteError(file_.string() + ": cannot lock (the lock file keeps being replaced)");
+    fd_ = fd;
+    removeLegacyLockFile();
+}
+
+void OutputFolderLock::removeLegacyLockFile() {
+    // Earlier versions locked `.terralux.lock` inside the folder; one a killed bake left is removed.
+    // One that is still locked belongs to a live bake of such a version, which keeps it.
+    const fs::path legacy = dir_ / kLegacyLockName;
+    const int fd = ::open(legacy.c_str(), O_RDWR | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) return;
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) ::unlink(legacy.c_str());
+    ::close(fd);
 }
 
 OutputFolderLock::~OutputFolderLock() {
-    // Unlinked while still held: whoever opened the old file sees it gone and retries.
-    ::unlink(file_.c_str());
     ::close(fd_);
     std::error_code ec;
     if (createdDir_ && fs::is_empty(dir_, ec) && !ec) fs::remove(dir_, ec);

@@ -7,21 +7,23 @@
 
 namespace terralux {
 
-// Takes `<dir>/.terralux.lock` with flock(LOCK_EX | LOCK_NB) and writes this process's pid into it;
-// `dir` is created if missing. The kernel drops the lock when its process dies, so a killed bake
-// never blocks the next one. Throws FileWriteError "<dir>: another bake is writing here (pid N);
-// wait for it or choose another --out" when a live bake holds it, and for file system failures.
+// Takes flock(LOCK_EX | LOCK_NB) on `dir` itself (created if missing), so the lock leaves no file
+// in the folder. The kernel drops the lock when its process dies, so a killed bake never blocks
+// the next one. Throws FileWriteError "<dir>: another bake is writing here (pid N); wait for it or
+// choose another --out" when a live bake holds it (the pid from /proc/locks), and for file system
+// failures. A `.terralux.lock` that an earlier version left, unlocked, is removed.
 class OutputFolderLock {
 public:
     explicit OutputFolderLock(const std::filesystem::path& dir);
-    // Removes the lock file (the folder too when this lock created it and it stayed empty).
+    // Lets go of the lock (and removes the folder when this lock created it and it stayed empty).
     ~OutputFolderLock();
     OutputFolderLock(const OutputFolderLock&) = delete;
     OutputFolderLock& operator=(const OutputFolderLock&) = delete;
 
 private:
     void acquire();
-    std::filesystem::path dir_, file_;
+    void removeLegacyLockFile();
+    std::filesystem::path dir_;
     int fd_ = -1;
     bool createdDir_ = false;
 };

@@ -13,6 +13,14 @@ bool onFootprint(vec2 t) { return all(greaterThanEqual(t, vec2(-1e-4))) && all(l
 // Texel centres span the footprint corner to corner (SurfaceMaps.h).
 vec2 surfaceUv(vec2 t, vec2 size) { return (clamp(t, 0.0, 1.0) * (size - 1.0) + 0.5) / size; }
 
+// The mip level of a texture read at texel-space position `texel`: the spec's λ = log2(ρmax) with
+// ρx = |∂texel/∂x| and ρy = |∂texel/∂y| taken from fine derivatives, and no level below 0 (a
+// conformant driver may approximate ρ, and a CPU and a GPU driver do differently).
+float normalMapLod(vec2 texel) {
+    vec2 dx = dFdxFine(texel), dy = dFdyFine(texel);
+    return max(0.5 * log2(max(max(dot(dx, dx), dot(dy, dy)), 1e-12)), 0.0);
+}
+
 // Normal variance from the shortening of a filtered mean normal (Toksvig 2005): σ² = (1 − |N̄|)/|N̄|.
 float toksvigVariance(float meanLength) {
     float len = clamp(meanLength, 1e-4, 1.0);

@@ -38,7 +38,11 @@ void main() {
     vec2 t = footprintT(worldPos);
     bool inside = onFootprint(t);
     vec2 uv = surfaceUv(t, surface.mapSizes.xy);
-    vec4 normalAo = texture(surfaceNormalAo, uv);
+    // The normal map's level by the Vulkan spec's formula (λ = log2 ρmax, ρ the length of the
+    // texel-space derivative along x and along y), from fine derivatives, not each driver's
+    // approximation of it: the normal variance (Toksvig) is the filtered normal's shortening,
+    // which the level sets, and drivers differ in the level they pick (normalMapLod, surface.glsl).
+    vec4 normalAo = textureLod(surfaceNormalAo, uv, normalMapLod(uv * surface.mapSizes.xy));
     float coarseAo = surface.ao.z > 0.0 ? textureLod(surfaceNormalAo, uv, surface.ao.z).w : normalAo.w;
     // Maps a frame does not read are not sampled (the conditions are uniform, so the derivatives
     // still hold): on a CPU rasteriser each trilinear lookup is a real cost.

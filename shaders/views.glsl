@@ -31,6 +31,7 @@ struct ShadingPoint {
     float lpvAo;       // view 63: cascade 0's geometry volume's ambient occlusion, 1 open
     float lpvCover;    // view 63: cascade 0's fade weight at the point, 0 outside it
     float lpvBlocking; // view 62: cascade 0's geometry, the share of light into the ground it stops
+    float lpvExposure; // views 61 and 64: 1 / cascade 0's light range (lpv::lightRange), 0 without
 };
 
 float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
@@ -138,11 +139,16 @@ vec3 viewWaterMask(ShadingPoint s) {
 vec3 viewShoreDistance(ShadingPoint s) { return linearOutput() ? vec3(0.0, 0.0, 0.0) : vec3(0.0); }
 vec3 viewWaterNormal(ShadingPoint s) { return vec3(0.5) * (0.6 + 0.4 * sunNdotL(s)); }
 
-// The LPV views: the irradiance of cascade 0 alone and of all cascades blended, shown like the
-// probe irradiance (E/π, a white Lambertian surface's radiance); cascade 0's geometry volume and
-// its ambient occlusion as scalars. Black where the frame holds no LPV.
-vec3 viewLpvCascade0(ShadingPoint s) { return display(s.lpv.irradiance / PI); }
-vec3 viewLpvAll(ShadingPoint s) { return display(s.lpv.irradiance / PI); }
+// The LPV views: the irradiance of cascade 0 alone and of all cascades blended, as E/π (a white
+// Lambertian surface's radiance). EXR holds E/π as it is; PNG shows it with the views' own exposure
+// (not the camera's): E/π over cascade 0's light range, the same scale for both views so they can be
+// told apart, through the display curve. Cascade 0's geometry volume and its ambient occlusion as
+// scalars. Black where the frame holds no LPV.
+vec3 lpvDisplay(vec3 radiance, float exposure) {
+    return linearOutput() ? radiance : srgb(aces(radiance * exposure));
+}
+vec3 viewLpvCascade0(ShadingPoint s) { return lpvDisplay(s.lpv.irradiance / PI, s.lpvExposure); }
+vec3 viewLpvAll(ShadingPoint s) { return lpvDisplay(s.lpv.irradiance / PI, s.lpvExposure); }
 vec3 viewLpvGeometry(ShadingPoint s) {
     if (linearOutput()) return vec3(s.lpvBlocking, 1.0, 0.0);
     return heat(0.1 * s.lpvBlocking) * (0.6 + 0.4 * sunNdotL(s));
@@ -168,8 +174,10 @@ vec3 shadeView(int view, ShadingPoint s) {
     s.lpvAo = 1.0;
     s.lpvCover = 0.0;
     s.lpvBlocking = 0.0;
+    s.lpvExposure = 0.0;
 #ifdef TLX_LPV
     if (kLpv && lpv.counts.x > 0) {
+        s.lpvExposure = lpv.params.w;
         bool firstOnly = view == kViewLpvCascade0 || view == kViewLpvGeometry || view == kViewLpvAo;
         int last = firstOnly ? 0 : lpv.counts.x - 1;
         s.lpv = lpvEvaluate(s.position, s.normal, -dir, lpv.counts.y, last);

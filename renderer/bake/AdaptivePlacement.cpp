@@ -283,6 +283,11 @@ public:
                                  " probes, more than adaptive.max_probes = " +
                                  std::to_string(*a.maxProbes) +
                                  "; raise it, adaptive.min_cell_size or adaptive.surface_cell_size");
+        if (L.validCount() > size_t(kMaxVolumeProbes))
+            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.validCount()) +
+                                 " probes, more than an adaptive volume's limit of " +
+                                 std::to_string(kMaxVolumeProbes) +
+                                 "; raise adaptive.min_cell_size or adaptive.surface_cell_size");
         if (a.maxBytes && L.fileBytes() > uint64_t(*a.maxBytes))
             throw PlacementError(where + ": " + what + " needs " + std::to_string(L.fileBytes()) +
                                  " bytes, more than adaptive.max_bytes = " +
@@ -418,7 +423,7 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
     if (v.adaptive.tolerance) {
         AdaptiveRefinement ref;
         ref.tolerance = *v.adaptive.tolerance;
-        const auto& budgetProbes = v.adaptive.maxProbes;
+        const std::optional<int> budgetProbes = v.adaptive.maxProbes ? v.adaptive.maxProbes : kMaxVolumeProbes;
         const auto& budgetBytes = v.adaptive.maxBytes;
         std::unordered_set<uint64_t> kept;  // tested leaves that stay
         for (int round = 1;; ++round) {

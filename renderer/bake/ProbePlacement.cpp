@@ -220,15 +220,28 @@ ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
 
 }  // namespace
 
+float defaultFallbackBlendDistance(glm::vec2 spacing, glm::vec2 extent) {
+    const float x = spacing.x > 0.0f ? spacing.x : extent.x;
+    const float z = spacing.y > 0.0f ? spacing.y : extent.y;
+    return 2.0f * std::min(x, z);
+}
+
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {
     ProbeLayout L = v.placement == ProbePlacement::Box        ? placeBoxGrid(v, hf)
                     : v.placement == ProbePlacement::Adaptive ? placeAdaptive(v, hf)
                                                               : placeTerrainGrid(v, hf);
-    float minSpacing = 0.0f;
-    for (int a = 0; a < 3; ++a)
-        if (L.spacing[a] > 0.0f) minSpacing = minSpacing > 0.0f ? std::min(minSpacing, L.spacing[a]) : L.spacing[a];
-    L.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
-                                                      : 2.0f * minSpacing;
+    if (v.fallbackBlendDistance) {
+        L.fallbackBlendDistance = float(*v.fallbackBlendDistance);
+    } else if (v.placement == ProbePlacement::Terrain) {
+        // An explicit spacing on a one-probe axis places nothing: that axis has no spacing.
+        const glm::vec2 spacing(L.probeDims[0] > 1 ? L.spacing.x : 0.0f, L.probeDims[2] > 1 ? L.spacing.z : 0.0f);
+        const glm::vec2 extent(std::max(hf.maxX() - hf.minX(), float(hf.cellSizeX())),
+                               std::max(hf.maxZ() - hf.minZ(), float(hf.cellSizeZ())));
+        L.fallbackBlendDistance = defaultFallbackBlendDistance(spacing, extent);
+    } else {
+        // Box and adaptive volumes: cubic cells, each probe standing for one (the smallest).
+        L.fallbackBlendDistance = defaultFallbackBlendDistance(glm::vec2(L.spacing.x), glm::vec2(L.spacing.x));
+    }
     return L;
 }
 

@@ -57,6 +57,12 @@ struct AdaptiveOctree {
     size_t uniformProbes = 0;
 };
 
+// Seed 000's fallback_blend_distance when it is unset, one rule for diffuse and reflection grids:
+// 2 * min(spacing_x, spacing_z) over the horizontal axes, where an axis that holds a single probe
+// (spacing 0) takes as its spacing the width that probe stands for, `extent` along that axis (the
+// footprint's extent for a terrain grid or a reflection grid, the cell for a box). docs/lighting.md.
+float defaultFallbackBlendDistance(glm::vec2 spacing, glm::vec2 extent);
+
 struct ProbeLayout {
     std::vector<glm::vec3> positions;  // every placed probe, valid or not, in placement order
     std::vector<uint8_t> valid;        // 0: inside the terrain, no SH, no occupancy cell
@@ -98,6 +104,12 @@ SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;
+// One cap per placement (docs/lighting.md, "Probe limits"): a terrain grid holds at most seed 000's
+// 4096 probes; a box grid at most kMaxVolumeProbes cells, an adaptive volume at most that many
+// valid probes (adaptive.max_probes may ask for fewer): 10 MiB of coefficients, the largest volume
+// an engine is asked to allocate for.
+inline constexpr int kMaxTerrainGridProbes = 4096;
+inline constexpr int kMaxVolumeProbes = 65536;
 
 // Throws PlacementError naming the volume setting, the value and the rule. Adaptive volumes get
 // their geometric octree here (AdaptivePlacement.h refines it by error).

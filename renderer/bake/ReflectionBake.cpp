@@ -188,12 +188,9 @@ ReflectionLayout placeReflectionProbes(const ReflectionProbeSettings& s, const H
                                                 z - 0.5 * L.cellSize.y, z + 0.5 * L.cellSize.y);
             L.lowestBelow.push_back(std::min(std::isfinite(r.lo) ? r.lo : ground, p.y));
         }
-    float minSpacing = 0.0f;
-    for (float sp : {L.spacing.x, L.spacing.y})
-        if (sp > 0.0f) minSpacing = minSpacing > 0.0f ? std::min(minSpacing, sp) : sp;
-    // seed 000: twice the smaller spacing; a 1×1 grid has none, and fades over its cell instead.
-    if (minSpacing <= 0.0f) minSpacing = std::min(L.cellSize.x, L.cellSize.y);
-    L.blendDistance = s.fallbackBlendDistance ? float(*s.fallbackBlendDistance) : 2.0f * minSpacing;
+    // The cell of a one-probe axis is the footprint's extent along it: the width that probe covers.
+    L.blendDistance = s.fallbackBlendDistance ? float(*s.fallbackBlendDistance)
+                                              : defaultFallbackBlendDistance(L.spacing, L.cellSize);
     return L;
 }
 

@@ -222,6 +222,21 @@ glm::dvec3 totalFlux(const LightVolume& v) {
     return sum * (2.0 * std::sqrt(std::numbers::pi));
 }
 
+double lightRange(const LightVolume& injected, double cellSize, double indirectIntensity) {
+    std::vector<double> radiance;
+    constexpr double kY00 = 0.28209479177387814;  // 1 / (2√π)
+    for (size_t cell = 0; cell < size_t(kCells); ++cell) {
+        const double y = 0.2126 * injected[lightOffset(0, cell, 0)] + 0.7152 * injected[lightOffset(1, cell, 0)] +
+                         0.0722 * injected[lightOffset(2, cell, 0)];
+        if (y > 0.0) radiance.push_back(y * kY00 / (cellSize * cellSize) * indirectIntensity);
+    }
+    if (radiance.empty()) return 0.0;
+    // Nearest rank, as the report's percentiles.
+    const size_t rank = std::max<size_t>(1, size_t(std::ceil(0.99 * double(radiance.size()))));
+    std::nth_element(radiance.begin(), radiance.begin() + std::ptrdiff_t(rank - 1), radiance.end());
+    return radiance[rank - 1];
+}
+
 void addBlocker(GeometryVolume& g, size_t corner, const glm::vec3& normal, float areaOverCellArea) {
     const Sh4 lobe = clampedCosine(normal, areaOverCellArea * (4.0f / 3.0f));
     for (int k = 0; k < 4; ++k) g[corner * 4 + k] += lobe[k];

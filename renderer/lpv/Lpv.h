@@ -120,6 +120,13 @@ GeometryVolume emptyGeometryVolume();
 // Total flux of a light volume per channel, W: Σ over cells of ∫ I dω = 2√π·c_0.
 glm::dvec3 totalFlux(const LightVolume& v);
 
+// The light range of a volume, for the LPV debug views' own exposure: the 99th percentile over
+// the cells holding light of a cell's mean radiance, c_0·Y_00 / h² (luminance, Rec. 709 weights),
+// × indirect_intensity, in W/(m²·sr). A white surface lit by a hemisphere of that radiance has
+// E/π equal to it. Device independent: it reads the injected light, which every device has.
+// 0 for a volume without light.
+double lightRange(const LightVolume& injected, double cellSize, double indirectIntensity);
+
 // Adds a surface's blocking potential at corner texel `corner`: area / h² of a surface facing
 // `normal` (Kaplanyan & Dachsbacher's B(ω) = A⟨n|ω⟩₊/h²), as 4/3 × its clamped-cosine L1
 // projection: L1 reaches 3/4 of the lobe's peak, and a surface seen head-on should block by its

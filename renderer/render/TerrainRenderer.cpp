@@ -124,6 +124,7 @@ struct LpvResources {
     vk::DescriptorSet propagationSet;
     int steps = 0;
     uint32_t cells = 0;  // cascades x 32^3
+    double viewRange = 0.0;  // lpv::lightRange of cascade 0: the LPV views' white point
 };
 
 // The water subsystem: present only while the scene has water. The field and mesh follow the
@@ -645,6 +646,11 @@ bool TerrainRenderer::hasReflectionResources() const { return gpu_->reflections 
 
 bool TerrainRenderer::hasLpvResources() const { return gpu_->lpv != nullptr; }
 
+std::optional<double> TerrainRenderer::lpvViewRange() const {
+    if (!gpu_->lpv || !(gpu_->lpv->viewRange > 0.0)) return std::nullopt;
+    return gpu_->lpv->viewRange;
+}
+
 bool TerrainRenderer::propagatesLpv() const { return ctx_.deviceType() != VK_PHYSICAL_DEVICE_TYPE_CPU; }
 
 const std::shared_ptr<const lpv::Volumes>& TerrainRenderer::lpv() const {
@@ -709,7 +715,9 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
         light.reserve(n * cascades[0].injected.size());
         geometry.reserve(n * cascades[0].geometry.size());
         r->block.counts = glm::ivec4(int(n), ls.quality, ls.coneTraceSamples, 0);
-        r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f, 0.0f);
+        r->viewRange = lpv::lightRange(cascades[0].injected, cascades[0].layout.cellSize, ls.indirectIntensity);
+        r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f,
+                                    r->viewRange > 0.0 ? float(1.0 / r->viewRange) : 0.0f);
         for (size_t c = 0; c < n; ++c) {
             const lpv::LightVolume& v = volumes->propagated() ? cascades[c].accumulated : cascades[c].injected;
             light.insert(light.end(), v.begin(), v.end());
@@ -1341,7 +1349,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
     slot.sunSky.write(&sunSky, sizeof sunSky);
     blocks::AtmosphereBlock atmosphere;
-    atmosphere.fog = glm::vec4(float(s.fog.density), float(s.fog.heightFalloff), float(s.fog.baseHeight.value_or(0.0)),
+    atmosphere.fog = glm::vec4(float(s.fog.density), float(s.fog.scaleHeight > 0.0 ? 1.0 / s.fog.scaleHeight : 0.0), float(s.fog.baseHeight.value_or(0.0)),
                                float(s.fog.anisotropy));
     atmosphere.fogColor = glm::vec4(s.fog.color.value_or(glm::vec3(0.0f)), float(s.fog.inscatter));
     slot.atmosphere.write(&atmosphere, sizeof atmosphere);

@@ -160,6 +160,9 @@ public:
     // The GPU time of the last propagation pass, milliseconds, from timestamps; none before the
     // first, or where the device writes no timestamps. Waits for the GPU.
     std::optional<double> lpvPropagationMilliseconds();
+    // The LPV views' white point (lpv::lightRange of cascade 0, W/(m²·sr)): views 61 and 64 show
+    // E/π divided by it through the display curve. None without an LPV holding light.
+    std::optional<double> lpvViewRange() const;
     // Bytes of the bound reflection probes on the GPU: their records and cube texels.
     size_t reflectionBytes() const { return reflectionBytes_; }
     // Probe positions for the overlay: xyz, w = 1 valid, 2 moved up, 0 inside the terrain.

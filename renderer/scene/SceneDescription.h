@@ -244,11 +244,11 @@ struct ShadowSettings {
 };
 
 // Exponential height fog (docs/lighting.md, "Height fog"): extinction
-// σ(h) = density · exp(−height_falloff · (h − base_height)).
+// σ(h) = density · exp(−(h − base_height) / scale_height).
 struct FogSettings {
     bool enabled = true;
     double density = 2.0e-5;                   // 1/m at the base height
-    double heightFalloff = 1.0 / 1200.0;       // 1/m
+    double scaleHeight = 1200.0;               // m over which the density falls by e; 0 = uniform
     std::optional<double> baseHeight;          // metres; unset = the lowest terrain
     std::optional<glm::vec3> color;            // ambient inscatter radiance; unset = the sky's mean
     double inscatter = 1.0;                    // scales the sun's inscatter

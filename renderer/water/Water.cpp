@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -169,18 +170,84 @@ double shoreFade(double distance, double fadeDistance) {
     return x * x * (3.0 - 2.0 * x);
 }
 
-double autoLevel(const Heightfield& hf) {
-    std::vector<float> h = hf.heights();
-    if (h.empty()) return 0.0;
-    // Nearest rank, like the report's percentiles (docs/lighting.md, "Metrics"): the
-    // ⌈0.1·N⌉-th smallest height.
-    const size_t rank = std::max<size_t>(1, size_t(std::ceil(0.1 * double(h.size()))));
-    std::nth_element(h.begin(), h.begin() + std::ptrdiff_t(rank - 1), h.end());
-    return double(h[rank - 1]);
+AutoLevel autoLevel(const Heightfield& hf) {
+    const int w = hf.width(), d = hf.depth();
+    const size_t n = size_t(w) * size_t(d);
+    const std::vector<float>& h = hf.heights();
+    AutoLevel out;
+    const size_t minCells = std::max(kMinWaterCells, n / 10000);
+    // Flat areas, each gathered from its first cell: a neighbour within the tolerance of that
+    // cell's height joins it (no drift along a gentle slope).
+    struct Surface {
+        float level;
+        size_t cells;
+    };
+    std::vector<Surface> found;
+    std::vector<uint8_t> seen(n, 0);
+    std::vector<uint32_t> stack;
+    for (size_t start = 0; start < n; ++start) {
+        if (seen[start]) continue;
+        const float level = h[start];
+        seen[start] = 1;
+        stack.assign(1, uint32_t(start));
+        size_t cells = 0;
+        bool minimum = true;
+        while (!stack.empty()) {
+            const uint32_t i = stack.back();
+            stack.pop_back();
+            ++cells;
+            const int x = int(i % uint32_t(w)), z = int(i / uint32_t(w));
+            const auto visit = [&](int nx, int nz) {
+                if (nx < 0 || nz < 0 || nx >= w || nz >= d) return;
+                const size_t j = size_t(nz) * size_t(w) + size_t(nx);
+                const float dh = h[j] - level;
+                if (dh < -kFlatTolerance) minimum = false;
+                if (seen[j] || std::abs(dh) > kFlatTolerance) return;
+                seen[j] = 1;
+                stack.push_back(uint32_t(j));
+            };
+            visit(x - 1, z);
+            visit(x + 1, z);
+            visit(x, z - 1);
+            visit(x, z + 1);
+        }
+        if (minimum && cells >= minCells) found.push_back({level, cells});
+    }
+    // A plane at a surface's level floods everything below it: keep a surface only when the dry
+    // land under its level is at most a tenth of its own area.
+    std::sort(found.begin(), found.end(), [](const Surface& a, const Surface& b) {
+        return a.cells != b.cells ? a.cells > b.cells : a.level < b.level;
+    });
+    size_t rejected = 0;
+    if (found.size() > 16) found.resize(16);
+    for (const Surface& s : found) {
+        size_t below = 0;
+        for (float v : h) below += v < s.level - kFlatTolerance;
+        if (below * 10 > s.cells) {
+            ++rejected;
+            continue;
+        }
+        out.level = double(s.level);
+        out.cells = s.cells;
+        out.share = double(s.cells) / double(n);
+        std::ostringstream line;
+        line << "a flat water surface at " << s.level << " m over " << std::setprecision(3)
+             << 100.0 * out.share << " % of the DEM's cells";
+        out.summary = line.str();
+        return out;
+    }
+    std::ostringstream line;
+    line << "the DEM shows no water surface (no flat area of at least " << minCells
+         << " cells that is a local minimum";
+    if (rejected > 0) line << " without flooding dry land below it; " << rejected << " would";
+    line << ")";
+    out.summary = line.str();
+    return out;
 }
 
-double waterLevel(const WaterSettings& settings, const Heightfield& hf) {
-    return settings.level ? *settings.level : autoLevel(hf);
+std::optional<double> waterLevel(const WaterSettings& settings, const Heightfield& hf) {
+    if (settings.level) return *settings.level;
+    return autoLevel(hf).level;
 }
 
 std::vector<float> shoreDistance(const Heightfield& hf, double level) {

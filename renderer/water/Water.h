@@ -3,6 +3,7 @@
 // and the distance to shore (docs/lighting.md, "Water"). The viewport's shaders (water.glsl)
 // evaluate the same waves; the tests hold the two to each other through these functions.
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,10 +48,22 @@ SurfacePoint gerstner(const std::vector<WaveTerms>& waves, glm::dvec2 xz, double
 // distance is 0).
 double shoreFade(double distance, double fadeDistance);
 
-// The level "auto" stands for: the 10th percentile of the DEM's heights (engine space).
-double autoLevel(const Heightfield& hf);
-// The water level in engine space (settings.level, or autoLevel).
-double waterLevel(const WaterSettings& settings, const Heightfield& hf);
+// What water.level "auto" finds (docs/lighting.md, "Water"): the water surface the DEM shows, or
+// none. DEMs store a sea or a lake as one height over the water body, so a surface is a connected
+// area of cells within kFlatTolerance of one height that is a local minimum (no neighbour lower),
+// at least kMinWaterCells cells and a ten-thousandth of the DEM, and whose level floods little dry
+// land below it (at most a tenth of its own area). Of those, the largest.
+inline constexpr float kFlatTolerance = 0.01f;  // metres
+inline constexpr size_t kMinWaterCells = 64;
+struct AutoLevel {
+    std::optional<double> level;  // engine space; unset when the DEM shows no water
+    size_t cells = 0;             // of the surface found
+    double share = 0.0;           // cells / the DEM's cells
+    std::string summary;          // one line: what was found, or that nothing was
+};
+AutoLevel autoLevel(const Heightfield& hf);
+// The water level in engine space: settings.level, or what autoLevel finds (unset: no water).
+std::optional<double> waterLevel(const WaterSettings& settings, const Heightfield& hf);
 
 // Euclidean distance in metres from every DEM vertex to the nearest land vertex (height >=
 // level), 0 on land; vertices with no land anywhere get +infinity. Row-major like the heights.

@@ -5,7 +5,8 @@
 TLX_BLOCK_BEGIN(LpvBlock, TLX_SET_SUBSYSTEM, 0)
     TLX_IVEC4(counts)     // x cascades (0: none bound), y quality, z cone-trace samples, w local lights
     TLX_VEC4(params)      // x indirect_intensity, y fade range (cells), z 1 = the LPV's light adds to
-                          // the ambient (lighting.indirect lpv or both)
+                          // the ambient (lighting.indirect lpv or both), w the LPV views' exposure:
+                          // 1 / cascade 0's light range (lpv::lightRange), 0 when it holds no light
     TLX_VEC4_ARRAY(cascades, 4)  // per cascade: xyz min corner (m), w cell size (m)
 TLX_BLOCK_END(lpv)
 

@@ -210,7 +210,7 @@ void BM_Water(benchmark::State& state) {
     Project p = fixtureProject();
     const int mode = int(state.range(0));
     p.scene.water.enabled = mode > 0;
-    p.scene.water.level = water::autoLevel(f.renderer->heightfield()) + 150.0;
+    p.scene.water.level = double(f.renderer->heightfield().minHeight()) + 150.0;
     p.scene.water.waves = water::wavePreset("choppy lake");
     p.scene.water.reflection = mode == 1 ? WaterReflection::Sky : WaterReflection::Planar;
     p.scene.water.reflectionScale = mode == 3 ? 1.0 : 0.5;

@@ -137,7 +137,7 @@ PY
     python3 - "$work/a" <<'PY' || fail "the glTF or the report does not describe the reflection files"
 import json, sys
 out = sys.argv[1]
-ext = json.load(open(out + "/scene.gltf"))["extensions"]["TERRALUX_lighting"]["reflection_probes"]
+ext = json.load(open(out + "/scene.gltf"))["scenes"][0]["extensions"]["TERRALUX_lighting"]["reflection_probes"]
 assert ext["uri"] == "reflection/probes.rprobe" and ext["probes"] == 16 and ext["simvx_probes"] == 8, ext
 assert ext["simvx_ids"] == list(range(8)) and ext["encoding"] == "cubemap" and ext["mip_count"] == 2, ext
 assert ext["enabled"] is True and ext["grid_dims"] == [4, 4], ext

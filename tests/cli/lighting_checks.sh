@@ -29,9 +29,9 @@ def close(a, b, rel=1e-6):
 
 expect("TERRALUX_lighting" in doc.get("extensionsUsed", []), "TERRALUX_lighting not in extensionsUsed")
 expect("TERRALUX_lighting" not in doc.get("extensionsRequired", []), "TERRALUX_lighting is required")
-ext = doc.get("extensions", {}).get("TERRALUX_lighting")
+ext = (doc.get("scenes") or [{}])[0].get("extensions", {}).get("TERRALUX_lighting")
 if ext is None:
-    print("FAIL: no extensions.TERRALUX_lighting")
+    print("FAIL: no scenes[0].extensions.TERRALUX_lighting")
     sys.exit(1)
 
 # The authored sections, less the keys the extension adds, are the printed project's.
@@ -76,10 +76,17 @@ elif mean_sky is not None:
            f"fog.resolved_color {fog['resolved_color']} is not the sky's mean {mean_sky}")
 
 # Water: every setting as the project prints it, the level and the waves resolved, and a water
-# node with a transmissive material; none of it without water.
+# node with a transmissive material; none of it without water, nor where "auto" found no water in
+# the DEM (resolved_level null).
 used = doc.get("extensionsUsed", [])
 water_nodes = [n for n in doc.get("nodes", []) if n.get("name") == "water"]
-if project["water"]["enabled"]:
+dry = project["water"]["enabled"] and project["water"]["level"] is None and \
+    ext.get("water", {}).get("resolved_level", 0) is None
+if dry:
+    expect(not water_nodes, "a water node where auto found no water")
+    expect("KHR_materials_transmission" not in used and "KHR_materials_ior" not in used,
+           "material extensions where auto found no water")
+elif project["water"]["enabled"]:
     w = ext.get("water")
     expect(w is not None, "no TERRALUX_lighting.water with water on")
     if w is not None:
@@ -177,11 +184,22 @@ mean=$(python3 -c 'print(",".join(str((m + 0.5) * 2.0 ** (130 - 136) * 0.5) for 
 check "$work/lit.json" "$work/lit/scene.gltf" 2 "$mean" || fail "project file: TERRALUX_lighting disagrees with --print-project"
 validate "$work/lit/scene.gltf"
 
-# The sample with a lake at its auto level, two waves, and the albedo texture beside it.
-sets=(--set water.enabled=true --set water.roughness=0.2 --set water.depth_aware=true --set bake.error_map_resolution=0
+# The sample with a lake at 800 m (its valleys are at 529 m), two waves, and the albedo texture beside it.
+sets=(--set water.enabled=true --set water.level=800 --set water.roughness=0.2 --set water.depth_aware=true --set bake.error_map_resolution=0
       --set 'water.waves=[{"direction_deg":60,"wavelength":30,"steepness":0.2},{"wavelength":7,"amplitude":0.15,"phase":2}]')
 "$terralux" --print-project "${sets[@]}" >"$work/lake.json" || fail "--print-project of the lake exited $?"
 "$terralux" --bake --quiet --quality draft "${sets[@]}" --out "$work/lake" >/dev/null || fail "bake of the lake exited $?"
 check "$work/lake.json" "$work/lake/scene.gltf" 4 0.09,0.11,0.15 || fail "lake: TERRALUX_lighting or the water node disagrees with --print-project"
 validate "$work/lake/scene.gltf"
+
+# "auto" on the sample, a dry range: no water surface in the DEM, so none is baked or exported,
+# the level resolves to null, and the bake says why on stderr.
+sets=(--set water.enabled=true --set bake.error_map_resolution=0)
+"$terralux" --print-project "${sets[@]}" >"$work/dry.json" || fail "--print-project of the dry lake exited $?"
+"$terralux" --bake --quality draft "${sets[@]}" --out "$work/dry" >/dev/null 2>"$work/dry.err" ||
+  fail "bake of the dry lake exited $?"
+grep -q "^terralux: warning: water.level auto: the DEM shows no water surface" "$work/dry.err" ||
+  fail "no warning for auto water on a dry DEM: $(cat "$work/dry.err")"
+check "$work/dry.json" "$work/dry/scene.gltf" 4 0.09,0.11,0.15 || fail "dry: the water was exported where auto found none"
+validate "$work/dry/scene.gltf"
 echo "ok"

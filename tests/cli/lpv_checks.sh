@@ -52,7 +52,7 @@ for (name, text), (_, value) in zip(pairs, expected):
     expect(float(text) == float(value), f"{name}={text}, project {value}")
 expect(f"; IndirectLightingIntensity={lpv['indirect_intensity']}" in ini, "no IndirectLightingIntensity comment")
 
-ext = doc["extensions"]["TERRALUX_lighting"]
+ext = doc["scenes"][0]["extensions"]["TERRALUX_lighting"]
 authored = {k: v for k, v in ext["lpv"].items()
             if k not in ("console_variables", "ini_uri") and not k.startswith("computed_")}
 expect(authored == lpv, f"TERRALUX_lighting.lpv {authored} != {lpv}")

@@ -289,8 +289,8 @@ void checkGolden(const std::string& stem, const RenderedImage& img) {
 
 TEST_F(RenderTest, GoldenImagesOfEveryView) {
     Project p = sampleProject("golden", 8, 8);
-    // The LPV views draw the volumes whatever lpv.enabled says; light carried across the cascades
-    // and four times as strong reads in 8 bits (no other view reads these settings).
+    // The LPV views draw the volumes whatever lpv.enabled says, here with light carried across the
+    // cascades; they expose for their own light (no other view reads these settings).
     p.scene.lpv.propagationWeight = 1.0;
     p.scene.lpv.indirectIntensity = 4.0;
     ProjectRenderer r(*ctx_, p);
@@ -875,7 +875,7 @@ TEST_F(RenderTest, FarTerrainIsFoggierThanNearTerrain) {
     Project p = sampleProject("fog", 8, 8);
     p.scene.fog.enabled = true;
     // Fog the same at every height: the amount then grows with distance alone.
-    p.scene.fog.heightFalloff = 0.0;
+    p.scene.fog.scaleHeight = 0.0;
     p.scene.fog.density = 1e-4;
     p.scene.camera.elevationDeg = 15.0;
     ProjectRenderer r(*ctx_, p);
@@ -1662,6 +1662,69 @@ TEST_F(RenderTest, LpvViewsDifferFromEachOtherAndShowTheVolumes) {
     draw(r, kViewBeauty);
     for (const PassInfo& pass : r.renderer().lastFramePasses())
         for (const std::string& b : pass.bindings) EXPECT_NE(b, "lpv-light") << pass.name;
+}
+
+// At usable settings (the seed's weight and intensity, cascade 0 of 4 km, two cascades, quality 2,
+// ratio 3) the LPV views were black: a mean of 1.1/255, and 61 and 64 apart by 0.003/255. They
+// now show E/π over cascade 0's light range, the same scale for both, whatever the intensity.
+TEST_F(RenderTest, LpvViewsShowTheirLightAtTheSeedsDefaults) {
+    Project p = sampleProject("lpv_exposure", 8, 8);
+    p.scene.lpv.size = 4000.0;
+    p.scene.lpv.cascades = 2;
+    p.scene.lpv.quality = 2;
+    p.scene.lpv.cascadeRatio = 3.0;
+    // Close enough that the finer cascade (1.3 km, centred ahead of the camera) reaches the ground.
+    p.scene.camera.radius = 900.0;
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    const std::vector<size_t> terrain = terrainPixels(r);
+    const RenderedImage c0 = draw(r, kViewLpvCascade0);
+    const RenderedImage all = draw(r, kViewLpvAll);
+    const std::optional<double> range = r.renderer().lpvViewRange();
+    ASSERT_TRUE(range.has_value());
+    auto terrainMean = [&](const RenderedImage& img) {
+        double sum = 0;
+        for (size_t i : terrain) sum += (img.rgba[i * 4] + img.rgba[i * 4 + 1] + img.rgba[i * 4 + 2]) / 3.0;
+        return sum / double(terrain.size());
+    };
+    auto terrainDiff = [&](const RenderedImage& a, const RenderedImage& b) {
+        double sum = 0;
+        for (size_t i : terrain)
+            for (int c = 0; c < 3; ++c) sum += std::abs(a.rgba[i * 4 + c] - b.rgba[i * 4 + c]) / 3.0;
+        return sum / double(terrain.size());
+    };
+    std::cout << "lpv views: range " << *range << " W/(m2 sr); terrain mean 61 " << terrainMean(c0) * 255.0 << "/255, 64 "
+              << terrainMean(all) * 255.0 << "/255, apart " << terrainDiff(c0, all) * 255.0 << "/255\n";
+    EXPECT_GT(terrainMean(c0), 20.0 / 255.0);
+    EXPECT_GT(terrainMean(all), 20.0 / 255.0);
+    // Where the finer cascade covers the ground it adds its detail: the views tell them apart there.
+    size_t apart = 0;
+    double most = 0;
+    for (size_t i : terrain) {
+        double d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, double(std::abs(c0.rgba[i * 4 + c] - all.rgba[i * 4 + c])));
+        apart += d > 8.0 / 255.0;
+        most = std::max(most, d);
+    }
+    std::cout << "lpv views: " << apart << " of " << terrain.size() << " terrain pixels apart by more than 8/255, most "
+              << most * 255.0 << "/255\n";
+    EXPECT_GT(double(apart), 0.02 * double(terrain.size()));
+    // EXR keeps the physical E/π; the PNG is that over the range through the display curve
+    // (tonemap.glsl: ACES fit, then sRGB), not the camera's exposure.
+    const RenderedImage linear = draw(r, kViewLpvAll, true, true);
+    auto shown = [](double x) {
+        const double a = std::clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+        return a <= 0.0031308 ? 12.92 * a : 1.055 * std::pow(a, 1.0 / 2.4) - 0.055;
+    };
+    double off = 0;
+    for (size_t i : terrain) off += std::abs(shown(linear.rgba[i * 4 + 1] / *range) - all.rgba[i * 4 + 1]);
+    EXPECT_LT(off / double(terrain.size()), 0.5 / 255.0);
+    // The exposure follows the light: four times the intensity draws the same PNG.
+    p.scene.lpv.indirectIntensity = 4.0;
+    r.setProject(p);
+    const RenderedImage brighter = draw(r, kViewLpvAll);
+    EXPECT_NEAR(*r.renderer().lpvViewRange(), 4.0 * *range, 1e-6 * *range);
+    EXPECT_LT(terrainDiff(brighter, all), 1.0 / 255.0);
 }
 
 TEST_F(RenderTest, IndirectNoneEqualsTheImageWithoutIndirectLight) {

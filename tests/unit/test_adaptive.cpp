@@ -383,6 +383,16 @@ TEST(AdaptivePlacement, SettingsTheTerrainDecidesAreChecked) {
                               std::to_string(unlimited.fileBytes()) +
                               " bytes, more than adaptive.max_bytes = 1000; raise it, "
                               "adaptive.min_cell_size or adaptive.surface_cell_size");
+    // One cap per placement: an adaptive volume holds at most kMaxVolumeProbes valid probes, as a
+    // box grid holds that many cells, whether adaptive.max_probes is set or not.
+    v = adaptive(1.0, 4.0);
+    v.name = "dense";
+    v.adaptive.size = glm::vec3(300.0f, 8.0f, 300.0f);
+    v.origin = glm::vec3(-150.0f, -4.0f, -150.0f);
+    const std::string dense = message(v);
+    EXPECT_NE(dense.find("probe_volumes 'dense': the surface band alone needs "), std::string::npos) << dense;
+    EXPECT_NE(dense.find(" probes, more than an adaptive volume's limit of 65536; raise adaptive.min_cell_size"),
+              std::string::npos) << dense;
     v = adaptive(30.0, 120.0);
     v.name = "band";
     v.adaptive.surfaceCellSize = 20.0;

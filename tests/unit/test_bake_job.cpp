@@ -3,8 +3,12 @@
 // and whether the reported Monte Carlo standard error is the error a bake really has.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <sys/stat.h>
 
 #include "BakeJob.h"
 #include "DemImport.h"
@@ -311,6 +315,28 @@ TEST(BakeCost, PresetsAreOrderedByRaysTracedOnSmallAndLargeGrids) {
     fs::remove_all(dir);
 }
 
+// The report's file times are Unix nanoseconds (what stat(2) and every other tool print), not
+// the C++ library's file clock, whose epoch is another.
+TEST(BakeJob, InputFileTimesAreUnixNanoseconds) {
+    const fs::path dir = tempDir("mtime");
+    fs::create_directories(dir);
+    const fs::path dem = dir / "dem.tif";
+    fs::copy_file(kCrop, dem);
+    const struct timespec times[2] = {{1795651200, 123456789}, {1795651200, 123456789}};  // 2026-11-26
+    ASSERT_EQ(::utimensat(AT_FDCWD, dem.c_str(), times, 0), 0);
+    Project p;
+    p.scene.terrain.dem = dem.string();
+    const nlohmann::json inputs = bakeInputs(p);
+    EXPECT_EQ(inputs["files"]["dem"]["modified_ns"].get<int64_t>(), 1795651200123456789);
+    // Touching the file makes the bake stale through the same field.
+    const struct timespec later[2] = {{1795651260, 0}, {1795651260, 0}};
+    ASSERT_EQ(::utimensat(AT_FDCWD, dem.c_str(), later, 0), 0);
+    const std::vector<std::string> diff = bakeInputDifferences(inputs, bakeInputs(p));
+    ASSERT_EQ(diff.size(), 1u);
+    EXPECT_NE(diff[0].find("modified_ns"), std::string::npos) << diff[0];
+    fs::remove_all(dir);
+}
+
 // Ambient occlusion is drawn over the probes by the renderer: editing it leaves a bake current.
 TEST(BakeJob, AmbientOcclusionIsNotABakeInput) {
     Project a, b;
@@ -364,20 +390,50 @@ TEST(BakeJob, WaterInTheInputsIsWhatTheBakeReads) {
 }
 
 TEST(BakeJob, WaterResolvesItsLevelOnTheTerrain) {
-    const Heightfield hf(10, 10, 5.0, 5.0, [] {
-        std::vector<float> h(100);
-        for (int i = 0; i < 100; ++i) h[size_t(i)] = float(i + 1);
+    // A slope with a flat pool at 10 m in its low corner (16 of its 144 cells).
+    const Heightfield hf(12, 12, 5.0, 5.0, [] {
+        std::vector<float> h(144);
+        for (int z = 0; z < 12; ++z)
+            for (int x = 0; x < 12; ++x) h[size_t(z) * 12 + size_t(x)] = x < 4 && z < 4 ? 10.0f : float(12 + x + z);
         return h;
     }());
     Project p;
     EXPECT_FALSE(bakeWaterOf(p, hf));
     p.scene.water.enabled = true;
     p.scene.water.color = glm::vec3(0.1f, 0.2f, 0.3f);
-    ASSERT_TRUE(bakeWaterOf(p, hf));
-    EXPECT_EQ(bakeWaterOf(p, hf)->level, 10.0f);  // the lowest decile
-    EXPECT_EQ(bakeWaterOf(p, hf)->scatter, glm::vec3(0.1f, 0.2f, 0.3f));
+    // Auto: a 16-cell pool is below the 64 cells a water surface needs, so none is found.
+    EXPECT_FALSE(bakeWaterOf(p, hf));
     p.scene.water.level = 42.5;
+    ASSERT_TRUE(bakeWaterOf(p, hf));
     EXPECT_EQ(bakeWaterOf(p, hf)->level, 42.5f);
+    EXPECT_EQ(bakeWaterOf(p, hf)->scatter, glm::vec3(0.1f, 0.2f, 0.3f));
+    // A pool of 64 cells is the water the DEM shows.
+    const Heightfield pool(24, 24, 5.0, 5.0, [] {
+        std::vector<float> h(576);
+        for (int z = 0; z < 24; ++z)
+            for (int x = 0; x < 24; ++x) h[size_t(z) * 24 + size_t(x)] = x < 8 && z < 8 ? 10.0f : float(12 + x + z);
+        return h;
+    }());
+    p.scene.water.level.reset();
+    ASSERT_TRUE(bakeWaterOf(p, pool));
+    EXPECT_EQ(bakeWaterOf(p, pool)->level, 10.0f);
+}
+
+// A bake whose water is "auto" on a DEM that shows none says so, and bakes and exports no water.
+TEST(BakeJob, AutoWaterOnADryDemIsNoneAndSaysSo) {
+    const fs::path dir = tempDir("dry_auto");
+    Project p = cropProject(dir, 4);
+    p.scene.bake.quality = QualityPreset::Draft;
+    p.scene.water.enabled = true;
+    p.scene.exportSettings.gltf = true;
+    const BakeOutcome out = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    ASSERT_EQ(out.warnings.size(), 1u);
+    EXPECT_EQ(out.warnings[0].rfind("water.level auto: the DEM shows no water surface", 0), 0u) << out.warnings[0];
+    std::ifstream gltf(dir / "scene.gltf");
+    const nlohmann::json doc = nlohmann::json::parse(gltf);
+    for (const auto& node : doc["nodes"]) EXPECT_NE(node.value("name", ""), "water");
+    EXPECT_TRUE(doc["scenes"][0]["extensions"]["TERRALUX_lighting"]["water"]["resolved_level"].is_null());
+    fs::remove_all(dir);
 }
 
 // A whole bake over a lake: the probes over the water see it, and the report counts those that

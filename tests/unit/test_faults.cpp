@@ -11,15 +11,19 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "AtomicFile.h"
 #include "FaultInjection.h"
 #include "GltfExport.h"
+#include "ImageFile.h"
 #include "OutputFolder.h"
 #include "Project.h"
 #include "ShProbeFile.h"
@@ -216,7 +220,8 @@ TEST_F(Faults, OneBakePerFolder) {
     {
         const OutputFolderLock held(out);
         ASSERT_TRUE(fs::is_directory(out));
-        EXPECT_EQ(readText(out / ".terralux.lock"), std::to_string(::getpid()) + "\n");
+        // The lock is on the folder: nothing lands in the export.
+        EXPECT_TRUE(fs::is_empty(out));
         // flock locks belong to the open file, so a second lock conflicts within one process too.
         const std::string msg = errorOf([&] { OutputFolderLock again(out); });
         EXPECT_EQ(msg, out.string() + ": another bake is writing here (pid " +
@@ -247,12 +252,42 @@ TEST_F(Faults, ADeadHoldersLockDoesNotBlock) {
     ASSERT_EQ(::read(ready[0], &c, 1), 1);
     EXPECT_NE(errorOf([&] { OutputFolderLock busy(out); }).find("(pid " + std::to_string(child) + ")"),
               std::string::npos);
+    EXPECT_TRUE(fs::is_empty(out));
     ::kill(child, SIGKILL);
     ::waitpid(child, nullptr, 0);
-    EXPECT_TRUE(fs::exists(out / ".terralux.lock"));
+    // The killed holder left nothing in the folder, and its lock went with it.
+    EXPECT_TRUE(fs::is_empty(out));
     EXPECT_EQ(errorOf([&] { OutputFolderLock mine(out); }), "");
     ::close(ready[0]);
     ::close(ready[1]);
+}
+
+// Every output is the same bytes from run to run: an EXR too, which OpenImageIO would otherwise
+// stamp with the second it was written.
+TEST_F(Faults, AnExrIsTheSameBytesWhenWrittenAgain) {
+    std::vector<float> rgba(8 * 4 * 4, 0.25f);
+    writeImage(dir / "a.exr", 8, 4, rgba);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+    writeImage(dir / "b.exr", 8, 4, rgba);
+    EXPECT_EQ(readText(dir / "a.exr"), readText(dir / "b.exr"));
+    uint32_t w = 0, h = 0;
+    EXPECT_EQ(readImageRgba(dir / "b.exr", w, h), rgba);
+}
+
+// The lock file an earlier version's killed bake left is removed; a locked one is kept.
+TEST_F(Faults, ALegacyLockFileIsRemovedUnlessHeld) {
+    const fs::path out = dir / "out";
+    fs::create_directories(out);
+    { std::ofstream(out / ".terralux.lock") << "12345\n"; }
+    { const OutputFolderLock mine(out); }
+    EXPECT_FALSE(fs::exists(out / ".terralux.lock"));
+    { std::ofstream(out / ".terralux.lock") << "12345\n"; }
+    const int held = ::open((out / ".terralux.lock").c_str(), O_RDWR);
+    ASSERT_GE(held, 0);
+    ASSERT_EQ(::flock(held, LOCK_EX | LOCK_NB), 0);
+    { const OutputFolderLock mine(out); }
+    EXPECT_TRUE(fs::exists(out / ".terralux.lock"));
+    ::close(held);
 }
 
 TEST_F(Faults, RemovesWhatDeadWritersLeft) {

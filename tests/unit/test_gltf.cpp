@@ -230,7 +230,11 @@ TEST_F(GltfExport, WritesTheLayoutAndTheContract) {
     // Our own extensions.
     const json doc = readJson(dir / "scene.gltf");
     EXPECT_FALSE(doc.contains("extensionsRequired"));
-    const json& geo = doc["extensions"]["TERRALUX_geo"];
+    // Seed 001's extension and ours are scene-level: in the default scene, none at the root.
+    ASSERT_EQ(doc["scene"], 0);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"], entries);
+    EXPECT_FALSE(doc.contains("extensions"));
+    const json& geo = doc["scenes"][0]["extensions"]["TERRALUX_geo"];
     EXPECT_EQ(geo["crs"], hf.geo.crsWkt);
     EXPECT_EQ(geo["crsName"], "WGS 84 / UTM zone 31N");
     EXPECT_EQ(geo["epsg"], 32631);
@@ -241,9 +245,9 @@ TEST_F(GltfExport, WritesTheLayoutAndTheContract) {
     EXPECT_EQ(geo["cellSize"], json({2.0, 3.0}));
     EXPECT_EQ(geo["gridSize"], json({5, 4}));
     EXPECT_EQ(geo["meshStride"], 1);
-    EXPECT_EQ(doc["extensions"]["TERRALUX_bake"], in.bake);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_bake"], in.bake);
     // No lighting given, no lighting extension.
-    EXPECT_FALSE(doc["extensions"].contains("TERRALUX_lighting"));
+    EXPECT_FALSE(doc["scenes"][0]["extensions"].contains("TERRALUX_lighting"));
     EXPECT_EQ(std::count(m.extensionsUsed.begin(), m.extensionsUsed.end(), "TERRALUX_lighting"), 0);
 
     // One node with the terrain mesh in the default scene.
@@ -308,7 +312,7 @@ TEST_F(GltfExport, LightingIsWrittenVerbatimAsAnOptionalExtension) {
                    {"exposure_ev", -0.5}};
     exportGltfScene(dir, in);
     const json doc = readJson(dir / "scene.gltf");
-    EXPECT_EQ(doc["extensions"]["TERRALUX_lighting"], in.lighting);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_lighting"], in.lighting);
     EXPECT_EQ(doc["extensionsUsed"], json({"VULKAN_SCHNEE_engine_properties", "TERRALUX_geo",
                                            "TERRALUX_bake", "TERRALUX_lighting"}));
     EXPECT_FALSE(doc.contains("extensionsRequired"));
@@ -342,8 +346,8 @@ TEST_F(GltfExport, VertexBudgetTakesEveryKthLineAndKeepsTheLast) {
     // Stride 2 needs 151 x 101 = 15251 vertices; stride 3 needs 101 x 68 = 6868
     // (columns 0, 3, ..., 297, 299 and rows 0, 3, ..., 198, 199).
     const json doc = readJson(dir / "scene.gltf");
-    EXPECT_EQ(doc["extensions"]["TERRALUX_geo"]["meshStride"], 3);
-    EXPECT_EQ(doc["extensions"]["TERRALUX_geo"]["gridSize"], json({300, 200}));
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_geo"]["meshStride"], 3);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_geo"]["gridSize"], json({300, 200}));
     Loaded l = load(dir / "scene.gltf");
     ASSERT_TRUE(l.ok) << l.err;
     EXPECT_EQ(l.warn, "");
@@ -370,7 +374,7 @@ TEST_F(GltfExport, VertexBudgetTakesEveryKthLineAndKeepsTheLast) {
     // Within budget: full resolution.
     in.meshMaxVertices = 60000;
     exportGltfScene(dir, in);
-    EXPECT_EQ(readJson(dir / "scene.gltf")["extensions"]["TERRALUX_geo"]["meshStride"], 1);
+    EXPECT_EQ(readJson(dir / "scene.gltf")["scenes"][0]["extensions"]["TERRALUX_geo"]["meshStride"], 1);
     EXPECT_EQ(readJson(dir / "scene.gltf")["accessors"][0]["count"], 60000);
 }
 
@@ -517,7 +521,7 @@ TEST_F(GltfExport, HeightfieldsWithoutTrianglesExportAMeshlessScene) {
         EXPECT_TRUE(l.model.buffers.empty());
         EXPECT_TRUE(l.model.accessors.empty());
         EXPECT_EQ(readShProbeGridEntries(dir / "scene.gltf").size(), 2u);
-        const json geo = readJson(dir / "scene.gltf")["extensions"]["TERRALUX_geo"];
+        const json geo = readJson(dir / "scene.gltf")["scenes"][0]["extensions"]["TERRALUX_geo"];
         EXPECT_EQ(geo["gridSize"], json({w, d}));
         EXPECT_EQ(geo["meshStride"], 1);
     }
@@ -599,7 +603,7 @@ TEST_F(GltfExport, TheMeshIsTheTracedSurfaceAboveAMillionVertices) {
     GltfSceneInput in = sampleInput(hf);
     exportGltfScene(dir, in);
     const json doc = readJson(dir / "scene.gltf");
-    EXPECT_EQ(doc["extensions"]["TERRALUX_geo"]["meshStride"], 1);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_geo"]["meshStride"], 1);
     const json& prim = doc["meshes"][0]["primitives"][0];
     const json& position = doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
     EXPECT_EQ(position["count"], 1100 * 1000);

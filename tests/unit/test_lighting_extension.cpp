@@ -208,7 +208,7 @@ TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {
     const json& used = doc["extensionsUsed"];
     EXPECT_NE(std::find(used.begin(), used.end(), "TERRALUX_lighting"), used.end());
     EXPECT_FALSE(doc.contains("extensionsRequired"));
-    EXPECT_EQ(doc["extensions"]["TERRALUX_lighting"], in.lighting);
+    EXPECT_EQ(doc["scenes"][0]["extensions"]["TERRALUX_lighting"], in.lighting);
 
     tinygltf::TinyGLTF loader;
     tinygltf::Model model;
@@ -216,7 +216,9 @@ TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {
     EXPECT_TRUE(loader.LoadASCIIFromFile(&model, &err, &warn, (dir / "scene.gltf").string())) << err;
     EXPECT_EQ(warn, "");
     EXPECT_TRUE(model.extensionsRequired.empty());
-    EXPECT_TRUE(model.extensions.count("TERRALUX_lighting"));
+    ASSERT_EQ(model.scenes.size(), 1u);
+    EXPECT_TRUE(model.scenes[0].extensions.count("TERRALUX_lighting"));
+    EXPECT_FALSE(model.extensions.count("TERRALUX_lighting"));
     fs::remove_all(dir);
 }
 
@@ -235,10 +237,17 @@ TEST(LightingExtension, WaterIsEverySettingWithTheLevelAndTheWavesResolved) {
     for (json& wave : authored.at("waves")) wave = authoredPart(wave);
     EXPECT_EQ(authored, printed);
     EXPECT_EQ(w["depth_aware"], true);
-    // The auto level resolves to the lowest decile of the terrain, in metres.
+    // This rolling terrain shows no water surface: the auto level resolves to none (null).
     EXPECT_TRUE(w["level"].is_null());
-    EXPECT_EQ(w["resolved_level"].get<double>(), shortestDecimal(float(water::autoLevel(hf))));
-    EXPECT_GT(w["resolved_level"].get<double>(), hf.minHeight());
+    EXPECT_FALSE(water::autoLevel(hf).level.has_value());
+    EXPECT_TRUE(w["resolved_level"].is_null());
+    // A flat lake in it resolves to the lake's surface, in metres.
+    std::vector<float> lake = hf.heights();
+    for (int r = 5; r < 25; ++r)
+        for (int c = 25; c < 40; ++c) lake[size_t(r) * 40 + size_t(c)] = std::min(lake[size_t(r) * 40 + size_t(c)], 140.5f);
+    const Heightfield withLake(40, 30, 25.0, 25.0, lake);
+    ASSERT_TRUE(water::autoLevel(withLake).level.has_value());
+    EXPECT_EQ(lightingExtension(p, withLake).at("water")["resolved_level"].get<double>(), 140.5);
     // Each wave: unit direction (x, z), amplitude, k = 2π/λ and the deep-water ω = √(g·k).
     const json& east = w["waves"][0];
     EXPECT_NEAR(east["resolved_direction"][0].get<double>(), 1.0, 1e-15);

@@ -98,7 +98,8 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"probe_volumes[0].adaptive.surface_band=-2", "p.json: probe_volumes[0].adaptive.surface_band = -2: must be in [0, 1000000] or null"},
         Rule{"probe_volumes[0].adaptive.tolerance=0", "p.json: probe_volumes[0].adaptive.tolerance = 0: must be in (0, 1] or null"},
         Rule{"probe_volumes[0].adaptive.tolerance=1.5", "p.json: probe_volumes[0].adaptive.tolerance = 1.5: must be in (0, 1] or null"},
-        Rule{"probe_volumes[0].adaptive.max_probes=0", "p.json: probe_volumes[0].adaptive.max_probes = 0: must be in [1, 2147483647] or null"},
+        Rule{"probe_volumes[0].adaptive.max_probes=0", "p.json: probe_volumes[0].adaptive.max_probes = 0: must be in [1, 65536] or null"},
+        Rule{"probe_volumes[0].adaptive.max_probes=70000", "p.json: probe_volumes[0].adaptive.max_probes = 70000: must be in [1, 65536] or null"},
         Rule{"probe_volumes[0].adaptive.max_bytes=2.5", "p.json: probe_volumes[0].adaptive.max_bytes = 2.5: must be an integer"},
         Rule{"probe_volumes[0].adaptive.max_bytes=0", "p.json: probe_volumes[0].adaptive.max_bytes = 0: must be in [1, 9007199254740992] or null"},
         Rule{"probe_volumes[0].adaptive.max_move_share=0.6", "p.json: probe_volumes[0].adaptive.max_move_share = 0.6: must be in [0, 0.5]"},
@@ -133,7 +134,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=3", "p.json: version = 3: is newer than this Terralux reads (2); open it with a newer Terralux"},
+        Rule{"version=4", "p.json: version = 4: is newer than this Terralux reads (3); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -472,7 +473,7 @@ TEST(ProjectVersions, VersionOneWithoutAnAlbedoModeKeepsItsConstantAlbedo) {
     const json v1 = {{"format", "terralux-project"}, {"version", 1}, {"terrain", {{"albedo", {0.4, 0.35, 0.3}}}}};
     std::vector<std::string> notes;
     const json migrated = migrateProjectJson(v1, "old.json", &notes);
-    EXPECT_EQ(migrated["version"], 2);
+    EXPECT_EQ(migrated["version"], kProjectVersion);
     EXPECT_EQ(migrated["terrain"]["albedo_mode"], "constant");
     ASSERT_EQ(notes.size(), 1u);
     EXPECT_EQ(notes[0], "old.json: version 1 migrated to 2: terrain.albedo_mode set to \"constant\", what version 1 drew without it");
@@ -503,6 +504,38 @@ TEST(ProjectVersions, VersionOneGroundColourBecomesAnAlbedo) {
     json v2 = v1;
     v2["version"] = 2;
     EXPECT_THROW(sceneFromJson(v2, "new.json", nullptr), ProjectError);
+}
+
+// Version 2 wrote the fog's falloff as 1/m (its default 1/1200 printed as 0.0008333333333333334);
+// version 3 writes the scale height in metres, and an older file keeps its fog.
+TEST(ProjectVersions, VersionTwoFogFalloffBecomesAScaleHeight) {
+    const json v2 = {{"version", 2}, {"fog", {{"height_falloff", 0.002}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v2, "old.json", &notes);
+    EXPECT_DOUBLE_EQ(s.fog.scaleHeight, 500.0);
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], "old.json: version 2 migrated to 3: fog.height_falloff 0.002 is fog.scale_height 500.0 m");
+    json uniform = v2;
+    uniform["fog"]["height_falloff"] = 0.0;
+    EXPECT_EQ(sceneFromJson(uniform, "old.json", nullptr).fog.scaleHeight, 0.0);
+    // The old default is the new one, and the new file prints a number a person would type.
+    json old = v2;
+    old["fog"]["height_falloff"] = 1.0 / 1200.0;
+    EXPECT_NEAR(sceneFromJson(old, "old.json", nullptr).fog.scaleHeight, 1200.0, 1e-9);
+    EXPECT_EQ(defaultProjectJson()["fog"]["scale_height"], 1200.0);
+    EXPECT_FALSE(defaultProjectJson()["fog"].contains("height_falloff"));
+    // The old key in a current file is unknown; a bad old value is named under the new key.
+    json current = v2;
+    current["version"] = kProjectVersion;
+    EXPECT_THROW(sceneFromJson(current, "new.json", nullptr), ProjectError);
+    json bad = v2;
+    bad["fog"]["height_falloff"] = "steep";
+    try {
+        sceneFromJson(bad, "old.json", nullptr);
+        ADD_FAILURE() << "a string falloff was accepted";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("fog.scale_height"), std::string::npos) << e.what();
+    }
 }
 
 TEST(ProjectVersions, SavingWritesTheCurrentVersion) {

@@ -126,6 +126,42 @@ TEST(ReflectionPlacement, AutoSpanPutsTheEndProbesOnTheEdgesAndOneProbeAtTheCent
     EXPECT_FLOAT_EQ(one.cellSize.y, 320.0f);
 }
 
+// Seed 000's 2 · min(spacing), one rule for both kinds of grid: a one-probe axis counts the width its
+// probe stands for (the footprint's extent along it), so a 1×1 diffuse volume and a 1×1 reflection
+// grid on the same terrain fade over the same distance, and so do 1×N grids.
+TEST(ReflectionPlacement, FallbackBlendIsTheDiffuseVolumesRule) {
+    std::vector<float> h(41 * 21, 3.0f);
+    const Heightfield hf(41, 21, 10.0, 20.0, std::move(h));  // 400 m × 400 m
+    std::vector<float> h2(41 * 11, 3.0f);
+    const Heightfield wide(41, 11, 10.0, 20.0, std::move(h2));  // 400 m × 200 m
+    for (const Heightfield* t : {&hf, &wide}) {
+        const float spanX = t->maxX() - t->minX(), spanZ = t->maxZ() - t->minZ();
+        for (const auto& [nx, nz] : {std::pair{1, 1}, std::pair{1, 5}, std::pair{5, 1}, std::pair{5, 3}}) {
+            ReflectionProbeSettings r;
+            r.gridDims = {nx, nz};
+            ProbeVolumeSettings v;
+            v.gridDims = {nx, 1, nz};
+            const float rd = placeReflectionProbes(r, *t).blendDistance;
+            const float dd = placeProbes(v, *t).fallbackBlendDistance;
+            const float sx = nx > 1 ? spanX / float(nx - 1) : spanX, sz = nz > 1 ? spanZ / float(nz - 1) : spanZ;
+            EXPECT_FLOAT_EQ(rd, 2.0f * std::min(sx, sz)) << nx << "x" << nz;
+            EXPECT_FLOAT_EQ(dd, rd) << nx << "x" << nz;
+        }
+    }
+    // An explicit spacing on a one-probe axis places nothing, so it is not that axis' spacing.
+    ProbeVolumeSettings v;
+    v.gridDims = {1, 1, 1};
+    v.spacing = glm::vec3(10.0f);
+    EXPECT_FLOAT_EQ(placeProbes(v, wide).fallbackBlendDistance, 2.0f * 200.0f);
+    // Set, it is taken as it is by both.
+    v.fallbackBlendDistance = 7.0;
+    ReflectionProbeSettings r;
+    r.gridDims = {1, 1};
+    r.fallbackBlendDistance = 7.0;
+    EXPECT_FLOAT_EQ(placeProbes(v, wide).fallbackBlendDistance, 7.0f);
+    EXPECT_FLOAT_EQ(placeReflectionProbes(r, wide).blendDistance, 7.0f);
+}
+
 TEST(ReflectionPlacement, BoxFollowsTheDocumentedRule) {
     std::vector<float> h(33 * 33);
     for (int z = 0; z < 33; ++z)

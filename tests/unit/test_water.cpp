@@ -310,23 +310,51 @@ TEST(WaterShore, OneIslandAndTheEdgeCases) {
     EXPECT_EQ(shoreDistance(column, 0.0), (std::vector<float>{15.0f, 10.0f, 5.0f, 0.0f}));
 }
 
-TEST(WaterLevel, AutoIsTheLowestDecile) {
-    // 1..100 in any order: the ⌈0.1·100⌉ = 10th smallest.
-    std::vector<float> h(100);
-    for (int i = 0; i < 100; ++i) h[size_t(i)] = float(i + 1);
-    std::shuffle(h.begin(), h.end(), std::mt19937(3));
-    const Heightfield hf(10, 10, 5.0, 5.0, h);
-    EXPECT_EQ(autoLevel(hf), 10.0);
-    // 12 samples: the ⌈1.2⌉ = 2nd smallest.
-    const Heightfield small(4, 3, 1.0, 1.0, {9, 3, 7, -2, 8, 4, 6, 5, 11, 10, 12, 0});
-    EXPECT_EQ(autoLevel(small), 0.0);
-    const Heightfield flat(3, 3, 1.0, 1.0, std::vector<float>(9, 42.5f));
-    EXPECT_EQ(autoLevel(flat), 42.5);
-    // The level: as set, else auto.
+// "auto" is the water the DEM shows: a sea or lake is stored as one height over the water body,
+// so the level is the largest flat area that is a local minimum; a dry DEM gets no water at all
+// (the lowest decile of a dry Pyrenean tile put a lake over 10 % of it).
+TEST(WaterLevel, AutoFindsTheWaterTheDemShowsOrNone) {
+    // A valley sloping down to the south-east: no flat area, no water.
+    const int w = 60, d = 50;
+    std::vector<float> valley(size_t(w) * d);
+    for (int z = 0; z < d; ++z)
+        for (int x = 0; x < w; ++x) valley[size_t(z) * w + size_t(x)] = float(0.02 * (x - 30) * (x - 30) + 0.7 * z + 400.0);
+    const Heightfield dry(w, d, 30.0, 30.0, valley);
+    const AutoLevel none = autoLevel(dry);
+    EXPECT_FALSE(none.level.has_value());
+    EXPECT_EQ(none.summary, "the DEM shows no water surface (no flat area of at least 64 cells that is a local minimum)");
     WaterSettings s;
-    EXPECT_EQ(waterLevel(s, hf), 10.0);
+    EXPECT_FALSE(waterLevel(s, dry).has_value());
     s.level = -3.5;
-    EXPECT_EQ(waterLevel(s, hf), -3.5);
+    EXPECT_EQ(waterLevel(s, dry), -3.5);
+
+    // A reservoir: the valley's floor flooded to 412 m, stored flat (to the centimetre).
+    std::vector<float> lake = valley;
+    for (float& v : lake) v = std::max(v, 412.0f);
+    const Heightfield reservoir(w, d, 30.0, 30.0, lake);
+    AutoLevel found = autoLevel(reservoir);
+    ASSERT_TRUE(found.level.has_value());
+    EXPECT_EQ(*found.level, 412.0);
+    size_t flooded = 0;
+    for (float v : lake) flooded += v == 412.0f;
+    EXPECT_EQ(found.cells, flooded);
+    EXPECT_NE(found.summary.find("a flat water surface at 412 m over "), std::string::npos) << found.summary;
+    EXPECT_EQ(waterLevel(WaterSettings{}, reservoir), 412.0);
+
+    // A sea along the south edge at 0 m (SRTM's sea), land rising from it: level 0.
+    std::vector<float> coast(size_t(w) * d);
+    for (int z = 0; z < d; ++z)
+        for (int x = 0; x < w; ++x) coast[size_t(z) * w + size_t(x)] = z >= 40 ? 0.0f : float(3.0 * (40 - z) + 0.1 * x);
+    EXPECT_EQ(autoLevel(Heightfield(w, d, 90.0, 90.0, coast)).level, 0.0);
+
+    // A mountain tarn above a dry valley: a flat corner at 421 m behind a 430 m rim. A plane at its
+    // level would flood the valley below it, so it is not the water level.
+    std::vector<float> tarn = valley;
+    for (int z = 0; z <= 10; ++z)
+        for (int x = 0; x <= 10; ++x) tarn[size_t(z) * w + size_t(x)] = x == 10 || z == 10 ? 430.0f : 421.0f;
+    const AutoLevel high = autoLevel(Heightfield(w, d, 30.0, 30.0, tarn));
+    EXPECT_FALSE(high.level.has_value()) << high.summary;
+    EXPECT_NE(high.summary.find("without flooding dry land below it; 1 would"), std::string::npos) << high.summary;
 }
 
 TEST(WaterPresets, EveryPresetIsAValidWaveSet) {
