@@ -615,9 +615,11 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     p.probes = layout.validCount();
 
     std::vector<float> err(points.size(), NAN);
+    const double floor = interpolationErrorFloor(reference);
     tbb::parallel_for(size_t(0), points.size(), [&](size_t k) {
         sh::ShRgb at;
-        if (interpolateProbes(layout, bake.sh, points[k], at)) err[k] = relativeIrradianceError(at, reference[k]);
+        if (interpolateProbes(layout, bake.sh, points[k], at))
+            err[k] = relativeIrradianceError(at, reference[k], floor);
     });
     std::vector<float> covered;
     for (float e : err)

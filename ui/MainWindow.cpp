@@ -221,6 +221,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     });
     connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {
         statusBar()->showMessage(QString("light propagation volumes updated in %1 ms").arg(ms, 0, 'f', 0), 3000);
+        updateLegend();
     });
     // The practical cascade splits the Shadows dock shows and writes depend on the view's shape.
     auto updateAspect = [this] {
@@ -564,17 +565,14 @@ void MainWindow::buildDocks() {
                        "6 pixels wide are left out, so zoom in to see the finest");
     bar->addWidget(leaves);
     connect(leaves, &QCheckBox::toggled, viewport_, &ViewportWindow::setLeaves);
-    // The colour key of the diagnostic views, where the status bar keeps it in sight.
-    auto* legend = new QLabel;
-    legend->setObjectName("status.legend");
-    connect(viewSelector_, &QComboBox::currentIndexChanged, this, [this, legend](int i) {
-        const int view = viewSelector_->itemData(i).toInt();
-        viewport_->setDebugView(view);
-        const auto v = findDebugView(std::to_string(view));
-        // The key alone: after the view's title, before any note in parentheses.
-        legend->setText(v && v->needs.probeDiagnostics
-                            ? QString::fromUtf8(v->shows).section(':', 1).section(" (", 0, 0).trimmed()
-                            : QString());
+    // The colour key of the diagnostic views, and the LPV views' scale, where the status bar
+    // keeps it in sight.
+    legend_ = new QLabel;
+    legend_->setObjectName("status.legend");
+    auto* legend = legend_;
+    connect(viewSelector_, &QComboBox::currentIndexChanged, this, [this](int i) {
+        viewport_->setDebugView(viewSelector_->itemData(i).toInt());
+        updateLegend();
     });
     connect(probeToggle_, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbeLighting);
     // Show cascades switches to the cascade view and back to the view before it; it follows the
@@ -691,6 +689,23 @@ void MainWindow::buildMenus() {
     bakeMenu->setObjectName("menu.bake");
     action(bakeMenu, "&Bake", "action.bake", QKeySequence("Ctrl+B"), [this] { startBake(); });
     action(bakeMenu, "&Cancel", "action.cancelBake", QKeySequence("Ctrl+."), [this] { bake_->cancel(); });
+}
+
+void MainWindow::updateLegend() {
+    const int view = viewSelector_->currentData().toInt();
+    const auto v = findDebugView(std::to_string(view));
+    if (view == kViewLpvCascade0 || view == kViewLpvAll) {
+        // The LPV views show E/π over the bound volumes' light range: say which.
+        const std::optional<double> range =
+            viewport_->renderer() ? viewport_->renderer()->renderer().lpvViewRange() : std::nullopt;
+        legend_->setText(range ? QString::fromUtf8("E/π ÷ %1 W/(m²·sr)").arg(*range, 0, 'g', 3)
+                               : QString("no light in the volumes yet"));
+        return;
+    }
+    // The key alone: after the view's title, before any note in parentheses.
+    legend_->setText(v && v->needs.probeDiagnostics
+                         ? QString::fromUtf8(v->shows).section(':', 1).section(" (", 0, 0).trimmed()
+                         : QString());
 }
 
 void MainWindow::showError(const QString& title, const QString& message) {

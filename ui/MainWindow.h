@@ -120,6 +120,8 @@ private:
     QLabel* estimate_ = nullptr;
     QLabel* eta_ = nullptr;
     QLabel* frameLabel_ = nullptr;
+    QLabel* legend_ = nullptr;  // status.legend: the key of the diagnostic views, the LPV views' scale
+    void updateLegend();
     QProgressBar* terrainBusy_ = nullptr;
     QLabel* probeLabel_ = nullptr;
     QLabel* sourceLabel_ = nullptr;

@@ -583,6 +583,7 @@ InterpolationError measureInterpolationError(const ProbeLayout& L, const std::ve
     for (size_t i = 0; i < points.size(); ++i)
         keys[i] = splitmix64(seed ^ 0x5A3D1E7Eull ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull));
     const ProbeBake truth = baker(points, keys);
+    const double floor = interpolationErrorFloor(truth.sh);
     for (size_t i = 0; i < points.size(); ++i) {
         sh::ShRgb value;
         if (!interpolateProbes(L, shs, points[i], value)) {
@@ -590,7 +591,7 @@ InterpolationError measureInterpolationError(const ProbeLayout& L, const std::ve
             continue;
         }
         e.positions.push_back(points[i]);
-        e.errors.push_back(relativeIrradianceError(value, truth.sh[i]));
+        e.errors.push_back(relativeIrradianceError(value, truth.sh[i], floor));
     }
     e.points = e.errors.size();
     if (e.errors.empty()) return e;

@@ -546,12 +546,19 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
     return out;
 }
 
-float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference) {
+namespace {
+const std::vector<glm::vec3>& metricNormals() {
     static const std::vector<glm::vec3> normals = [] {
         std::vector<glm::vec3> n;
         for (uint32_t i = 0; i < 256; ++i) n.push_back(fibonacciSphere(i, 256, 0.0f));
         return n;
     }();
+    return normals;
+}
+}  // namespace
+
+float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference, double floor) {
+    const auto& normals = metricNormals();
     double num = 0, den = 0;
     for (const auto& n : normals) {
         const double e = luminance(sh::evalIrradiance(value, n));
@@ -559,7 +566,25 @@ float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference
         num += (e - r) * (e - r);
         den += r * r;
     }
+    den = std::max(den, floor * floor * double(normals.size()));
     return den > 0 ? float(std::sqrt(num / den)) : 0.0f;
+}
+
+double rmsIrradiance(const sh::ShRgb& sh) {
+    const auto& normals = metricNormals();
+    double sq = 0;
+    for (const auto& n : normals) {
+        const double r = luminance(sh::evalIrradiance(sh, n));
+        sq += r * r;
+    }
+    return std::sqrt(sq / double(normals.size()));
+}
+
+double interpolationErrorFloor(const std::vector<sh::ShRgb>& truths) {
+    if (truths.empty()) return 0.0;
+    double sum = 0;
+    for (const auto& t : truths) sum += rmsIrradiance(t);
+    return kInterpolationErrorFloor * sum / double(truths.size());
 }
 
 ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,

@@ -208,7 +208,16 @@ float tracedSkyVisibility(const HeightfieldTracer& tracer, const glm::vec3& p, c
 glm::vec3 sunFirstBounce(const BakeLighting& lighting, const glm::vec3& p, const glm::vec3& n, uint32_t rays,
                          uint64_t seed);
 // The per-probe term of that metric: relative RMS of irradiance luminance over the 256 fixed
-// normals of `value` against `reference` (0 when the reference is black).
-float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference);
+// normals of `value` against `reference` (0 when the reference is black). With `floor` > 0 the
+// difference is relative to at least that RMS irradiance: the interpolation error's floor.
+float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference, double floor = 0.0);
+// RMS irradiance luminance of `sh` over the same 256 normals: the metric's denominator.
+double rmsIrradiance(const sh::ShRgb& sh);
+// Where the true light is nearly black a relative error explodes (a mean of 73 000 % with a black
+// sky and the sun on the horizon), so the interpolation error of each point is relative to at least
+// kInterpolationErrorFloor of the mean RMS irradiance over the points measured (docs/lighting.md,
+// "Metrics").
+inline constexpr double kInterpolationErrorFloor = 0.05;
+double interpolationErrorFloor(const std::vector<sh::ShRgb>& truths);
 
 }  // namespace terralux

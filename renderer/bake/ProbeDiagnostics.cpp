@@ -84,10 +84,11 @@ ErrorMap measureErrorMap(const ProbeLayout& L, const std::vector<sh::ShRgb>& sh,
         }
     if (points.empty()) return m;
     const ProbeBake truth = baker(points, keys);
+    const double floor = interpolationErrorFloor(truth.sh);
     for (size_t n = 0; n < points.size(); ++n) {
         sh::ShRgb value;
         interpolateProbes(L, sh, points[n], value);
-        m.error[slot[n]] = relativeIrradianceError(value, truth.sh[n]);
+        m.error[slot[n]] = relativeIrradianceError(value, truth.sh[n], floor);
     }
     return m;
 }

@@ -139,6 +139,18 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
         throw PlacementError(where + ": occupancy grid of " + num(cells) +
                              " cells exceeds " + std::to_string(kMaxOccupancyCells) +
                              "; use fewer, wider-spaced probes");
+    // The cells are cubes of the smaller spacing: on a long thin footprint that spacing is metres
+    // while the other side and the relief are kilometres, and the file holds millions of cells for
+    // a handful of probes (a 512 x 2 raster wrote 18.5 MB for 64).
+    const double probes = double(nx) * double(nz);
+    if (cells > double(kMaxOccupancyCellsPerProbe) * probes) {
+        const bool alongZ = nx > 1 && nz > 1 ? spacing.z < spacing.x : nz > 1;
+        throw PlacementError(where + ": occupancy grid of " + num(cells) + " cells (" + num(dimsD[0]) + " x " +
+                             num(dimsD[1]) + " x " + num(dimsD[2]) + " of " + num(cell) + " m) for " +
+                             num(probes) + " probes, more than " + std::to_string(kMaxOccupancyCellsPerProbe) +
+                             " a probe: its cells are the " + num(cell) + " m spacing along " +
+                             (alongZ ? "z" : "x") + "; use fewer probes along " + (alongZ ? "z" : "x"));
+    }
     L.cellSize = cell;
     L.cellDims = {uint32_t(std::max(dimsD[0], 1.0)), uint32_t(std::max(dimsD[1], 1.0)),
                   uint32_t(std::max(dimsD[2], 1.0))};

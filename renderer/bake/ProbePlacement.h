@@ -104,6 +104,8 @@ SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;
+// A terrain grid's occupancy cells per probe at most (a grid over a square footprint has a few).
+inline constexpr uint64_t kMaxOccupancyCellsPerProbe = 1024;
 // One cap per placement (docs/lighting.md, "Probe limits"): a terrain grid holds at most seed 000's
 // 4096 probes; a box grid at most kMaxVolumeProbes cells, an adaptive volume at most that many
 // valid probes (adaptive.max_probes may ask for fewer): 10 MiB of coefficients, the largest volume

@@ -69,7 +69,7 @@ const std::vector<DebugView>& debugViews() {
          true, ViewBackground::Black, diagnostics},
         {kViewLpvCascade0, "lpv-cascade0",
          "irradiance of the LPV's cascade 0 alone, as E/π (what a white Lambertian surface reflects), "
-         "black outside it",
+         "black outside it; PNG exposed for the volumes' light (E/π ÷ cascade 0's light range, printed), EXR as it is",
          true, ViewBackground::Black, lpvOnly},
         {kViewLpvGeometry, "lpv-geometry",
          "cascade 0's geometry volume at the surface: the share of the light flowing into the ground "
@@ -79,7 +79,7 @@ const std::vector<DebugView>& debugViews() {
          "sky visibility marched through cascade 0's geometry volume, 1 open, fading to black at the "
          "cascade's edge as view 61 (EXR: value in red, 1 in green on terrain inside cascade 0)",
          true, ViewBackground::Black, lpvOnly},
-        {kViewLpvAll, "lpv-all", "LPV irradiance of all cascades blended, as E/π, black outside them", true,
+        {kViewLpvAll, "lpv-all", "LPV irradiance of all cascades blended, as E/π, black outside them; PNG on view 61's scale", true,
          ViewBackground::Black, lpvOnly},
         {kViewWaterMask, "water-mask",
          "water / land: blue where the water surface is in view, brown land (EXR: 1 in red on water, 1 in green everywhere)",

@@ -334,6 +334,12 @@ private slots:
             // The diagnostic views keep their colour key in the status bar.
             const int number = selector->itemData(i).toInt();
             QCOMPARE(legend->text().contains("red"), findDebugView(number)->needs.probeDiagnostics);
+            // The LPV views name their own exposure: E/π over the bound volumes' light range.
+            if (number == kViewLpvCascade0 || number == kViewLpvAll) {
+                const std::optional<double> range = w_->viewport()->renderer()->renderer().lpvViewRange();
+                QVERIFY(range.has_value());
+                QTRY_COMPARE(legend->text(), QString::fromUtf8("E/π ÷ %1 W/(m²·sr)").arg(*range, 0, 'g', 3));
+            }
             RenderRequest q;
             q.width = shown.width;
             q.height = shown.height;

@@ -189,6 +189,28 @@ TEST(Bake, ReferenceAgreesWithAnalyticFlatPlane) {
     EXPECT_EQ(referencePathLength(glm::vec3(0.5f)), 10);  // 0.5^10 < 0.1 %
 }
 
+// The interpolation error is relative to at least 5 % of the mean light measured: near-black truths
+// no longer explode it (a black sky with the sun on the horizon gave a mean of 73 000 %), and a
+// black truth lit by the interpolated probes is an error, not 0.
+TEST(Bake, InterpolationErrorIsRelativeToAtLeastAShareOfTheMeanLight) {
+    const sh::ShRgb bright = sh::projectConstant(glm::vec3(1.0f));
+    const sh::ShRgb dim = sh::projectConstant(glm::vec3(1e-4f));
+    EXPECT_NEAR(rmsIrradiance(bright), luminance(sh::evalIrradiance(bright, kUp)), 1e-4);
+    const double floor = interpolationErrorFloor({bright, dim});
+    EXPECT_NEAR(floor, 0.05 * (rmsIrradiance(bright) + rmsIrradiance(dim)) / 2.0, 1e-9);
+    // A dim truth with a brighter interpolation: 500x its own light, 2x against the floor.
+    sh::ShRgb leaked = sh::projectConstant(glm::vec3(0.05f));
+    EXPECT_GT(relativeIrradianceError(leaked, dim), 400.0f);
+    EXPECT_NEAR(relativeIrradianceError(leaked, dim, floor), (rmsIrradiance(leaked) - rmsIrradiance(dim)) / floor, 1e-3);
+    EXPECT_LT(relativeIrradianceError(leaked, dim, floor), 2.1f);
+    EXPECT_GT(relativeIrradianceError(leaked, sh::ShRgb{}, floor), 0.0f);
+    // Above the floor nothing changes.
+    sh::ShRgb off = bright;
+    off *= 1.1f;
+    EXPECT_EQ(relativeIrradianceError(off, bright, floor), relativeIrradianceError(off, bright));
+    EXPECT_EQ(interpolationErrorFloor({}), 0.0);
+}
+
 TEST(Bake, ErrorMetricIsRelativeRmsOfIrradiance) {
     sh::ShRgb a = sh::projectConstant(glm::vec3(1.0f)), b = a;
     b *= 1.1f;

@@ -232,6 +232,15 @@ std::vector<Row> rows() {
                      return quick(utmDem("r16385", 16385, 2, 1.0, [](int c, int) { return 50.0f * std::sin(0.001f * float(c)); }));
                  },
                  "probe_volumes 'probes': occupancy grid of .* cells exceeds 67108864; use fewer, wider-spaced probes"});
+    r.push_back({"raster_512x2_occupancy_per_probe_refused", [] {
+                     // A 15 km strip 30 m deep: an 8 x 8 grid spaces its rows 4.3 m apart, and
+                     // cubes of 4.3 m over the strip and its relief made 18.5 MB for 64 probes.
+                     Project p = quick(utmDem("r512", 512, 2, 30.0, [](int c, int) { return 400.0f + 300.0f * std::sin(0.02f * float(c)); }));
+                     p.scene.probeVolumes[0].gridDims = {8, 1, 8};
+                     return p;
+                 },
+                 "probe_volumes 'probes': occupancy grid of .* cells \\(.* of .* m\\) for 64 probes, more than 1024 a "
+                 "probe: its cells are the .* m spacing along z; use fewer probes along z"});
     r.push_back({"void_9_percent", [] {
                      // One 30 × 30 hole in a 100 × 100 raster.
                      std::vector<float> z(100 * 100);
