@@ -87,6 +87,10 @@ Options:
                                 positions: gold valid, cyan moved up, red rejected), leaves
                                 (adaptive octree leaves).
   --time T                      --render: seconds into the water's wave animation (default 0).
+  --profile                     --render: draw the frame a second time, warm, and print what it
+                                cost: each pass's GPU time from timestamps (where the device
+                                writes them), the GPU total, and the host's recording and
+                                read-back conversion, beside both frames' wall time.
   --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
                                 degrees, radius in metres (default: the project's camera).
   --no-probes                   Render without probe lighting.
@@ -166,12 +170,13 @@ struct Args {
     QCommandLineOption time{"time", "Seconds.", "T"};
     QCommandLineOption study{"study", "Study."};
     QCommandLineOption budget{"budget", "Seconds.", "SECONDS"};
+    QCommandLineOption profile{"profile", "Per-pass GPU time."};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget});
+                           device, dryRun, overlay, time, study, budget, profile});
     }
 };
 
@@ -592,10 +597,32 @@ int commandRender(const Args& a) {
                   << kViewInterpolationError << " is grey\n";
     const RenderedImage img = renderer.render(request);
     writeImage(image, img.width, img.height, img.rgba);
+    // The first frame builds pipelines, maps and volumes; the profile is of the same frame warm.
+    std::optional<RenderedImage> warm;
+    if (a.parser.isSet(a.profile)) warm = renderer.render(request);
     const auto view = findDebugView(std::to_string(request.debugView));
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    if (warm) {
+        const FrameTimings& t = renderer.renderer().lastFrameTimings();
+        std::cout << "profile (the frame drawn again, warm):\n";
+        if (t.gpuTimed()) {
+            size_t width = 8;
+            for (const auto& p : t.passes) width = std::max(width, p.name.size());
+            std::cout << "  " << std::left << std::setw(int(width)) << "pass" << std::right << "  GPU ms\n";
+            for (const auto& p : t.passes)
+                std::cout << "  " << std::left << std::setw(int(width)) << p.name << std::right << std::setw(8)
+                          << fixed(p.gpuMilliseconds, 3) << "\n";
+            std::cout << "  " << std::left << std::setw(int(width)) << "GPU total" << std::right << std::setw(8)
+                      << fixed(t.gpuMilliseconds, 3) << "\n";
+        } else {
+            std::cout << "  GPU: " << ctx->deviceName() << " writes no timestamps\n";
+        }
+        std::cout << "  host: recording " << fixed(t.recordMilliseconds, 2) << " ms, read-back conversion "
+                  << fixed(t.readbackMilliseconds, 2) << " ms; wall " << fixed(warm->milliseconds, 1)
+                  << " ms warm, " << fixed(img.milliseconds, 1) << " ms cold\n";
+    }
     // The LPV views' own exposure, printed with the view so the image can be read as numbers.
     if (view->number == kViewLpvCascade0 || view->number == kViewLpvAll) {
         if (const std::optional<double> range = renderer.renderer().lpvViewRange())
@@ -705,6 +732,8 @@ int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot)
             throw UsageError("--overlay: only with --render");
         if (a.parser.isSet(a.time) && !a.parser.isSet(a.render))
             throw UsageError("--time: only with --render");
+        if (a.parser.isSet(a.profile) && !a.parser.isSet(a.render))
+            throw UsageError("--profile: only with --render");
         if (a.parser.isSet(a.noRebake) && !a.parser.isSet(a.render))
             throw UsageError("--no-rebake: only with --render");
         if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))

@@ -217,7 +217,17 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         statusBar()->showMessage(QString("reflection probe %1").arg(probe), 4000);
     });
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
-        frameLabel_->setText(QString("frame %1 ms").arg(ms, 0, 'f', 1));
+        // The wall time of the frame on this thread; the GPU's time from the frame graph's
+        // timestamps and the host's recording, of the last frame known finished.
+        QString text = QString("frame %1 ms").arg(ms, 0, 'f', 1);
+        if (viewport_->renderer()) {
+            const FrameTimings& t = viewport_->renderer()->renderer().lastFrameTimings();
+            if (t.gpuTimed()) text += QString(" · GPU %1 ms").arg(t.gpuMilliseconds, 0, 'f', 2);
+            if (t.recordMilliseconds > 0.0) text += QString(" · host %1 ms").arg(t.recordMilliseconds, 0, 'f', 1);
+        }
+        frameLabel_->setText(text);
+        frameLabel_->setToolTip("Wall time of the last frame; GPU: its passes' time from timestamps; host: "
+                                "recording it (the per-pass times: terralux --render --profile)");
     });
     connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {
         statusBar()->showMessage(QString("light propagation volumes updated in %1 ms").arg(ms, 0, 'f', 0), 3000);

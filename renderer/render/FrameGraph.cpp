@@ -184,16 +184,26 @@ void FrameGraph::barrier(VkCommandBuffer cb, const ResourceUse& use) {
     }
 }
 
-void FrameGraph::execute(VkCommandBuffer cb) {
+uint32_t FrameGraph::execute(VkCommandBuffer cb, VkQueryPool timestamps, uint32_t capacity) {
     last_.clear();
+    const uint32_t queries = timestamps && passes_.size() + 1 <= capacity ? uint32_t(passes_.size()) + 1 : 0;
+    if (queries > 0) {
+        vkCmdResetQueryPool(cb, timestamps, 0, queries);
+        // The start once everything submitted before has finished, so no earlier work is counted.
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, timestamps, 0);
+    }
+    uint32_t query = 1;
     for (Pass& p : passes_) {
         for (const ResourceUse& u : p.info.uses) barrier(cb, u);
         if (p.record) p.record(cb);
+        // Bottom of the pipe: when every command recorded so far has completed.
+        if (queries > 0) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps, query++);
         last_.push_back(std::move(p.info));
     }
     passes_.clear();
     for (const ResourceUse& u : finals_) barrier(cb, u);
     finals_.clear();
+    return queries;
 }
 
 }  // namespace terralux

@@ -70,7 +70,11 @@ public:
     // an image.
     void addFinalUse(ResourceUse use);
     // Records every pass added since the last execute, with its barriers, then clears the list.
-    void execute(VkCommandBuffer cb);
+    // With a timestamp query pool of at least passes + 1 queries (`capacity`), it also resets
+    // them and writes query 0 before the first pass's barriers and query k + 1 once pass k's
+    // commands are done, so pass k took the ticks between queries k and k + 1 (its barriers
+    // included). Returns the queries written: 0 without a pool, or when it is too small.
+    uint32_t execute(VkCommandBuffer cb, VkQueryPool timestamps = VK_NULL_HANDLE, uint32_t capacity = 0);
     // The passes of the last executed frame, in order.
     const std::vector<PassInfo>& lastFrame() const { return last_; }
 

@@ -109,7 +109,16 @@ struct FrameSlot {
     size_t localLightCapacity = 0;
     vk::DescriptorSet lpvSet;
     uint64_t lpvSetKey = 0;
+    // Timestamps around the frame graph's passes (devices that write them): the queries the last
+    // frame drawn in this slot wrote, and its passes' names, read once its fence has passed.
+    vk::UniqueQueryPool timestamps;
+    uint32_t timestampsWritten = 0;
+    std::vector<std::string> timedPasses;
+    double recordMilliseconds = 0.0;
 };
+
+// Timestamps a slot's pool holds: one before the first pass and one after each.
+constexpr uint32_t kFrameTimestamps = 64;
 
 // The LPV subsystem: present only while volumes are bound. Every cascade's light volume (its
 // three channels one after another, Lpv.h's layout) and geometry volume, uploaded once per
@@ -382,6 +391,14 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.overlays = vk::DescriptorSetBuilder()
                          .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
                          .build(ctx_);
+        if (ctx_.timestampPeriod() > 0.0) {
+            VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+            qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+            qci.queryCount = kFrameTimestamps;
+            VkQueryPool pool = VK_NULL_HANDLE;
+            vk::check(vkCreateQueryPool(ctx_.device(), &qci, nullptr, &pool), "vkCreateQueryPool");
+            f.timestamps = vk::UniqueQueryPool(ctx_.device(), pool);
+        }
         g.slots.push_back(std::move(f));
     }
     g.trilinear = vk::Sampler::trilinearClamp(ctx_);
@@ -1153,13 +1170,39 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, s, Output{}); });
+    readFrameTimings(0);
     RenderedImage img;
     img.width = s.width;
     img.height = s.height;
+    const auto readback = std::chrono::steady_clock::now();
     img.rgba = gpu_->target->readback.pixels();
-    img.milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const auto end = std::chrono::steady_clock::now();
+    timings_.readbackMilliseconds = std::chrono::duration<double, std::milli>(end - readback).count();
+    img.milliseconds = std::chrono::duration<double, std::milli>(end - start).count();
     return img;
+}
+
+void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
+    FrameSlot& slot = gpu_->slots[slotIndex];
+    timings_ = FrameTimings{};
+    timings_.recordMilliseconds = slot.recordMilliseconds;
+    const uint32_t n = slot.timestampsWritten;
+    slot.timestampsWritten = 0;
+    if (n < 2) return;
+    std::vector<uint64_t> ticks(n);
+    // The slot's fence has passed: no wait, and results not yet available are left out.
+    if (vkGetQueryPoolResults(ctx_.device(), slot.timestamps.get(), 0, n, n * sizeof(uint64_t), ticks.data(),
+                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT) != VK_SUCCESS)
+        return;
+    const uint32_t bits = ctx_.timestampBits();
+    const uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+    const double msPerTick = ctx_.timestampPeriod() * 1e-6;
+    auto span = [&](uint32_t a, uint32_t b) {
+        return double(((ticks[b] & mask) - (ticks[a] & mask)) & mask) * msPerTick;
+    };
+    for (uint32_t k = 0; k + 1 < n && k < slot.timedPasses.size(); ++k)
+        timings_.passes.push_back({slot.timedPasses[k], span(k, k + 1)});
+    timings_.gpuMilliseconds = span(0, n - 1);
 }
 
 bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain) {
@@ -1170,6 +1213,8 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
     out.readback = false;
     out.swapchainImage = frame->image;
     out.extent = frame->extent;
+    // begin() waited for this slot's fence: the frame drawn in it before is done.
+    readFrameTimings(frame->slot);
     recordFrame(frame->cb, frame->slot, s, out);
     swapchain.submitAndPresent(*frame);
     return true;
@@ -1177,6 +1222,7 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
 
 void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
                                   const Output& out) {
+    const auto recordStart = std::chrono::steady_clock::now();
     Gpu& g = *gpu_;
     FrameSlot& slot = g.slots[slotIndex];
     const DebugView view = findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty));
@@ -1787,8 +1833,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                       });
         graph.addFinalUse({kSwapchain, Access::Present});
     }
-    graph.execute(cb);
+    slot.timestampsWritten = graph.execute(cb, slot.timestamps.get(), slot.timestamps ? kFrameTimestamps : 0);
+    slot.timedPasses.clear();
+    for (const PassInfo& p : graph.lastFrame()) slot.timedPasses.push_back(p.name);
     if (probes) probes->lightStale = false;
+    slot.recordMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - recordStart).count();
 }
 
 }  // namespace terralux

@@ -114,6 +114,20 @@ struct RenderedImage {
     double milliseconds = 0.0;    // draw + readback, wall clock
 };
 
+// What one frame cost (TerrainRenderer::lastFrameTimings): the GPU time of each pass of the frame
+// graph, from timestamps, and the host's part.
+struct FrameTimings {
+    struct Pass {
+        std::string name;
+        double gpuMilliseconds = 0.0;  // between the timestamps before and after it, barriers included
+    };
+    std::vector<Pass> passes;          // in order; empty where the device writes no timestamps
+    double gpuMilliseconds = 0.0;      // first timestamp to last: the passes summed
+    double recordMilliseconds = 0.0;   // host: recording the frame (uniforms, passes, barriers)
+    double readbackMilliseconds = 0.0; // host: converting the read-back pixels (render() only)
+    bool gpuTimed() const { return !passes.empty(); }
+};
+
 class TerrainRenderer {
 public:
     // Large DEMs are drawn from every k-th row and column (always including the last), the
@@ -192,6 +206,10 @@ public:
     bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
     // The passes of the last frame, in order, with what each used and bound.
     const std::vector<PassInfo>& lastFramePasses() const;
+    // The cost of the last frame whose GPU work is known to have finished: after render(), that
+    // frame; after present(), the frame last drawn in the slot it reused (whose fence it waited
+    // for), so reading them never stalls a later frame.
+    const FrameTimings& lastFrameTimings() const { return timings_; }
     // Whether the probe subsystem holds GPU resources (volumes are bound).
     bool hasProbeResources() const;
     // Whether the shadow subsystem holds GPU resources (a frame drew shadows and the scene's
@@ -223,6 +241,7 @@ private:
     void buildReflectionSets();
     void recordLpvPropagation(VkCommandBuffer cb);
     void propagateLpvNow();  // runs the owed propagation in a submission of its own
+    void readFrameTimings(uint32_t slot);  // the slot's last frame into timings_; its fence has passed
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<Gpu> gpu_;
@@ -238,6 +257,7 @@ private:
     bool hasAo_ = false, hasAlbedoMap_ = false;
     glm::ivec2 surfaceMapSize_{1, 1}, albedoMapSize_{1, 1};
     float finestProbeSpacing_ = 0.0f;  // of the bound volumes; 0 without
+    FrameTimings timings_;
 };
 
 }  // namespace terralux

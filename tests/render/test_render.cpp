@@ -652,6 +652,39 @@ bool binds(const std::vector<PassInfo>& passes, const std::string& pass, const s
 
 }  // namespace
 
+// Timestamps around every pass of the frame graph: one time per pass, in the frame's order, none
+// negative (the ticks only grow), summing to the GPU total, which fits in the frame's wall time.
+TEST_F(RenderTest, FrameTimingsArePerPassMonotoneAndWithinTheFrame) {
+    if (!(ctx_->timestampPeriod() > 0.0)) GTEST_SKIP() << ctx_->deviceName() << " writes no timestamps";
+    Project p = sampleProject("timings", 8, 8);
+    p.scene.water.enabled = true;
+    p.scene.water.level = 900.0;
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    draw(r, kViewBeauty);
+    const RenderedImage img = draw(r, kViewBeauty);
+    const FrameTimings& t = r.renderer().lastFrameTimings();
+    ASSERT_TRUE(t.gpuTimed());
+    EXPECT_EQ(t.passes.size(), r.renderer().lastFramePasses().size());
+    double sum = 0;
+    for (size_t i = 0; i < t.passes.size() && i < r.renderer().lastFramePasses().size(); ++i) {
+        EXPECT_EQ(t.passes[i].name, r.renderer().lastFramePasses()[i].name);
+        EXPECT_GE(t.passes[i].gpuMilliseconds, 0.0) << t.passes[i].name;
+        EXPECT_LE(t.passes[i].gpuMilliseconds, img.milliseconds) << t.passes[i].name;
+        sum += t.passes[i].gpuMilliseconds;
+    }
+    EXPECT_NEAR(sum, t.gpuMilliseconds, 1e-6 * std::max(1.0, sum));
+    EXPECT_GT(t.gpuMilliseconds, 0.0);
+    EXPECT_LE(t.gpuMilliseconds, img.milliseconds);
+    EXPECT_GT(t.recordMilliseconds, 0.0);
+    EXPECT_GT(t.readbackMilliseconds, 0.0);
+    EXPECT_LE(t.recordMilliseconds + t.readbackMilliseconds, img.milliseconds);
+    // The water and the shadow maps are passes of their own, timed like the rest.
+    const std::vector<std::string> names = passNames(r.renderer().lastFramePasses());
+    EXPECT_NE(std::find(names.begin(), names.end(), "terrain"), names.end());
+    EXPECT_GT(names.size(), 3u);
+}
+
 TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
     using Names = std::vector<std::string>;
     ProjectRenderer without(*ctx_, sampleProject("novolumes", 8, 8));  // no probes loaded at all
