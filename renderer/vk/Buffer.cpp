@@ -38,6 +38,16 @@ Buffer Buffer::hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBuffer
                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
 }
 
+Buffer Buffer::hostReadable(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage) {
+    try {
+        return Buffer(ctx, size, usage,
+                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
+                          VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+    } catch (const VulkanError&) {
+        return hostVisible(ctx, size, usage);  // no cached, coherent type: the plain one
+    }
+}
+
 Buffer Buffer::deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                            VkBufferUsageFlags usage, VkDeviceSize capacity) {
     Buffer staging = hostVisible(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);

@@ -32,8 +32,12 @@ public:
     // `capacity` bytes long where that is more (the rest undefined until written).
     static Buffer deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                               VkBufferUsageFlags usage, VkDeviceSize capacity = 0);
-    // A host-visible, coherent buffer (uniforms, readback).
+    // A host-visible, coherent buffer (uniforms, staging).
     static Buffer hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
+    // A host-visible, coherent buffer the host reads: host-cached memory where the device has it.
+    // A discrete GPU's plain host-visible memory is write-combined, and reading it back a value
+    // at a time is an order of magnitude slower than reading cached memory.
+    static Buffer hostReadable(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
 
     VkBuffer handle() const { return buffer_.get(); }
     VkDeviceSize size() const { return size_; }

@@ -2,6 +2,9 @@
 
 #include <cstring>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace terralux::vk {
 
 namespace {
@@ -30,11 +33,21 @@ float halfToFloat(uint16_t h) {
     std::memcpy(&f, &bits, 4);
     return f;
 }
+
+// Every half's float, once (256 KiB): a frame's pixels then convert with one load each.
+const std::vector<float>& halfTable() {
+    static const std::vector<float> table = [] {
+        std::vector<float> t(65536);
+        for (uint32_t h = 0; h < 65536; ++h) t[h] = halfToFloat(uint16_t(h));
+        return t;
+    }();
+    return table;
+}
 }  // namespace
 
 Readback::Readback(const VulkanContext& ctx, uint32_t width, uint32_t height)
     : width_(width), height_(height),
-      buffer_(Buffer::hostVisible(ctx, VkDeviceSize(width) * height * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT)) {}
+      buffer_(Buffer::hostReadable(ctx, VkDeviceSize(width) * height * 8, VK_BUFFER_USAGE_TRANSFER_DST_BIT)) {}
 
 void Readback::recordCopy(VkCommandBuffer cb, VkImage image) const {
     VkBufferImageCopy copy{};
@@ -45,8 +58,11 @@ void Readback::recordCopy(VkCommandBuffer cb, VkImage image) const {
 
 std::vector<float> Readback::pixels() {
     const auto* half = static_cast<const uint16_t*>(buffer_.map());
+    const float* table = halfTable().data();
     std::vector<float> out(size_t(width_) * height_ * 4);
-    for (size_t i = 0; i < out.size(); ++i) out[i] = halfToFloat(half[i]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
+    });
     return out;
 }
 
