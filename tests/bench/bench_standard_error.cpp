@@ -1,0 +1,86 @@
+// The reported Monte Carlo standard error against the sampling error it stands for, on every
+// shared DEM and the embedded sample, with the project's default lighting (physical sky, the
+// height ramp's albedo, the terrain's own bounce): a 16 x 16 terrain grid baked at each preset's
+// rays and again at 16 384 rays over the same irradiance cache, so the difference is the probes'
+// own sampling. Measured two ways, each as the RMS and the mean |.| over the valid probes: E(up),
+// what the estimator models, and the relative RMS over 256 normals, the metric every other error
+// figure uses (docs/lighting.md, "Metrics"). A ratio measured / reported above 1 means the
+// reported error is optimistic.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "SceneLighting.h"
+#include "TerrainLoading.h"
+#include "bake/DiffuseBake.h"
+#include "bake/HeightfieldTracer.h"
+#include "bake/ProbePlacement.h"
+
+using namespace terralux;
+
+namespace {
+
+const char* const kDems[] = {"", "N42E001.hgt", "mt_rainier_90m.tif", "srtm_bigtujunga30m_utm11.tif",
+                             "topotoolbox_exampleDEM.asc"};
+
+void BM_StandardError(benchmark::State& state) {
+    const std::string name = kDems[state.range(0)];
+    const std::filesystem::path dem = std::filesystem::path(TERRALUX_SHARED_DATA) / "dem" / name;
+    if (!name.empty() && !std::filesystem::exists(dem)) {
+        state.SkipWithError(("shared DEM " + name + " not present").c_str());
+        return;
+    }
+    const auto preset = QualityPreset(state.range(1));
+    Project p = loadEffectiveProject("", {}, name.empty() ? "" : dem.string(), nullptr);
+    const DemImportResult terrain = loadProjectTerrain(p);
+    const Heightfield& hf = terrain.heightfield;
+    const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{p.scene.terrain.skirt});
+    BakeLighting L = lightingOf(p);
+    L.tracer = &tracer;
+    L.water = bakeWaterOf(p, hf);
+    L.surface = surfaceAlbedoOf(p, hf);
+    ProbeVolumeSettings v;
+    v.gridDims = {16, 1, 16};
+    const ProbeLayout layout = placeProbes(v, hf);
+    const BakeQuality q = qualityPreset(preset);
+    double reported = 0, reportedAbs = 0, up = 0, upAbs = 0, full = 0, fullAbs = 0;
+    int n = 0;
+    for (auto _ : state) {
+        const IrradianceCache cache(L, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, {});
+        const ProbeBake bake = bakeProbes(L, &cache, q.bounces, layout.positions, layout.valid, q.rays, 5, {});
+        const ProbeBake fine = bakeProbes(L, &cache, q.bounces, layout.positions, layout.valid, 16384, 6, {});
+        auto upLuminance = [](const sh::ShRgb& s) {
+            return double(luminance(sh::evalIrradiance(s, glm::vec3(0, 1, 0))));
+        };
+        for (size_t i = 0; i < layout.positions.size(); ++i) {
+            if (!layout.valid[i]) continue;
+            const double e = (upLuminance(bake.sh[i]) - upLuminance(fine.sh[i])) / upLuminance(fine.sh[i]);
+            const double f = relativeIrradianceError(bake.sh[i], fine.sh[i]);
+            const double s = bake.standardError[i];
+            reported += s * s, reportedAbs += s;
+            up += e * e, upAbs += std::abs(e);
+            full += f * f, fullAbs += f;
+            ++n;
+        }
+    }
+    if (n == 0) return;
+    const double rRms = std::sqrt(reported / n), rMean = reportedAbs / n;
+    state.SetLabel((name.empty() ? std::string("sample") : name) + " " + qualityName(preset));
+    state.counters["reported_rms_pct"] = 100.0 * rRms;
+    state.counters["up_rms_over_reported"] = std::sqrt(up / n) / rRms;
+    state.counters["up_mean_over_reported"] = (upAbs / n) / rMean;
+    state.counters["full_rms_over_reported"] = std::sqrt(full / n) / rRms;
+    state.counters["full_mean_over_reported"] = (fullAbs / n) / rMean;
+}
+BENCHMARK(BM_StandardError)
+    ->ArgsProduct({{0, 1, 2, 3, 4},
+                   {int(QualityPreset::Draft), int(QualityPreset::Standard), int(QualityPreset::High)}})
+    ->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
