@@ -1,5 +1,6 @@
 #include "ParameterTable.h"
 
+#include <cctype>
 #include <charconv>
 #include <cstdlib>
 
@@ -1015,6 +1016,55 @@ unsigned invalidatedBy(const std::string& path) {
     for (const auto& p : parameterTable())
         if (p.path.rfind(key + ".", 0) == 0) flags |= p.invalidates;
     return flags & ~kNothing;
+}
+
+std::string editLabel(const std::string& path, const nlohmann::json& doc) {
+    // The element a path is inside ("probe_volumes[2]" -> volume 'name'), and the section's words.
+    static const std::pair<const char*, const char*> kSections[] = {
+        {"terrain", "terrain"}, {"sun", "sun"}, {"sky", "sky"}, {"probe_volumes", "probe volumes"},
+        {"reflection_probes", "reflection probes"}, {"bake", "bake"}, {"camera", "camera"},
+        {"export", "export"}, {"shadows", "shadows"}, {"fog", "fog"}, {"detail", "detail"},
+        {"ao", "ambient occlusion"}, {"water", "water"}, {"lpv", "LPV"}, {"lighting", "lighting"},
+        {"lights", "lights"}};
+    std::string element;
+    for (const std::string& list : objectLists()) {
+        if (path.rfind(list + "[", 0) != 0) continue;
+        const size_t close = path.find(']', list.size());
+        if (close == std::string::npos) break;
+        const std::string digits = path.substr(list.size() + 1, close - list.size() - 1);
+        size_t i = 0;
+        try {
+            i = size_t(std::stoul(digits));
+        } catch (const std::exception&) {
+            break;
+        }
+        if (list == "probe_volumes") {
+            const nlohmann::json* v = nullptr;
+            if (doc.contains("probe_volumes") && doc["probe_volumes"].is_array() && i < doc["probe_volumes"].size())
+                v = &doc["probe_volumes"][i];
+            element = v && v->is_object() && v->contains("name") && (*v)["name"].is_string()
+                          ? "volume '" + (*v)["name"].get<std::string>() + "'"
+                          : "volume " + std::to_string(i + 1);
+        } else {
+            element = (list == "lights" ? "light " : "wave ") + std::to_string(i + 1);
+        }
+        if (close + 1 == path.size()) return element;
+        break;
+    }
+    if (const ParameterSpec* spec = findParameter(path); spec && !spec->label.empty()) {
+        if (!element.empty()) return spec->label + " of " + element;
+        const std::string section = path.substr(0, path.find('.'));
+        std::string lower = spec->label;
+        for (char& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+        for (const auto& [key, words] : kSections)
+            if (section == key && path != section)
+                // "Sun elevation" says its section already; "Density" does not.
+                return lower.find(words) != std::string::npos ? spec->label : spec->label + " (" + words + ")";
+        return spec->label;
+    }
+    for (const auto& [key, words] : kSections)
+        if (path == key) return std::string(key == std::string("sun") ? "the " : "") + words;
+    return path;
 }
 
 bool isParameterSection(const std::string& path) {

@@ -123,6 +123,10 @@ std::string normaliseParameterPath(const std::string& path);
 // project).
 unsigned invalidatedBy(const std::string& path);
 
+// An edit at `path` in words, for undo: "Grid (probes) of volume 'probes'" (the element named
+// from `doc`, the project as JSON), "Scale height (fog)", "wave 2", "the sun".
+std::string editLabel(const std::string& path, const nlohmann::json& doc);
+
 // Sections that hold rows ("sun", "probe_volumes[].adaptive"): JSON objects in the project.
 bool isParameterSection(const std::string& path);
 

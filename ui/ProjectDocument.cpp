@@ -21,8 +21,8 @@ class SetParameterCommand : public QUndoCommand {
 public:
     SetParameterCommand(ProjectDocument* doc, std::string path, nlohmann::json before,
                         nlohmann::json after)
-        : QUndoCommand(QString::fromStdString("Set " + path)), doc_(doc), path_(std::move(path)),
-          before_(std::move(before)), after_(std::move(after)) {}
+        : QUndoCommand(QString::fromStdString("Set " + editLabel(path, doc->json()))), doc_(doc),
+          path_(std::move(path)), before_(std::move(before)), after_(std::move(after)) {}
     void undo() override { doc_->apply(path_, before_); }
     void redo() override { doc_->apply(path_, after_); }
 
@@ -38,8 +38,9 @@ class SetTerrainCommand : public QUndoCommand {
 public:
     SetTerrainCommand(ProjectDocument* doc, std::string path, nlohmann::json before, nlohmann::json after,
                       std::shared_ptr<DemImportResult> terrainBefore, std::shared_ptr<DemImportResult> terrainAfter)
-        : QUndoCommand(QString::fromStdString("Set " + path)), doc_(doc), path_(std::move(path)),
-          before_(std::move(before)), after_(std::move(after)), terrainBefore_(std::move(terrainBefore)),
+        : QUndoCommand(QString::fromStdString("Set " + editLabel(path, doc->json()))), doc_(doc),
+          path_(std::move(path)), before_(std::move(before)), after_(std::move(after)),
+          terrainBefore_(std::move(terrainBefore)),
           terrainAfter_(std::move(terrainAfter)) {}
     void undo() override { doc_->apply(path_, before_, terrainBefore_); }
     void redo() override { doc_->apply(path_, after_, terrainAfter_); }
@@ -203,7 +204,7 @@ bool ProjectDocument::setParameters(const std::vector<std::pair<std::string, nlo
             if (at(json_, e) == at(next, e)) continue;
             before.emplace_back(e, at(json_, e));
             after.emplace_back(e, at(next, e));
-            names << QString::fromStdString(e);
+            names << QString::fromStdString(editLabel(e, json_));
         }
         if (after.empty()) return true;
         // Undo restores in reverse, so a section and a path inside it land as they were.

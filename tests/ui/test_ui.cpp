@@ -757,6 +757,19 @@ private slots:
 
     // The split chart: switching to manual writes the practical splits, a drag moves one split in
     // one undoable edit, a new cascade count resamples the splits; Show cascades toggles view 34.
+    // Undo names an edit in words, not by its JSON path ("Undo Set probe_volumes[0].grid_dims").
+    void undoLabelsAreWords() {
+        ProjectDocument& doc = *w_->document();
+        QUndoStack& undo = *doc.undoStack();
+        const int start = undo.index();
+        QString error;
+        QVERIFY2(doc.setParameter("probe_volumes[0].grid_dims", nlohmann::json{9, 9}, &error), qPrintable(error));
+        QCOMPARE(undo.undoText(), QString("Set Grid (probes) of volume 'probes'"));
+        QVERIFY2(doc.setParameters({{"fog.scale_height", 900.0}, {"sun.elevation_deg", 20.0}}, &error), qPrintable(error));
+        QCOMPARE(undo.undoText(), QString("Set Scale height (fog), Sun elevation"));
+        while (undo.index() > start) undo.undo();
+    }
+
     void splitChartEditsTheSplits() {
         ProjectDocument& doc = *w_->document();
         w_->findChild<QDockWidget*>("dock.shadows")->raise();

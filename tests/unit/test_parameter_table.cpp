@@ -43,6 +43,28 @@ std::string errorFor(const ParameterSpec& spec, const json& value) {
 
 }  // namespace
 
+// Undo's words for an edit: the row's label and what holds it, never the JSON path.
+TEST(ParameterTable, EditLabelsNameTheRowAndItsOwner) {
+    json doc = defaultProjectJson();
+    doc["probe_volumes"][0]["name"] = "valley";
+    EXPECT_EQ(editLabel("probe_volumes[0].grid_dims", doc), "Grid (probes) of volume 'valley'");
+    EXPECT_EQ(editLabel("probe_volumes[0].adaptive.max_probes", doc), "Adaptive: max probes of volume 'valley'");
+    EXPECT_EQ(editLabel("probe_volumes[3].grid_dims", doc), "Grid (probes) of volume 4");
+    EXPECT_EQ(editLabel("probe_volumes[0]", doc), "volume 'valley'");
+    EXPECT_EQ(editLabel("fog.scale_height", doc), "Scale height (fog)");
+    EXPECT_EQ(editLabel("sun.elevation_deg", doc), "Sun elevation");
+    EXPECT_EQ(editLabel("water.waves[1].wavelength", doc),
+              findParameter("water.waves[].wavelength")->label + " of wave 2");
+    EXPECT_EQ(editLabel("lights[0]", doc), "light 1");
+    EXPECT_EQ(editLabel("sun", doc), "the sun");
+    // Every row has words of its own.
+    for (const auto& spec : parameterTable()) {
+        std::string path = spec.path;
+        for (size_t at; (at = path.find("[]")) != std::string::npos;) path.replace(at, 2, "[0]");
+        EXPECT_NE(editLabel(path, doc), path) << spec.path;
+    }
+}
+
 TEST(ParameterTable, PathsAreUniqueAndEveryRowIsDeclaredWhole) {
     std::set<std::string> paths;
     for (const auto& s : parameterTable()) {
