@@ -148,6 +148,10 @@ public:
         };
         return *this;
     }
+    Row& resolvedBy(std::function<json(const SceneDescription&, const Heightfield&, size_t)> f) {
+        s_.resolved = std::move(f);
+        return *this;
+    }
     Row& custom(std::function<json(const SceneDescription&, size_t)> get,
                 std::function<void(SceneDescription&, size_t, const json&)> set) {
         s_.get = std::move(get);
@@ -540,6 +544,15 @@ std::vector<ParameterSpec> buildTable() {
     const auto isAdaptive = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Adaptive;
     };
+    // A terrain or box grid as the bake places it, for the values "auto" resolves to.
+    const auto placedGrid = [=](const SceneDescription& s, const Heightfield& hf, size_t i) -> std::optional<ProbeLayout> {
+        if (isAdaptive(s, i)) return std::nullopt;
+        try {
+            return placeProbes(s.probeVolumes.at(i), hf);
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+    };
     add(Row("probe_volumes[].name", T::String))
         .pattern("[A-Za-z0-9_-]{1,64}", "must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)")
         .label("Name").about("File stem of the volume's .shprobe; unique among volumes")
@@ -590,7 +603,13 @@ std::vector<ParameterSpec> buildTable() {
                 if (v.is_null()) { o.reset(); return; }
                 o = v.size() == 3 ? glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>())
                                   : glm::vec3(v[0].get<float>(), 0.0f, v[1].get<float>());
-            });
+            })
+        .resolvedBy([=](const SceneDescription& s, const Heightfield& hf, size_t i) {
+            const std::optional<ProbeLayout> L = placedGrid(s, hf, i);
+            if (!L || L->positions.empty()) return json(nullptr);
+            if (isBox(s, i)) return json{shortest(L->cellOrigin.x), shortest(L->cellOrigin.y), shortest(L->cellOrigin.z)};
+            return json{shortest(L->positions[0].x), shortest(L->positions[0].z)};
+        });
     add(Row("probe_volumes[].spacing", T::NumberList)).items(2, 2).scalarToo().above(0.0, 1.0e6).unit("m")
         .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
         .about("terrain: [sx, sz] between probes; box: the cube edge, one number; adaptive volumes ignore it")
@@ -608,7 +627,13 @@ std::vector<ParameterSpec> buildTable() {
                 if (v.is_number()) { sp = glm::vec3(v.get<float>()); return; }
                 const float x = v[0].get<float>(), z = v[1].get<float>();
                 sp = glm::vec3(x, std::min(x, z), z);
-            });
+            })
+        .resolvedBy([=](const SceneDescription& s, const Heightfield& hf, size_t i) {
+            const std::optional<ProbeLayout> L = placedGrid(s, hf, i);
+            if (!L) return json(nullptr);
+            if (isBox(s, i)) return json(shortest(L->cellSize));
+            return json{shortest(L->spacing.x), shortest(L->spacing.z)};
+        });
     add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
         .about("terrain placement: probes sit this far above the triangle surface the bake traces; 0 or less leaves them on or in it, unbaked")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset)
@@ -709,7 +734,15 @@ std::vector<ParameterSpec> buildTable() {
                     auto& o = s.reflectionProbes.origin;
                     if (v.is_null()) o.reset();
                     else o = glm::vec2(v[0].get<float>(), v[1].get<float>());
-                });
+                })
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
+            try {
+                const ReflectionLayout L = placeReflectionProbes(s.reflectionProbes, hf);
+                return json{shortest(L.origin.x), shortest(L.origin.y)};
+            } catch (const std::exception&) {
+                return json(nullptr);
+            }
+        });
     add(Row("reflection_probes.spacing", T::NumberList)).items(2, 2).above(0.0, 1.0e6).unit("m")
         .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
         .about("[sx, sz] between probes").redoes(kRebake).onlyWhen(reflectionOn)
@@ -721,7 +754,15 @@ std::vector<ParameterSpec> buildTable() {
                     auto& sp = s.reflectionProbes.spacing;
                     if (v.is_null()) sp.reset();
                     else sp = glm::vec2(v[0].get<float>(), v[1].get<float>());
-                });
+                })
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
+            try {
+                const ReflectionLayout L = placeReflectionProbes(s.reflectionProbes, hf);
+                return json{shortest(L.spacing.x), shortest(L.spacing.y)};
+            } catch (const std::exception&) {
+                return json(nullptr);
+            }
+        });
     add(Row("reflection_probes.height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m")
         .label("Height offset").about("Probes sit this far above the traced terrain surface").redoes(kRebake).onlyWhen(reflectionOn)
         .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::heightOffset);

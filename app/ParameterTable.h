@@ -19,6 +19,8 @@
 
 namespace terralux {
 
+class Heightfield;
+
 enum class ParamType {
     Number,       // a finite double in [min, max]
     Integer,      // a whole number in [min, max]
@@ -79,6 +81,10 @@ struct ParameterSpec {
     std::function<nlohmann::json(const SceneDescription&, size_t volume)> get;
     // Receives a value that passed the row's own checks; may reject with the row's context.
     std::function<void(SceneDescription&, size_t volume, const nlohmann::json&)> set;
+    // Rows whose null stands for a value the terrain decides (auto-span origins and spacings):
+    // that value on `terrain`, in the row's JSON shape, for an editor to show while "auto" is
+    // ticked; null where the placement cannot say it (an adaptive volume, a refused grid).
+    std::function<nlohmann::json(const SceneDescription&, const Heightfield& terrain, size_t volume)> resolved;
 
     bool perVolume() const { return path.rfind("probe_volumes[].", 0) == 0; }
     bool perWave() const { return path.rfind("water.waves[].", 0) == 0; }

@@ -275,11 +275,18 @@ void ParameterForm::addList(const ParameterSpec& spec) {
             QSignalBlocker b(autoBox);
             autoBox->setChecked(v.is_null());
         }
+        // While "auto" is ticked the greyed boxes show what it resolves to on this terrain (the
+        // spacing the grid really has), not whatever they held.
+        json shown = v;
+        if (v.is_null() && spec.resolved && isRead(spec))
+            shown = spec.resolved(doc_->project().scene, doc_->terrain().heightfield, size_t(element_));
         for (size_t i = 0; i < spins.size(); ++i) {
             QSignalBlocker b(spins[i]);
             spins[i]->setVisible(int(i) < n);
             spins[i]->setEnabled(!v.is_null());
-            const json e = v.is_array() && i < v.size() ? v[i] : v.is_number() && i == 0 ? v : json();
+            const json e = shown.is_array() && i < shown.size() ? shown[i]
+                           : shown.is_number() && i == 0        ? shown
+                                                                : json();
             if (!e.is_number()) continue;
             if (integer) static_cast<QSpinBox*>(spins[i])->setValue(e.get<int>());
             else static_cast<QDoubleSpinBox*>(spins[i])->setValue(e.get<double>());

@@ -757,6 +757,32 @@ private slots:
 
     // The split chart: switching to manual writes the practical splits, a drag moves one split in
     // one undoable edit, a new cascade count resamples the splits; Show cascades toggles view 34.
+    // With "auto" ticked, Origin and Spacing showed 0.00 m and 0.01 m; they show what auto-span
+    // resolves to on the terrain: the sample's 7 650 m over 8 probes is 1 092.86 m a step.
+    void autoOriginAndSpacingShowTheResolvedValues() {
+        ProjectDocument& doc = *w_->document();
+        QVERIFY(doc.value("probe_volumes[0].spacing").is_null());
+        w_->findChild<QDockWidget*>("dock.probeVolumes")->raise();
+        auto* spacing = w_->findChild<QDoubleSpinBox*>("param.volume.spacing.0");
+        auto* spacingZ = w_->findChild<QDoubleSpinBox*>("param.volume.spacing.1");
+        auto* origin = w_->findChild<QDoubleSpinBox*>("param.volume.origin.0");
+        QVERIFY(spacing && spacingZ && origin);
+        QVERIFY(w_->findChild<QCheckBox*>("param.volume.spacing.auto")->isChecked());
+        QVERIFY(!spacing->isEnabled());
+        const Heightfield& hf = doc.terrain().heightfield;
+        const double span = hf.maxX() - hf.minX();
+        QCOMPARE(spacing->text(), QString::number(span / 7.0, 'f', spacing->decimals()) + " m");
+        QCOMPARE(spacingZ->value(), spacing->value());
+        QCOMPARE(origin->value(), double(hf.minX()));
+        // The reflection grid's likewise (4 x 4 over the footprint).
+        QString error;
+        QVERIFY2(doc.setParameter("reflection_probes.enabled", true, &error), qPrintable(error));
+        auto* reflection = w_->findChild<QDoubleSpinBox*>("param.reflection_probes.spacing.0");
+        QVERIFY(reflection);
+        QCOMPARE(reflection->value(), std::round(span / 3.0 * 100.0) / 100.0);
+        doc.undoStack()->undo();
+    }
+
     // Undo names an edit in words, not by its JSON path ("Undo Set probe_volumes[0].grid_dims").
     void undoLabelsAreWords() {
         ProjectDocument& doc = *w_->document();
