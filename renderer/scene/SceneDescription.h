@@ -280,7 +280,7 @@ enum class WaterReflection { Planar, Sky };
 // crests never loop: the waves' summed steepness Σ k_i·A_i is at most 1.
 struct WaterSettings {
     bool enabled = false;
-    std::optional<double> level;                 // engine-space metres; unset = the DEM's lowest decile
+    std::optional<double> level;                 // engine-space metres; unset = the water the DEM shows (water::autoLevel)
     glm::vec3 color{0.02f, 0.05f, 0.06f};        // deep-water scatter albedo, linear RGB in [0, 1]
     glm::vec3 absorption{0.45f, 0.09f, 0.06f};   // extinction per metre, linear RGB, >= 0
     double roughness = 0.05;                     // GGX, of the sun's highlight on the waves, [0.02, 1]

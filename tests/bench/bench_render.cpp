@@ -221,7 +221,7 @@ void BM_BeautySurface(benchmark::State& state) {
 BENCHMARK(BM_BeautySurface)->Args({0, 0, 0})->Args({1, 0, 0})->Args({0, 1, 0})->Args({0, 0, 1})->Args({1, 1, 1})
     ->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
-// A lake on N42E001 (the level 150 m over its lowest decile, two waves) at 1280 x 720: the frame
+// A lake on N42E001 (the level 150 m over its lowest point, two waves) at 1280 x 720: the frame
 // without water, with water reflecting the sky, and with the planar reflection at half and full
 // resolution. The reflection's cost is the planar frame less the sky frame; the reference it is
 // held to is the terrain pass at half resolution (the frame without water at 640 x 360).
