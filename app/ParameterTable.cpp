@@ -723,6 +723,17 @@ std::vector<ParameterSpec> buildTable() {
                     checkProduct({v[0].get<int>(), v[1].get<int>(), 1}, kMaxReflectionProbes);
                     s.reflectionProbes.gridDims = {v[0].get<int>(), v[1].get<int>()};
                 });
+    // What auto-span resolves a reflection grid's (x, z) pair to: that member of its placement.
+    const auto resolvedReflection = [](glm::vec2 ReflectionLayout::*member) {
+        return [member](const SceneDescription& s, const Heightfield& hf, size_t) {
+            try {
+                const glm::vec2 v = placeReflectionProbes(s.reflectionProbes, hf).*member;
+                return json{shortest(v.x), shortest(v.y)};
+            } catch (const std::exception&) {
+                return json(nullptr);
+            }
+        };
+    };
     add(Row("reflection_probes.origin", T::NumberList)).items(2, 2).range(-1.0e7, 1.0e7).unit("m")
         .autoMeans("auto-span: the grid spans the terrain footprint").label("Origin")
         .about("(x, z) of the first probe, engine space").redoes(kRebake).onlyWhen(reflectionOn)
@@ -735,14 +746,7 @@ std::vector<ParameterSpec> buildTable() {
                     if (v.is_null()) o.reset();
                     else o = glm::vec2(v[0].get<float>(), v[1].get<float>());
                 })
-        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
-            try {
-                const ReflectionLayout L = placeReflectionProbes(s.reflectionProbes, hf);
-                return json{shortest(L.origin.x), shortest(L.origin.y)};
-            } catch (const std::exception&) {
-                return json(nullptr);
-            }
-        });
+        .resolvedBy(resolvedReflection(&ReflectionLayout::origin));
     add(Row("reflection_probes.spacing", T::NumberList)).items(2, 2).above(0.0, 1.0e6).unit("m")
         .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
         .about("[sx, sz] between probes").redoes(kRebake).onlyWhen(reflectionOn)
@@ -755,14 +759,7 @@ std::vector<ParameterSpec> buildTable() {
                     if (v.is_null()) sp.reset();
                     else sp = glm::vec2(v[0].get<float>(), v[1].get<float>());
                 })
-        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
-            try {
-                const ReflectionLayout L = placeReflectionProbes(s.reflectionProbes, hf);
-                return json{shortest(L.spacing.x), shortest(L.spacing.y)};
-            } catch (const std::exception&) {
-                return json(nullptr);
-            }
-        });
+        .resolvedBy(resolvedReflection(&ReflectionLayout::spacing));
     add(Row("reflection_probes.height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m")
         .label("Height offset").about("Probes sit this far above the traced terrain surface").redoes(kRebake).onlyWhen(reflectionOn)
         .field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::heightOffset);
