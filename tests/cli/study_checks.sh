@@ -65,9 +65,12 @@ for q in irr:
     dominated = any(f["time_s"] <= q["time_s"] and f["error"]["p95"] <= q["error"]["p95"] for f in front)
     expect(dominated, "%s is off the front but nothing on it beats it" % q["label"])
 # Denser probes lower the interpolation-dominated error on this terrain: the densest grid studied
-# errs less at p95 than the sparsest.
-sp = sorted([p for p in pts if p["knob"] == "spacing"], key=lambda p: p["probes"])
-expect(len(sp) >= 3 and sp[-1]["error"]["p95"] < sp[0]["error"]["p95"], "denser grids do not lower the error")
+# (the spacing sweep, or the dense placements measured with another preset, which a slow build
+# reaches first) errs less at p95 than the sparsest. Neighbouring counts need not be monotone:
+# a 6x6 grid can sit worse on the ridges than a 4x4 one.
+sp = sorted([p for p in pts if p["knob"] in ("spacing", "placement_quality")], key=lambda p: p["probes"])
+expect(len(sp) >= 2 and sp[-1]["probes"] >= 4 * sp[0]["probes"], "the spacing sweep spans too few probe counts")
+expect(sp and sp[-1]["error"]["p95"] < sp[0]["error"]["p95"], "denser grids do not lower the error")
 rows = list(csv.DictReader(open(d + "/study.csv")))
 expect(len(rows) == len(pts), "study.csv has %d rows for %d points" % (len(rows), len(pts)))
 page = open(d + "/study.html").read()
