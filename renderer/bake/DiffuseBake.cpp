@@ -1,6 +1,7 @@
 #include "bake/DiffuseBake.h"
 
 #include <algorithm>
+#include <array>
 
 #include <glm/common.hpp>
 #include <cmath>
@@ -16,52 +17,74 @@ namespace terralux {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-// Standard error of E(up) (docs/lighting.md "Monte Carlo standard error"): the spread of the
-// estimates of 3 interleaved sub-lattices (ray i in batch i mod 3) over sqrt(3), as for
-// independent batches, times a factor. A spherical Fibonacci lattice is stratified, so the whole
-// lattice errs far less than independent batches of its size would (quasi-Monte Carlo: about
-// N^-3/4 against N^-1/2 where the integrand jumps, Brauchart et al. 2014, "QMC designs"), and
-// its sub-lattices are poorer spirals than the whole. The factors are measured: each preset
-// against the same probes at 16384 rays on the same irradiance cache (pure sampling error),
-// 16 x 16 grids over the Big Tujunga crop and full tile and N42E001: the batch spread over
-// sqrt(3) overstated it 2.6-4.4x for the bakes (lattice error plus one shadow ray per hit) and
-// 1.6-1.8x for the path-traced reference (random continuations, closer to independent samples).
-// With these factors the estimate is within 1.35x of the measured error for every preset there
-// (tests/unit/test_bake_job.cpp checks 1.5x).
-constexpr int kErrorBatches = 3;
-constexpr double kLatticeErrorFactor = 0.29;
-constexpr double kPathErrorFactor = 0.55;
+// Standard error (docs/lighting.md "Monte Carlo standard error"), by randomised quasi-Monte Carlo
+// (Owen 1997; L'Ecuyer & Lemieux 2002, "Recent advances in randomized quasi-Monte Carlo
+// methods"): a probe's N rays are kReplicates spherical Fibonacci lattices of about
+// N / kReplicates rays, each turned about the vertical by its own uniform random azimuth. Each
+// replicate is then an unbiased estimate of the lattice's height quadrature (one ray at the centre
+// of each equal-area height band: exact for flat ground's horizon, which falls on a band edge, and
+// off by O(N^-2) where the light varies smoothly with height) and the replicates are independent,
+// so the spread of their coefficients over sqrt(kReplicates) estimates the error of their mean
+// with no factor to calibrate, whatever the terrain, sky or albedo. (No estimate can be had from
+// one lattice: its error is not a sum of independent parts.) The figure is of the metric every
+// other error uses, the relative RMS over normals of the irradiance: for orthonormal SH,
+// (1/4π)∫ δE(n)² dn = (1/4π) Σ_k A_l² δL_k², so
+//   SE = sqrt(Σ_k A_l² Var(L_k) / K) / sqrt(Σ_k A_l² L_k²)
+// on the luminance of the coefficients (Ramamoorthi & Hanrahan 2001 for A_l). Two replicates
+// suffice: the estimate pools nine coefficients (reported within 1.2x of the measured error,
+// mean and 95th percentile over probes, on every shared DEM), and more replicates make each
+// lattice smaller and the bake noisier.
+constexpr int kReplicates = 2;
 
-// The L2 clamped-cosine kernel toward +Y: E(up) from the stored SH is the sum over rays of
-// weight × radiance × this (Σ_l Â_l (2l+1)/4π P_l(y), Ramamoorthi & Hanrahan 2001), so the
-// error estimate is of the irradiance the file gives, not of an exact cosine integral.
-double upKernel(double y) { return 0.25 + 0.5 * y + 5.0 * (3.0 * y * y - 1.0) / 32.0; }
+// Accumulates each replicate's luminance SH (radiance projections with the replicate's own weight
+// 4π / its rays) and gives the relative standard error of their mean.
+struct Replicates {
+    std::array<std::array<double, sh::kCoeffCount>, kReplicates> lum{};
+    std::array<int, kReplicates> count{};
 
-// Accumulates per-batch sums of luminance(radiance) × upKernel and gives the relative standard
-// error of their total.
-struct ErrorBatches {
-    double sum[kErrorBatches] = {};
-    int count[kErrorBatches] = {};
-    void add(int ray, const glm::vec3& radiance, const glm::vec3& d) {
-        sum[ray % kErrorBatches] += double(luminance(radiance)) * upKernel(d.y);
-        ++count[ray % kErrorBatches];
+    void add(int k, const glm::vec3& radiance, const glm::vec3& d) {
+        float y[sh::kCoeffCount];
+        sh::evalBasis(d, y);
+        const double l = double(luminance(radiance));
+        for (int j = 0; j < sh::kCoeffCount; ++j) lum[size_t(k)][size_t(j)] += l * double(y[j]);
+        ++count[size_t(k)];
     }
-    float relativeError(double factor) const {
-        double total = 0, mean = 0, sq = 0;
-        int k = 0, n = 0;
-        for (int b = 0; b < kErrorBatches; ++b) {
-            total += sum[b];
-            n += count[b];
-            if (count[b] == 0) continue;
-            const double e = sum[b] / count[b];
-            mean += e;
-            sq += e * e;
-            ++k;
+    float relativeError() const {
+        double num = 0.0, den = 0.0;
+        int k = 0;
+        for (int r = 0; r < kReplicates; ++r) k += count[size_t(r)] > 0;
+        if (k < 2) return 0.0f;
+        for (int j = 0; j < sh::kCoeffCount; ++j) {
+            double mean = 0.0, sq = 0.0;
+            for (int r = 0; r < kReplicates; ++r) {
+                if (count[size_t(r)] == 0) continue;
+                const double e = 4.0 * std::numbers::pi * lum[size_t(r)][size_t(j)] / count[size_t(r)];
+                mean += e;
+                sq += e * e;
+            }
+            mean /= k;
+            const double var = std::max(0.0, sq / k - mean * mean) * k / (k - 1);
+            const double a = sh::kCosineLobe[size_t(sh::bandOf(j))];
+            num += a * a * var / k;
+            den += a * a * mean * mean;
         }
-        if (k < 2 || !(total > 0)) return 0.0f;
-        mean /= k;
-        const double var = std::max(0.0, sq / k - mean * mean) * k / (k - 1);
-        return float(factor * std::sqrt(var / k) / (total / n));
+        return den > 0.0 ? float(std::sqrt(num / den)) : 0.0f;
+    }
+};
+
+// Ray r of a probe's `rays` is point r / kReplicates of replicate r mod kReplicates, a lattice of
+// rays / kReplicates points (one more for the first rays % kReplicates replicates).
+struct ReplicateLattices {
+    int rays;
+    std::array<float, kReplicates> azimuth{};
+    ReplicateLattices(int rays, Rng& rng) : rays(rays) {
+        for (float& a : azimuth) a = rng.next();
+    }
+    int replicateOf(int r) const { return r % kReplicates; }
+    glm::vec3 direction(int r) const {
+        const int k = replicateOf(r);
+        const int n = rays / kReplicates + (k < rays % kReplicates);
+        return fibonacciSphere(uint32_t(r / kReplicates), uint32_t(n), azimuth[size_t(k)]);
     }
 };
 
@@ -230,7 +253,7 @@ BakeQuality qualityOf(const BakeSettings& bake) {
 
 BakeQuality qualityPreset(QualityPreset preset) {
     switch (preset) {
-        case QualityPreset::Draft: return {64, 1, 64, 32, 2};
+        case QualityPreset::Draft: return {96, 1, 64, 32, 2};
         case QualityPreset::Standard: return {256, 2, 128, 64, 4};
         case QualityPreset::High: return {1024, 3, 256, 128, 8};
         case QualityPreset::Reference: return {4096, 16, 0, 0, 1};
@@ -425,23 +448,23 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
     parallelIndices(positions.size(), control, [&](size_t i) {
         if (!valid[i]) return;
         Rng rng(splitmix64(seeds[i]));
-        const float offset = rng.next();
+        const ReplicateLattices lattices(rays, rng);
         sh::ShRgb acc;
-        ErrorBatches batches;
+        Replicates replicates;
         int fromBelow = 0;
         for (int r = 0; r < rays; ++r) {
-            const glm::vec3 d = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
+            const glm::vec3 d = lattices.direction(r);
             RayHit hit;
             const bool terrain = L.tracer->intersect(positions[i], d, INFINITY, hit);
             if (terrain) fromBelow += glm::dot(d, hit.normal) > 0.0f;
             const glm::vec3 radiance =
                 rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng);
             sh::accumulate(acc, d, radiance, weight);
-            batches.add(r, radiance, d);
+            replicates.add(lattices.replicateOf(r), radiance, d);
         }
         out.sh[i] = acc;
         out.fromBelowShare[i] = float(fromBelow) / float(rays);
-        out.standardError[i] = batches.relativeError(kLatticeErrorFactor);
+        out.standardError[i] = replicates.relativeError();
         traced.fetch_add(uint64_t(rays), std::memory_order_relaxed);
     });
     out.rays = traced.load();
@@ -475,9 +498,9 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
     parallelIndices(positions.size(), control, [&](size_t i) {
         if (!valid[i]) return;
         Rng rng(splitmix64(seeds[i] ^ 0xBADC0FFEEull));
-        const float offset = rng.next();
+        const ReplicateLattices lattices(rays, rng);
         sh::ShRgb acc;
-        ErrorBatches batches;
+        Replicates replicates;
         uint64_t count = 0;
         int fromBelow = 0;
         // The light a path from terrain hit `hit` brings back: at each terrain vertex, sun by a
@@ -514,7 +537,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
             return radiance;
         };
         for (int r = 0; r < rays; ++r) {
-            const glm::vec3 d0 = fibonacciSphere(uint32_t(r), uint32_t(rays), offset);
+            const glm::vec3 d0 = lattices.direction(r);
             RayHit hit;
             ++count;
             glm::vec3 radiance(0.0f);
@@ -535,11 +558,11 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                 radiance = path(hit);
             }
             sh::accumulate(acc, d0, radiance, weight);
-            batches.add(r, radiance, d0);
+            replicates.add(lattices.replicateOf(r), radiance, d0);
         }
         out.sh[i] = acc;
         out.fromBelowShare[i] = float(fromBelow) / float(rays);
-        out.standardError[i] = batches.relativeError(kPathErrorFactor);
+        out.standardError[i] = replicates.relativeError();
         traced.fetch_add(count, std::memory_order_relaxed);
     });
     out.rays = traced.load();

@@ -124,7 +124,7 @@ private:
 
 struct ProbeBake {
     std::vector<sh::ShRgb> sh;          // radiance projections per probe (zero when invalid)
-    std::vector<float> standardError;   // relative Monte Carlo standard error of E(up) per probe
+    std::vector<float> standardError;   // relative Monte Carlo standard error per probe (RMS over normals)
     // docs/lighting.md probe validity: the share of a probe's rays whose first hit is the terrain seen
     // from below (dot(dir, normal) > 0; the surface normals face up). A heightfield can only be
     // reached from below by a probe inside it, so any valid probe has 0.
