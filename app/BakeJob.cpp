@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <map>
+#include <optional>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -125,54 +127,123 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
 
 // The mean error a suggested terrain grid aims at.
 constexpr double kSuggestTargetMeanError = 0.02;
+// Trial grids a suggestion may measure before it settles.
+constexpr int kSuggestTrials = 3;
 
-// For a volume whose interpolation error is high: what to set instead, each with the probes and
-// time the dry run's calibration estimates. Bilinear interpolation error falls with the square
-// of the probe spacing, so a terrain grid aiming at the target grows by sqrt(mean / target) a
-// side, within the 4096-probe limit; past that an error-driven adaptive volume is the way.
-nlohmann::json suggestions(const BakeRequest& request, size_t index, double meanError, BakeSetup& setup,
-                           int threads) {
-    nlohmann::json out = nlohmann::json::array();
-    if (!(meanError > kSuggestAboveMeanError)) return out;
-    const ProbeVolumeSettings& v = request.project.scene.probeVolumes[index];
+bool errorIsHigh(const ErrorMapStats& m) {
+    return m.points > 0 && (m.mean > kSuggestAboveMeanError || m.p95 > kSuggestAboveP95Error);
+}
+
+// A denser terrain grid for a volume whose interpolation error is high, measured, not modelled:
+// each trial grid is placed and baked like the volume (same rays, seed, cache and deringing) and
+// its error map taken over the same points, against the same truths (measureErrorMap's truth
+// cache), so its figures are what the bake with that setting reports, up to the finer cache a
+// denser grid earns. The first trial grows each side by sqrt(mean / target) (bilinear error falls
+// with the square of the spacing); later ones by the exponent the last two grids showed, for on
+// steep terrain the error falls far slower than that. Within the 4096-probe limit; at most
+// kSuggestTrials grids. The fewest probes that meet the target, else the last grid measured.
+struct GridSuggestion {
+    std::vector<std::string> sets;
+    size_t probes = 0;
+    ErrorMapStats error;
+    bool meets = false;
+    int trials = 0;
+    uint64_t rays = 0;
+};
+
+std::optional<GridSuggestion> denserGrid(
+    const ProbeVolumeSettings& v, size_t index, const ProbeLayout& layout, const ErrorMapStats& now,
+    const std::function<std::optional<ErrorMapStats>(const ProbeVolumeSettings&, size_t&, uint64_t&)>& measure) {
     const std::string at = "probe_volumes[" + std::to_string(index) + "].";
-    std::vector<std::vector<std::string>> candidates;
-    if (v.placement == ProbePlacement::Terrain) {
-        const double grow = std::sqrt(meanError / kSuggestTargetMeanError);
-        double nx = std::ceil(v.gridDims[0] * grow), nz = std::ceil(v.gridDims[2] * grow);
+    const int ax = layout.probeDims[0], az = layout.probeDims[2];
+    double side = std::sqrt(double(ax) * az), error = now.mean, exponent = 2.0;
+    std::optional<GridSuggestion> best;
+    GridSuggestion last;
+    int trials = 0;
+    uint64_t rays = 0;
+    for (; trials < kSuggestTrials; ++trials) {
+        const double grow = std::pow(error / kSuggestTargetMeanError, 1.0 / exponent);
+        double nx = std::ceil(ax * side / std::sqrt(double(ax) * az) * grow);
+        double nz = std::ceil(az * side / std::sqrt(double(ax) * az) * grow);
         const double fit = std::sqrt(double(kMaxTerrainGridProbes) / (nx * nz));
         if (fit < 1.0) nx = std::floor(nx * fit), nz = std::floor(nz * fit);
-        if (nx * nz > double(v.gridDims[0]) * v.gridDims[2])
-            candidates.push_back({at + "grid_dims=" + std::to_string(int(nx)) + "," + std::to_string(int(nz))});
-    }
-    if (v.placement != ProbePlacement::Adaptive || !v.adaptive.tolerance)
-        candidates.push_back({at + "placement=adaptive", at + "adaptive.tolerance=0.02"});
-    for (const auto& sets : candidates) {
-        BakeRequest r = request;
-        nlohmann::json doc = projectToJson(r.project);
-        for (const auto& s : sets) applyOverride(doc, s);
-        r.project.scene = sceneFromJson(doc, "suggestion", nullptr);
-        // Only the probe volumes differ from the bake's own: its terrain, sky and tracer stand.
-        const std::vector<const ProbeVolumeSettings*> own = setup.volumes;
-        setup.volumes.clear();
-        for (const auto& candidate : r.project.scene.probeVolumes)
-            if (candidate.enabled) setup.volumes.push_back(&candidate);
-        try {
-            const BakeEstimate e = estimateWith(r, setup, threads);
-            setup.volumes = own;
-            const VolumeEstimate* ve = nullptr;
-            for (const auto& x : e.volumes)
-                if (x.name == v.name) ve = &x;
-            if (!ve) continue;
-            out.push_back({{"set", sets},
-                           {"probes", ve->probes},
-                           {"probes_max", ve->probesMax},
-                           {"estimated_time_s", e.seconds},
-                           {"estimated_max_time_s", e.secondsMax}});
-        } catch (const std::exception&) {
-            // A suggestion the estimate refuses (a placement limit) is not made.
-            setup.volumes = own;
+        if (nx * nz <= side * side + 0.5) break;  // no denser grid left to try
+        ProbeVolumeSettings candidate = v;
+        candidate.gridDims = {int(nx), 1, int(nz)};
+        std::vector<std::string> sets = {at + "grid_dims=" + std::to_string(int(nx)) + "," + std::to_string(int(nz))};
+        if (v.spacing) {
+            // Keep the footprint: the spacing shrinks as the count grows.
+            candidate.spacing = glm::vec3(v.spacing->x * float(ax - 1) / float(std::max(nx - 1.0, 1.0)), 0.0f,
+                                          v.spacing->z * float(az - 1) / float(std::max(nz - 1.0, 1.0)));
+            std::ostringstream o;
+            o << std::setprecision(6) << candidate.spacing->x << "," << candidate.spacing->z;
+            sets.push_back(at + "spacing=" + o.str());
         }
+        size_t probes = 0;
+        const std::optional<ErrorMapStats> m = measure(candidate, probes, rays);
+        if (!m || m->points == 0) break;
+        last = {sets, probes, *m, m->mean <= kSuggestTargetMeanError, 0, 0};
+        if (last.meets) {
+            best = last;
+            ++trials;
+            break;
+        }
+        const double newSide = std::sqrt(nx * nz);
+        if (m->mean < error && newSide > side)
+            exponent = std::clamp(std::log(error / m->mean) / std::log(newSide / side), 0.25, 2.0);
+        side = newSide;
+        error = m->mean;
+        if (fit < 1.0) {
+            ++trials;
+            break;  // at the limit: nothing denser to measure
+        }
+    }
+    if (!best && !last.sets.empty()) best = last;
+    if (best) {
+        best->trials = trials;
+        best->rays = rays;
+    }
+    return best;
+}
+
+nlohmann::json suggestionReport(const GridSuggestion& g, const BakeEstimate& e, const VolumeEstimate& ve) {
+    return {{"set", g.sets},
+            {"probes", ve.probes},
+            {"probes_max", ve.probesMax},
+            {"estimated_time_s", e.seconds},
+            {"estimated_max_time_s", e.secondsMax},
+            {"predicted_error", {{"mean", g.error.mean}, {"p95", g.error.p95}, {"max", g.error.max},
+                                 {"points", g.error.points}}},
+            {"target_mean", kSuggestTargetMeanError},
+            {"meets_target", g.meets},
+            {"trials", g.trials},
+            {"rays", g.rays}};
+}
+
+// The suggestion's report entry: its measured error, and the probes and time the dry run's
+// calibration estimates for the project with its settings.
+nlohmann::json suggestions(const BakeRequest& request, size_t index, const std::optional<GridSuggestion>& grid,
+                           BakeSetup& setup, int threads) {
+    nlohmann::json out = nlohmann::json::array();
+    if (!grid) return out;
+    const ProbeVolumeSettings& v = request.project.scene.probeVolumes[index];
+    BakeRequest r = request;
+    nlohmann::json doc = projectToJson(r.project);
+    for (const auto& s : grid->sets) applyOverride(doc, s);
+    r.project.scene = sceneFromJson(doc, "suggestion", nullptr);
+    // Only the probe volumes differ from the bake's own: its terrain, sky and tracer stand.
+    const std::vector<const ProbeVolumeSettings*> own = setup.volumes;
+    setup.volumes.clear();
+    for (const auto& candidate : r.project.scene.probeVolumes)
+        if (candidate.enabled) setup.volumes.push_back(&candidate);
+    try {
+        const BakeEstimate e = estimateWith(r, setup, threads);
+        setup.volumes = own;
+        for (const auto& x : e.volumes)
+            if (x.name == v.name) out.push_back(suggestionReport(*grid, e, x));
+    } catch (const std::exception&) {
+        // A suggestion the estimate refuses (a placement limit) is not made.
+        setup.volumes = own;
     }
     return out;
 }
@@ -785,6 +856,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     std::vector<GltfProbeVolume> grids;
     uint64_t totalRays = 0, referenceRays = 0;
     size_t done = 0, doneWork = 0;
+    std::map<size_t, GridSuggestion> measuredSuggestions;
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *volumes[vi];
         ProbeLayout& layout = layouts[vi];
@@ -922,10 +994,43 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
             // The truth gets the same window as the probes, so the map shows interpolation alone.
             const ProbeBaker counted =
                 deringedBaker(keyedBaker(setup, cache.get(), rays, seed, mc), scene.bake.deringing, &mapRays);
+            std::unordered_map<size_t, sh::ShRgb> truths;
             diagnostics.errorMap = measureErrorMap(layout, bake.sh, hf, counted,
                                                    scene.bake.errorMapResolution,
-                                                   errorMapHeight(v, layout), seed);
+                                                   errorMapHeight(v, layout), seed, &truths);
             const ErrorMapStats ms = errorMapStats(diagnostics.errorMap);
+            // High error on a terrain grid: measure a denser one (a target chooses its own).
+            if (errorIsHigh(ms) && v.placement == ProbePlacement::Terrain && !targets.count(volumeIndex)) {
+                phase = "measuring a suggestion for '" + v.name + "'";
+                auto measure = [&](const ProbeVolumeSettings& candidate, size_t& probes,
+                                   uint64_t& suggestionRays) -> std::optional<ErrorMapStats> {
+                    ProbeLayout trial;
+                    try {
+                        trial = placeProbes(candidate, hf);
+                    } catch (const PlacementError&) {
+                        return std::nullopt;
+                    }
+                    probes = trial.validCount();
+                    ProbeBake b = referenceMode ? referenceProbes(lighting, q.bounces, trial.positions, trial.valid,
+                                                                  rays, seed, mc)
+                                                : bakeProbes(lighting, cache.get(), q.bounces, trial.positions,
+                                                             trial.valid, rays, seed, mc);
+                    suggestionRays += b.rays;
+                    if (scene.bake.deringing)
+                        for (size_t i = 0; i < b.sh.size(); ++i)
+                            if (trial.valid[i]) sh::deringIrradiance(b.sh[i]);
+                    uint64_t before = mapRays;
+                    const ErrorMap m = measureErrorMap(trial, b.sh, hf, counted, scene.bake.errorMapResolution,
+                                                       errorMapHeight(candidate, trial), seed, &truths);
+                    suggestionRays += mapRays - before;
+                    mapRays = before;
+                    return errorMapStats(m);
+                };
+                if (auto g = denserGrid(v, volumeIndex, layout, ms, measure)) {
+                    totalRays += g->rays;
+                    measuredSuggestions[volumeIndex] = *g;
+                }
+            }
             totalRays += mapRays;
             vr["error_map"] = {{"size", {diagnostics.errorMap.nx, diagnostics.errorMap.nz}},
                                {"step_m", diagnostics.errorMap.step},
@@ -991,7 +1096,11 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         // A volume with a target_error has its placement from the target.
         if (vr.contains("target")) continue;
         const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
-        vr["suggestions"] = suggestions(request, index, vr["error_map"]["mean"].get<double>(), setup, threads);
+        const auto g = measuredSuggestions.find(index);
+        vr["suggestions"] = suggestions(request, index,
+                                        g == measuredSuggestions.end() ? std::nullopt
+                                                                       : std::optional<GridSuggestion>(g->second),
+                                        setup, threads);
     }
     nlohmann::json errorEstimate = nlohmann::json::object();
     for (const auto& vr : volumeReports) {

@@ -42,8 +42,10 @@ nlohmann::json bakeInputs(const Project& project);
 // [32,32]". Empty when they are the same.
 std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const nlohmann::json& now);
 
-// Above this mean interpolation error a bake's report suggests denser probes ("suggestions").
+// Above this mean, or this 95th percentile, of the interpolation error a bake's report suggests
+// denser probes ("suggestions").
 inline constexpr double kSuggestAboveMeanError = 0.05;
+inline constexpr double kSuggestAboveP95Error = 0.10;
 
 // What a volume's target_error chose (docs/lighting.md, "Asking for an accuracy"): the search's
 // trials bake with a small irradiance cache and a coarse error map; the bake then measures its

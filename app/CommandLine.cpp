@@ -451,7 +451,8 @@ int commandBake(const Args& a) {
         }
         if (v.contains("suggestions") && !v["suggestions"].empty()) {
             std::cout << "    that is more than " << int(std::lround(100.0 * kSuggestAboveMeanError))
-                      << " % on average; denser probes lower it:\n";
+                      << " % on average or " << int(std::lround(100.0 * kSuggestAboveP95Error))
+                      << " % at p95; denser probes lower it (measured on the same points):\n";
             for (const auto& s : v["suggestions"]) {
                 std::cout << "     ";
                 for (const auto& set : s["set"]) std::cout << " --set " << set.get<std::string>();
@@ -461,7 +462,13 @@ int commandBake(const Args& a) {
                 std::cout << ", about " << duration(s["estimated_time_s"].get<double>());
                 if (s["estimated_max_time_s"].get<double>() > s["estimated_time_s"].get<double>())
                     std::cout << ", up to " << duration(s["estimated_max_time_s"].get<double>());
-                std::cout << ")\n";
+                const auto& e = s["predicted_error"];
+                std::cout << "): mean " << fixed(100.0 * e["mean"].get<double>(), 2) << " % / p95 "
+                          << fixed(100.0 * e["p95"].get<double>(), 2) << " %";
+                if (!s["meets_target"].get<bool>())
+                    std::cout << ", short of the " << fixed(100.0 * s["target_mean"].get<double>(), 0)
+                              << " % mean aimed at";
+                std::cout << "\n";
             }
         }
     }

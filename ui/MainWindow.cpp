@@ -916,10 +916,13 @@ void MainWindow::showReport(const nlohmann::json& report) {
     QString advice;
     for (const auto& v : volumes) {
         if (!v.contains("suggestions") || v["suggestions"].empty()) continue;
-        advice += QString("<p><b>%1</b>: interpolation error %2 on average, above %3 %. Denser probes lower it:")
+        advice += QString("<p><b>%1</b>: interpolation error %2 on average and %3 at p95, above %4 % or %5 %. "
+                          "Denser probes lower it (measured on the same points):")
                       .arg(QString::fromStdString(v.value("name", "")))
                       .arg(percent(v["error_map"].value("mean", json())))
-                      .arg(int(std::lround(100.0 * kSuggestAboveMeanError)));
+                      .arg(percent(v["error_map"].value("p95", json())))
+                      .arg(int(std::lround(100.0 * kSuggestAboveMeanError)))
+                      .arg(int(std::lround(100.0 * kSuggestAboveP95Error)));
         for (const auto& s : v["suggestions"]) {
             QStringList sets;
             for (const auto& x : s["set"]) sets << QString::fromStdString(x.get<std::string>()).toHtmlEscaped();
@@ -929,6 +932,11 @@ void MainWindow::showReport(const nlohmann::json& report) {
                           .arg(s["estimated_time_s"].get<double>(), 0, 'f', 1);
             if (s["estimated_max_time_s"].get<double>() > s["estimated_time_s"].get<double>())
                 advice += QString(" (up to %1 s)").arg(s["estimated_max_time_s"].get<double>(), 0, 'f', 0);
+            advice += QString(", error %1 mean / %2 p95")
+                          .arg(percent(s["predicted_error"].value("mean", json())))
+                          .arg(percent(s["predicted_error"].value("p95", json())));
+            if (!s["meets_target"].get<bool>())
+                advice += QString(", short of the %1 % aimed at").arg(s["target_mean"].get<double>() * 100.0, 0, 'f', 0);
         }
         advice += "</p>";
     }

@@ -66,11 +66,11 @@ ErrorMap errorMapGrid(const ProbeLayout& L, const Heightfield& hf, int resolutio
 
 ErrorMap measureErrorMap(const ProbeLayout& L, const std::vector<sh::ShRgb>& sh,
                          const Heightfield& hf, const ProbeBaker& baker, int resolution,
-                         float height, uint64_t seed) {
+                         float height, uint64_t seed, std::unordered_map<size_t, sh::ShRgb>* truths) {
     ErrorMap m = errorMapGrid(L, hf, resolution, height);
-    std::vector<glm::vec3> points;
+    std::vector<glm::vec3> points, missing;
     std::vector<uint64_t> keys;
-    std::vector<size_t> slot;
+    std::vector<size_t> slot, missingSlot;
     for (uint32_t j = 0; j < m.nz; ++j)
         for (uint32_t i = 0; i < m.nx; ++i) {
             const float x = m.x0 + m.step * float(i), z = m.z0 + m.step * float(j);
@@ -79,16 +79,27 @@ ErrorMap measureErrorMap(const ProbeLayout& L, const std::vector<sh::ShRgb>& sh,
             if (!interpolateProbes(L, sh, p, unused)) continue;
             const size_t k = size_t(j) * m.nx + i;
             points.push_back(p);
-            keys.push_back(splitmix64(seed ^ 0xE7707A9ull ^ (uint64_t(k) * 0x9E3779B97F4A7C15ull)));
             slot.push_back(k);
+            if (truths && truths->count(k)) continue;
+            missing.push_back(p);
+            missingSlot.push_back(k);
+            keys.push_back(splitmix64(seed ^ 0xE7707A9ull ^ (uint64_t(k) * 0x9E3779B97F4A7C15ull)));
         }
     if (points.empty()) return m;
-    const ProbeBake truth = baker(points, keys);
-    const double floor = interpolationErrorFloor(truth.sh);
+    std::unordered_map<size_t, sh::ShRgb> own;
+    std::unordered_map<size_t, sh::ShRgb>& known = truths ? *truths : own;
+    if (!missing.empty()) {
+        const ProbeBake baked = baker(missing, keys);
+        for (size_t n = 0; n < missing.size(); ++n) known[missingSlot[n]] = baked.sh[n];
+    }
+    std::vector<sh::ShRgb> truth;
+    truth.reserve(points.size());
+    for (size_t k : slot) truth.push_back(known.at(k));
+    const double floor = interpolationErrorFloor(truth);
     for (size_t n = 0; n < points.size(); ++n) {
         sh::ShRgb value;
         interpolateProbes(L, sh, points[n], value);
-        m.error[slot[n]] = relativeIrradianceError(value, truth.sh[n], floor);
+        m.error[slot[n]] = relativeIrradianceError(value, truth[n], floor);
     }
     return m;
 }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -64,8 +65,12 @@ ErrorMap errorMapGrid(const ProbeLayout& layout, const Heightfield& hf, int reso
 // The error map of a baked layout: every point of errorMapGrid with probes around it is baked with
 // `baker` (point k keyed from `seed` and k) and compared with interpolateProbes over `sh`
 // (aligned with layout.positions). The baker's exceptions (BakeCancelled) pass through.
+// `truths`, when given, keeps every point's truth by its index in the map: a later map over the
+// same points (another layout of the same footprint, the same seed) reads them instead of baking
+// them again, and bakes only the points it adds (keyed alike, so they are the same probes).
 ErrorMap measureErrorMap(const ProbeLayout& layout, const std::vector<sh::ShRgb>& sh,
                          const Heightfield& hf, const ProbeBaker& baker, int resolution,
-                         float height, uint64_t seed);
+                         float height, uint64_t seed,
+                         std::unordered_map<size_t, sh::ShRgb>* truths = nullptr);
 
 }  // namespace terralux

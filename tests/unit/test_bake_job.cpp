@@ -486,3 +486,47 @@ TEST(BakeJob, ProbesOverALakeSeeTheWater) {
     EXPECT_GT(c.report["volumes"][0]["probes_under_water"].get<int>(), 0);
     fs::remove_all(dir);
 }
+
+// A suggestion is measured, not modelled: baking what it says gives the error it printed, within
+// 1.5x (the suggested bake earns a finer irradiance cache; nothing else differs), on two
+// committed mountain crops under the project's default lighting.
+TEST(BakeSuggestions, TheSuggestedGridDeliversThePredictedError) {
+    for (const char* crop : {"bigtujunga_utm11_crop.tif", "rainier_crop.tif"}) {
+        const fs::path dir = tempDir(std::string("suggest_") + crop);
+        Project p;
+        p.scene.terrain.dem = (fs::path(TERRALUX_TEST_DATA) / "dem" / crop).string();
+        p.scene.exportSettings.outDir = (dir / "first").string();
+        p.scene.exportSettings.gltf = false;
+        p.scene.bake.quality = QualityPreset::Draft;
+        p.scene.bake.errorMapResolution = 32;
+        p.scene.probeVolumes[0].gridDims = {4, 1, 4};
+        const nlohmann::json first = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+        const nlohmann::json& v = first["volumes"][0];
+        const double mean = v["error_map"]["mean"].get<double>(), p95 = v["error_map"]["p95"].get<double>();
+        ASSERT_TRUE(mean > kSuggestAboveMeanError || p95 > kSuggestAboveP95Error) << crop << ": " << v["error_map"].dump();
+        ASSERT_EQ(v["suggestions"].size(), 1u) << crop << ": " << v.dump(1);
+        const nlohmann::json& s = v["suggestions"][0];
+        const double predictedMean = s["predicted_error"]["mean"].get<double>();
+        const double predictedP95 = s["predicted_error"]["p95"].get<double>();
+        // Denser than 4 x 4, and better than it.
+        EXPECT_GT(s["probes"].get<size_t>(), 16u);
+        EXPECT_LT(predictedMean, mean);
+        nlohmann::json doc = projectToJson(p);
+        for (const auto& set : s["set"]) applyOverride(doc, set.get<std::string>());
+        Project suggested = p;
+        suggested.scene = sceneFromJson(doc, "suggestion", nullptr);
+        suggested.scene.exportSettings.outDir = (dir / "suggested").string();
+        const nlohmann::json second = runBake(BakeRequest{suggested, 0, false}, {}, nullptr).report;
+        const nlohmann::json& m = second["volumes"][0]["error_map"];
+        std::printf("%s: 4 x 4 mean %.2f %% / p95 %.2f %%; %s predicted %.2f / %.2f %%, baked %.2f / %.2f %%\n", crop,
+                    100 * mean, 100 * p95, s["set"][0].get<std::string>().c_str(), 100 * predictedMean,
+                    100 * predictedP95, 100 * m["mean"].get<double>(), 100 * m["p95"].get<double>());
+        EXPECT_LT(m["mean"].get<double>(), 1.5 * predictedMean) << crop;
+        EXPECT_GT(m["mean"].get<double>(), predictedMean / 1.5) << crop;
+        EXPECT_LT(m["p95"].get<double>(), 1.5 * predictedP95) << crop;
+        EXPECT_GT(m["p95"].get<double>(), predictedP95 / 1.5) << crop;
+        // The prediction says whether it meets the mean it aims at.
+        EXPECT_EQ(s["meets_target"].get<bool>(), predictedMean <= s["target_mean"].get<double>()) << crop;
+        fs::remove_all(dir);
+    }
+}
