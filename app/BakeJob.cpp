@@ -628,7 +628,7 @@ nlohmann::json lpvReport(const SceneDescription& scene, const Heightfield& hf, c
                          std::vector<std::string>& warnings) {
     const auto start = std::chrono::steady_clock::now();
     const OrbitCamera camera = OrbitCamera::fromSettings(scene.camera, hf);
-    const lpv::Volumes volumes(scene.lpv, {&lighting, &scene.lights}, glm::dvec3(camera.lpvEye()),
+    const lpv::Volumes volumes(lpv::resolvedOn(scene.lpv, hf), {&lighting, &scene.lights}, glm::dvec3(camera.lpvEye()),
                                glm::dvec3(camera.lpvViewDirection()));
     nlohmann::json cascades = nlohmann::json::array();
     for (const lpv::Cascade& c : volumes.cascades()) {
@@ -1159,6 +1159,25 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                "; no water is baked or exported; set water.level to place it");
     for (const auto& [index, c] : targets)
         if (!c.warning.empty()) out.warnings.push_back(c.warning);
+    // A probe above the surface cannot meet the terrain's underside: one that does sits where the
+    // tracer's surface and the placement's disagree (terrain far steeper than any real DEM, as
+    // with a large terrain.vertical_scale), and its light is wrong. None does on the shared DEMs.
+    for (size_t vi = 0; vi < volumes.size(); ++vi) {
+        const nlohmann::json& vr = volumeReports[vi];
+        const size_t below = vr["validity"]["probes_with_rays_from_below"].get<size_t>();
+        if (below == 0) continue;
+        const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
+        std::ostringstream w;
+        w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << below << " of "
+          << vr["probes"].get<size_t>() << " probes see the terrain from below (up to "
+          << percent(vr["validity"]["rays_from_below"]["max"].get<double>())
+          << " of their rays), so their light is wrong (debug view 54, probe validity); the surface is steeper than "
+             "their clearance";
+        if (scene.terrain.verticalScale != 1.0) w << " at terrain.vertical_scale " << scene.terrain.verticalScale;
+        w << ": raise probe_volumes[" << index << "].height_offset";
+        if (scene.terrain.verticalScale > 1.0) w << " or lower terrain.vertical_scale";
+        out.warnings.push_back(w.str());
+    }
     if (sampling) {
         // Judged on the bake's own probes, every volume's, not only the pilot's.
         double baked = 0.0;
@@ -1203,7 +1222,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         in.lights = scene.lights;
         // lpv.ini is the bake's whenever the LPV is on; a bake with it off removes an earlier one.
         in.ownedFiles.push_back(kLpvIniName);
-        if (scene.lpv.enabled) in.extraFiles.push_back({kLpvIniName, lpvIni(scene.lpv)});
+        if (scene.lpv.enabled) in.extraFiles.push_back({kLpvIniName, lpvIni(lpv::resolvedOn(scene.lpv, hf))});
         in.generatorVersion = TERRALUX_VERSION;
         in.scene = scene.exportSettings.gltf;
         // The report lists every file of the bake, itself included, in the order written.

@@ -8,6 +8,7 @@
 #include "Project.h"
 #include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
+#include "lpv/Lpv.h"
 
 #include <algorithm>
 #include <bit>
@@ -813,8 +814,13 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("lpv.enabled", T::Boolean)).label("Light propagation volumes")
         .about("rEx.GI.Method: 1 with LPV on, else 0. On: the bake writes lpv.ini and TERRALUX_lighting.lpv, and the viewport draws the LPV when lighting.indirect is lpv or both")
         .redoes(kUpload).field(&SceneDescription::lpv, &LpvSettings::enabled);
-    add(Row("lpv.size", T::Number)).above(0.0, 1.0e6).unit("m").decimals(0).label("LPV size")
-        .about("rEx.LPV.Size: edge of the largest cascade (cascade 0), 32 cells across")
+    add(Row("lpv.size", T::Number)).above(0.0, 1.0e6).unit("m").decimals(0)
+        .autoMeans("terrain side: cascade 0 spans the terrain's longer side (at least 32 DEM cells, at most 1e6 m), so it can hold the whole footprint")
+        .label("LPV size")
+        .about("rEx.LPV.Size: edge of the largest cascade (cascade 0), 32 cells across; lpv.ini and the glTF carry the metres")
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
+            return json(*lpv::resolvedOn(s.lpv, hf).size);
+        })
         .redoes(kUpload).onlyWhen(lpvOn).field(&SceneDescription::lpv, &LpvSettings::size);
     add(Row("lpv.fade_range", T::Number)).range(0.0, 16.0).unit("cells").decimals(1).label("Fade range")
         .about("rEx.LPV.FadeRange: cells at each cascade's boundary over which it fades out (to the next coarser cascade, or to nothing)")
@@ -956,7 +962,9 @@ std::vector<ParameterSpec> buildTable() {
 
     // The console variables in the lpv rows' order (lpv.indirect_intensity is none): the lpv.ini
     // writer's names, so tooltips and lpv.ini cannot drift apart.
-    const auto cvars = lpvConsoleVariables(LpvSettings{});
+    LpvSettings named;
+    named.size = 1.0;  // any resolved size: only the names are read
+    const auto cvars = lpvConsoleVariables(named);
     size_t cvar = 0;
     for (Row& r : rows)
         if (r.s_.path.rfind("lpv.", 0) == 0 && r.s_.path != "lpv.indirect_intensity" && cvar < cvars.size())

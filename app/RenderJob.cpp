@@ -323,7 +323,7 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
         tracer_ = std::make_shared<const HeightfieldTracer>(terrain_.heightfield, o);
     }
     LpvJob job;
-    job.settings = scene.lpv;
+    job.settings = lpv::resolvedOn(scene.lpv, terrain_.heightfield);
     job.lights = scene.lights;
     job.lighting = lightingOf(project_);
     job.lighting.surface = albedo_;
@@ -335,7 +335,7 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     const nlohmann::json sceneJson = sceneToJson(scene);
     nlohmann::json key = {{"albedo", reinterpret_cast<uintptr_t>(albedo_.get())}};
     for (const char* section : {"lpv", "lights", "sun", "sky", "terrain"}) key[section] = sceneJson.value(section, nlohmann::json());
-    for (const lpv::CascadeLayout& c : lpv::placeCascades(scene.lpv, job.eye, job.viewDir))
+    for (const lpv::CascadeLayout& c : lpv::placeCascades(job.settings, job.eye, job.viewDir))
         key["cascades"].push_back({c.originCell[0], c.originCell[1], c.originCell[2]});
     job.key = key.dump();
     return job;

@@ -234,9 +234,11 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     ext["indirect"] = authored.at("lighting").at("indirect");
     if (scene.lpv.enabled) {
         nlohmann::json& lpv = ext["lpv"] = authored.at("lpv");
-        lpv["console_variables"] = lpvConsoleVariablesJson(scene.lpv);
-        lpv["computed_cascade_ratio"] = lpv::cascadeRatio(scene.lpv);
-        lpv["computed_cascade_sizes"] = lpv::cascadeSizes(scene.lpv);
+        // A null size is the terrain's (lpv::autoSize): the console variables carry the metres.
+        const LpvSettings resolved = lpv::resolvedOn(scene.lpv, hf);
+        lpv["console_variables"] = lpvConsoleVariablesJson(resolved);
+        lpv["computed_cascade_ratio"] = lpv::cascadeRatio(resolved);
+        lpv["computed_cascade_sizes"] = lpv::cascadeSizes(resolved);
         lpv["ini_uri"] = "lpv.ini";
     }
     return ext;

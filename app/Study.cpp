@@ -707,7 +707,7 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     if (lpvTruth.empty()) {
         // Ground points inside the finest cascade of the project's own settings, less its fade:
         // where every cascade count and quality is read.
-        const lpv::CascadeLayout c0 = lpv::placeCascades(project.scene.lpv, eye, view).front();
+        const lpv::CascadeLayout c0 = lpv::placeCascades(lpv::resolvedOn(project.scene.lpv, hf()), eye, view).front();
         const glm::dvec3 lo = c0.origin() + glm::dvec3(project.scene.lpv.fadeRange * c0.cellSize);
         const double span = c0.size - 2.0 * project.scene.lpv.fadeRange * c0.cellSize;
         Rng rng(kStudySeed ^ 0x1F);
@@ -730,7 +730,7 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     p.metric = StudyMetric::Lpv;
     const PeakMemory memory;
     const auto t0 = Clock::now();
-    const lpv::Volumes volumes(s.lpv, {&lighting, &s.lights}, eye, view);
+    const lpv::Volumes volumes(lpv::resolvedOn(s.lpv, hf()), {&lighting, &s.lights}, eye, view);
     p.seconds = secondsSince(t0);
     p.peakMemoryBytes = memory.added();
     std::vector<float> err;

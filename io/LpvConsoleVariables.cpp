@@ -1,6 +1,7 @@
 #include "LpvConsoleVariables.h"
 
 #include <charconv>
+#include <stdexcept>
 
 namespace terralux {
 namespace {
@@ -14,10 +15,11 @@ std::string shortest(double d) {
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> lpvConsoleVariables(const LpvSettings& s) {
+    if (!s.size) throw std::logic_error("lpv.size is unresolved: resolve it on the terrain (lpv::resolvedOn) first");
     auto flag = [](bool b) { return std::string(b ? "1" : "0"); };
     return {
         {"rEx.GI.Method", flag(s.enabled)},
-        {"rEx.LPV.Size", shortest(s.size)},
+        {"rEx.LPV.Size", shortest(*s.size)},
         {"rEx.LPV.FadeRange", shortest(s.fadeRange)},
         {"rEx.LPV.PropagationWeight", shortest(s.propagationWeight)},
         {"rEx.LPV.PropagationIterations", std::to_string(s.propagationIterations)},

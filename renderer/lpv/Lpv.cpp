@@ -170,17 +170,34 @@ const std::array<PropagationNeighbour, 6>& propagationNeighbours() {
 
 // ---- Cascades ---------------------------------------------------------------------------------
 
+double autoSize(const Heightfield& terrain) {
+    const double side = std::max(double(terrain.maxX()) - double(terrain.minX()),
+                                 double(terrain.maxZ()) - double(terrain.minZ()));
+    const double cells = double(kGrid) * std::max(terrain.cellSizeX(), terrain.cellSizeZ());
+    return std::min(std::max(side, cells), 1.0e6);
+}
+
+LpvSettings resolvedOn(LpvSettings settings, const Heightfield& terrain) {
+    if (!settings.size) settings.size = autoSize(terrain);
+    return settings;
+}
+
+double sizeOf(const LpvSettings& s) {
+    if (!s.size) throw std::logic_error("lpv.size is unresolved: resolve it on the terrain (lpv::resolvedOn) first");
+    return *s.size;
+}
+
 double cascadeRatio(const LpvSettings& s) {
     double r = s.cascadeRatio;
     if (s.autoCascadeMinSize > 0.0 && s.cascades > 1)
-        r = std::max(r, std::pow(s.size / s.autoCascadeMinSize, 1.0 / double(s.cascades - 1)));
+        r = std::max(r, std::pow(sizeOf(s) / s.autoCascadeMinSize, 1.0 / double(s.cascades - 1)));
     return r;
 }
 
 std::vector<double> cascadeSizes(const LpvSettings& s) {
     const double r = cascadeRatio(s);
     std::vector<double> sizes;
-    for (int i = 0; i < s.cascades; ++i) sizes.push_back(s.size / std::pow(r, double(i)));
+    for (int i = 0; i < s.cascades; ++i) sizes.push_back(sizeOf(s) / std::pow(r, double(i)));
     return sizes;
 }
 

@@ -82,6 +82,15 @@ float hallucinatedZonal(const Sh4& l, const glm::vec3& axis);
 
 // ---- Cascades -----------------------------------------------------------------------------------
 
+// lpv.size left null: cascade 0 spans the terrain footprint's longer side, so the coarsest cascade
+// can hold the whole terrain whatever its size (a fixed default held 7 % of an 80 km tile's width
+// and left the LPV views nearly black), and at least 32 DEM cells, one per LPV cell; at most 1e6 m.
+double autoSize(const Heightfield& terrain);
+// The settings with `size` resolved on `terrain` (kept when set). Everything below reads a
+// resolved size and throws std::logic_error on an unresolved one.
+LpvSettings resolvedOn(LpvSettings settings, const Heightfield& terrain);
+double sizeOf(const LpvSettings& s);
+
 // The size ratio between consecutive cascades: cascade_ratio, raised with auto_cascade_min_size
 // > 0 (and two or more cascades) to (size / min)^(1/(cascades − 1)) when that is larger, so the
 // smallest cascade is at most the minimum size (exactly it when the rule raised the ratio).

@@ -308,7 +308,9 @@ struct LightingSettings {
 // console variables (lpv.ini); the ranges are ours where the seed gives none.
 struct LpvSettings {
     bool enabled = false;                 // rEx.GI.Method = 1
-    double size = 5312.0;                 // edge of cascade 0, metres, (0, 1e6]
+    // Edge of cascade 0, metres, (0, 1e6]; unset: from the terrain (lpv::autoSize), resolved by
+    // lpv::resolvedOn wherever the settings meet their terrain.
+    std::optional<double> size;
     double fadeRange = 6.0;               // cells at each cascade's boundary faded out, [0, 16]
     double propagationWeight = 0.01;      // share left after crossing a cascade: w^(1/32) per step, [0, 1]
     int propagationIterations = 4;        // [0, 64]

@@ -1382,7 +1382,9 @@ private slots:
         }
         QCOMPARE(rows, 14);
         // The tooltips name every console variable lpv.ini writes.
-        for (const auto& [cvar, value] : lpvConsoleVariables(doc->project().scene.lpv))
+        LpvSettings named = doc->project().scene.lpv;
+        named.size = 1.0;  // the size the terrain resolves: only the names are read here
+        for (const auto& [cvar, value] : lpvConsoleVariables(named))
             QVERIFY2(std::find(tipped.begin(), tipped.end(), cvar) != tipped.end(), cvar.c_str());
         QVERIFY(shownTip(dock->findChild<QWidget*>("param.lpv.size")).startsWith("Console variable rEx.LPV.Size\n"));
         // Quality 2 shows the cone-trace samples.

@@ -530,3 +530,30 @@ TEST(BakeSuggestions, TheSuggestedGridDeliversThePredictedError) {
         fs::remove_all(dir);
     }
 }
+
+// Probes that see the terrain from below are reported, not passed off as sound: at
+// terrain.vertical_scale 100 the Rainier crop's slopes are steeper than 5 m of clearance lets the
+// probes stand clear of; at 50 m none sees the underside and the bake says nothing.
+TEST(BakeValidity, ProbesThatSeeTheTerrainFromBelowAreReported) {
+    const fs::path dir = tempDir("from_below");
+    Project p;
+    p.scene.terrain.dem = (fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif").string();
+    p.scene.exportSettings.outDir = dir.string();
+    p.scene.exportSettings.gltf = false;
+    p.scene.bake.quality = QualityPreset::Draft;
+    p.scene.bake.errorMapResolution = 0;
+    p.scene.terrain.verticalScale = 100.0;
+    const BakeOutcome steep = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const size_t below = steep.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>();
+    EXPECT_GT(below, 0u);
+    bool warned = false;
+    for (const std::string& w : steep.warnings)
+        warned |= w.find(std::to_string(below) + " of 64 probes see the terrain from below") != std::string::npos &&
+                  w.find("raise probe_volumes[0].height_offset or lower terrain.vertical_scale") != std::string::npos;
+    EXPECT_TRUE(warned) << steep.report["warnings"].dump();
+    p.scene.probeVolumes[0].heightOffset = 50.0;
+    const BakeOutcome clear = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    EXPECT_EQ(clear.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>(), 0u);
+    for (const std::string& w : clear.warnings) EXPECT_EQ(w.find("from below"), std::string::npos) << w;
+    fs::remove_all(dir);
+}

@@ -451,7 +451,7 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
         BakeLighting lighting = lightingOf(request.project);
         lighting.tracer = &tracer;
         const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, hf);
-        const lpv::Volumes v(request.project.scene.lpv, {&lighting, &request.project.scene.lights},
+        const lpv::Volumes v(lpv::resolvedOn(request.project.scene.lpv, hf), {&lighting, &request.project.scene.lights},
                              glm::dvec3(camera.position()), glm::dvec3(camera.target - camera.position()));
         for (int j = 0; j < 9; ++j)
             for (int i = 0; i < 9; ++i) {

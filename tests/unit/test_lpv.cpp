@@ -62,7 +62,8 @@ LpvSettings smallLpv() {
 }  // namespace
 
 TEST(Lpv, CascadeSizesFollowTheRatioAndTheAutoMinimumRule) {
-    LpvSettings s;  // 5312 m, 3 cascades, ratio 2, auto 768 m
+    LpvSettings s;  // 3 cascades, ratio 2, auto 768 m
+    s.size = 5312.0;
     EXPECT_NEAR(cascadeRatio(s), std::sqrt(5312.0 / 768.0), 1e-12);
     std::vector<double> sizes = cascadeSizes(s);
     ASSERT_EQ(sizes.size(), 3u);
@@ -81,8 +82,30 @@ TEST(Lpv, CascadeSizesFollowTheRatioAndTheAutoMinimumRule) {
     EXPECT_DOUBLE_EQ(cascadeRatio(s), 2.0);
 }
 
+// lpv.size null: cascade 0 spans the terrain's longer side, at least 32 DEM cells, at most 1e6 m;
+// a set size stands; nothing reads an unresolved one.
+TEST(Lpv, AutoSizeIsTheTerrainsLongerSide) {
+    const Heightfield wide(1001, 401, 80.0, 80.0, std::vector<float>(1001 * 401, 100.0f));  // 80 x 32 km
+    EXPECT_DOUBLE_EQ(autoSize(wide), 80000.0);
+    EXPECT_DOUBLE_EQ(*resolvedOn(LpvSettings{}, wide).size, 80000.0);
+    const Heightfield small(5, 5, 30.0, 30.0, std::vector<float>(25, 0.0f));  // 120 m: under 32 cells
+    EXPECT_DOUBLE_EQ(autoSize(small), 32.0 * 30.0);
+    const Heightfield huge(3, 3, 1.0e6, 1.0e6, std::vector<float>(9, 0.0f));  // 2000 km
+    EXPECT_DOUBLE_EQ(autoSize(huge), 1.0e6);
+    LpvSettings set;
+    set.size = 700.0;
+    EXPECT_DOUBLE_EQ(*resolvedOn(set, wide).size, 700.0);
+    EXPECT_THROW(cascadeSizes(LpvSettings{}), std::logic_error);
+    // On the 80 km tile the default cascades run from the whole tile down to the 768 m minimum.
+    const std::vector<double> sizes = cascadeSizes(resolvedOn(LpvSettings{}, wide));
+    ASSERT_EQ(sizes.size(), 3u);
+    EXPECT_DOUBLE_EQ(sizes[0], 80000.0);
+    EXPECT_NEAR(sizes[2], 768.0, 1e-9);
+}
+
 TEST(Lpv, CascadesSitAheadOfTheCameraSnappedToTheirCells) {
     LpvSettings s;
+    s.size = 5312.0;
     const glm::dvec3 view = glm::normalize(glm::dvec3(1.0, -0.5, 0.25));
     const glm::dvec3 camera(1234.5, 880.25, -4321.0);
     const std::vector<CascadeLayout> cs = placeCascades(s, camera, view);
@@ -562,6 +585,7 @@ TEST(Lpv, GeometryVolumeAmbientOcclusionFollowsTheTracedSkyVisibility) {
     const BakeLighting lighting = sunLighting(tracer);
     LpvSettings s;
     s.enabled = true;
+    s.size = 5312.0;
     s.cascades = 1;
     s.propagationIterations = 0;
     const float cx = 0.5f * (hf.minX() + hf.maxX()), cz = 0.5f * (hf.minZ() + hf.maxZ());
@@ -621,6 +645,9 @@ TEST(Lpv, GroundPointsCompareWithTheOneBounceReference) {
 TEST(Lpv, IniIsTheConsoleVariablesInTheTablesOrder) {
     LpvSettings s;
     s.enabled = true;
+    // Unresolved, the size has no metres to write: the writer refuses rather than guess.
+    EXPECT_THROW(lpvIni(s), std::logic_error);
+    s.size = 5312.0;
     EXPECT_EQ(lpvIni(s),
               "[SystemSettings]\n"
               "rEx.GI.Method=1\n"

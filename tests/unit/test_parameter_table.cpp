@@ -325,7 +325,7 @@ TEST(ParameterTable, LpvRowsAreTheConsoleVariablesWithTheirRules) {
     EXPECT_EQ(rows, 14);
     const json doc = defaultProjectJson();
     EXPECT_EQ(test::projectErrorFor("lpv.cascades", 5, doc), "p.json: lpv.cascades = 5: must be in [1, 4]");
-    EXPECT_EQ(test::projectErrorFor("lpv.size", 0, doc), "p.json: lpv.size = 0: must be in (0, 1000000]");
+    EXPECT_EQ(test::projectErrorFor("lpv.size", 0, doc), "p.json: lpv.size = 0: must be in (0, 1000000] or null");
     EXPECT_EQ(test::projectErrorFor("lpv.cascade_ratio", 1, doc), "p.json: lpv.cascade_ratio = 1: must be in (1, 16]");
     EXPECT_EQ(test::projectErrorFor("lpv.quality", 3, doc), "p.json: lpv.quality = 3: must be in [0, 2]");
     EXPECT_EQ(test::projectErrorFor("lpv.cone_trace_samples", 0, doc),

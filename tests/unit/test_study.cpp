@@ -252,7 +252,9 @@ TEST(Study, TargetsAreResolvedAndAPointClearsTheTargetItOverrides) {
     // then the study must say it skipped it.
     const bool spacingSkipped = std::any_of(r.skipped.begin(), r.skipped.end(),
                                             [](const StudySkip& s) { return s.knob == "spacing"; });
-    if (!spacingSkipped) EXPECT_GT(spacingPoints, 0u);
+    if (!spacingSkipped) {
+        EXPECT_GT(spacingPoints, 0u);
+    }
 }
 
 TEST(Study, CancelStopsTheStudy) {
