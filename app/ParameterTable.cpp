@@ -9,6 +9,7 @@
 #include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
 #include "lpv/Lpv.h"
+#include "water/Water.h"
 
 #include <algorithm>
 #include <bit>
@@ -497,6 +498,10 @@ std::vector<ParameterSpec> buildTable() {
         .about("Waves slow down in the shallows: ω² = g·k·tanh(k·h), h the water depth over the DEM; off: deep water everywhere, ω² = g·k")
         .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::depthAware);
     add(Row("water.shore_fade_distance", T::Number)).range(0.0, 1.0e5).unit("m").decimals(1).zeroMeans("no fade")
+        .autoMeans("two cells: twice the DEM's larger cell spacing, so the fade ramps over vertices on any DEM")
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
+            return json(water::shoreFadeDistance(s.water, hf));
+        })
         .label("Shore fade")
         .about("Distance from the shore (the nearest DEM vertex at or above the level) over which the waves grow from nothing to their full amplitude, smoothstep; 0 = no fade")
         .redoes(kUpload).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::shoreFadeDistance);

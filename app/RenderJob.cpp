@@ -110,7 +110,7 @@ void ProjectRenderer::setProject(const Project& project) {
         w.absorption = ws.absorption;
         w.roughness = float(ws.roughness);
         w.depthAware = ws.depthAware;
-        w.shoreFadeDistance = float(ws.shoreFadeDistance);
+        w.shoreFadeDistance = float(water::shoreFadeDistance(ws, terrain_.heightfield));
         w.planarReflection = ws.reflection == WaterReflection::Planar;
         w.reflectionScale = float(ws.reflectionScale);
         w.distortion = float(ws.distortion);

@@ -218,6 +218,9 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
         w["resolved_level"] = scene.water.level ? w.at("level")
                               : level           ? nlohmann::json(shortestDecimal(float(*level)))
                                                 : nlohmann::json(nullptr);
+        w["resolved_shore_fade_distance"] = scene.water.shoreFadeDistance
+                                                ? w.at("shore_fade_distance")
+                                                : nlohmann::json(water::shoreFadeDistance(scene.water, hf));
         for (size_t i = 0; i < scene.water.waves.size(); ++i) {
             const water::WaveTerms t = water::waveTerms(scene.water.waves[i]);
             nlohmann::json& wave = w.at("waves").at(i);

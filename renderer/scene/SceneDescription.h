@@ -286,7 +286,9 @@ struct WaterSettings {
     double roughness = 0.05;                     // GGX, of the sun's highlight on the waves, [0.02, 1]
     std::vector<GerstnerWave> waves;             // at most kMaxWaves
     bool depthAware = false;                     // ω² = g·k·tanh(k·h) with the depth h, not g·k
-    double shoreFadeDistance = 50.0;             // metres from shore over which the waves grow to full
+    // Metres from shore over which the waves grow to full; unset = two DEM cells
+    // (water::shoreFadeDistance).
+    std::optional<double> shoreFadeDistance;
     WaterReflection reflection = WaterReflection::Planar;
     double reflectionScale = 0.5;                // planar reflection target size / frame size, [0.25, 1]
     double distortion = 0.02;                    // screen-space offset of the reflection per unit of wave slope, [0, 0.2]

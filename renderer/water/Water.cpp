@@ -250,6 +250,11 @@ std::optional<double> waterLevel(const WaterSettings& settings, const Heightfiel
     return autoLevel(hf).level;
 }
 
+double shoreFadeDistance(const WaterSettings& settings, const Heightfield& hf) {
+    if (settings.shoreFadeDistance) return *settings.shoreFadeDistance;
+    return 2.0 * std::max(hf.cellSizeX(), hf.cellSizeZ());
+}
+
 std::vector<float> shoreDistance(const Heightfield& hf, double level) {
     const int w = hf.width(), d = hf.depth();
     const size_t n = size_t(w) * size_t(d);

@@ -65,6 +65,12 @@ AutoLevel autoLevel(const Heightfield& hf);
 // The water level in engine space: settings.level, or what autoLevel finds (unset: no water).
 std::optional<double> waterLevel(const WaterSettings& settings, const Heightfield& hf);
 
+// The shore fade in metres: settings.shore_fade_distance, or two of the DEM's cells (the larger
+// spacing) when unset. The shore distance is known at the vertices only, so a fade shorter than
+// a cell jumps from nothing to full between two of them; two cells make a ramp on any DEM (a fixed
+// 50 m was under one cell of an 81 m tile).
+double shoreFadeDistance(const WaterSettings& settings, const Heightfield& hf);
+
 // Euclidean distance in metres from every DEM vertex to the nearest land vertex (height >=
 // level), 0 on land; vertices with no land anywhere get +infinity. Row-major like the heights.
 // Exact squared distance transform of Felzenszwalb & Huttenlocher (2012), separable in x then z,

@@ -237,6 +237,13 @@ TEST(LightingExtension, WaterIsEverySettingWithTheLevelAndTheWavesResolved) {
     for (json& wave : authored.at("waves")) wave = authoredPart(wave);
     EXPECT_EQ(authored, printed);
     EXPECT_EQ(w["depth_aware"], true);
+    // The shore fade as set, and left null: two of the DEM's cells (25 m here; 81 m cells would
+    // get 162 m, where the former fixed 50 m was under one cell).
+    EXPECT_EQ(w["resolved_shore_fade_distance"].get<double>(), 12.0);
+    const json unset = lightingExtension(projectWith({"water.enabled=true"}), hf).at("water");
+    EXPECT_TRUE(unset["shore_fade_distance"].is_null());
+    EXPECT_EQ(unset["resolved_shore_fade_distance"].get<double>(), 2.0 * std::max(hf.cellSizeX(), hf.cellSizeZ()));
+    EXPECT_EQ(unset["resolved_shore_fade_distance"].get<double>(), 50.0);
     // This rolling terrain shows no water surface: the auto level resolves to none (null).
     EXPECT_TRUE(w["level"].is_null());
     EXPECT_FALSE(water::autoLevel(hf).level.has_value());
