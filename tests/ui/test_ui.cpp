@@ -299,6 +299,12 @@ private slots:
         QVERIFY(!volume["suggestions"].empty());
         QVERIFY2(advice->text().contains("probe_volumes[0].grid_dims=") && advice->text().contains("probes, about"),
                  qPrintable(advice->text()));
+        // With the error the suggested grid was measured to give.
+        const nlohmann::json& predicted = volume["suggestions"][0]["predicted_error"];
+        QVERIFY2(advice->text().contains(QString(", error %1 % mean / %2 % p95")
+                                             .arg(predicted["mean"].get<double>() * 100.0, 0, 'f', 2)
+                                             .arg(predicted["p95"].get<double>() * 100.0, 0, 'f', 2)),
+                 qPrintable(advice->text()));
 
         QString error;
         QVERIFY(w_->document()->setParameter("bake.quality", "reference", &error));
