@@ -174,6 +174,18 @@ void ParameterForm::addNumber(const ParameterSpec& spec) {
     refreshers_.push_back([=, this] {
         const json v = doc_->value(docPath(spec));
         QSignalBlocker b1(spin);
+        if (nullable) {
+            // "auto" names what it resolves to on this terrain, where the table can say it.
+            QString text = QString::fromStdString(autoShort(spec));
+            if (v.is_null() && spec.resolved && isRead(spec)) {
+                const json r = spec.resolved(doc_->project().scene, doc_->terrain().heightfield, size_t(element_));
+                if (r.is_number())
+                    text += QString(" (%1%2)")
+                                .arg(QLocale().toString(r.get<double>(), 'f', spec.decimals))
+                                .arg(spec.unit.empty() ? QString() : QString::fromStdString(" " + spec.unit));
+            }
+            spin->setSpecialValueText(text);
+        }
         spin->setValue(v.is_number() ? v.get<double>() : lo - step);
         if (s && v.is_number()) {
             QSignalBlocker b2(s);

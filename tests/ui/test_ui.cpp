@@ -1351,6 +1351,10 @@ private slots:
         QVERIFY(!rowOf(dock->findChild<QWidget*>("param.lpv.size"))->isVisibleTo(dock));
         enabled->setChecked(true);
         QVERIFY(doc->project().scene.lpv.enabled);
+        // lpv.size "auto" says what it is on this terrain: the sample's longer side.
+        auto* size = dock->findChild<QDoubleSpinBox*>("param.lpv.size");
+        QVERIFY(size);
+        QCOMPARE(size->text(), QString("terrain side (%1 m)").arg(QLocale().toString(7650.0, 'f', 0)));
         // What hovering shows: the editor's tooltip, or (spin boxes in a row) its row's.
         auto shownTip = [](QWidget* w) {
             while (w && w->toolTip().isEmpty()) w = w->parentWidget();
