@@ -7,22 +7,13 @@
 #include <iostream>
 #include <sstream>
 
-#include <QCommandLineParser>
-#include <QStringList>
-
-#include <atomic>
-#include <chrono>
-#include <csignal>
 #include <filesystem>
-#include <mutex>
-
-#include <unistd.h>
 
 #include "AtomicFile.h"
 #include "BakeJob.h"
+#include "CommandLineHelp.h"
+#include "CommandLineSupport.h"
 #include "ImageFile.h"
-#include "RenderJob.h"
-#include "Study.h"
 #include "render/DebugViews.h"
 #include "DemImport.h"
 #include "EnvironmentImage.h"
@@ -41,157 +32,7 @@
 namespace terralux {
 namespace {
 
-const char* const kUsageTemplate = R"(Usage: terralux [PROJECT]              open the authoring window
-       terralux COMMAND [OPTIONS]       work headless
-
-Terrain-lighting authoring: import a DEM, bake spherical-harmonics probes, export .shprobe + glTF.
-
-Commands:
-  --bake [PROJECT]              Bake every enabled probe volume and export .shprobe files, a glTF
-                                scene and bake_report.json into the output folder.
-  --render [PROJECT]            Render the terrain lit by the probes of the last bake in the
-                                output folder (baking first when there is none or it is stale)
-                                into --out IMAGE (.png display-encoded, .exr scene-linear), on
-                                the Vulkan device.
-  --study [PROJECT]             Sweep the settings that trade bake time for accuracy (quality,
-                                rays, bounces, probe spacing or adaptive tolerance, error-map
-                                resolution, AO directions, LPV quality and cascades, reflection
-                                cube size, rays and encoding; shadow cascades, map size and
-                                filter on the Vulkan device), measure each against the exact
-                                answer on the same points, and write study.json, study.csv,
-                                study.png and study.html into --out DIR (default: "study"
-                                beside the project or in the current folder).
-  --info [FILE]                 Describe a DEM (GDAL raster) as Terralux imports it; no FILE:
-                                the embedded sample terrain.
-  --print-project [PROJECT]     Print the effective project (defaults, PROJECT, --set) as JSON.
-  --print-schema                Print the JSON Schema (draft 2020-12) of the project file, for
-                                editors that check a project as it is typed.
-  --print-reference             Print the parameter reference (Markdown): every parameter with
-                                its type, default, range, unit and meaning.
-  --help, -h                    Show this help.
-  --version                     Show the version.
-
-Options:
-  --dem FILE                    Use FILE as the terrain instead of the project's (or the sample).
-  --out DIR | IMAGE             --bake: the output folder (default: export.out_dir, "bake" beside
-                                the project or in the current folder); --study: its folder;
-                                --render: the image.
-  --budget SECONDS              --study: the time it may take (default 120); settings that
-                                would not fit are skipped and listed with their estimate.
-  --quality PRESET              draft | standard | high | reference (bake.quality).
-  --compare-reference           Also run the brute-force reference and report the error of
-                                every probe against it (slow).
-  --size WxH                    Render size (default 1280x720).
-  --debug-view N|NAME           What --render draws: {views}.
-  --overlay LIST                --render: draw over the image, comma-separated: probes (probe
-                                positions: gold valid, cyan moved up, red rejected), leaves
-                                (adaptive octree leaves).
-  --time T                      --render: seconds into the water's wave animation (default 0).
-  --profile                     --render: draw the frame a second time, warm, and print what it
-                                cost: each pass's GPU time from timestamps (where the device
-                                writes them), the GPU total, and the host's recording and
-                                read-back conversion, beside both frames' wall time.
-  --camera AZ,EL[,RADIUS]       Orbit camera: azimuth (clockwise from north) and elevation in
-                                degrees, radius in metres (default: the project's camera).
-  --no-probes                   Render without probe lighting.
-  --no-rebake                   --render: draw the bake in the output folder even when it is
-                                stale (its recorded settings or input files differ from the
-                                project's), saying what differs; without it such a bake is
-                                baked again first.
-  --device NAME                 --render, --study: the Vulkan device: cpu, gpu, or part of its
-                                name (default: discrete GPU, integrated, then CPU).
-  --dry-run                     With --bake: place the probes and print, per volume, the probe
-                                count, the .shprobe bytes and the estimated bake time; bake and
-                                write nothing.
-  --set KEY.PATH=VALUE          Override a project parameter by its JSON path; repeatable.
-                                Examples: --set sun.elevation_deg=12
-                                          --set probe_volumes[0].grid_dims=16,16
-                                          --set terrain.albedo=[0.25,0.22,0.2]
-                                An unknown path is an error.
-  --threads N                   Worker threads (default: all cores).
-  --quiet                       No progress on stderr.
-
-With no project and no --dem, commands use the embedded sample terrain (256 x 256 cells of a
-30 m SRTM DEM of the San Gabriel Mountains).
-
-Exit codes: 0 success, 2 bad usage or invalid input, 3 runtime failure, 130 interrupted.
-)";
-
-// The help text, with the debug views listed from their table and wrapped under their option.
-std::string usage() {
-    std::string text = kUsageTemplate;
-    const std::string marker = "{views}";
-    const size_t at = text.find(marker);
-    const size_t column = at - text.rfind('\n', at) - 1;
-    std::string wrapped;
-    size_t width = column;
-    const auto& views = debugViews();
-    for (size_t i = 0; i < views.size(); ++i) {
-        // "30 ndotl," stays on one line.
-        const std::string entry = std::to_string(views[i].number) + " " + views[i].name + (i + 1 < views.size() ? "," : "");
-        if (i > 0 && width + 1 + entry.size() > 97) {
-            wrapped += "\n" + std::string(32, ' ');
-            width = 32;
-        } else if (i > 0) {
-            wrapped += ' ';
-            ++width;
-        }
-        wrapped += entry;
-        width += entry.size();
-    }
-    return text.replace(at, marker.size(), wrapped);
-}
-
-struct Args {
-    QCommandLineParser parser;
-    QCommandLineOption info{"info", "Describe a DEM."};
-    QCommandLineOption printProject{"print-project", "Print the effective project."};
-    QCommandLineOption printSchema{"print-schema", "Print the project JSON Schema."};
-    QCommandLineOption printReference{"print-reference", "Print the parameter reference."};
-    QCommandLineOption help{QStringList{"help", "h"}, "Show help."};
-    QCommandLineOption version{"version", "Show the version."};
-    QCommandLineOption dem{"dem", "Terrain file.", "FILE"};
-    QCommandLineOption set{"set", "Override.", "KEY=VALUE"};
-    QCommandLineOption threads{"threads", "Worker threads.", "N"};
-    QCommandLineOption quiet{"quiet", "No progress."};
-    QCommandLineOption bake{"bake", "Bake."};
-    QCommandLineOption out{"out", "Output folder.", "DIR"};
-    QCommandLineOption quality{"quality", "Preset.", "PRESET"};
-    QCommandLineOption compareReference{"compare-reference", "Compare with the reference."};
-    QCommandLineOption noRebake{"no-rebake", "Draw a stale bake."};
-    QCommandLineOption render{"render", "Render."};
-    QCommandLineOption size{"size", "Size.", "WxH"};
-    QCommandLineOption debugView{"debug-view", "View.", "N"};
-    QCommandLineOption camera{"camera", "Camera.", "AZ,EL[,R]"};
-    QCommandLineOption noProbes{"no-probes", "No probes."};
-    QCommandLineOption device{"device", "Device.", "NAME"};
-    QCommandLineOption dryRun{"dry-run", "Estimate the bake only."};
-    QCommandLineOption overlay{"overlay", "Overlays.", "LIST"};
-    QCommandLineOption time{"time", "Seconds.", "T"};
-    QCommandLineOption study{"study", "Study."};
-    QCommandLineOption budget{"budget", "Seconds.", "SECONDS"};
-    QCommandLineOption profile{"profile", "Per-pass GPU time."};
-
-    Args() {
-        parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
-        parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
-                           quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget, profile});
-    }
-};
-
-class UsageError : public std::runtime_error {
-public:
-    using std::runtime_error::runtime_error;
-};
-
-std::string str(const QString& s) { return s.toStdString(); }
-
-std::string fixed(double v, int decimals) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-    return buf;
-}
+using namespace cli;
 
 int commandInfo(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
@@ -203,7 +44,7 @@ int commandInfo(const Args& a) {
         r = importDem(str(positional[0]));
     const Heightfield& hf = r.heightfield;
     const DemSourceInfo& s = r.source;
-    for (const auto& w : s.warnings) std::cerr << "terralux: warning: " << s.path << ": " << w << "\n";
+    for (const auto& w : s.warnings) std::cerr << programName() << ": warning: " << s.path << ": " << w << "\n";
 
     const size_t cells = size_t(hf.width()) * hf.depth();
     double sum = 0.0;
@@ -236,53 +77,6 @@ int commandInfo(const Args& a) {
       << fixed(hf.geo.northing, 3) << " (footprint centre, engine x = z = 0)\n";
     std::cout << o.str();
     return kExitOk;
-}
-
-std::atomic<bool> gInterrupted{false};
-extern "C" void onInterrupt(int) { gInterrupted.store(true); }
-
-// Percent, phase and ETA on stderr: redrawn in place on a terminal, a line per 10 % otherwise.
-class ProgressPrinter {
-public:
-    explicit ProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(2)) {}
-    // Called from the bake's worker threads: one at a time.
-    void operator()(const std::string& phase, double f) {
-        if (quiet_) return;
-        const std::lock_guard lock(mutex_);
-        const int percent = int(f * 100.0);
-        const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-        if (!tty_ && percent / 10 == last_ / 10 && phase == phase_ && percent != 100) return;
-        if (tty_ && percent == last_ && phase == phase_ &&
-            elapsed - lastDraw_ < 0.2)
-            return;
-        last_ = percent;
-        phase_ = phase;
-        lastDraw_ = elapsed;
-        std::string eta = "";
-        if (f > 0.02 && f < 1.0) eta = ", ETA " + fixed(elapsed * (1.0 - f) / f, 0) + " s";
-        char line[200];
-        std::snprintf(line, sizeof line, "[%3d%%] %s (%.1f s%s)", percent, phase.c_str(), elapsed,
-                      eta.c_str());
-        if (tty_) std::fprintf(stderr, "\r%-78s", line);
-        else std::fprintf(stderr, "%s\n", line);
-        if (tty_ && percent == 100) std::fprintf(stderr, "\n");
-        std::fflush(stderr);
-    }
-
-private:
-    using Clock = std::chrono::steady_clock;
-    bool quiet_, tty_;
-    std::mutex mutex_;
-    Clock::time_point start_ = Clock::now();
-    int last_ = -1;
-    double lastDraw_ = 0;
-    std::string phase_;
-};
-
-std::string duration(double seconds) {
-    if (seconds < 10.0) return fixed(seconds, 1) + " s";
-    if (seconds < 600.0) return fixed(seconds, 0) + " s";
-    return fixed(seconds / 60.0, 0) + " min";
 }
 
 int printEstimate(const BakeEstimate& e) {
@@ -338,7 +132,7 @@ int printEstimate(const BakeEstimate& e) {
     std::cout << "estimated bake time: about " << duration(e.seconds);
     if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
     std::cout << " (" << fixed(e.probeRaysPerSecond / 1e6, 2) << " M probe rays/s measured here)\n";
-    for (const auto& w : e.warnings) std::cerr << "terralux: warning: " << w << "\n";
+    for (const auto& w : e.warnings) std::cerr << programName() << ": warning: " << w << "\n";
     return kExitOk;
 }
 
@@ -366,7 +160,7 @@ int commandBake(const Args& a) {
         request.project.scene.exportSettings.outDir =
             std::filesystem::absolute(dir).lexically_normal().string();
     }
-    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
+    for (const auto& w : warnings) std::cerr << programName() << ": warning: " << w << "\n";
     request.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
     request.compareReference = a.parser.isSet(a.compareReference);
 
@@ -391,14 +185,13 @@ int commandBake(const Args& a) {
         }
     } cleanup{outDir, existed};
 
-    std::signal(SIGINT, onInterrupt);
-    std::signal(SIGTERM, onInterrupt);
+    installInterruptHandlers();
     ProgressPrinter printer(a.parser.isSet(a.quiet));
     BakeOutcome outcome;
     try {
         outcome = runBake(request, std::ref(printer), &gInterrupted);
     } catch (const BakeCancelled&) {
-        std::cerr << "\nterralux: interrupted; earlier outputs in " << outDir.string()
+        std::cerr << "\n" << programName() << ": interrupted; earlier outputs in " << outDir.string()
                   << " are untouched\n";
         return kExitInterrupted;
     }
@@ -495,150 +288,11 @@ int commandBake(const Args& a) {
         for (const auto& l : lpv["lights"]) injected += l["injected"].get<bool>() ? 1 : 0;
         std::cout << " m), " << injected << " of " << lpv["lights"].size() << " lights injected\n";
     }
-    for (const auto& w : outcome.warnings) std::cerr << "terralux: warning: " << w << "\n";
+    for (const auto& w : outcome.warnings) std::cerr << programName() << ": warning: " << w << "\n";
     std::cout << "wrote " << outcome.outDir.string() << ":\n";
     for (const auto& f : outcome.files)
         std::cout << "  " << f.lexically_relative(outcome.outDir).generic_string() << " ("
                   << std::filesystem::file_size(f) << " bytes)\n";
-    return kExitOk;
-}
-
-int commandRender(const Args& a) {
-    const QStringList positional = a.parser.positionalArguments();
-    if (positional.size() > 1) throw UsageError("--render takes one PROJECT");
-    if (!a.parser.isSet(a.out)) throw UsageError("--render needs --out IMAGE (.png or .exr)");
-    const std::filesystem::path image = std::filesystem::absolute(str(a.parser.value(a.out)));
-    const std::string ext = image.extension().string();
-    if (ext != ".png" && ext != ".exr")
-        throw UsageError("--out " + image.string() + ": extension must be .png or .exr");
-    RenderRequest request;
-    request.width = 1280;
-    request.height = 720;
-    if (a.parser.isSet(a.size)) {
-        const std::string v = str(a.parser.value(a.size));
-        unsigned w = 0, h = 0;
-        char x = 0, extra = 0;
-        if (std::sscanf(v.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 ||
-            h < 1 || w > 16384 || h > 16384)
-            throw UsageError("--size " + v + ": expected WxH, each in [1, 16384]");
-        request.width = w;
-        request.height = h;
-    }
-    if (a.parser.isSet(a.debugView)) {
-        const std::string v = str(a.parser.value(a.debugView));
-        const auto view = findDebugView(v);
-        if (!view) throw UsageError("--debug-view " + v + ": not one of " + debugViewList());
-        request.debugView = view->number;
-    }
-    if (a.parser.isSet(a.time)) {
-        bool ok = false;
-        const double t = a.parser.value(a.time).toDouble(&ok);
-        if (!ok || !std::isfinite(t) || t < 0.0 || t > 1.0e6)
-            throw UsageError("--time " + str(a.parser.value(a.time)) + ": expected seconds, a number in [0, 1000000]");
-        request.time = t;
-    }
-    request.probes = !a.parser.isSet(a.noProbes);
-    request.linearOutput = ext == ".exr";
-    for (const QString& o : a.parser.values(a.overlay))
-        for (const QString& part : o.split(',')) {
-            if (part == "probes")
-                request.probePositions = true;
-            else if (part == "leaves")
-                request.leaves = true;
-            else
-                throw UsageError("--overlay " + str(o) + ": '" + str(part) +
-                                 "' is not one of probes, leaves");
-        }
-
-    std::vector<std::string> warnings, sets;
-    for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
-    if (a.parser.isSet(a.camera)) {
-        const QStringList parts = a.parser.value(a.camera).split(',');
-        bool ok = parts.size() == 2 || parts.size() == 3;
-        double v[3] = {0, 0, 0};
-        for (int i = 0; ok && i < parts.size(); ++i) v[i] = parts[i].toDouble(&ok);
-        if (!ok)
-            throw UsageError("--camera " + str(a.parser.value(a.camera)) +
-                             ": expected AZ,EL[,RADIUS] in degrees and metres");
-        sets.push_back("camera.azimuth_deg=" + std::to_string(v[0]));
-        sets.push_back("camera.elevation_deg=" + std::to_string(v[1]));
-        if (parts.size() == 3) sets.push_back("camera.radius=" + std::to_string(v[2]));
-    }
-    const Project project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
-                                                 a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "",
-                                                 &warnings);
-    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
-
-    vk::ContextOptions options;
-    if (a.parser.isSet(a.device)) options.device = str(a.parser.value(a.device));
-    std::unique_ptr<vk::VulkanContext> ctx;
-    try {
-        ctx = std::make_unique<vk::VulkanContext>(options);
-    } catch (const vk::VulkanUnavailable& e) {
-        std::cerr << "terralux: " << e.what() << "; --bake works without one\n";
-        return kExitRuntime;
-    }
-    ProjectRenderer renderer(*ctx, project);
-    std::string note;
-    std::vector<std::string> probeWarnings;
-    const size_t volumes =
-        request.probes ? renderer.loadProbes(!a.parser.isSet(a.noRebake), &note, &probeWarnings) : 0;
-    if (!note.empty() && !a.parser.isSet(a.quiet)) std::cerr << "terralux: " << note << "\n";
-    if (request.probes && volumes == 0) {
-        // --no-rebake with nothing baked: say so, rather than call a missing bake stale.
-        std::cerr << "terralux: warning: " << project.outDir().string()
-                  << " holds no bake to draw (--no-rebake): " << renderer.staleBake().front()
-                  << "; rendering without probes\n";
-    } else if (!renderer.staleBake().empty()) {
-        std::cerr << "terralux: warning: " << project.outDir().string() << " holds a stale bake (--no-rebake draws it):";
-        for (const auto& d : renderer.staleBake()) std::cerr << (&d == &renderer.staleBake().front() ? " " : "; ") << d;
-        std::cerr << "\n";
-    }
-    // Only the views that need the diagnostics complain about their absence.
-    if (findDebugView(request.debugView)->needs.probeDiagnostics)
-        for (const auto& w : probeWarnings) std::cerr << "terralux: warning: " << w << "\n";
-    if (request.debugView == kViewInterpolationError && volumes > 0 && probeWarnings.empty() &&
-        !renderer.hasErrorMap())
-        std::cerr << "terralux: note: this bake measured no interpolation-error map "
-                     "(bake.error_map_resolution = 0, or no volume over the terrain): view "
-                  << kViewInterpolationError << " is grey\n";
-    const RenderedImage img = renderer.render(request);
-    writeImage(image, img.width, img.height, img.rgba);
-    // The first frame builds pipelines, maps and volumes; the profile is of the same frame warm.
-    std::optional<RenderedImage> warm;
-    if (a.parser.isSet(a.profile)) warm = renderer.render(request);
-    const auto view = findDebugView(std::to_string(request.debugView));
-    std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
-              << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
-              << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
-    if (warm) {
-        const FrameTimings& t = renderer.renderer().lastFrameTimings();
-        std::cout << "profile (the frame drawn again, warm):\n";
-        if (t.gpuTimed()) {
-            size_t width = 8;
-            for (const auto& p : t.passes) width = std::max(width, p.name.size());
-            std::cout << "  " << std::left << std::setw(int(width)) << "pass" << std::right << "  GPU ms\n";
-            for (const auto& p : t.passes)
-                std::cout << "  " << std::left << std::setw(int(width)) << p.name << std::right << std::setw(8)
-                          << fixed(p.gpuMilliseconds, 3) << "\n";
-            std::cout << "  " << std::left << std::setw(int(width)) << "GPU total" << std::right << std::setw(8)
-                      << fixed(t.gpuMilliseconds, 3) << "\n";
-        } else {
-            std::cout << "  GPU: " << ctx->deviceName() << " writes no timestamps\n";
-        }
-        std::cout << "  host: recording " << fixed(t.recordMilliseconds, 2) << " ms, read-back conversion "
-                  << fixed(t.readbackMilliseconds, 2) << " ms; wall " << fixed(warm->milliseconds, 1)
-                  << " ms warm, " << fixed(img.milliseconds, 1) << " ms cold\n";
-    }
-    // The LPV views' own exposure, printed with the view so the image can be read as numbers.
-    if (view->number == kViewLpvCascade0 || view->number == kViewLpvAll) {
-        if (const std::optional<double> range = renderer.renderer().lpvViewRange())
-            std::cout << "LPV view scale: E/pi / " << std::setprecision(4) << *range
-                      << " W/(m2 sr) through the display curve ("
-                      << (request.linearOutput ? "this EXR holds E/pi unscaled" : "1.0 shows as 0.9") << ")\n";
-        else
-            std::cout << "LPV view scale: the light propagation volumes hold no light here\n";
-    }
     return kExitOk;
 }
 
@@ -651,74 +305,34 @@ int commandPrintProject(const Args& a) {
     const Project p = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
                                            a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "",
                                            &warnings);
-    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
+    for (const auto& w : warnings) std::cerr << programName() << ": warning: " << w << "\n";
     std::cout << projectToJson(p).dump(2) << "\n";
     return kExitOk;
 }
 
 }  // namespace
 
-int commandStudy(const Args& a, const StudyPlotWriter& writePlot) {
-    const QStringList positional = a.parser.positionalArguments();
-    if (positional.size() > 1) throw UsageError("--study takes one PROJECT");
-    StudyOptions options;
-    if (a.parser.isSet(a.budget)) {
-        bool ok = false;
-        options.budgetSeconds = a.parser.value(a.budget).toDouble(&ok);
-        if (!ok || !(options.budgetSeconds >= kMinStudyBudget && options.budgetSeconds <= kMaxStudyBudget))
-            throw UsageError("--budget " + str(a.parser.value(a.budget)) + ": must be a number of seconds in [" +
-                             fixed(kMinStudyBudget, 0) + ", " + fixed(kMaxStudyBudget, 0) + "]");
-    }
-    options.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
-    if (a.parser.isSet(a.device)) options.device = str(a.parser.value(a.device));
-    std::vector<std::string> sets, warnings;
-    for (const QString& s : a.parser.values(a.set)) sets.push_back(str(s));
-    const Project project = loadEffectiveProject(positional.isEmpty() ? "" : str(positional[0]), sets,
-                                                 a.parser.isSet(a.dem) ? str(a.parser.value(a.dem)) : "", &warnings);
-    for (const auto& w : warnings) std::cerr << "terralux: warning: " << w << "\n";
-    std::filesystem::path outDir;
-    if (a.parser.isSet(a.out)) {
-        const std::string dir = str(a.parser.value(a.out));
-        if (dir.empty()) throw UsageError("--out: must name a folder");
-        outDir = std::filesystem::absolute(dir).lexically_normal();
-    } else {
-        outDir = project.resolve("study");
-    }
-    std::error_code ec;
-    if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec))
-        throw UsageError("--out " + outDir.string() + ": exists and is not a folder");
-
-    std::signal(SIGINT, onInterrupt);
-    std::signal(SIGTERM, onInterrupt);
-    ProgressPrinter printer(a.parser.isSet(a.quiet));
-    StudyResult result;
-    try {
-        result = runStudy(project, options, std::ref(printer), &gInterrupted);
-    } catch (const BakeCancelled&) {
-        std::cerr << "\nterralux: interrupted; nothing written\n";
-        return kExitInterrupted;
-    }
-    const auto files = writeStudy(result, outDir, writePlot);
-    std::cout << studySummary(result);
-    std::cout << "wrote " << outDir.string() << ":\n";
-    for (const auto& f : files) std::cout << "  " << f.filename().string() << "\n";
-    return kExitOk;
-}
-
-int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot) {
+int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands& authoring) {
+    const CommandLineHelp help = commandLineHelp(binary);
+    setProgramName(help.program);
     Args a;
     QStringList arguments;
     for (int i = 0; i < argc; ++i) arguments << QString::fromLocal8Bit(argv[i]);
     try {
         if (!a.parser.parse(arguments)) throw UsageError(str(a.parser.errorText()));
         if (a.parser.isSet(a.help)) {
-            std::cout << usage();
+            std::cout << helpText(help);
             return kExitOk;
         }
         if (a.parser.isSet(a.version)) {
-            std::cout << "terralux " << TERRALUX_VERSION << "\n";
+            std::cout << help.program << " " << TERRALUX_VERSION << "\n";
             return kExitOk;
         }
+        if (binary == Binary::Headless)
+            for (const std::string& name : authoringOnlyOptions())
+                if (a.parser.isSet(QString::fromStdString(name)))
+                    throw UsageError("--" + name + ": not in " + help.program +
+                                     ", which runs without a display or a GPU; it is a command of terralux");
         const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
                              int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render)) +
                              int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference)) +
@@ -750,9 +364,9 @@ int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot)
         if (a.parser.isSet(a.device) && !a.parser.isSet(a.render) && !a.parser.isSet(a.study))
             throw UsageError("--device: only with --render or --study");
         if (a.parser.isSet(a.info)) return commandInfo(a);
-        if (a.parser.isSet(a.study)) return commandStudy(a, writeStudyPlot);
+        if (a.parser.isSet(a.study)) return authoring.study(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
-        if (a.parser.isSet(a.render)) return commandRender(a);
+        if (a.parser.isSet(a.render)) return authoring.render(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);
         if (a.parser.isSet(a.printSchema) || a.parser.isSet(a.printReference)) {
             if (!a.parser.positionalArguments().isEmpty())
@@ -764,36 +378,33 @@ int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot)
         if (!a.parser.positionalArguments().isEmpty())
             throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) +
                              "' (no command given)");
-        std::cout << usage();
+        std::cout << helpText(help);
         return kExitOk;
     } catch (const UsageError& e) {
-        std::cerr << "terralux: " << e.what() << "\nTry 'terralux --help'.\n";
+        std::cerr << programName() << ": " << e.what() << "\nTry '" << programName() << " --help'.\n";
         return kExitUsage;
     } catch (const DemError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitUsage;
     } catch (const ProjectError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitUsage;
     } catch (const FileWriteError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitRuntime;
     } catch (const std::filesystem::filesystem_error& e) {
         // "filesystem error: cannot create directories: ..." becomes the path and the reason.
-        std::cerr << "terralux: " << (e.path1().empty() ? std::string() : e.path1().string() + ": ")
+        std::cerr << programName() << ": " << (e.path1().empty() ? std::string() : e.path1().string() + ": ")
                   << e.code().message() << "\n";
         return kExitRuntime;
-    } catch (const vk::VulkanError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
-        return kExitRuntime;
     } catch (const ImageError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitUsage;
     } catch (const PlacementError& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitUsage;
     } catch (const std::exception& e) {
-        std::cerr << "terralux: " << e.what() << "\n";
+        std::cerr << programName() << ": " << e.what() << "\n";
         return kExitRuntime;
     }
 }

@@ -1,9 +1,17 @@
 #pragma once
-// `terralux` on the command line: argument handling, the commands and their exit codes.
+// The command line of both binaries: argument handling, the commands and their exit codes.
+// terralux-bake runs the commands that need no display and no GPU; terralux adds the ones that
+// do (AuthoringCommands), which live above this layer with the renderer and the charts.
 
-#include "Study.h"
+#include <functional>
+
+#include "CommandLineHelp.h"
 
 namespace terralux {
+
+namespace cli {
+struct Args;
+}
 
 enum ExitCode : int {
     kExitOk = 0,
@@ -12,8 +20,11 @@ enum ExitCode : int {
     kExitInterrupted = 130,
 };
 
-// `writeStudyPlot` draws study.png for --study (the chart lives with the widgets, above this layer);
-// without it the study writes its JSON, CSV and HTML only.
-int runCommandLine(int argc, char** argv, const StudyPlotWriter& writeStudyPlot = {});
+// --render and --study; absent in terralux-bake, which refuses their options by name.
+struct AuthoringCommands {
+    std::function<int(const cli::Args&)> render, study;
+};
+
+int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands& authoring = {});
 
 }  // namespace terralux

@@ -1298,6 +1298,26 @@ json projectSchema() {
     return schema;
 }
 
+std::vector<ParameterReferenceRow> parameterReferenceRows() {
+    std::vector<ParameterReferenceRow> rows;
+    for (const auto& s : parameterTable()) {
+        ParameterReferenceRow r;
+        r.section = s.inList() ? s.listPath() + "[]" : s.path.substr(0, s.path.find('.'));
+        r.path = s.path;
+        r.type = typeName(s);
+        r.defaultValue = s.defaultValue().dump();
+        if (s.type == ParamType::Choice) r.allowed = s.rangeText();
+        else if (s.type == ParamType::String) r.allowed = s.patternRule.empty() ? "any" : s.patternRule;
+        else if (s.type != ParamType::Boolean) r.allowed = (s.type == ParamType::Color || s.type == ParamType::NumberList || s.type == ParamType::IntegerList ? "each " : "") + s.rangeText();
+        r.unit = s.unit;
+        r.edit = invalidationText(s.invalidates);
+        r.autoMeaning = s.autoMeaning.value_or("");
+        r.description = s.description;
+        rows.push_back(std::move(r));
+    }
+    return rows;
+}
+
 std::string parameterReferenceMarkdown() {
     std::ostringstream md;
     md << "# Project parameters\n\n"
@@ -1309,21 +1329,16 @@ std::string parameterReferenceMarkdown() {
           "work an edit in the authoring window costs: redraw < upload < preview bake < re-place <\n"
           "re-import; \"bake only\" parameters change nothing on screen.\n";
     std::string section;
-    for (const auto& s : parameterTable()) {
-        const std::string head = s.inList() ? s.listPath() + "[]" : s.path.substr(0, s.path.find('.'));
-        if (head != section) {
-            section = head;
+    for (const ParameterReferenceRow& r : parameterReferenceRows()) {
+        if (r.section != section) {
+            section = r.section;
             md << "\n## `" << section << "`\n\n"
                << "| parameter | type | default | allowed | unit | edit redoes | null (auto) | description |\n"
                << "|---|---|---|---|---|---|---|---|\n";
         }
-        std::string allowed;
-        if (s.type == ParamType::Choice) allowed = s.rangeText();
-        else if (s.type == ParamType::String) allowed = s.patternRule.empty() ? "any" : s.patternRule;
-        else if (s.type != ParamType::Boolean) allowed = (s.type == ParamType::Color || s.type == ParamType::NumberList || s.type == ParamType::IntegerList ? "each " : "") + s.rangeText();
-        md << "| `" << s.path << "` | " << typeName(s) << " | `" << cell(s.defaultValue().dump()) << "` | "
-           << cell(allowed) << " | " << cell(s.unit) << " | " << invalidationText(s.invalidates) << " | "
-           << cell(s.autoMeaning.value_or("")) << " | " << cell(s.description) << " |\n";
+        md << "| `" << r.path << "` | " << r.type << " | `" << cell(r.defaultValue) << "` | " << cell(r.allowed)
+           << " | " << cell(r.unit) << " | " << r.edit << " | " << cell(r.autoMeaning) << " | "
+           << cell(r.description) << " |\n";
     }
     return md.str();
 }

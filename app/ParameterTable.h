@@ -156,6 +156,12 @@ double shortestDecimal(float f);
 
 // JSON Schema (draft 2020-12) of the project file, generated from the table.
 nlohmann::json projectSchema();
+// One row of the parameter reference, as text: what docs/parameters.md and the manual page show.
+struct ParameterReferenceRow {
+    std::string section;  // "sun", "probe_volumes[]"
+    std::string path, type, defaultValue, allowed, unit, edit, autoMeaning, description;
+};
+std::vector<ParameterReferenceRow> parameterReferenceRows();
 // The parameter reference in Markdown (docs/parameters.md), generated from the table.
 std::string parameterReferenceMarkdown();
 // The parameter editors of each dock with their objectNames (docs/UI_OBJECT_NAMES.md), generated

@@ -2,7 +2,7 @@
 #include <cstring>
 #include <iostream>
 
-#include "CommandLine.h"
+#include "AuthoringCommands.h"
 #include "MainWindow.h"
 #include "StudyChart.h"
 
@@ -11,9 +11,11 @@ int main(int argc, char** argv) {
     // the command line, which never needs a display.
     const bool gui = argc == 1 || (argc == 2 && argv[1][0] != '-');
     if (!gui)
-        return terralux::runCommandLine(argc, argv, [](const terralux::StudyResult& r, const std::filesystem::path& png) {
-            terralux::writeStudyPlotPng(r, png);
-        });
+        return terralux::runCommandLine(
+            argc, argv, terralux::Binary::Authoring,
+            terralux::authoringCommands([](const terralux::StudyResult& r, const std::filesystem::path& png) {
+                terralux::writeStudyPlotPng(r, png);
+            }));
     if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY") && !std::getenv("QT_QPA_PLATFORM")) {
         std::cerr << "terralux: no display for the authoring window; the headless commands are in "
                      "'terralux --help'\n";

@@ -27,6 +27,10 @@ packages=(
   python3 python3-jsonschema
   mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
   xvfb xauth fonts-dejavu-core
+  # the Debian packages (cpack -G DEB): icon sizes drawn from the SVG, dependencies from the
+  # binaries, and the checks of the package tests (lintian, the desktop entry, AppStream, the
+  # MIME database, the manual pages)
+  librsvg2-bin dpkg-dev lintian desktop-file-utils appstream shared-mime-info man-db
   # the glTF validator is an npm package, installed by the test set-up
   nodejs
 )

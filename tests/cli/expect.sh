@@ -2,7 +2,7 @@
 # expect.sh CODE STDERR_REGEX STDOUT_REGEX -- COMMAND...
 # Runs COMMAND and checks its exit code, that stderr matches STDERR_REGEX (extended regex; "" =
 # must be empty, "*" = anything) and that stdout matches STDOUT_REGEX ("" = anything). Error output must be one
-# line, plus the "Try 'terralux --help'." hint for usage errors.
+# line, plus the "Try 'terralux --help'." (or terralux-bake) hint for usage errors.
 set -u
 code=$1 errRe=$2 outRe=$3
 shift 4
@@ -19,7 +19,7 @@ elif [ -z "$errRe" ]; then
 else
   grep -Eq -- "$errRe" "$err" || fail "stderr does not match /$errRe/"
   if [ "$code" -ne 0 ]; then
-    lines=$(grep -vc "^Try 'terralux --help'.$" "$err")
+    lines=$(grep -Evc "^Try 'terralux(-bake)? --help'.$" "$err")
     [ "$lines" -eq 1 ] || fail "error is $lines lines, expected one"
   fi
 fi
