@@ -23,6 +23,8 @@ packages=(
   clang libclang-rt-14-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # bench_tracer's Embree columns (benchmark only; the bench builds without them when absent)
+  libembree-dev
   # the project JSON Schema is checked against --print-project with a real validator
   python3 python3-jsonschema
   mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
