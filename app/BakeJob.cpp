@@ -934,7 +934,9 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
             }
         vr["standard_error"] = stats(se);
         vr["validity"] = {{"rays_from_below", stats(below)},
-                          {"probes_with_rays_from_below", fromBelow}};
+                          {"probes_with_rays_from_below", fromBelow},
+                          {"lifted_clear_of_surface", layout.liftedForClearance},
+                          {"max_lift_m", layout.maxLift}};
         // Probes at or below the water level do not see the water (docs/lighting.md, "Water").
         if (lighting.water) {
             size_t under = 0;
@@ -1164,6 +1166,18 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     // with a large terrain.vertical_scale), and its light is wrong. None does on the shared DEMs.
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const nlohmann::json& vr = volumeReports[vi];
+        const size_t lifted = vr["validity"]["lifted_clear_of_surface"].get<size_t>();
+        if (lifted > 0) {
+            const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
+            std::ostringstream w;
+            w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << lifted << " of "
+              << vr["probes"].get<size_t>() << " probes stand higher than height_offset (up to "
+              << std::fixed << std::setprecision(1) << vr["validity"]["max_lift_m"].get<double>()
+              << " m) to clear slopes too steep for the tracer to resolve at " << std::defaultfloat
+              << std::setprecision(6) << volumes[vi]->heightOffset << " m";
+            if (scene.terrain.verticalScale != 1.0) w << " (terrain.vertical_scale " << scene.terrain.verticalScale << ")";
+            out.warnings.push_back(w.str());
+        }
         const size_t below = vr["validity"]["probes_with_rays_from_below"].get<size_t>();
         if (below == 0) continue;
         const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());

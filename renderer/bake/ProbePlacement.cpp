@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "bake/AdaptivePlacement.h"
+#include "bake/HeightfieldTracer.h"
 
 namespace terralux {
 
@@ -112,6 +113,12 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
             glm::vec3 p(x, ground + float(v.heightOffset), z);
             // An offset below the float spacing at this height would round onto the surface.
             if (v.heightOffset > 0.0 && !(p.y > ground)) p.y = std::nextafter(ground, INFINITY);
+            if (p.y > ground) {
+                const float clear = liftClearOfSelfHits(hf, p);
+                L.liftedForClearance += clear > p.y;
+                L.maxLift = std::max(L.maxLift, clear - p.y);
+                p.y = clear;
+            }
             L.positions.push_back(p);
             L.valid.push_back(p.y > ground ? 1 : 0);
         }
@@ -236,6 +243,15 @@ float defaultFallbackBlendDistance(glm::vec2 spacing, glm::vec2 extent) {
     const float x = spacing.x > 0.0f ? spacing.x : extent.x;
     const float z = spacing.y > 0.0f ? spacing.y : extent.y;
     return 2.0f * std::min(x, z);
+}
+
+float liftClearOfSelfHits(const Heightfield& hf, const glm::vec3& p) {
+    // The distance is taken at a point a little above p, as the lift raises it (it grows with
+    // the coordinates' magnitude).
+    const double r = 2.0 * double(HeightfieldTracer::minDistance(p + glm::vec3(0.0f, 1.0f, 0.0f)));
+    const float hi = surfaceRange(hf, p.x - r, p.x + r, p.z - r, p.z + r).hi;
+    const float clear = float(double(hi) + r);
+    return clear > p.y ? std::nextafter(clear, INFINITY) : p.y;
 }
 
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {

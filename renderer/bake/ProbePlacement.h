@@ -80,6 +80,10 @@ struct ProbeLayout {
     // Box grids: cells partly above the ground whose own probe is inside the terrain, pointing
     // at the first valid probe above them (adaptive volumes count theirs in octree->borrowed).
     size_t borrowedCells = 0;
+    // Terrain grids: probes lifted above height_offset to stand clear of the tracer's self-hit
+    // distance (liftClearOfSelfHits); only on slopes far steeper than real terrain.
+    size_t liftedForClearance = 0;
+    float maxLift = 0.0f;  // metres, the largest of those lifts
 
     // Adaptive volumes: per probe, the key its bake seed derives from (the leaf's identity, so a
     // leaf gets the same bytes however the refinement reached it). Empty: seeds follow the index.
@@ -101,6 +105,15 @@ struct SurfaceRange {
     float lo = INFINITY, hi = -INFINITY;
 };
 SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0, double z1);
+
+// The height at which a probe at p stands clear of the surface in every direction by twice
+// the tracer's self-hit distance (HeightfieldTracer::minDistance), at least p.y. The tracer ignores
+// hits nearer than that distance, so a probe closer to a face (5 m above a slope steeper than
+// 5 m over that distance, as terrain.vertical_scale 100 makes) would send rays through it that
+// then meet the terrain from below. The highest surface point within that distance
+// horizontally is exact (surfaceRange), so the ball of that radius around the result holds no
+// surface.
+float liftClearOfSelfHits(const Heightfield& hf, const glm::vec3& p);
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;

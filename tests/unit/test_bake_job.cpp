@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 
@@ -15,6 +17,7 @@
 #include "ShProbeFile.h"
 #include "TestScenes.h"
 #include "bake/DiffuseBake.h"
+#include "bake/HeightfieldTracer.h"
 #include "bake/ProbePlacement.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
@@ -531,10 +534,10 @@ TEST(BakeSuggestions, TheSuggestedGridDeliversThePredictedError) {
     }
 }
 
-// Probes that see the terrain from below are reported, not passed off as sound: at
-// terrain.vertical_scale 100 the Rainier crop's slopes are steeper than 5 m of clearance lets the
-// probes stand clear of; at 50 m none sees the underside and the bake says nothing.
-TEST(BakeValidity, ProbesThatSeeTheTerrainFromBelowAreReported) {
+// At terrain.vertical_scale 100 the Rainier crop's slopes are so steep that 5 m above the ground
+// lies within the tracer's self-hit distance of the slope beside it: such probes are lifted clear
+// (and the bake says by how much), so none sees the terrain from below. 50 m needs fewer lifts.
+TEST(BakeValidity, ProbesOnSlopesTooSteepForTheTracerAreLiftedClear) {
     const fs::path dir = tempDir("from_below");
     Project p;
     p.scene.terrain.dem = (fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif").string();
@@ -544,16 +547,60 @@ TEST(BakeValidity, ProbesThatSeeTheTerrainFromBelowAreReported) {
     p.scene.bake.errorMapResolution = 0;
     p.scene.terrain.verticalScale = 100.0;
     const BakeOutcome steep = runBake(BakeRequest{p, 0, false}, {}, nullptr);
-    const size_t below = steep.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>();
-    EXPECT_GT(below, 0u);
-    bool warned = false;
-    for (const std::string& w : steep.warnings)
-        warned |= w.find(std::to_string(below) + " of 64 probes see the terrain from below") != std::string::npos &&
-                  w.find("raise probe_volumes[0].height_offset or lower terrain.vertical_scale") != std::string::npos;
-    EXPECT_TRUE(warned) << steep.report["warnings"].dump();
+    const nlohmann::json& validity = steep.report["volumes"][0]["validity"];
+    EXPECT_EQ(validity["probes_with_rays_from_below"].get<size_t>(), 0u) << validity.dump();
+    const size_t lifted = validity["lifted_clear_of_surface"].get<size_t>();
+    EXPECT_GT(lifted, 32u) << validity.dump();
+    EXPECT_GT(validity["max_lift_m"].get<double>(), 5.0);
+    bool said = false;
+    for (const std::string& w : steep.warnings) {
+        said |= w.find(std::to_string(lifted) + " of 64 probes stand higher than height_offset (up to ") !=
+                    std::string::npos &&
+                w.find("at 5 m (terrain.vertical_scale 100)") != std::string::npos;
+        EXPECT_EQ(w.find("from below"), std::string::npos) << w;
+    }
+    EXPECT_TRUE(said) << nlohmann::json(steep.warnings).dump();
     p.scene.probeVolumes[0].heightOffset = 50.0;
-    const BakeOutcome clear = runBake(BakeRequest{p, 0, false}, {}, nullptr);
-    EXPECT_EQ(clear.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>(), 0u);
-    for (const std::string& w : clear.warnings) EXPECT_EQ(w.find("from below"), std::string::npos) << w;
+    const BakeOutcome higher = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    EXPECT_EQ(higher.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>(), 0u);
+    EXPECT_LT(higher.report["volumes"][0]["validity"]["lifted_clear_of_surface"].get<size_t>(), lifted);
+    // At the real scale nothing moves.
+    p.scene.terrain.verticalScale = 1.0;
+    p.scene.probeVolumes[0].heightOffset = 5.0;
+    const BakeOutcome real = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    EXPECT_EQ(real.report["volumes"][0]["validity"]["lifted_clear_of_surface"].get<size_t>(), 0u);
     fs::remove_all(dir);
+}
+
+// Why the lift: from a point 5 m above such a slope, rays pass through the face within the
+// self-hit distance and meet the terrain from below; from the lifted point none does.
+TEST(BakeValidity, TheLiftIsWhatKeepsRaysOffTheUnderside) {
+    const DemImportResult dem = importDem((fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif").string());
+    std::vector<float> h(dem.heightfield.heights().begin(), dem.heightfield.heights().end());
+    for (float& v : h) v *= 100.0f;
+    const Heightfield hf(dem.heightfield.width(), dem.heightfield.depth(), dem.heightfield.cellSizeX(),
+                         dem.heightfield.cellSizeZ(), std::move(h));
+    const HeightfieldTracer tracer(hf, {true});
+    const auto fromBelow = [&](const glm::vec3& p) {
+        int n = 0;
+        for (int k = 0; k < 512; ++k) {
+            // A Fibonacci sphere.
+            const double y = 1.0 - (k + 0.5) / 256.0, r = std::sqrt(1.0 - y * y), phi = 2.399963229728653 * k;
+            const glm::vec3 d(float(r * std::cos(phi)), float(y), float(r * std::sin(phi)));
+            RayHit hit;
+            n += tracer.intersect(p, d, INFINITY, hit) && glm::dot(d, hit.normal) > 0.0f;
+        }
+        return n;
+    };
+    int before = 0, after = 0;
+    for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+            const float x = hf.minX() + (i + 0.5f) / 8.0f * (hf.maxX() - hf.minX());
+            const float z = hf.minZ() + (j + 0.5f) / 8.0f * (hf.maxZ() - hf.minZ());
+            const glm::vec3 p(x, hf.surfaceHeight(x, z) + 5.0f, z);
+            before += fromBelow(p) > 0;
+            after += fromBelow(glm::vec3(x, liftClearOfSelfHits(hf, p), z)) > 0;
+        }
+    EXPECT_GT(before, 8);
+    EXPECT_EQ(after, 0);
 }
