@@ -652,7 +652,11 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
         .autoMeans("2 × spacing: twice the smallest probe spacing").label("Fallback blend")
         .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
-        .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance);
+        .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance)
+        .resolvedBy([=](const SceneDescription& s, const Heightfield& hf, size_t i) {
+            const std::optional<ProbeLayout> L = placedGrid(s, hf, i);
+            return L ? json(shortest(L->fallbackBlendDistance)) : json(nullptr);
+        });
     add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
         .autoMeans("auto: the DEM's cell size, or 1/128 of the box's longer horizontal side when larger").label("Adaptive: min cell")
         .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
@@ -794,7 +798,14 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("reflection_probes.fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
         .autoMeans("2 × spacing: twice the smaller probe spacing").label("Fallback blend")
         .about("Distance outside the grid over which the probes blend to the sky's specular; the box records' blend distance")
-        .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::fallbackBlendDistance);
+        .redoes(kRebake).onlyWhen(reflectionOn).field(&SceneDescription::reflectionProbes, &ReflectionProbeSettings::fallbackBlendDistance)
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) {
+            try {
+                return json(shortest(placeReflectionProbes(s.reflectionProbes, hf).blendDistance));
+            } catch (const std::exception&) {
+                return json(nullptr);
+            }
+        });
     add(Row("reflection_probes.simvx_subset", T::IntegerList)).items(0, kSimvxMaxProbes).range(0, kMaxReflectionProbes - 1)
         .label("simvx probes")
         .about("Indices (scene order) of the at most 8 probes the simvx box records carry; empty: the first 8. In the window: the probe inspector's check box")

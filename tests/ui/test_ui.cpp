@@ -780,12 +780,20 @@ private slots:
         QCOMPARE(spacing->text(), QString::number(span / 7.0, 'f', spacing->decimals()) + " m");
         QCOMPARE(spacingZ->value(), spacing->value());
         QCOMPARE(origin->value(), double(hf.minX()));
+        // The fallback blend's "2 × spacing" says how far that is here: twice 1 092.86 m.
+        auto* blend = w_->findChild<QDoubleSpinBox*>("param.volume.fallback_blend_distance");
+        QVERIFY(blend);
+        QCOMPARE(blend->text(), QString("2 × spacing (%1 m)").arg(QLocale().toString(2.0 * span / 7.0, 'f', 1)));
         // The reflection grid's likewise (4 x 4 over the footprint).
         QString error;
         QVERIFY2(doc.setParameter("reflection_probes.enabled", true, &error), qPrintable(error));
         auto* reflection = w_->findChild<QDoubleSpinBox*>("param.reflection_probes.spacing.0");
         QVERIFY(reflection);
         QCOMPARE(reflection->value(), std::round(span / 3.0 * 100.0) / 100.0);
+        auto* reflectionBlend = w_->findChild<QDoubleSpinBox*>("param.reflection_probes.fallback_blend_distance");
+        QVERIFY(reflectionBlend);
+        QCOMPARE(reflectionBlend->text(),
+                 QString("2 × spacing (%1 m)").arg(QLocale().toString(2.0 * span / 3.0, 'f', 1)));
         doc.undoStack()->undo();
     }
 
