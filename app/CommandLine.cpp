@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <filesystem>
+#include <vector>
 
 #include "AtomicFile.h"
 #include "BakeJob.h"
@@ -333,13 +334,21 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
                 if (a.parser.isSet(QString::fromStdString(name)))
                     throw UsageError("--" + name + ": not in " + help.program +
                                      ", which runs without a display or a GPU; it is a command of terralux");
-        const int commands = int(a.parser.isSet(a.info)) + int(a.parser.isSet(a.printProject)) +
-                             int(a.parser.isSet(a.bake)) + int(a.parser.isSet(a.render)) +
-                             int(a.parser.isSet(a.printSchema)) + int(a.parser.isSet(a.printReference)) +
-                             int(a.parser.isSet(a.study));
-        if (commands > 1)
-            throw UsageError("choose one command: --bake, --render, --study, --info, --print-project, "
-                             "--print-schema or --print-reference");
+        // The commands this binary has, from its help: at most one of them.
+        std::vector<std::string> names;
+        int commands = 0;
+        for (const HelpEntry& e : help.commands) {
+            const std::string name = e.syntax.substr(0, e.syntax.find_first_of(" ,"));
+            if (name == "--help" || name == "--version") continue;
+            names.push_back(name);
+            commands += a.parser.isSet(QString::fromStdString(name.substr(2)));
+        }
+        if (commands > 1) {
+            std::string list;
+            for (size_t i = 0; i < names.size(); ++i)
+                list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+            throw UsageError("choose one command: " + list);
+        }
         if (a.parser.isSet(a.threads)) {
             bool ok = false;
             const int n = a.parser.value(a.threads).toInt(&ok);
