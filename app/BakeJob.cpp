@@ -23,6 +23,7 @@
 #include "GltfExport.h"
 #include "LpvConsoleVariables.h"
 #include "OutputFolder.h"
+#include "ParameterTable.h"
 #include "ProbeDiagnosticsFile.h"
 #include "ReflectionProbeFile.h"
 #include "SceneLighting.h"
@@ -1328,49 +1329,11 @@ nlohmann::json targetChoiceReport(const TargetChoice& c) {
 }
 
 nlohmann::json bakeInputs(const Project& project) {
-    nlohmann::json settings = sceneToJson(project.scene);
-    // Not read by a bake: where the camera stands and its exposure, the shadows, fog, ambient
-    // occlusion, specular and micro-detail the renderer draws over the probes, and where the files
-    // go.
-    settings.erase("camera");
-    settings.erase("shadows");
-    settings.erase("fog");
-    settings.erase("ao");
-    settings.erase("detail");
-    // Nor the indirect-light choice, the light propagation volumes and the local lights: the
-    // viewport computes the LPV live; lpv.ini and the glTF's lights export them, as the scene
-    // exports the shadows and the fog.
-    settings.erase("lighting");
-    settings.erase("lpv");
-    settings.erase("lights");
-    settings["terrain"].erase("roughness");
-    settings["terrain"].erase("specular_aa");
-    // Reflection probes off is the scene before they existed: no key at all.
-    if (!project.scene.reflectionProbes.enabled) settings.erase("reflection_probes");
-    settings["export"].erase("out_dir");
-    // Files count by what they resolve to (below), not by how the project spells their path.
-    settings["terrain"].erase("dem");
-    settings["terrain"].erase("albedo_map");
-    settings["sky"].erase("hdr");
-    // Of the water the bake reads its level and scatter colour, only while it is on (and the
-    // level's auto value through the DEM's file); waves, absorption and the reflection settings
-    // are the renderer's. Water off is the scene before water existed: no key at all.
-    if (!project.scene.water.enabled)
-        settings.erase("water");
-    else
-        settings["water"] = {{"enabled", true},
-                             {"level", settings["water"]["level"]},
-                             {"color", settings["water"]["color"]}};
-    // The ramp is read in mode ramp only: an edit of it in another mode leaves the bake current.
-    if (project.scene.terrain.albedoMode != AlbedoMode::Ramp)
-        for (const char* key : {"ramp_heights", "ramp_colors", "ramp_rock_color", "ramp_rock_slope"})
-            settings["terrain"].erase(key);
-    nlohmann::json files = {{"dem", project.demPath().empty() ? nlohmann::json("embedded sample")
-                                                              : fileIdentity(project.demPath())}};
-    if (project.scene.sky.mode == SkyMode::Hdr) files["hdr"] = fileIdentity(project.hdrPath());
-    if (project.scene.terrain.albedoMode == AlbedoMode::Map)
-        files["albedo_map"] = fileIdentity(project.albedoMapPath());
-    return {{"settings", settings}, {"files", files}};
+    // The parameter table says which rows a bake reads (BakeUse); a file counts by what it
+    // resolves to, not by how the project spells its path.
+    return bakeReadSettings(project.scene, [&](const ParameterSpec&, const std::string& value) {
+        return fileIdentity(project.resolve(value));
+    });
 }
 
 std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const nlohmann::json& now) {

@@ -33,10 +33,9 @@ struct BakeOutcome {
     std::vector<std::string> warnings;  // one line each, also in the report's "warnings"
 };
 
-// What a bake depends on: every parameter it reads (the project less the camera, the output
-// folder and what no bake reads yet) and the identity (path, size, modification time) of the DEM
-// and HDR files. bake_report.json records it as "inputs"; a bake whose inputs differ from the
-// project's is stale.
+// What a bake depends on: every parameter the parameter table says it reads (ParameterSpec::bake)
+// and the identity (path, size, modification time) of the files it reads (DEM, albedo map, HDR).
+// bake_report.json records it as "inputs"; a bake whose inputs differ from the project's is stale.
 nlohmann::json bakeInputs(const Project& project);
 // Where two bakeInputs differ, one line each: "probe_volumes[0].grid_dims: baked [8,8], now
 // [32,32]". Empty when they are the same.

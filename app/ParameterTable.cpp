@@ -94,6 +94,7 @@ public:
     Row& label(std::string l) { s_.label = std::move(l); return *this; }
     Row& about(std::string d) { s_.description = std::move(d); return *this; }
     Row& redoes(unsigned i) { s_.invalidates = i; return *this; }
+    Row& bakeUse(BakeUse b) { s_.bake = b; return *this; }
     Row& decimals(int d) { s_.decimals = d; return *this; }
     Row& slider() { s_.slider = true; return *this; }
     Row& colorList() { s_.colorList = true; return *this; }
@@ -186,11 +187,18 @@ constexpr int kMaxOctreeLevels = 16;
 
 std::vector<ParameterSpec> buildTable() {
     std::vector<Row> rows;
-    auto add = [&rows](Row r) -> Row& { rows.push_back(std::move(r)); return rows.back(); };
+    // Whether the bake reads the rows that follow (a row may say otherwise): each section sets it.
+    BakeUse bake = BakeUse::Reads;
+    auto add = [&rows, &bake](Row r) -> Row& {
+        r.s_.bake = bake;
+        rows.push_back(std::move(r));
+        return rows.back();
+    };
     using T = ParamType;
 
+    bake = BakeUse::Reads;
     // Terrain.
-    add(Row("terrain.dem", T::String)).zeroMeans("embedded sample")
+    add(Row("terrain.dem", T::String)).bakeUse(BakeUse::File).zeroMeans("embedded sample")
         .label("DEM").about("Elevation raster GDAL reads (GeoTIFF, SRTM .hgt, ASCII grid, VRT, /vsizip/...); relative to the project file; empty = the embedded sample")
         .redoes(kReimport).field(&SceneDescription::terrain, &TerrainSettings::dem);
     add(Row("terrain.vertical_scale", T::Number)).above(0.0, 100.0).unit("×").label("Vertical scale")
@@ -206,7 +214,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("Lambertian reflectance of the ground, linear RGB; in mode map, where the map does not cover the terrain")
         .redoes(kUpload | kRebake).onlyWhen(std::not_fn(albedoMode(AlbedoMode::Ramp)))
         .field(&SceneDescription::terrain, &TerrainSettings::albedo);
-    add(Row("terrain.albedo_map", T::String)).label("Albedo map")
+    add(Row("terrain.albedo_map", T::String)).bakeUse(BakeUse::File).label("Albedo map")
         .about("RGB or RGBA raster GDAL reads (orthophoto GeoTIFF, PNG/JPEG with a world file), 8 or 16 bits, sRGB-encoded, for mode map; reprojected onto the DEM; relative to the project file")
         .redoes(kUpload | kRebake).onlyWhen(albedoMode(AlbedoMode::Map))
         .custom([](const SceneDescription& s, size_t) { return json(s.terrain.albedoMap); },
@@ -279,10 +287,10 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("terrain.skirt", T::Boolean)).label("Ground beyond border")
         .about("The ground continues beyond the footprint at the border height (rays leaving the DEM still meet terrain)")
         .redoes(kRebake).field(&SceneDescription::terrain, &TerrainSettings::skirt);
-    add(Row("terrain.roughness", T::Number)).range(kRoughnessFloor, 1.0).decimals(2).slider().label("Roughness")
+    add(Row("terrain.roughness", T::Number)).bakeUse(BakeUse::Ignores).range(kRoughnessFloor, 1.0).decimals(2).slider().label("Roughness")
         .about("GGX roughness of the sun's highlight on the ground, before the normal variance widens it (0.25 is the floor)")
         .redoes(kUpload).field(&SceneDescription::terrain, &TerrainSettings::roughness);
-    add(Row("terrain.specular_aa", T::Boolean)).label("Normal-variance specular")
+    add(Row("terrain.specular_aa", T::Boolean)).bakeUse(BakeUse::Ignores).label("Normal-variance specular")
         .about("Widens the roughness by the variance of the normals a pixel covers (Toksvig 2005): no sparkle from detail smaller than a pixel")
         .redoes(kUpload).field(&SceneDescription::terrain, &TerrainSettings::specularAA);
 
@@ -327,7 +335,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("sky.turbidity", T::Number)).range(kMinTurbidity, kMaxTurbidity).label("Turbidity")
         .about("Haze of the physical sky: 2 very clear, 3 clear, 6 and above hazy; a hazier sky is brighter and whiter, its sun dimmer and redder")
         .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sky, &SkySettings::turbidity);
-    add(Row("sky.hdr", T::String)).label("HDR image")
+    add(Row("sky.hdr", T::String)).bakeUse(BakeUse::File).label("HDR image")
         .about("Equirectangular HDR or EXR sky, for mode hdr; relative to the project file")
         .redoes(kUpload | kRebake).onlyWhen(hdr)
         .custom([](const SceneDescription& s, size_t) { return json(s.sky.hdr); },
@@ -340,6 +348,7 @@ std::vector<ParameterSpec> buildTable() {
         .label("HDR rotation").about("Turns the HDR sky about +Y").redoes(kUpload | kRebake).onlyWhen(hdr)
         .field(&SceneDescription::sky, &SkySettings::rotationDeg);
 
+    bake = BakeUse::Ignores;  // from here to the probe volumes, what the renderer draws
     // Shadows.
     const auto manualSplits = [](const SceneDescription& s, size_t) {
         return s.shadows.splitMode == SplitMode::Manual && s.shadows.cascades > 1 ? s.shadows.cascades - 1 : -1;
@@ -477,14 +486,14 @@ std::vector<ParameterSpec> buildTable() {
     const auto planar = [](const SceneDescription& s, size_t) {
         return s.water.enabled && s.water.reflection == WaterReflection::Planar;
     };
-    add(Row("water.enabled", T::Boolean)).label("Water")
+    add(Row("water.enabled", T::Boolean)).bakeUse(BakeUse::Reads).label("Water")
         .about("A lake or sea: a level plane at water.level with Gerstner waves over the terrain below it; the viewport and --render draw it, the bake's probe rays see it, the glTF exports it")
         .redoes(kUpload | kRebake).field(&SceneDescription::water, &WaterSettings::enabled);
-    add(Row("water.level", T::Number)).range(-1.0e5, 1.0e5).unit("m").decimals(1)
+    add(Row("water.level", T::Number)).bakeUse(BakeUse::Reads).range(-1.0e5, 1.0e5).unit("m").decimals(1)
         .autoMeans("the water the DEM shows: its largest flat, lowest surface (none when it shows none)").label("Water level")
         .about("Height of the water at rest, engine space (DEM elevation × terrain.vertical_scale); the water covers the terrain below it")
         .redoes(kUpload | kRebake).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::level);
-    add(Row("water.color", T::Color)).range(0.0, 1.0).label("Scatter colour")
+    add(Row("water.color", T::Color)).bakeUse(BakeUse::Reads).range(0.0, 1.0).label("Scatter colour")
         .about("Deep-water scatter albedo, linear RGB: the share of the light entering the water that the water sends back up, (1 − F)·color·E/π toward a viewer")
         .redoes(kUpload | kRebake).onlyWhen(waterOn).field(&SceneDescription::water, &WaterSettings::color);
     add(Row("water.absorption", T::NumberList)).items(3, 3).range(0.0, 100.0).unit("1/m").decimals(3)
@@ -543,6 +552,7 @@ std::vector<ParameterSpec> buildTable() {
         .label("Phase").about("Phase at t = 0 and the engine origin, radians (periodic in 2π)")
         .redoes(kUpload).noUiRow().wave(&GerstnerWave::phase);
 
+    bake = BakeUse::Reads;
     // Probe volumes: every row below is per volume.
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
@@ -649,7 +659,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
         .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)
         .volume(&ProbeVolumeSettings::rayCount);
-    add(Row("probe_volumes[].fallback_blend_distance", T::Number)).range(0.0, 1.0e7).unit("m").decimals(1)
+    add(Row("probe_volumes[].fallback_blend_distance", T::Number)).bakeUse(BakeUse::Ignores).range(0.0, 1.0e7).unit("m").decimals(1)
         .autoMeans("2 × spacing: twice the smallest probe spacing").label("Fallback blend")
         .about("Distance outside the grid over which engines blend the probes to their fallback (the sky)")
         .redoes(kUpload).volume(&ProbeVolumeSettings::fallbackBlendDistance)
@@ -820,6 +830,7 @@ std::vector<ParameterSpec> buildTable() {
                     s.reflectionProbes.simvxSubset = idx;
                 });
 
+    bake = BakeUse::Ignores;  // the viewport computes the LPV live; lpv.ini and the glTF export it
     // Indirect light and light propagation volumes (docs/lighting.md, "Light propagation
     // volumes"). Each lpv row is one console variable of seed 003 (lpv.ini); the LPV dock edits
     // them, its lights table the lights.
@@ -917,6 +928,7 @@ std::vector<ParameterSpec> buildTable() {
                         throw ParameterRejection{"must be above inner_cone_deg (" + number(l.innerConeDeg) + ")", ""};
                 });
 
+    bake = BakeUse::Reads;
     // Bake.
     add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
         .about("Preset of rays, bounces and irradiance cache (rays and bounces below override it)")
@@ -941,6 +953,7 @@ std::vector<ParameterSpec> buildTable() {
         .about("Points along the longer side of each volume's interpolation-error map (debug view interpolation-error); 0 = no map; each costs one probe bake")
         .redoes(kRebake).field(&SceneDescription::bake, &BakeSettings::errorMapResolution);
 
+    bake = BakeUse::Ignores;
     // Camera (edited by the viewport, stored in the project).
     add(Row("camera.target", T::NumberList)).items(3, 3).range(-1.0e7, 1.0e7).unit("m")
         .autoMeans("the footprint centre at the mean terrain height").label("Camera target")
@@ -964,7 +977,8 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::exposureEv);
 
     // Export.
-    add(Row("export.out_dir", T::String)).pattern(".+", "must name a folder").label("Output folder")
+    bake = BakeUse::Reads;  // the exporters' settings; where the files go is not an input
+    add(Row("export.out_dir", T::String)).bakeUse(BakeUse::Ignores).pattern(".+", "must name a folder").label("Output folder")
         .about("Where bakes are written; relative to the project file").redoes(kNothing)
         .field(&SceneDescription::exportSettings, &ExportSettings::outDir);
     add(Row("export.gltf", T::Boolean)).label("glTF scene").about("Write scene.gltf with the probe-grid extension")
@@ -1309,6 +1323,48 @@ json projectSchema() {
     return schema;
 }
 
+namespace {
+// Elements of a row's list in `scene` (1 for a row outside lists).
+size_t elementCount(const SceneDescription& scene, const ParameterSpec& spec) {
+    if (spec.perVolume()) return scene.probeVolumes.size();
+    if (spec.perWave()) return scene.water.waves.size();
+    if (spec.perLight()) return scene.lights.size();
+    return 1;
+}
+
+// The JSON pointer of a row's value: "/sun/elevation_deg", "/probe_volumes/2/adaptive/size".
+json::json_pointer valuePointer(const ParameterSpec& spec, size_t element) {
+    std::string local = spec.inList() ? spec.localPath() : spec.path;
+    std::string pointer;
+    if (spec.inList()) {
+        std::string list = spec.listPath();
+        std::replace(list.begin(), list.end(), '.', '/');
+        pointer = "/" + list + "/" + std::to_string(element);
+    }
+    std::replace(local.begin(), local.end(), '.', '/');
+    return json::json_pointer(pointer + "/" + local);
+}
+}  // namespace
+
+json bakeReadSettings(const SceneDescription& scene,
+                      const std::function<json(const ParameterSpec&, const std::string&)>& identity) {
+    json settings = json::object(), files = json::object();
+    for (const ParameterSpec& spec : parameterTable()) {
+        if (spec.bake == BakeUse::Ignores) continue;
+        for (size_t e = 0; e < elementCount(scene, spec); ++e) {
+            if (!spec.isRead(scene, e)) continue;
+            const json value = spec.get(scene, e);
+            if (spec.bake == BakeUse::File)
+                files[spec.path] = value.is_string() && !value.get<std::string>().empty()
+                                       ? identity(spec, value.get<std::string>())
+                                       : json(spec.zeroText);
+            else
+                settings[valuePointer(spec, e)] = value;
+        }
+    }
+    return {{"settings", settings}, {"files", files}};
+}
+
 std::vector<ParameterReferenceRow> parameterReferenceRows() {
     std::vector<ParameterReferenceRow> rows;
     for (const auto& s : parameterTable()) {
@@ -1322,6 +1378,7 @@ std::vector<ParameterReferenceRow> parameterReferenceRows() {
         else if (s.type != ParamType::Boolean) r.allowed = (s.type == ParamType::Color || s.type == ParamType::NumberList || s.type == ParamType::IntegerList ? "each " : "") + s.rangeText();
         r.unit = s.unit;
         r.edit = invalidationText(s.invalidates);
+        r.bake = s.bake == BakeUse::Reads ? "reads" : s.bake == BakeUse::File ? "reads the file" : "ignores";
         r.autoMeaning = s.autoMeaning.value_or("");
         r.description = s.description;
         rows.push_back(std::move(r));
@@ -1338,17 +1395,18 @@ std::string parameterReferenceMarkdown() {
           "(`probe_volumes[0].grid_dims`), and a whole list is one JSON array (`--set water.waves=[...]`).\n"
           "`null` means \"auto\" where the last column says what auto does. \"Edit redoes\" is the\n"
           "work an edit in the authoring window costs: redraw < upload < preview bake < re-place <\n"
-          "re-import; \"bake only\" parameters change nothing on screen.\n";
+          "re-import; \"bake only\" parameters change nothing on screen. \"Bake\" says whether a bake\n"
+          "reads the parameter: an edit of one it ignores leaves a finished bake current.\n";
     std::string section;
     for (const ParameterReferenceRow& r : parameterReferenceRows()) {
         if (r.section != section) {
             section = r.section;
             md << "\n## `" << section << "`\n\n"
-               << "| parameter | type | default | allowed | unit | edit redoes | null (auto) | description |\n"
-               << "|---|---|---|---|---|---|---|---|\n";
+               << "| parameter | type | default | allowed | unit | edit redoes | bake | null (auto) | description |\n"
+               << "|---|---|---|---|---|---|---|---|---|\n";
         }
         md << "| `" << r.path << "` | " << r.type << " | `" << cell(r.defaultValue) << "` | " << cell(r.allowed)
-           << " | " << cell(r.unit) << " | " << r.edit << " | " << cell(r.autoMeaning) << " | "
+           << " | " << cell(r.unit) << " | " << r.edit << " | " << r.bake << " | " << cell(r.autoMeaning) << " | "
            << cell(r.description) << " |\n";
     }
     return md.str();

@@ -42,6 +42,15 @@ enum Invalidation : unsigned {
     kNothing = 1u << 4,    // read only by the bake and the exporters: nothing to redraw
 };
 
+// Whether a bake reads a row: what bakeInputs (BakeJob.h) records in a bake's report and the
+// staleness check compares, so an edit of a row the bake ignores never marks a bake stale.
+enum class BakeUse {
+    Reads,    // the value, wherever the scene reads the row (isRead)
+    File,     // a file path: the bake reads the file it resolves to (path, size, modification
+              // time); the empty path stands for the row's zeroText ("embedded sample")
+    Ignores,  // the renderer's, the viewport's or the output's: no bake reads it
+};
+
 inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
 struct ParameterSpec {
@@ -62,6 +71,7 @@ struct ParameterSpec {
     // ("source", "no map", "embedded sample"); empty when it means nothing special.
     std::string zeroText;
     unsigned invalidates = kRedraw;
+    BakeUse bake = BakeUse::Reads;
     int decimals = 2;     // UI precision
     bool slider = false;  // UI: a slider beside the spin box (angles)
     bool colorList = false;  // UI: a NumberList of RGB triples, one colour button per triple
@@ -156,10 +166,17 @@ double shortestDecimal(float f);
 
 // JSON Schema (draft 2020-12) of the project file, generated from the table.
 nlohmann::json projectSchema();
+// What a bake of `scene` reads, as JSON in the project's shape: every row whose BakeUse is Reads,
+// wherever the scene reads it (isRead), under "settings"; every File row's value, under "files"
+// keyed by the row's path, through `identity` (which BakeJob gives the file's path, size and
+// modification time).
+nlohmann::json bakeReadSettings(const SceneDescription& scene,
+                                const std::function<nlohmann::json(const ParameterSpec&, const std::string& value)>& identity);
+
 // One row of the parameter reference, as text: what docs/parameters.md and the manual page show.
 struct ParameterReferenceRow {
     std::string section;  // "sun", "probe_volumes[]"
-    std::string path, type, defaultValue, allowed, unit, edit, autoMeaning, description;
+    std::string path, type, defaultValue, allowed, unit, edit, bake, autoMeaning, description;
 };
 std::vector<ParameterReferenceRow> parameterReferenceRows();
 // The parameter reference in Markdown (docs/parameters.md), generated from the table.

@@ -331,8 +331,8 @@ TEST(AlbedoBake, InputsFollowTheModeAndTheMapFile) {
     map.scene.terrain.albedoMode = AlbedoMode::Map;
     map.scene.terrain.albedoMap = kUtmMap;
     const nlohmann::json inputs = bakeInputs(map);
-    EXPECT_EQ(inputs["files"]["albedo_map"]["path"], fs::path(kUtmMap).lexically_normal().generic_string());
-    EXPECT_EQ(inputs["files"]["albedo_map"]["bytes"], fs::file_size(kUtmMap));
+    EXPECT_EQ(inputs["files"]["terrain.albedo_map"]["path"], fs::path(kUtmMap).lexically_normal().generic_string());
+    EXPECT_EQ(inputs["files"]["terrain.albedo_map"]["bytes"], fs::file_size(kUtmMap));
 }
 
 namespace {

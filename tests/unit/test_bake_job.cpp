@@ -339,7 +339,7 @@ TEST(BakeJob, InputFileTimesAreUnixNanoseconds) {
     Project p;
     p.scene.terrain.dem = dem.string();
     const nlohmann::json inputs = bakeInputs(p);
-    EXPECT_EQ(inputs["files"]["dem"]["modified_ns"].get<int64_t>(), 1795651200123456789);
+    EXPECT_EQ(inputs["files"]["terrain.dem"]["modified_ns"].get<int64_t>(), 1795651200123456789);
     // Touching the file makes the bake stale through the same field.
     const struct timespec later[2] = {{1795651260, 0}, {1795651260, 0}};
     ASSERT_EQ(::utimensat(AT_FDCWD, dem.c_str(), later, 0), 0);
@@ -363,11 +363,11 @@ TEST(BakeJob, AmbientOcclusionIsNotABakeInput) {
 }
 
 // The bake reads the water's level and scatter colour while it is on; the rest of the section is
-// the renderer's. Water off is the scene before water: no key at all.
+// the renderer's. Water off is water.enabled false and nothing else of the section.
 TEST(BakeJob, WaterInTheInputsIsWhatTheBakeReads) {
     Project off;
     const nlohmann::json before = bakeInputs(off);
-    EXPECT_FALSE(before["settings"].contains("water"));
+    EXPECT_EQ(before["settings"]["water"], nlohmann::json::parse(R"({"enabled": false})"));
     Project offEdited = off;
     offEdited.scene.water.color = glm::vec3(0.5f);
     offEdited.scene.water.level = 300.0;
@@ -380,7 +380,7 @@ TEST(BakeJob, WaterInTheInputsIsWhatTheBakeReads) {
               nlohmann::json::parse(R"({"enabled": true, "level": null, "color": [0.02, 0.05, 0.06]})"));
     EXPECT_EQ(bakeInputDifferences(before, lake),
               (std::vector<std::string>{"water.color: not in the bake, now [0.02,0.05,0.06]",
-                                        "water.enabled: not in the bake, now true",
+                                        "water.enabled: baked false, now true",
                                         "water.level: not in the bake, now null"}));
     // Render settings leave the bake current...
     Project rendered = on;
