@@ -1,14 +1,17 @@
 // Height-fog optics in closed form, written in the common subset of GLSL and C++ so the shaders
 // and the CPU (tests, exporters) evaluate the same expressions (docs/lighting.md, "Height fog").
-// C++ includes it inside a namespace that brings exp, abs, sqrt and max into scope for float.
+// C++ includes it through shaders/ShaderMath.h.
 #ifndef TLX_FOG_MATH_GLSL
 #define TLX_FOG_MATH_GLSL
+#ifndef TLX_SHARED
+#define TLX_SHARED
+#endif
 
 // Optical depth of σ(h) = density · exp(−falloff · (h − base)) along a ray that starts at height
 // `startAboveBase` above the base, rises `dirY` metres per metre and runs `distance` metres:
 // ∫₀ᴰ σ dt = σ(h₀) · D · g(x), with x = falloff · dirY · D and g(x) = (1 − e^−x) / x. Near x = 0
 // (a horizontal ray, or no falloff) g takes its series 1 − x/2 + x²/6 − x³/24: no division by zero.
-float fogOpticalDepth(float density, float falloff, float startAboveBase, float dirY, float distance) {
+TLX_SHARED float fogOpticalDepth(float density, float falloff, float startAboveBase, float dirY, float distance) {
     float x = max(falloff * dirY * distance, -80.0f);  // e^80 is within float range
     float series = 1.0f - x * (0.5f - x * (0.16666667f - x * 0.041666667f));
     float g = series;
@@ -18,7 +21,7 @@ float fogOpticalDepth(float density, float falloff, float startAboveBase, float 
 
 // Henyey–Greenstein phase function (Henyey & Greenstein 1941), normalised over the sphere;
 // cosTheta between the direction light travels and the direction it scatters into.
-float henyeyGreenstein(float g, float cosTheta) {
+TLX_SHARED float henyeyGreenstein(float g, float cosTheta) {
     float d = 1.0f + g * g - 2.0f * g * cosTheta;
     return (1.0f - g * g) / (4.0f * 3.14159265f * d * sqrt(max(d, 1.0e-6f)));
 }

@@ -31,19 +31,16 @@ const int kLpvGrid = 32;
 const int kLpvCorners = 33;
 const int kLpvCells = kLpvGrid * kLpvGrid * kLpvGrid;
 const int kLpvCornerCount = kLpvCorners * kLpvCorners * kLpvCorners;
-const float kLpvY0 = 0.28209479177387814;   // 1/(2√π)
-const float kLpvY1 = 0.4886025119029199;    // √(3/4π)
-const float kLpvY20 = 0.31539156525252005;  // √(5/16π)
 // Lpv.h kAoDirections, kAoSteps, kAoCutoff.
 const int kLpvAoDirections = 16;
 const int kLpvAoSteps = 48;
 const float kLpvAoCutoff = 1e-3;
 
 // L1 SH in SphericalHarmonics.h's order (1, y, z, x) evaluated toward d (Lpv.cpp evaluate()).
-float lpvShEvaluate(vec4 sh, vec3 d) { return sh.x * kLpvY0 + kLpvY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
+float lpvShEvaluate(vec4 sh, vec3 d) { return sh.x * kShY00 + kShY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
 // Σ Â_l L_k Y_k(n), Â = {π, 2π/3} (Ramamoorthi & Hanrahan 2001; Lpv.cpp irradianceLinear()).
 float lpvIrradianceLinear(vec4 l, vec3 n) {
-    return PI * kLpvY0 * l.x + (2.0 * PI / 3.0) * kLpvY1 * (l.y * n.y + l.z * n.z + l.w * n.x);
+    return PI * kShY00 * l.x + (2.0 * PI / 3.0) * kShY1 * (l.y * n.y + l.z * n.z + l.w * n.x);
 }
 float lpvLuminance(vec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
@@ -180,7 +177,7 @@ vec3 lpvIrradianceZh3(vec4 l[3], vec3 n) {
             z2 = l[c].x * (0.08 * ratio + 0.6 * ratio * ratio);
         }
         float t = dot(axis, n);
-        e[c] = linear + 0.25 * PI * z2 * kLpvY20 * (3.0 * t * t - 1.0);
+        e[c] = linear + 0.25 * PI * z2 * kShY20 * (3.0 * t * t - 1.0);
     }
     return e;
 }

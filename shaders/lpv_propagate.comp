@@ -16,6 +16,7 @@
 layout(local_size_x = 256) in;
 #include "blocks/glsl.h"
 #include "blocks/lpv_propagation.h"
+#include "sh_basis.glsl"
 
 layout(set = TLX_SET_SUBSYSTEM, binding = TLX_LPV_WORK_BINDING, std430) buffer Work { vec4 v[]; } work;
 layout(set = TLX_SET_SUBSYSTEM, binding = TLX_LPV_SCALES_BINDING, std430) buffer Scales { float v[]; } scales;
@@ -30,11 +31,9 @@ layout(push_constant) uniform Push { ivec4 p; } push;
 const int kGrid = 32;
 const int kCorners = 33;
 const int kCells = kGrid * kGrid * kGrid;
-const float kY0 = 0.28209479177387814;  // 1/(2√π)
-const float kY1 = 0.4886025119029199;   // √(3/4π)
 const float kTwoSqrtPi = 3.5449077018110318;
 
-float shEvaluate(vec4 sh, vec3 d) { return sh.x * kY0 + kY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
+float shEvaluate(vec4 sh, vec3 d) { return sh.x * kShY00 + kShY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
 
 int cascades() { return int(propagation.params.y); }
 int regionBase(int region) { return region * cascades() * 3 * kCells; }

@@ -35,15 +35,12 @@ layout(location = 0) out vec4 outColor;
 const float kWaterIor = 1.33;
 
 // The frame under the water back to scene-linear light: the target holds the display encoding
-// (sRGB of the ACES fit of the exposed light) unless the output is linear. The ACES fit is a
-// ratio of quadratics, so its inverse is a root of one (clamped just below its asymptote).
+// (sRGB of the ACES fit of the exposed light) unless the output is linear: display_math.glsl's
+// inverses undo it.
 vec3 storedToLinear(vec3 stored) {
     if (linearOutput() || camera.view.x == kViewLinear) return stored;
-    vec3 c = clamp(stored, 0.0, 1.0);
-    vec3 y = mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
-    y = min(y, vec3(0.999));
-    vec3 a = 2.43 * y - 2.51, b = 0.59 * y - 0.03, k = 0.14 * y;
-    vec3 x = (-b - sqrt(max(b * b - 4.0 * a * k, 0.0))) / (2.0 * a);
+    vec3 x = vec3(acesFitInverse(srgbDecode(stored.r)), acesFitInverse(srgbDecode(stored.g)),
+                  acesFitInverse(srgbDecode(stored.b)));
     return x / max(surface.material.y, 1e-6);
 }
 

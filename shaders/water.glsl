@@ -40,7 +40,7 @@ void gerstner(vec2 xz, float depth, float fade, float shortest, out vec3 displac
     displacement = vec3(0.0);
     vec3 tx = vec3(1.0, 0.0, 0.0), tz = vec3(0.0, 0.0, 1.0);  // ∂P/∂x, ∂P/∂z
     int count = int(water.look.y);
-    for (int i = 0; i < 8; ++i) {
+    for (int i = 0; i < TLX_MAX_WAVES; ++i) {
         if (i >= count) break;
         vec2 d = water.waves[i].xy;
         float k = water.waves[i].z;

@@ -11,16 +11,14 @@
 #include <QVBoxLayout>
 
 #include "ProjectDocument.h"
+#include "ShaderMath.h"
 
 namespace terralux {
 namespace {
 
-// The viewport's display encoding (shaders/tonemap.glsl): the ACES fit of Narkowicz 2015, then
-// the sRGB transfer curve.
+// The viewport's display encoding (shaders/display_math.glsl): the ACES fit, then sRGB.
 int displayByte(float linear) {
-    const float x = std::max(linear, 0.0f);
-    float c = std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
-    c = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+    const float c = glsl::srgbEncode(glsl::acesFit(std::max(linear, 0.0f)));
     return std::clamp(int(std::lround(255.0f * c)), 0, 255);
 }
 

@@ -11,15 +11,16 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "ShaderMath.h"
 #include "bake/SphereSampling.h"
 
 namespace terralux::lpv {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-constexpr float kY0 = 0.28209479177387814f;  // 1/(2√π)
-constexpr float kY1 = 0.4886025119029199f;   // √(3/4π)
-constexpr float kY20 = 0.31539156525252005f; // √(5/16π)
+using glsl::kShY00;  // the SH basis constants the shaders use (sh_basis.glsl)
+using glsl::kShY1;
+using glsl::kShY20;
 // Solid angles a cell's centre sees of a neighbour's faces (Kaplanyan & Dachsbacher 2010, Sec. 5.2):
 // the far face, a unit square 1.5 cells away, and each side face. 0.4006696846 + 4 · 0.4234413544 =
 // 2π/3, so the six neighbours' thirty faces cover the sphere.
@@ -96,24 +97,24 @@ glm::vec3 reflectDir(const glm::vec3& incident, const glm::vec3& n) { return inc
 
 // ---- SH ---------------------------------------------------------------------------------------
 
-Sh4 basis(const glm::vec3& d) { return {kY0, kY1 * d.y, kY1 * d.z, kY1 * d.x}; }
+Sh4 basis(const glm::vec3& d) { return {kShY00, kShY1 * d.y, kShY1 * d.z, kShY1 * d.x}; }
 
 float evaluate(const Sh4& sh, const glm::vec3& d) {
-    return sh[0] * kY0 + kY1 * (sh[1] * d.y + sh[2] * d.z + sh[3] * d.x);
+    return sh[0] * kShY00 + kShY1 * (sh[1] * d.y + sh[2] * d.z + sh[3] * d.x);
 }
 
 Sh4 clampedCosine(const glm::vec3& n, float scale) {
-    const float a0 = kPi * kY0 * scale, a1 = (2.0f * kPi / 3.0f) * kY1 * scale;
+    const float a0 = kPi * kShY00 * scale, a1 = (2.0f * kPi / 3.0f) * kShY1 * scale;
     return {a0, a1 * n.y, a1 * n.z, a1 * n.x};
 }
 
 float irradianceLinear(const Sh4& l, const glm::vec3& n) {
-    return kPi * kY0 * l[0] + (2.0f * kPi / 3.0f) * kY1 * (l[1] * n.y + l[2] * n.z + l[3] * n.x);
+    return kPi * kShY00 * l[0] + (2.0f * kPi / 3.0f) * kShY1 * (l[1] * n.y + l[2] * n.z + l[3] * n.x);
 }
 
 float irradianceZh3(const Sh4& l, float z2, const glm::vec3& axis, const glm::vec3& n) {
     const float t = glm::dot(axis, n);
-    return irradianceLinear(l, n) + 0.25f * kPi * z2 * kY20 * (3.0f * t * t - 1.0f);
+    return irradianceLinear(l, n) + 0.25f * kPi * z2 * kShY20 * (3.0f * t * t - 1.0f);
 }
 
 float hallucinatedZonal(const Sh4& l, const glm::vec3& axis) {
@@ -241,7 +242,7 @@ glm::dvec3 totalFlux(const LightVolume& v) {
 
 double lightRange(const LightVolume& injected, double cellSize, double indirectIntensity) {
     std::vector<double> radiance;
-    constexpr double kY00 = 0.28209479177387814;  // 1 / (2√π)
+    const double kY00 = kShY00;
     for (size_t cell = 0; cell < size_t(kCells); ++cell) {
         const double y = 0.2126 * injected[lightOffset(0, cell, 0)] + 0.7152 * injected[lightOffset(1, cell, 0)] +
                          0.0722 * injected[lightOffset(2, cell, 0)];

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "ShaderBinaries.h"
+#include "ShaderMath.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
@@ -1426,7 +1427,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         block.plane = glm::vec4(water->level, float(look.time), look.shoreFadeDistance, look.depthAware ? 1.0f : 0.0f);
         block.scatter = glm::vec4(look.scatter, look.roughness);
         block.absorption = glm::vec4(look.absorption, look.planarReflection ? 1.0f : 0.0f);
-        const size_t waves = std::min<size_t>(look.waves.size(), 8);
+        const size_t waves = std::min<size_t>(look.waves.size(), WaterSettings::kMaxWaves);
         block.look = glm::vec4(look.distortion, float(waves), glm::vec2(water->fieldSize));
         block.mesh = glm::vec4(water->spacing, 0.0f, 0.0f, 0.0f);
         for (size_t i = 0; i < waves; ++i) {
@@ -1500,9 +1501,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         bg = glm::max(sh::evalRadiance(s.skySh, glm::normalize(glm::vec3(0.0f, 0.2f, -1.0f))), glm::vec3(0.0f));
         if (!s.linearOutput && view.background == ViewBackground::Sky) {
             // tonemap.glsl's display(), for the one colour the shader does not draw.
-            auto aces = [](float x) { return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f); };
-            auto srgb = [](float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f; };
-            for (int i = 0; i < 3; ++i) bg[i] = srgb(aces(bg[i] * s.exposure));
+            for (int i = 0; i < 3; ++i) bg[i] = glsl::srgbEncode(glsl::acesFit(bg[i] * s.exposure));
         } else if (!s.linearOutput) {
             bg = glm::clamp(bg, glm::vec3(0.0f), glm::vec3(1.0f));
         }

@@ -10,6 +10,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "blocks/limits.h"
+
 namespace terralux {
 
 // Where the terrain's albedo comes from (docs/lighting.md, "Terrain albedo").
@@ -292,7 +294,7 @@ struct WaterSettings {
     WaterReflection reflection = WaterReflection::Planar;
     double reflectionScale = 0.5;                // planar reflection target size / frame size, [0.25, 1]
     double distortion = 0.02;                    // screen-space offset of the reflection per unit of wave slope, [0, 0.2]
-    static constexpr int kMaxWaves = 8;
+    static constexpr int kMaxWaves = TLX_MAX_WAVES;  // what the water pass's block holds
 };
 
 // Which indirect light the viewport and --render add to the direct sun (docs/lighting.md,

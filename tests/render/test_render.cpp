@@ -16,6 +16,7 @@
 #include "ImageCompare.h"
 #include "ImageFile.h"
 #include "RenderJob.h"
+#include "ShaderMath.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ReflectionBake.h"
@@ -1745,10 +1746,7 @@ TEST_F(RenderTest, LpvViewsShowTheirLightAtTheSeedsDefaults) {
     // EXR keeps the physical E/π; the PNG is that over the range through the display curve
     // (tonemap.glsl: ACES fit, then sRGB), not the camera's exposure.
     const RenderedImage linear = draw(r, kViewLpvAll, true, true);
-    auto shown = [](double x) {
-        const double a = std::clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-        return a <= 0.0031308 ? 12.92 * a : 1.055 * std::pow(a, 1.0 / 2.4) - 0.055;
-    };
+    auto shown = [](double x) { return glsl::srgbEncode(glsl::acesFit(float(x))); };
     double off = 0;
     for (size_t i : terrain) off += std::abs(shown(linear.rgba[i * 4 + 1] / *range) - all.rgba[i * 4 + 1]);
     EXPECT_LT(off / double(terrain.size()), 0.5 / 255.0);

@@ -8,15 +8,10 @@
 #include "ParameterTable.h"
 #include "Project.h"
 #include "ProjectErrors.h"
+#include "ShaderMath.h"
 #include "render/ShadowCascades.h"
 
-namespace terralux::fogmath {
-using std::abs;
-using std::exp;
-using std::max;
-using std::sqrt;
-#include "fog_math.glsl"
-}  // namespace terralux::fogmath
+namespace fogmath = terralux::glsl;
 
 using namespace terralux;
 using nlohmann::json;

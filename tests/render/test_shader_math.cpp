@@ -1,0 +1,152 @@
+// The rules C++ and GLSL share (shaders/ShaderMath.h: display encoding, SH basis, fog optics)
+// evaluated by a compute shader built from the same headers, against their C++ evaluation, at
+// samples spread over each function's domain; and the SH basis against the CPU bake's own
+// double-precision closed forms.
+#include <cmath>
+#include <random>
+#include <span>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
+#include <glm/vec4.hpp>
+
+#include "ShaderMath.h"
+#include "bake/SphericalHarmonics.h"
+#include "vk/Buffer.h"
+#include "vk/ComputePipeline.h"
+#include "vk/Descriptors.h"
+#include "vk/PipelineLayout.h"
+#include "vk/VulkanContext.h"
+
+namespace terralux::shaders {
+std::span<const uint32_t> shaderMathComp();  // tests/render/shader_math.comp
+}
+
+using namespace terralux;
+
+namespace {
+
+constexpr int kOutputs = 16;
+
+struct Sample {
+    glm::vec4 a, b;
+};
+
+// Samples over the domains: light 0..64 (log-spaced, with 0), values 0..1 with the sRGB knees,
+// heights −200..2000 m, g −0.9..0.9, directions over the sphere (the horizontal included), and
+// distances 0..20 km.
+std::vector<Sample> samples() {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<Sample> s;
+    const float knees[] = {0.0f, 0.0031308f, 0.04045f, 0.5f, 0.999f, 1.0f};
+    for (int i = 0; i < 512; ++i) {
+        const float light = i == 0 ? 0.0f : std::exp2(u(rng) * 12.0f - 6.0f);
+        const float value = i < 6 ? knees[i] : u(rng);
+        glm::vec3 d(u(rng) * 2.0f - 1.0f, i % 17 == 0 ? 0.0f : u(rng) * 2.0f - 1.0f, u(rng) * 2.0f - 1.0f);
+        d = glm::normalize(d + glm::vec3(1e-3f));
+        s.push_back({glm::vec4(light, value, u(rng) * 2200.0f - 200.0f, u(rng) * 1.8f - 0.9f),
+                     glm::vec4(d, u(rng) * 20000.0f)});
+    }
+    return s;
+}
+
+std::array<float, kOutputs> onCpu(const Sample& s) {
+    std::array<float, kOutputs> o{};
+    o[0] = glsl::acesFit(s.a.x);
+    o[1] = glsl::srgbEncode(s.a.y);
+    o[2] = glsl::srgbDecode(s.a.y);
+    o[3] = glsl::acesFitInverse(s.a.y);
+    for (int k = 0; k < 9; ++k) o[size_t(4 + k)] = glsl::shBasis(k, s.b.x, s.b.y, s.b.z);
+    o[13] = glsl::fogOpticalDepth(0.002f, 0.001f, s.a.z, s.b.y, s.b.w);
+    o[14] = glsl::henyeyGreenstein(s.a.w, s.b.y);
+    o[15] = glsl::srgbEncode(glsl::acesFit(s.a.x));
+    return o;
+}
+
+const char* kNames[kOutputs] = {"acesFit", "srgbEncode", "srgbDecode", "acesFitInverse", "Y0", "Y1", "Y2",
+                                "Y3", "Y4", "Y5", "Y6", "Y7", "Y8", "fogOpticalDepth", "henyeyGreenstein",
+                                "display"};
+
+}  // namespace
+
+TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
+    std::unique_ptr<vk::VulkanContext> ctx;
+    try {
+        vk::ContextOptions o;
+        o.validation = true;
+        ctx = std::make_unique<vk::VulkanContext>(o);
+    } catch (const vk::VulkanUnavailable& e) {
+        GTEST_SKIP() << "no Vulkan: " << e.what();
+    }
+    const std::vector<Sample> in = samples();
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    const vk::Buffer inputs = vk::Buffer::deviceLocal(*ctx, in.data(), in.size() * sizeof(Sample),
+                                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::Buffer outputs = vk::Buffer::hostReadable(*ctx, in.size() * kOutputs * sizeof(float),
+                                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    const vk::DescriptorSet set = vk::DescriptorSetBuilder()
+                                      .storage(0, "inputs", inputs, compute)
+                                      .storage(1, "outputs", outputs, compute)
+                                      .build(*ctx);
+    const VkDescriptorSetLayout layouts[] = {set.layout()};
+    const vk::PipelineLayout layout(*ctx, layouts, sizeof(glm::ivec4), compute);
+    const vk::UniquePipeline pipeline = vk::createComputePipeline(*ctx, layout.handle(), shaders::shaderMathComp());
+    const glm::ivec4 push(int(in.size()), 0, 0, 0);
+    ctx->submitAndWait([&](VkCommandBuffer cb) {
+        VkMemoryBarrier toShader{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                 VK_ACCESS_SHADER_READ_BIT};
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                             &toShader, 0, nullptr, 0, nullptr);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
+        const VkDescriptorSet handle = set.handle();
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), 0, 1, &handle, 0, nullptr);
+        vkCmdPushConstants(cb, layout.handle(), compute, 0, sizeof push, &push);
+        vkCmdDispatch(cb, uint32_t(in.size() + 63) / 64, 1, 1);
+        VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT,
+                               VK_ACCESS_HOST_READ_BIT};
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0,
+                             nullptr, 0, nullptr);
+    });
+    const auto* gpu = static_cast<const float*>(outputs.map());
+    // Bounds relative to the value (to 0.1 near zero). Arithmetic alone agrees to an ulp or two
+    // (a fused multiply-add here or there): 2.5e-7, which a constant copied to six digits fails
+    // (the SH basis's old 0.282095 was 7.4e-7 off). Vulkan lets pow be a few ulps off IEEE
+    // (2e-6) and exp's error grows with its argument, up to 80 in the fog's optical depth (5e-5).
+    const double bound[kOutputs] = {2.5e-7, 2e-6, 2e-6, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7,
+                                    2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6};
+    for (int f = 0; f < kOutputs; ++f) {
+        double worst = 0.0;
+        for (size_t i = 0; i < in.size(); ++i) {
+            const float cpu = onCpu(in[i])[size_t(f)], dev = gpu[i * kOutputs + size_t(f)];
+            worst = std::max(worst, std::abs(double(cpu) - double(dev)) / std::max(std::abs(double(cpu)), 0.1));
+        }
+        EXPECT_LT(worst, bound[f]) << kNames[f];
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// The shared float basis is the CPU bake's double-precision basis rounded once.
+TEST(ShaderMath, TheSharedShBasisIsTheBakesBasis) {
+    std::mt19937 rng(3);
+    std::normal_distribution<float> g;
+    for (int i = 0; i < 1000; ++i) {
+        const glm::vec3 d = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)));
+        const std::array<float, 9> bake = sh::evalBasis(d);
+        for (int k = 0; k < 9; ++k)
+            EXPECT_NEAR(glsl::shBasis(k, d.x, d.y, d.z), bake[size_t(k)], 2e-7f) << "k " << k;
+    }
+    EXPECT_EQ(glsl::kShY00, sh::evalBasis(glm::vec3(0.0f, 1.0f, 0.0f))[0]);
+}
+
+// The display curve's inverses undo it (the water pass reads the frame under it back to light).
+TEST(ShaderMath, TheDisplayCurveInvertsWhereItIsNotClamped) {
+    for (float x = 0.0f; x < 8.0f; x += 0.01f) {
+        const float y = glsl::acesFit(x);
+        if (y >= 0.999f) break;
+        EXPECT_NEAR(glsl::acesFitInverse(y), x, 1e-4f * std::max(1.0f, x)) << x;
+        EXPECT_NEAR(glsl::srgbDecode(glsl::srgbEncode(y)), y, 1e-6f) << y;
+    }
+}
