@@ -48,9 +48,8 @@ void ProjectRenderer::setProject(const Project& project) {
     const SceneDescription& scene = project_.scene;
     const BakeLighting lighting = lightingOf(project_);
     base_.albedo = lighting.albedo;
-    base_.surface.roughness = float(scene.terrain.roughness);
-    base_.surface.specularAA = scene.terrain.specularAA;
-    base_.surface.detail = scene.detail;
+    base_.terrain = scene.terrain;
+    base_.detail = scene.detail;
     // The terrain is this renderer's for good: only an edit of the terrain section (or, in mode
     // map, of the file, which surfaceAlbedoOf notices) makes a new field, not a camera move.
     nlohmann::json terrainSection = sceneToJson(scene).at("terrain");
@@ -74,8 +73,7 @@ void ProjectRenderer::setProject(const Project& project) {
         else
             renderer_->setAlbedoMap(0, 0, {});
     }
-    base_.surface.ao = scene.ao.enabled;
-    base_.surface.aoStrength = float(scene.ao.strength);
+    base_.ao = scene.ao;
     if (computeAo_ && !aoCurrent()) {
         const HorizonAoSettings wanted = *wantedAo();
         setAmbientOcclusion(wanted, horizonSkyVisibility(terrain_.heightfield, wanted));
@@ -94,29 +92,14 @@ void ProjectRenderer::setProject(const Project& project) {
     // Water: the level and the highest crest decide the field and the mesh (built again only when
     // they change); everything else is uniforms.
     const WaterSettings& ws = scene.water;
-    base_.water = WaterLook{};
+    base_.water = ws;
+    std::optional<double> level;
+    double crest = 0.0;
     if (ws.enabled) {
-        WaterLook& w = base_.water;
-        w.enabled = true;
-        double crest = 0.0;
-        for (const GerstnerWave& wave : ws.waves) {
-            w.waves.push_back(water::waveTerms(wave));
-            crest += w.waves.back().amplitude;
-        }
-        const std::optional<double> level = water::waterLevel(ws, terrain_.heightfield);
-        if (level) renderer_->setWater(float(*level), float(crest));
-        else w.enabled = false;  // "auto" found no water in the DEM: none is drawn
-        w.scatter = ws.color;
-        w.absorption = ws.absorption;
-        w.roughness = float(ws.roughness);
-        w.depthAware = ws.depthAware;
-        w.shoreFadeDistance = float(water::shoreFadeDistance(ws, terrain_.heightfield));
-        w.planarReflection = ws.reflection == WaterReflection::Planar;
-        w.reflectionScale = float(ws.reflectionScale);
-        w.distortion = float(ws.distortion);
-    } else {
-        renderer_->setWater(std::nullopt, 0.0f);
+        for (const GerstnerWave& wave : ws.waves) crest += water::waveTerms(wave).amplitude;
+        level = water::waterLevel(ws, terrain_.heightfield);  // "auto" may find no water: none is drawn
     }
+    renderer_->setWater(level ? std::optional<float>(float(*level)) : std::nullopt, float(crest));
     // Placement reads only the volumes' settings and this renderer's terrain: edits of the sun,
     // sky or camera keep the markers they had.
     const std::string volumes = sceneToJson(scene).at("probe_volumes").dump();
@@ -369,7 +352,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
-    s.water.time = r.time;
+    s.time = r.time;
     return s;
 }
 

@@ -1260,8 +1260,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // under it only where the view shades it, the reflection only when planar.
     WaterResources* water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
     const bool waterShading = water && view.needs.waterShading;
-    const bool planarReflection = waterShading && s.water.planarReflection;
-    if (water) ensureWaterTargets(s.width, s.height, s.water.reflectionScale);
+    const bool planarReflection = waterShading && s.water.reflection == WaterReflection::Planar;
+    if (water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
 
     // Pipelines, built on first use.
     if (probes && !g.probePass) {
@@ -1369,9 +1369,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                              sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0, 0);
     slot.camera.write(&camera, sizeof camera);
     blocks::SurfaceBlock surface;
-    const SurfaceLook& look = s.surface;
     surface.albedo = glm::vec4(s.albedo, hasAlbedoMap_ ? 1.0f : 0.0f);
-    surface.material = glm::vec4(look.roughness, s.exposure, look.specularAA ? 1.0f : 0.0f, look.roughnessFloor);
+    surface.material = glm::vec4(float(s.terrain.roughness), s.exposure, s.terrain.specularAA ? 1.0f : 0.0f,
+                                 float(kRoughnessFloor));
     const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
     surface.footprint = glm::vec4(hf_.minX(), hf_.minZ(), spanX > 0.0f ? 1.0f / spanX : 0.0f,
                                   spanZ > 0.0f ? 1.0f / spanZ : 0.0f);
@@ -1384,8 +1384,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                                      spanZ / float(std::max(surfaceMapSize_.y - 1, 1)));
         if (texel > 0.0f) probeLevel = std::max(std::log2(finestProbeSpacing_ / texel), 0.0f);
     }
-    surface.ao = glm::vec4(look.ao && hasAo_ ? 1.0f : 0.0f, look.ao ? look.aoStrength : 0.0f, probeLevel, 0.0f);
-    const DetailSettings& d = look.detail;
+    surface.ao = glm::vec4(s.ao.enabled && hasAo_ ? 1.0f : 0.0f, s.ao.enabled ? float(s.ao.strength) : 0.0f,
+                           probeLevel, 0.0f);
+    const DetailSettings& d = s.detail;
     surface.detail = d.enabled ? glm::vec4(float(d.normalStrength), float(d.scale), float(d.fadeDistance),
                                            float(d.albedoVariation))
                                : glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);
@@ -1422,16 +1423,17 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         cascades_.clear();
     }
     if (water) {
-        const WaterLook& look = s.water;
+        const WaterSettings& ws = s.water;
         blocks::WaterBlock block;
-        block.plane = glm::vec4(water->level, float(look.time), look.shoreFadeDistance, look.depthAware ? 1.0f : 0.0f);
-        block.scatter = glm::vec4(look.scatter, look.roughness);
-        block.absorption = glm::vec4(look.absorption, look.planarReflection ? 1.0f : 0.0f);
-        const size_t waves = std::min<size_t>(look.waves.size(), WaterSettings::kMaxWaves);
-        block.look = glm::vec4(look.distortion, float(waves), glm::vec2(water->fieldSize));
+        block.plane = glm::vec4(water->level, float(s.time), float(water::shoreFadeDistance(ws, hf_)),
+                                ws.depthAware ? 1.0f : 0.0f);
+        block.scatter = glm::vec4(ws.color, float(ws.roughness));
+        block.absorption = glm::vec4(ws.absorption, planarReflection ? 1.0f : 0.0f);
+        const size_t waves = std::min<size_t>(ws.waves.size(), WaterSettings::kMaxWaves);
+        block.look = glm::vec4(float(ws.distortion), float(waves), glm::vec2(water->fieldSize));
         block.mesh = glm::vec4(water->spacing, 0.0f, 0.0f, 0.0f);
         for (size_t i = 0; i < waves; ++i) {
-            const water::WaveTerms& wave = look.waves[i];
+            const water::WaveTerms wave = water::waveTerms(ws.waves[i]);
             block.waves[i] = glm::vec4(float(wave.direction.x), float(wave.direction.y), float(wave.k), float(wave.amplitude));
             block.phases[i] = glm::vec4(float(wave.omegaDeep), float(wave.phase), 0.0f, 0.0f);
         }

@@ -52,32 +52,6 @@ struct GpuProbeVolume {
     std::optional<ProbeDiagnostics> diagnostics;
 };
 
-// How the terrain surface is drawn beyond its albedo (docs/lighting.md, "Surface").
-struct SurfaceLook {
-    float roughness = 0.6f;         // GGX, before the normal variance widens it
-    bool specularAA = true;         // widen the roughness by the normals' variance (Toksvig)
-    float roughnessFloor = float(kRoughnessFloor);   // the least roughness after the variance
-    bool ao = true;                 // the AO darkens sky light, and probe light by aoStrength
-    float aoStrength = 1.0f;
-    DetailSettings detail;          // the procedural micro-detail
-};
-
-// The water as a frame draws it (docs/lighting.md, "Water"); setWater holds the level and what
-// is built for it.
-struct WaterLook {
-    bool enabled = false;               // false: no water pass, nothing bound
-    glm::vec3 scatter{0.0f};            // deep-water scatter albedo
-    glm::vec3 absorption{0.0f};         // per metre
-    float roughness = 0.05f;
-    std::vector<water::WaveTerms> waves;
-    bool depthAware = false;
-    float shoreFadeDistance = 0.0f;     // metres
-    bool planarReflection = true;       // false: the sky's radiance is reflected
-    float reflectionScale = 0.5f;       // reflection target size / frame size
-    float distortion = 0.02f;           // reflection offset per unit of wave slope (screen share)
-    double time = 0.0;                  // seconds: the waves' phase
-};
-
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
@@ -86,7 +60,15 @@ struct RenderSettings {
     bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
     OrbitCamera camera;
     glm::vec3 albedo{0.3f};       // the constant albedo (when no albedo map is set)
-    SurfaceLook surface;          // roughness, AO use, micro-detail
+    // The scene's own sections, read as they are (docs/lighting.md): the terrain's roughness and
+    // normal-variance switch, the AO's use and strength, the micro-detail, the water.
+    TerrainSettings terrain;
+    AoSettings ao;
+    DetailSettings detail;
+    // The water is drawn where it is enabled and setWater found its level (none: no water pass,
+    // nothing bound).
+    WaterSettings water;
+    double time = 0.0;            // seconds: the waves' phase
     SunLight sun;
     sh::ShRgb skySh;
     float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
@@ -97,7 +79,6 @@ struct RenderSettings {
     bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
-    WaterLook water;
     // reflection_probes.strength, [0, 1]: how far bound reflection probes replace the sky's
     // specular (0 draws the image without them, bit for bit).
     float reflectionStrength = 1.0f;
