@@ -10,9 +10,9 @@
 #include "CommandLineSupport.h"
 #include "ImageFile.h"
 #include "Project.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "TerrainLoading.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux {

@@ -38,7 +38,7 @@
 #include "bake/SphereSampling.h"
 #include "bake/TargetSearch.h"
 #include "lpv/Lpv.h"
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 #include "water/Water.h"
 
 #ifndef TERRALUX_VERSION
@@ -87,7 +87,7 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
 struct BakeSetup {
     DemImportResult terrain;
     BakeLighting lighting;
-    std::unique_ptr<HeightfieldTracer> tracer;
+    std::unique_ptr<HeightfieldTracer> tracer;  // bakeSceneOf's, which `lighting` points at
     BakeQuality q;
     bool referenceMode = false;
     std::vector<const ProbeVolumeSettings*> volumes;
@@ -103,14 +103,10 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     report("loading terrain", 0.0);
     b.terrain = loadProjectTerrain(project);
     if (cancelled()) throw BakeCancelled();
-    report("loading sky", 0.01);
-    b.lighting = lightingOf(project);
-    b.tracer = std::make_unique<HeightfieldTracer>(b.terrain.heightfield,
-                                                   HeightfieldTracer::Options{scene.terrain.skirt});
-    b.lighting.tracer = b.tracer.get();
-    b.lighting.water = bakeWaterOf(project, b.terrain.heightfield);
-    report("loading albedo", 0.015);
-    b.lighting.surface = surfaceAlbedoOf(project, b.terrain.heightfield);
+    report("loading sky and albedo", 0.01);
+    BakeScene traced = bakeSceneOf(project, b.terrain.heightfield);
+    b.lighting = traced.lighting;
+    b.tracer = std::move(traced.tracer);
     if (cancelled()) throw BakeCancelled();
     b.q = qualityOf(scene.bake);
     b.referenceMode = scene.bake.quality == QualityPreset::Reference;

@@ -15,7 +15,7 @@
 #include "CommandLineHelp.h"
 #include "CommandLineSupport.h"
 #include "ImageFile.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 #include "DemImport.h"
 #include "EnvironmentImage.h"
 #include "ShProbeFile.h"

@@ -4,7 +4,7 @@
 #include <sstream>
 
 #include "ParameterTable.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 namespace terralux {
 namespace {

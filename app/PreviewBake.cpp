@@ -23,16 +23,10 @@ constexpr int kPreviewReflectionRays = 4;
 
 PreviewBake previewBake(const Project& project, const Heightfield& hf, const std::atomic<bool>* cancel) {
     const SceneDescription& scene = project.scene;
-    BakeLighting lighting = lightingOf(project);
-    const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{scene.terrain.skirt});
-    lighting.tracer = &tracer;
-    lighting.water = bakeWaterOf(project, hf);
-    try {
-        lighting.surface = surfaceAlbedoOf(project, hf);
-    } catch (const ImageError&) {
-        // A map that cannot be read: the preview lights with the constant albedo, as the viewport
-        // draws it (ProjectRenderer::albedoError says why); a bake reports the error.
-    }
+    // A map that cannot be read: the preview lights with the constant albedo, as the viewport
+    // draws it (ProjectRenderer::albedoError says why); a bake reports the error.
+    const BakeScene traced = bakeSceneOf(project, hf, true);
+    const BakeLighting& lighting = traced.lighting;
     const BakeQuality q = qualityPreset(QualityPreset::Draft);
     const BakeControl control{nullptr, cancel};
     const IrradianceCache cache(lighting, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, control);

@@ -10,11 +10,14 @@
 #include <glm/common.hpp>
 
 #include "EnvironmentImage.h"
+#include "ImageFile.h"
+#include "TerrainLoading.h"
+#include "bake/HeightfieldTracer.h"
 #include "LpvConsoleVariables.h"
 #include "lpv/Lpv.h"
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 #include "water/Water.h"
 
 namespace terralux {
@@ -142,6 +145,20 @@ std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
     const std::optional<double> level = water::waterLevel(w, hf);
     if (!level) return std::nullopt;  // "auto" found no water in the DEM
     return BakeWater{float(*level), w.color};
+}
+
+BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable) {
+    BakeScene b;
+    b.lighting = lightingOf(project);
+    b.tracer = std::make_unique<HeightfieldTracer>(hf, HeightfieldTracer::Options{project.scene.terrain.skirt});
+    b.lighting.tracer = b.tracer.get();
+    b.lighting.water = bakeWaterOf(project, hf);
+    try {
+        b.lighting.surface = surfaceAlbedoOf(project, hf);
+    } catch (const ImageError&) {
+        if (!constantAlbedoIfUnreadable) throw;
+    }
+    return b;
 }
 
 namespace {

@@ -2,6 +2,8 @@
 // The project's sun, sky and terrain albedo as the bake and the renderer use them: one place, so
 // the baked probes and the preview light the terrain the same way.
 
+#include <memory>
+
 #include "Project.h"
 #include "bake/DiffuseBake.h"
 
@@ -25,13 +27,21 @@ BakeLighting lightingOf(const Project& project);
 FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfield& terrain);
 // The authored sun as a light: direction toward it, illuminance × colour, radius in radians.
 SunLight sunOf(const SunSettings& sun);
-// Sun, sky and albedo; the caller sets the tracer.
-BakeLighting lightingOf(const Project& project);
-
 // The water the bake's probe rays see (BakeWater): unset while water.enabled is off, or when the
 // level is "auto" and the DEM shows no water surface (water::autoLevel); else the level resolved
 // on `hf`.
 std::optional<BakeWater> bakeWaterOf(const Project& project, const Heightfield& hf);
+
+// The scene a bake traces, set up once for the bake, the preview and the study: the project's
+// sun, sky and albedo (lightingOf), a tracer over `hf` as terrain.skirt says, the water its rays
+// see (bakeWaterOf) and the albedo field (surfaceAlbedoOf). The tracer lives here; `lighting`
+// points at it. An albedo map that cannot be read throws ImageError, or with
+// `constantAlbedoIfUnreadable` leaves terrain.albedo (as the viewport draws it).
+struct BakeScene {
+    std::unique_ptr<HeightfieldTracer> tracer;
+    BakeLighting lighting;
+};
+BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable = false);
 
 // The aspect ratio TERRALUX_lighting's cascade splits are computed for (shadows.computed_for_aspect).
 inline constexpr double kLightingExportAspect = 16.0 / 9.0;

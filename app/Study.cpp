@@ -19,7 +19,7 @@
 #include "AtomicFile.h"
 #include "BakeJob.h"
 #include "ReflectionProbeFile.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "SceneLighting.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
@@ -29,7 +29,7 @@
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 #include "terrain/HorizonAO.h"
 
 #ifndef TERRALUX_VERSION
@@ -303,11 +303,9 @@ struct Study {
 void Study::prepare() {
     report("loading terrain");
     terrain = loadProjectTerrain(project);
-    lighting = lightingOf(project);
-    tracer = std::make_unique<HeightfieldTracer>(hf(), HeightfieldTracer::Options{project.scene.terrain.skirt});
-    lighting.tracer = tracer.get();
-    lighting.water = bakeWaterOf(project, hf());
-    lighting.surface = surfaceAlbedoOf(project, hf());
+    BakeScene traced = bakeSceneOf(project, hf());
+    lighting = traced.lighting;
+    tracer = std::move(traced.tracer);
     const auto& vols = project.scene.probeVolumes;
     auto it = std::find_if(vols.begin(), vols.end(), [](const ProbeVolumeSettings& v) { return v.enabled; });
     if (it == vols.end())

@@ -9,7 +9,7 @@
 
 #include <QWidget>
 
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 
 namespace terralux {
 

@@ -13,7 +13,7 @@
 #include "ParameterPanels.h"
 #include "ParameterTable.h"
 #include "ProjectDocument.h"
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 
 namespace terralux {
 

@@ -54,7 +54,7 @@
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 namespace terralux {
 

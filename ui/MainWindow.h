@@ -13,7 +13,7 @@
 
 #include "BakeController.h"
 #include "ProjectDocument.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "ViewportWindow.h"
 
 class QComboBox;

@@ -17,7 +17,7 @@
 
 #include "DemImport.h"
 #include "Project.h"
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 
 namespace terralux {
 

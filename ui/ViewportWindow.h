@@ -12,9 +12,9 @@
 
 #include <QWindow>
 
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "lpv/UpdateSchedule.h"
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 #include "vk/Swapchain.h"
 
 class QVulkanInstance;

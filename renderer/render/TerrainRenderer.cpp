@@ -17,7 +17,7 @@
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
 #include "terrain/SurfaceAlbedo.h"
 #include "terrain/SurfaceMaps.h"

@@ -14,7 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include "PreviewBake.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "TerrainLoading.h"
 
 using namespace terralux;

@@ -14,10 +14,10 @@
 #include <benchmark/benchmark.h>
 
 #include "PreviewBake.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "TerrainLoading.h"
 #include "lpv/Lpv.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 using namespace terralux;
 

@@ -48,11 +48,11 @@
 #include "ParameterTable.h"
 #include "bake/ProbePlacement.h"
 #include "BakeJob.h"
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 #include "TerrainLoading.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 #include "water/Water.h"
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 
 using namespace terralux;
 namespace fs = std::filesystem;

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 using namespace terralux;
 

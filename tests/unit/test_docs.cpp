@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "ParameterTable.h"
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 namespace fs = std::filesystem;
 using namespace terralux;

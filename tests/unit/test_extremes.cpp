@@ -28,7 +28,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "lpv/Lpv.h"
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 #include "bake/SphereSampling.h"
 
 using namespace terralux;

@@ -18,7 +18,7 @@
 #include "ParameterTable.h"
 #include "Project.h"
 #include "SceneLighting.h"
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 #include "water/Water.h"
 
 namespace fs = std::filesystem;

@@ -9,7 +9,7 @@
 #include "Project.h"
 #include "ProjectErrors.h"
 #include "ShaderMath.h"
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 
 namespace fogmath = terralux::glsl;
 

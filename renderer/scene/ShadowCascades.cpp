@@ -1,4 +1,4 @@
-#include "render/ShadowCascades.h"
+#include "scene/ShadowCascades.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "RenderJob.h"
+#include "ProjectRenderer.h"
 
 #include <cmath>
 #include <fstream>
@@ -14,8 +14,8 @@
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
 #include "lpv/Lpv.h"
-#include "render/DebugViews.h"
-#include "render/OrbitCamera.h"
+#include "scene/DebugViews.h"
+#include "scene/OrbitCamera.h"
 
 namespace terralux {
 

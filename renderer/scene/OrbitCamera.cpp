@@ -1,4 +1,4 @@
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "render/DebugViews.h"
+#include "scene/DebugViews.h"
 
 namespace terralux {
 

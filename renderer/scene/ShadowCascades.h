@@ -9,7 +9,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 
-#include "render/OrbitCamera.h"
+#include "scene/OrbitCamera.h"
 #include "scene/SceneDescription.h"
 
 namespace terralux {
