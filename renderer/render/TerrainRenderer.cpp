@@ -17,6 +17,7 @@
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
+#include "render/features/Packing.h"
 #include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
 #include "terrain/SurfaceAlbedo.h"
@@ -1360,22 +1361,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const float extent = std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(),
                                    hf_.maxHeight() - hf_.minHeight(), 1.0f});
     const float aspect = float(s.width) / float(s.height);
-    blocks::CameraBlock camera;
-    camera.viewProj = s.camera.viewProjection(aspect, extent);
-    camera.invViewProj = glm::inverse(camera.viewProj);
-    camera.position = glm::vec4(s.camera.position(), s.camera.planes(extent).farPlane);
-    camera.viewport = glm::vec4(float(s.width), float(s.height), 1.0f / float(s.width), 1.0f / float(s.height));
-    camera.view = glm::ivec4(s.debugView, s.linearOutput ? 1 : 0,
-                             sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0, 0);
+    const blocks::CameraBlock camera = features::packCamera(s, extent, view);
     slot.camera.write(&camera, sizeof camera);
-    blocks::SurfaceBlock surface;
-    surface.albedo = glm::vec4(s.albedo, hasAlbedoMap_ ? 1.0f : 0.0f);
-    surface.material = glm::vec4(float(s.terrain.roughness), s.exposure, s.terrain.specularAA ? 1.0f : 0.0f,
-                                 float(kRoughnessFloor));
     const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
-    surface.footprint = glm::vec4(hf_.minX(), hf_.minZ(), spanX > 0.0f ? 1.0f / spanX : 0.0f,
-                                  spanZ > 0.0f ? 1.0f / spanZ : 0.0f);
-    surface.mapSizes = glm::vec4(glm::vec2(surfaceMapSize_), glm::vec2(albedoMapSize_));
     // The normal-AO mip level whose texels are as large as the finest probe spacing: the AO at
     // that scale is what the probes already hold.
     float probeLevel = 0.0f;
@@ -1384,70 +1372,45 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                                      spanZ / float(std::max(surfaceMapSize_.y - 1, 1)));
         if (texel > 0.0f) probeLevel = std::max(std::log2(finestProbeSpacing_ / texel), 0.0f);
     }
-    surface.ao = glm::vec4(s.ao.enabled && hasAo_ ? 1.0f : 0.0f, s.ao.enabled ? float(s.ao.strength) : 0.0f,
-                           probeLevel, 0.0f);
-    const DetailSettings& d = s.detail;
-    surface.detail = d.enabled ? glm::vec4(float(d.normalStrength), float(d.scale), float(d.fadeDistance),
-                                           float(d.albedoVariation))
-                               : glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);
+    features::SurfaceInputs surfaceIn;
+    surfaceIn.footprintMin = glm::vec2(hf_.minX(), hf_.minZ());
+    surfaceIn.footprintSpan = glm::vec2(spanX, spanZ);
+    surfaceIn.normalAoMapSize = glm::vec2(surfaceMapSize_);
+    surfaceIn.albedoMapSize = glm::vec2(albedoMapSize_);
+    surfaceIn.albedoMap = hasAlbedoMap_;
+    surfaceIn.ao = hasAo_;
+    surfaceIn.probeAoLevel = probeLevel;
+    const blocks::SurfaceBlock surface = features::packSurface(s, surfaceIn);
     slot.surface.write(&surface, sizeof surface);
-    blocks::SunSkyBlock sunSky;
-    sunSky.sunDirection = glm::vec4(s.sun.direction, s.sun.angularRadius);
-    sunSky.sunIlluminance = glm::vec4(s.sun.illuminance, 0.0f);
-    for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
+    const blocks::SunSkyBlock sunSky = features::packSunSky(s);
     slot.sunSky.write(&sunSky, sizeof sunSky);
-    blocks::AtmosphereBlock atmosphere;
-    atmosphere.fog = glm::vec4(float(s.fog.density), float(s.fog.scaleHeight > 0.0 ? 1.0 / s.fog.scaleHeight : 0.0), float(s.fog.baseHeight.value_or(0.0)),
-                               float(s.fog.anisotropy));
-    atmosphere.fogColor = glm::vec4(s.fog.color.value_or(glm::vec3(0.0f)), float(s.fog.inscatter));
+    const blocks::AtmosphereBlock atmosphere = features::packAtmosphere(s.fog);
     slot.atmosphere.write(&atmosphere, sizeof atmosphere);
     const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
     std::vector<glm::mat4> lightMatrices;
     if (shadows) {
         const CascadeRange range = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
         cascades_ = fitCascades(range, s.camera, aspect, s.sun.direction, shadows->resolution, boundsMin, boundsMax);
-        blocks::ShadowBlock block;
-        for (size_t i = 0; i < cascades_.size(); ++i) {
-            block.lightViewProj[i] = cascades_[i].lightViewProj;
-            block.ends[int(i)] = float(cascades_[i].farDistance);
-            block.texel[int(i)] = cascades_[i].texelSize;
-            block.depthRange[int(i)] = cascades_[i].depthRange;
-            lightMatrices.push_back(cascades_[i].lightViewProj);
-        }
-        block.forward = glm::vec4(glm::normalize(s.camera.target - s.camera.position()), float(range.nearDistance));
-        block.bias = glm::vec4(float(s.shadows.depthBias), float(s.shadows.normalBias),
-                               std::tan(s.sun.angularRadius), float(shadows->resolution));
-        block.mode = glm::ivec4(int(cascades_.size()), int(s.shadows.filter), 0, 0);
+        for (const Cascade& c : cascades_) lightMatrices.push_back(c.lightViewProj);
+        const blocks::ShadowBlock block = features::packShadows(s, cascades_, range, shadows->resolution);
         slot.shadow.write(&block, sizeof block);
     } else if (!s.shadows.enabled) {
         cascades_.clear();
     }
     if (water) {
-        const WaterSettings& ws = s.water;
-        blocks::WaterBlock block;
-        block.plane = glm::vec4(water->level, float(s.time), float(water::shoreFadeDistance(ws, hf_)),
-                                ws.depthAware ? 1.0f : 0.0f);
-        block.scatter = glm::vec4(ws.color, float(ws.roughness));
-        block.absorption = glm::vec4(ws.absorption, planarReflection ? 1.0f : 0.0f);
-        const size_t waves = std::min<size_t>(ws.waves.size(), WaterSettings::kMaxWaves);
-        block.look = glm::vec4(float(ws.distortion), float(waves), glm::vec2(water->fieldSize));
-        block.mesh = glm::vec4(water->spacing, 0.0f, 0.0f, 0.0f);
-        for (size_t i = 0; i < waves; ++i) {
-            const water::WaveTerms wave = water::waveTerms(ws.waves[i]);
-            block.waves[i] = glm::vec4(float(wave.direction.x), float(wave.direction.y), float(wave.k), float(wave.amplitude));
-            block.phases[i] = glm::vec4(float(wave.omegaDeep), float(wave.phase), 0.0f, 0.0f);
-        }
+        features::WaterInputs in;
+        in.level = water->level;
+        in.shoreFadeDistance = float(water::shoreFadeDistance(s.water, hf_));
+        in.fieldSize = glm::vec2(water->fieldSize);
+        in.meshSpacing = water->spacing;
+        const blocks::WaterBlock block = features::packWater(s, in);
         water->blocks[slotIndex].write(&block, sizeof block);
     }
     if (planarReflection) {
         // The camera mirrored in the plane, drawing scene-linear beauty into the reflection.
-        blocks::CameraBlock mirrored = camera;
-        const float rw = float(water->reflectionWidth), rh = float(water->reflectionHeight);
-        mirrored.viewProj = s.camera.reflectedViewProjection(aspect, extent, water->level);
-        mirrored.invViewProj = glm::inverse(mirrored.viewProj);
-        mirrored.position = glm::vec4(s.camera.reflectedPosition(water->level), camera.position.w);
-        mirrored.viewport = glm::vec4(rw, rh, 1.0f / rw, 1.0f / rh);
-        mirrored.view = glm::ivec4(kViewBeauty, 1, camera.view.z, 0);
+        const blocks::CameraBlock mirrored =
+            features::packMirroredCamera(s, camera, extent, water->level, float(water->reflectionWidth),
+                                         float(water->reflectionHeight));
         slot.reflectionCamera.write(&mirrored, sizeof mirrored);
     }
     if (reflections) {
@@ -1463,19 +1426,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             slot.localLightCapacity = wanted;
             slot.lpvSetKey = 0;
         }
-        std::vector<blocks::LocalLightRecord> records(wanted);
-        for (size_t i = 0; localLights && i < s.lights.size(); ++i) {
-            const LocalLight& l = s.lights[i];
-            blocks::LocalLightRecord& r = records[i];
-            const bool spot = l.type == LocalLightType::Spot;
-            r.positionRange = glm::vec4(l.position, float(l.range));
-            r.emitted = glm::vec4(l.color * float(l.intensity), spot ? 1.0f : 0.0f);
-            const float len = glm::length(l.direction);
-            r.direction = glm::vec4(len > 0.0f ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f), 0.0f);
-            const float cosOuter = std::cos(glm::radians(float(l.outerConeDeg)));
-            const float cosInner = std::cos(glm::radians(float(l.innerConeDeg)));
-            r.cone = glm::vec4(cosOuter, 1.0f / std::max(0.001f, cosInner - cosOuter), 0.0f, 0.0f);
-        }
+        const std::vector<blocks::LocalLightRecord> records = features::packLocalLights(s.lights, localLights);
         slot.localLights.write(records.data(), records.size() * sizeof(records[0]));
         blocks::LpvBlock block = lpvVolumes ? lpvVolumes->block : blocks::LpvBlock{};
         block.counts.w = localLights ? int(s.lights.size()) : 0;
@@ -1490,9 +1441,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         }
     }
     if (drawMarkers || drawReflectionMarkers || drawLeaves) {
-        blocks::OverlayBlock overlay;
-        overlay.leaves = glm::vec4(smallestLeaf_, kSmallestLeafPixels, 0.0f, 0.0f);
-        overlay.markers = glm::ivec4(s.showProbePositions ? 1 : 0, 1, 0, 0);
+        const blocks::OverlayBlock overlay = features::packOverlay(s, smallestLeaf_, kSmallestLeafPixels);
         slot.overlay.write(&overlay, sizeof overlay);
     }
 

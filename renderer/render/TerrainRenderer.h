@@ -20,6 +20,7 @@
 #include "bake/Sky.h"
 #include "bake/SphericalHarmonics.h"
 #include "render/FrameGraph.h"
+#include "render/RenderSettings.h"
 #include "scene/OrbitCamera.h"
 #include "scene/ShadowCascades.h"
 #include "scene/SceneDescription.h"
@@ -50,43 +51,6 @@ struct GpuProbeVolume {
     // What the bake wrote beside the file (moved probes and the error map of the diagnostics views);
     // unset for bakes without it.
     std::optional<ProbeDiagnostics> diagnostics;
-};
-
-struct RenderSettings {
-    uint32_t width = 640, height = 360;
-    int debugView = 0;
-    bool probes = true;           // false: exactly the image without probes, diffuse or reflection
-                                  // (no probe pass, no reflection probes bound)
-    bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
-    OrbitCamera camera;
-    glm::vec3 albedo{0.3f};       // the constant albedo (when no albedo map is set)
-    // The scene's own sections, read as they are (docs/lighting.md): the terrain's roughness and
-    // normal-variance switch, the AO's use and strength, the micro-detail, the water.
-    TerrainSettings terrain;
-    AoSettings ao;
-    DetailSettings detail;
-    // The water is drawn where it is enabled and setWater found its level (none: no water pass,
-    // nothing bound).
-    WaterSettings water;
-    double time = 0.0;            // seconds: the waves' phase
-    SunLight sun;
-    sh::ShRgb skySh;
-    float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
-    ShadowSettings shadows;       // the sun's cascades (shadows.enabled false: no shadow pass)
-    // Height fog with base height and colour resolved (fog.enabled false: no fog code runs).
-    FogSettings fog;
-    bool skirt = true;            // the traced surface of the sun-visibility view (terrain.skirt)
-    bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
-                                      // moved and rejected probes)
-    bool showLeaves = false;          // the overlay of setProbeLeaves
-    // reflection_probes.strength, [0, 1]: how far bound reflection probes replace the sky's
-    // specular (0 draws the image without them, bit for bit).
-    float reflectionStrength = 1.0f;
-    // lighting.indirect is lpv or both: the bound LPV's irradiance (and at quality 2 its specular)
-    // adds to the ambient in the lit views. The LPV views draw a bound LPV whatever this says.
-    bool lpvLight = false;
-    // Point and spot lights: their direct light, unshadowed (none: no lights code runs).
-    std::vector<LocalLight> lights;
 };
 
 struct RenderedImage {
