@@ -11,51 +11,42 @@ BakeController::BakeController(QObject* parent) : QObject(parent) {
     qRegisterMetaType<nlohmann::json>("nlohmann::json");
 }
 
-BakeController::~BakeController() {
-    cancel();
-    wait();
-}
+BakeController::~BakeController() = default;  // the bake's job cancels and waits
 
 void BakeController::start(const Project& project) {
     if (running_) return;
-    wait();
     running_ = true;
-    cancel_ = false;
-    worker_ = std::thread([this, project] {
+    job_.start([this, project](const LatestJob::Context& job) {
         const auto start = std::chrono::steady_clock::now();
         auto onProgress = [&](const std::string& phase, double f) {
             const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             const double eta = f > 0.02 ? elapsed * (1.0 - f) / f : -1.0;
-            QMetaObject::invokeMethod(this, [this, f, p = QString::fromStdString(phase), eta] {
-                emit progress(f, p, eta);
-            }, Qt::QueuedConnection);
+            job.post([this, f, p = QString::fromStdString(phase), eta] { emit progress(f, p, eta); });
         };
         try {
             BakeRequest request;
             request.project = project;
-            const BakeOutcome outcome = runBake(request, onProgress, &cancel_);
-            QMetaObject::invokeMethod(this, [this, report = outcome.report] {
+            const BakeOutcome outcome = runBake(request, onProgress, job.cancelFlag());
+            job.post([this, report = outcome.report] {
                 running_ = false;
                 emit finished(report);
-            }, Qt::QueuedConnection);
+            });
         } catch (const BakeCancelled&) {
-            QMetaObject::invokeMethod(this, [this] {
+            job.post([this] {
                 running_ = false;
                 emit cancelled();
-            }, Qt::QueuedConnection);
+            });
         } catch (const std::exception& e) {
-            QMetaObject::invokeMethod(this, [this, m = QString::fromStdString(e.what())] {
+            job.post([this, m = QString::fromStdString(e.what())] {
                 running_ = false;
                 emit failed(m);
-            }, Qt::QueuedConnection);
+            });
         }
     });
 }
 
-void BakeController::cancel() { cancel_ = true; }
+void BakeController::cancel() { job_.cancel(); }
 
-void BakeController::wait() {
-    if (worker_.joinable()) worker_.join();
-}
+void BakeController::wait() { job_.wait(); }
 
 }  // namespace terralux

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "LatestJob.h"
 #include "Project.h"
 
 namespace terralux {
@@ -34,8 +35,7 @@ signals:
     void failed(const QString& message);
 
 private:
-    std::thread worker_;
-    std::atomic<bool> cancel_{false};
+    LatestJob job_{this};  // the bake
     bool running_ = false;
 };
 

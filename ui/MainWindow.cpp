@@ -295,8 +295,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
 }
 
 MainWindow::~MainWindow() {
-    previewCancel_ = true;
-    if (previewWorker_.joinable()) previewWorker_.join();
+    previewJob_.stop();
     stopAmbientOcclusion();
     bake_->cancel();
     bake_->wait();
@@ -310,21 +309,28 @@ QString MainWindow::autosaveDir() {
     return env.isEmpty() ? QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) : env;
 }
 
-void MainWindow::buildDocks() {
-    auto dock = [this](const QString& title, const QString& name, QWidget* w) {
-        // A dock title is plain text: '&' needs no escaping here (unlike buttons and actions).
-        auto* d = new QDockWidget(title, this);
-        d->setObjectName(name);
-        d->setWidget(scrolled(w));
-        addDockWidget(Qt::RightDockWidgetArea, d);
-        return d;
-    };
-    auto connectRejected = [this](auto* w) {
-        connect(w, &std::remove_pointer_t<decltype(w)>::rejected, this,
-                [this](const QString& m) { statusBar()->showMessage(m, 8000); });
-    };
+QDockWidget* MainWindow::addDock(const QString& title, const QString& name, QWidget* w) {
+    // A dock title is plain text: '&' needs no escaping here (unlike buttons and actions).
+    auto* d = new QDockWidget(title, this);
+    d->setObjectName(name);
+    d->setWidget(scrolled(w));
+    addDockWidget(Qt::RightDockWidgetArea, d);
+    return d;
+}
 
-    // Terrain.
+void MainWindow::showRejection(const QString& message) { statusBar()->showMessage(message, 8000); }
+
+ParameterForm* MainWindow::dockForm(const std::string& dockName) {
+    auto* form = new ParameterForm(doc_);
+    for (const auto& spec : parameterTable())
+        if (spec.uiRow && parameterDock(spec).objectName == dockName) form->addParameter(spec.path);
+    reportRejections(form);
+    form->refresh();
+    return form;
+}
+
+// The terrain: what was imported, the import button and the terrain rows.
+QDockWidget* MainWindow::buildTerrainDock() {
     auto* terrain = new QWidget;
     auto* tv = new QVBoxLayout(terrain);
     terrainSummary_ = statusLabel("terrain.summary");
@@ -332,15 +338,6 @@ void MainWindow::buildDocks() {
     auto* importDem = new QPushButton("Import DEM…");
     importDem->setObjectName("terrain.import");
     tv->addWidget(importDem);
-    // A form of the rows of one dock of the parameter table (parameterDock), in table order.
-    auto dockForm = [this, connectRejected](const std::string& dockName) {
-        auto* form = new ParameterForm(doc_);
-        for (const auto& spec : parameterTable())
-            if (spec.uiRow && parameterDock(spec).objectName == dockName) form->addParameter(spec.path);
-        connectRejected(form);
-        form->refresh();
-        return form;
-    };
     tv->addWidget(dockForm("dock.terrain"));
     tv->addStretch(1);
     connect(importDem, &QPushButton::clicked, this, [this] {
@@ -348,9 +345,11 @@ void MainWindow::buildDocks() {
                                                        "Rasters (*.tif *.tiff *.hgt *.asc *.vrt *.zip *.img *.dem);;All files (*)");
         if (!f.isEmpty()) importDemFile(f);
     });
-    auto* terrainDock = dock("Terrain", "dock.terrain", terrain);
+    return addDock("Terrain", "dock.terrain", terrain);
+}
 
-    // Sun & Sky.
+// Sun & Sky.
+QDockWidget* MainWindow::buildSunSkyDock() {
     auto* sky = new ParameterForm(doc_);
     sky->addParameters("sun.");
     sky->addParameters("sky.");
@@ -361,11 +360,14 @@ void MainWindow::buildDocks() {
         const QString f = QFileDialog::getOpenFileName(this, "Import HDR sky", QString(), "HDR images (*.hdr *.exr);;All files (*)");
         if (!f.isEmpty()) importHdrFile(f);
     });
-    connectRejected(sky);
-    auto* skyDock = dock("Sun & Sky", "dock.sunSky", sky);
+    reportRejections(sky);
+    sky->refresh();
+    return addDock("Sun & Sky", "dock.sunSky", sky);
+}
 
-    // Shadows: the table's rows with the cascade splits over the view below the split rows, and
-    // the cascade view.
+// Shadows: the table's rows with the cascade splits over the view below the split rows, and
+// the cascade view.
+QDockWidget* MainWindow::buildShadowsDock() {
     auto* shadows = new QWidget;
     auto* sv = new QVBoxLayout(shadows);
     auto* sf = new ParameterForm(doc_);
@@ -380,8 +382,9 @@ void MainWindow::buildDocks() {
         sf->addParameter(spec.path);
         if (spec.path == "shadows.splits") sf->addWidget(chartBox);
     }
-    connectRejected(sf);
-    connectRejected(chart);
+    reportRejections(sf);
+    reportRejections(chart);
+    sf->refresh();
     sv->addWidget(sf);
     showCascades_ = new QPushButton("Show cascades");
     showCascades_->setObjectName("shadows.showCascades");
@@ -390,16 +393,21 @@ void MainWindow::buildDocks() {
                               "the view shown before");
     sv->addWidget(showCascades_);
     sv->addStretch(1);
-    auto* shadowsDock = dock("Shadows", "dock.shadows", shadows);
+    return addDock("Shadows", "dock.shadows", shadows);
+}
 
-    // Atmosphere: height fog and the exposure of the whole image.
+// Atmosphere: height fog and the exposure of the whole image.
+QDockWidget* MainWindow::buildAtmosphereDock() {
     auto* atmosphere = new ParameterForm(doc_);
     atmosphere->addParameters("fog.");
     atmosphere->addParameter("camera.exposure_ev");
-    connectRejected(atmosphere);
-    auto* atmosphereDock = dock("Atmosphere", "dock.atmosphere", atmosphere);
+    reportRejections(atmosphere);
+    atmosphere->refresh();
+    return addDock("Atmosphere", "dock.atmosphere", atmosphere);
+}
 
-    // Surface: albedo, roughness and micro-detail.
+// Surface: albedo, roughness and micro-detail.
+QDockWidget* MainWindow::buildSurfaceDock() {
     auto* surface = new QWidget;
     auto* uv = new QVBoxLayout(surface);
     uv->addWidget(dockForm("dock.surface"));
@@ -417,9 +425,11 @@ void MainWindow::buildDocks() {
     albedoStatus_ = statusLabel("surface.albedoStatus");
     uv->addWidget(albedoStatus_);
     uv->addStretch(1);
-    auto* surfaceDock = dock("Surface", "dock.surface", surface);
+    return addDock("Surface", "dock.surface", surface);
+}
 
-    // Ambient occlusion: its settings and the progress of the field.
+// Ambient occlusion: its settings and the progress of the field.
+QDockWidget* MainWindow::buildAoDock() {
     auto* ao = new QWidget;
     auto* av = new QVBoxLayout(ao);
     av->addWidget(dockForm("dock.ao"));
@@ -438,24 +448,28 @@ void MainWindow::buildDocks() {
     });
     av->addWidget(showAo);
     av->addStretch(1);
-    auto* aoDock = dock("Ambient Occlusion", "dock.ao", ao);
+    return addDock("Ambient Occlusion", "dock.ao", ao);
+}
 
-    // Water: the plane, its optics and reflection, the waves and their animation.
+// Water: the plane, its optics and reflection, the waves and their animation.
+QDockWidget* MainWindow::buildWaterDock() {
     auto* waterPage = new QWidget;
     auto* wv = new QVBoxLayout(waterPage);
     wv->addWidget(dockForm("dock.water"));
     waterPanel_ = new WaterPanel(doc_, viewport_);
-    connectRejected(waterPanel_);
+    reportRejections(waterPanel_);
     wv->addWidget(waterPanel_);
     wv->addStretch(1);
-    auto* waterDock = dock("Water", "dock.water", waterPage);
+    return addDock("Water", "dock.water", waterPage);
+}
 
-    // Reflection probes: their settings and the probe inspector.
+// Reflection probes: their settings and the probe inspector.
+QDockWidget* MainWindow::buildReflectionDock() {
     auto* reflectionPage = new QWidget;
     auto* rv = new QVBoxLayout(reflectionPage);
     rv->addWidget(dockForm("dock.reflectionProbes"));
     reflectionPanel_ = new ReflectionPanel(doc_);
-    connectRejected(reflectionPanel_);
+    reportRejections(reflectionPanel_);
     rv->addWidget(reflectionPanel_);
     auto* showReflection = new QPushButton("Show reflection");
     showReflection->setObjectName("reflection.show");
@@ -465,26 +479,33 @@ void MainWindow::buildDocks() {
     });
     rv->addWidget(showReflection);
     rv->addStretch(1);
-    auto* reflectionDock = dock("Reflection Probes", "dock.reflectionProbes", reflectionPage);
+    return addDock("Reflection Probes", "dock.reflectionProbes", reflectionPage);
+}
 
-    // Light propagation volumes: their settings, the indirect light selector and the lights.
+// Light propagation volumes: their settings, the indirect light selector and the lights.
+QDockWidget* MainWindow::buildLpvDock() {
     auto* lpvPanel = new LpvPanel(doc_);
-    connectRejected(lpvPanel);
-    auto* lpvDock = dock("LPV", "dock.lpv", lpvPanel);
+    reportRejections(lpvPanel);
+    return addDock("LPV", "dock.lpv", lpvPanel);
+}
 
-    // Probe Volumes.
+// Probe Volumes.
+QDockWidget* MainWindow::buildVolumesDock() {
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
-    connectRejected(volumes);
-    auto* volumesDock = dock("Probe Volumes", "dock.probeVolumes", volumes);
+    reportRejections(volumes);
+    return addDock("Probe Volumes", "dock.probeVolumes", volumes);
+}
 
-    // Bake & Export.
+// Bake & Export: the settings, the button, progress, the last report and its suggestions.
+QDockWidget* MainWindow::buildBakeDock() {
     auto* bakeWidget = new QWidget;
     auto* bv = new QVBoxLayout(bakeWidget);
     auto* bf = new ParameterForm(doc_);
     bf->addParameters("bake.");
     bf->addParameters("export.");
-    connectRejected(bf);
+    reportRejections(bf);
+    bf->refresh();
     bv->addWidget(bf);
     outputPath_ = statusLabel("bake.outputPath");
     outputPath_->setTextInteractionFlags(Qt::TextSelectableByMouse);
@@ -523,14 +544,29 @@ void MainWindow::buildDocks() {
     bv->addWidget(suggestions_);
     connect(bakeButton_, &QPushButton::clicked, this, [this] { startBake(); });
     connect(cancelButton_, &QPushButton::clicked, bake_, &BakeController::cancel);
-    auto* bakeDock = dock("Bake & Export", "dock.bakeExport", bakeWidget);
+    return addDock("Bake & Export", "dock.bakeExport", bakeWidget);
+}
 
-    // Trade-off: the speed/accuracy study of the bake's knobs, its points applied as edits.
+// Trade-off: the speed/accuracy study of the bake's knobs, its points applied as edits.
+QDockWidget* MainWindow::buildTradeoffDock() {
     auto* tradeoff = new TradeoffPanel(doc_);
-    connectRejected(tradeoff);
-    auto* tradeoffDock = dock("Trade-off", "dock.tradeoff", tradeoff);
+    reportRejections(tradeoff);
+    return addDock("Trade-off", "dock.tradeoff", tradeoff);
+}
 
-    for (auto* f : {sky, sf, atmosphere, bf}) f->refresh();
+void MainWindow::buildDocks() {
+    auto* terrainDock = buildTerrainDock();
+    auto* skyDock = buildSunSkyDock();
+    auto* shadowsDock = buildShadowsDock();
+    auto* atmosphereDock = buildAtmosphereDock();
+    auto* surfaceDock = buildSurfaceDock();
+    auto* aoDock = buildAoDock();
+    auto* waterDock = buildWaterDock();
+    auto* reflectionDock = buildReflectionDock();
+    auto* lpvDock = buildLpvDock();
+    auto* volumesDock = buildVolumesDock();
+    auto* bakeDock = buildBakeDock();
+    auto* tradeoffDock = buildTradeoffDock();
     // The lighting docks share the upper tab group with the terrain.
     tabifyDockWidget(terrainDock, skyDock);
     tabifyDockWidget(skyDock, shadowsDock);
@@ -550,7 +586,12 @@ void MainWindow::buildDocks() {
     terrainDock->raise();
     volumesDock->raise();
 
-    // Viewport toolbar: debug view and probe lighting.
+    buildViewportToolbar();
+    buildStatusBar();
+}
+
+// The viewport toolbar: debug view, probe lighting and the overlays.
+void MainWindow::buildViewportToolbar() {
     auto* bar = addToolBar("Viewport");
     bar->setObjectName("toolbar.viewport");
     viewSelector_ = new QComboBox;
@@ -579,7 +620,6 @@ void MainWindow::buildDocks() {
     // keeps it in sight.
     legend_ = new QLabel;
     legend_->setObjectName("status.legend");
-    auto* legend = legend_;
     connect(viewSelector_, &QComboBox::currentIndexChanged, this, [this](int i) {
         viewport_->setDebugView(viewSelector_->itemData(i).toInt());
         updateLegend();
@@ -597,13 +637,17 @@ void MainWindow::buildDocks() {
         showCascades_->setChecked(view == kViewCascades);
     });
 
+}
+
+// The status bar: the legend, probes, frame time, the import's progress and the device.
+void MainWindow::buildStatusBar() {
     frameLabel_ = new QLabel;
     frameLabel_->setObjectName("status.frame");
     probeLabel_ = new QLabel;
     probeLabel_->setObjectName("status.probes");
     sourceLabel_ = new QLabel;
     sourceLabel_->setObjectName("status.device");
-    statusBar()->addWidget(legend, 1);
+    statusBar()->addWidget(legend_, 1);
     statusBar()->addPermanentWidget(probeLabel_);
     statusBar()->addPermanentWidget(frameLabel_);
     terrainBusy_ = new QProgressBar;
@@ -959,10 +1003,8 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 }
 
 void MainWindow::rebuildRenderer() {
-    previewCancel_ = true;
-    if (previewWorker_.joinable()) previewWorker_.join();
     // A preview that finished for the terrain before may still be queued: it must not land.
-    ++previewGeneration_;
+    previewJob_.stop();
     viewport_->setRenderer(nullptr);
     stopAmbientOcclusion();
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
@@ -1000,11 +1042,8 @@ void MainWindow::refreshLighting() {
 }
 
 void MainWindow::stopAmbientOcclusion() {
-    aoCancel_ = true;
-    if (aoWorker_.joinable()) aoWorker_.join();
-    aoCancel_ = false;
+    aoJob_.stop();  // a result already queued must not land
     aoRunning_.reset();
-    ++aoGeneration_;  // a result already queued must not land
     if (aoProgress_) aoProgress_->setVisible(false);
 }
 
@@ -1024,41 +1063,35 @@ void MainWindow::updateAmbientOcclusion() {
         return;
     stopAmbientOcclusion();
     aoRunning_ = wanted;
-    const unsigned generation = aoGeneration_;
     aoProgress_->setValue(0);
     aoProgress_->setVisible(true);
     aoStatus_->setText(QString("Computing %1 directions over %2 vertices…")
                            .arg(wanted->directions)
                            .arg(QLocale().toString(qulonglong(renderer_->heightfield().heights().size()))));
     auto terrain = doc_->terrainShared();
-    aoWorker_ = std::thread([this, terrain, settings = *wanted, generation] {
+    aoJob_.start([this, terrain, settings = *wanted](const LatestJob::Context& job) {
         const auto start = std::chrono::steady_clock::now();
-        auto shown = std::make_shared<std::atomic<int>>(-1);
+        std::atomic<int> shown{-1};  // the progress may come from any of the AO's threads
         std::vector<float> field;
         try {
-            field = horizonSkyVisibility(terrain->heightfield, settings, [this, shown, generation](double f) {
+            field = horizonSkyVisibility(terrain->heightfield, settings, [this, &shown, &job](double f) {
                 const int percent = int(f * 100.0);
-                if (shown->exchange(percent) != percent)
-                    QMetaObject::invokeMethod(this, [this, percent, generation] {
-                        if (generation == aoGeneration_) aoProgress_->setValue(percent);
-                    }, Qt::QueuedConnection);
-                return !aoCancel_.load();
+                if (shown.exchange(percent) != percent) job.post([this, percent] { aoProgress_->setValue(percent); });
+                return !job.cancelled();
             });
         } catch (const std::exception& e) {
-            const QString message = QString::fromStdString(e.what());
-            QMetaObject::invokeMethod(this, [this, message, generation] {
-                if (generation != aoGeneration_) return;
+            job.post([this, message = QString::fromStdString(e.what())] {
                 aoRunning_.reset();
                 aoProgress_->setVisible(false);
                 aoStatus_->setText("Not computed: " + message);
-            }, Qt::QueuedConnection);
+            });
             return;
         }
         if (field.empty()) return;  // cancelled
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         auto result = std::make_shared<std::vector<float>>(std::move(field));
-        QMetaObject::invokeMethod(this, [this, result, settings, seconds, generation] {
-            if (generation != aoGeneration_ || !renderer_) return;
+        job.post([this, result, settings, seconds] {
+            if (!renderer_) return;
             renderer_->setAmbientOcclusion(settings, *result);
             aoRunning_.reset();
             aoProgress_->setVisible(false);
@@ -1067,44 +1100,40 @@ void MainWindow::updateAmbientOcclusion() {
                                    .arg(QLocale().toString(qulonglong(result->size())))
                                    .arg(seconds, 0, 'f', 2));
             viewport_->requestUpdate();
-        }, Qt::QueuedConnection);
+        });
     });
 }
 
 void MainWindow::schedulePreview() { previewTimer_.start(); }
 
 void MainWindow::startPreview() {
-    previewCancel_ = true;
-    if (previewWorker_.joinable()) previewWorker_.join();
-    previewCancel_ = false;
     ++previewsStarted_;
-    const unsigned generation = ++previewGeneration_;
     const Project project = doc_->project();
     auto terrain = doc_->terrainShared();
-    previewWorker_ = std::thread([this, project, terrain, generation] {
+    previewJob_.start([this, project, terrain](const LatestJob::Context& job) {
         try {
-            auto preview = std::make_shared<PreviewBake>(previewBake(project, terrain->heightfield, &previewCancel_));
-            QMetaObject::invokeMethod(this, [this, preview, generation] {
-                if (generation != previewGeneration_ || !renderer_) return;
+            auto preview = std::make_shared<PreviewBake>(previewBake(project, terrain->heightfield, job.cancelFlag()));
+            job.post([this, preview] {
+                if (!renderer_) return;
                 renderer_->setProbes(preview->volumes);
                 renderer_->setReflectionProbes(preview->reflections);
                 probeSource_ = "draft preview";
                 reflectionPanel_->setProbes(preview->reflections, probeSource_);
                 viewport_->renderNow();
                 updateStatus();
-            }, Qt::QueuedConnection);
+            });
         } catch (const PlacementError&) {
             // Settings the bake would refuse (the Probe Volumes dock says why): light with
             // nothing rather than with the probes of settings that are gone.
-            QMetaObject::invokeMethod(this, [this, generation] {
-                if (generation != previewGeneration_ || !renderer_) return;
+            job.post([this] {
+                if (!renderer_) return;
                 renderer_->setProbes({});
                 renderer_->setReflectionProbes(nullptr);
                 probeSource_ = "no preview: placement failed";
                 reflectionPanel_->setProbes(nullptr, probeSource_);
                 viewport_->renderNow();
                 updateStatus();
-            }, Qt::QueuedConnection);
+            });
         } catch (const std::exception&) {
             // Cancelled by a newer edit.
         }

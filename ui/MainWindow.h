@@ -7,11 +7,13 @@
 #include <optional>
 #include <thread>
 
+#include <QDockWidget>
 #include <QMainWindow>
 #include <QTimer>
 #include <QVulkanInstance>
 
 #include "BakeController.h"
+#include "LatestJob.h"
 #include "ProjectDocument.h"
 #include "ProjectRenderer.h"
 #include "ViewportWindow.h"
@@ -27,6 +29,7 @@ class QCheckBox;
 
 namespace terralux {
 
+class ParameterForm;
 class ProbeVolumesPanel;
 class WaterPanel;
 class ReflectionPanel;
@@ -78,7 +81,31 @@ protected:
 
 private:
     void buildMenus();
-    void buildDocks();
+    void buildDocks();  // the docks below, tabbed, then the toolbar and the status bar
+    QDockWidget* buildTerrainDock();
+    QDockWidget* buildSunSkyDock();
+    QDockWidget* buildShadowsDock();
+    QDockWidget* buildAtmosphereDock();
+    QDockWidget* buildSurfaceDock();
+    QDockWidget* buildAoDock();
+    QDockWidget* buildWaterDock();
+    QDockWidget* buildReflectionDock();
+    QDockWidget* buildLpvDock();
+    QDockWidget* buildVolumesDock();
+    QDockWidget* buildBakeDock();
+    QDockWidget* buildTradeoffDock();
+    void buildViewportToolbar();
+    void buildStatusBar();
+    // `w` scrolled in a dock on the right, titled `title`, named `name`.
+    QDockWidget* addDock(const QString& title, const QString& name, QWidget* w);
+    // A form of the rows of one dock of the parameter table (parameterDock), in table order.
+    ParameterForm* dockForm(const std::string& dockName);
+    // A panel's rejected edits go to the status bar.
+    template <class Panel>
+    void reportRejections(Panel* panel) {
+        connect(panel, &Panel::rejected, this, &MainWindow::showRejection);
+    }
+    void showRejection(const QString& message);
     void showError(const QString& title, const QString& message);
     bool maybeSave();
     // File > Save (as = false: only asks for a name when untitled) and Save As.
@@ -139,16 +166,12 @@ private:
     std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;
     QTimer previewTimer_, autosaveTimer_;
-    std::thread previewWorker_;
-    std::thread aoWorker_;
-    std::atomic<bool> aoCancel_{false};
-    unsigned aoGeneration_ = 0;
+    LatestJob previewJob_{this};  // the draft preview bake
+    LatestJob aoJob_{this};       // the horizon AO
     std::optional<HorizonAoSettings> aoRunning_;  // the settings the worker computes
     QProgressBar* aoProgress_ = nullptr;
     QLabel* aoStatus_ = nullptr;
     QLabel* albedoStatus_ = nullptr;
-    std::atomic<bool> previewCancel_{false};
-    unsigned previewGeneration_ = 0;
     unsigned previewsStarted_ = 0;
     QString probeSource_;
 };

@@ -241,9 +241,7 @@ bool ProjectDocument::setAssignments(const std::vector<std::string>& assignments
     return setParameters(values, error);
 }
 
-ProjectDocument::~ProjectDocument() {
-    if (loader_.joinable()) loader_.join();
-}
+ProjectDocument::~ProjectDocument() = default;  // the loader waits for its import
 
 void ProjectDocument::startTerrainEdit(const std::string& path, nlohmann::json before,
                                        nlohmann::json after, Project candidate) {
@@ -255,10 +253,10 @@ void ProjectDocument::startTerrainEdit(const std::string& path, nlohmann::json b
 
 void ProjectDocument::startTerrainLoad(Project candidate,
                                        std::function<void(std::shared_ptr<DemImportResult>)> land) {
-    if (loader_.joinable()) loader_.join();  // an earlier import's result is superseded
-    const unsigned generation = ++loadGeneration_;
+    // An earlier import's result is superseded (an import is not cancelled: it is waited for).
+    loading_ = true;
     emit terrainLoadingChanged(true);
-    loader_ = std::thread([this, generation, candidate = std::move(candidate), land = std::move(land)] {
+    loader_.start([this, candidate = std::move(candidate), land = std::move(land)](const LatestJob::Context& job) {
         std::shared_ptr<DemImportResult> terrain;
         QString error;
         try {
@@ -266,16 +264,15 @@ void ProjectDocument::startTerrainLoad(Project candidate,
         } catch (const std::exception& e) {
             error = QString::fromStdString(e.what());
         }
-        QMetaObject::invokeMethod(this, [this, generation, terrain, error, land] {
-            if (generation != loadGeneration_) return;  // a newer load is under way
-            landedGeneration_ = generation;
+        job.post([this, terrain, error, land] {
+            loading_ = false;
             emit terrainLoadingChanged(false);
             if (!terrain) {
                 emit terrainEditFailed(error);
                 return;
             }
             land(terrain);
-        }, Qt::QueuedConnection);
+        });
     });
 }
 

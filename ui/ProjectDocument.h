@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "DemImport.h"
+#include "LatestJob.h"
 #include "Project.h"
 #include "scene/ShadowCascades.h"
 
@@ -53,7 +54,7 @@ public:
     // Throws ProjectError on a bad assignment.
     static std::pair<std::string, nlohmann::json> assignmentValue(const nlohmann::json& base,
                                                                    const std::string& assignment);
-    bool terrainLoading() const { return loadGeneration_ != landedGeneration_; }
+    bool terrainLoading() const { return loading_; }
     // Blocks (processing events) until no terrain import is running; for tests and shutdown.
     void waitForTerrain();
     // Camera moves from the viewport: stored, marked as unsaved, not undoable (like a view).
@@ -116,8 +117,8 @@ private:
     QUndoStack undo_;
     bool dirtyOutsideUndo_ = false;
     double viewAspect_ = 16.0 / 9.0;
-    std::thread loader_;
-    unsigned loadGeneration_ = 0, landedGeneration_ = 0;
+    LatestJob loader_{this};  // the terrain import
+    bool loading_ = false;    // an import has started whose terrain has not landed
 };
 
 }  // namespace terralux

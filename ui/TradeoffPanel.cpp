@@ -131,16 +131,11 @@ TradeoffPanel::TradeoffPanel(ProjectDocument* doc, QWidget* parent) : QWidget(pa
     });
 }
 
-TradeoffPanel::~TradeoffPanel() {
-    cancelFlag_ = true;
-    if (worker_.joinable()) worker_.join();
-}
+TradeoffPanel::~TradeoffPanel() = default;  // the study's job cancels and waits
 
 void TradeoffPanel::start() {
     if (running_) return;
-    if (worker_.joinable()) worker_.join();
     running_ = true;
-    cancelFlag_ = false;
     note_.clear();
     noteIsError_ = false;
     run_->setEnabled(false);
@@ -154,50 +149,50 @@ void TradeoffPanel::start() {
     const Project project = doc_->project();
     StudyOptions options;
     options.budgetSeconds = budget_->value();
-    worker_ = std::thread([this, project, options] {
-        auto onProgress = [this](const std::string& phase, double f) {
-            QMetaObject::invokeMethod(this, [this, f, p = QString::fromStdString(phase)] {
+    job_.start([this, project, options](const LatestJob::Context& job) {
+        auto onProgress = [this, &job](const std::string& phase, double f) {
+            job.post([this, f, p = QString::fromStdString(phase)] {
                 if (!running_) return;
                 progress_->setValue(int(std::lround(std::clamp(f, 0.0, 1.0) * 100.0)));
                 progress_->setFormat(p + " %p%");
-            }, Qt::QueuedConnection);
+            });
         };
         try {
-            StudyResult r = runStudy(project, options, onProgress, &cancelFlag_);
-            QMetaObject::invokeMethod(this, [this, r = std::move(r)]() mutable {
-                result_ = std::move(r);
+            auto r = std::make_shared<StudyResult>(runStudy(project, options, onProgress, job.cancelFlag()));
+            job.post([this, r] {
+                result_ = std::move(*r);
                 studied_ = startedJson_;
                 setIdle();
                 showResult();
                 emit finished();
-            }, Qt::QueuedConnection);
+            });
         } catch (const BakeCancelled&) {
-            QMetaObject::invokeMethod(this, [this] {
+            job.post([this] {
                 setIdle();
                 note_ = result_ ? "Cancelled: the last study is still shown." : "Cancelled.";
                 updateStatus();
                 emit finished();
-            }, Qt::QueuedConnection);
+            });
         } catch (const std::exception& e) {
-            QMetaObject::invokeMethod(this, [this, m = QString::fromStdString(e.what())] {
+            job.post([this, m = QString::fromStdString(e.what())] {
                 setIdle();
                 fail("Study failed: " + m);
                 emit finished();
-            }, Qt::QueuedConnection);
+            });
         }
     });
 }
 
 void TradeoffPanel::cancel() {
     if (!running_) return;
-    cancelFlag_ = true;
+    job_.cancel();
     cancel_->setEnabled(false);
     progress_->setFormat("cancelling…");
 }
 
 void TradeoffPanel::setIdle() {
     running_ = false;
-    if (worker_.joinable()) worker_.join();  // it has handed over its result and is ending
+    job_.wait();  // it has handed over its result and is ending
     run_->setEnabled(true);
     cancel_->setEnabled(false);
     budget_->setEnabled(true);

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "LatestJob.h"
 #include "Study.h"
 #include "StudyChart.h"
 
@@ -84,8 +85,7 @@ private:
     QString note_;                    // what happened last (cancelled, failed, refused)
     bool noteIsError_ = false;
 
-    std::thread worker_;
-    std::atomic<bool> cancelFlag_{false};
+    LatestJob job_{this};  // the study
     bool running_ = false;
 };
 

@@ -84,8 +84,7 @@ void ViewportWindow::updateSize() {
 }
 
 void ViewportWindow::stopLpv() {
-    ++lpvGeneration_;
-    if (lpvWorker_.joinable()) lpvWorker_.join();
+    lpvJob_.stop();
     lpvBusy_ = false;
     lpvSchedule_.reset();
 }
@@ -108,10 +107,9 @@ void ViewportWindow::scheduleLpv() {
         if (lpvSchedule_.pending() && !lpvBusy_) requestUpdate();
         return;
     }
-    if (lpvWorker_.joinable()) lpvWorker_.join();  // finished: its result has landed
     lpvBusy_ = true;
-    const unsigned generation = lpvGeneration_;
-    lpvWorker_ = std::thread([this, job = std::move(*job), generation] {
+    // The one before has finished: its result has landed.
+    lpvJob_.start([this, job = std::move(*job)](const LatestJob::Context& context) {
         const auto start = std::chrono::steady_clock::now();
         std::shared_ptr<const lpv::Volumes> volumes;
         try {
@@ -120,14 +118,13 @@ void ViewportWindow::scheduleLpv() {
             // Settings the volumes refuse draw none; the next change tries again.
         }
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        QMetaObject::invokeMethod(this, [this, volumes, key = job.key, generation, ms] {
-            if (generation != lpvGeneration_) return;
+        context.post([this, volumes, key = job.key, ms] {
             lpvBusy_ = false;
             if (!renderer_) return;
             renderer_->setLpv(volumes, key);
             emit lpvUpdated(ms);
             requestUpdate();
-        }, Qt::QueuedConnection);
+        });
     });
 }
 

@@ -12,6 +12,7 @@
 
 #include <QWindow>
 
+#include "LatestJob.h"
 #include "ProjectRenderer.h"
 #include "lpv/UpdateSchedule.h"
 #include "scene/OrbitCamera.h"
@@ -88,9 +89,8 @@ private:
     QPointF lastMouse_, pressedAt_;
     bool dragged_ = false;
     lpv::UpdateSchedule lpvSchedule_;
-    std::thread lpvWorker_;
+    LatestJob lpvJob_{this};
     bool lpvBusy_ = false;  // UI thread only: set when a worker starts, cleared when its result lands
-    unsigned lpvGeneration_ = 0;  // a result of an older generation (another renderer) is dropped
 };
 
 }  // namespace terralux

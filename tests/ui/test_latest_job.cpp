@@ -1,0 +1,93 @@
+// LatestJob, the "latest job wins" worker every panel uses: a superseded job's result never
+// lands, stop() drops what is queued, cancel reaches the running job, and posts land in order on
+// the owner's thread.
+#include <atomic>
+#include <chrono>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <QCoreApplication>
+#include <QObject>
+
+#include "LatestJob.h"
+
+using namespace terralux;
+
+namespace {
+
+QCoreApplication& app() {
+    static int argc = 1;
+    static char name[] = "test_latest_job";
+    static char* argv[] = {name, nullptr};
+    static QCoreApplication a(argc, argv);
+    return a;
+}
+
+// Runs the owner's event loop until `done` or two seconds pass.
+template <class F>
+void pump(F done) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    while (!done() && std::chrono::steady_clock::now() < until) {
+        QCoreApplication::processEvents(QEventLoop::AllEvents, 10);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    QCoreApplication::processEvents();
+}
+
+}  // namespace
+
+TEST(LatestJob, ASupersededJobsResultNeverLands) {
+    app();
+    QObject owner;
+    std::vector<int> landed;
+    {
+        LatestJob job(&owner);
+        // The first job posts its result; it is queued, not yet run, when the second starts.
+        job.start([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(1); }); });
+        job.wait();
+        job.start([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(2); }); });
+        job.wait();
+        pump([&] { return !landed.empty(); });
+    }
+    EXPECT_EQ(landed, std::vector<int>{2});
+}
+
+TEST(LatestJob, StopDropsWhatIsQueuedAndCancelReachesTheJob) {
+    app();
+    QObject owner;
+    std::vector<int> landed;
+    std::atomic<bool> sawCancel{false};
+    LatestJob job(&owner);
+    job.start([&](const LatestJob::Context& c) {
+        c.post([&] { landed.push_back(1); });
+        while (!c.cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        sawCancel = c.cancelFlag()->load();
+        c.post([&] { landed.push_back(2); });
+    });
+    job.stop();
+    pump([] { return false; });
+    EXPECT_TRUE(sawCancel);
+    EXPECT_TRUE(landed.empty());
+    // After a stop a new job's posts land, in order.
+    job.start([&](const LatestJob::Context& c) {
+        for (int i = 3; i < 6; ++i) c.post([&, i] { landed.push_back(i); });
+    });
+    pump([&] { return landed.size() == 3; });
+    EXPECT_EQ(landed, (std::vector<int>{3, 4, 5}));
+}
+
+TEST(LatestJob, CancelLetsTheJobReportItself) {
+    app();
+    QObject owner;
+    std::vector<int> landed;
+    LatestJob job(&owner);
+    job.start([&](const LatestJob::Context& c) {
+        while (!c.cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        c.post([&] { landed.push_back(7); });  // "cancelled", as the bake and the study say
+    });
+    job.cancel();
+    pump([&] { return !landed.empty(); });
+    EXPECT_EQ(landed, std::vector<int>{7});
+}
