@@ -1,5 +1,5 @@
 // Gerstner waves over the water plane (docs/lighting.md, "Water"); the C++ twin is
-// renderer/water/Water.cpp. Include after blocks/water.h, blocks/surface.h and sh.glsl (PI).
+// renderer/water/Water.cpp, held to this one by tests/render/test_shader_math.cpp. Include after blocks/water.h, blocks/surface.h and sh.glsl (PI).
 #ifndef TLX_WATER_GLSL
 #define TLX_WATER_GLSL
 

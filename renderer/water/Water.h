@@ -1,7 +1,7 @@
 #pragma once
 // Water: Gerstner waves and their dispersion, the steepness rule, the level "auto" stands for,
 // and the distance to shore (docs/lighting.md, "Water"). The viewport's shaders (water.glsl)
-// evaluate the same waves; the tests hold the two to each other through these functions.
+// evaluate the same waves in float; tests/render/test_shader_math.cpp holds gerstner() to them.
 
 #include <cstddef>
 #include <optional>

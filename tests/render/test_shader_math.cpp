@@ -14,14 +14,17 @@
 
 #include "ShaderMath.h"
 #include "bake/SphericalHarmonics.h"
+#include "render/features/Packing.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
 #include "vk/Descriptors.h"
 #include "vk/PipelineLayout.h"
 #include "vk/VulkanContext.h"
+#include "water/Water.h"
 
 namespace terralux::shaders {
 std::span<const uint32_t> shaderMathComp();  // tests/render/shader_math.comp
+std::span<const uint32_t> waterWavesComp();  // tests/render/water_waves.comp
 }
 
 using namespace terralux;
@@ -149,4 +152,92 @@ TEST(ShaderMath, TheDisplayCurveInvertsWhereItIsNotClamped) {
         EXPECT_NEAR(glsl::acesFitInverse(y), x, 1e-4f * std::max(1.0f, x)) << x;
         EXPECT_NEAR(glsl::srgbDecode(glsl::srgbEncode(y)), y, 1e-6f) << y;
     }
+}
+
+// The water shaders' Gerstner waves (water.glsl, through the block packWater writes) against
+// water::gerstner, the CPU's double-precision evaluation: displacement and normal at rest points
+// over a kilometre, in deep water and with the depth-aware dispersion, with the shore fade.
+TEST(ShaderMath, TheWaterShadersWavesAreTheCpusWaves) {
+    std::unique_ptr<vk::VulkanContext> ctx;
+    try {
+        vk::ContextOptions o;
+        o.validation = true;
+        ctx = std::make_unique<vk::VulkanContext>(o);
+    } catch (const vk::VulkanUnavailable& e) {
+        GTEST_SKIP() << "no Vulkan: " << e.what();
+    }
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<glm::vec4> points;
+    for (int i = 0; i < 256; ++i)
+        points.emplace_back(u(rng) * 1000.0f - 500.0f, u(rng) * 1000.0f - 500.0f, 0.3f + u(rng) * 40.0f, u(rng));
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    const vk::Buffer input = vk::Buffer::deviceLocal(*ctx, points.data(), points.size() * sizeof(glm::vec4),
+                                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::Buffer output = vk::Buffer::hostReadable(*ctx, points.size() * 2 * sizeof(glm::vec4),
+                                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::Buffer block = vk::Buffer::hostVisible(*ctx, sizeof(blocks::WaterBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    const vk::DescriptorSet set = vk::DescriptorSetBuilder()
+                                      .uniform(0, "water", block, compute)
+                                      .storage(5, "points", input, compute)
+                                      .storage(6, "results", output, compute)
+                                      .build(*ctx);
+    const vk::UniqueSetLayout empty = vk::DescriptorSetBuilder().buildLayout(*ctx);
+    const VkDescriptorSetLayout layouts[] = {empty.get(), empty.get(), set.layout()};
+    const vk::PipelineLayout layout(*ctx, layouts, sizeof(glm::ivec4), compute);
+    const vk::UniquePipeline pipeline = vk::createComputePipeline(*ctx, layout.handle(), shaders::waterWavesComp());
+
+    RenderSettings s;
+    s.water.enabled = true;
+    // The open sea's eight waves (the most a scene holds), the last one given by amplitude.
+    s.water.waves = water::wavePreset("open sea");
+    ASSERT_EQ(s.water.waves.size(), size_t(WaterSettings::kMaxWaves));
+    s.water.waves.back() = GerstnerWave{200.0, 3.0, 0.05, std::nullopt, 0.7};
+    ASSERT_EQ(water::checkWaves(s.water.waves), "");
+    double amplitudes = 0.0;
+    std::vector<water::WaveTerms> terms;
+    for (const GerstnerWave& w : s.water.waves) {
+        terms.push_back(water::waveTerms(w));
+        amplitudes += terms.back().amplitude;
+    }
+    for (const bool depthAware : {false, true}) {
+        s.water.depthAware = depthAware;
+        s.time = 37.25;
+        features::WaterInputs in;
+        in.level = 0.0f;
+        const blocks::WaterBlock packed = features::packWater(s, in);
+        block.write(&packed, sizeof packed);
+        const glm::ivec4 push(int(points.size()), 0, 0, 0);
+        ctx->submitAndWait([&](VkCommandBuffer cb) {
+            VkMemoryBarrier toShader{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                     VK_ACCESS_SHADER_READ_BIT};
+            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                                 &toShader, 0, nullptr, 0, nullptr);
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
+            const VkDescriptorSet handle = set.handle();
+            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), TLX_SET_SUBSYSTEM, 1, &handle,
+                                    0, nullptr);
+            vkCmdPushConstants(cb, layout.handle(), compute, 0, sizeof push, &push);
+            vkCmdDispatch(cb, uint32_t(points.size() + 63) / 64, 1, 1);
+            VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT,
+                                   VK_ACCESS_HOST_READ_BIT};
+            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
+                                 0, nullptr, 0, nullptr);
+        });
+        const auto* gpu = static_cast<const glm::vec4*>(output.map());
+        double worstDisplacement = 0.0, worstNormal = 0.0;
+        for (size_t i = 0; i < points.size(); ++i) {
+            const glm::vec4 p = points[i];
+            const water::SurfacePoint cpu =
+                water::gerstner(terms, {p.x, p.y}, s.time, depthAware ? std::optional<double>(p.z) : std::nullopt, p.w);
+            worstDisplacement = std::max(worstDisplacement, glm::length(cpu.displacement - glm::dvec3(gpu[2 * i])));
+            worstNormal = std::max(worstNormal, glm::length(cpu.normal - glm::dvec3(gpu[2 * i + 1])));
+        }
+        // Float phases of up to a thousand radians carry about 1e-4 rad: a thousandth of the
+        // summed amplitude holds them, and a convention that differs (a sign, an axis, the
+        // azimuth) is off by the amplitude itself.
+        EXPECT_LT(worstDisplacement, 1e-3 * amplitudes) << (depthAware ? "depth-aware" : "deep");
+        EXPECT_LT(worstNormal, 1e-3) << (depthAware ? "depth-aware" : "deep");
+    }
+    EXPECT_EQ(ctx->validationMessageCount(), 0u);
 }
