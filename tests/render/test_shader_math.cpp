@@ -73,17 +73,46 @@ const char* kNames[kOutputs] = {"acesFit", "srgbEncode", "srgbDecode", "acesFitI
                                 "Y3", "Y4", "Y5", "Y6", "Y7", "Y8", "fogOpticalDepth", "henyeyGreenstein",
                                 "display"};
 
-}  // namespace
-
-TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
-    std::unique_ptr<vk::VulkanContext> ctx;
+// A device with validation, or none (the test skips).
+std::unique_ptr<vk::VulkanContext> device(std::string& why) {
     try {
         vk::ContextOptions o;
         o.validation = true;
-        ctx = std::make_unique<vk::VulkanContext>(o);
+        return std::make_unique<vk::VulkanContext>(o);
     } catch (const vk::VulkanUnavailable& e) {
-        GTEST_SKIP() << "no Vulkan: " << e.what();
+        why = e.what();
+        return nullptr;
     }
+}
+
+// One compute dispatch of `count` invocations (64 a group) with `set` bound at `setIndex`, after
+// the uploads and before the host reads the results; waits for it.
+void dispatch(const vk::VulkanContext& ctx, VkPipeline pipeline, const vk::PipelineLayout& layout,
+              const vk::DescriptorSet& set, uint32_t setIndex, size_t count) {
+    const glm::ivec4 push(int(count), 0, 0, 0);
+    ctx.submitAndWait([&](VkCommandBuffer cb) {
+        VkMemoryBarrier toShader{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                 VK_ACCESS_SHADER_READ_BIT};
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                             &toShader, 0, nullptr, 0, nullptr);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+        const VkDescriptorSet handle = set.handle();
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), setIndex, 1, &handle, 0, nullptr);
+        vkCmdPushConstants(cb, layout.handle(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatch(cb, uint32_t(count + 63) / 64, 1, 1);
+        VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT,
+                               VK_ACCESS_HOST_READ_BIT};
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0,
+                             nullptr, 0, nullptr);
+    });
+}
+
+}  // namespace
+
+TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
+    std::string why;
+    const std::unique_ptr<vk::VulkanContext> ctx = device(why);
+    if (!ctx) GTEST_SKIP() << "no Vulkan: " << why;
     const std::vector<Sample> in = samples();
     constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
     const vk::Buffer inputs = vk::Buffer::deviceLocal(*ctx, in.data(), in.size() * sizeof(Sample),
@@ -97,22 +126,7 @@ TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
     const VkDescriptorSetLayout layouts[] = {set.layout()};
     const vk::PipelineLayout layout(*ctx, layouts, sizeof(glm::ivec4), compute);
     const vk::UniquePipeline pipeline = vk::createComputePipeline(*ctx, layout.handle(), shaders::shaderMathComp());
-    const glm::ivec4 push(int(in.size()), 0, 0, 0);
-    ctx->submitAndWait([&](VkCommandBuffer cb) {
-        VkMemoryBarrier toShader{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                 VK_ACCESS_SHADER_READ_BIT};
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                             &toShader, 0, nullptr, 0, nullptr);
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
-        const VkDescriptorSet handle = set.handle();
-        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), 0, 1, &handle, 0, nullptr);
-        vkCmdPushConstants(cb, layout.handle(), compute, 0, sizeof push, &push);
-        vkCmdDispatch(cb, uint32_t(in.size() + 63) / 64, 1, 1);
-        VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT,
-                               VK_ACCESS_HOST_READ_BIT};
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0,
-                             nullptr, 0, nullptr);
-    });
+    dispatch(*ctx, pipeline.get(), layout, set, 0, in.size());
     const auto* gpu = static_cast<const float*>(outputs.map());
     // Bounds relative to the value (to 0.1 near zero). Arithmetic alone agrees to an ulp or two
     // (a fused multiply-add here or there): 2.5e-7, which a constant copied to six digits fails
@@ -158,14 +172,9 @@ TEST(ShaderMath, TheDisplayCurveInvertsWhereItIsNotClamped) {
 // water::gerstner, the CPU's double-precision evaluation: displacement and normal at rest points
 // over a kilometre, in deep water and with the depth-aware dispersion, with the shore fade.
 TEST(ShaderMath, TheWaterShadersWavesAreTheCpusWaves) {
-    std::unique_ptr<vk::VulkanContext> ctx;
-    try {
-        vk::ContextOptions o;
-        o.validation = true;
-        ctx = std::make_unique<vk::VulkanContext>(o);
-    } catch (const vk::VulkanUnavailable& e) {
-        GTEST_SKIP() << "no Vulkan: " << e.what();
-    }
+    std::string why;
+    const std::unique_ptr<vk::VulkanContext> ctx = device(why);
+    if (!ctx) GTEST_SKIP() << "no Vulkan: " << why;
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::vector<glm::vec4> points;
@@ -207,23 +216,7 @@ TEST(ShaderMath, TheWaterShadersWavesAreTheCpusWaves) {
         in.level = 0.0f;
         const blocks::WaterBlock packed = features::packWater(s, in);
         block.write(&packed, sizeof packed);
-        const glm::ivec4 push(int(points.size()), 0, 0, 0);
-        ctx->submitAndWait([&](VkCommandBuffer cb) {
-            VkMemoryBarrier toShader{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                     VK_ACCESS_SHADER_READ_BIT};
-            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
-                                 &toShader, 0, nullptr, 0, nullptr);
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.get());
-            const VkDescriptorSet handle = set.handle();
-            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), TLX_SET_SUBSYSTEM, 1, &handle,
-                                    0, nullptr);
-            vkCmdPushConstants(cb, layout.handle(), compute, 0, sizeof push, &push);
-            vkCmdDispatch(cb, uint32_t(points.size() + 63) / 64, 1, 1);
-            VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER, nullptr, VK_ACCESS_SHADER_WRITE_BIT,
-                                   VK_ACCESS_HOST_READ_BIT};
-            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost,
-                                 0, nullptr, 0, nullptr);
-        });
+        dispatch(*ctx, pipeline.get(), layout, set, TLX_SET_SUBSYSTEM, points.size());
         const auto* gpu = static_cast<const glm::vec4*>(output.map());
         double worstDisplacement = 0.0, worstNormal = 0.0;
         for (size_t i = 0; i < points.size(); ++i) {
