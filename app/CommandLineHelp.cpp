@@ -277,7 +277,7 @@ std::string manualPage(const CommandLineHelp& h, const std::string& version, con
         if (!r.allowed.empty()) facts += "Allowed: " + r.allowed + ". ";
         if (!r.unit.empty()) facts += "Unit: " + r.unit + ". ";
         if (!r.autoMeaning.empty()) facts += "null: " + r.autoMeaning + ". ";
-        facts += "An edit redoes: " + r.edit + ". The bake " + r.bake + " it.";
+        facts += "An edit redoes: " + r.edit + ". Bake: " + r.bake + ".";
         m << ".br\n" << roff(facts) << "\n";
     }
     if (h.program == "terralux") {
