@@ -12,7 +12,7 @@ const bool kFog = kFogEnabled != 0;
 // Transmittance from the camera to a point `distance` metres along the unit view ray `dir`.
 float fogTransmittance(vec3 dir, float distance) {
     if (!kFog) return 1.0;
-    float depth = fogOpticalDepth(atmosphere.fog.x, atmosphere.fog.y, camera.position.y - atmosphere.fog.z,
+    float depth = fogOpticalDepth(atmosphere.fogDensity, atmosphere.fogFalloff, camera.position.y - atmosphere.fogBase,
                                   dir.y, distance);
     return exp(-depth);
 }
@@ -21,9 +21,9 @@ float fogTransmittance(vec3 dir, float distance) {
 // radiance, plus the sun through the Henyey–Greenstein phase (single scattering, albedo 1, the
 // sun unshadowed inside the fog).
 vec3 fogInscatter(vec3 dir, float t) {
-    float cosTheta = dot(dir, normalize(sunSky.sunDirection.xyz));
-    vec3 sun = sunSky.sunIlluminance.rgb * atmosphere.fogColor.w * henyeyGreenstein(atmosphere.fog.w, cosTheta);
-    return (1.0 - t) * (atmosphere.fogColor.rgb + sun);
+    float cosTheta = dot(dir, normalize(sunSky.sunDirection));
+    vec3 sun = sunSky.sunIlluminance * atmosphere.sunInscatter * henyeyGreenstein(atmosphere.fogAnisotropy, cosTheta);
+    return (1.0 - t) * (atmosphere.fogColor + sun);
 }
 
 // Scene-linear light of a point seen through the fog.

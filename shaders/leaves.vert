@@ -17,18 +17,18 @@ void main() {
     int corner = ends[gl_VertexIndex % 24];
     vec3 offset = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
     gl_Position = camera.viewProj * vec4(inLeaf.xyz + inLeaf.w * offset, 1.0);
-    // Level of detail: a leaf narrower than overlay.leaves.y pixels on screen is left out, so a whole terrain
+    // Level of detail: a leaf narrower than overlay.smallestLeafPixels pixels on screen is left out, so a whole terrain
     // shows its coarse leaves and zooming in reveals the fine ones.
     vec3 centre = inLeaf.xyz + 0.5 * inLeaf.w;
     vec4 c = camera.viewProj * vec4(centre, 1.0);
     vec4 cx = camera.viewProj * vec4(centre + vec3(inLeaf.w, 0.0, 0.0), 1.0);
     vec4 cz = camera.viewProj * vec4(centre + vec3(0.0, 0.0, inLeaf.w), 1.0);
     if (c.w > 0.0 && cx.w > 0.0 && cz.w > 0.0) {
-        vec2 halfSize = 0.5 * camera.viewport.xy;
+        vec2 halfSize = 0.5 * camera.viewportSize;
         vec2 p = c.xy / c.w * halfSize;
         float pixels = max(length(cx.xy / cx.w * halfSize - p), length(cz.xy / cz.w * halfSize - p));
-        if (pixels < overlay.leaves.y) gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
+        if (pixels < overlay.smallestLeafPixels) gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
     }
-    float level = log2(max(inLeaf.w / max(overlay.leaves.x, 1e-6), 1.0));
+    float level = log2(max(inLeaf.w / max(overlay.smallestLeaf, 1e-6), 1.0));
     color = mix(vec3(1.0, 0.95, 0.6), vec3(0.35, 0.25, 0.9), clamp(level / 5.0, 0.0, 1.0));
 }

@@ -46,13 +46,13 @@ float lpvLuminance(vec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; 
 
 // A cascade's fade weight at p: 1 inside, falling to 0 over the fade range (cells) at its faces.
 float lpvFade(int c, vec3 p) {
-    vec4 cas = lpv.cascades[c];
-    vec3 u = (p - cas.xyz) / cas.w;
+    LpvCascadeRecord cas = lpv.cascades[c];
+    vec3 u = (p - cas.minCorner) / cas.cellSize;
     float dist = float(kLpvGrid);
     dist = min(dist, min(min(u.x, u.y), u.z));
     dist = min(dist, min(min(float(kLpvGrid) - u.x, float(kLpvGrid) - u.y), float(kLpvGrid) - u.z));
     if (!(dist >= 0.0)) return 0.0;
-    float fade = lpv.params.y;
+    float fade = lpv.fadeRange;
     if (fade <= 0.0) return dist > 0.0 ? 1.0 : 0.0;
     return clamp(dist / fade, 0.0, 1.0);
 }
@@ -72,19 +72,19 @@ void lpvRadiance(vec3 p, int last, out vec4 sh[3], out float weight, out float c
     sh[1] = vec4(0.0);
     sh[2] = vec4(0.0);
     float remaining = 1.0, best = 0.0;
-    cellSize = lpv.cascades[0].w;
+    cellSize = lpv.cascades[0].cellSize;
     for (int c = last; c >= 0; --c) {
         float fade = lpvFade(c, p);
         float w = fade * remaining;
         if (w <= 0.0) continue;
-        float h = lpv.cascades[c].w;
+        float h = lpv.cascades[c].cellSize;
         if (w > best) {
             best = w;
             cellSize = h;
         }
         ivec3 i0;
         vec3 t;
-        lpvTrilinear((p - lpv.cascades[c].xyz) / h - 0.5, kLpvGrid, i0, t);
+        lpvTrilinear((p - lpv.cascades[c].minCorner) / h - 0.5, kLpvGrid, i0, t);
         float toRadiance = 1.0 / (h * h);
         int base = c * 3 * kLpvCells;
         for (int k = 0; k < 8; ++k) {
@@ -107,14 +107,14 @@ void lpvRadiance(vec3 p, int last, out vec4 sh[3], out float weight, out float c
 // The cascades' total weight at p and the dominant cell, without reading the volumes.
 float lpvWeight(vec3 p, int last, out float cellSize) {
     float remaining = 1.0, best = 0.0;
-    cellSize = lpv.cascades[0].w;
+    cellSize = lpv.cascades[0].cellSize;
     for (int c = last; c >= 0; --c) {
         float fade = lpvFade(c, p);
         float w = fade * remaining;
         if (w <= 0.0) continue;
         if (w > best) {
             best = w;
-            cellSize = lpv.cascades[c].w;
+            cellSize = lpv.cascades[c].cellSize;
         }
         remaining *= 1.0 - fade;
     }
@@ -128,7 +128,7 @@ float lpvBlendedCell(vec3 p, int last) {
         float fade = lpvFade(c, p);
         float w = fade * remaining;
         if (w <= 0.0) continue;
-        sum += w * lpv.cascades[c].w;
+        sum += w * lpv.cascades[c].cellSize;
         remaining *= 1.0 - fade;
     }
     float total = 1.0 - remaining;
@@ -145,7 +145,7 @@ vec4 lpvGeometryAt(vec3 p, int last) {
         if (w <= 0.0) continue;
         ivec3 i0;
         vec3 t;
-        lpvTrilinear((p - lpv.cascades[c].xyz) / lpv.cascades[c].w, kLpvCorners, i0, t);
+        lpvTrilinear((p - lpv.cascades[c].minCorner) / lpv.cascades[c].cellSize, kLpvCorners, i0, t);
         int base = c * kLpvCornerCount;
         for (int k = 0; k < 8; ++k) {
             ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
@@ -219,7 +219,7 @@ LpvSample lpvEvaluate(vec3 p, vec3 n, vec3 toEye, int quality, int last) {
         vec3 r = reflect(-toEye, n);
         vec3 sum = vec3(0.0);
         float transmit = 1.0;
-        int samples = max(lpv.counts.z, 1);
+        int samples = max(lpv.coneSamples, 1);
         for (int i = 0; i < samples; ++i) {
             vec3 x = q + float(i + 1) * h * r;
             vec4 l[3];
@@ -228,9 +228,9 @@ LpvSample lpvEvaluate(vec3 p, vec3 n, vec3 toEye, int quality, int last) {
             for (int c = 0; c < 3; ++c) sum[c] += transmit * max(0.0, lpvShEvaluate(l[c], -r));
             transmit *= 1.0 - clamp(lpvShEvaluate(lpvGeometryAt(x, last), r), 0.0, 1.0);
         }
-        s.specular = sum / float(samples) * lpv.params.x;
+        s.specular = sum / float(samples) * lpv.indirectIntensity;
     }
-    s.irradiance = e * lpv.params.x;
+    s.irradiance = e * lpv.indirectIntensity;
     return s;
 }
 
@@ -282,12 +282,12 @@ float lpvAmbientOcclusion(vec3 p, vec3 n, int last) {
 // smooth cone falloff (Lpv.cpp lightAttenuation()): the irradiance on a surface facing the light
 // per unit of emitted colour × intensity.
 float localLightAttenuation(LocalLightRecord light, vec3 toSurface, float d) {
-    float ratio = d / light.positionRange.w;
+    float ratio = d / light.range;
     float window = clamp(1.0 - ratio * ratio * ratio * ratio, 0.0, 1.0);
     float dd = max(d, 0.01);
     float att = window / (dd * dd);
-    if (light.emitted.w > 0.5) {
-        float t = clamp((dot(light.direction.xyz, toSurface) - light.cone.x) * light.cone.y, 0.0, 1.0);
+    if (light.spot > 0.5) {
+        float t = clamp((dot(light.direction, toSurface) - light.cosOuter) * light.invConeWidth, 0.0, 1.0);
         att *= t * t;
     }
     return att;
@@ -296,15 +296,15 @@ float localLightAttenuation(LocalLightRecord light, vec3 toSurface, float d) {
 // The local lights' direct light leaving p toward v: Lambert and GGX as for the sun, unshadowed.
 vec3 localLightsDirect(vec3 p, vec3 n, vec3 v, vec3 albedo, float roughness) {
     vec3 sum = vec3(0.0);
-    for (int i = 0; i < lpv.counts.w; ++i) {
+    for (int i = 0; i < lpv.lightCount; ++i) {
         LocalLightRecord light = localLights.l[i];
-        vec3 toLight = light.positionRange.xyz - p;
+        vec3 toLight = light.position - p;
         float d = length(toLight);
-        if (!(d < light.positionRange.w) || d <= 0.0) continue;
+        if (!(d < light.range) || d <= 0.0) continue;
         vec3 l = toLight / d;
         float att = localLightAttenuation(light, -l, d);
         if (att <= 0.0) continue;
-        vec3 e = light.emitted.rgb * att;
+        vec3 e = light.emitted * att;
         sum += albedo / PI * e * max(dot(n, l), 0.0) + ggxSpecular(n, v, l, roughness) * e;
     }
     return sum;

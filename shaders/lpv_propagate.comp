@@ -35,7 +35,7 @@ const float kTwoSqrtPi = 3.5449077018110318;
 
 float shEvaluate(vec4 sh, vec3 d) { return sh.x * kShY00 + kShY1 * (sh.y * d.y + sh.z * d.z + sh.w * d.x); }
 
-int cascades() { return int(propagation.params.y); }
+int cascades() { return int(propagation.cascadeCount); }
 int regionBase(int region) { return region * cascades() * 3 * kCells; }
 int lightIndex(int cascade, int channel, int cell) { return (cascade * 3 + channel) * kCells + cell; }
 int cellIndex(ivec3 c) { return c.x + kGrid * (c.y + kGrid * c.z); }
@@ -85,7 +85,7 @@ void sendScales(int cascade, int cell) {
 void gather(int cascade, int cell) {
     int source = regionBase(push.p.y), destination = regionBase(push.p.z);
     bool first = push.p.y == 0;
-    float weight = propagation.params.x;
+    float weight = propagation.stepWeight;
     ivec3 t = ivec3(cell % kGrid, (cell / kGrid) % kGrid, cell / (kGrid * kGrid));
     vec4 sum[3] = vec4[3](vec4(0.0), vec4(0.0), vec4(0.0));
     for (int n = 0; n < 6; ++n) {

@@ -21,7 +21,7 @@ void main() {
     int i = int(gl_GlobalInvocationID.x);
     if (i >= push.countLast.x) return;
     vec3 p = queries.v[3 * i].xyz, n = queries.v[3 * i + 1].xyz, toEye = queries.v[3 * i + 2].xyz;
-    LpvSample s = lpvEvaluate(p, n, toEye, lpv.counts.y, push.countLast.y);
+    LpvSample s = lpvEvaluate(p, n, toEye, lpv.quality, push.countLast.y);
     results.v[2 * i] = vec4(s.irradiance, lpvAmbientOcclusion(p, n, push.countLast.y));
     results.v[2 * i + 1] = vec4(s.specular, 0.0);
 }

@@ -14,11 +14,11 @@ void main() {
     const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
                                    vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
     vec4 clip = camera.viewProj * vec4(inProbe.xyz, 1.0);
-    clip.xy += corners[gl_VertexIndex % 6] * 3.0 / camera.viewport.xy * 2.0 * clip.w;
+    clip.xy += corners[gl_VertexIndex % 6] * 3.0 / camera.viewportSize * 2.0 * clip.w;
     gl_Position = clip;
     bool reflection = inProbe.w > 2.5;
     bool valid = reflection || (inProbe.w > 0.5 && inProbe.w < 1.5);
-    if (valid ? overlay.markers.x == 0 : overlay.markers.y == 0)
+    if (valid ? overlay.drawValid == 0 : overlay.drawMovedRejected == 0)
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);  // outside the depth range: clipped
     // Valid gold, moved cyan, rejected red; reflection probes violet (apart from all three).
     color = reflection ? vec3(0.70, 0.30, 1.0)

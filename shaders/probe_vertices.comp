@@ -23,10 +23,10 @@ layout(set = TLX_SET_SUBSYSTEM, binding = 6, std430) writeonly buffer ProbeLight
 // Bilinear over the map points around (x, z); uncovered points drop out. known = 0: no value.
 float mapError(ProbeVolumeRecord vol, vec2 xz, out float known) {
     known = 0.0;
-    ivec2 size = vol.errorMap.yz;
+    ivec2 size = ivec2(vol.errorNx, vol.errorNz);
     if (size.x <= 0 || size.y <= 0) return 0.0;
-    if (!(vol.errorGrid.z > 0.0)) return 0.0;
-    vec2 u = (xz - vol.errorGrid.xy) / vol.errorGrid.z;
+    if (!(vol.errorStep > 0.0)) return 0.0;
+    vec2 u = (xz - vec2(vol.errorX0, vol.errorZ0)) / vol.errorStep;
     // Beyond half a step outside the outermost points nothing was measured.
     if (any(lessThan(u, vec2(-0.5))) || any(greaterThan(u, vec2(size) - 0.5))) return 0.0;
     vec2 g = clamp(u, vec2(0.0), vec2(size - 1));
@@ -36,7 +36,7 @@ float mapError(ProbeVolumeRecord vol, vec2 xz, out float known) {
     for (int k = 0; k < 4; ++k) {
         ivec2 o = ivec2(k & 1, k >> 1);
         ivec2 c = min(c0 + o, size - 1);
-        float e = errors.e[vol.errorMap.x + c.x + c.y * size.x];
+        float e = errors.e[vol.firstError + c.x + c.y * size.x];
         vec2 wv = mix(vec2(1.0) - f, f, vec2(o));
         float w = wv.x * wv.y;
         if (e < 0.0 || w <= 0.0) continue;
@@ -50,14 +50,14 @@ float mapError(ProbeVolumeRecord vol, vec2 xz, out float known) {
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= uint(probeSet.counts.y)) return;
+    if (i >= uint(probeSet.vertexCount)) return;
     vec3 p = vec3(vertices.v[6 * i], vertices.v[6 * i + 1], vertices.v[6 * i + 2]);
     vec3 n = normalize(vec3(vertices.v[6 * i + 3], vertices.v[6 * i + 4], vertices.v[6 * i + 5]));
     float weight = 0.0, moved = 0.0, known = 0.0, error = 0.0;
     int volume = -1;
     bool unlit = false;
     vec3 irradiance = probeIrradiance(p, n, weight, moved, volume, unlit);
-    if (volume >= 0 && probeSet.flags.x == 1) error = mapError(volumes.v[volume], p.xz, known);
+    if (volume >= 0 && probeSet.anyErrorMap == 1) error = mapError(volumes.v[volume], p.xz, known);
     probeLight.v[2 * i] = vec4(irradiance, weight);
     probeLight.v[2 * i + 1] = vec4(volume >= 0 ? moved : -1.0, error * known, known, unlit ? 1.0 : 0.0);
 }

@@ -9,7 +9,7 @@ layout(set = TLX_SET_SUBSYSTEM, binding = 2, std430) readonly buffer Cells { int
 layout(set = TLX_SET_SUBSYSTEM, binding = 3, std430) readonly buffer Volumes { ProbeVolumeRecord v[]; } volumes;
 
 int cellIndex(ProbeVolumeRecord vol, ivec3 c) {
-    return vol.occupancy.x + c.x + c.y * vol.dimsProbe.x + c.z * vol.dimsProbe.x * vol.dimsProbe.y;
+    return vol.firstCell + c.x + c.y * vol.dims.x + c.z * vol.dims.x * vol.dims.y;
 }
 
 // Probe irradiance at p: trilinear over the centres of the .shprobe occupancy cells around p
@@ -26,15 +26,15 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
     volume = -1;
     unlit = false;
     bool inBox = false;
-    for (int vi = 0; vi < probeSet.counts.x; ++vi) {
+    for (int vi = 0; vi < probeSet.volumeCount; ++vi) {
         ProbeVolumeRecord vol = volumes.v[vi];
-        vec3 lo = vol.originSpacing.xyz;
-        float h = vol.originSpacing.w;
-        ivec3 dims = vol.dimsProbe.xyz;
+        vec3 lo = vol.origin;
+        float h = vol.spacing;
+        ivec3 dims = vol.dims;
         vec3 hi = lo + h * vec3(dims);
         vec3 q = clamp(p, lo, hi);
         float dist = length(p - q);
-        float fallback = vol.blend.x;
+        float fallback = vol.fallbackBlend;
         float fade = dist <= 0.0 ? 1.0 : (fallback > 0.0 ? clamp(1.0 - dist / fallback, 0.0, 1.0) : 0.0);
         if (fade <= 0.0) continue;
         vec3 g = (q - lo) / h - 0.5;
@@ -53,7 +53,7 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
                 if (probe < 0) continue;
                 vec3 wv = mix(vec3(1.0) - f, f, vec3(o));
                 float w = max(wv.x * wv.y * wv.z, 1e-6);  // a corner on a cell centre still counts
-                int base = (vol.dimsProbe.w + probe) * 9;
+                int base = (vol.firstProbe + probe) * 9;
                 for (int j = 0; j < 9; ++j) blended[j] += w * probes.coeffs[base + j].rgb;
                 moved += w * probes.coeffs[base].w;
                 wsum += w;
@@ -63,7 +63,7 @@ vec3 probeIrradiance(vec3 p, vec3 n, out float weight, out float movedShare, out
                 movedShare = moved / wsum;
                 volume = vi;
                 for (int j = 0; j < 9; ++j) blended[j] /= wsum;
-                return max(shIrradiance(blended, n, vol.occupancy.y == 1) * vol.blend.y, vec3(0.0));
+                return max(shIrradiance(blended, n, vol.preConvolved == 1) * vol.shScale, vec3(0.0));
             }
         }
         inBox = inBox || dist <= 0.0;

@@ -17,19 +17,19 @@ layout(set = TLX_SET_LIGHTS, binding = TLX_REFLECTION_CUBES_BINDING) uniform sam
 // probes' cells, first probe − cell/2 to last probe + cell/2 in x and z), fading linearly to 0 at
 // the fallback blend distance outside it, like a probe volume's fade (probes.glsl).
 float reflectionWeight(vec3 p) {
-    vec2 lo = reflection.origin.xy - 0.5 * reflection.coverage.xy;
-    vec2 hi = reflection.origin.xy + reflection.origin.zw * vec2(reflection.grid.xy - 1) + 0.5 * reflection.coverage.xy;
+    vec2 lo = reflection.origin - 0.5 * reflection.cellSize;
+    vec2 hi = reflection.origin + reflection.spacing * vec2(ivec2(reflection.nx, reflection.nz) - 1) + 0.5 * reflection.cellSize;
     float dist = length(p.xz - clamp(p.xz, lo, hi));
-    float fallback = reflection.coverage.z;
+    float fallback = reflection.blendDistance;
     float fade = dist <= 0.0 ? 1.0 : (fallback > 0.0 ? clamp(1.0 - dist / fallback, 0.0, 1.0) : 0.0);
-    return fade * reflection.coverage.w;
+    return fade * reflection.strength;
 }
 
 // Parallax-corrected lookup direction (Lagarde and Zanuttini, "Local Image-based Lighting With
 // Parallax-corrected Cubemap", SIGGRAPH 2012): where the ray p + t·r leaves the probe's box, as
 // seen from the capture point. From outside the box the probe is read along r itself.
 vec3 boxProjected(ReflectionProbeRecord probe, vec3 p, vec3 r) {
-    vec3 q = p - probe.position.xyz, e = probe.halfExtent.xyz;
+    vec3 q = p - probe.position, e = probe.halfExtent;
     if (any(greaterThan(abs(q), e))) return r;
     // 1/r without infinities: an axis the ray barely moves along exits last.
     vec3 inv = vec3(r.x < 0.0 ? -1.0 : 1.0, r.y < 0.0 ? -1.0 : 1.0, r.z < 0.0 ? -1.0 : 1.0) / max(abs(r), vec3(1e-6));
@@ -43,28 +43,28 @@ vec3 boxProjected(ReflectionProbeRecord probe, vec3 p, vec3 r) {
 // convention), filters bilinearly across face edges too and linearly between the two mips.
 vec3 probeRadiance(int i, vec3 d, float roughness) {
     d = normalize(d);
-    if (reflection.grid.z == 0) {
+    if (reflection.encoding == 0) {
         vec3 d2 = d * d;
         return d2.x * reflectionProbes.p[i].faces[d.x < 0.0 ? 1 : 0].rgb +
                d2.y * reflectionProbes.p[i].faces[d.y < 0.0 ? 3 : 2].rgb +
                d2.z * reflectionProbes.p[i].faces[d.z < 0.0 ? 5 : 4].rgb;
     }
-    float lod = clamp(roughness, 0.0, 1.0) * float(reflection.grid.w - 1);
+    float lod = clamp(roughness, 0.0, 1.0) * float(reflection.mipLevels - 1);
     return textureLod(reflectionCubes, vec4(d, float(i)), lod).rgb;
 }
 
 // Where p lies on the probe lattice, in probes from probe 0 (0 on a one-probe axis).
 vec2 reflectionLattice(vec3 p) {
-    vec2 spacing = reflection.origin.zw;
+    vec2 spacing = reflection.spacing;
     vec2 g = vec2(spacing.x > 0.0 ? (p.x - reflection.origin.x) / spacing.x : 0.0,
                   spacing.y > 0.0 ? (p.z - reflection.origin.y) / spacing.y : 0.0);
-    return clamp(g, vec2(0.0), vec2(reflection.grid.xy - 1));
+    return clamp(g, vec2(0.0), vec2(ivec2(reflection.nx, reflection.nz) - 1));
 }
 
 // The probes' radiance reflected at p along r: bilinear over the 4 probes around p (clamped at
 // the grid's ends), each box-projected on its own.
 vec3 reflectionProbeRadiance(vec3 p, vec3 r, float roughness) {
-    ivec2 n = reflection.grid.xy;
+    ivec2 n = ivec2(reflection.nx, reflection.nz);
     vec2 g = reflectionLattice(p);
     ivec2 i0 = min(ivec2(floor(g)), max(n - 2, ivec2(0)));
     vec2 f = g - vec2(i0);
@@ -84,7 +84,7 @@ vec3 reflectionProbeRadiance(vec3 p, vec3 r, float roughness) {
 // The nearest probe's radiance at p along r (the water's reflection), box-projected.
 vec3 nearestReflectionProbeRadiance(vec3 p, vec3 r, float roughness) {
     ivec2 c = ivec2(floor(reflectionLattice(p) + 0.5));
-    int i = c.y * reflection.grid.x + c.x;
+    int i = c.y * reflection.nx + c.x;
     return probeRadiance(i, boxProjected(reflectionProbes.p[i], p, r), roughness);
 }
 #else

@@ -17,8 +17,8 @@ const float kMaxKernelTexels = 24.0;
 
 // The cascade whose slice holds p (by view depth), -1 beyond the shadow distance.
 int sunCascade(vec3 p) {
-    float d = dot(p - camera.position.xyz, shadow.forward.xyz);
-    for (int i = 0; i < shadow.mode.x; ++i)
+    float d = dot(p - camera.position, shadow.forward);
+    for (int i = 0; i < shadow.cascadeCount; ++i)
         if (d <= shadow.ends[i]) return i;
     return -1;
 }
@@ -41,24 +41,24 @@ vec2 spiralTap(int i, int n, float rotation) {
 // half-width Δ·tan(radius), converted to the cascade's texels.
 float sunShadow(vec3 p, vec3 n) {
     int c = sunCascade(p);
-    if (c < 0) return dot(n, sunSky.sunDirection.xyz) > 0.0 ? 1.0 : 0.0;
-    vec3 l = normalize(sunSky.sunDirection.xyz);
+    if (c < 0) return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0;
+    vec3 l = normalize(sunSky.sunDirection);
     // A surface facing away from the sun does not see it (as the traced visibility has it).
     float ndotl = dot(n, l);
     if (ndotl <= 0.0) return 0.0;
     float texelWorld = shadow.texel[c];
     // Normal offset grows as the surface turns from the sun (slopes facing away need more).
-    vec3 q = p + n * (shadow.bias.y * texelWorld * sqrt(1.0 - ndotl * ndotl)) + l * (shadow.bias.x * texelWorld);
+    vec3 q = p + n * (shadow.normalBias * texelWorld * sqrt(1.0 - ndotl * ndotl)) + l * (shadow.depthBias * texelWorld);
     vec4 lc = shadow.lightViewProj[c] * vec4(q, 1.0);
     vec2 uv = lc.xy * 0.5 + 0.5;
     float z = lc.z;
     float layer = float(c);
-    if (shadow.mode.y == kFilterHard) return texture(shadowCompare, vec4(uv, layer, z));
-    float texelUv = 1.0 / shadow.bias.w;
+    if (shadow.filterMode == kFilterHard) return texture(shadowCompare, vec4(uv, layer, z));
+    float texelUv = 1.0 / shadow.mapResolution;
     float rotation = shadowNoise();
     float radiusTexels = 1.5;
-    if (shadow.mode.y == kFilterPcss) {
-        float tanR = shadow.bias.z;
+    if (shadow.filterMode == kFilterPcss) {
+        float tanR = shadow.tanSunRadius;
         // Blocker search: the widest penumbra comes from a blocker at the map's near plane.
         float searchTexels = clamp(z * shadow.depthRange[c] * tanR / texelWorld, 1.0, kMaxKernelTexels);
         float blockers = 0.0, blockerDepth = 0.0;
@@ -85,14 +85,14 @@ float sunShadow(vec3 p, vec3 n) {
 // Whether p lies within about a pixel of the boundary between two cascades (or of the shadow
 // distance), for the cascade overlay.
 bool nearCascadeBoundary(vec3 p) {
-    float d = dot(p - camera.position.xyz, shadow.forward.xyz);
+    float d = dot(p - camera.position, shadow.forward);
     float w = 1.5 * fwidth(d);
-    for (int i = 0; i < shadow.mode.x; ++i)
+    for (int i = 0; i < shadow.cascadeCount; ++i)
         if (abs(d - shadow.ends[i]) < w) return true;
     return false;
 }
 #else
-float sunShadow(vec3 p, vec3 n) { return dot(n, sunSky.sunDirection.xyz) > 0.0 ? 1.0 : 0.0; }
+float sunShadow(vec3 p, vec3 n) { return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0; }
 int sunCascade(vec3 p) { return -1; }
 bool nearCascadeBoundary(vec3 p) { return false; }
 #endif

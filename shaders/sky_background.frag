@@ -18,13 +18,13 @@ layout(location = 0) out vec4 outColor;
 
 void main() {
     vec4 far = camera.invViewProj * vec4(ndc, 0.0, 1.0);  // reversed Z: depth 0 is the far plane
-    vec3 dir = normalize(far.xyz / far.w - camera.position.xyz);
+    vec3 dir = normalize(far.xyz / far.w - camera.position);
     vec3 radiance = skyRadiance(dir);
     // The sun's disc: its illuminance spread over the disc's solid angle π·r².
-    float r = sunSky.sunDirection.w;
-    vec3 l = normalize(sunSky.sunDirection.xyz);
+    float r = sunSky.sunAngularRadius;
+    vec3 l = normalize(sunSky.sunDirection);
     if (r > 0.0 && dir.y > 0.0 && dot(dir, l) >= cos(r))
-        radiance += sunSky.sunIlluminance.rgb / (PI * r * r);
-    radiance = applyFog(radiance, dir, camera.position.w);
+        radiance += sunSky.sunIlluminance / (PI * r * r);
+    radiance = applyFog(radiance, dir, camera.farPlane);
     outColor = vec4(display(radiance), 1.0);
 }

@@ -8,7 +8,7 @@ layout(set = TLX_SET_VIEW, binding = TLX_SURFACE_ALBEDO_BINDING) uniform sampler
 layout(set = TLX_SET_VIEW, binding = TLX_SURFACE_FILLED_BINDING) uniform sampler2D surfaceFilled;
 
 // Position across the footprint, [0, 1] on each axis inside it.
-vec2 footprintT(vec3 p) { return (p.xz - surface.footprint.xy) * surface.footprint.zw; }
+vec2 footprintT(vec3 p) { return (p.xz - surface.footprintMin) * surface.invFootprintSpan; }
 bool onFootprint(vec2 t) { return all(greaterThanEqual(t, vec2(-1e-4))) && all(lessThanEqual(t, vec2(1.0 + 1e-4))); }
 // Texel centres span the footprint corner to corner (SurfaceMaps.h).
 vec2 surfaceUv(vec2 t, vec2 size) { return (clamp(t, 0.0, 1.0) * (size - 1.0) + 0.5) / size; }
@@ -88,7 +88,7 @@ vec3 reorient(vec3 base, vec3 detailN) {
 // normal (triplanar, so steep faces are not stretched; the RNM-per-plane form of Golus 2017).
 // `amount` in [0, 1] scales the detail's slope: 0 returns the base normal.
 vec3 detailNormal(vec3 n, vec3 p, float amount) {
-    float scale = surface.detail.y, strength = surface.detail.x * amount;
+    float scale = surface.detailScale, strength = surface.detailStrength * amount;
     vec3 an = abs(n);
     vec3 w = an * an;
     w *= w;
@@ -106,16 +106,16 @@ vec3 detailNormal(vec3 n, vec3 p, float amount) {
 // nothing pops; and none where a pixel spans more than a quarter of a repeat, where it would only
 // alias into sparkle.
 float detailAmount(float distance, float pixelMetres) {
-    if (surface.detail.x <= 0.0 || surface.detail.z <= 0.0) return 0.0;
-    float fade = clamp(1.0 - distance / surface.detail.z, 0.0, 1.0);
-    float resolved = clamp(2.0 - pixelMetres * 8.0 / surface.detail.y, 0.0, 1.0);
+    if (surface.detailStrength <= 0.0 || surface.detailFade <= 0.0) return 0.0;
+    float fade = clamp(1.0 - distance / surface.detailFade, 0.0, 1.0);
+    float resolved = clamp(2.0 - pixelMetres * 8.0 / surface.detailScale, 0.0, 1.0);
     return fade * resolved;
 }
 
 // Procedural albedo variation: a multiplier in [1 − v, 1 + v] from gradient noise over 64 m and
 // 9 m (the finer octave fades where pixels are too large to resolve it).
 float albedoVariation(vec2 xz, float pixelMetres) {
-    float v = surface.detail.w;
+    float v = surface.albedoVariation;
     if (v <= 0.0) return 1.0;
     float coarse = gradientNoise(xz / 64.0 + 31.0).x;
     float fine = gradientNoise(xz / 9.0 - 57.0).x * clamp(2.0 - pixelMetres * 8.0 / 9.0, 0.0, 1.0);

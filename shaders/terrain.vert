@@ -9,7 +9,7 @@
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 #ifdef TLX_PROBE_LIGHT
-// From probe_vertices.comp: irradiance and weight, or the diagnostics (camera.view.z).
+// From probe_vertices.comp: irradiance and weight, or the diagnostics (camera.vertexAttribute).
 layout(location = 2) in vec4 inProbeLight;
 #endif
 layout(location = 0) out vec3 worldPos;
@@ -25,7 +25,7 @@ void main() {
     probeIrradianceWeight = inProbeLight;
 #else
     // No light, weight 0; in the diagnostics: no probe lights the point.
-    probeIrradianceWeight = camera.view.z == 1 ? vec4(-1.0, 0.0, 0.0, 0.0) : vec4(0.0);
+    probeIrradianceWeight = camera.vertexAttribute == 1 ? vec4(-1.0, 0.0, 0.0, 0.0) : vec4(0.0);
 #endif
     gl_Position = camera.viewProj * vec4(inPosition, 1.0);
 }

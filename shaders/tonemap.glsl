@@ -6,10 +6,10 @@
 
 vec3 aces(vec3 x) { return vec3(acesFit(x.r), acesFit(x.g), acesFit(x.b)); }
 vec3 srgb(vec3 c) { return vec3(srgbEncode(c.r), srgbEncode(c.g), srgbEncode(c.b)); }
-bool linearOutput() { return camera.view.y == 1; }
+bool linearOutput() { return camera.linearOutput == 1; }
 // Scene-linear light as the output wants it: as is for EXR, exposed, tonemapped and sRGB for PNG.
 vec3 display(vec3 linear) {
-    return linearOutput() ? linear : srgb(aces(linear * surface.material.y));
+    return linearOutput() ? linear : srgb(aces(linear * surface.exposure));
 }
 
 // Heat ramp: 0 dark blue, 2.5 % cyan, 5 % green, 7.5 % yellow, 10 % and above red. Piecewise

@@ -34,7 +34,7 @@ struct ShadingPoint {
     float lpvExposure; // views 61 and 64: 1 / cascade 0's light range (lpv::lightRange), 0 without
 };
 
-float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection.xyz)), 0.0); }
+float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDirection)), 0.0); }
 
 // Scene-linear light leaving the point toward the camera: Lambert + GGX sun, sky irradiance
 // (darkened by the AO) with the baked probe irradiance blended over it (absent probes leave the
@@ -45,8 +45,8 @@ float sunNdotL(ShadingPoint s) { return max(dot(s.normal, normalize(sunSky.sunDi
 // leaves the sky's term exactly as it is).
 vec3 sceneLinear(ShadingPoint s) {
     vec3 n = s.normal;
-    vec3 l = normalize(sunSky.sunDirection.xyz);
-    vec3 v = normalize(camera.position.xyz - s.position);
+    vec3 l = normalize(sunSky.sunDirection);
+    vec3 v = normalize(camera.position - s.position);
     float ndotl = max(dot(n, l), 0.0);
     vec3 sky = skyIrradiance(n) * s.ao;
     float weight = s.probe.a;
@@ -57,14 +57,14 @@ vec3 sceneLinear(ShadingPoint s) {
     // The LPV's bounce light adds to the sky's (lighting.indirect lpv) or to the probes' (both):
     // the LPV carries the sun's and the lights' first bounce only, never the sky.
 #ifdef TLX_LPV
-    if (kLpv && lpv.params.z > 0.5) {
+    if (kLpv && lpv.addsToAmbient > 0.5) {
         ambient += s.lpv.irradiance;
         environment += s.lpv.specular;
     }
 #endif
     vec3 specEnv = envBrdf(kGroundF0, dot(n, v), s.roughness) * environment;
     // Probes hold no direct sun: the sun alone is shadowed by the cascades.
-    vec3 sun = sunSky.sunIlluminance.rgb * s.shadow;
+    vec3 sun = sunSky.sunIlluminance * s.shadow;
     vec3 color = s.albedo / PI * (sun * ndotl + ambient) + spec * sun + specEnv;
 #ifdef TLX_LPV
     if (kLocalLights) color += localLightsDirect(s.position, n, v, s.albedo, s.roughness);
@@ -162,7 +162,7 @@ vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
     // views that need the full shading share one evaluation.
     s.shadow = sunShadow(s.position, s.normal);
-    vec3 toPoint = s.position - camera.position.xyz;
+    vec3 toPoint = s.position - camera.position;
     float distance = length(toPoint);
     vec3 dir = toPoint / max(distance, 1e-6);
     s.fogAmount = 1.0 - fogTransmittance(dir, distance);
@@ -176,11 +176,11 @@ vec3 shadeView(int view, ShadingPoint s) {
     s.lpvBlocking = 0.0;
     s.lpvExposure = 0.0;
 #ifdef TLX_LPV
-    if (kLpv && lpv.counts.x > 0) {
-        s.lpvExposure = lpv.params.w;
+    if (kLpv && lpv.cascadeCount > 0) {
+        s.lpvExposure = lpv.viewExposure;
         bool firstOnly = view == kViewLpvCascade0 || view == kViewLpvGeometry || view == kViewLpvAo;
-        int last = firstOnly ? 0 : lpv.counts.x - 1;
-        s.lpv = lpvEvaluate(s.position, s.normal, -dir, lpv.counts.y, last);
+        int last = firstOnly ? 0 : lpv.cascadeCount - 1;
+        s.lpv = lpvEvaluate(s.position, s.normal, -dir, lpv.quality, last);
         if (view == kViewLpvGeometry) s.lpvBlocking = clamp(lpvShEvaluate(lpvGeometryAt(s.position, 0), s.normal), 0.0, 1.0);
         if (view == kViewLpvAo) {
             float cell;

@@ -38,10 +38,10 @@ const float kWaterIor = 1.33;
 // (sRGB of the ACES fit of the exposed light) unless the output is linear: display_math.glsl's
 // inverses undo it.
 vec3 storedToLinear(vec3 stored) {
-    if (linearOutput() || camera.view.x == kViewLinear) return stored;
+    if (linearOutput() || camera.debugView == kViewLinear) return stored;
     vec3 x = vec3(acesFitInverse(srgbDecode(stored.r)), acesFitInverse(srgbDecode(stored.g)),
                   acesFitInverse(srgbDecode(stored.b)));
-    return x / max(surface.material.y, 1e-6);
+    return x / max(surface.exposure, 1e-6);
 }
 
 void main() {
@@ -51,19 +51,19 @@ void main() {
     float pixelMetres = length(fwidth(worldPos));
     vec3 displacement, n;
     gerstner(restPos.xz, depth, shoreFade(field.y), pixelMetres, displacement, n);
-    vec2 screen = gl_FragCoord.xy * camera.viewport.zw;
-    float distortion = water.look.x;
+    vec2 screen = gl_FragCoord.xy * camera.invViewportSize;
+    float distortion = water.distortion;
     vec3 planar = texture(reflectionMap, screen + n.xz * distortion).rgb;
     vec3 bedStored = texture(sceneBelow, clamp(screen + n.xz * (0.5 * distortion), vec2(0.0), vec2(1.0))).rgb;
 
-    int view = camera.view.x;
+    int view = camera.debugView;
     if (view == kViewWaterMask) {
         outColor = vec4(linearOutput() ? vec3(1.0, 1.0, 0.0) : vec3(0.10, 0.45, 1.0), 1.0);
         return;
     }
     if (view == kViewShoreDistance) {
         // EXR: metres in red; PNG: the fade distance as the ramp's span (heat's 10 % = full).
-        float span = max(water.plane.z, 1.0);
+        float span = max(water.shoreFade, 1.0);
         outColor = vec4(linearOutput() ? vec3(field.y, 1.0, 0.0) : heat(0.1 * clamp(field.y / span, 0.0, 1.0)), 1.0);
         return;
     }
@@ -72,23 +72,23 @@ void main() {
         return;
     }
 
-    vec3 v = normalize(camera.position.xyz - worldPos);
+    vec3 v = normalize(camera.position - worldPos);
     float ndotv = max(dot(n, v), 1e-3);
     float fresnel = kWaterF0 + (1.0 - kWaterF0) * pow(1.0 - ndotv, 5.0);
     vec3 reflected = planar;
-    if (water.absorption.w <= 0.5) {
+    if (water.planarReflection <= 0.5) {
         // The sky's reflection, or where reflection probes cover the water the nearest probe's
         // (one probe: the water is a mirror, and a blend of probes would double its images).
         vec3 r = reflect(-v, n);
         reflected = skyRadiance(r);
         float w = reflectionWeight(worldPos);
-        if (w > 0.0) reflected = mix(reflected, nearestReflectionProbeRadiance(worldPos, r, water.scatter.w), w);
+        if (w > 0.0) reflected = mix(reflected, nearestReflectionProbeRadiance(worldPos, r, water.roughness), w);
     }
 
-    vec3 l = normalize(sunSky.sunDirection.xyz);
+    vec3 l = normalize(sunSky.sunDirection);
     float shadowed = sunShadow(worldPos, n);
-    vec3 sun = sunSky.sunIlluminance.rgb * shadowed;
-    vec3 highlight = ggxSpecularF0(n, v, l, water.scatter.w, kWaterF0) * sun;
+    vec3 sun = sunSky.sunIlluminance * shadowed;
+    vec3 highlight = ggxSpecularF0(n, v, l, water.roughness, kWaterF0) * sun;
 
     // Below the surface: the path to the bed along the refracted view ray, and the sun's path
     // down to it along its refracted direction; both absorb (Beer–Lambert). The bed in the frame
@@ -99,13 +99,13 @@ void main() {
     float viewPath = depth / max(-t.y, 0.2);
     vec3 ls = refract(-l, vec3(0.0, 1.0, 0.0), 1.0 / kWaterIor);
     float sunPath = depth / max(-ls.y, 0.2);
-    vec3 viewT = exp(-water.absorption.rgb * viewPath);
-    vec3 bed = storedToLinear(bedStored) * viewT * exp(-water.absorption.rgb * sunPath);
+    vec3 viewT = exp(-water.absorption * viewPath);
+    vec3 bed = storedToLinear(bedStored) * viewT * exp(-water.absorption * sunPath);
     vec3 irradiance = sun * max(l.y, 0.0) + skyIrradiance(vec3(0.0, 1.0, 0.0));
-    vec3 body = water.scatter.rgb * irradiance / PI * (1.0 - viewT);
+    vec3 body = water.scatter * irradiance / PI * (1.0 - viewT);
     vec3 radiance = fresnel * reflected + (1.0 - fresnel) * (bed + body) + highlight;
 
-    vec3 toPoint = worldPos - camera.position.xyz;
+    vec3 toPoint = worldPos - camera.position;
     float distance = length(toPoint);
     radiance = applyFog(radiance, toPoint / max(distance, 1e-6), distance);
     if (view == kViewLinear) {

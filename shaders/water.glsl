@@ -12,21 +12,21 @@ const float kWaterF0 = 0.02;  // ((1.33 − 1) / (1.33 + 1))²
 // the footprint corner to corner, like the surface maps; off the footprint it holds the
 // border's values).
 vec2 waterFieldAt(vec2 xz) {
-    vec2 t = clamp((xz - surface.footprint.xy) * surface.footprint.zw, 0.0, 1.0);
-    vec2 size = water.look.zw;
+    vec2 t = clamp((xz - surface.footprintMin) * surface.invFootprintSpan, 0.0, 1.0);
+    vec2 size = water.fieldSize;
     return textureLod(waterField, (t * (size - 1.0) + 0.5) / size, 0.0).xy;
 }
 
 // Amplitude scale near the shore: smoothstep over the fade distance.
 float shoreFade(float distance) {
-    float d = water.plane.z;
+    float d = water.shoreFade;
     return d > 0.0 ? smoothstep(0.0, d, distance) : 1.0;
 }
 
 // ω of wave i at water depth h: √(g·k·tanh(k·h)) when depth-aware (Airy), else deep water √(g·k).
 float waveOmega(int i, float depth) {
-    float k = water.waves[i].z;
-    return water.plane.w > 0.5 ? sqrt(kGravity * k * tanh(k * max(depth, 0.0))) : water.phases[i].x;
+    float k = water.waves[i].k;
+    return water.depthAware > 0.5 ? sqrt(kGravity * k * tanh(k * max(depth, 0.0))) : water.waves[i].omegaDeep;
 }
 
 // Displacement of the rest point xz and the surface's unit normal there (Tessendorf 2001, eq.
@@ -39,17 +39,17 @@ float waveOmega(int i, float depth) {
 void gerstner(vec2 xz, float depth, float fade, float shortest, out vec3 displacement, out vec3 normal) {
     displacement = vec3(0.0);
     vec3 tx = vec3(1.0, 0.0, 0.0), tz = vec3(0.0, 0.0, 1.0);  // ∂P/∂x, ∂P/∂z
-    int count = int(water.look.y);
+    int count = int(water.waveCount);
     for (int i = 0; i < TLX_MAX_WAVES; ++i) {
         if (i >= count) break;
-        vec2 d = water.waves[i].xy;
-        float k = water.waves[i].z;
+        vec2 d = water.waves[i].direction;
+        float k = water.waves[i].k;
         float wavelength = 2.0 * PI / k;
         // None at `shortest`, full from twice it: a wave sampled fewer than four times a
         // wavelength would alias into moiré.
         float keep = clamp(wavelength / max(shortest, 1e-6) - 1.0, 0.0, 1.0);
-        float a = water.waves[i].w * fade * keep;
-        float theta = k * dot(d, xz) - waveOmega(i, depth) * water.plane.y + water.phases[i].y;
+        float a = water.waves[i].amplitude * fade * keep;
+        float theta = k * dot(d, xz) - waveOmega(i, depth) * water.time + water.waves[i].phase;
         float c = cos(theta), s = sin(theta);
         displacement += vec3(d.x * a * c, a * s, d.y * a * c);
         float ka = k * a;

@@ -17,8 +17,8 @@ void main() {
     vec2 field = waterFieldAt(inRest);
     vec3 displacement, normal;
     // Two vertices per wavelength at the least (Nyquist) for a wave to move the mesh.
-    gerstner(inRest, max(field.x, 0.0), shoreFade(field.y), 2.0 * water.mesh.x, displacement, normal);
-    restPos = vec3(inRest.x, water.plane.x, inRest.y);
+    gerstner(inRest, max(field.x, 0.0), shoreFade(field.y), 2.0 * water.meshSpacing, displacement, normal);
+    restPos = vec3(inRest.x, water.level, inRest.y);
     worldPos = restPos + displacement;
     gl_Position = camera.viewProj * vec4(worldPos, 1.0);
 }

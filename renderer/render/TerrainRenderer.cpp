@@ -713,7 +713,8 @@ blocks::LpvPropagationBlock propagationBlock(float stepWeight, int cascades) {
             b.faceLobes[5 * n + f] = glm::vec4(face.lobe[0], face.lobe[1], face.lobe[2], face.lobe[3]);
         }
     }
-    b.params = glm::vec4(stepWeight, float(cascades), 0.0f, 0.0f);
+    b.stepWeight = stepWeight;
+    b.cascadeCount = cascades;
     return b;
 }
 
@@ -733,15 +734,19 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
         std::vector<float> light, geometry;
         light.reserve(n * cascades[0].injected.size());
         geometry.reserve(n * cascades[0].geometry.size());
-        r->block.counts = glm::ivec4(int(n), ls.quality, ls.coneTraceSamples, 0);
+        r->block.cascadeCount = int(n);
+        r->block.quality = ls.quality;
+        r->block.coneSamples = ls.coneTraceSamples;
         r->viewRange = lpv::lightRange(cascades[0].injected, cascades[0].layout.cellSize, ls.indirectIntensity);
-        r->block.params = glm::vec4(float(ls.indirectIntensity), float(ls.fadeRange), 0.0f,
-                                    r->viewRange > 0.0 ? float(1.0 / r->viewRange) : 0.0f);
+        r->block.indirectIntensity = float(ls.indirectIntensity);
+        r->block.fadeRange = float(ls.fadeRange);
+        r->block.viewExposure = r->viewRange > 0.0 ? float(1.0 / r->viewRange) : 0.0f;
         for (size_t c = 0; c < n; ++c) {
             const lpv::LightVolume& v = volumes->propagated() ? cascades[c].accumulated : cascades[c].injected;
             light.insert(light.end(), v.begin(), v.end());
             geometry.insert(geometry.end(), cascades[c].geometry.begin(), cascades[c].geometry.end());
-            r->block.cascades[c] = glm::vec4(glm::vec3(cascades[c].layout.origin()), float(cascades[c].layout.cellSize));
+            r->block.cascades[c].minCorner = glm::vec3(cascades[c].layout.origin());
+            r->block.cascades[c].cellSize = float(cascades[c].layout.cellSize);
         }
         constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
         const VkDeviceSize lightBytes = VkDeviceSize(n) * cascades[0].injected.size() * 4;
@@ -871,7 +876,7 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
     const std::vector<std::array<glm::vec3, 3>>& queries, int lastCascade) {
     Gpu& g = *gpu_;
     if (!g.lpv || queries.empty()) return {};
-    const int cascades = g.lpv->block.counts.x;
+    const int cascades = g.lpv->block.cascadeCount;
     const int last = lastCascade < 0 ? cascades - 1 : std::min(lastCascade, cascades - 1);
     std::vector<glm::vec4> packed;
     for (const auto& q : queries)
@@ -955,8 +960,8 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
     std::vector<glm::vec4> markers(n);
     for (size_t i = 0; i < n; ++i) {
         const ReflectionProbe& p = s.probes[i];
-        records[i].position = glm::vec4(p.position, 0.0f);
-        records[i].halfExtent = glm::vec4(p.halfExtent, 0.0f);
+        records[i].position = p.position;
+        records[i].halfExtent = p.halfExtent;
         for (int f = 0; f < 6; ++f) records[i].faces[f] = glm::vec4(p.faces[size_t(f)], 0.0f);
         markers[i] = glm::vec4(p.position, 3.0f);  // markers.vert: a reflection probe
     }
@@ -992,9 +997,14 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
     r->markers = vk::Buffer::deviceLocal(ctx_, markers.data(), markers.size() * sizeof(glm::vec4),
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     r->markerCount = uint32_t(n);
-    r->grid.grid = glm::ivec4(s.dims[0], s.dims[1], cubemap ? 1 : 0, cubemap ? s.mipCount : 1);
-    r->grid.origin = glm::vec4(s.origin, s.spacing);
-    r->grid.coverage = glm::vec4(s.cellSize, s.blendDistance, 0.0f);
+    r->grid.nx = s.dims[0];
+    r->grid.nz = s.dims[1];
+    r->grid.encoding = cubemap ? 1 : 0;
+    r->grid.mipLevels = cubemap ? s.mipCount : 1;
+    r->grid.origin = s.origin;
+    r->grid.spacing = s.spacing;
+    r->grid.cellSize = s.cellSize;
+    r->grid.blendDistance = s.blendDistance;
     for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
         r->blocks.push_back(vk::Buffer::hostVisible(ctx_, sizeof(blocks::ReflectionBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
     g.graph.importBuffer(kReflectionRecords, r->records.handle(), true);
@@ -1064,17 +1074,25 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     std::vector<float> errors;
     for (const auto& v : volumes) {
         blocks::ProbeVolumeRecord rec{};
-        rec.originSpacing = glm::vec4(v.origin, v.spacing);
-        rec.dimsProbe = glm::ivec4(glm::ivec3(v.dims), int32_t(coeffs.size() / 9));
-        rec.occupancy = glm::ivec4(int32_t(cells.size()), v.irradianceEncoded ? 1 : 0, 0, 0);
-        rec.blend = glm::vec4(v.fallbackBlendDistance, v.scale, 0.0f, 0.0f);
+        rec.origin = v.origin;
+        rec.spacing = v.spacing;
+        rec.dims = glm::ivec3(v.dims);
+        rec.firstProbe = int32_t(coeffs.size() / 9);
+        rec.firstCell = int32_t(cells.size());
+        rec.preConvolved = v.irradianceEncoded ? 1 : 0;
+        rec.fallbackBlend = v.fallbackBlendDistance;
+        rec.shScale = v.scale;
         static const ProbeDiagnostics none;
         const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
         const ErrorMap& m = d.errorMap;
         // A map that does not hold nx·nz values (or has no step) is no map.
         if (m.error.size() == size_t(m.nx) * m.nz && m.step > 0.0f && !m.error.empty()) {
-            rec.errorMap = glm::ivec4(int32_t(errors.size()), int32_t(m.nx), int32_t(m.nz), 0);
-            rec.errorGrid = glm::vec4(m.x0, m.z0, m.step, 0.0f);
+            rec.firstError = int32_t(errors.size());
+            rec.errorNx = int32_t(m.nx);
+            rec.errorNz = int32_t(m.nz);
+            rec.errorX0 = m.x0;
+            rec.errorZ0 = m.z0;
+            rec.errorStep = m.step;
             for (float e : m.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
             anyErrorMap_ = true;
         }
@@ -1102,8 +1120,9 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     p->light = vk::Buffer(ctx_, std::max<size_t>(vertexCount_, 1) * 32,
                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     blocks::ProbesBlock block;
-    block.counts = glm::ivec4(volumeCount_, int32_t(vertexCount_), 0, 0);
-    block.flags = glm::ivec4(anyErrorMap_ ? 1 : 0, 0, 0, 0);
+    block.volumeCount = volumeCount_;
+    block.vertexCount = int32_t(vertexCount_);
+    block.anyErrorMap = anyErrorMap_ ? 1 : 0;
     p->block = vk::Buffer::hostVisible(ctx_, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     p->block.write(&block, sizeof block);
     constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -1415,7 +1434,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     }
     if (reflections) {
         blocks::ReflectionBlock block = reflections->grid;
-        block.coverage.w = std::clamp(s.reflectionStrength, 0.0f, 1.0f);
+        block.strength = std::clamp(s.reflectionStrength, 0.0f, 1.0f);
         reflections->blocks[slotIndex].write(&block, sizeof block);
     }
     if (lpvSet) {
@@ -1429,8 +1448,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         const std::vector<blocks::LocalLightRecord> records = features::packLocalLights(s.lights, localLights);
         slot.localLights.write(records.data(), records.size() * sizeof(records[0]));
         blocks::LpvBlock block = lpvVolumes ? lpvVolumes->block : blocks::LpvBlock{};
-        block.counts.w = localLights ? int(s.lights.size()) : 0;
-        block.params.z = lpvVolumes && s.lpvLight && view.needs.sceneLights ? 1.0f : 0.0f;
+        block.lightCount = localLights ? int(s.lights.size()) : 0;
+        block.addsToAmbient = lpvVolumes && s.lpvLight && view.needs.sceneLights ? 1.0f : 0.0f;
         slot.lpvBlock.write(&block, sizeof block);
         const uint64_t key = lpvVolumes ? g.lpvGeneration : 1;
         if (slot.lpvSetKey != key) {

@@ -22,3 +22,17 @@
 #undef TLX_MAT4
 #undef TLX_MAT4_ARRAY
 #undef TLX_VEC4_ARRAY
+#undef TLX_STRUCT_ARRAY
+#undef TLX_VEC3
+#undef TLX_VEC3_FLOAT
+#undef TLX_IVEC3_INT
+#undef TLX_VEC2_VEC2
+#undef TLX_VEC2_FLOAT2
+#undef TLX_FLOAT1
+#undef TLX_FLOAT2
+#undef TLX_FLOAT3
+#undef TLX_FLOAT4
+#undef TLX_INT1
+#undef TLX_INT2
+#undef TLX_INT3
+#undef TLX_INT4

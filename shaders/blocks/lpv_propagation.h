@@ -5,7 +5,8 @@ TLX_BLOCK_BEGIN(LpvPropagationBlock, TLX_SET_SUBSYSTEM, 0)
     TLX_VEC4_ARRAY(neighbours, 6)  // xyz offset from source to destination cell, w its axis
     TLX_VEC4_ARRAY(faceDirs, 30)   // neighbour n's face f at 5n + f: xyz centre direction, w solid angle
     TLX_VEC4_ARRAY(faceLobes, 30)  // the same face's unit clamped-cosine lobe (L1 SH)
-    TLX_VEC4(params)               // x the step weight (propagationStepWeight), y cascades
+    TLX_FLOAT1(stepWeight)         // propagationStepWeight
+    TLX_INT1(cascadeCount)
 TLX_BLOCK_END(propagation)
 #define TLX_LPV_WORK_BINDING 1      // storage: vec4 [region][cascade][channel][cell]; region 0 the
                                     // injected light, 1 and 2 alternate as the steps' output

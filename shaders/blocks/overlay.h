@@ -1,5 +1,5 @@
 // The overlay pass: probe markers and octree leaves.
 TLX_BLOCK_BEGIN(OverlayBlock, TLX_SET_SUBSYSTEM, 0)
-    TLX_VEC4(leaves)     // x smallest leaf edge (metres), y smallest leaf drawn (pixels)
-    TLX_IVEC4(markers)   // x 1 = draw valid probes, y 1 = draw moved and rejected probes
+    TLX_FLOAT2(smallestLeaf, smallestLeafPixels)  // smallest leaf edge (m); smallest leaf drawn (px)
+    TLX_INT2(drawValid, drawMovedRejected)  // 1 = draw valid probes; 1 = draw moved and rejected
 TLX_BLOCK_END(overlay)

@@ -16,12 +16,15 @@ blocks::CameraBlock packCamera(const RenderSettings& s, float extent, const Debu
     blocks::CameraBlock camera;
     camera.viewProj = s.camera.viewProjection(aspect, extent);
     camera.invViewProj = glm::inverse(camera.viewProj);
-    camera.position = glm::vec4(s.camera.position(), s.camera.planes(extent).farPlane);
-    camera.viewport = glm::vec4(float(s.width), float(s.height), 1.0f / float(s.width), 1.0f / float(s.height));
+    camera.position = s.camera.position();
+    camera.farPlane = s.camera.planes(extent).farPlane;
+    camera.viewportSize = glm::vec2(float(s.width), float(s.height));
+    camera.invViewportSize = 1.0f / camera.viewportSize;
+    camera.debugView = s.debugView;
+    camera.linearOutput = s.linearOutput ? 1 : 0;
     // What the per-vertex attribute holds: 2 the traced sun visibility, 1 the probe diagnostics,
     // 0 probe light.
-    camera.view = glm::ivec4(s.debugView, s.linearOutput ? 1 : 0,
-                             view.needs.sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0, 0);
+    camera.vertexAttribute = view.needs.sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0;
     return camera;
 }
 
@@ -31,42 +34,55 @@ blocks::CameraBlock packMirroredCamera(const RenderSettings& s, const blocks::Ca
     blocks::CameraBlock mirrored = camera;
     mirrored.viewProj = s.camera.reflectedViewProjection(aspect, extent, level);
     mirrored.invViewProj = glm::inverse(mirrored.viewProj);
-    mirrored.position = glm::vec4(s.camera.reflectedPosition(level), camera.position.w);
-    mirrored.viewport = glm::vec4(width, height, 1.0f / width, 1.0f / height);
-    mirrored.view = glm::ivec4(kViewBeauty, 1, camera.view.z, 0);
+    mirrored.position = s.camera.reflectedPosition(level);
+    mirrored.viewportSize = glm::vec2(width, height);
+    mirrored.invViewportSize = 1.0f / mirrored.viewportSize;
+    mirrored.debugView = kViewBeauty;
+    mirrored.linearOutput = 1;
     return mirrored;
 }
 
 blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& in) {
     blocks::SurfaceBlock surface;
-    surface.albedo = glm::vec4(s.albedo, in.albedoMap ? 1.0f : 0.0f);
-    surface.material = glm::vec4(float(s.terrain.roughness), s.exposure, s.terrain.specularAA ? 1.0f : 0.0f,
-                                 float(kRoughnessFloor));
-    surface.footprint = glm::vec4(in.footprintMin, in.footprintSpan.x > 0.0f ? 1.0f / in.footprintSpan.x : 0.0f,
-                                  in.footprintSpan.y > 0.0f ? 1.0f / in.footprintSpan.y : 0.0f);
-    surface.mapSizes = glm::vec4(in.normalAoMapSize, in.albedoMapSize);
-    surface.ao = glm::vec4(s.ao.enabled && in.ao ? 1.0f : 0.0f, s.ao.enabled ? float(s.ao.strength) : 0.0f,
-                           in.probeAoLevel, 0.0f);
+    surface.albedo = s.albedo;
+    surface.albedoFromMap = in.albedoMap ? 1.0f : 0.0f;
+    surface.roughness = float(s.terrain.roughness);
+    surface.exposure = s.exposure;
+    surface.specularAA = s.terrain.specularAA ? 1.0f : 0.0f;
+    surface.roughnessFloor = float(kRoughnessFloor);
+    surface.footprintMin = in.footprintMin;
+    surface.invFootprintSpan = glm::vec2(in.footprintSpan.x > 0.0f ? 1.0f / in.footprintSpan.x : 0.0f,
+                                         in.footprintSpan.y > 0.0f ? 1.0f / in.footprintSpan.y : 0.0f);
+    surface.normalAoMapSize = in.normalAoMapSize;
+    surface.albedoMapSize = in.albedoMapSize;
+    surface.aoOnSky = s.ao.enabled && in.ao ? 1.0f : 0.0f;
+    surface.aoOnProbes = s.ao.enabled ? float(s.ao.strength) : 0.0f;
+    surface.probeAoLevel = in.probeAoLevel;
     const DetailSettings& d = s.detail;
-    surface.detail = d.enabled ? glm::vec4(float(d.normalStrength), float(d.scale), float(d.fadeDistance),
-                                           float(d.albedoVariation))
-                               : glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);
+    surface.detailStrength = d.enabled ? float(d.normalStrength) : 0.0f;
+    surface.detailScale = d.enabled ? float(d.scale) : 1.0f;
+    surface.detailFade = d.enabled ? float(d.fadeDistance) : 0.0f;
+    surface.albedoVariation = d.enabled ? float(d.albedoVariation) : 0.0f;
     return surface;
 }
 
 blocks::SunSkyBlock packSunSky(const RenderSettings& s) {
     blocks::SunSkyBlock sunSky;
-    sunSky.sunDirection = glm::vec4(s.sun.direction, s.sun.angularRadius);
-    sunSky.sunIlluminance = glm::vec4(s.sun.illuminance, 0.0f);
+    sunSky.sunDirection = s.sun.direction;
+    sunSky.sunAngularRadius = s.sun.angularRadius;
+    sunSky.sunIlluminance = s.sun.illuminance;
     for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
     return sunSky;
 }
 
 blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog) {
     blocks::AtmosphereBlock atmosphere;
-    atmosphere.fog = glm::vec4(float(fog.density), float(fog.scaleHeight > 0.0 ? 1.0 / fog.scaleHeight : 0.0),
-                               float(fog.baseHeight.value_or(0.0)), float(fog.anisotropy));
-    atmosphere.fogColor = glm::vec4(fog.color.value_or(glm::vec3(0.0f)), float(fog.inscatter));
+    atmosphere.fogDensity = float(fog.density);
+    atmosphere.fogFalloff = float(fog.scaleHeight > 0.0 ? 1.0 / fog.scaleHeight : 0.0);
+    atmosphere.fogBase = float(fog.baseHeight.value_or(0.0));
+    atmosphere.fogAnisotropy = float(fog.anisotropy);
+    atmosphere.fogColor = fog.color.value_or(glm::vec3(0.0f));
+    atmosphere.sunInscatter = float(fog.inscatter);
     return atmosphere;
 }
 
@@ -79,26 +95,41 @@ blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Casca
         block.texel[int(i)] = cascades[i].texelSize;
         block.depthRange[int(i)] = cascades[i].depthRange;
     }
-    block.forward = glm::vec4(glm::normalize(s.camera.target - s.camera.position()), float(range.nearDistance));
-    block.bias = glm::vec4(float(s.shadows.depthBias), float(s.shadows.normalBias), std::tan(s.sun.angularRadius),
-                           float(resolution));
-    block.mode = glm::ivec4(int(cascades.size()), int(s.shadows.filter), 0, 0);
+    block.forward = glm::normalize(s.camera.target - s.camera.position());
+    block.nearDepth = float(range.nearDistance);
+    block.depthBias = float(s.shadows.depthBias);
+    block.normalBias = float(s.shadows.normalBias);
+    block.tanSunRadius = std::tan(s.sun.angularRadius);
+    block.mapResolution = float(resolution);
+    block.cascadeCount = int(cascades.size());
+    block.filterMode = int(s.shadows.filter);
     return block;
 }
 
 blocks::WaterBlock packWater(const RenderSettings& s, const WaterInputs& in) {
     const WaterSettings& ws = s.water;
     blocks::WaterBlock block;
-    block.plane = glm::vec4(in.level, float(s.time), in.shoreFadeDistance, ws.depthAware ? 1.0f : 0.0f);
-    block.scatter = glm::vec4(ws.color, float(ws.roughness));
-    block.absorption = glm::vec4(ws.absorption, ws.reflection == WaterReflection::Planar ? 1.0f : 0.0f);
+    block.level = in.level;
+    block.time = float(s.time);
+    block.shoreFade = in.shoreFadeDistance;
+    block.depthAware = ws.depthAware ? 1.0f : 0.0f;
+    block.scatter = ws.color;
+    block.roughness = float(ws.roughness);
+    block.absorption = ws.absorption;
+    block.planarReflection = ws.reflection == WaterReflection::Planar ? 1.0f : 0.0f;
     const size_t waves = std::min<size_t>(ws.waves.size(), WaterSettings::kMaxWaves);
-    block.look = glm::vec4(float(ws.distortion), float(waves), in.fieldSize);
-    block.mesh = glm::vec4(in.meshSpacing, 0.0f, 0.0f, 0.0f);
+    block.fieldSize = in.fieldSize;
+    block.distortion = float(ws.distortion);
+    block.waveCount = float(waves);
+    block.meshSpacing = in.meshSpacing;
     for (size_t i = 0; i < waves; ++i) {
         const water::WaveTerms wave = water::waveTerms(ws.waves[i]);
-        block.waves[i] = glm::vec4(float(wave.direction.x), float(wave.direction.y), float(wave.k), float(wave.amplitude));
-        block.phases[i] = glm::vec4(float(wave.omegaDeep), float(wave.phase), 0.0f, 0.0f);
+        blocks::WaveRecord& r = block.waves[i];
+        r.direction = glm::vec2(wave.direction);
+        r.k = float(wave.k);
+        r.amplitude = float(wave.amplitude);
+        r.omegaDeep = float(wave.omegaDeep);
+        r.phase = float(wave.phase);
     }
     return block;
 }
@@ -109,21 +140,26 @@ std::vector<blocks::LocalLightRecord> packLocalLights(const std::vector<LocalLig
         const LocalLight& l = lights[i];
         blocks::LocalLightRecord& r = records[i];
         const bool spot = l.type == LocalLightType::Spot;
-        r.positionRange = glm::vec4(l.position, float(l.range));
-        r.emitted = glm::vec4(l.color * float(l.intensity), spot ? 1.0f : 0.0f);
+        r.position = l.position;
+        r.range = float(l.range);
+        r.emitted = l.color * float(l.intensity);
+        r.spot = spot ? 1.0f : 0.0f;
         const float len = glm::length(l.direction);
-        r.direction = glm::vec4(len > 0.0f ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f), 0.0f);
+        r.direction = len > 0.0f ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f);
         const float cosOuter = std::cos(glm::radians(float(l.outerConeDeg)));
         const float cosInner = std::cos(glm::radians(float(l.innerConeDeg)));
-        r.cone = glm::vec4(cosOuter, 1.0f / std::max(0.001f, cosInner - cosOuter), 0.0f, 0.0f);
+        r.cosOuter = cosOuter;
+        r.invConeWidth = 1.0f / std::max(0.001f, cosInner - cosOuter);
     }
     return records;
 }
 
 blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels) {
     blocks::OverlayBlock overlay;
-    overlay.leaves = glm::vec4(smallestLeaf, smallestLeafPixels, 0.0f, 0.0f);
-    overlay.markers = glm::ivec4(s.showProbePositions ? 1 : 0, 1, 0, 0);
+    overlay.smallestLeaf = smallestLeaf;
+    overlay.smallestLeafPixels = smallestLeafPixels;
+    overlay.drawValid = s.showProbePositions ? 1 : 0;
+    overlay.drawMovedRejected = 1;
     return overlay;
 }
 
