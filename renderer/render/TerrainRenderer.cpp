@@ -17,7 +17,15 @@
 #include "bake/ReflectionBake.h"
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
-#include "render/features/Packing.h"
+#include "render/Frame.h"
+#include "render/features/Atmosphere.h"
+#include "render/features/Lpv.h"
+#include "render/features/Overlays.h"
+#include "render/features/Probes.h"
+#include "render/features/Reflections.h"
+#include "render/features/Shadows.h"
+#include "render/features/Terrain.h"
+#include "render/features/Water.h"
 #include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
 #include "terrain/SurfaceAlbedo.h"
@@ -34,38 +42,9 @@
 
 namespace terralux {
 
-namespace {
+using namespace frame;
 
-// Frame-graph resource names.
-const char* const kColor = "color";
-const char* const kDepth = "depth";
-const char* const kReadback = "readback";
-const char* const kSwapchain = "swapchain";
-const char* const kVertices = "terrain-vertices";
-const char* const kIndices = "terrain-indices";
-const char* const kMarkers = "markers";
-const char* const kLeaves = "leaves";
-const char* const kProbeCoefficients = "probe-coefficients";
-const char* const kProbeCells = "probe-cells";
-const char* const kProbeVolumes = "probe-volumes";
-const char* const kProbeErrorMaps = "probe-error-maps";
-const char* const kProbeLight = "probe-light";
-const char* const kShadowMaps = "shadow-maps";
-const char* const kSunVisibility = "sun-visibility";
-const char* const kWaterReflection = "water-reflection";
-const char* const kWaterReflectionDepth = "water-reflection-depth";
-const char* const kWaterScene = "water-scene";
-const char* const kWaterVertices = "water-vertices";
-const char* const kWaterIndices = "water-indices";
-const char* const kWaterField = "water-field";
-const char* const kReflectionGrid = "reflection-probe-grid";
-const char* const kReflectionRecords = "reflection-probe-records";
-const char* const kReflectionCubes = "reflection-probe-cubes";
-const char* const kReflectionMarkers = "reflection-probe-markers";
-const char* const kLpvLight = "lpv-light";
-const char* const kLpvGeometry = "lpv-geometry";
-const char* const kLpvWork = "lpv-work";
-const char* const kLpvScales = "lpv-scales";
+namespace {
 
 // Vertices along the longer side of the water mesh, at most: the waves longer than two of its
 // cells move it, the shorter ones live in the normal (water.glsl).
@@ -79,164 +58,7 @@ constexpr float kSmallestLeafPixels = 6.0f;
 
 constexpr VkShaderStageFlags kVertexFragment = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
-const char* const kSurfaceNormalAo = "surface-normal-ao";
-const char* const kSurfaceAlbedo = "surface-albedo";
-const char* const kSurfaceFilled = "surface-filled";
-
-std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
-}
-
 }  // namespace
-
-// The probe subsystem: present only while volumes are bound.
-struct ProbeResources {
-    vk::Buffer block, coeffs, cells, volumes, errors, light;
-    vk::DescriptorSet set;
-    bool lightStale = true;  // the probe pass has not run since the volumes changed
-};
-
-// What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
-// `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do (the lights
-// sets with reflection probes belong to ReflectionResources).
-// `reflectionCamera` and `reflectionView`: the view set again with the camera mirrored in the
-// water (the planar reflection pass).
-struct FrameSlot {
-    vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay, reflectionCamera;
-    vk::DescriptorSet view, lights, shadowedLights, overlays, reflectionView;
-    // The terrain pass's LPV and local-lights set: its block, the lights (grown as needed), and
-    // the set, written again when the bound volumes or the lights buffer change (`lpvSetKey`).
-    vk::Buffer lpvBlock, localLights;
-    size_t localLightCapacity = 0;
-    vk::DescriptorSet lpvSet;
-    uint64_t lpvSetKey = 0;
-    // Timestamps around the frame graph's passes (devices that write them): the queries the last
-    // frame drawn in this slot wrote, and its passes' names, read once its fence has passed.
-    vk::UniqueQueryPool timestamps;
-    uint32_t timestampsWritten = 0;
-    std::vector<std::string> timedPasses;
-    double recordMilliseconds = 0.0;
-};
-
-// Timestamps a slot's pool holds: one before the first pass and one after each.
-constexpr uint32_t kFrameTimestamps = 64;
-
-// The LPV subsystem: present only while volumes are bound. Every cascade's light volume (its
-// three channels one after another, Lpv.h's layout) and geometry volume, uploaded once per
-// update; the block's cascade records come with them. Volumes left to the renderer to propagate
-// upload their injected light instead (to `light`, and to region 0 of `work`), and the first frame
-// or sample that reads `light` runs the propagation pass into it (`steps` > 0 until then).
-struct LpvResources {
-    std::shared_ptr<const lpv::Volumes> volumes;
-    vk::Buffer light, geometry;
-    blocks::LpvBlock block;
-    vk::Buffer work, scales, propagationBlock;
-    vk::DescriptorSet propagationSet;
-    int steps = 0;
-    uint32_t cells = 0;  // cascades x 32^3
-    double viewRange = 0.0;  // lpv::lightRange of cascade 0: the LPV views' white point
-};
-
-// The water subsystem: present only while the scene has water. The field and mesh follow the
-// level; the reflection target and the copy of the frame follow the frame's size.
-struct WaterResources {
-    float level = 0.0f, margin = 0.0f;
-    glm::ivec2 fieldSize{1, 1};
-    vk::Image field;  // RG16F: depth below the level (negative on land), distance to shore
-    vk::Buffer vertices, indices;
-    uint32_t indexCount = 0;
-    float spacing = 1.0f;  // metres between mesh vertices
-    uint32_t width = 0, height = 0, reflectionWidth = 0, reflectionHeight = 0;
-    vk::Image reflection, reflectionDepth, scene;
-    vk::Framebuffer reflectionFramebuffer;
-    std::vector<vk::Buffer> blocks;        // per frame slot: the WaterBlock
-    std::vector<vk::DescriptorSet> sets;   // per frame slot: block, reflection, scene, field
-};
-
-// The reflection-probe subsystem: present only while a probe set is bound. The probe records
-// and, for the cubemap encoding, their cubes (one cube-map array, layer 6·probe + face, with the
-// set's mip chain; a 1×1 placeholder cube for the faces encoding) are uploaded once per set. The
-// cubes are an image rather than texels in the buffer so that the sampler does the filtering the
-// bake's evaluate() describes, bilinear (seamless across face edges, as cube-map hardware
-// filters) and linear between mips, in one fetch per probe.
-// Per frame slot: the grid block (it holds the live strength) and the lights sets that bind it,
-// without and with the shadow cascades (the latter while the maps exist).
-struct ReflectionResources {
-    blocks::ReflectionBlock grid;
-    vk::Buffer records, markers;
-    vk::Image cubes;
-    uint32_t markerCount = 0;
-    std::vector<vk::Buffer> blocks;
-    std::vector<vk::DescriptorSet> lights, shadowedLights;
-};
-
-// The shadow subsystem: the cascades' depth maps (one layer each) and a framebuffer per layer.
-struct ShadowResources {
-    vk::Image maps;
-    std::vector<vk::Framebuffer> framebuffers;
-    int resolution = 0, cascades = 0;
-    std::vector<glm::mat4> drawn;  // the light projections the maps hold now (empty: none yet)
-};
-
-struct RenderTarget {
-    vk::Image color, depth;
-    vk::Framebuffer framebuffer;
-    vk::Readback readback;
-};
-
-// The surface maps the view set binds (SurfaceMaps.h), always present: a terrain without AO or
-// an albedo map binds neutral ones.
-struct SurfaceTextures {
-    vk::Image normalAo, albedo, filled;
-};
-
-struct TerrainRenderer::Gpu {
-    vk::Buffer vertices, indices, markers, leaves;
-    SurfaceTextures surface;
-    vk::Sampler trilinear;
-    vk::UniqueSetLayout viewLayout;
-    std::unique_ptr<ProbeResources> probes;
-    std::unique_ptr<ShadowResources> shadows;
-    std::unique_ptr<WaterResources> water;
-    vk::Sampler linear;
-    vk::UniqueSetLayout waterLayout;
-    std::array<vk::PipelineLayout, 4> waterLayouts;  // by lights variant
-    // By variant: kShadowVariant | kFogVariant | kReflectionVariant.
-    std::map<int, vk::UniquePipeline> waterPipelines;
-    // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
-    // sun and surface it was traced for.
-    vk::Buffer sunVisibility;
-    glm::vec4 sunVisibilityKey{0.0f};
-    int sunVisibilitySkirt = -1;
-    std::unique_ptr<HeightfieldTracer> tracer;
-    bool tracerSkirt = true;
-    std::vector<FrameSlot> slots;
-    std::unique_ptr<RenderTarget> target;
-    vk::RenderPass clearPass, drawPass, shadowPass;
-    vk::Sampler compareSampler, depthSampler;
-    vk::UniqueSetLayout emptySet;
-    std::array<vk::UniqueSetLayout, 4> lightsLayouts;     // by lights variant
-    std::array<vk::PipelineLayout, 4> terrainLayouts;     // view and lights, by lights variant
-    vk::PipelineLayout overlayLayout, probeLayout, shadowDepthLayout;
-    std::unique_ptr<ReflectionResources> reflections;
-    std::unique_ptr<LpvResources> lpv;
-    uint64_t lpvGeneration = 1;  // counts setLpv calls: a slot's LPV set is written for one
-    vk::Buffer lpvDummy;  // one vec4 standing in for the volumes where none are bound
-    vk::UniqueSetLayout lpvLayout;
-    std::array<vk::PipelineLayout, 4> terrainLpvLayouts;  // view, lights and the LPV set, by lights variant
-    vk::PipelineLayout lpvSampleLayout, lpvPropagateLayout;
-    vk::UniquePipeline lpvSample, lpvPropagate;
-    // Timestamps around the last propagation pass (devices that write them).
-    vk::UniqueQueryPool lpvQueries;
-    bool lpvTimed = false;
-    // Built on first use: lavapipe compiles a pipeline when it is created. Terrain pipelines by
-    // variant: kProbeLightVariant | kShadowVariant | kFogVariant | kReflectionVariant |
-    // kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV shaders and layout).
-    std::map<int, vk::UniquePipeline> terrain;
-    vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, probePass;
-    FrameGraph graph;
-};
 
 struct TerrainRenderer::Output {
     bool readback = true;
@@ -245,11 +67,6 @@ struct TerrainRenderer::Output {
 };
 
 namespace {
-
-constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8,
-              kLpvVariant = 16, kLocalLightsVariant = 32;
-// The lights set's variants, an index into the layouts: the shadow cascades, the reflection probes.
-constexpr int kShadowedLights = 1, kReflectedLights = 2;
 
 // The lights set of a variant: sun and sky and the atmosphere; with kShadowedLights the
 // cascades' block and their maps (compared, and raw for the PCSS blocker search); with
@@ -338,7 +155,7 @@ vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
 }  // namespace
 
 TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget)
-    : ctx_(ctx), hf_(hf), gpu_(std::make_unique<Gpu>()) {
+    : ctx_(ctx), hf_(hf), gpu_(std::make_unique<RendererGpu>()) {
     const size_t w = size_t(hf.width()), d = size_t(hf.depth());
     while (((w - 1) / size_t(stride_) + 2) * ((d - 1) / size_t(stride_) + 2) > vertexBudget &&
            stride_ < int(std::max(w, d)))
@@ -368,7 +185,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     indexCount_ = indices.size();
     meshVertices_ = vertices;
 
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     g.indices = vk::Buffer::deviceLocal(ctx_, indices.data(), std::max<size_t>(indices.size(), 1) * 4,
@@ -445,7 +262,7 @@ bool TerrainRenderer::hasWaterResources() const { return gpu_->water != nullptr;
 glm::ivec2 TerrainRenderer::waterFieldSize() const { return gpu_->water ? gpu_->water->fieldSize : glm::ivec2(0); }
 
 void TerrainRenderer::setWater(std::optional<float> level, float margin) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (level && g.water && g.water->level == *level && g.water->margin == margin) return;
     ctx_.waitIdle();  // frames in flight may still read the old resources
     for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene, kWaterVertices, kWaterIndices})
@@ -510,7 +327,7 @@ void TerrainRenderer::setWater(std::optional<float> level, float margin) {
 }
 
 void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     WaterResources& w = *g.water;
     const uint32_t rw = std::max(uint32_t(std::lround(float(width) * reflectionScale)), 1u);
     const uint32_t rh = std::max(uint32_t(std::lround(float(height) * reflectionScale)), 1u);
@@ -547,7 +364,7 @@ void TerrainRenderer::redrawShadowMaps() {
 }
 
 void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     const SurfaceMaps maps = buildSurfaceMaps(hf_, ao);
     std::vector<vk::MipLevel> levels;
     int w = maps.width, h = maps.height;
@@ -575,7 +392,7 @@ void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) {
 }
 
 void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     const bool map = width > 0 && height > 0 && srgb.size() == size_t(width) * size_t(height) * 3;
     // A full mip chain of box means in linear light, stored sRGB-encoded (the hardware decodes);
     // level 0 holds the field's own codes.
@@ -615,7 +432,7 @@ void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint
 }
 
 void TerrainRenderer::buildViewSets() {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     for (FrameSlot& f : g.slots) {
         f.view = viewSetBuilder(f, f.camera, &g.surface, g.trilinear.handle()).build(ctx_);
         f.reflectionView = viewSetBuilder(f, f.reflectionCamera, &g.surface, g.trilinear.handle()).build(ctx_);
@@ -623,7 +440,7 @@ void TerrainRenderer::buildViewSets() {
 }
 
 void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (g.shadows ? g.shadows->resolution == resolution && g.shadows->cascades == cascades : resolution <= 0)
         return;
     ctx_.waitIdle();  // frames in flight may still read the old maps
@@ -648,7 +465,7 @@ void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
 }
 
 void TerrainRenderer::buildReflectionSets() {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     ReflectionResources* r = g.reflections.get();
     if (!r) return;
     r->lights.clear();
@@ -721,7 +538,7 @@ blocks::LpvPropagationBlock propagationBlock(float stepWeight, int cascades) {
 }  // namespace
 
 void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (g.lpv ? g.lpv->volumes == volumes : !volumes) return;
     std::unique_ptr<LpvResources> r;
     if (volumes && !volumes->cascades().empty()) {
@@ -795,7 +612,7 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
 }
 
 void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     LpvResources& r = *g.lpv;
     if (g.lpvQueries) {
         // The first once everything before has finished, so an earlier pass's tail is not counted.
@@ -826,7 +643,7 @@ void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
 }
 
 void TerrainRenderer::propagateLpvNow() {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (!g.lpv || g.lpv->steps == 0) return;
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
@@ -841,7 +658,7 @@ void TerrainRenderer::propagateLpvNow() {
 }
 
 std::optional<double> TerrainRenderer::lpvPropagationMilliseconds() {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (!g.lpvTimed) return std::nullopt;
     ctx_.waitIdle();
     uint64_t ticks[2] = {0, 0};
@@ -854,7 +671,7 @@ std::optional<double> TerrainRenderer::lpvPropagationMilliseconds() {
 }
 
 std::vector<float> TerrainRenderer::readLpvLight() {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (!g.lpv) return {};
     propagateLpvNow();
     vk::Buffer host = vk::Buffer::hostVisible(ctx_, g.lpv->light.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
@@ -874,7 +691,7 @@ std::vector<float> TerrainRenderer::readLpvLight() {
 
 std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
     const std::vector<std::array<glm::vec3, 3>>& queries, int lastCascade) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (!g.lpv || queries.empty()) return {};
     const int cascades = g.lpv->block.cascadeCount;
     const int last = lastCascade < 0 ? cascades - 1 : std::min(lastCascade, cascades - 1);
@@ -926,7 +743,7 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
 }
 
 void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     ctx_.waitIdle();  // no frame may still read the old probes
     for (const char* name : {kReflectionRecords, kReflectionMarkers}) g.graph.forget(name);
     g.reflections.reset();
@@ -1014,7 +831,7 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
 }
 
 void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     const glm::vec4 key(sun.direction, sun.angularRadius);
     if (g.sunVisibility.handle() != VK_NULL_HANDLE && key == g.sunVisibilityKey && g.sunVisibilitySkirt == int(skirt))
         return;
@@ -1055,7 +872,7 @@ bool TerrainRenderer::hasProbeResources() const { return gpu_->probes != nullptr
 const std::vector<PassInfo>& TerrainRenderer::lastFramePasses() const { return gpu_->graph.lastFrame(); }
 
 void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     ctx_.waitIdle();  // no frame may still read the old buffers
     for (const char* name : {kProbeCoefficients, kProbeCells, kProbeVolumes, kProbeErrorMaps, kProbeLight})
         g.graph.forget(name);
@@ -1169,7 +986,7 @@ void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
 }
 
 void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height) {
-    Gpu& g = *gpu_;
+    RendererGpu& g = *gpu_;
     if (g.target && g.target->color.width() == width && g.target->color.height() == height) return;
     ctx_.waitIdle();  // frames in flight may still draw into the old target
     for (const char* name : {kColor, kDepth, kReadback}) g.graph.forget(name);
@@ -1241,152 +1058,22 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
     return true;
 }
 
-void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
-                                  const Output& out) {
-    const auto recordStart = std::chrono::steady_clock::now();
-    Gpu& g = *gpu_;
-    FrameSlot& slot = g.slots[slotIndex];
-    const DebugView view = findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty));
-    // The probe subsystem takes part only when volumes are bound, probes are on and the view
-    // reads their light.
-    ProbeResources* probes =
-        g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
-    // Reflection probes take part only when a set is bound, probes are on and the view reads the
-    // environment's specular. The strength does not decide it: it is a live uniform, and a weight
-    // of 0 leaves the sky's specular as it is.
-    ReflectionResources* reflections =
-        g.reflections && s.probes && view.needs.reflectionProbes ? g.reflections.get() : nullptr;
-    // The LPV takes part when volumes are bound and either the view lights with them and
-    // lighting.indirect asks for them, or the view shows them; the local lights in the lit views
-    // whenever the scene has some. Either binds the terrain's LPV set.
-    LpvResources* lpvVolumes =
-        g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes) ? g.lpv.get() : nullptr;
-    const bool localLights = !s.lights.empty() && view.needs.sceneLights;
-    const bool lpvSet = lpvVolumes || localLights;
-    const bool drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
-    // The reflection probes' markers, with the probe positions.
-    const bool drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
-    const bool drawLeaves = s.showLeaves && leafCount_ > 0;
-    // Shadows: the scene has them on, the sun is up and the view draws them.
-    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f;
-    const bool fog = s.fog.enabled;
-    const bool sunVisibility = view.needs.sunVisibility;
-    const bool sky = view.needs.sky;
-    if (sunVisibility) updateSunVisibility(s.sun, s.skirt);
-    if (!s.shadows.enabled) ensureShadowMaps(0, 0);  // a scene without shadows holds no maps
-    if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
-    ShadowResources* shadows = shadowed ? g.shadows.get() : nullptr;
-    // Water: the scene has it and the view draws it; the reflection and the copy of the frame
-    // under it only where the view shades it, the reflection only when planar.
-    WaterResources* water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
-    const bool waterShading = water && view.needs.waterShading;
-    const bool planarReflection = waterShading && s.water.reflection == WaterReflection::Planar;
-    if (water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
-
-    // Pipelines, built on first use.
-    if (probes && !g.probePass) {
-        const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), probes->set.layout()};
-        g.probeLayout = vk::PipelineLayout(ctx_, sets);
-        g.probePass = vk::createComputePipeline(ctx_, g.probeLayout.handle(), shaders::probeVerticesComp());
-    }
-    const VkVertexInputBindingDescription meshBinding{0, 24, VK_VERTEX_INPUT_RATE_VERTEX};
-    const VkVertexInputAttributeDescription position{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
-        normal{1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12};
-    // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
-    // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
-    const bool vertexAttribute = probes || sunVisibility;
-    const int lightsVariant = (shadows ? kShadowedLights : 0) | (reflections ? kReflectedLights : 0);
-    const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
-                        (fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0) |
-                        (lpvVolumes ? kLpvVariant : 0) | (localLights ? kLocalLightsVariant : 0);
-    const VkPipelineLayout terrainLayout = lpvSet ? g.terrainLpvLayouts[size_t(lightsVariant)].handle()
-                                                  : g.terrainLayouts[size_t(lightsVariant)].handle();
-    vk::UniquePipeline& terrainPipeline = g.terrain[variant];
-    if (!terrainPipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
-        if (lpvSet)
-            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionLpvFrag() : shaders::terrainReflectionLpvFrag())
-                                 : (shadows ? shaders::terrainShadowLpvFrag() : shaders::terrainLpvFrag());
-        else
-            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
-                                 : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
-        d.fragConstants = {fog ? 1u : 0u};
-        if (lpvSet) d.fragConstants.insert(d.fragConstants.end(), {lpvVolumes ? 1u : 0u, localLights ? 1u : 0u});
-        d.bindings = {meshBinding};
-        d.attributes = {position, normal};
-        if (vertexAttribute) {
-            d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
-            d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
-        }
-        terrainPipeline = vk::createGraphicsPipeline(ctx_, g.clearPass.handle(), terrainLayout, d);
-    }
-    vk::UniquePipeline& skyPipeline = fog ? g.skyFog : g.skyPlain;
-    if ((sky || planarReflection) && !skyPipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::fullscreenVert();
-        d.frag = shaders::skyBackgroundFrag();
-        d.fragConstants = {fog ? 1u : 0u};
-        d.depthWrite = false;
-        skyPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.terrainLayouts[0].handle(), d);
-    }
-    const int waterVariant = (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0) |
-                             (reflections ? kReflectionVariant : 0);
-    vk::UniquePipeline& waterPipeline = g.waterPipelines[waterVariant];
-    if (water && !waterPipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::waterVert();
-        d.frag = reflections ? (shadows ? shaders::waterShadowReflectionFrag() : shaders::waterReflectionFrag())
-                             : (shadows ? shaders::waterShadowFrag() : shaders::waterFrag());
-        d.fragConstants = {fog ? 1u : 0u};
-        d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
-        d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
-        waterPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(),
-                                                   g.waterLayouts[size_t(lightsVariant)].handle(), d);
-    }
-    if (shadows && !g.shadowDepth) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::shadowDepthVert();
-        d.bindings = {meshBinding};
-        d.attributes = {position};
-        d.colorAttachments = 0;
-        d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
-        g.shadowDepth = vk::createGraphicsPipeline(ctx_, g.shadowPass.handle(), g.shadowDepthLayout.handle(), d);
-    }
-    const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
-    const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
-    if ((drawMarkers || drawReflectionMarkers) && !g.markerPipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::markersVert();
-        d.frag = shaders::markersFrag();
-        d.bindings = {instance};
-        d.attributes = {record};
-        d.depthWrite = false;
-        g.markerPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.overlayLayout.handle(), d);
-    }
-    if (drawLeaves && !g.leafPipeline) {
-        // The 12 edges of each leaf box as a line list.
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::leavesVert();
-        d.frag = shaders::markersFrag();
-        d.bindings = {instance};
-        d.attributes = {record};
-        d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
-        d.depthWrite = false;
-        g.leafPipeline = vk::createGraphicsPipeline(ctx_, g.drawPass.handle(), g.overlayLayout.handle(), d);
-    }
-
-    // This slot's uniform blocks (the GPU finished the slot's previous frame).
+// This slot's uniform blocks (the GPU finished the slot's previous frame), each from its
+// feature's packing, and the frame's background.
+void TerrainRenderer::writeBlocks(Frame& f) {
+    RendererGpu& g = *gpu_;
+    const RenderSettings& s = f.s;
+    FrameSlot& slot = f.slot;
     const float extent = std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(),
                                    hf_.maxHeight() - hf_.minHeight(), 1.0f});
     const float aspect = float(s.width) / float(s.height);
-    const blocks::CameraBlock camera = features::packCamera(s, extent, view);
+    const blocks::CameraBlock camera = features::packCamera(s, extent, f.view);
     slot.camera.write(&camera, sizeof camera);
     const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
     // The normal-AO mip level whose texels are as large as the finest probe spacing: the AO at
     // that scale is what the probes already hold.
     float probeLevel = 0.0f;
-    if (probes && hasAo_ && finestProbeSpacing_ > 0.0f) {
+    if (f.probes && hasAo_ && finestProbeSpacing_ > 0.0f) {
         const float texel = std::max(spanX / float(std::max(surfaceMapSize_.x - 1, 1)),
                                      spanZ / float(std::max(surfaceMapSize_.y - 1, 1)));
         if (texel > 0.0f) probeLevel = std::max(std::log2(finestProbeSpacing_ / texel), 0.0f);
@@ -1406,406 +1093,157 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const blocks::AtmosphereBlock atmosphere = features::packAtmosphere(s.fog);
     slot.atmosphere.write(&atmosphere, sizeof atmosphere);
     const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
-    std::vector<glm::mat4> lightMatrices;
-    if (shadows) {
+        if (f.shadows) {
         const CascadeRange range = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
-        cascades_ = fitCascades(range, s.camera, aspect, s.sun.direction, shadows->resolution, boundsMin, boundsMax);
-        for (const Cascade& c : cascades_) lightMatrices.push_back(c.lightViewProj);
-        const blocks::ShadowBlock block = features::packShadows(s, cascades_, range, shadows->resolution);
+        cascades_ = fitCascades(range, s.camera, aspect, s.sun.direction, f.shadows->resolution, boundsMin, boundsMax);
+        for (const Cascade& c : cascades_) f.lightMatrices.push_back(c.lightViewProj);
+        const blocks::ShadowBlock block = features::packShadows(s, cascades_, range, f.shadows->resolution);
         slot.shadow.write(&block, sizeof block);
     } else if (!s.shadows.enabled) {
         cascades_.clear();
     }
-    if (water) {
+    if (f.water) {
         features::WaterInputs in;
-        in.level = water->level;
+        in.level = f.water->level;
         in.shoreFadeDistance = float(water::shoreFadeDistance(s.water, hf_));
-        in.fieldSize = glm::vec2(water->fieldSize);
-        in.meshSpacing = water->spacing;
+        in.fieldSize = glm::vec2(f.water->fieldSize);
+        in.meshSpacing = f.water->spacing;
         const blocks::WaterBlock block = features::packWater(s, in);
-        water->blocks[slotIndex].write(&block, sizeof block);
+        f.water->blocks[f.slotIndex].write(&block, sizeof block);
     }
-    if (planarReflection) {
+    if (f.planarReflection) {
         // The camera mirrored in the plane, drawing scene-linear beauty into the reflection.
         const blocks::CameraBlock mirrored =
-            features::packMirroredCamera(s, camera, extent, water->level, float(water->reflectionWidth),
-                                         float(water->reflectionHeight));
+            features::packMirroredCamera(s, camera, extent, f.water->level, float(f.water->reflectionWidth),
+                                         float(f.water->reflectionHeight));
         slot.reflectionCamera.write(&mirrored, sizeof mirrored);
     }
-    if (reflections) {
-        blocks::ReflectionBlock block = reflections->grid;
-        block.strength = std::clamp(s.reflectionStrength, 0.0f, 1.0f);
-        reflections->blocks[slotIndex].write(&block, sizeof block);
+    if (f.reflections) {
+        const blocks::ReflectionBlock block = features::packReflections(*f.reflections, s);
+        f.reflections->blocks[f.slotIndex].write(&block, sizeof block);
     }
-    if (lpvSet) {
-        const size_t wanted = std::max<size_t>(localLights ? s.lights.size() : 0, 1);
+    if (f.lpvSet) {
+        const size_t wanted = std::max<size_t>(f.localLights ? s.lights.size() : 0, 1);
         if (slot.localLightCapacity < wanted) {
             slot.localLights = vk::Buffer::hostVisible(ctx_, wanted * sizeof(blocks::LocalLightRecord),
                                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
             slot.localLightCapacity = wanted;
             slot.lpvSetKey = 0;
         }
-        const std::vector<blocks::LocalLightRecord> records = features::packLocalLights(s.lights, localLights);
+        const std::vector<blocks::LocalLightRecord> records = features::packLocalLights(s.lights, f.localLights);
         slot.localLights.write(records.data(), records.size() * sizeof(records[0]));
-        blocks::LpvBlock block = lpvVolumes ? lpvVolumes->block : blocks::LpvBlock{};
-        block.lightCount = localLights ? int(s.lights.size()) : 0;
-        block.addsToAmbient = lpvVolumes && s.lpvLight && view.needs.sceneLights ? 1.0f : 0.0f;
+        const blocks::LpvBlock block = features::packLpv(f);
         slot.lpvBlock.write(&block, sizeof block);
-        const uint64_t key = lpvVolumes ? g.lpvGeneration : 1;
+        const uint64_t key = f.lpvVolumes ? g.lpvGeneration : 1;
         if (slot.lpvSetKey != key) {
-            slot.lpvSet = lpvSetBuilder(slot.lpvBlock, lpvVolumes ? lpvVolumes->light : g.lpvDummy,
-                                        lpvVolumes ? lpvVolumes->geometry : g.lpvDummy, slot.localLights)
+            slot.lpvSet = lpvSetBuilder(slot.lpvBlock, f.lpvVolumes ? f.lpvVolumes->light : g.lpvDummy,
+                                        f.lpvVolumes ? f.lpvVolumes->geometry : g.lpvDummy, slot.localLights)
                               .build(ctx_);
             slot.lpvSetKey = key;
         }
     }
-    if (drawMarkers || drawReflectionMarkers || drawLeaves) {
+    if (f.drawMarkers || f.drawReflectionMarkers || f.drawLeaves) {
         const blocks::OverlayBlock overlay = features::packOverlay(s, smallestLeaf_, kSmallestLeafPixels);
         slot.overlay.write(&overlay, sizeof overlay);
     }
 
     // Background where no pass draws the sky: black, or the sky toward the horizon in the view's
     // encoding (the sky pass draws over it per pixel).
-    glm::vec3 bg(0.0f);
-    if (view.background != ViewBackground::Black) {
+    glm::vec3& bg = f.background;
+    if (f.view.background != ViewBackground::Black) {
         bg = glm::max(sh::evalRadiance(s.skySh, glm::normalize(glm::vec3(0.0f, 0.2f, -1.0f))), glm::vec3(0.0f));
-        if (!s.linearOutput && view.background == ViewBackground::Sky) {
+        if (!s.linearOutput && f.view.background == ViewBackground::Sky) {
             // tonemap.glsl's display(), for the one colour the shader does not draw.
             for (int i = 0; i < 3; ++i) bg[i] = glsl::srgbEncode(glsl::acesFit(bg[i] * s.exposure));
         } else if (!s.linearOutput) {
             bg = glm::clamp(bg, glm::vec3(0.0f), glm::vec3(1.0f));
         }
     }
+}
 
-    FrameGraph& graph = g.graph;
-    graph.beginFrame();
-    const uint32_t w = s.width, h = s.height;
-    auto setViewport = [](VkCommandBuffer c, uint32_t vw, uint32_t vh) {
-        VkViewport vp{0, 0, float(vw), float(vh), 0.0f, 1.0f};
-        VkRect2D sc{{0, 0}, {vw, vh}};
-        vkCmdSetViewport(c, 0, 1, &vp);
-        vkCmdSetScissor(c, 0, 1, &sc);
-    };
-    VkFramebuffer framebuffer = g.target->framebuffer.handle();
-    // A pass that draws on top of what the frame holds (sky, overlays).
-    const auto beginDrawing = [&g, framebuffer, w, h, setViewport](VkCommandBuffer c) {
-        VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-        rbi.renderPass = g.drawPass.handle();
-        rbi.framebuffer = framebuffer;
-        rbi.renderArea = {{0, 0}, {w, h}};
-        vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-        setViewport(c, w, h);
-    };
+void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
+                                  const Output& out) {
+    const auto recordStart = std::chrono::steady_clock::now();
+    RendererGpu& g = *gpu_;
+    Frame f{ctx_, g, g.slots[slotIndex], slotIndex, s,
+            findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty))};
+    const DebugView& view = f.view;
+    // Who takes part. Probes: volumes bound, probes on and the view reads their light. Reflection
+    // probes: a set bound, probes on and the view reads the environment's specular (the strength
+    // does not decide it: it is a live uniform, and a weight of 0 leaves the sky's specular as it
+    // is). The LPV: volumes bound and either the view lights with them and lighting.indirect asks
+    // for them, or the view shows them; the local lights in the lit views whenever the scene has
+    // some; either binds the terrain's LPV set.
+    f.probes = g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
+    f.reflections = g.reflections && s.probes && view.needs.reflectionProbes ? g.reflections.get() : nullptr;
+    f.lpvVolumes = g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes) ? g.lpv.get() : nullptr;
+    f.localLights = !s.lights.empty() && view.needs.sceneLights;
+    f.lpvSet = f.lpvVolumes || f.localLights;
+    f.drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
+    f.drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
+    f.drawLeaves = s.showLeaves && leafCount_ > 0;
+    f.fog = s.fog.enabled;
+    f.sunVisibility = view.needs.sunVisibility;
+    f.sky = view.needs.sky;
+    if (f.sunVisibility) updateSunVisibility(s.sun, s.skirt);
+    // Shadows: the scene has them on, the sun is up and the view draws them. A scene without
+    // shadows holds no maps.
+    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f;
+    if (!s.shadows.enabled) ensureShadowMaps(0, 0);
+    if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
+    f.shadows = shadowed ? g.shadows.get() : nullptr;
+    // Water: the scene has it and the view draws it; the reflection and the copy of the frame
+    // under it only where the view shades it, the reflection only when planar.
+    f.water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
+    f.waterShading = f.water && view.needs.waterShading;
+    f.planarReflection = f.waterShading && s.water.reflection == WaterReflection::Planar;
+    if (f.water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
+    f.vertexCount = uint32_t(vertexCount_);
+    f.indexCount = uint32_t(indexCount_);
+    f.markerCount = markerCount_;
+    f.leafCount = leafCount_;
+    f.width = s.width;
+    f.height = s.height;
+    f.framebuffer = g.target->framebuffer.handle();
+    writeBlocks(f);
 
-    if (probes && probes->lightStale) {
-        PassInfo info{"probe-vertices",
-                      {{kProbeCoefficients, Access::ComputeStorageRead},
-                       {kProbeCells, Access::ComputeStorageRead},
-                       {kProbeVolumes, Access::ComputeStorageRead},
-                       {kProbeErrorMaps, Access::ComputeStorageRead},
-                       {kVertices, Access::ComputeStorageRead},
-                       {kProbeLight, Access::ComputeStorageWrite}},
-                      probes->set.bindingNames()};
-        const uint32_t n = uint32_t(vertexCount_);
-        graph.addPass(std::move(info), [&g, probes, n](VkCommandBuffer c) {
-            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probePass.get());
-            VkDescriptorSet set = probes->set.handle();
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probeLayout.handle(),
-                                    TLX_SET_SUBSYSTEM, 1, &set, 0, nullptr);
-            vkCmdDispatch(c, (n + 63) / 64, 1, 1);
-        });
-    }
-
-    // Volumes bound for the renderer to propagate: their steps, once, before anything reads them.
-    if (lpvVolumes && lpvVolumes->steps > 0) {
-        PassInfo info{"lpv-propagate",
-                      {{kLpvWork, Access::ComputeStorageReadWrite},
-                       {kLpvScales, Access::ComputeStorageReadWrite},
-                       {kLpvGeometry, Access::ComputeStorageRead},
-                       {kLpvLight, Access::ComputeStorageReadWrite}},
-                      lpvVolumes->propagationSet.bindingNames()};
-        graph.addPass(std::move(info), [this](VkCommandBuffer c) { recordLpvPropagation(c); });
-    }
-
-    // The cascades, drawn again only when their light projections moved (the camera, the sun or
-    // a shadow setting changed).
-    if (shadows && shadows->drawn != lightMatrices) {
-        PassInfo info{"shadow",
-                      {{kShadowMaps, Access::DepthAttachmentClear},
-                       {kVertices, Access::VertexAttributeRead},
-                       {kIndices, Access::IndexRead}},
-                      {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
-        const uint32_t indexCount = uint32_t(indexCount_), res = uint32_t(shadows->resolution);
-        graph.addPass(std::move(info), [&g, shadows, lightMatrices, indexCount, res, setViewport](VkCommandBuffer c) {
-            for (size_t i = 0; i < lightMatrices.size(); ++i) {
-                VkClearValue clear{};
-                clear.depthStencil = {1.0f, 0};
-                VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-                rbi.renderPass = g.shadowPass.handle();
-                rbi.framebuffer = shadows->framebuffers[i].handle();
-                rbi.renderArea = {{0, 0}, {res, res}};
-                rbi.clearValueCount = 1;
-                rbi.pClearValues = &clear;
-                vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-                if (indexCount > 0) {
-                    setViewport(c, res, res);
-                    vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.shadowDepth.get());
-                    vkCmdPushConstants(c, g.shadowDepthLayout.handle(), VK_SHADER_STAGE_VERTEX_BIT, 0,
-                                       sizeof(glm::mat4), &lightMatrices[i]);
-                    const VkBuffer vb = g.vertices.handle();
-                    const VkDeviceSize offset = 0;
-                    vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
-                    vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-                    vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
-                }
-                vkCmdEndRenderPass(c);
-            }
-        });
-        shadows->drawn = lightMatrices;
-    }
-
-    // The terrain draw, shared by the frame and the planar reflection (which binds the mirrored
-    // camera's view set): its uses and bindings beyond the targets, and its recording.
-    const vk::DescriptorSet& lights = reflections ? (shadows ? reflections->shadowedLights[slotIndex]
-                                                             : reflections->lights[slotIndex])
-                                    : shadows ? slot.shadowedLights
-                                              : slot.lights;
-    VkBuffer attribute = VK_NULL_HANDLE;
-    const char* attributeName = nullptr;
-    if (probes) {
-        attribute = probes->light.handle();
-        attributeName = kProbeLight;
-    } else if (sunVisibility) {
-        attribute = g.sunVisibility.handle();
-        attributeName = kSunVisibility;
-    }
-    // The diagnostics views read the probe pass's second vec4 in place of the first: one
-    // attribute and one varying either way, so no view pays for the other.
-    const VkDeviceSize attributeOffset = probes && view.needs.probeDiagnostics ? 16 : 0;
-    const uint32_t indexCount = uint32_t(indexCount_);
-    const VkPipeline terrainHandle = terrainPipeline.get();
-    const VkDescriptorSet lightsSet = lights.handle();
-    const VkDescriptorSet lpvSetHandle = lpvSet ? slot.lpvSet.handle() : VK_NULL_HANDLE;
-    const auto terrainPass = [&](const char* name, std::vector<ResourceUse> targets, const vk::DescriptorSet& viewSet) {
-        PassInfo info{name, std::move(targets),
-                      concat(concat(viewSet.bindingNames(), lights.bindingNames()),
-                             {std::string("vertex:") + kVertices, std::string("index:") + kIndices})};
-        info.uses.push_back({kVertices, Access::VertexAttributeRead});
-        info.uses.push_back({kIndices, Access::IndexRead});
-        if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
-        if (reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
-        if (lpvVolumes) {
-            info.uses.push_back({kLpvLight, Access::FragmentStorageRead});
-            info.uses.push_back({kLpvGeometry, Access::FragmentStorageRead});
-        }
-        if (lpvSet) info.bindings = concat(info.bindings, slot.lpvSet.bindingNames());
-        if (attributeName) {
-            info.uses.push_back({attributeName, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + attributeName);
-        }
-        if (fog) info.bindings.push_back("fog");
-        return info;
-    };
-    const auto drawTerrain = [&g, terrainHandle, terrainLayout, lightsSet, lpvSetHandle, attribute, attributeOffset,
-                              indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {
-        if (indexCount == 0) return;
-        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainHandle);
-        const VkDescriptorSet sets[] = {viewSet, lightsSet, lpvSetHandle};
-        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, terrainLayout, TLX_SET_VIEW,
-                                lpvSetHandle != VK_NULL_HANDLE ? 3 : 2, sets, 0, nullptr);
-        const VkBuffer vb[2] = {g.vertices.handle(), attribute};
-        const VkDeviceSize offsets[2] = {0, attributeOffset};
-        vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
-        vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-        vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
-    };
-    // Begins the clearing render pass on a framebuffer, with the viewport over it.
-    const auto beginClearing = [&g, setViewport](VkCommandBuffer c, VkFramebuffer fb, uint32_t fw, uint32_t fh,
-                                                 glm::vec3 clearColor) {
-        VkClearValue clear[2];
-        clear[0].color = {{clearColor.x, clearColor.y, clearColor.z, 1.0f}};
-        clear[1].depthStencil = {0.0f, 0};  // reversed Z: the far plane
-        VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-        rbi.renderPass = g.clearPass.handle();
-        rbi.framebuffer = fb;
-        rbi.renderArea = {{0, 0}, {fw, fh}};
-        rbi.clearValueCount = 2;
-        rbi.pClearValues = clear;
-        vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-        setViewport(c, fw, fh);
-    };
-    {
-        PassInfo info = terrainPass("terrain", {{kColor, Access::ColorAttachmentClear}, {kDepth, Access::DepthAttachmentClear}},
-                                    slot.view);
-        const VkDescriptorSet viewSet = slot.view.handle();
-        graph.addPass(std::move(info), [drawTerrain, beginClearing, viewSet, bg, w, h, framebuffer](VkCommandBuffer c) {
-            beginClearing(c, framebuffer, w, h, bg);
-            drawTerrain(c, viewSet);
-            vkCmdEndRenderPass(c);
-        });
-    }
-
-    if (sky) {
-        PassInfo info{"sky",
-                      {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
-                      concat(slot.view.bindingNames(), slot.lights.bindingNames())};
-        if (fog) info.bindings.push_back("fog");
-        const VkPipeline pipeline = skyPipeline.get();
-        const VkDescriptorSet sets[] = {slot.view.handle(), slot.lights.handle()};
-        graph.addPass(std::move(info), [&g, pipeline, sets, beginDrawing](VkCommandBuffer c) {
-            beginDrawing(c);
-            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayouts[0].handle(), TLX_SET_VIEW, 2,
-                                    sets, 0, nullptr);
-            vkCmdDraw(c, 3, 1, 0, 0);
-            vkCmdEndRenderPass(c);
-        });
-    }
-
-    if (planarReflection) {
-        // The terrain and the sky seen from the mirrored camera, scene-linear, with everything below
-        // the water clipped by the oblique near plane.
-        PassInfo info = terrainPass("water-reflection",
-                                    {{kWaterReflection, Access::ColorAttachmentClear},
-                                     {kWaterReflectionDepth, Access::DepthAttachmentClear}},
-                                    slot.reflectionView);
-        info.bindings.push_back("sky");
-        const VkDescriptorSet viewSet = slot.reflectionView.handle(), skyLights = slot.lights.handle();
-        const VkFramebuffer fb = water->reflectionFramebuffer.handle();
-        const uint32_t rw = water->reflectionWidth, rh = water->reflectionHeight;
-        const VkPipeline skyHandle = skyPipeline.get();
-        graph.addPass(std::move(info), [&g, drawTerrain, beginClearing, setViewport, viewSet, skyLights, fb, rw, rh,
-                                        skyHandle](VkCommandBuffer c) {
-            beginClearing(c, fb, rw, rh, glm::vec3(0.0f));
-            drawTerrain(c, viewSet);
-            vkCmdEndRenderPass(c);
-            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-            rbi.renderPass = g.drawPass.handle();
-            rbi.framebuffer = fb;
-            rbi.renderArea = {{0, 0}, {rw, rh}};
-            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            setViewport(c, rw, rh);
-            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, skyHandle);
-            const VkDescriptorSet sets[] = {viewSet, skyLights};
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.terrainLayouts[0].handle(), TLX_SET_VIEW, 2,
-                                    sets, 0, nullptr);
-            vkCmdDraw(c, 3, 1, 0, 0);
-            vkCmdEndRenderPass(c);
-        });
-    }
-    if (waterShading) {
-        // What lies under the water as the frame drew it, for the refraction.
-        const VkImage source = g.target->color.handle(), dest = water->scene.handle();
-        graph.addPass({"water-scene", {{kColor, Access::TransferRead}, {kWaterScene, Access::TransferWrite}}, {}},
-                      [source, dest, w, h](VkCommandBuffer c) {
-                          VkImageCopy region{};
-                          region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.extent = {w, h, 1};
-                          vkCmdCopyImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
-                                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-                      });
-    }
-    if (water) {
-        const vk::DescriptorSet& waterSet = water->sets[slotIndex];
-        PassInfo info{"water",
-                      {{kColor, Access::ColorAttachmentDraw},
-                       {kDepth, Access::DepthAttachmentDraw},
-                       {kWaterVertices, Access::VertexAttributeRead},
-                       {kWaterIndices, Access::IndexRead},
-                       {kWaterReflection, Access::FragmentSampledRead},
-                       {kWaterScene, Access::FragmentSampledRead}},
-                      concat(concat(concat(slot.view.bindingNames(), lights.bindingNames()), waterSet.bindingNames()),
-                             {std::string("vertex:") + kWaterVertices, std::string("index:") + kWaterIndices})};
-        if (shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
-        if (reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
-        if (fog) info.bindings.push_back("fog");
-        const VkPipeline pipeline = waterPipeline.get();
-        const VkPipelineLayout layout = g.waterLayouts[size_t(lightsVariant)].handle();
-        const VkDescriptorSet sets[] = {slot.view.handle(), lightsSet, waterSet.handle()};
-        const VkBuffer vb = water->vertices.handle(), ib = water->indices.handle();
-        const uint32_t waterIndices = water->indexCount;
-        graph.addPass(std::move(info), [beginDrawing, pipeline, layout, sets, vb, ib, waterIndices](VkCommandBuffer c) {
-            beginDrawing(c);
-            if (waterIndices > 0) {
-                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-                vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW, 3, sets, 0, nullptr);
-                const VkDeviceSize offset = 0;
-                vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
-                vkCmdBindIndexBuffer(c, ib, 0, VK_INDEX_TYPE_UINT32);
-                vkCmdDrawIndexed(c, waterIndices, 1, 0, 0, 0);
-            }
-            vkCmdEndRenderPass(c);
-        });
-    }
-
-    if (drawMarkers || drawReflectionMarkers || drawLeaves) {
-        PassInfo info{"overlays",
-                      {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
-                      concat(slot.view.bindingNames(), slot.overlays.bindingNames())};
-        if (drawLeaves) {
-            info.uses.push_back({kLeaves, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + kLeaves);
-        }
-        if (drawMarkers) {
-            info.uses.push_back({kMarkers, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + kMarkers);
-        }
-        if (drawReflectionMarkers) {
-            info.uses.push_back({kReflectionMarkers, Access::VertexAttributeRead});
-            info.bindings.push_back(std::string("vertex:") + kReflectionMarkers);
-        }
-        const uint32_t leafCount = drawLeaves ? leafCount_ : 0, markerCount = drawMarkers ? markerCount_ : 0;
-        const vk::Buffer* reflectionMarkers = drawReflectionMarkers ? &g.reflections->markers : nullptr;
-        const uint32_t reflectionMarkerCount = drawReflectionMarkers ? g.reflections->markerCount : 0;
-        graph.addPass(std::move(info), [&g, &slot, leafCount, markerCount, reflectionMarkers, reflectionMarkerCount,
-                                        beginDrawing](VkCommandBuffer c) {
-            beginDrawing(c);
-            const VkDescriptorSet view = slot.view.handle(), overlay = slot.overlays.handle();
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
-                                    TLX_SET_VIEW, 1, &view, 0, nullptr);
-            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
-                                    TLX_SET_SUBSYSTEM, 1, &overlay, 0, nullptr);
-            auto draw = [&](VkPipeline pipeline, const vk::Buffer& instances, uint32_t vertices, uint32_t count) {
-                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-                const VkDeviceSize offset = 0;
-                const VkBuffer b = instances.handle();
-                vkCmdBindVertexBuffers(c, 0, 1, &b, &offset);
-                vkCmdDraw(c, vertices, count, 0, 0);
-            };
-            if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
-            if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
-            if (reflectionMarkerCount > 0) draw(g.markerPipeline.get(), *reflectionMarkers, 6, reflectionMarkerCount);
-            vkCmdEndRenderPass(c);
-        });
-    }
-
+    // The passes, in order; a feature that does not take part adds none.
+    g.graph.beginFrame();
+    features::addProbePass(f);
+    features::addLpvPropagationPass(f, [this](VkCommandBuffer c) { recordLpvPropagation(c); });
+    features::addShadowPass(f);
+    features::addTerrainPass(f);
+    features::addSkyPass(f);
+    features::addWaterPasses(f);
+    features::addOverlayPass(f);
     if (out.readback) {
         RenderTarget& t = *g.target;
-        graph.addPass({"readback", {{kColor, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
-                      [&t](VkCommandBuffer c) { t.readback.recordCopy(c, t.color.handle()); });
-        graph.addFinalUse({kReadback, Access::HostRead});
+        g.graph.addPass({"readback", {{kColor, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
+                        [&t](VkCommandBuffer c) { t.readback.recordCopy(c, t.color.handle()); });
+        g.graph.addFinalUse({kReadback, Access::HostRead});
     } else {
-        graph.importImage(kSwapchain, out.swapchainImage, VK_IMAGE_ASPECT_COLOR_BIT, 1,
-                          VK_PIPELINE_STAGE_TRANSFER_BIT);
+        g.graph.importImage(kSwapchain, out.swapchainImage, VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                            VK_PIPELINE_STAGE_TRANSFER_BIT);
         const VkImage source = g.target->color.handle(), dest = out.swapchainImage;
         const VkExtent2D dstExtent = out.extent;
-        graph.addPass({"present", {{kColor, Access::TransferRead}, {kSwapchain, Access::TransferWrite}}, {}},
-                      [source, dest, w, h, dstExtent](VkCommandBuffer c) {
-                          VkImageBlit blit{};
-                          blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          blit.srcOffsets[1] = {int32_t(w), int32_t(h), 1};
-                          blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          blit.dstOffsets[1] = {int32_t(dstExtent.width), int32_t(dstExtent.height), 1};
-                          vkCmdBlitImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
-                                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
-                      });
-        graph.addFinalUse({kSwapchain, Access::Present});
+        const uint32_t w = s.width, h = s.height;
+        g.graph.addPass({"present", {{kColor, Access::TransferRead}, {kSwapchain, Access::TransferWrite}}, {}},
+                        [source, dest, w, h, dstExtent](VkCommandBuffer c) {
+                            VkImageBlit blit{};
+                            blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                            blit.srcOffsets[1] = {int32_t(w), int32_t(h), 1};
+                            blit.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                            blit.dstOffsets[1] = {int32_t(dstExtent.width), int32_t(dstExtent.height), 1};
+                            vkCmdBlitImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
+                                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
+                        });
+        g.graph.addFinalUse({kSwapchain, Access::Present});
     }
-    slot.timestampsWritten = graph.execute(cb, slot.timestamps.get(), slot.timestamps ? kFrameTimestamps : 0);
+    FrameSlot& slot = f.slot;
+    slot.timestampsWritten = g.graph.execute(cb, slot.timestamps.get(), slot.timestamps ? kFrameTimestamps : 0);
     slot.timedPasses.clear();
-    for (const PassInfo& p : graph.lastFrame()) slot.timedPasses.push_back(p.name);
-    if (probes) probes->lightStale = false;
+    for (const PassInfo& p : g.graph.lastFrame()) slot.timedPasses.push_back(p.name);
+    if (f.probes) f.probes->lightStale = false;
     slot.recordMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - recordStart).count();
 }

@@ -31,6 +31,8 @@
 
 namespace terralux {
 
+struct RendererGpu;  // render/Frame.h
+struct Frame;
 struct ReflectionProbeSet;  // bake/ReflectionBake.h
 namespace lpv {
 class Volumes;  // lpv/Lpv.h
@@ -174,9 +176,9 @@ public:
     size_t probeBytes() const { return probeBytes_; }
 
 private:
-    struct Gpu;
     struct Output;
     void recordFrame(VkCommandBuffer cb, uint32_t slot, const RenderSettings& s, const Output& out);
+    void writeBlocks(Frame& f);
     void ensureTarget(uint32_t width, uint32_t height);
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
@@ -189,7 +191,7 @@ private:
     void readFrameTimings(uint32_t slot);  // the slot's last frame into timings_; its fence has passed
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
-    std::unique_ptr<Gpu> gpu_;
+    std::unique_ptr<RendererGpu> gpu_;
     int stride_ = 1;
     size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
     int volumeCount_ = 0;

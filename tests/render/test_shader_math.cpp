@@ -14,7 +14,7 @@
 
 #include "ShaderMath.h"
 #include "bake/SphericalHarmonics.h"
-#include "render/features/Packing.h"
+#include "render/features/Water.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
 #include "vk/Descriptors.h"

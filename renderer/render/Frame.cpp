@@ -1,0 +1,62 @@
+#include "render/Frame.h"
+
+#include "bake/HeightfieldTracer.h"
+#include "render/features/Lpv.h"
+#include "render/features/Probes.h"
+#include "render/features/Reflections.h"
+#include "render/features/Shadows.h"
+#include "render/features/Water.h"
+
+namespace terralux {
+
+namespace frame {
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
+void setViewport(VkCommandBuffer cb, uint32_t width, uint32_t height) {
+    VkViewport vp{0, 0, float(width), float(height), 0.0f, 1.0f};
+    VkRect2D sc{{0, 0}, {width, height}};
+    vkCmdSetViewport(cb, 0, 1, &vp);
+    vkCmdSetScissor(cb, 0, 1, &sc);
+}
+
+}  // namespace frame
+
+RendererGpu::~RendererGpu() = default;
+
+int Frame::lightsVariant() const {
+    return (shadows ? frame::kShadowedLights : 0) | (reflections ? frame::kReflectedLights : 0);
+}
+
+const vk::DescriptorSet& Frame::lights() const {
+    if (reflections) return shadows ? reflections->shadowedLights[slotIndex] : reflections->lights[slotIndex];
+    return shadows ? slot.shadowedLights : slot.lights;
+}
+
+void Frame::beginDrawing(VkCommandBuffer cb) const {
+    VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    rbi.renderPass = g.drawPass.handle();
+    rbi.framebuffer = framebuffer;
+    rbi.renderArea = {{0, 0}, {width, height}};
+    vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+    frame::setViewport(cb, width, height);
+}
+
+void Frame::beginClearing(VkCommandBuffer cb, VkFramebuffer fb, uint32_t fw, uint32_t fh, glm::vec3 clearColor) const {
+    VkClearValue clear[2];
+    clear[0].color = {{clearColor.x, clearColor.y, clearColor.z, 1.0f}};
+    clear[1].depthStencil = {0.0f, 0};  // reversed Z: the far plane
+    VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    rbi.renderPass = g.clearPass.handle();
+    rbi.framebuffer = fb;
+    rbi.renderArea = {{0, 0}, {fw, fh}};
+    rbi.clearValueCount = 2;
+    rbi.pClearValues = clear;
+    vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+    frame::setViewport(cb, fw, fh);
+}
+
+}  // namespace terralux

@@ -1,0 +1,60 @@
+#include "render/features/Atmosphere.h"
+
+#include "ShaderBinaries.h"
+
+namespace terralux::features {
+
+using namespace frame;
+
+blocks::SunSkyBlock packSunSky(const RenderSettings& s) {
+    blocks::SunSkyBlock sunSky;
+    sunSky.sunDirection = s.sun.direction;
+    sunSky.sunAngularRadius = s.sun.angularRadius;
+    sunSky.sunIlluminance = s.sun.illuminance;
+    for (int k = 0; k < 9; ++k) sunSky.skySh[k] = glm::vec4(s.skySh.c[size_t(k)], 0.0f);
+    return sunSky;
+}
+
+blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog) {
+    blocks::AtmosphereBlock atmosphere;
+    atmosphere.fogDensity = float(fog.density);
+    atmosphere.fogFalloff = float(fog.scaleHeight > 0.0 ? 1.0 / fog.scaleHeight : 0.0);
+    atmosphere.fogBase = float(fog.baseHeight.value_or(0.0));
+    atmosphere.fogAnisotropy = float(fog.anisotropy);
+    atmosphere.fogColor = fog.color.value_or(glm::vec3(0.0f));
+    atmosphere.sunInscatter = float(fog.inscatter);
+    return atmosphere;
+}
+
+VkPipeline skyPipeline(Frame& f) {
+    vk::UniquePipeline& pipeline = f.fog ? f.g.skyFog : f.g.skyPlain;
+    if (!pipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::fullscreenVert();
+        d.frag = shaders::skyBackgroundFrag();
+        d.fragConstants = {f.fog ? 1u : 0u};
+        d.depthWrite = false;
+        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.terrainLayouts[0].handle(), d);
+    }
+    return pipeline.get();
+}
+
+void addSkyPass(Frame& f) {
+    if (!f.sky) return;
+    PassInfo info{"sky",
+                  {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
+                  concat(f.slot.view.bindingNames(), f.slot.lights.bindingNames())};
+    if (f.fog) info.bindings.push_back("fog");
+    const VkPipeline pipeline = skyPipeline(f);
+    const VkDescriptorSet sets[] = {f.slot.view.handle(), f.slot.lights.handle()};
+    f.g.graph.addPass(std::move(info), [&f, pipeline, sets](VkCommandBuffer c) {
+        f.beginDrawing(c);
+        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, f.g.terrainLayouts[0].handle(), TLX_SET_VIEW, 2,
+                                sets, 0, nullptr);
+        vkCmdDraw(c, 3, 1, 0, 0);
+        vkCmdEndRenderPass(c);
+    });
+}
+
+}  // namespace terralux::features

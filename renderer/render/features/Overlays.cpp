@@ -1,0 +1,95 @@
+#include "render/features/Overlays.h"
+
+#include "ShaderBinaries.h"
+#include "render/features/Reflections.h"
+
+namespace terralux::features {
+
+using namespace frame;
+
+blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels) {
+    blocks::OverlayBlock overlay;
+    overlay.smallestLeaf = smallestLeaf;
+    overlay.smallestLeafPixels = smallestLeafPixels;
+    overlay.drawValid = s.showProbePositions ? 1 : 0;
+    overlay.drawMovedRejected = 1;
+    return overlay;
+}
+
+namespace {
+
+// Pipelines read one vec4 per instance: a marker (xyz, w its kind) or a leaf (min corner, edge).
+void ensurePipelines(Frame& f) {
+    RendererGpu& g = f.g;
+    const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
+    const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
+    if ((f.drawMarkers || f.drawReflectionMarkers) && !g.markerPipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::markersVert();
+        d.frag = shaders::markersFrag();
+        d.bindings = {instance};
+        d.attributes = {record};
+        d.depthWrite = false;
+        g.markerPipeline = vk::createGraphicsPipeline(f.ctx, g.drawPass.handle(), g.overlayLayout.handle(), d);
+    }
+    if (f.drawLeaves && !g.leafPipeline) {
+        // The 12 edges of each leaf box as a line list.
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::leavesVert();
+        d.frag = shaders::markersFrag();
+        d.bindings = {instance};
+        d.attributes = {record};
+        d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
+        d.depthWrite = false;
+        g.leafPipeline = vk::createGraphicsPipeline(f.ctx, g.drawPass.handle(), g.overlayLayout.handle(), d);
+    }
+}
+
+}  // namespace
+
+void addOverlayPass(Frame& f) {
+    if (!f.drawMarkers && !f.drawReflectionMarkers && !f.drawLeaves) return;
+    ensurePipelines(f);
+    RendererGpu& g = f.g;
+    PassInfo info{"overlays",
+                  {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
+                  concat(f.slot.view.bindingNames(), f.slot.overlays.bindingNames())};
+    if (f.drawLeaves) {
+        info.uses.push_back({kLeaves, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + kLeaves);
+    }
+    if (f.drawMarkers) {
+        info.uses.push_back({kMarkers, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + kMarkers);
+    }
+    if (f.drawReflectionMarkers) {
+        info.uses.push_back({kReflectionMarkers, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + kReflectionMarkers);
+    }
+    const uint32_t leafCount = f.drawLeaves ? f.leafCount : 0, markerCount = f.drawMarkers ? f.markerCount : 0;
+    const vk::Buffer* reflectionMarkers = f.drawReflectionMarkers ? &g.reflections->markers : nullptr;
+    const uint32_t reflectionMarkerCount = f.drawReflectionMarkers ? g.reflections->markerCount : 0;
+    g.graph.addPass(std::move(info), [&f, leafCount, markerCount, reflectionMarkers,
+                                      reflectionMarkerCount](VkCommandBuffer c) {
+        RendererGpu& g = f.g;
+        f.beginDrawing(c);
+        const VkDescriptorSet view = f.slot.view.handle(), overlay = f.slot.overlays.handle();
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
+                                TLX_SET_VIEW, 1, &view, 0, nullptr);
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.overlayLayout.handle(),
+                                TLX_SET_SUBSYSTEM, 1, &overlay, 0, nullptr);
+        auto draw = [&](VkPipeline pipeline, const vk::Buffer& instances, uint32_t vertices, uint32_t count) {
+            vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+            const VkDeviceSize offset = 0;
+            const VkBuffer b = instances.handle();
+            vkCmdBindVertexBuffers(c, 0, 1, &b, &offset);
+            vkCmdDraw(c, vertices, count, 0, 0);
+        };
+        if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
+        if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
+        if (reflectionMarkerCount > 0) draw(g.markerPipeline.get(), *reflectionMarkers, 6, reflectionMarkerCount);
+        vkCmdEndRenderPass(c);
+    });
+}
+
+}  // namespace terralux::features

@@ -1,0 +1,80 @@
+#include "render/features/Shadows.h"
+
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "ShaderBinaries.h"
+
+namespace terralux::features {
+
+using namespace frame;
+
+blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Cascade>& cascades,
+                                const CascadeRange& range, int resolution) {
+    blocks::ShadowBlock block;
+    for (size_t i = 0; i < cascades.size(); ++i) {
+        block.lightViewProj[i] = cascades[i].lightViewProj;
+        block.ends[int(i)] = float(cascades[i].farDistance);
+        block.texel[int(i)] = cascades[i].texelSize;
+        block.depthRange[int(i)] = cascades[i].depthRange;
+    }
+    block.forward = glm::normalize(s.camera.target - s.camera.position());
+    block.nearDepth = float(range.nearDistance);
+    block.depthBias = float(s.shadows.depthBias);
+    block.normalBias = float(s.shadows.normalBias);
+    block.tanSunRadius = std::tan(s.sun.angularRadius);
+    block.mapResolution = float(resolution);
+    block.cascadeCount = int(cascades.size());
+    block.filterMode = int(s.shadows.filter);
+    return block;
+}
+
+void addShadowPass(Frame& f) {
+    ShadowResources* shadows = f.shadows;
+    if (!shadows || shadows->drawn == f.lightMatrices) return;
+    RendererGpu& g = f.g;
+    if (!g.shadowDepth) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::shadowDepthVert();
+        d.bindings = {kMeshBinding};
+        d.attributes = {kMeshPosition};
+        d.colorAttachments = 0;
+        d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+        g.shadowDepth = vk::createGraphicsPipeline(f.ctx, g.shadowPass.handle(), g.shadowDepthLayout.handle(), d);
+    }
+    PassInfo info{"shadow",
+                  {{kShadowMaps, Access::DepthAttachmentClear},
+                   {kVertices, Access::VertexAttributeRead},
+                   {kIndices, Access::IndexRead}},
+                  {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
+    const uint32_t indexCount = f.indexCount, res = uint32_t(shadows->resolution);
+    g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, res](VkCommandBuffer c) {
+        for (size_t i = 0; i < lightMatrices.size(); ++i) {
+            VkClearValue clear{};
+            clear.depthStencil = {1.0f, 0};
+            VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+            rbi.renderPass = g.shadowPass.handle();
+            rbi.framebuffer = shadows->framebuffers[i].handle();
+            rbi.renderArea = {{0, 0}, {res, res}};
+            rbi.clearValueCount = 1;
+            rbi.pClearValues = &clear;
+            vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
+            if (indexCount > 0) {
+                setViewport(c, res, res);
+                vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.shadowDepth.get());
+                vkCmdPushConstants(c, g.shadowDepthLayout.handle(), VK_SHADER_STAGE_VERTEX_BIT, 0,
+                                   sizeof(glm::mat4), &lightMatrices[i]);
+                const VkBuffer vb = g.vertices.handle();
+                const VkDeviceSize offset = 0;
+                vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
+                vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+                vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+            }
+            vkCmdEndRenderPass(c);
+        }
+    });
+    shadows->drawn = f.lightMatrices;
+}
+
+}  // namespace terralux::features

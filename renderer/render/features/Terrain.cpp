@@ -1,0 +1,164 @@
+#include "render/features/Terrain.h"
+
+#include <glm/matrix.hpp>
+
+#include "ShaderBinaries.h"
+#include "render/features/Probes.h"
+#include "render/features/Reflections.h"
+#include "render/features/Lpv.h"
+#include "render/features/Shadows.h"
+
+namespace terralux::features {
+
+using namespace frame;
+
+blocks::CameraBlock packCamera(const RenderSettings& s, float extent, const DebugView& view) {
+    const float aspect = float(s.width) / float(s.height);
+    blocks::CameraBlock camera;
+    camera.viewProj = s.camera.viewProjection(aspect, extent);
+    camera.invViewProj = glm::inverse(camera.viewProj);
+    camera.position = s.camera.position();
+    camera.farPlane = s.camera.planes(extent).farPlane;
+    camera.viewportSize = glm::vec2(float(s.width), float(s.height));
+    camera.invViewportSize = 1.0f / camera.viewportSize;
+    camera.debugView = s.debugView;
+    camera.linearOutput = s.linearOutput ? 1 : 0;
+    // What the per-vertex attribute holds: 2 the traced sun visibility, 1 the probe diagnostics,
+    // 0 probe light.
+    camera.vertexAttribute = view.needs.sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0;
+    return camera;
+}
+
+blocks::CameraBlock packMirroredCamera(const RenderSettings& s, const blocks::CameraBlock& camera, float extent,
+                                       float level, float width, float height) {
+    const float aspect = float(s.width) / float(s.height);
+    blocks::CameraBlock mirrored = camera;
+    mirrored.viewProj = s.camera.reflectedViewProjection(aspect, extent, level);
+    mirrored.invViewProj = glm::inverse(mirrored.viewProj);
+    mirrored.position = s.camera.reflectedPosition(level);
+    mirrored.viewportSize = glm::vec2(width, height);
+    mirrored.invViewportSize = 1.0f / mirrored.viewportSize;
+    mirrored.debugView = kViewBeauty;
+    mirrored.linearOutput = 1;
+    return mirrored;
+}
+
+blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& in) {
+    blocks::SurfaceBlock surface;
+    surface.albedo = s.albedo;
+    surface.albedoFromMap = in.albedoMap ? 1.0f : 0.0f;
+    surface.roughness = float(s.terrain.roughness);
+    surface.exposure = s.exposure;
+    surface.specularAA = s.terrain.specularAA ? 1.0f : 0.0f;
+    surface.roughnessFloor = float(kRoughnessFloor);
+    surface.footprintMin = in.footprintMin;
+    surface.invFootprintSpan = glm::vec2(in.footprintSpan.x > 0.0f ? 1.0f / in.footprintSpan.x : 0.0f,
+                                         in.footprintSpan.y > 0.0f ? 1.0f / in.footprintSpan.y : 0.0f);
+    surface.normalAoMapSize = in.normalAoMapSize;
+    surface.albedoMapSize = in.albedoMapSize;
+    surface.aoOnSky = s.ao.enabled && in.ao ? 1.0f : 0.0f;
+    surface.aoOnProbes = s.ao.enabled ? float(s.ao.strength) : 0.0f;
+    surface.probeAoLevel = in.probeAoLevel;
+    const DetailSettings& d = s.detail;
+    surface.detailStrength = d.enabled ? float(d.normalStrength) : 0.0f;
+    surface.detailScale = d.enabled ? float(d.scale) : 1.0f;
+    surface.detailFade = d.enabled ? float(d.fadeDistance) : 0.0f;
+    surface.albedoVariation = d.enabled ? float(d.albedoVariation) : 0.0f;
+    return surface;
+}
+
+TerrainDraw terrainDraw(Frame& f) {
+    RendererGpu& g = f.g;
+    // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
+    // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
+    const bool vertexAttribute = f.probes || f.sunVisibility;
+    const bool shadows = f.shadows, reflections = f.reflections;
+    const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
+                        (f.fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0) |
+                        (f.lpvVolumes ? kLpvVariant : 0) | (f.localLights ? kLocalLightsVariant : 0);
+    const size_t lightsVariant = size_t(f.lightsVariant());
+    const VkPipelineLayout layout =
+        f.lpvSet ? g.terrainLpvLayouts[lightsVariant].handle() : g.terrainLayouts[lightsVariant].handle();
+    vk::UniquePipeline& pipeline = g.terrain[variant];
+    if (!pipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
+        if (f.lpvSet)
+            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionLpvFrag() : shaders::terrainReflectionLpvFrag())
+                                 : (shadows ? shaders::terrainShadowLpvFrag() : shaders::terrainLpvFrag());
+        else
+            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
+                                 : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
+        d.fragConstants = {f.fog ? 1u : 0u};
+        if (f.lpvSet) d.fragConstants.insert(d.fragConstants.end(), {f.lpvVolumes ? 1u : 0u, f.localLights ? 1u : 0u});
+        d.bindings = {kMeshBinding};
+        d.attributes = {kMeshPosition, kMeshNormal};
+        if (vertexAttribute) {
+            d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
+            d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
+        }
+        pipeline = vk::createGraphicsPipeline(f.ctx, g.clearPass.handle(), layout, d);
+    }
+    VkBuffer attribute = VK_NULL_HANDLE;
+    if (f.probes)
+        attribute = f.probes->light.handle();
+    else if (f.sunVisibility)
+        attribute = g.sunVisibility.handle();
+    // The diagnostics views read the probe pass's second vec4 in place of the first: one
+    // attribute and one varying either way, so no view pays for the other.
+    const VkDeviceSize attributeOffset = f.probes && f.view.needs.probeDiagnostics ? 16 : 0;
+    const VkPipeline handle = pipeline.get();
+    const VkDescriptorSet lights = f.lights().handle();
+    const VkDescriptorSet lpvSet = f.lpvSet ? f.slot.lpvSet.handle() : VK_NULL_HANDLE;
+    const VkBuffer vertices = g.vertices.handle(), indices = g.indices.handle();
+    const uint32_t indexCount = f.indexCount;
+    return [handle, layout, lights, lpvSet, vertices, indices, attribute, attributeOffset,
+            indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {
+        if (indexCount == 0) return;
+        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, handle);
+        const VkDescriptorSet sets[] = {viewSet, lights, lpvSet};
+        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW,
+                                lpvSet != VK_NULL_HANDLE ? 3 : 2, sets, 0, nullptr);
+        const VkBuffer vb[2] = {vertices, attribute};
+        const VkDeviceSize offsets[2] = {0, attributeOffset};
+        vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
+        vkCmdBindIndexBuffer(c, indices, 0, VK_INDEX_TYPE_UINT32);
+        vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+    };
+}
+
+PassInfo terrainPassInfo(const Frame& f, const char* name, std::vector<ResourceUse> targets,
+                         const vk::DescriptorSet& viewSet) {
+    PassInfo info{name, std::move(targets),
+                  concat(concat(viewSet.bindingNames(), f.lights().bindingNames()),
+                         {std::string("vertex:") + kVertices, std::string("index:") + kIndices})};
+    info.uses.push_back({kVertices, Access::VertexAttributeRead});
+    info.uses.push_back({kIndices, Access::IndexRead});
+    if (f.shadows) info.uses.push_back({kShadowMaps, Access::FragmentSampledRead});
+    if (f.reflections) info.uses.push_back({kReflectionRecords, Access::FragmentStorageRead});
+    if (f.lpvVolumes) {
+        info.uses.push_back({kLpvLight, Access::FragmentStorageRead});
+        info.uses.push_back({kLpvGeometry, Access::FragmentStorageRead});
+    }
+    if (f.lpvSet) info.bindings = concat(info.bindings, f.slot.lpvSet.bindingNames());
+    const char* attribute = f.probes ? kProbeLight : f.sunVisibility ? kSunVisibility : nullptr;
+    if (attribute) {
+        info.uses.push_back({attribute, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + attribute);
+    }
+    if (f.fog) info.bindings.push_back("fog");
+    return info;
+}
+
+void addTerrainPass(Frame& f) {
+    PassInfo info = terrainPassInfo(f, "terrain", {{kColor, Access::ColorAttachmentClear}, {kDepth, Access::DepthAttachmentClear}},
+                                    f.slot.view);
+    const VkDescriptorSet viewSet = f.slot.view.handle();
+    f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f), viewSet](VkCommandBuffer c) {
+        f.beginClearing(c, f.framebuffer, f.width, f.height, f.background);
+        draw(c, viewSet);
+        vkCmdEndRenderPass(c);
+    });
+}
+
+}  // namespace terralux::features

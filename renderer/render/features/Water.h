@@ -1,0 +1,44 @@
+#pragma once
+// The water plane: its field and mesh, its block, and its passes (the planar reflection, the copy
+// of the frame under it, the water surface).
+
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "render/Frame.h"
+
+namespace terralux {
+
+// Present only while the scene has water. The field and mesh follow the level; the reflection
+// target and the copy of the frame follow the frame's size.
+struct WaterResources {
+    float level = 0.0f, margin = 0.0f;
+    glm::ivec2 fieldSize{1, 1};
+    vk::Image field;  // RG16F: depth below the level (negative on land), distance to shore
+    vk::Buffer vertices, indices;
+    uint32_t indexCount = 0;
+    float spacing = 1.0f;  // metres between mesh vertices
+    uint32_t width = 0, height = 0, reflectionWidth = 0, reflectionHeight = 0;
+    vk::Image reflection, reflectionDepth, scene;
+    vk::Framebuffer reflectionFramebuffer;
+    std::vector<vk::Buffer> blocks;        // per frame slot: the WaterBlock
+    std::vector<vk::DescriptorSet> sets;   // per frame slot: block, reflection, scene, field
+};
+
+namespace features {
+
+// The water's field and mesh as setWater built them.
+struct WaterInputs {
+    float level = 0.0f;           // engine y
+    float shoreFadeDistance = 0;  // metres (water::shoreFadeDistance)
+    glm::vec2 fieldSize{1.0f};    // texels of the depth/shore field
+    float meshSpacing = 1.0f;     // metres between the water mesh's vertices
+};
+blocks::WaterBlock packWater(const RenderSettings& s, const WaterInputs& in);
+// The planar reflection (terrain and sky from the mirrored camera), the copy of the frame the
+// water refracts, and the water surface; each only where the frame needs it.
+void addWaterPasses(Frame& f);
+
+}  // namespace features
+}  // namespace terralux
