@@ -766,8 +766,316 @@ ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettin
     return out;
 }
 
+// What a bake will do, decided before it traces a ray: every volume's placement (an adaptive
+// one geometrically, for the progress shares and early errors; it is placed again, with its
+// refinement, when it bakes) and its error map's points, the reflection probes (placed first, so
+// their settings fail before any work), and the rays and cache resolution they imply. The bake
+// and its estimate read the same plan.
+struct BakePlan {
+    std::vector<ProbeLayout> layouts;  // per enabled volume
+    std::vector<size_t> mapPoints;     // per enabled volume: its error map's points
+    size_t totalProbes = 0;            // placed probes, every volume's
+    size_t totalWork = 0;              // probe bakes progress counts: probes and map points
+    std::optional<ReflectionLayout> reflections;
+    uint64_t plannedRays = 0;          // plannedProbeRays and the reflection probes' rays
+    int cacheResolution = 0;           // cacheResolutionFor those rays
+};
+
+BakePlan planBake(const SceneDescription& scene, const BakeSetup& setup) {
+    const Heightfield& hf = setup.terrain.heightfield;
+    BakePlan p;
+    for (const auto* v : setup.volumes) {
+        p.layouts.push_back(placeProbes(*v, hf));
+        const ProbeLayout& layout = p.layouts.back();
+        requireProbes(scene, *v, layout);
+        p.mapPoints.push_back(
+            errorMapGrid(layout, hf, scene.bake.errorMapResolution, errorMapHeight(*v, layout)).error.size());
+        p.totalProbes += layout.positions.size();
+        p.totalWork += layout.positions.size() + p.mapPoints.back();
+    }
+    if (scene.reflectionProbes.enabled) {
+        p.reflections = placeReflectionProbes(scene.reflectionProbes, hf);
+        simvxProbes(scene.reflectionProbes.simvxSubset, p.reflections->count());
+    }
+    p.plannedRays = plannedProbeRays(setup, p.layouts, p.mapPoints);
+    if (p.reflections) {
+        const ReflectionProbeSettings& rs = scene.reflectionProbes;
+        p.plannedRays += uint64_t(p.reflections->count()) * 6 * uint64_t(rs.resolution) * uint64_t(rs.resolution) *
+                         uint64_t(rs.rayCount);
+    }
+    p.cacheResolution = cacheResolutionFor(hf, setup.q, p.plannedRays);
+    return p;
+}
+
+// One volume's probes as traced: a grid's (or the reference tracer's), or an adaptive volume's
+// after its refinement, with the interpolation error it measured.
+struct VolumeTrace {
+    ProbeBake bake;
+    std::optional<AdaptiveRefinement> refinement;
+    std::optional<InterpolationError> interpolation;
+    uint64_t interpolationRays = 0;
+};
+
+// `phase` names the step for the progress the control reports; an adaptive volume replaces
+// `layout` with its refined one.
+VolumeTrace traceVolume(const BakeSetup& setup, const IrradianceCache* cache, const ProbeVolumeSettings& v,
+                        ProbeLayout& layout, uint64_t seed, const BakeControl& c, std::string& phase) {
+    const Heightfield& hf = setup.terrain.heightfield;
+    const int rays = raysOf(setup, v);
+    VolumeTrace t;
+    if (v.placement != ProbePlacement::Adaptive) {
+        t.bake = setup.referenceMode
+                     ? referenceProbes(setup.lighting, setup.q.bounces, layout.positions, layout.valid, rays, seed, c)
+                     : bakeProbes(setup.lighting, cache, setup.q.bounces, layout.positions, layout.valid, rays, seed, c);
+        return t;
+    }
+    const ProbeBaker baker = keyedBaker(setup, cache, rays, seed, c);
+    AdaptiveBake a = bakeAdaptive(v, hf, baker, [&](int round, size_t leaves) {
+        phase = "refining '" + v.name + "' (round " + std::to_string(round) + ", " + std::to_string(leaves) +
+                " leaves)";
+    });
+    layout = std::move(a.layout);
+    t.bake = std::move(a.bake);
+    t.refinement = a.refinement;
+    phase = "interpolation error '" + v.name + "'";
+    const ProbeBaker truth = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
+        ProbeBake b = baker(p, k);
+        t.interpolationRays += b.rays;
+        return b;
+    };
+    t.interpolation = measureInterpolationError(layout, t.bake.sh, hf, truth, kInterpolationPoints, seed,
+                                                v.adaptive.tolerance);
+    return t;
+}
+
+// What a volume's report says of its probes before any comparison: placement, counts, rays,
+// standard error and validity.
+nlohmann::json volumeReport(const BakeSetup& setup, const ProbeVolumeSettings& v,
+                            const ProbeLayout& layout, const VolumeTrace& t, double seconds) {
+    nlohmann::json vr = {
+        {"name", v.name},
+        {"placement", placementName(v.placement)},
+        {"probes", layout.validCount()},
+        {"invalid_probes", layout.positions.size() - layout.validCount()},
+        {"rays_per_probe", raysOf(setup, v)},
+        {"rays", t.bake.rays},
+        {"time_s", seconds},
+        {"fallback_blend_distance", layout.fallbackBlendDistance},
+        {"moved_probes", layout.octree ? layout.octree->moved : size_t(0)},
+        {"borrowed_cells", layout.octree ? layout.octree->borrowed : layout.borrowedCells},
+        {"split_for_inside", layout.octree ? layout.octree->splitForInside : size_t(0)},
+    };
+    if (layout.octree) {
+        vr["adaptive"] = adaptiveReport(*layout.octree, t.refinement);
+        vr["interpolation_error"] = interpolationReport(*t.interpolation, v.adaptive.tolerance, t.interpolationRays);
+    } else {
+        vr["probe_grid"] = {layout.probeDims[0], layout.probeDims[1], layout.probeDims[2]};
+    }
+    std::vector<float> se, below;
+    size_t fromBelow = 0;
+    for (size_t i = 0; i < layout.valid.size(); ++i)
+        if (layout.valid[i]) {
+            se.push_back(t.bake.standardError[i]);
+            below.push_back(t.bake.fromBelowShare[i]);
+            fromBelow += t.bake.fromBelowShare[i] > 0.0f;
+        }
+    vr["standard_error"] = stats(se);
+    vr["validity"] = {{"rays_from_below", stats(below)},
+                      {"probes_with_rays_from_below", fromBelow},
+                      {"lifted_clear_of_surface", layout.liftedForClearance},
+                      {"max_lift_m", layout.maxLift}};
+    // Probes at or below the water level do not see the water (docs/lighting.md, "Water").
+    if (setup.lighting.water) {
+        size_t under = 0;
+        for (size_t i = 0; i < layout.valid.size(); ++i)
+            under += layout.valid[i] && !(layout.positions[i].y > setup.lighting.water->level);
+        vr["probes_under_water"] = under;
+    }
+    return vr;
+}
+
+// The probes against the reference path tracer at the reference preset's rays, as written (after
+// deringing). A reference bake's probes are the tracer's own: only their standard error speaks.
+nlohmann::json referenceReport(const BakeSetup& setup, const ProbeLayout& layout, const std::vector<sh::ShRgb>& sh,
+                               uint64_t seed, const BakeControl& c, uint64_t& referenceRays) {
+    if (setup.referenceMode)
+        return {{"mean", nullptr}, {"p95", nullptr}, {"max", nullptr}, {"note", kReferenceNote}};
+    const int refRays = qualityPreset(QualityPreset::Reference).rays;
+    const auto start = Clock::now();
+    const ProbeBake ref = referenceProbes(setup.lighting, setup.q.bounces, layout.positions, layout.valid, refRays,
+                                          seed ^ 0xF00Dull, c);
+    referenceRays += ref.rays;
+    const ErrorStats err = compareToReference(sh, ref.sh, layout.valid);
+    return {{"mean", err.mean},
+            {"p95", err.p95},
+            {"max", err.max},
+            {"reference_rays_per_probe", refRays},
+            {"reference_path_length",
+             setup.q.bounces == 0 ? 0 : referencePathLength(setup.lighting.maxAlbedo())},
+            {"reference_rays", ref.rays},
+            {"reference_time_s", secondsSince(start)}};
+}
+
+// A volume's interpolation-error map (the probes as the engine will read them, against the truth
+// at each point), and, where its error is high on a terrain grid without a target, a denser grid
+// measured against the same truths.
+struct VolumeErrorMap {
+    ErrorMapStats stats;
+    uint64_t rays = 0;             // the map's own
+    double seconds = 0.0;
+    std::optional<GridSuggestion> suggestion;
+};
+
+VolumeErrorMap measureVolumeErrorMap(const SceneDescription& scene, const BakeSetup& setup, const IrradianceCache* cache,
+                                     const ProbeVolumeSettings& v, size_t volumeIndex, const ProbeLayout& layout,
+                                     const std::vector<sh::ShRgb>& sh, bool hasTarget, uint64_t seed,
+                                     const BakeControl& mc, std::string& phase, ErrorMap& map) {
+    const Heightfield& hf = setup.terrain.heightfield;
+    const int rays = raysOf(setup, v);
+    const auto start = Clock::now();
+    VolumeErrorMap out;
+    // The truth gets the same window as the probes, so the map shows interpolation alone.
+    const ProbeBaker counted =
+        deringedBaker(keyedBaker(setup, cache, rays, seed, mc), scene.bake.deringing, &out.rays);
+    std::unordered_map<size_t, sh::ShRgb> truths;
+    map = measureErrorMap(layout, sh, hf, counted, scene.bake.errorMapResolution, errorMapHeight(v, layout), seed,
+                          &truths);
+    out.stats = errorMapStats(map);
+    if (errorIsHigh(out.stats) && v.placement == ProbePlacement::Terrain && !hasTarget) {
+        phase = "measuring a suggestion for '" + v.name + "'";
+        auto measure = [&](const ProbeVolumeSettings& candidate, size_t& probes,
+                           uint64_t& suggestionRays) -> std::optional<ErrorMapStats> {
+            ProbeLayout trial;
+            try {
+                trial = placeProbes(candidate, hf);
+            } catch (const PlacementError&) {
+                return std::nullopt;
+            }
+            probes = trial.validCount();
+            ProbeBake b = setup.referenceMode
+                              ? referenceProbes(setup.lighting, setup.q.bounces, trial.positions, trial.valid, rays,
+                                                seed, mc)
+                              : bakeProbes(setup.lighting, cache, setup.q.bounces, trial.positions, trial.valid,
+                                           rays, seed, mc);
+            suggestionRays += b.rays;
+            if (scene.bake.deringing)
+                for (size_t i = 0; i < b.sh.size(); ++i)
+                    if (trial.valid[i]) sh::deringIrradiance(b.sh[i]);
+            const uint64_t before = out.rays;
+            const ErrorMap m = measureErrorMap(trial, b.sh, hf, counted, scene.bake.errorMapResolution,
+                                               errorMapHeight(candidate, trial), seed, &truths);
+            suggestionRays += out.rays - before;
+            out.rays = before;
+            return errorMapStats(m);
+        };
+        out.suggestion = denserGrid(v, volumeIndex, layout, out.stats, measure);
+    }
+    out.seconds = secondsSince(start);
+    return out;
+}
+
+// The warnings a bake's volumes earn: probes lifted clear of slopes the tracer cannot resolve,
+// and probes that see the terrain from below.
+void volumeWarnings(const SceneDescription& scene, const std::vector<const ProbeVolumeSettings*>& volumes,
+                    const nlohmann::json& volumeReports, std::vector<std::string>& warnings) {
+    // A probe above the surface cannot meet the terrain's underside: one that does sits where the
+    // tracer's surface and the placement's disagree (terrain far steeper than any real DEM, as
+    // with a large terrain.vertical_scale), and its light is wrong. None does on the shared DEMs.
+    for (size_t vi = 0; vi < volumes.size(); ++vi) {
+        const nlohmann::json& vr = volumeReports[vi];
+        const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
+        const size_t lifted = vr["validity"]["lifted_clear_of_surface"].get<size_t>();
+        if (lifted > 0) {
+            std::ostringstream w;
+            w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << lifted << " of "
+              << vr["probes"].get<size_t>() << " probes stand higher than height_offset (up to "
+              << std::fixed << std::setprecision(1) << vr["validity"]["max_lift_m"].get<double>()
+              << " m) to clear slopes too steep for the tracer to resolve at " << std::defaultfloat
+              << std::setprecision(6) << volumes[vi]->heightOffset << " m";
+            if (scene.terrain.verticalScale != 1.0) w << " (terrain.vertical_scale " << scene.terrain.verticalScale << ")";
+            warnings.push_back(w.str());
+        }
+        const size_t below = vr["validity"]["probes_with_rays_from_below"].get<size_t>();
+        if (below == 0) continue;
+        std::ostringstream w;
+        w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << below << " of "
+          << vr["probes"].get<size_t>() << " probes see the terrain from below (up to "
+          << percent(vr["validity"]["rays_from_below"]["max"].get<double>())
+          << " of their rays), so their light is wrong (debug view 54, probe validity); the surface is steeper than "
+             "their clearance";
+        if (scene.terrain.verticalScale != 1.0) w << " at terrain.vertical_scale " << scene.terrain.verticalScale;
+        w << ": raise probe_volumes[" << index << "].height_offset";
+        if (scene.terrain.verticalScale > 1.0) w << " or lower terrain.vertical_scale";
+        warnings.push_back(w.str());
+    }
+}
+
+// bake.target_error's choice judged on the bake's own probes, every volume's, not only the pilot's.
+nlohmann::json samplingReport(const SamplingChoice& sampling, const nlohmann::json& volumeReports,
+                              std::vector<std::string>& warnings) {
+    double baked = 0.0;
+    for (const auto& vr : volumeReports) baked = std::max(baked, vr["standard_error"]["p95"].get<double>());
+    nlohmann::json t = samplingChoiceReport(sampling);
+    t["pilot_met"] = t["met"];
+    t["baked_standard_error_p95"] = baked;
+    t["met"] = sampling.bounceSearch.met && baked <= sampling.target;
+    if (!t["met"].get<bool>()) {
+        std::ostringstream w;
+        w << "bake.target_error " << percent(sampling.target) << " is not met: ";
+        if (!sampling.bounceSearch.met)
+            w << "after " << kMaxBounces << " bounces one more still adds " << percent(sampling.bounceSearch.error);
+        else
+            w << grouped(uint64_t(sampling.rays)) << " rays leave a p95 standard error of " << percent(baked);
+        w << "; raise the target"
+          << (sampling.rays >= kMaxTargetRays ? "" : " or set bake.rays above " + std::to_string(sampling.rays));
+        warnings.push_back(w.str());
+    }
+    return t;
+}
+
+// The .shprobe files and their sidecars, the scene when export.gltf is on, and the report: staged
+// together and committed with rollback, so a failed export leaves the earlier files, and an
+// earlier bake's files that this one does not write go. Fills the report's file list and time.
+std::vector<std::filesystem::path> writeBake(const Project& project, const BakeSetup& setup, std::vector<GltfProbeVolume> grids,
+                                   const nlohmann::json& bakeInfo, std::optional<ReflectionOutput>& reflections,
+                                   BakeOutcome& out, Clock::time_point start) {
+    const SceneDescription& scene = project.scene;
+    const BakeLighting& lighting = setup.lighting;
+    GltfSceneInput in;
+    in.heightfield = &setup.terrain.heightfield;
+    in.albedo = scene.terrain.albedo;
+    in.albedoTexture = lighting.surface.get();
+    in.roughness = float(scene.terrain.roughness);
+    in.verticalScale = scene.terrain.verticalScale;
+    in.volumes = std::move(grids);
+    in.bake = bakeInfo;
+    in.lighting = lightingExtension(project, setup.terrain.heightfield, lighting);
+    if (reflections) {
+        for (const auto& [k, v] : reflections->gltf.items()) in.lighting["reflection_probes"][k] = v;
+        in.reflectionFiles = std::move(reflections->files);
+    }
+    if (lighting.water) in.water = GltfWater{lighting.water->level, scene.water.color, float(scene.water.roughness)};
+    in.lights = scene.lights;
+    // lpv.ini is the bake's whenever the LPV is on; a bake with it off removes an earlier one.
+    in.ownedFiles.push_back(kLpvIniName);
+    if (scene.lpv.enabled)
+        in.extraFiles.push_back({kLpvIniName, lpvIni(lpv::resolvedOn(scene.lpv, setup.terrain.heightfield))});
+    in.generatorVersion = TERRALUX_VERSION;
+    in.scene = scene.exportSettings.gltf;
+    // The report lists every file of the bake, itself included, in the order written.
+    in.extraFiles.push_back({"bake_report.json", ""});
+    out.report["files"] = exportedFileNames(in);
+    out.report["time_s"] = secondsSince(start);
+    in.extraFiles.back().second = out.report.dump(2) + "\n";
+    return exportGltfScene(out.outDir, in).files;
+}
+
 }  // namespace
 
+// The bake's stages: prepare (terrain, lighting, quality), the targets, the plan, the irradiance
+// cache, then per volume its probes (traceVolume), their reference comparison, their error map
+// (measureVolumeErrorMap) and encoding; the reflection probes; the report and its warnings; and
+// the staged write (writeBake).
 BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                     const std::atomic<bool>* cancel) {
     const auto start = Clock::now();
@@ -792,33 +1100,11 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         chooseTargets(request.project.scene, setup, [&](const std::string& p) { report(p, 0.02); });
     if (cancelled()) throw BakeCancelled();
     const Heightfield& hf = setup.terrain.heightfield;
-    const DemImportResult& terrain = setup.terrain;
     const BakeLighting& lighting = setup.lighting;
     const BakeQuality& q = setup.q;
     const bool referenceMode = setup.referenceMode;
     const auto& volumes = setup.volumes;
-
-    // Adaptive volumes are placed here geometrically (for the progress shares and early errors)
-    // and again, with their refinement, when they bake.
-    std::vector<ProbeLayout> layouts;
-    // Progress counts probe bakes: the probes, then each volume's error-map points.
-    size_t totalProbes = 0, totalWork = 0;
-    std::vector<size_t> mapPoints;
-    for (const auto* v : volumes) {
-        layouts.push_back(placeProbes(*v, hf));
-        requireProbes(scene, *v, layouts.back());
-        totalProbes += layouts.back().positions.size();
-        mapPoints.push_back(errorMapGrid(layouts.back(), hf, scene.bake.errorMapResolution,
-                                         errorMapHeight(*v, layouts.back())).error.size());
-        totalWork += layouts.back().positions.size() + mapPoints.back();
-    }
-
-    // Reflection probes are placed before any work, so their settings fail first.
-    std::optional<ReflectionLayout> reflectionLayout;
-    if (scene.reflectionProbes.enabled) {
-        reflectionLayout = placeReflectionProbes(scene.reflectionProbes, hf);
-        simvxProbes(scene.reflectionProbes.simvxSubset, reflectionLayout->count());
-    }
+    BakePlan plan = planBake(scene, setup);
 
     // One bake writes into a folder at a time, from here to its end, so two never mix their files.
     // Taken once the inputs are checked, so that an input error is reported as such, and before
@@ -829,20 +1115,15 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     // Phase weights for one progress bar: cache, probes, reference.
     const double cacheShare = (!referenceMode && q.bounces > 0) ? 0.35 : 0.0;
     const double refShare = request.compareReference && !referenceMode && !volumes.empty() ? 0.45 : 0.0;
-    const double reflectionShare = !reflectionLayout ? 0.0 : volumes.empty() ? 0.95 - cacheShare : 0.3;
+    const double reflectionShare = !plan.reflections ? 0.0 : volumes.empty() ? 0.95 - cacheShare : 0.3;
     const double probeShare = 0.97 - 0.02 - cacheShare - refShare - reflectionShare;
     double base = 0.02;
 
     std::unique_ptr<IrradianceCache> cache;
     const auto cacheStart = Clock::now();
-    uint64_t plannedRays = plannedProbeRays(setup, layouts, mapPoints);
-    if (reflectionLayout)
-        plannedRays += uint64_t(reflectionLayout->count()) * 6 * uint64_t(scene.reflectionProbes.resolution) *
-                       uint64_t(scene.reflectionProbes.resolution) * uint64_t(scene.reflectionProbes.rayCount);
-    const int cacheResolution = cacheResolutionFor(hf, q, plannedRays);
     if (!referenceMode && q.bounces > 0) {
         BakeControl c{[&](double f) { report("irradiance cache", base + cacheShare * f); }, cancel};
-        cache = std::make_unique<IrradianceCache>(lighting, cacheResolution, q.cacheRays,
+        cache = std::make_unique<IrradianceCache>(lighting, plan.cacheResolution, q.cacheRays,
                                                   q.sunSamples, q.bounces - 1, c);
     }
     const double cacheSeconds = secondsSince(cacheStart);
@@ -856,91 +1137,23 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     std::map<size_t, GridSuggestion> measuredSuggestions;
     for (size_t vi = 0; vi < volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *volumes[vi];
-        ProbeLayout& layout = layouts[vi];
-        const auto volumeStart = Clock::now();
-        const double share = totalProbes ? double(layout.positions.size()) / double(totalProbes) : 1.0;
-        const uint64_t seed = volumeSeed(vi);
-        const int rays = raysOf(setup, v);
-        std::string phase = "probes '" + v.name + "'";
-        const double probeWork = double(layout.positions.size()), mapWork = double(mapPoints[vi]);
-        BakeControl c{[&](double f) {
-                          report(phase, base + probeShare * (double(doneWork) + f * probeWork) /
-                                                   double(std::max<size_t>(totalWork, 1)));
-                      },
-                      cancel};
-        ProbeBake bake;
-        std::optional<AdaptiveRefinement> refinement;
-        std::optional<InterpolationError> interpolation;
-        uint64_t interpolationRays = 0;
-        if (v.placement == ProbePlacement::Adaptive) {
-            const ProbeBaker baker = keyedBaker(setup, cache.get(), rays, seed, c);
-            AdaptiveBake a = bakeAdaptive(v, hf, baker, [&](int round, size_t leaves) {
-                phase = "refining '" + v.name + "' (round " + std::to_string(round) + ", " +
-                        std::to_string(leaves) + " leaves)";
-            });
-            layout = std::move(a.layout);
-            bake = std::move(a.bake);
-            refinement = a.refinement;
-            phase = "interpolation error '" + v.name + "'";
-            const ProbeBaker truth = [&](const std::vector<glm::vec3>& p, const std::vector<uint64_t>& k) {
-                ProbeBake t = baker(p, k);
-                interpolationRays += t.rays;
-                return t;
-            };
-            interpolation = measureInterpolationError(layout, bake.sh, hf, truth,
-                                                      kInterpolationPoints, seed,
-                                                      v.adaptive.tolerance);
-        } else {
-            bake = referenceMode ? referenceProbes(lighting, q.bounces, layout.positions,
-                                                   layout.valid, rays, seed, c)
-                                 : bakeProbes(lighting, cache.get(), q.bounces, layout.positions,
-                                              layout.valid, rays, seed, c);
-        }
-        totalRays += bake.rays + interpolationRays;
-        const double volumeSeconds = secondsSince(volumeStart);
-
-        nlohmann::json vr = {
-            {"name", v.name},
-            {"placement", placementName(v.placement)},
-            {"probes", layout.validCount()},
-            {"invalid_probes", layout.positions.size() - layout.validCount()},
-            {"rays_per_probe", rays},
-            {"rays", bake.rays},
-            {"time_s", volumeSeconds},
-            {"fallback_blend_distance", layout.fallbackBlendDistance},
-            {"moved_probes", layout.octree ? layout.octree->moved : size_t(0)},
-            {"borrowed_cells", layout.octree ? layout.octree->borrowed : layout.borrowedCells},
-            {"split_for_inside", layout.octree ? layout.octree->splitForInside : size_t(0)},
-        };
         const size_t volumeIndex = size_t(volumes[vi] - scene.probeVolumes.data());
+        ProbeLayout& layout = plan.layouts[vi];
+        const auto volumeStart = Clock::now();
+        const double share = plan.totalProbes ? double(layout.positions.size()) / double(plan.totalProbes) : 1.0;
+        const uint64_t seed = volumeSeed(vi);
+        std::string phase = "probes '" + v.name + "'";
+        const double probeWork = double(layout.positions.size()), mapWork = double(plan.mapPoints[vi]);
+        const double totalWork = double(std::max<size_t>(plan.totalWork, 1));
+        const BakeControl c{[&](double f) {
+                                report(phase, base + probeShare * (double(doneWork) + f * probeWork) / totalWork);
+                            },
+                            cancel};
+        VolumeTrace trace = traceVolume(setup, cache.get(), v, layout, seed, c, phase);
+        ProbeBake& bake = trace.bake;
+        totalRays += bake.rays + trace.interpolationRays;
+        nlohmann::json vr = volumeReport(setup, v, layout, trace, secondsSince(volumeStart));
         if (targets.count(volumeIndex)) vr["target"] = targetChoiceReport(targets.at(volumeIndex));
-        if (layout.octree) {
-            vr["adaptive"] = adaptiveReport(*layout.octree, refinement);
-            vr["interpolation_error"] =
-                interpolationReport(*interpolation, v.adaptive.tolerance, interpolationRays);
-        } else {
-            vr["probe_grid"] = {layout.probeDims[0], layout.probeDims[1], layout.probeDims[2]};
-        }
-        std::vector<float> se, below;
-        size_t fromBelow = 0;
-        for (size_t i = 0; i < layout.valid.size(); ++i)
-            if (layout.valid[i]) {
-                se.push_back(bake.standardError[i]);
-                below.push_back(bake.fromBelowShare[i]);
-                fromBelow += bake.fromBelowShare[i] > 0.0f;
-            }
-        vr["standard_error"] = stats(se);
-        vr["validity"] = {{"rays_from_below", stats(below)},
-                          {"probes_with_rays_from_below", fromBelow},
-                          {"lifted_clear_of_surface", layout.liftedForClearance},
-                          {"max_lift_m", layout.maxLift}};
-        // Probes at or below the water level do not see the water (docs/lighting.md, "Water").
-        if (lighting.water) {
-            size_t under = 0;
-            for (size_t i = 0; i < layout.valid.size(); ++i)
-                under += layout.valid[i] && !(layout.positions[i].y > lighting.water->level);
-            vr["probes_under_water"] = under;
-        }
 
         // Radiance projections, optionally windowed so irradiance is never negative. Before the
         // reference comparison, so that measures the probes as they are written.
@@ -955,82 +1168,35 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
             }
         }
 
-        if (request.compareReference && referenceMode) {
-            // The probes are the reference path tracer's own: a comparison would set the reference
-            // against itself, so only its Monte Carlo error (standard_error) says anything.
-            vr["reference_error"] = {{"mean", nullptr}, {"p95", nullptr}, {"max", nullptr},
-                                     {"note", kReferenceNote}};
-        } else if (request.compareReference) {
-            BakeControl rc{[&](double f) {
-                               report("reference '" + v.name + "'",
-                                      base + probeShare + refShare * (double(done) / double(totalProbes) + share * f));
-                           },
-                           cancel};
-            const int refRays = qualityPreset(QualityPreset::Reference).rays;
-            const auto refStart = Clock::now();
-            const ProbeBake ref = referenceProbes(lighting, q.bounces, layout.positions,
-                                                  layout.valid, refRays, seed ^ 0xF00Dull, rc);
-            referenceRays += ref.rays;
-            const ErrorStats err = compareToReference(bake.sh, ref.sh, layout.valid);
-            vr["reference_error"] = {{"mean", err.mean}, {"p95", err.p95}, {"max", err.max},
-                                     {"reference_rays_per_probe", refRays},
-                                     {"reference_path_length", q.bounces == 0 ? 0 : referencePathLength(lighting.maxAlbedo())},
-                                     {"reference_rays", ref.rays},
-                                     {"reference_time_s", secondsSince(refStart)}};
+        if (request.compareReference) {
+            const BakeControl rc{[&](double f) {
+                                     report("reference '" + v.name + "'",
+                                            base + probeShare +
+                                                refShare * (double(done) / double(plan.totalProbes) + share * f));
+                                 },
+                                 cancel};
+            vr["reference_error"] = referenceReport(setup, layout, bake.sh, seed, rc, referenceRays);
         }
 
-        // The interpolation-error map of the probes as the engine will read them (the interpolation-error debug view).
+        // The interpolation-error map of the probes as the engine will read them (the
+        // interpolation-error debug view).
         ProbeDiagnostics diagnostics = describeProbes(layout);
         if (scene.bake.errorMapResolution > 0) {
             phase = "error map '" + v.name + "'";
-            const auto mapStart = Clock::now();
-            uint64_t mapRays = 0;
             const BakeControl mc{[&](double f) {
                                      report(phase, base + probeShare * (double(doneWork) + probeWork + f * mapWork) /
-                                                              double(std::max<size_t>(totalWork, 1)));
+                                                              totalWork);
                                  },
                                  cancel};
-            // The truth gets the same window as the probes, so the map shows interpolation alone.
-            const ProbeBaker counted =
-                deringedBaker(keyedBaker(setup, cache.get(), rays, seed, mc), scene.bake.deringing, &mapRays);
-            std::unordered_map<size_t, sh::ShRgb> truths;
-            diagnostics.errorMap = measureErrorMap(layout, bake.sh, hf, counted,
-                                                   scene.bake.errorMapResolution,
-                                                   errorMapHeight(v, layout), seed, &truths);
-            const ErrorMapStats ms = errorMapStats(diagnostics.errorMap);
-            // High error on a terrain grid: measure a denser one (a target chooses its own).
-            if (errorIsHigh(ms) && v.placement == ProbePlacement::Terrain && !targets.count(volumeIndex)) {
-                phase = "measuring a suggestion for '" + v.name + "'";
-                auto measure = [&](const ProbeVolumeSettings& candidate, size_t& probes,
-                                   uint64_t& suggestionRays) -> std::optional<ErrorMapStats> {
-                    ProbeLayout trial;
-                    try {
-                        trial = placeProbes(candidate, hf);
-                    } catch (const PlacementError&) {
-                        return std::nullopt;
-                    }
-                    probes = trial.validCount();
-                    ProbeBake b = referenceMode ? referenceProbes(lighting, q.bounces, trial.positions, trial.valid,
-                                                                  rays, seed, mc)
-                                                : bakeProbes(lighting, cache.get(), q.bounces, trial.positions,
-                                                             trial.valid, rays, seed, mc);
-                    suggestionRays += b.rays;
-                    if (scene.bake.deringing)
-                        for (size_t i = 0; i < b.sh.size(); ++i)
-                            if (trial.valid[i]) sh::deringIrradiance(b.sh[i]);
-                    uint64_t before = mapRays;
-                    const ErrorMap m = measureErrorMap(trial, b.sh, hf, counted, scene.bake.errorMapResolution,
-                                                       errorMapHeight(candidate, trial), seed, &truths);
-                    suggestionRays += mapRays - before;
-                    mapRays = before;
-                    return errorMapStats(m);
-                };
-                if (auto g = denserGrid(v, volumeIndex, layout, ms, measure)) {
-                    totalRays += g->rays;
-                    measuredSuggestions[volumeIndex] = *g;
-                }
+            const VolumeErrorMap m = measureVolumeErrorMap(scene, setup, cache.get(), v, volumeIndex, layout, bake.sh,
+                                                           targets.count(volumeIndex) > 0, seed, mc, phase,
+                                                           diagnostics.errorMap);
+            if (m.suggestion) {
+                totalRays += m.suggestion->rays;
+                measuredSuggestions[volumeIndex] = *m.suggestion;
             }
-            totalRays += mapRays;
+            totalRays += m.rays;
+            const ErrorMapStats& ms = m.stats;
             vr["error_map"] = {{"size", {diagnostics.errorMap.nx, diagnostics.errorMap.nz}},
                                {"step_m", diagnostics.errorMap.step},
                                {"height_m", diagnostics.errorMap.height},
@@ -1039,8 +1205,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                {"mean", ms.mean},
                                {"p95", ms.p95},
                                {"max", ms.max},
-                               {"rays", mapRays},
-                               {"time_s", secondsSince(mapStart)}};
+                               {"rays", m.rays},
+                               {"time_s", m.seconds}};
             // The target is judged on this map, the bake's own, not the search's coarser one.
             if (targets.count(volumeIndex) && ms.points > 0) {
                 TargetChoice judged = targets.at(volumeIndex);
@@ -1067,17 +1233,17 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         volumeReports.push_back(vr);
         std::string sidecar = encodeProbeDiagnostics(diagnostics, v.name, grid);
         grids.push_back({v.name, std::move(grid), std::move(sidecar)});
-        done += layouts[vi].positions.size();
-        doneWork += layouts[vi].positions.size() + mapPoints[vi];
+        done += layout.positions.size();
+        doneWork += layout.positions.size() + plan.mapPoints[vi];
     }
     if (cancelled()) throw BakeCancelled();
 
     std::optional<ReflectionOutput> reflections;
-    if (reflectionLayout) {
+    if (plan.reflections) {
         const BakeControl rc{[&](double f) { report("reflection probes", 0.97 - reflectionShare * (1.0 - f)); },
                              cancel};
-        reflections = bakeReflections(setup, scene.reflectionProbes, *reflectionLayout, cache.get(), cacheResolution,
-                                      request.compareReference, rc);
+        reflections = bakeReflections(setup, scene.reflectionProbes, *plan.reflections, cache.get(),
+                                      plan.cacheResolution, request.compareReference, rc);
     }
 
     nlohmann::json bakeInfo = {
@@ -1116,7 +1282,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     out.report = {
         {"generator", std::string("Terralux ") + TERRALUX_VERSION},
         {"terrain",
-         {{"source", terrain.source.path},
+         {{"source", setup.terrain.source.path},
           {"grid", {hf.width(), hf.depth()}},
           {"cell_size_m", {hf.cellSizeX(), hf.cellSizeZ()}},
           {"height_range_m", {hf.minHeight(), hf.maxHeight()}},
@@ -1128,7 +1294,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
          {{"preset", qualityName(scene.bake.quality)},
           {"rays", q.rays},
           {"bounces", q.bounces},
-          {"cache_resolution", cache ? cacheResolution : 0},
+          {"cache_resolution", cache ? plan.cacheResolution : 0},
           {"cache_points", cache ? size_t(cache->pointsX()) * size_t(cache->pointsZ()) : size_t(0)},
           {"cache_rays", cache ? q.cacheRays : 0},
           {"cache_time_s", cacheSeconds}}},
@@ -1158,92 +1324,10 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                "; no water is baked or exported; set water.level to place it");
     for (const auto& [index, c] : targets)
         if (!c.warning.empty()) out.warnings.push_back(c.warning);
-    // A probe above the surface cannot meet the terrain's underside: one that does sits where the
-    // tracer's surface and the placement's disagree (terrain far steeper than any real DEM, as
-    // with a large terrain.vertical_scale), and its light is wrong. None does on the shared DEMs.
-    for (size_t vi = 0; vi < volumes.size(); ++vi) {
-        const nlohmann::json& vr = volumeReports[vi];
-        const size_t lifted = vr["validity"]["lifted_clear_of_surface"].get<size_t>();
-        if (lifted > 0) {
-            const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
-            std::ostringstream w;
-            w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << lifted << " of "
-              << vr["probes"].get<size_t>() << " probes stand higher than height_offset (up to "
-              << std::fixed << std::setprecision(1) << vr["validity"]["max_lift_m"].get<double>()
-              << " m) to clear slopes too steep for the tracer to resolve at " << std::defaultfloat
-              << std::setprecision(6) << volumes[vi]->heightOffset << " m";
-            if (scene.terrain.verticalScale != 1.0) w << " (terrain.vertical_scale " << scene.terrain.verticalScale << ")";
-            out.warnings.push_back(w.str());
-        }
-        const size_t below = vr["validity"]["probes_with_rays_from_below"].get<size_t>();
-        if (below == 0) continue;
-        const size_t index = size_t(volumes[vi] - scene.probeVolumes.data());
-        std::ostringstream w;
-        w << "probe_volumes[" << index << "] '" << vr["name"].get<std::string>() << "': " << below << " of "
-          << vr["probes"].get<size_t>() << " probes see the terrain from below (up to "
-          << percent(vr["validity"]["rays_from_below"]["max"].get<double>())
-          << " of their rays), so their light is wrong (debug view 54, probe validity); the surface is steeper than "
-             "their clearance";
-        if (scene.terrain.verticalScale != 1.0) w << " at terrain.vertical_scale " << scene.terrain.verticalScale;
-        w << ": raise probe_volumes[" << index << "].height_offset";
-        if (scene.terrain.verticalScale > 1.0) w << " or lower terrain.vertical_scale";
-        out.warnings.push_back(w.str());
-    }
-    if (sampling) {
-        // Judged on the bake's own probes, every volume's, not only the pilot's.
-        double baked = 0.0;
-        for (const auto& vr : volumeReports) baked = std::max(baked, vr["standard_error"]["p95"].get<double>());
-        nlohmann::json t = samplingChoiceReport(*sampling);
-        t["pilot_met"] = t["met"];
-        t["baked_standard_error_p95"] = baked;
-        t["met"] = sampling->bounceSearch.met && baked <= sampling->target;
-        if (!t["met"].get<bool>()) {
-            std::ostringstream w;
-            w << "bake.target_error " << percent(sampling->target) << " is not met: ";
-            if (!sampling->bounceSearch.met)
-                w << "after " << kMaxBounces << " bounces one more still adds " << percent(sampling->bounceSearch.error);
-            else
-                w << grouped(uint64_t(sampling->rays)) << " rays leave a p95 standard error of " << percent(baked);
-            w << "; raise the target"
-              << (sampling->rays >= kMaxTargetRays ? "" : " or set bake.rays above " + std::to_string(sampling->rays));
-            out.warnings.push_back(w.str());
-        }
-        out.report["sampling_target"] = t;
-    }
+    volumeWarnings(scene, volumes, volumeReports, out.warnings);
+    if (sampling) out.report["sampling_target"] = samplingReport(*sampling, volumeReports, out.warnings);
     out.report["warnings"] = out.warnings;
-    {
-        // The .shprobe files and their sidecars, the scene when export.gltf is on, and the
-        // report: staged together and committed with rollback, so a failed export leaves the
-        // earlier files, and an earlier bake's files that this one does not write go.
-        GltfSceneInput in;
-        in.heightfield = &hf;
-        in.albedo = scene.terrain.albedo;
-        in.albedoTexture = lighting.surface.get();
-        in.roughness = float(project.scene.terrain.roughness);
-        in.verticalScale = scene.terrain.verticalScale;
-        in.volumes = grids;
-        in.bake = bakeInfo;
-        in.lighting = lightingExtension(project, hf, lighting);
-        if (reflections) {
-            for (const auto& [k, v] : reflections->gltf.items()) in.lighting["reflection_probes"][k] = v;
-            in.reflectionFiles = std::move(reflections->files);
-        }
-        if (lighting.water)
-            in.water = GltfWater{lighting.water->level, scene.water.color, float(scene.water.roughness)};
-        in.lights = scene.lights;
-        // lpv.ini is the bake's whenever the LPV is on; a bake with it off removes an earlier one.
-        in.ownedFiles.push_back(kLpvIniName);
-        if (scene.lpv.enabled) in.extraFiles.push_back({kLpvIniName, lpvIni(lpv::resolvedOn(scene.lpv, hf))});
-        in.generatorVersion = TERRALUX_VERSION;
-        in.scene = scene.exportSettings.gltf;
-        // The report lists every file of the bake, itself included, in the order written.
-        in.extraFiles.push_back({"bake_report.json", ""});
-        out.report["files"] = exportedFileNames(in);
-        out.report["time_s"] = secondsSince(start);
-        in.extraFiles.back().second = out.report.dump(2) + "\n";
-        const GltfExportResult r = exportGltfScene(out.outDir, in);
-        out.files = r.files;
-    }
+    out.files = writeBake(project, setup, std::move(grids), bakeInfo, reflections, out, start);
     report("done", 1.0);
     return out;
 }
@@ -1405,17 +1489,12 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
     e.lpvIni = scene.lpv.enabled;
     e.lights = scene.lights.size();
 
-    std::vector<ProbeLayout> layouts;
-    std::vector<size_t> points;
+    // The bake's own plan: its placements, error-map points, reflection probes and cache size.
+    const BakePlan plan = planBake(scene, setup);
     std::vector<glm::vec3> all;
-    for (const auto* v : setup.volumes) {
-        layouts.push_back(placeProbes(*v, hf));
-        requireProbes(project.scene, *v, layouts.back());
-        points.push_back(errorMapGrid(layouts.back(), hf, scene.bake.errorMapResolution,
-                                      errorMapHeight(*v, layouts.back())).error.size());
-        for (size_t i = 0; i < layouts.back().positions.size(); ++i)
-            if (layouts.back().valid[i]) all.push_back(layouts.back().positions[i]);
-    }
+    for (const ProbeLayout& layout : plan.layouts)
+        for (size_t i = 0; i < layout.positions.size(); ++i)
+            if (layout.valid[i]) all.push_back(layout.positions[i]);
 
     // The cache: a small one with the real ray counts, scaled by the point count.
     std::unique_ptr<IrradianceCache> cache;
@@ -1426,8 +1505,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
                                                   q.cacheRays, q.sunSamples, q.bounces - 1,
                                                   BakeControl{});
         const double seconds = secondsSince(t);
-        const std::array<int, 2> full = IrradianceCache::gridPoints(
-            hf, cacheResolutionFor(hf, q, plannedProbeRays(setup, layouts, points)));
+        const std::array<int, 2> full = IrradianceCache::gridPoints(hf, plan.cacheResolution);
         e.cacheSeconds = seconds * double(full[0]) * double(full[1]) /
                          double(cache->pointsX() * cache->pointsZ());
     }
@@ -1450,10 +1528,9 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
     }
 
     e.seconds = e.secondsMax = e.cacheSeconds;
-    if (scene.reflectionProbes.enabled) {
+    if (plan.reflections) {
         const ReflectionProbeSettings& rs = scene.reflectionProbes;
-        const ReflectionLayout layout = placeReflectionProbes(rs, hf);
-        simvxProbes(rs.simvxSubset, layout.count());
+        const ReflectionLayout& layout = *plan.reflections;
         // One probe at the bake's cube size and a ray or two per texel, its tracing scaled to the
         // bake's rays; probes bake in parallel.
         std::unique_ptr<IrradianceCache> own;
@@ -1483,7 +1560,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
     }
     for (size_t vi = 0; vi < setup.volumes.size(); ++vi) {
         const ProbeVolumeSettings& v = *setup.volumes[vi];
-        const ProbeLayout& L = layouts[vi];
+        const ProbeLayout& L = plan.layouts[vi];
         VolumeEstimate ve;
         ve.name = v.name;
         ve.placement = v.placement;
@@ -1534,7 +1611,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
                 probesMax = probes;
             }
         }
-        ve.errorMapPoints = points[vi];
+        ve.errorMapPoints = plan.mapPoints[vi];
         probes += double(ve.errorMapPoints);
         probesMax += double(ve.errorMapPoints);
         ve.seconds = probes * perProbe;
