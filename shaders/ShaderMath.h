@@ -1,12 +1,18 @@
 #pragma once
 // The rules C++ and GLSL share, each written once in the common subset of the two languages:
 // height-fog optics (fog_math.glsl), the display encoding (display_math.glsl) and the SH basis
-// (sh_basis.glsl). C++ sees them here as inline float functions in terralux::glsl, with the GLSL
+// (sh_basis.glsl), and the Gerstner waves (water_math.glsl). C++ sees them here as inline float
+// functions in terralux::glsl (the waves in double, in terralux::glsl::dbl), with the GLSL
 // built-ins they call; tests/render/test_shader_math.cpp holds each against the shaders' own
 // evaluation on the device.
 
 #include <algorithm>
 #include <cmath>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 
 namespace terralux::glsl {
 
@@ -25,3 +31,29 @@ inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo
 #undef TLX_SHARED
 
 }  // namespace terralux::glsl
+
+namespace terralux::glsl::dbl {
+
+using glm::clamp;
+using glm::cross;
+using glm::dot;
+using glm::max;
+using glm::normalize;
+using std::cos;
+using std::sin;
+using std::sqrt;
+using std::tanh;
+
+#define TLX_SHARED inline
+#define TLX_REAL double
+#define TLX_RVEC2 glm::dvec2
+#define TLX_RVEC3 glm::dvec3
+#define TLX_INOUT(T) T&
+#include "water_math.glsl"
+#undef TLX_SHARED
+#undef TLX_REAL
+#undef TLX_RVEC2
+#undef TLX_RVEC3
+#undef TLX_INOUT
+
+}  // namespace terralux::glsl::dbl

@@ -101,7 +101,7 @@ double angularFrequency(double k, std::optional<double> depth) {
     // Ocean Water", SIGGRAPH 2001 course notes, "dispersion relation"). Dry ground (h <= 0)
     // holds a wave still.
     if (!depth) return std::sqrt(kGravity * k);
-    return std::sqrt(kGravity * k * std::tanh(k * std::max(*depth, 0.0)));
+    return glsl::dbl::waveOmegaAtDepth(k, *depth);
 }
 
 double summedSteepness(const std::vector<GerstnerWave>& waves) {
@@ -142,33 +142,20 @@ std::string checkWaves(const std::vector<GerstnerWave>& waves) {
 
 SurfacePoint gerstner(const std::vector<WaveTerms>& waves, glm::dvec2 xz, double t,
                       std::optional<double> depth, double fade) {
-    // Finch, "Effective Water Simulation from Physical Models", GPU Gems (2004), ch. 1, Gerstner
-    // waves with Q_i = 1/(k_i·A_i); Tessendorf's (2001) form shifted by a quarter period:
-    //   P = (x + Σ D_x·A·cos θ, Σ A·sin θ, z + Σ D_z·A·cos θ),  θ = k·(D·(x, z)) − ω·t + φ.
-    // A point moves on a circle of radius A; crests (θ = π/2) gather points and sharpen.
-    // The normal is the normalised cross product of the surface's exact tangents, ∂P/∂z × ∂P/∂x.
+    // The terms of water_math.glsl, which the water shaders evaluate in float.
     SurfacePoint out;
     glm::dvec3 tx(1.0, 0.0, 0.0), tz(0.0, 0.0, 1.0);
     for (const WaveTerms& w : waves) {
-        const double a = w.amplitude * fade;
         const double omega = depth ? angularFrequency(w.k, depth) : w.omegaDeep;
-        const double theta = w.k * glm::dot(w.direction, xz) - omega * t + w.phase;
-        const double c = std::cos(theta), s = std::sin(theta);
-        const glm::dvec2 d = w.direction;
-        out.displacement += glm::dvec3(d.x * a * c, a * s, d.y * a * c);
-        const double ka = w.k * a;
-        tx += glm::dvec3(-d.x * d.x * ka * s, d.x * ka * c, -d.x * d.y * ka * s);
-        tz += glm::dvec3(-d.x * d.y * ka * s, d.y * ka * c, -d.y * d.y * ka * s);
+        glsl::dbl::gerstnerAdd(w.direction, w.k, w.amplitude * fade,
+                               glsl::dbl::gerstnerPhase(w.direction, w.k, xz, omega, t, w.phase), out.displacement,
+                               tx, tz);
     }
-    out.normal = glm::normalize(glm::cross(tz, tx));
+    out.normal = glsl::dbl::gerstnerNormal(tx, tz);
     return out;
 }
 
-double shoreFade(double distance, double fadeDistance) {
-    if (!(fadeDistance > 0.0)) return 1.0;
-    const double x = std::clamp(distance / fadeDistance, 0.0, 1.0);
-    return x * x * (3.0 - 2.0 * x);
-}
+double shoreFade(double distance, double fadeDistance) { return glsl::dbl::waveShoreFade(distance, fadeDistance); }
 
 AutoLevel autoLevel(const Heightfield& hf) {
     const int w = hf.width(), d = hf.depth();

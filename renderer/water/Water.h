@@ -1,7 +1,8 @@
 #pragma once
 // Water: Gerstner waves and their dispersion, the steepness rule, the level "auto" stands for,
-// and the distance to shore (docs/lighting.md, "Water"). The viewport's shaders (water.glsl)
-// evaluate the same waves in float; tests/render/test_shader_math.cpp holds gerstner() to them.
+// and the distance to shore (docs/lighting.md, "Water"). The waves' terms are written once, in
+// shaders/water_math.glsl: evaluated here in double and by the viewport's shaders in float;
+// tests/render/test_shader_math.cpp holds the two together.
 
 #include <cstddef>
 #include <optional>
@@ -11,12 +12,13 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "ShaderMath.h"
 #include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
 
 namespace terralux::water {
 
-inline constexpr double kGravity = 9.81;  // m/s²
+inline constexpr double kGravity = TLX_GRAVITY;  // m/s², water_math.glsl's
 inline constexpr double kWaterIor = 1.33;
 inline constexpr double kWaterF0 = 0.02;  // Schlick's F0 for ((1.33 − 1) / (1.33 + 1))²
 
