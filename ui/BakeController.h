@@ -2,9 +2,7 @@
 // Runs a bake off the UI thread: progress, ETA, cancel. A cancelled or failed bake leaves the
 // previous outputs as they were (runBake stages and renames).
 
-#include <atomic>
 #include <chrono>
-#include <thread>
 
 #include <QObject>
 #include <QString>

@@ -1,11 +1,9 @@
 #pragma once
 // The authoring window: menus, the parameter docks, the live Vulkan viewport, background bakes.
 
-#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include <QDockWidget>
 #include <QMainWindow>

@@ -4,9 +4,7 @@
 // its points kept in step. A point picked on the plot or in the table applies its settings to the
 // project as one undoable edit.
 
-#include <atomic>
 #include <optional>
-#include <thread>
 #include <vector>
 
 #include <QWidget>

@@ -5,10 +5,8 @@
 //   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom   left click: pick
 //   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
 
-#include <atomic>
 #include <memory>
 #include <optional>
-#include <thread>
 
 #include <QWindow>
 
