@@ -23,6 +23,14 @@ void setViewport(VkCommandBuffer cb, uint32_t width, uint32_t height) {
     vkCmdSetScissor(cb, 0, 1, &sc);
 }
 
+void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cb, srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
 }  // namespace frame
 
 RendererGpu::~RendererGpu() = default;

@@ -83,11 +83,17 @@ inline constexpr VkVertexInputBindingDescription kMeshBinding{0, 24, VK_VERTEX_I
 inline constexpr VkVertexInputAttributeDescription kMeshPosition{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0};
 inline constexpr VkVertexInputAttributeDescription kMeshNormal{1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12};
 
+inline constexpr VkShaderStageFlags kVertexFragment = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+
 // Timestamps a slot's pool holds: one before the first pass and one after each.
 inline constexpr uint32_t kFrameTimestamps = 64;
 
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
 void setViewport(VkCommandBuffer cb, uint32_t width, uint32_t height);
+// One global memory dependency: what `srcStages` wrote through `srcAccess` is visible to
+// `dstAccess` in `dstStages`.
+void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,
+                   VkPipelineStageFlags dstStages, VkAccessFlags dstAccess);
 
 }  // namespace frame
 

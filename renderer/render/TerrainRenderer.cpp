@@ -46,9 +46,6 @@ using namespace frame;
 
 namespace {
 
-// Vertices along the longer side of the water mesh, at most: the waves longer than two of its
-// cells move it, the shorter ones live in the normal (water.glsl).
-constexpr int kWaterMeshSide = 512;
 
 // Shadow rays per vertex of the sun-visibility view, stratified over the sun's disc.
 constexpr int kSunVisibilitySamples = 16;
@@ -56,7 +53,6 @@ constexpr int kSunVisibilitySamples = 16;
 // Smallest octree leaf the leaf overlay draws, in pixels on screen.
 constexpr float kSmallestLeafPixels = 6.0f;
 
-constexpr VkShaderStageFlags kVertexFragment = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
 
 }  // namespace
 
@@ -108,17 +104,6 @@ vk::DescriptorSetBuilder viewSetBuilder(const FrameSlot& f, const vk::Buffer& ca
         .image(TLX_SURFACE_FILLED_BINDING, kSurfaceFilled, t ? t->filled.view() : VK_NULL_HANDLE, sampler, frag);
 }
 
-// The water set: its block, the reflection, the frame under the water and the field (read by the
-// mesh too). Null views: the layout alone.
-vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView reflection, VkImageView scene,
-                                         VkImageView field, VkSampler sampler) {
-    constexpr VkShaderStageFlags frag = VK_SHADER_STAGE_FRAGMENT_BIT;
-    return vk::DescriptorSetBuilder()
-        .uniform(blocks::WaterBlock::kBinding, "water", block, kVertexFragment)
-        .image(TLX_WATER_REFLECTION_BINDING, kWaterReflection, reflection, sampler, frag)
-        .image(TLX_WATER_SCENE_BINDING, kWaterScene, scene, sampler, frag)
-        .image(TLX_WATER_FIELD_BINDING, kWaterField, field, sampler, kVertexFragment);
-}
 
 // The terrain pass's LPV set: the block, the volumes (or the placeholder) and the lights. Null
 // buffers: the layout alone.
@@ -131,16 +116,6 @@ vk::DescriptorSetBuilder lpvSetBuilder(const vk::Buffer& block, const vk::Buffer
         .storage(TLX_LOCAL_LIGHTS_BINDING, "local-lights", lights, stages);
 }
 
-// Bilinear sample of a row-major DEM-grid array at fractional (col, row).
-float gridSample(const std::vector<float>& values, int width, int depth, double col, double row) {
-    col = std::clamp(col, 0.0, double(width - 1));
-    row = std::clamp(row, 0.0, double(depth - 1));
-    const int c0 = std::min(int(col), std::max(width - 2, 0)), r0 = std::min(int(row), std::max(depth - 2, 0));
-    const int c1 = std::min(c0 + 1, width - 1), r1 = std::min(r0 + 1, depth - 1);
-    const double fx = col - c0, fz = row - r0;
-    auto at = [&](int c, int r) { return double(values[size_t(r) * size_t(width) + size_t(c)]); };
-    return float((at(c0, r0) * (1 - fx) + at(c1, r0) * fx) * (1 - fz) + (at(c0, r1) * (1 - fx) + at(c1, r1) * fx) * fz);
-}
 
 // Texel bytes of a level: RGBA16F normal-AO, RGBA8 sRGB albedo, R8 filled share.
 vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
@@ -239,7 +214,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
     g.linear = vk::Sampler::linearClamp(ctx_);
     static const vk::Buffer noBuffer;
-    g.waterLayout = waterSetBuilder(noBuffer, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, g.linear.handle())
+    g.waterLayout = features::waterSetBuilder(noBuffer, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, g.linear.handle())
                         .buildLayout(ctx_);
     const glm::vec4 zero(0.0f);
     g.lpvDummy = vk::Buffer::deviceLocal(ctx_, &zero, sizeof zero, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -269,92 +244,21 @@ void TerrainRenderer::setWater(std::optional<float> level, float margin) {
         g.graph.forget(name);
     g.water.reset();
     if (!level) return;
-    auto w = std::make_unique<WaterResources>();
-    w->level = *level;
-    w->margin = margin;
-
-    // The field over the footprint, texel centres corner to corner like the surface maps: depth
-    // below the level and distance to shore, from the DEM grid (bilinear where it is coarser).
-    const std::vector<float> shore = water::shoreDistance(hf_, double(*level));
-    const int hw = hf_.width(), hd = hf_.depth();
-    const int fw = std::min(hw, 2048), fd = std::min(hd, 2048);
-    vk::MipLevel texels{uint32_t(fw), uint32_t(fd), std::vector<uint8_t>(size_t(fw) * size_t(fd) * 4)};
-    tbb::parallel_for(0, fd, [&](int j) {
-        const double row = fd > 1 ? double(j) * double(hd - 1) / double(fd - 1) : 0.0;
-        for (int i = 0; i < fw; ++i) {
-            const double col = fw > 1 ? double(i) * double(hw - 1) / double(fw - 1) : 0.0;
-            const float depth = *level - gridSample(hf_.heights(), hw, hd, col, row);
-            const float distance = gridSample(shore, hw, hd, col, row);
-            // Half floats hold ±65504: deeper water and farther shores than that look the same.
-            const glm::vec2 v(std::clamp(depth, -6.0e4f, 6.0e4f), std::isfinite(distance) ? std::min(distance, 6.0e4f) : 6.0e4f);
-            const uint32_t packed = glm::packHalf2x16(v);
-            std::memcpy(texels.bytes.data() + 4 * (size_t(j) * size_t(fw) + size_t(i)), &packed, 4);
-        }
-    });
-    w->fieldSize = {fw, fd};
-    w->field = vk::Image::texture(ctx_, VK_FORMAT_R16G16_SFLOAT, {texels});
-
-    // The mesh: a grid at rest on the plane over the footprint, keeping the cells whose bed lies
-    // below the highest crest somewhere.
-    const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
-    const float longer = std::max({spanX, spanZ, 1e-3f});
-    const float step = longer / float(kWaterMeshSide - 1);
-    const int nx = std::max(int(std::ceil(spanX / step)) + 1, 2), nz = std::max(int(std::ceil(spanZ / step)) + 1, 2);
-    w->spacing = std::max(spanX / float(nx - 1), spanZ / float(nz - 1));
-    std::vector<glm::vec2> rest(size_t(nx) * size_t(nz));
-    std::vector<uint8_t> wet(rest.size());
-    for (int j = 0; j < nz; ++j)
-        for (int i = 0; i < nx; ++i) {
-            const glm::vec2 p(hf_.minX() + spanX * float(i) / float(nx - 1), hf_.minZ() + spanZ * float(j) / float(nz - 1));
-            rest[size_t(j) * size_t(nx) + size_t(i)] = p;
-            wet[size_t(j) * size_t(nx) + size_t(i)] = hf_.surfaceHeight(p.x, p.y) < *level + margin ? 1 : 0;
-        }
-    std::vector<uint32_t> indices;
-    for (int j = 0; j + 1 < nz; ++j)
-        for (int i = 0; i + 1 < nx; ++i) {
-            const uint32_t v00 = uint32_t(j * nx + i), v10 = v00 + 1, v01 = v00 + uint32_t(nx), v11 = v01 + 1;
-            if (wet[v00] || wet[v10] || wet[v01] || wet[v11]) indices.insert(indices.end(), {v00, v01, v11, v00, v11, v10});
-        }
-    w->indexCount = uint32_t(indices.size());
-    if (indices.empty()) indices.push_back(0);
-    w->vertices = vk::Buffer::deviceLocal(ctx_, rest.data(), rest.size() * sizeof(glm::vec2), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    w->indices = vk::Buffer::deviceLocal(ctx_, indices.data(), indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    g.graph.importBuffer(kWaterVertices, w->vertices.handle(), true);
-    g.graph.importBuffer(kWaterIndices, w->indices.handle(), true);
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
-        w->blocks.push_back(vk::Buffer::hostVisible(ctx_, sizeof(blocks::WaterBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
-    g.water = std::move(w);
+    g.water = features::buildWater(ctx_, hf_, *level, margin);
+    g.graph.importBuffer(kWaterVertices, g.water->vertices.handle(), true);
+    g.graph.importBuffer(kWaterIndices, g.water->indices.handle(), true);
 }
 
 void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale) {
     RendererGpu& g = *gpu_;
     WaterResources& w = *g.water;
-    const uint32_t rw = std::max(uint32_t(std::lround(float(width) * reflectionScale)), 1u);
-    const uint32_t rh = std::max(uint32_t(std::lround(float(height) * reflectionScale)), 1u);
-    if (w.width == width && w.height == height && w.reflectionWidth == rw && w.reflectionHeight == rh) return;
+    if (!features::waterTargetsNeeded(w, width, height, reflectionScale)) return;
     ctx_.waitIdle();  // frames in flight may still read the old targets
     for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene}) g.graph.forget(name);
-    w.sets.clear();
-    w.reflection = vk::Image::colorTarget(ctx_, rw, rh);
-    w.reflectionDepth = vk::Image::depthTarget(ctx_, rw, rh);
-    const VkImageView views[] = {w.reflection.view(), w.reflectionDepth.view()};
-    w.reflectionFramebuffer = vk::Framebuffer(ctx_, g.clearPass, views, rw, rh);
-    vk::ImageDesc copy;
-    copy.width = width;
-    copy.height = height;
-    copy.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    w.scene = vk::Image(ctx_, copy);
+    features::buildWaterTargets(ctx_, g, w, width, height, reflectionScale);
     g.graph.importImage(kWaterReflection, w.reflection.handle(), w.reflection.aspect());
     g.graph.importImage(kWaterReflectionDepth, w.reflectionDepth.handle(), w.reflectionDepth.aspect());
     g.graph.importImage(kWaterScene, w.scene.handle(), w.scene.aspect());
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
-        w.sets.push_back(waterSetBuilder(w.blocks[i], w.reflection.view(), w.scene.view(), w.field.view(),
-                                         g.linear.handle())
-                             .build(ctx_));
-    w.width = width;
-    w.height = height;
-    w.reflectionWidth = rw;
-    w.reflectionHeight = rh;
 }
 
 bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
@@ -448,15 +352,7 @@ void TerrainRenderer::ensureShadowMaps(int resolution, int cascades) {
     for (FrameSlot& f : g.slots) f.shadowedLights = vk::DescriptorSet();
     g.shadows.reset();
     if (resolution <= 0) return buildReflectionSets();
-    auto sh = std::make_unique<ShadowResources>();
-    sh->resolution = resolution;
-    sh->cascades = cascades;
-    sh->maps = vk::Image::depthLayers(ctx_, uint32_t(resolution), uint32_t(resolution), uint32_t(cascades));
-    for (uint32_t i = 0; i < uint32_t(cascades); ++i) {
-        const VkImageView view = sh->maps.layerView(i);
-        sh->framebuffers.emplace_back(ctx_, g.shadowPass, std::span<const VkImageView>(&view, 1),
-                                      uint32_t(resolution), uint32_t(resolution));
-    }
+    auto sh = features::buildShadowMaps(ctx_, g, resolution, cascades);
     for (FrameSlot& f : g.slots)
         f.shadowedLights = lightsBuilder(kShadowedLights, f, g, sh->maps.view(), nullptr, 0).build(ctx_);
     g.graph.importImage(kShadowMaps, sh->maps.handle(), sh->maps.aspect(), uint32_t(cascades));
@@ -496,108 +392,13 @@ const std::shared_ptr<const lpv::Volumes>& TerrainRenderer::lpv() const {
 
 namespace {
 
-// One global memory dependency: what `srcStages` wrote through `srcAccess` is visible to
-// `dstAccess` in `dstStages`.
-void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,
-                   VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
-    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    b.srcAccessMask = srcAccess;
-    b.dstAccessMask = dstAccess;
-    vkCmdPipelineBarrier(cb, srcStages, dstStages, 0, 1, &b, 0, nullptr, 0, nullptr);
-}
-
-// The propagation pass's set: its block, the work regions, the send scales, the geometry and the
-// light it accumulates into.
-vk::DescriptorSetBuilder lpvPropagationSetBuilder(const LpvResources& r) {
-    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
-    vk::DescriptorSetBuilder b;
-    b.uniform(blocks::LpvPropagationBlock::kBinding, "lpv-propagation", r.propagationBlock, compute)
-        .storage(TLX_LPV_WORK_BINDING, kLpvWork, r.work, compute)
-        .storage(TLX_LPV_SCALES_BINDING, kLpvScales, r.scales, compute)
-        .storage(TLX_LPV_PROPAGATE_GEOMETRY_BINDING, kLpvGeometry, r.geometry, compute)
-        .storage(TLX_LPV_ACCUMULATED_BINDING, kLpvLight, r.light, compute);
-    return b;
-}
-
-blocks::LpvPropagationBlock propagationBlock(float stepWeight, int cascades) {
-    blocks::LpvPropagationBlock b;
-    const auto& table = lpv::propagationNeighbours();
-    for (size_t n = 0; n < table.size(); ++n) {
-        b.neighbours[n] = glm::vec4(glm::vec3(table[n].offset), float(table[n].axis));
-        for (size_t f = 0; f < table[n].faces.size(); ++f) {
-            const lpv::PropagationFace& face = table[n].faces[f];
-            b.faceDirs[5 * n + f] = glm::vec4(face.dir, face.solidAngle);
-            b.faceLobes[5 * n + f] = glm::vec4(face.lobe[0], face.lobe[1], face.lobe[2], face.lobe[3]);
-        }
-    }
-    b.stepWeight = stepWeight;
-    b.cascadeCount = cascades;
-    return b;
-}
 
 }  // namespace
 
 void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     RendererGpu& g = *gpu_;
     if (g.lpv ? g.lpv->volumes == volumes : !volumes) return;
-    std::unique_ptr<LpvResources> r;
-    if (volumes && !volumes->cascades().empty()) {
-        r = std::make_unique<LpvResources>();
-        const auto& cascades = volumes->cascades();
-        const size_t n = std::min<size_t>(cascades.size(), 4);
-        const LpvSettings& ls = volumes->settings();
-        // Propagated here unless the volumes already are, or have no step to take.
-        const bool propagate = !volumes->propagated() && ls.propagationIterations > 0;
-        std::vector<float> light, geometry;
-        light.reserve(n * cascades[0].injected.size());
-        geometry.reserve(n * cascades[0].geometry.size());
-        r->block.cascadeCount = int(n);
-        r->block.quality = ls.quality;
-        r->block.coneSamples = ls.coneTraceSamples;
-        r->viewRange = lpv::lightRange(cascades[0].injected, cascades[0].layout.cellSize, ls.indirectIntensity);
-        r->block.indirectIntensity = float(ls.indirectIntensity);
-        r->block.fadeRange = float(ls.fadeRange);
-        r->block.viewExposure = r->viewRange > 0.0 ? float(1.0 / r->viewRange) : 0.0f;
-        for (size_t c = 0; c < n; ++c) {
-            const lpv::LightVolume& v = volumes->propagated() ? cascades[c].accumulated : cascades[c].injected;
-            light.insert(light.end(), v.begin(), v.end());
-            geometry.insert(geometry.end(), cascades[c].geometry.begin(), cascades[c].geometry.end());
-            r->block.cascades[c].minCorner = glm::vec3(cascades[c].layout.origin());
-            r->block.cascades[c].cellSize = float(cascades[c].layout.cellSize);
-        }
-        constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-        const VkDeviceSize lightBytes = VkDeviceSize(n) * cascades[0].injected.size() * 4;
-        r->geometry = vk::Buffer::deviceLocal(ctx_, geometry.data(), geometry.size() * 4, storage);
-        // The injected light until the pass has run, should a frame read it before.
-        r->light = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage);
-        if (propagate) {
-            // Region 0 the injected light; regions 1 and 2 the steps' outputs, written before read.
-            r->work = vk::Buffer::deviceLocal(ctx_, light.data(), lightBytes, storage, 3 * lightBytes);
-            r->cells = uint32_t(n) * uint32_t(lpv::kCells);
-            r->scales = vk::Buffer(ctx_, VkDeviceSize(2 * 3) * r->cells * 4, storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-            const blocks::LpvPropagationBlock block =
-                propagationBlock(lpv::propagationStepWeight(ls.propagationWeight), int(n));
-            r->propagationBlock = vk::Buffer::hostVisible(ctx_, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-            r->propagationBlock.write(&block, sizeof block);
-            r->propagationSet = lpvPropagationSetBuilder(*r).build(ctx_);
-            r->steps = ls.propagationIterations;
-            if (!g.lpvPropagate) {
-                constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
-                const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), r->propagationSet.layout()};
-                g.lpvPropagateLayout = vk::PipelineLayout(ctx_, sets, sizeof(glm::ivec4), compute);
-                g.lpvPropagate = vk::createComputePipeline(ctx_, g.lpvPropagateLayout.handle(), shaders::lpvPropagateComp());
-            }
-            if (!g.lpvQueries && ctx_.timestampPeriod() > 0.0) {
-                VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-                qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-                qci.queryCount = 2;
-                VkQueryPool pool = VK_NULL_HANDLE;
-                vk::check(vkCreateQueryPool(ctx_.device(), &qci, nullptr, &pool), "vkCreateQueryPool");
-                g.lpvQueries = vk::UniqueQueryPool(ctx_.device(), pool);
-            }
-        }
-        r->volumes = std::move(volumes);
-    }
+    std::unique_ptr<LpvResources> r = features::buildLpv(ctx_, g, std::move(volumes));
     ctx_.waitIdle();  // no frame may still read the old volumes
     for (const char* name : {kLpvLight, kLpvGeometry, kLpvWork, kLpvScales}) g.graph.forget(name);
     g.lpv = std::move(r);
@@ -611,36 +412,6 @@ void TerrainRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes) {
     g.graph.importBuffer(kLpvScales, g.lpv->scales.handle());
 }
 
-void TerrainRenderer::recordLpvPropagation(VkCommandBuffer cb) {
-    RendererGpu& g = *gpu_;
-    LpvResources& r = *g.lpv;
-    if (g.lpvQueries) {
-        // The first once everything before has finished, so an earlier pass's tail is not counted.
-        vkCmdResetQueryPool(cb, g.lpvQueries.get(), 0, 2);
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, g.lpvQueries.get(), 0);
-    }
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagate.get());
-    const VkDescriptorSet set = r.propagationSet.handle();
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvPropagateLayout.handle(), TLX_SET_SUBSYSTEM, 1,
-                            &set, 0, nullptr);
-    const uint32_t groups = (r.cells + 255) / 256;
-    const auto dispatch = [&](const glm::ivec4& push) {
-        vkCmdPushConstants(cb, g.lpvPropagateLayout.handle(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatch(cb, groups, 1, 1);
-    };
-    dispatch(glm::ivec4(0, 0, 0, 0));  // the injected light's send scales
-    for (int step = 0; step < r.steps; ++step) {
-        // Each dispatch reads what the one before it wrote.
-        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-        // Step 0 reads the injected light (region 0); then the regions 1 and 2 alternate.
-        const int source = step == 0 ? 0 : 1 + (step - 1) % 2, destination = 1 + step % 2;
-        dispatch(glm::ivec4(1, source, destination, step + 1 < r.steps ? 1 : 0));
-    }
-    if (g.lpvQueries) vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, g.lpvQueries.get(), 1);
-    g.lpvTimed = bool(g.lpvQueries);
-    r.steps = 0;
-}
 
 void TerrainRenderer::propagateLpvNow() {
     RendererGpu& g = *gpu_;
@@ -648,11 +419,11 @@ void TerrainRenderer::propagateLpvNow() {
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         // The injected light and the geometry were filled by transfers.
-        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-        recordLpvPropagation(cb);
+        features::recordLpvPropagation(g, cb);
         // Whatever reads the light later, in this submission's successors, sees it written.
-        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                       VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
     });
 }
@@ -677,12 +448,12 @@ std::vector<float> TerrainRenderer::readLpvLight() {
     vk::Buffer host = vk::Buffer::hostVisible(ctx_, g.lpv->light.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
-        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                       VK_ACCESS_TRANSFER_READ_BIT);
         const VkBufferCopy region{0, 0, g.lpv->light.size()};
         vkCmdCopyBuffer(cb, g.lpv->light.handle(), host.handle(), 1, &region);
-        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                       VK_ACCESS_HOST_READ_BIT);
     });
     const auto* values = static_cast<const float*>(host.map());
@@ -720,7 +491,7 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
     ctx_.submitAndWait([&](VkCommandBuffer cb) {
         // The volumes and the queries were filled by transfers (the light perhaps by the
         // propagation pass).
-        memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                       VK_ACCESS_SHADER_READ_BIT);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, g.lpvSample.get());
@@ -729,7 +500,7 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
                                 &handle, 0, nullptr);
         vkCmdPushConstants(cb, g.lpvSampleLayout.handle(), compute, 0, sizeof push, &push);
         vkCmdDispatch(cb, uint32_t(queries.size() + 63) / 64, 1, 1);
-        memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+        frame::memoryBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                       VK_ACCESS_HOST_READ_BIT);
     });
     const auto* values = static_cast<const glm::vec4*>(results.map());
@@ -749,84 +520,8 @@ void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeS
     g.reflections.reset();
     reflectionBytes_ = 0;
     if (!set || set->probes.empty()) return;
-    const ReflectionProbeSet& s = *set;
-    const size_t n = s.probes.size();
-    if (s.dims[0] < 1 || s.dims[1] < 1 || size_t(s.dims[0]) * size_t(s.dims[1]) != n)
-        throw std::invalid_argument("reflection probes: a grid of " + std::to_string(s.dims[0]) + " x " +
-                                    std::to_string(s.dims[1]) + " holds " + std::to_string(n) + " probes");
-    const bool cubemap = s.encoding == ReflectionEncoding::Cubemap;
-    if (cubemap) {
-        if (s.faceSize < 1 || (s.faceSize & (s.faceSize - 1)) != 0 || s.mipCount != cubeMipCount(s.faceSize))
-            throw std::invalid_argument("reflection probes: cube faces of " + std::to_string(s.faceSize) +
-                                        " texels with " + std::to_string(s.mipCount) + " mip levels");
-        for (const ReflectionProbe& p : s.probes)
-            if (p.texels.size() != s.texelsPerProbe())
-                throw std::invalid_argument("reflection probe " + std::to_string(p.id) + " holds " +
-                                            std::to_string(p.texels.size()) + " texels, not " +
-                                            std::to_string(s.texelsPerProbe()));
-        VkPhysicalDeviceProperties props;
-        vkGetPhysicalDeviceProperties(ctx_.physicalDevice(), &props);
-        if (6 * n > props.limits.maxImageArrayLayers)
-            throw std::invalid_argument("reflection probes: " + std::to_string(n) + " cubes need " +
-                                        std::to_string(6 * n) + " image layers, the device holds " +
-                                        std::to_string(props.limits.maxImageArrayLayers));
-    }
-
-    auto r = std::make_unique<ReflectionResources>();
-    std::vector<blocks::ReflectionProbeRecord> records(n);
-    std::vector<glm::vec4> markers(n);
-    for (size_t i = 0; i < n; ++i) {
-        const ReflectionProbe& p = s.probes[i];
-        records[i].position = p.position;
-        records[i].halfExtent = p.halfExtent;
-        for (int f = 0; f < 6; ++f) records[i].faces[f] = glm::vec4(p.faces[size_t(f)], 0.0f);
-        markers[i] = glm::vec4(p.position, 3.0f);  // markers.vert: a reflection probe
-    }
-    // Level m holds every probe's six faces, layer 6·probe + face, as the probe's chain holds them
-    // (rows top to bottom, x fastest: the bake's faces are Vulkan's), in half floats.
-    std::vector<vk::MipLevel> levels;
-    if (cubemap) {
-        for (int m = 0; m < s.mipCount; ++m) {
-            const uint32_t side = uint32_t(cubeMipSize(s.faceSize, m));
-            const size_t faceTexels = size_t(side) * side;
-            vk::MipLevel level{side, side, std::vector<uint8_t>(n * 6 * faceTexels * 8)};
-            tbb::parallel_for(size_t(0), n, [&](size_t i) {
-                const glm::vec3* texels = s.probes[i].texels.data();
-                for (int f = 0; f < 6; ++f) {
-                    const glm::vec3* face = texels + s.texelOffset(m, f);
-                    uint8_t* out = level.bytes.data() + (i * 6 + size_t(f)) * faceTexels * 8;
-                    for (size_t t = 0; t < faceTexels; ++t) {
-                        const uint64_t packed = glm::packHalf4x16(glm::vec4(face[t], 1.0f));
-                        std::memcpy(out + 8 * t, &packed, 8);
-                    }
-                }
-            });
-            reflectionBytes_ += level.bytes.size();
-            levels.push_back(std::move(level));
-        }
-    } else {
-        levels.push_back(vk::MipLevel{1, 1, std::vector<uint8_t>(6 * 8, 0)});  // nothing reads it
-    }
-    reflectionBytes_ += records.size() * sizeof(records[0]);
-    r->cubes = vk::Image::cubeArrayTexture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, cubemap ? uint32_t(n) : 1u, levels);
-    r->records = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(records[0]),
-                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    r->markers = vk::Buffer::deviceLocal(ctx_, markers.data(), markers.size() * sizeof(glm::vec4),
-                                         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    r->markerCount = uint32_t(n);
-    r->grid.nx = s.dims[0];
-    r->grid.nz = s.dims[1];
-    r->grid.encoding = cubemap ? 1 : 0;
-    r->grid.mipLevels = cubemap ? s.mipCount : 1;
-    r->grid.origin = s.origin;
-    r->grid.spacing = s.spacing;
-    r->grid.cellSize = s.cellSize;
-    r->grid.blendDistance = s.blendDistance;
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
-        r->blocks.push_back(vk::Buffer::hostVisible(ctx_, sizeof(blocks::ReflectionBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
-    g.graph.importBuffer(kReflectionRecords, r->records.handle(), true);
-    g.graph.importBuffer(kReflectionMarkers, r->markers.handle(), true);
-    g.reflections = std::move(r);
+    g.reflections = features::buildReflections(ctx_, g, *set);
+    reflectionBytes_ = g.reflections->bytes;
     buildReflectionSets();
 }
 
@@ -885,79 +580,10 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
     for (const auto& v : volumes)
         finestProbeSpacing_ = finestProbeSpacing_ > 0.0f ? std::min(finestProbeSpacing_, v.spacing) : v.spacing;
 
-    std::vector<glm::vec4> coeffs;
-    std::vector<int32_t> cells;
-    std::vector<blocks::ProbeVolumeRecord> records;
-    std::vector<float> errors;
-    for (const auto& v : volumes) {
-        blocks::ProbeVolumeRecord rec{};
-        rec.origin = v.origin;
-        rec.spacing = v.spacing;
-        rec.dims = glm::ivec3(v.dims);
-        rec.firstProbe = int32_t(coeffs.size() / 9);
-        rec.firstCell = int32_t(cells.size());
-        rec.preConvolved = v.irradianceEncoded ? 1 : 0;
-        rec.fallbackBlend = v.fallbackBlendDistance;
-        rec.shScale = v.scale;
-        static const ProbeDiagnostics none;
-        const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
-        const ErrorMap& m = d.errorMap;
-        // A map that does not hold nx·nz values (or has no step) is no map.
-        if (m.error.size() == size_t(m.nx) * m.nz && m.step > 0.0f && !m.error.empty()) {
-            rec.firstError = int32_t(errors.size());
-            rec.errorNx = int32_t(m.nx);
-            rec.errorNz = int32_t(m.nz);
-            rec.errorX0 = m.x0;
-            rec.errorZ0 = m.z0;
-            rec.errorStep = m.step;
-            for (float e : m.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
-            anyErrorMap_ = true;
-        }
-        for (size_t i = 0; i < v.coeffs.size(); ++i) {
-            const float moved = i < d.moved.size() && d.moved[i] ? 1.0f : 0.0f;
-            coeffs.push_back(glm::vec4(v.coeffs[i][0], moved));
-            for (size_t k = 1; k < 9; ++k) coeffs.push_back(glm::vec4(v.coeffs[i][k], 0.0f));
-        }
-        cells.insert(cells.end(), v.occupancy.begin(), v.occupancy.end());
-        records.push_back(rec);
-    }
-    volumeCount_ = int(records.size());
-    probeBytes_ = coeffs.size() * sizeof(glm::vec4) + cells.size() * 4;
-    // Storage buffers may not be empty: a placeholder element where there is nothing to hold.
-    if (errors.empty()) errors.push_back(-1.0f);
-    if (coeffs.empty()) coeffs.push_back(glm::vec4(0.0f));
-    if (cells.empty()) cells.push_back(-1);
-
-    auto p = std::make_unique<ProbeResources>();
-    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    p->coeffs = vk::Buffer::deviceLocal(ctx_, coeffs.data(), coeffs.size() * sizeof(glm::vec4), storage);
-    p->cells = vk::Buffer::deviceLocal(ctx_, cells.data(), cells.size() * 4, storage);
-    p->volumes = vk::Buffer::deviceLocal(ctx_, records.data(), records.size() * sizeof(records[0]), storage);
-    p->errors = vk::Buffer::deviceLocal(ctx_, errors.data(), errors.size() * 4, storage);
-    p->light = vk::Buffer(ctx_, std::max<size_t>(vertexCount_, 1) * 32,
-                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    blocks::ProbesBlock block;
-    block.volumeCount = volumeCount_;
-    block.vertexCount = int32_t(vertexCount_);
-    block.anyErrorMap = anyErrorMap_ ? 1 : 0;
-    p->block = vk::Buffer::hostVisible(ctx_, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    p->block.write(&block, sizeof block);
-    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
-    p->set = vk::DescriptorSetBuilder()
-                 .uniform(blocks::ProbesBlock::kBinding, "probes", p->block, compute)
-                 .storage(1, kProbeCoefficients, p->coeffs, compute)
-                 .storage(2, kProbeCells, p->cells, compute)
-                 .storage(3, kProbeVolumes, p->volumes, compute)
-                 .storage(4, kProbeErrorMaps, p->errors, compute)
-                 .storage(5, kVertices, g.vertices, compute)
-                 .storage(6, kProbeLight, p->light, compute)
-                 .build(ctx_);
-    g.graph.importBuffer(kProbeCoefficients, p->coeffs.handle(), true);
-    g.graph.importBuffer(kProbeCells, p->cells.handle(), true);
-    g.graph.importBuffer(kProbeVolumes, p->volumes.handle(), true);
-    g.graph.importBuffer(kProbeErrorMaps, p->errors.handle(), true);
-    g.graph.importBuffer(kProbeLight, p->light.handle());
-    g.probes = std::move(p);
+    g.probes = features::buildProbes(ctx_, g, uint32_t(vertexCount_), volumes);
+    volumeCount_ = g.probes->volumeCount;
+    anyErrorMap_ = g.probes->anyErrorMap;
+    probeBytes_ = g.probes->bytes;
 }
 
 void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions) {
@@ -1210,7 +836,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // The passes, in order; a feature that does not take part adds none.
     g.graph.beginFrame();
     features::addProbePass(f);
-    features::addLpvPropagationPass(f, [this](VkCommandBuffer c) { recordLpvPropagation(c); });
+    features::addLpvPropagationPass(f);
     features::addShadowPass(f);
     features::addTerrainPass(f);
     features::addSkyPass(f);

@@ -186,7 +186,6 @@ private:
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
     void buildReflectionSets();
-    void recordLpvPropagation(VkCommandBuffer cb);
     void propagateLpvNow();  // runs the owed propagation in a submission of its own
     void readFrameTimings(uint32_t slot);  // the slot's last frame into timings_; its fence has passed
     vk::VulkanContext& ctx_;

@@ -2,7 +2,6 @@
 // Light propagation volumes and the local lights: the volumes on the GPU, the block and lights the
 // terrain's LPV set binds, and the propagation pass for volumes the renderer propagates.
 
-#include <functional>
 #include <memory>
 #include <vector>
 
@@ -37,8 +36,15 @@ namespace features {
 std::vector<blocks::LocalLightRecord> packLocalLights(const std::vector<LocalLight>& lights, bool used);
 // The terrain's LPV block for this frame: the volumes' (or none) with the frame's local lights.
 blocks::LpvBlock packLpv(const Frame& f);
-// The owed propagation steps, once, before anything reads the light; `record` records them.
-void addLpvPropagationPass(Frame& f, std::function<void(VkCommandBuffer)> record);
+// The volumes' light and geometry uploaded with the block's cascades; for volumes left to the
+// renderer to propagate, the work regions, send scales and the propagation pass's set and
+// pipeline too. Null for no volumes.
+std::unique_ptr<LpvResources> buildLpv(vk::VulkanContext& ctx, RendererGpu& g,
+                                       std::shared_ptr<const lpv::Volumes> volumes);
+// The owed propagation steps (lpv_propagate.comp), timed where the device writes timestamps.
+void recordLpvPropagation(RendererGpu& g, VkCommandBuffer cb);
+// Those steps as the frame's pass, once, before anything reads the light.
+void addLpvPropagationPass(Frame& f);
 
 }  // namespace features
 }  // namespace terralux

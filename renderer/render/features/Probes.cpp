@@ -1,11 +1,90 @@
 #include "render/features/Probes.h"
 
+#include <cmath>
+
 #include "ShaderBinaries.h"
 #include "vk/ComputePipeline.h"
 
 namespace terralux::features {
 
 using namespace frame;
+
+std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu& g, uint32_t vertexCount,
+                                            const std::vector<GpuProbeVolume>& volumes) {
+    auto p = std::make_unique<ProbeResources>();
+    std::vector<glm::vec4> coeffs;
+    std::vector<int32_t> cells;
+    std::vector<blocks::ProbeVolumeRecord> records;
+    std::vector<float> errors;
+    for (const auto& v : volumes) {
+        blocks::ProbeVolumeRecord rec{};
+        rec.origin = v.origin;
+        rec.spacing = v.spacing;
+        rec.dims = glm::ivec3(v.dims);
+        rec.firstProbe = int32_t(coeffs.size() / 9);
+        rec.firstCell = int32_t(cells.size());
+        rec.preConvolved = v.irradianceEncoded ? 1 : 0;
+        rec.fallbackBlend = v.fallbackBlendDistance;
+        rec.shScale = v.scale;
+        static const ProbeDiagnostics none;
+        const ProbeDiagnostics& d = v.diagnostics ? *v.diagnostics : none;
+        const ErrorMap& m = d.errorMap;
+        // A map that does not hold nx·nz values (or has no step) is no map.
+        if (m.error.size() == size_t(m.nx) * m.nz && m.step > 0.0f && !m.error.empty()) {
+            rec.firstError = int32_t(errors.size());
+            rec.errorNx = int32_t(m.nx);
+            rec.errorNz = int32_t(m.nz);
+            rec.errorX0 = m.x0;
+            rec.errorZ0 = m.z0;
+            rec.errorStep = m.step;
+            for (float e : m.error) errors.push_back(std::isfinite(e) ? e : -1.0f);
+            p->anyErrorMap = true;
+        }
+        for (size_t i = 0; i < v.coeffs.size(); ++i) {
+            const float moved = i < d.moved.size() && d.moved[i] ? 1.0f : 0.0f;
+            coeffs.push_back(glm::vec4(v.coeffs[i][0], moved));
+            for (size_t k = 1; k < 9; ++k) coeffs.push_back(glm::vec4(v.coeffs[i][k], 0.0f));
+        }
+        cells.insert(cells.end(), v.occupancy.begin(), v.occupancy.end());
+        records.push_back(rec);
+    }
+    p->volumeCount = int(records.size());
+    p->bytes = coeffs.size() * sizeof(glm::vec4) + cells.size() * 4;
+    // Storage buffers may not be empty: a placeholder element where there is nothing to hold.
+    if (errors.empty()) errors.push_back(-1.0f);
+    if (coeffs.empty()) coeffs.push_back(glm::vec4(0.0f));
+    if (cells.empty()) cells.push_back(-1);
+
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    p->coeffs = vk::Buffer::deviceLocal(ctx, coeffs.data(), coeffs.size() * sizeof(glm::vec4), storage);
+    p->cells = vk::Buffer::deviceLocal(ctx, cells.data(), cells.size() * 4, storage);
+    p->volumes = vk::Buffer::deviceLocal(ctx, records.data(), records.size() * sizeof(records[0]), storage);
+    p->errors = vk::Buffer::deviceLocal(ctx, errors.data(), errors.size() * 4, storage);
+    p->light = vk::Buffer(ctx, std::max<size_t>(vertexCount, 1) * 32,
+                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    blocks::ProbesBlock block;
+    block.volumeCount = p->volumeCount;
+    block.vertexCount = int32_t(vertexCount);
+    block.anyErrorMap = p->anyErrorMap ? 1 : 0;
+    p->block = vk::Buffer::hostVisible(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    p->block.write(&block, sizeof block);
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    p->set = vk::DescriptorSetBuilder()
+                 .uniform(blocks::ProbesBlock::kBinding, "probes", p->block, compute)
+                 .storage(1, kProbeCoefficients, p->coeffs, compute)
+                 .storage(2, kProbeCells, p->cells, compute)
+                 .storage(3, kProbeVolumes, p->volumes, compute)
+                 .storage(4, kProbeErrorMaps, p->errors, compute)
+                 .storage(5, kVertices, g.vertices, compute)
+                 .storage(6, kProbeLight, p->light, compute)
+                 .build(ctx);
+    g.graph.importBuffer(kProbeCoefficients, p->coeffs.handle(), true);
+    g.graph.importBuffer(kProbeCells, p->cells.handle(), true);
+    g.graph.importBuffer(kProbeVolumes, p->volumes.handle(), true);
+    g.graph.importBuffer(kProbeErrorMaps, p->errors.handle(), true);
+    g.graph.importBuffer(kProbeLight, p->light.handle());
+    return p;
+}
 
 void addProbePass(Frame& f) {
     ProbeResources* probes = f.probes;

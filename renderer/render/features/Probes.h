@@ -2,7 +2,11 @@
 // Diffuse probe volumes: the baked grids on the GPU and the compute pass that evaluates them at
 // every terrain vertex (the probe light the terrain pass reads as a vertex attribute).
 
+#include <memory>
+#include <vector>
+
 #include "render/Frame.h"
+#include "render/TerrainRenderer.h"
 
 namespace terralux {
 
@@ -11,10 +15,18 @@ struct ProbeResources {
     vk::Buffer block, coeffs, cells, volumes, errors, light;
     vk::DescriptorSet set;
     bool lightStale = true;  // the probe pass has not run since the volumes changed
+    int volumeCount = 0;
+    bool anyErrorMap = false;  // some volume carries an interpolation-error map
+    size_t bytes = 0;          // coefficients and cells on the GPU
 };
 
 namespace features {
 
+// The volumes' records, coefficients (with the moved flag), cells and error maps uploaded, the
+// per-vertex light buffer for `vertexCount` vertices, the probe pass's set; their graph names
+// imported.
+std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu& g, uint32_t vertexCount,
+                                            const std::vector<GpuProbeVolume>& volumes);
 // Evaluates the volumes at the vertices, once after they changed.
 void addProbePass(Frame& f);
 

@@ -2,11 +2,14 @@
 // Reflection probes: the records and cubes of a bound set, and the grid block the lit passes
 // read with the lights.
 
+#include <memory>
 #include <vector>
 
 #include "render/Frame.h"
 
 namespace terralux {
+
+struct ReflectionProbeSet;  // bake/ReflectionBake.h
 
 // Present only while a probe set is bound. The probe records and, for the cubemap encoding, their
 // cubes (one cube-map array, layer 6·probe + face, with the set's mip chain; a 1×1 placeholder
@@ -23,10 +26,16 @@ struct ReflectionResources {
     uint32_t markerCount = 0;
     std::vector<vk::Buffer> blocks;
     std::vector<vk::DescriptorSet> lights, shadowedLights;
+    size_t bytes = 0;  // records and cube texels on the GPU
 };
 
 namespace features {
 
+// The set's records, cubes (cubemap encoding), markers and per-slot grid blocks, uploaded once;
+// their graph names imported. Throws std::invalid_argument for a set whose probes, grid and
+// texels disagree, or that holds more faces than the device's image arrays.
+std::unique_ptr<ReflectionResources> buildReflections(vk::VulkanContext& ctx, RendererGpu& g,
+                                                     const ReflectionProbeSet& set);
 // The set's grid with the frame's strength.
 blocks::ReflectionBlock packReflections(const ReflectionResources& r, const RenderSettings& s);
 

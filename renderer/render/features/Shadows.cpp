@@ -1,6 +1,7 @@
 #include "render/features/Shadows.h"
 
 #include <cmath>
+#include <span>
 
 #include <glm/geometric.hpp>
 
@@ -28,6 +29,20 @@ blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Casca
     block.cascadeCount = int(cascades.size());
     block.filterMode = int(s.shadows.filter);
     return block;
+}
+
+std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const RendererGpu& g, int resolution,
+                                                 int cascades) {
+    auto sh = std::make_unique<ShadowResources>();
+    sh->resolution = resolution;
+    sh->cascades = cascades;
+    sh->maps = vk::Image::depthLayers(ctx, uint32_t(resolution), uint32_t(resolution), uint32_t(cascades));
+    for (uint32_t i = 0; i < uint32_t(cascades); ++i) {
+        const VkImageView view = sh->maps.layerView(i);
+        sh->framebuffers.emplace_back(ctx, g.shadowPass, std::span<const VkImageView>(&view, 1),
+                                      uint32_t(resolution), uint32_t(resolution));
+    }
+    return sh;
 }
 
 void addShadowPass(Frame& f) {

@@ -1,6 +1,7 @@
 #pragma once
 // The sun's shadow cascades: their depth maps, their block and the pass that draws them.
 
+#include <memory>
 #include <vector>
 
 #include "render/Frame.h"
@@ -22,6 +23,9 @@ namespace features {
 // resolution.
 blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Cascade>& cascades,
                                 const CascadeRange& range, int resolution);
+// `cascades` depth maps of `resolution`² texels, one layer each, with a framebuffer per layer.
+std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const RendererGpu& g, int resolution,
+                                                 int cascades);
 // Draws the cascades again when their light projections moved (the camera, the sun or a shadow
 // setting changed); a still camera keeps the maps it drew.
 void addShadowPass(Frame& f);

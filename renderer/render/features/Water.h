@@ -2,11 +2,13 @@
 // The water plane: its field and mesh, its block, and its passes (the planar reflection, the copy
 // of the frame under it, the water surface).
 
+#include <memory>
 #include <vector>
 
 #include <glm/vec2.hpp>
 
 #include "render/Frame.h"
+#include "terrain/Heightfield.h"
 
 namespace terralux {
 
@@ -36,6 +38,19 @@ struct WaterInputs {
     float meshSpacing = 1.0f;     // metres between the water mesh's vertices
 };
 blocks::WaterBlock packWater(const RenderSettings& s, const WaterInputs& in);
+// The field over the footprint (depth below `level` and distance to shore) and the mesh over
+// every cell whose bed lies below level + `margin`, with a block per frame slot.
+std::unique_ptr<WaterResources> buildWater(vk::VulkanContext& ctx, const Heightfield& hf, float level, float margin);
+// Whether a frame of `width` × `height` needs new targets: the planar reflection at
+// `reflectionScale` and the copy of the frame under the water.
+bool waterTargetsNeeded(const WaterResources& w, uint32_t width, uint32_t height, float reflectionScale);
+// Builds those targets and the per-slot sets that bind them with the block and the field.
+void buildWaterTargets(vk::VulkanContext& ctx, const RendererGpu& g, WaterResources& w, uint32_t width,
+                       uint32_t height, float reflectionScale);
+// The water set: its block, the reflection, the frame under the water and the field (read by the
+// mesh too). Null views: the layout alone.
+vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView reflection, VkImageView scene,
+                                         VkImageView field, VkSampler sampler);
 // The planar reflection (terrain and sky from the mirrored camera), the copy of the frame the
 // water refracts, and the water surface; each only where the frame needs it.
 void addWaterPasses(Frame& f);
