@@ -47,6 +47,16 @@ LpvPanel::LpvPanel(ProjectDocument* doc, QWidget* parent) : QWidget(parent), doc
     settings_->addParameters("lpv.");
     v->addWidget(settings_);
 
+    auto* hintRow = new QHBoxLayout;
+    hint_ = new QLabel;
+    hint_->setObjectName("lpv.hint");
+    hint_->setWordWrap(true);
+    hintFix_ = new QPushButton;
+    hintFix_->setObjectName("lpv.hintFix");
+    hintRow->addWidget(hint_, 1);
+    hintRow->addWidget(hintFix_);
+    v->addLayout(hintRow);
+
     error_ = new QLabel;
     error_->setObjectName("lpv.error");
     error_->setWordWrap(true);
@@ -98,12 +108,52 @@ LpvPanel::LpvPanel(ProjectDocument* doc, QWidget* parent) : QWidget(parent), doc
         light_->setElement(std::max(row, 0));
         delete_->setEnabled(row >= 0);
     });
+    connect(hintFix_, &QPushButton::clicked, this, [this] {
+        const SceneDescription& scene = doc_->project().scene;
+        QString error;
+        const bool ok = scene.lpv.enabled
+                            ? doc_->setParameter("lighting.indirect",
+                                                 scene.lighting.indirect == IndirectLighting::None ? "lpv" : "both", &error)
+                            : doc_->setParameter("lpv.enabled", true, &error);
+        if (!ok) showRejection(error);
+    });
     connect(doc_, &ProjectDocument::parametersChanged, this, [this](const QString& path) {
         // A change that went through clears the last refusal.
         error_->hide();
         if (path.isEmpty() || path.startsWith("lights")) refresh();
+        if (path.isEmpty() || path.startsWith("lpv") || path.startsWith("lighting")) refreshHint();
     });
     refresh();
+    refreshHint();
+}
+
+void LpvPanel::refreshHint() {
+    const SceneDescription& scene = doc_->project().scene;
+    const bool on = scene.lpv.enabled;
+    const IndirectLighting mode = scene.lighting.indirect;
+    const bool lit = mode == IndirectLighting::Lpv || mode == IndirectLighting::Both;
+    const std::string indirect = doc_->value("lighting.indirect").get<std::string>();
+    if (on == lit) {
+        hint_->hide();
+        hintFix_->hide();
+        return;
+    }
+    if (on) {
+        hint_->setText(QString("The LPV is computed but adds no light: Indirect light is '%1'. Only its debug "
+                               "views (61 to 64) show it.")
+                           .arg(QString::fromStdString(indirect)));
+        hintFix_->setText(indirect == "none" ? "Light with the LPV" : "Light with probes and LPV");
+        hintFix_->setToolTip(QString("Sets Indirect light to '%1': one undoable edit")
+                                 .arg(indirect == "none" ? "lpv" : "both"));
+    } else {
+        hint_->setText(QString("Indirect light is '%1', but Light propagation volumes is off: the views get "
+                               "no LPV light and the bake exports none.")
+                           .arg(QString::fromStdString(indirect)));
+        hintFix_->setText("Turn the LPV on");
+        hintFix_->setToolTip("Ticks Light propagation volumes: one undoable edit");
+    }
+    hint_->show();
+    hintFix_->show();
 }
 
 int LpvPanel::currentLight() const { return table_->currentRow(); }

@@ -1330,6 +1330,53 @@ private slots:
     // Load: a thousand edits through the docks' editors, back to back with no waits. Nothing
     // crashes, the viewport then draws what the command line draws for the final project, undo
     // unwinds to the start, and memory does not grow with the edits.
+    // The LPV on while the indirect light leaves it out lights nothing: the dock says so and offers
+    // the edit that adds its light; the indirect light asking for an LPV that is off, likewise.
+    void lpvDockSaysWhenTheLpvLightsNothing() {
+        auto* dock = w_->findChild<QDockWidget*>("dock.lpv");
+        QVERIFY(dock);
+        dock->raise();
+        ProjectDocument* doc = w_->document();
+        auto* hint = dock->findChild<QLabel*>("lpv.hint");
+        auto* fix = dock->findChild<QPushButton*>("lpv.hintFix");
+        QVERIFY(hint && fix);
+        // The defaults agree: no LPV, probes.
+        QVERIFY(!hint->isVisibleTo(dock));
+        auto* enabled = dock->findChild<QCheckBox*>("param.lpv.enabled");
+        enabled->setChecked(true);
+        QVERIFY(doc->project().scene.lpv.enabled);
+        QVERIFY(hint->isVisibleTo(dock) && fix->isVisibleTo(dock));
+        QVERIFY(hint->text().contains("adds no light: Indirect light is 'probes'"));
+        QCOMPARE(fix->text(), QString("Light with probes and LPV"));
+        // The beauty frame's terrain pass reads the LPV's light only once the fix is made.
+        const auto terrainReadsLpv = [&] {
+            w_->viewport()->renderNow();
+            for (const PassInfo& p : w_->viewport()->renderer()->renderer().lastFramePasses())
+                if (p.name == "terrain")
+                    for (const ResourceUse& u : p.uses)
+                        if (u.resource == "lpv-light") return true;
+            return false;
+        };
+        QVERIFY(!terrainReadsLpv());
+        fix->click();
+        QCOMPARE(doc->project().scene.lighting.indirect, IndirectLighting::Both);
+        QVERIFY(!hint->isVisibleTo(dock));
+        QVERIFY(QTest::qWaitFor(terrainReadsLpv, 60000));
+        // One undoable edit, named in words.
+        QCOMPARE(doc->undoStack()->undoText(), QString("Set Indirect light (lighting)"));
+        doc->undoStack()->undo();
+        QVERIFY(hint->isVisibleTo(dock));
+        // Off with the indirect light asking for it: the other way round.
+        dock->findChild<QComboBox*>("param.lighting.indirect")->setCurrentText("lpv");
+        enabled->setChecked(false);
+        QVERIFY(hint->isVisibleTo(dock));
+        QVERIFY(hint->text().contains("Indirect light is 'lpv', but Light propagation volumes is off"));
+        QCOMPARE(fix->text(), QString("Turn the LPV on"));
+        fix->click();
+        QVERIFY(doc->project().scene.lpv.enabled);
+        QVERIFY(!hint->isVisibleTo(dock));
+    }
+
     // The LPV dock edits every lpv setting and the indirect selector (undoable), names each
     // setting's console variable in its tooltip, and adds, edits and deletes lights.
     void lpvDockEditsSettingsAndLights() {
