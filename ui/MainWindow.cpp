@@ -567,14 +567,15 @@ void MainWindow::buildDocks() {
     auto* volumesDock = buildVolumesDock();
     auto* bakeDock = buildBakeDock();
     auto* tradeoffDock = buildTradeoffDock();
-    // The lighting docks share the upper tab group with the terrain.
-    tabifyDockWidget(terrainDock, skyDock);
-    tabifyDockWidget(skyDock, shadowsDock);
-    tabifyDockWidget(shadowsDock, atmosphereDock);
-    tabifyDockWidget(atmosphereDock, surfaceDock);
+    // Three tab groups of four, so every tab shows its whole label at the window's usual widths:
+    // the ground (terrain, surface, AO, water), the light (sun and sky, shadows, atmosphere, LPV),
+    // and the probes and their output.
+    tabifyDockWidget(terrainDock, surfaceDock);
     tabifyDockWidget(surfaceDock, aoDock);
     tabifyDockWidget(aoDock, waterDock);
-    tabifyDockWidget(waterDock, lpvDock);
+    tabifyDockWidget(skyDock, shadowsDock);
+    tabifyDockWidget(shadowsDock, atmosphereDock);
+    tabifyDockWidget(atmosphereDock, lpvDock);
     tabifyDockWidget(volumesDock, reflectionDock);
     tabifyDockWidget(reflectionDock, bakeDock);
     tabifyDockWidget(bakeDock, tradeoffDock);
@@ -584,7 +585,10 @@ void MainWindow::buildDocks() {
         bar->setUsesScrollButtons(true);
     }
     terrainDock->raise();
+    skyDock->raise();
     volumesDock->raise();
+    // The probe volumes' form is the longest: the lower group gets the most height.
+    resizeDocks({terrainDock, skyDock, volumesDock}, {26, 32, 42}, Qt::Vertical);
 
     buildViewportToolbar();
     buildStatusBar();

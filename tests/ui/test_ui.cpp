@@ -18,6 +18,7 @@
 #include <QFileDialog>
 #include <QFormLayout>
 #include <QStatusBar>
+#include <QTabBar>
 #include <QTableWidget>
 #include <QLabel>
 #include <QLineEdit>
@@ -155,6 +156,26 @@ private slots:
     void cleanup() {
         if (w_) w_->document()->undoStack()->setClean();
         w_.reset();
+    }
+
+    // The docks stand in three tab groups of four, each tab's whole label on show at the test's
+    // 1280 x 800 window: none hides behind the scroll arrows (eight tabs in one group did).
+    void everyDockTabShowsWithoutScrolling() {
+        int groups = 0;
+        QStringList titles;
+        for (QTabBar* bar : w_->findChildren<QTabBar*>()) {
+            if (bar->parentWidget() != w_.get() || bar->count() < 2 || !bar->isVisible()) continue;
+            ++groups;
+            for (int i = 0; i < bar->count(); ++i) {
+                titles << bar->tabText(i);
+                const QRect r = bar->tabRect(i);
+                QVERIFY2(r.left() >= 0 && r.right() < bar->width(),
+                         qPrintable(bar->tabText(i) + " lies outside its tab bar"));
+            }
+        }
+        QCOMPARE(groups, 3);
+        QCOMPARE(titles.size(), 12);
+        for (const char* t : {"Water", "LPV", "Trade-off", "Atmosphere"}) QVERIFY(titles.contains(t));
     }
 
     void startsWithTheSampleAndEditsAreUndoable() {
