@@ -213,6 +213,10 @@ std::string summary(const std::vector<std::string>& differences) {
 
 }  // namespace
 
+std::vector<std::string> bakeStaleness(const Project& project, const std::filesystem::path& folder) {
+    return staleness(project, folder, readReport(folder / "bake_report.json"));
+}
+
 size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<std::string>* warnings,
                                    const std::filesystem::path& from) {
     const SceneDescription& scene = project_.scene;

@@ -176,4 +176,8 @@ private:
     size_t lpvUpdates_ = 0;
 };
 
+// Why the bake in `folder` is not `project`'s: the differences between its recorded inputs and the
+// project's (bakeInputs), or what is missing; empty when it is current.
+std::vector<std::string> bakeStaleness(const Project& project, const std::filesystem::path& folder);
+
 }  // namespace terralux

@@ -1111,6 +1111,21 @@ void MainWindow::updateAmbientOcclusion() {
 void MainWindow::schedulePreview() { previewTimer_.start(); }
 
 void MainWindow::startPreview() {
+    // The project's own bake, when current, holds what a draft preview would only approximate:
+    // show it (again, after an edit that was undone) and bake no preview.
+    const auto folder = bakeFolder();
+    if (renderer_ && folder && bakeStaleness(doc_->project(), *folder).empty()) {
+        previewJob_.stop();  // a preview started for an edit since undone must not land
+        if (probeSource_ != "last bake") {
+            renderer_->setProject(doc_->project());
+            renderer_->loadProbes(false, nullptr, nullptr, *folder);
+            probeSource_ = withStaleness("last bake");
+            reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
+            viewport_->renderNow();
+            updateStatus();
+        }
+        return;
+    }
     ++previewsStarted_;
     const Project project = doc_->project();
     auto terrain = doc_->terrainShared();

@@ -178,6 +178,31 @@ private slots:
         for (const char* t : {"Water", "LPV", "Trade-off", "Atmosphere"}) QVERIFY(titles.contains(t));
     }
 
+    // A project whose bake is current shows the bake and bakes no preview: when it is opened, and
+    // again once an edit that made the bake stale is undone.
+    void aCurrentBakeStaysShownOverThePreview() {
+        ProjectDocument* doc = w_->document();
+        quickBakeSettings(*doc);
+        w_->startBake();
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 60000));
+        const QString file = QString::fromStdString((kOut / "current_bake.terralux.json").string());
+        QString error;
+        QVERIFY2(doc->saveAs(file, &error), qPrintable(error));
+        const unsigned previews = w_->previewsStarted();
+        QVERIFY2(doc->open(file, &error), qPrintable(error));
+        QVERIFY(waitForProbes(*w_, "last bake"));
+        QTest::qWait(1500);
+        QCOMPARE(w_->probeSource(), QString("last bake"));
+        QCOMPARE(w_->previewsStarted(), previews);
+        // An edit the bake reads: a draft preview; undone: the bake again; redone: the preview.
+        QVERIFY(doc->setParameter("sun.elevation_deg", 20.0, &error));
+        QVERIFY(waitForProbes(*w_, "draft preview"));
+        doc->undoStack()->undo();
+        QVERIFY(waitForProbes(*w_, "last bake"));
+        doc->undoStack()->redo();
+        QVERIFY(waitForProbes(*w_, "draft preview"));
+    }
+
     void startsWithTheSampleAndEditsAreUndoable() {
         QCOMPARE(w_->document()->terrain().heightfield.width(), 256);
         // Probe irradiance shows a grid change most directly.
@@ -698,6 +723,10 @@ private slots:
 
     // The ramp colours the viewport at once (and the preview bakes again: the bake reflects with it).
     void albedoRampColoursTheTerrain() {
+        // A folder with no bake: one current for the ramp (an earlier test's) would be shown
+        // instead of a preview.
+        QString error;
+        QVERIFY(w_->document()->setParameter("export.out_dir", (kOut / "no_bake").string(), &error));
         w_->findChild<QDockWidget*>("dock.surface")->raise();
         w_->findChild<QComboBox*>("param.terrain.albedo_mode")->setCurrentText("constant");
         w_->viewport()->renderNow();
