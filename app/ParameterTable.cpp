@@ -6,6 +6,7 @@
 
 #include "LpvConsoleVariables.h"
 #include "Project.h"
+#include "SceneLighting.h"
 #include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
 #include "lpv/Lpv.h"
@@ -438,6 +439,14 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::baseHeight);
     add(Row("fog.color", T::Color)).range(0.0, kUnbounded).autoMeans("the sky's mean radiance").label("Fog colour")
         .about("Radiance the fog scatters toward the camera from the sky, linear RGB")
+        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
+            // The skies the scene alone describes; an HDR sky's mean needs its file, read by the bake.
+            if (s.sky.mode == SkyMode::Hdr) return nullptr;
+            Project p;
+            p.scene = s;
+            const glm::vec3 c = *resolvedFog(s.fog, skyOf(p), hf).color;
+            return json{c.x, c.y, c.z};
+        })
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::color);
     add(Row("fog.inscatter", T::Number)).range(0.0, 100.0).label("Sun inscatter")
         .about("Scales the sunlight the fog scatters toward the camera")

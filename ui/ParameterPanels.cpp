@@ -366,12 +366,22 @@ void ParameterForm::addColor(const ParameterSpec& spec) {
     button->setObjectName(QString::fromStdString(uiObjectName(spec)));
     const QString title = QString::fromStdString(spec.label);
     connect(button, &QPushButton::clicked, this, [=, this] {
-        const json v = doc_->value(docPath(spec));
+        json v = doc_->value(docPath(spec));
+        // Left to the scene ("auto"): start from what it resolves to here, where the row can say.
+        if (v.is_null() && spec.resolved)
+            v = spec.resolved(doc_->project().scene, doc_->terrain().heightfield, size_t(element_));
+        if (!v.is_array() || v.size() != 3) v = json{0.5, 0.5, 0.5};
         double rgb[3] = {v[0].get<double>(), v[1].get<double>(), v[2].get<double>()};
         if (pickColor(this, title, rgb)) set(docPath(spec), json{rgb[0], rgb[1], rgb[2]});
     });
     refreshers_.push_back([=, this] {
         const json v = doc_->value(docPath(spec));
+        if (v.is_null() && spec.autoMeaning) {
+            // A colour the scene decides: say which, in the button's own colours.
+            button->setStyleSheet(QString());
+            button->setText(QString::fromStdString("auto: " + autoShort(spec)));
+            return;
+        }
         if (!v.is_array() || v.size() != 3) return;
         showColor(button, v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
     });

@@ -203,6 +203,36 @@ private slots:
         QVERIFY(waitForProbes(*w_, "draft preview"));
     }
 
+    // The fog colour left to the sky says so on its button, and the picker starts from the colour
+    // it resolves to (the uniform sky's mean radiance), not from nothing.
+    void fogColourLeftToTheSkySaysSo() {
+        auto* dock = w_->findChild<QDockWidget*>("dock.atmosphere");
+        dock->raise();
+        ProjectDocument* doc = w_->document();
+        QString error;
+        QVERIFY(doc->setParameter("fog.enabled", true, &error));
+        QVERIFY(doc->value("fog.color").is_null());
+        auto* button = dock->findChild<QPushButton*>("param.fog.color");
+        QVERIFY(button);
+        QCOMPARE(button->text(), QString("auto: the sky's mean radiance"));
+        const glm::vec3 sky = doc->project().scene.sky.color * float(doc->project().scene.sky.intensity);
+        QColor started;
+        QTimer::singleShot(200, [&] {
+            auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
+            if (!dialog) return;
+            started = dialog->currentColor();
+            dialog->accept();
+        });
+        button->click();
+        QVERIFY(started.isValid());
+        // The sky's colour (below 1, so no intensity on top), as the dialog's 8-bit channels hold it.
+        QVERIFY(std::abs(started.redF() - sky.x) < 0.01 && std::abs(started.blueF() - sky.z) < 0.01);
+        const auto& set = doc->project().scene.fog.color;
+        QVERIFY(set.has_value());
+        QVERIFY(std::abs(set->x - sky.x) < 0.01f && std::abs(set->z - sky.z) < 0.01f);
+        QVERIFY(button->text().startsWith("0.09"));
+    }
+
     void startsWithTheSampleAndEditsAreUndoable() {
         QCOMPARE(w_->document()->terrain().heightfield.width(), 256);
         // Probe irradiance shows a grid change most directly.
