@@ -958,9 +958,7 @@ VolumeErrorMap measureVolumeErrorMap(const SceneDescription& scene, const BakeSe
                               : bakeProbes(setup.lighting, cache, setup.q.bounces, trial.positions, trial.valid,
                                            rays, seed, mc);
             suggestionRays += b.rays;
-            if (scene.bake.deringing)
-                for (size_t i = 0; i < b.sh.size(); ++i)
-                    if (trial.valid[i]) sh::deringIrradiance(b.sh[i]);
+            if (scene.bake.deringing) sh::deringProbes(b.sh, trial.valid);
             const uint64_t before = out.rays;
             const ErrorMap m = measureErrorMap(trial, b.sh, hf, counted, scene.bake.errorMapResolution,
                                                errorMapHeight(candidate, trial), seed, &truths);
@@ -1157,16 +1155,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
 
         // Radiance projections, optionally windowed so irradiance is never negative. Before the
         // reference comparison, so that measures the probes as they are written.
-        int windowed = 0;
-        float strongest = INFINITY;
-        for (size_t i = 0; i < bake.sh.size(); ++i) {
-            if (!layout.valid[i] || !scene.bake.deringing) continue;
-            const sh::DeringResult d = sh::deringIrradiance(bake.sh[i]);
-            if (d.windowed) {
-                ++windowed;
-                strongest = std::min(strongest, d.width);
-            }
-        }
+        const sh::DeringSummary dering =
+            scene.bake.deringing ? sh::deringProbes(bake.sh, layout.valid) : sh::DeringSummary{};
 
         if (request.compareReference) {
             const BakeControl rc{[&](double f) {
@@ -1222,9 +1212,9 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                     bake.sh[i].c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
         if (scene.bake.deringing)
             vr["deringing"] = {{"window", "lanczos-sigma"},
-                               {"probes_windowed", windowed},
-                               {"strongest_width", std::isfinite(strongest) ? nlohmann::json(strongest)
-                                                                            : nlohmann::json(nullptr)}};
+                               {"probes_windowed", dering.windowed},
+                               {"strongest_width", std::isfinite(dering.strongest) ? nlohmann::json(dering.strongest)
+                                                                                   : nlohmann::json(nullptr)}};
         ShProbeGrid grid = toGrid(layout, bake.sh, scene.exportSettings);
         vr["bytes"] = grid.fileSize();
         vr["grid"] = {{"dims", {grid.dims.x, grid.dims.y, grid.dims.z}},

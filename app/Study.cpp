@@ -604,9 +604,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
                           control());
     }
     traced += bake.rays;
-    if (s.bake.deringing)
-        for (size_t i = 0; i < bake.sh.size(); ++i)
-            if (layout.valid[i]) sh::deringIrradiance(bake.sh[i]);
+    if (s.bake.deringing) sh::deringProbes(bake.sh, layout.valid);
     p.seconds = secondsSince(t0);
     p.peakMemoryBytes = memory.added();
     p.outputBytes = layout.fileBytes();

@@ -476,4 +476,17 @@ DeringResult deringIrradiance(ShRgb& sh) {
     return result;
 }
 
+DeringSummary deringProbes(std::vector<ShRgb>& sh, const std::vector<uint8_t>& valid) {
+    DeringSummary out;
+    for (size_t i = 0; i < sh.size(); ++i) {
+        if (!valid[i]) continue;
+        const DeringResult d = deringIrradiance(sh[i]);
+        if (d.windowed) {
+            ++out.windowed;
+            out.strongest = std::min(out.strongest, d.width);
+        }
+    }
+    return out;
+}
+
 }  // namespace terralux::sh

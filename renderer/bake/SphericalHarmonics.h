@@ -15,8 +15,10 @@
 // Maps"). A constant sky of radiance 1 gives L_0 = 2 sqrt(pi) and E = pi for every n.
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -92,5 +94,12 @@ struct DeringResult {
 // irradiance in all three channels is applied. If only DC remains feasible the result is DC only
 // (width = 0); a negative L_0 is then clamped to 0, the only non-negative option left.
 DeringResult deringIrradiance(ShRgb& sh);
+// deringIrradiance on every probe `valid` marks (size of `sh`): how many were windowed and the
+// narrowest window applied (infinity when none was).
+struct DeringSummary {
+    int windowed = 0;
+    float strongest = std::numeric_limits<float>::infinity();
+};
+DeringSummary deringProbes(std::vector<ShRgb>& sh, const std::vector<uint8_t>& valid);
 
 }  // namespace terralux::sh
