@@ -1,5 +1,6 @@
 #include "MainWindow.h"
 
+#include <array>
 #include <chrono>
 #include <functional>
 
@@ -570,15 +571,11 @@ void MainWindow::buildDocks() {
     // Three tab groups of four, so every tab shows its whole label at the window's usual widths:
     // the ground (terrain, surface, AO, water), the light (sun and sky, shadows, atmosphere, LPV),
     // and the probes and their output.
-    tabifyDockWidget(terrainDock, surfaceDock);
-    tabifyDockWidget(surfaceDock, aoDock);
-    tabifyDockWidget(aoDock, waterDock);
-    tabifyDockWidget(skyDock, shadowsDock);
-    tabifyDockWidget(shadowsDock, atmosphereDock);
-    tabifyDockWidget(atmosphereDock, lpvDock);
-    tabifyDockWidget(volumesDock, reflectionDock);
-    tabifyDockWidget(reflectionDock, bakeDock);
-    tabifyDockWidget(bakeDock, tradeoffDock);
+    const std::array<std::array<QDockWidget*, 4>, 3> groups{{{terrainDock, surfaceDock, aoDock, waterDock},
+                                                             {skyDock, shadowsDock, atmosphereDock, lpvDock},
+                                                             {volumesDock, reflectionDock, bakeDock, tradeoffDock}}};
+    for (const auto& group : groups)
+        for (size_t i = 1; i < group.size(); ++i) tabifyDockWidget(group[i - 1], group[i]);
     // Whole tab labels, scrolled when the docks are narrow, rather than "Terr…" and "Wa…".
     for (auto* bar : findChildren<QTabBar*>()) {
         bar->setElideMode(Qt::ElideNone);

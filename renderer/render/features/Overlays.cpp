@@ -1,5 +1,7 @@
 #include "render/features/Overlays.h"
 
+#include <span>
+
 #include "ShaderBinaries.h"
 #include "render/features/Reflections.h"
 
@@ -18,31 +20,26 @@ blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, fl
 
 namespace {
 
-// Pipelines read one vec4 per instance: a marker (xyz, w its kind) or a leaf (min corner, edge).
+// An overlay pipeline: one vec4 per instance (a marker: xyz, w its kind; a leaf: min corner,
+// edge), drawn over the frame without writing depth.
+vk::UniquePipeline overlayPipeline(Frame& f, std::span<const uint32_t> vert, VkPrimitiveTopology topology) {
+    vk::GraphicsPipelineDesc d;
+    d.vert = vert;
+    d.frag = shaders::markersFrag();
+    d.bindings = {{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE}};
+    d.attributes = {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
+    d.topology = topology;
+    d.depthWrite = false;
+    return vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.overlayLayout.handle(), d);
+}
+
 void ensurePipelines(Frame& f) {
     RendererGpu& g = f.g;
-    const VkVertexInputBindingDescription instance{0, 16, VK_VERTEX_INPUT_RATE_INSTANCE};
-    const VkVertexInputAttributeDescription record{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0};
-    if ((f.drawMarkers || f.drawReflectionMarkers) && !g.markerPipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::markersVert();
-        d.frag = shaders::markersFrag();
-        d.bindings = {instance};
-        d.attributes = {record};
-        d.depthWrite = false;
-        g.markerPipeline = vk::createGraphicsPipeline(f.ctx, g.drawPass.handle(), g.overlayLayout.handle(), d);
-    }
-    if (f.drawLeaves && !g.leafPipeline) {
-        // The 12 edges of each leaf box as a line list.
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::leavesVert();
-        d.frag = shaders::markersFrag();
-        d.bindings = {instance};
-        d.attributes = {record};
-        d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
-        d.depthWrite = false;
-        g.leafPipeline = vk::createGraphicsPipeline(f.ctx, g.drawPass.handle(), g.overlayLayout.handle(), d);
-    }
+    if ((f.drawMarkers || f.drawReflectionMarkers) && !g.markerPipeline)
+        g.markerPipeline = overlayPipeline(f, shaders::markersVert(), VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST);
+    // The 12 edges of each leaf box as a line list.
+    if (f.drawLeaves && !g.leafPipeline)
+        g.leafPipeline = overlayPipeline(f, shaders::leavesVert(), VK_PRIMITIVE_TOPOLOGY_LINE_LIST);
 }
 
 }  // namespace
