@@ -260,12 +260,12 @@ void requireProbes(const SceneDescription& scene, const ProbeVolumeSettings& v, 
 }
 
 // Bakes probes seeded by key (adaptive leaves, interpolation-error points).
-ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed,
+ProbeBaker keyedBaker(const BakeSetup& b, const IrradianceCache* cache, const ProbeRays& rays, uint64_t seed,
                       const BakeControl& control) {
     return seededBaker(b.lighting, cache, b.q.bounces, rays, seed, control, b.referenceMode);
 }
 
-int raysOf(const BakeSetup& b, const ProbeVolumeSettings& v);
+ProbeRays raysOf(const BakeSetup& b, const ProbeVolumeSettings& v);
 
 // Probes in groups of three digits: "3 914".
 std::string grouped(uint64_t n) {
@@ -293,7 +293,8 @@ int searchMapResolution(const BakeSettings& b) {
 
 // The trials' baker: seeded like the bake's, windowed like its probes, so a trial's map measures
 // the probes the bake writes.
-ProbeBaker trialBaker(const BakeSetup& b, const IrradianceCache* cache, int rays, uint64_t seed, bool dering) {
+ProbeBaker trialBaker(const BakeSetup& b, const IrradianceCache* cache, const ProbeRays& rays, uint64_t seed,
+                      bool dering) {
     return deringedBaker(seededBaker(b.lighting, cache, b.q.bounces, rays, seed, BakeControl{}, b.referenceMode),
                          dering);
 }
@@ -341,7 +342,7 @@ std::optional<SamplingChoice> chooseSampling(SceneDescription& scene, BakeSetup&
     const BakeQuality preset = qualityPreset(scene.bake.quality);
     replaced << (scene.bake.rays ? "bake.rays " + std::to_string(*scene.bake.rays)
                                  : "the " + std::string(qualityName(scene.bake.quality)) + " preset's " +
-                                       std::to_string(preset.rays) + " rays")
+                                       raysDescription(preset.probeRays()))
              << " and "
              << (scene.bake.bounces ? "bake.bounces " + std::to_string(*scene.bake.bounces)
                                     : std::to_string(preset.bounces) + " bounces");
@@ -408,6 +409,7 @@ std::optional<SamplingChoice> chooseSampling(SceneDescription& scene, BakeSetup&
     c.summary = sum.str();
 
     setup.q.rays = c.rays;
+    setup.q.targetError = 0.0f;
     setup.q.bounces = c.bounces;
     return c;
 }
@@ -436,7 +438,10 @@ std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup&
         c.target = *v.targetError;
         c.mapResolution = searchMapResolution(scene.bake);
         const uint64_t seed = volumeSeed(vi);
-        const ProbeBaker baker = trialBaker(setup, cache.get(), raysOf(setup, v), seed, scene.bake.deringing);
+        // Trials trace the least rays as a fixed count, as the error map does (measureVolumeErrorMap):
+        // the bake's own probes then err no more than the trials that chose them.
+        const ProbeBaker baker =
+            trialBaker(setup, cache.get(), ProbeRays(raysOf(setup, v).rays), seed, scene.bake.deringing);
         PlacementSearch search;
         std::ostringstream value;
         if (v.placement == ProbePlacement::Terrain) {
@@ -652,17 +657,18 @@ nlohmann::json lpvReport(const SceneDescription& scene, const Heightfield& hf, c
 // Points at which every adaptive volume measures its interpolation error (docs/lighting.md).
 constexpr int kInterpolationPoints = 256;
 
-int raysOf(const BakeSetup& b, const ProbeVolumeSettings& v) { return v.rayCount ? *v.rayCount : b.q.rays; }
+ProbeRays raysOf(const BakeSetup& b, const ProbeVolumeSettings& v) { return volumeRays(b.q, v); }
 
-// Probe rays the bake is known to trace before it starts: every volume's placed probes, its
-// interpolation points (adaptive) and its error-map points. Refinement octants come on top.
+// Probe rays the bake plans for before it starts: every volume's placed probes and its
+// interpolation points (adaptive) at the rays planned (ProbeRays::planned), and its error-map
+// points at the least rays. Refinement octants come on top.
 uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& layouts,
                           const std::vector<size_t>& mapPoints) {
     uint64_t rays = 0;
     for (size_t vi = 0; vi < b.volumes.size(); ++vi) {
-        const uint64_t probes = layouts[vi].validCount() + mapPoints[vi] +
-                                (layouts[vi].octree ? kInterpolationPoints : 0);
-        rays += probes * uint64_t(raysOf(b, *b.volumes[vi]));
+        const ProbeRays r = raysOf(b, *b.volumes[vi]);
+        const uint64_t probes = layouts[vi].validCount() + (layouts[vi].octree ? kInterpolationPoints : 0);
+        rays += probes * uint64_t(r.planned()) + mapPoints[vi] * uint64_t(r.rays);
     }
     return rays;
 }
@@ -821,7 +827,7 @@ struct VolumeTrace {
 VolumeTrace traceVolume(const BakeSetup& setup, const IrradianceCache* cache, const ProbeVolumeSettings& v,
                         ProbeLayout& layout, uint64_t seed, const BakeControl& c, std::string& phase) {
     const Heightfield& hf = setup.terrain.heightfield;
-    const int rays = raysOf(setup, v);
+    const ProbeRays rays = raysOf(setup, v);
     VolumeTrace t;
     if (v.placement != ProbePlacement::Adaptive) {
         t.bake = setup.referenceMode
@@ -857,7 +863,6 @@ nlohmann::json volumeReport(const BakeSetup& setup, const ProbeVolumeSettings& v
         {"placement", placementName(v.placement)},
         {"probes", layout.validCount()},
         {"invalid_probes", layout.positions.size() - layout.validCount()},
-        {"rays_per_probe", raysOf(setup, v)},
         {"rays", t.bake.rays},
         {"time_s", seconds},
         {"fallback_blend_distance", layout.fallbackBlendDistance},
@@ -880,6 +885,13 @@ nlohmann::json volumeReport(const BakeSetup& setup, const ProbeVolumeSettings& v
             fromBelow += t.bake.fromBelowShare[i] > 0.0f;
         }
     vr["standard_error"] = stats(se);
+    const ProbeRays schedule = raysOf(setup, v);
+    const RaySpread spread = raySpreadOf(t.bake, layout.valid);
+    vr["rays_per_probe"] = {{"min", spread.min}, {"median", spread.median}, {"max", spread.max},
+                            {"mean", spread.mean}};
+    vr["ray_schedule"] = {{"first", schedule.rays},
+                          {"target_standard_error", schedule.adaptive() ? nlohmann::json(schedule.target) : nullptr},
+                          {"max", schedule.most()}};
     vr["validity"] = {{"rays_from_below", stats(below)},
                       {"probes_with_rays_from_below", fromBelow},
                       {"lifted_clear_of_surface", layout.liftedForClearance},
@@ -894,22 +906,37 @@ nlohmann::json volumeReport(const BakeSetup& setup, const ProbeVolumeSettings& v
     return vr;
 }
 
-// The probes against the reference path tracer at the reference preset's rays, as written (after
-// deringing). A reference bake's probes are the tracer's own: only their standard error speaks.
-nlohmann::json referenceReport(const BakeSetup& setup, const ProbeLayout& layout, const std::vector<sh::ShRgb>& sh,
-                               uint64_t seed, const BakeControl& c, uint64_t& referenceRays) {
+// The probes against the reference path tracer, as written (after deringing). The reference
+// traces rounds from the reference preset's rays until each probe's standard error is a third of
+// the bake's median (so its own noise adds at most about 5 % to the error measured), at most
+// kReferenceMaxRays. A reference bake's probes are the tracer's own: only their standard error speaks.
+constexpr int kReferenceMaxRays = 65536;
+nlohmann::json referenceReport(const BakeSetup& setup, const ProbeLayout& layout, const ProbeBake& bake,
+                               const std::vector<sh::ShRgb>& sh, uint64_t seed, const BakeControl& c,
+                               uint64_t& referenceRays) {
     if (setup.referenceMode)
         return {{"mean", nullptr}, {"p95", nullptr}, {"max", nullptr}, {"note", kReferenceNote}};
-    const int refRays = qualityPreset(QualityPreset::Reference).rays;
+    std::vector<float> se;
+    for (size_t i = 0; i < layout.valid.size(); ++i)
+        if (layout.valid[i]) se.push_back(bake.standardError[i]);
+    std::nth_element(se.begin(), se.begin() + ptrdiff_t(se.size() / 2), se.end());
+    const float median = se.empty() ? 0.0f : se[se.size() / 2];
+    const ProbeRays schedule(qualityPreset(QualityPreset::Reference).rays, median / 3.0f, kReferenceMaxRays);
     const auto start = Clock::now();
-    const ProbeBake ref = referenceProbes(setup.lighting, setup.q.bounces, layout.positions, layout.valid, refRays,
+    const ProbeBake ref = referenceProbes(setup.lighting, setup.q.bounces, layout.positions, layout.valid, schedule,
                                           seed ^ 0xF00Dull, c);
     referenceRays += ref.rays;
     const ErrorStats err = compareToReference(sh, ref.sh, layout.valid);
+    std::vector<float> refSe;
+    for (size_t i = 0; i < layout.valid.size(); ++i)
+        if (layout.valid[i]) refSe.push_back(ref.standardError[i]);
+    const RaySpread spread = raySpreadOf(ref, layout.valid);
     return {{"mean", err.mean},
             {"p95", err.p95},
             {"max", err.max},
-            {"reference_rays_per_probe", refRays},
+            {"reference_standard_error", stats(refSe)},
+            {"reference_rays_per_probe",
+             {{"min", spread.min}, {"median", spread.median}, {"max", spread.max}, {"mean", spread.mean}}},
             {"reference_path_length",
              setup.q.bounces == 0 ? 0 : referencePathLength(setup.lighting.maxAlbedo())},
             {"reference_rays", ref.rays},
@@ -931,7 +958,10 @@ VolumeErrorMap measureVolumeErrorMap(const SceneDescription& scene, const BakeSe
                                      const std::vector<sh::ShRgb>& sh, bool hasTarget, uint64_t seed,
                                      const BakeControl& mc, std::string& phase, ErrorMap& map) {
     const Heightfield& hf = setup.terrain.heightfield;
-    const int rays = raysOf(setup, v);
+    // The truths and the trial grids trace the volume's least rays as a fixed count: their
+    // sampling error is a small part of an interpolation error worth mapping, and a target's extra
+    // rays over every map point would cost more than the bake.
+    const ProbeRays rays(raysOf(setup, v).rays);
     const auto start = Clock::now();
     VolumeErrorMap out;
     // The truth gets the same window as the probes, so the map shows interpolation alone.
@@ -953,8 +983,8 @@ VolumeErrorMap measureVolumeErrorMap(const SceneDescription& scene, const BakeSe
             }
             probes = trial.validCount();
             ProbeBake b = setup.referenceMode
-                              ? referenceProbes(setup.lighting, setup.q.bounces, trial.positions, trial.valid, rays,
-                                                seed, mc)
+                              ? referenceProbes(setup.lighting, setup.q.bounces, trial.positions, trial.valid,
+                                                rays.rays, seed, mc)
                               : bakeProbes(setup.lighting, cache, setup.q.bounces, trial.positions, trial.valid,
                                            rays, seed, mc);
             suggestionRays += b.rays;
@@ -1165,7 +1195,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                                 refShare * (double(done) / double(plan.totalProbes) + share * f));
                                  },
                                  cancel};
-            vr["reference_error"] = referenceReport(setup, layout, bake.sh, seed, rc, referenceRays);
+            vr["reference_error"] = referenceReport(setup, layout, bake, bake.sh, seed, rc, referenceRays);
         }
 
         // The interpolation-error map of the probes as the engine will read them (the
@@ -1283,6 +1313,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         {"quality",
          {{"preset", qualityName(scene.bake.quality)},
           {"rays", q.rays},
+          {"target_standard_error", q.targetError > 0.0f ? nlohmann::json(q.targetError) : nullptr},
+          {"max_rays", q.probeRays().most()},
           {"bounces", q.bounces},
           {"cache_resolution", cache ? plan.cacheResolution : 0},
           {"cache_points", cache ? size_t(cache->pointsX()) * size_t(cache->pointsZ()) : size_t(0)},
@@ -1501,19 +1533,22 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
     }
 
 
-    // Probes: a few of the volumes' own, spread over them, baked as the bake would.
-    double secondsPerProbeRay = 0.0;
+    // Probes: a few of the volumes' own, spread over them, baked as the bake would; with a target,
+    // the rays they traced stand for every probe's.
+    double secondsPerProbeRay = 0.0, meanRays = double(q.rays);
     if (!all.empty()) {
         const size_t n = std::min(all.size(), std::max<size_t>(64, 16 * size_t(threads)));
         std::vector<glm::vec3> sample(n);
         for (size_t i = 0; i < n; ++i) sample[i] = all[i * all.size() / n];
         const std::vector<uint8_t> valid(n, 1);
         const auto t = Clock::now();
-        if (setup.referenceMode)
-            referenceProbes(setup.lighting, q.bounces, sample, valid, q.rays, 1, BakeControl{});
-        else
-            bakeProbes(setup.lighting, cache.get(), q.bounces, sample, valid, q.rays, 1, BakeControl{});
-        secondsPerProbeRay = secondsSince(t) / (double(n) * double(q.rays));
+        const ProbeBake b = setup.referenceMode
+                                ? referenceProbes(setup.lighting, q.bounces, sample, valid, q.probeRays(), 1,
+                                                  BakeControl{})
+                                : bakeProbes(setup.lighting, cache.get(), q.bounces, sample, valid, q.probeRays(), 1,
+                                             BakeControl{});
+        meanRays = raySpreadOf(b, valid).mean;
+        secondsPerProbeRay = secondsSince(t) / (double(n) * meanRays);
         e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
     }
 
@@ -1558,9 +1593,11 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         ve.cellSize = L.cellSize;
         ve.probes = ve.probesMax = L.validCount();
         ve.bytes = ve.bytesMax = L.fileBytes();
-        ve.raysPerProbe = v.rayCount ? *v.rayCount : q.rays;
+        ve.raysPerProbe = v.rayCount ? *v.rayCount : int(std::lround(meanRays));
         ve.borrowed = L.borrowedCells;
         const double perProbe = double(ve.raysPerProbe) * secondsPerProbeRay;
+        // Error-map points trace the least rays only (measureVolumeErrorMap).
+        const double perMapPoint = double(raysOf(setup, v).rays) * secondsPerProbeRay;
         double probes = double(ve.probes), probesMax = probes;
         if (L.octree) {
             const AdaptiveOctree& t = *L.octree;
@@ -1602,10 +1639,9 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
             }
         }
         ve.errorMapPoints = plan.mapPoints[vi];
-        probes += double(ve.errorMapPoints);
-        probesMax += double(ve.errorMapPoints);
-        ve.seconds = probes * perProbe;
-        ve.secondsMax = std::max(probesMax, probes) * perProbe;
+        const double mapSeconds = double(ve.errorMapPoints) * perMapPoint;
+        ve.seconds = probes * perProbe + mapSeconds;
+        ve.secondsMax = std::max(probesMax, probes) * perProbe + mapSeconds;
         e.seconds += ve.seconds;
         e.secondsMax += ve.secondsMax;
         e.volumes.push_back(std::move(ve));

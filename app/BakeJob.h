@@ -117,7 +117,7 @@ struct VolumeEstimate {
     float cellSize = 0.0f;
     size_t probes = 0;                      // placed (adaptive: the geometric octree)
     uint64_t bytes = 0;                     // its .shprobe size
-    int raysPerProbe = 0;
+    int raysPerProbe = 0;                   // fixed, or the mean a target's rounds reached on sampled probes
     size_t errorMapPoints = 0;              // probes baked for the interpolation-error map (at most)
     double seconds = 0.0;
     // Adaptive volumes.

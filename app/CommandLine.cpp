@@ -197,10 +197,16 @@ int commandBake(const Args& a) {
         return kExitInterrupted;
     }
     const auto& r = outcome.report;
+    const auto& quality = r["quality"];
     std::cout << "baked " << r["volumes"].size() << " volume(s) in " << fixed(r["time_s"].get<double>(), 2)
-              << " s (" << r["quality"]["preset"].get<std::string>() << ", "
-              << r["quality"]["rays"].get<int>() << " rays, " << r["quality"]["bounces"].get<int>()
-              << " bounces, " << r["threads"].get<int>() << " threads)\n";
+              << " s (" << quality["preset"].get<std::string>() << ", ";
+    if (quality["target_standard_error"].is_null())
+        std::cout << quality["rays"].get<int>() << " rays";
+    else
+        std::cout << "each probe to " << fixed(100.0 * quality["target_standard_error"].get<double>(), 2)
+                  << " % standard error in " << quality["rays"].get<int>() << " to " << quality["max_rays"].get<int>()
+                  << " rays";
+    std::cout << ", " << quality["bounces"].get<int>() << " bounces, " << r["threads"].get<int>() << " threads)\n";
     if (r.contains("sampling_target")) {
         const auto& t = r["sampling_target"];
         std::cout << "  bake.target_error " << fixed(100.0 * t["target"].get<double>(), 1) << " %: "
@@ -212,8 +218,11 @@ int commandBake(const Args& a) {
     for (const auto& v : r["volumes"]) {
         std::cout << "  " << v["name"].get<std::string>() << ": " << v["probes"].get<size_t>()
                   << " probes (" << v["invalid_probes"].get<size_t>() << " inside the terrain), "
-                  << v["bytes"].get<uint64_t>() << " bytes, standard error mean "
-                  << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " %";
+                  << v["bytes"].get<uint64_t>() << " bytes, rays per probe "
+                  << v["rays_per_probe"]["min"].get<uint32_t>() << " / " << v["rays_per_probe"]["median"].get<uint32_t>()
+                  << " / " << v["rays_per_probe"]["max"].get<uint32_t>() << " (min / median / max), standard error mean "
+                  << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " % / max "
+                  << fixed(100.0 * v["standard_error"]["max"].get<double>(), 2) << " %";
         if (v.contains("reference_error") && v["reference_error"]["mean"].is_null())
             std::cout << "\n    error vs reference " << v["reference_error"]["note"].get<std::string>();
         else if (v.contains("reference_error"))

@@ -666,7 +666,7 @@ std::vector<ParameterSpec> buildTable() {
             return s.probeVolumes.at(i).placement == ProbePlacement::Terrain;
         });
     add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
-        .label("Rays per probe").about("Rays traced per probe by the bake").redoes(kRebake)
+        .label("Rays per probe").about("Rays traced per probe by the bake, the same for every probe of the volume").redoes(kRebake)
         .volume(&ProbeVolumeSettings::rayCount);
     add(Row("probe_volumes[].fallback_blend_distance", T::Number)).bakeUse(BakeUse::Ignores).range(0.0, 1.0e7).unit("m").decimals(1)
         .autoMeans("2 × spacing: twice the smallest probe spacing").label("Fallback blend")
@@ -940,10 +940,10 @@ std::vector<ParameterSpec> buildTable() {
     bake = BakeUse::Reads;
     // Bake.
     add(Row("bake.quality", T::Choice)).choices({"draft", "standard", "high", "reference"}).label("Quality")
-        .about("Preset of rays, bounces and irradiance cache (rays and bounces below override it)")
+        .about("Preset of each probe's standard error (draft 2 %, standard 0.4 %, high 0.2 %: each probe traces the rays it needs for it, within the preset's range), bounces and irradiance cache; rays and bounces below override it")
         .redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::quality);
-    add(Row("bake.rays", T::Integer)).range(1, 1 << 20).autoMeans("preset: the quality preset decides").label("Rays per probe")
-        .about("Rays traced per probe").redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::rays);
+    add(Row("bake.rays", T::Integer)).range(1, 1 << 20).autoMeans("preset: each probe traces what the preset's standard error asks").label("Rays per probe")
+        .about("Rays traced per probe, the same for every probe").redoes(kNothing).field(&SceneDescription::bake, &BakeSettings::rays);
     add(Row("bake.bounces", T::Integer)).range(0, kMaxBounces).autoMeans("preset: the quality preset decides").label("Bounces")
         .about("Light bounces off the terrain; 0 = sky visibility only").redoes(kNothing)
         .field(&SceneDescription::bake, &BakeSettings::bounces);

@@ -249,6 +249,7 @@ struct Study {
     void placePoints();
     void bakeReference();
     std::vector<Candidate> candidates(const ProbeLayout& currentLayout);
+    double expectedRays(const ProbeRays& r) const;
     double estimate(const Candidate& c) const;
     StudyPoint measureProbes(const Candidate& c);
     StudyPoint measureErrorMap(const Candidate& c);
@@ -265,7 +266,8 @@ struct Study {
         std::vector<sh::ShRgb> sh;
         std::unique_ptr<IrradianceCache> cache;
         BakeQuality q;
-        int rays = 0;
+        ProbeRays rays;
+        double meanRays = 0.0;  // per valid probe, as traced
     };
     std::unique_ptr<Baked> current;
     std::optional<ErrorMapStats> denseMap;  // the error-map knob's truth
@@ -364,6 +366,15 @@ void Study::bakeReference() {
 
 // The sweeps: each knob over its useful range with everything else as the project has it. The
 // project's own value is the current point, so it is not repeated in its knob.
+// Rays a probe is expected to trace under `r`, for the estimates: a fixed count, or a target's
+// first round times the growth the current bake measured on this terrain (1 before any bake).
+double Study::expectedRays(const ProbeRays& r) const {
+    if (!r.adaptive()) return double(r.rays);
+    const double growth =
+        current && current->rays.adaptive() && current->meanRays > 0 ? current->meanRays / current->rays.rays : 1.0;
+    return std::min(double(r.maxRays), double(r.rays) * growth);
+}
+
 std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
     const SceneDescription& s = project.scene;
     const ProbeVolumeSettings& v = volumeOf(s);
@@ -383,9 +394,9 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
         if (p != s.bake.quality || s.bake.rays || s.bake.bounces)
             add("quality", qualityName(p),
                 {std::string("bake.quality=") + qualityName(p), "bake.rays=null", "bake.bounces=null"});
-    const int volumeRays = v.rayCount.value_or(q.rays);
+    const ProbeRays volume = volumeRays(q, v);
     for (int r : {16, 32, 64, 128, 256, 512, 1024, 2048})
-        if (r != volumeRays)
+        if (volume.adaptive() || r != volume.rays)
             add("rays", "rays " + std::to_string(r),
                 {v.rayCount ? volumePath() + "ray_count=" + std::to_string(r) : "bake.rays=" + std::to_string(r)});
     for (int b = 0; b <= 4; ++b)
@@ -516,7 +527,7 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
             case StudyMetric::Irradiance: {
                 const ProbeVolumeSettings& cv = volumeOf(cs);
                 const BakeQuality cq = qualityOf(cs.bake);
-                const int rays = cv.rayCount.value_or(cq.rays);
+                const double rays = expectedRays(volumeRays(cq, cv));
                 double probes;
                 if (cv.placement == ProbePlacement::Adaptive) {
                     // The refinement bakes each tested leaf's 8 octants: up to about three times the
@@ -534,7 +545,9 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                 c.work = double(probeRays) + cacheRays;
                 break;
             }
-            case StudyMetric::ErrorMapP95: c.work = double(c.param) * c.param * double(current ? current->rays : q.rays); break;
+            case StudyMetric::ErrorMapP95:
+                c.work = double(c.param) * c.param * (current ? current->meanRays : expectedRays(volumeRays(q, v)));
+                break;
             case StudyMetric::AmbientOcclusion: c.work = double(hf().width()) * hf().depth() * c.param; break;
             case StudyMetric::Lpv: c.work = double(cs.lpv.cascades) * (cs.lpv.quality == 2 ? 1.3 : 1.0); break;
             case StudyMetric::Reflection: {
@@ -577,7 +590,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     const SceneDescription s = sceneWith(c.sets);
     const ProbeVolumeSettings& v = volumeOf(s);
     const BakeQuality q = qualityOf(s.bake);
-    const int rays = v.rayCount.value_or(q.rays);
+    const ProbeRays rays = volumeRays(q, v);
     StudyPoint p;
     const PeakMemory memory;
     const auto t0 = Clock::now();
@@ -587,7 +600,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     ProbeLayout layout = placeProbes(v, hf());
     uint64_t traced = 0;
     if (q.bounces > 0) {
-        uint64_t planned = uint64_t(layout.validCount()) * uint64_t(rays);
+        uint64_t planned = uint64_t(layout.validCount()) * uint64_t(rays.planned());
         if (v.placement == ProbePlacement::Adaptive) planned *= 3;
         baked->cache = std::make_unique<IrradianceCache>(lighting, cacheResolutionFor(hf(), q, planned), q.cacheRays,
                                                          q.sunSamples, q.bounces - 1, control());
@@ -604,6 +617,7 @@ StudyPoint Study::measureProbes(const Candidate& c) {
                           control());
     }
     traced += bake.rays;
+    baked->meanRays = raySpreadOf(bake, layout.valid).mean;
     if (s.bake.deringing) sh::deringProbes(bake.sh, layout.valid);
     p.seconds = secondsSince(t0);
     p.peakMemoryBytes = memory.added();
@@ -864,7 +878,7 @@ void Study::run() {
     if (original)
         for (Candidate& c : todo) c.sets = pinTargets(c.sets, *original, project, volumeIndex);
     {
-        const double work = double(denseMapResolution) * denseMapResolution * current->rays;
+        const double work = double(denseMapResolution) * denseMapResolution * current->meanRays;
         const double est = kSafety * work * rate["rays"];
         if (est < 0.25 * left()) {
             report("error map " + std::to_string(denseMapResolution) + " (the error map's truth)");
@@ -887,7 +901,7 @@ void Study::run() {
             c.label = "error map " + std::to_string(s.bake.errorMapResolution);
             c.metric = StudyMetric::ErrorMapP95;
             c.param = s.bake.errorMapResolution;
-            c.work = double(c.param) * c.param * current->rays;
+            c.work = double(c.param) * c.param * current->meanRays;
             todo.push_back(c);
         }
     }

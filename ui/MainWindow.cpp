@@ -931,6 +931,12 @@ void MainWindow::showReport(const nlohmann::json& report) {
         {"Probes", [&](const json& v) { return number(v.value("probes", json())); }},
         {"Invalid (in terrain)", [&](const json& v) { return number(v.value("invalid_probes", json())); }},
         {"Rays", [&](const json& v) { return number(v.value("rays", json())); }},
+        {"Rays per probe (min / median / max)",
+         [&](const json& v) {
+             const json& r = v.value("rays_per_probe", json::object());
+             return number(r.value("min", json())) + " / " + number(r.value("median", json())) + " / " +
+                    number(r.value("max", json()));
+         }},
         {"Time", [](const json& v) { return QString("%1 s").arg(v.value("time_s", 0.0), 0, 'f', 2); }},
         {"File size", [](const json& v) { return formatBytes(v.value("bytes", 0.0)); }},
         {"Standard error (mean)", [](const json& v) { return percent(v["standard_error"].value("mean", json())); }},
@@ -1174,11 +1180,12 @@ void MainWindow::updateEstimate() {
             probes += l.validCount();
             invalid += l.positions.size() - l.validCount();
             bytes += 48 + 160ull * l.validCount() + 4ull * l.cellProbe.size();
-            rays += double(l.validCount()) * (v.rayCount ? *v.rayCount : q.rays);
+            // A preset's target: the rays the bake plans for (its probes trace what they need).
+            rays += double(l.validCount()) * volumeRays(q, v).planned();
             const size_t points = errorMapGrid(l, doc_->terrain().heightfield, p.scene.bake.errorMapResolution,
                                                errorMapHeight(v, l)).error.size();
             mapPoints += points;
-            rays += double(points) * (v.rayCount ? *v.rayCount : q.rays);
+            rays += double(points) * volumeRays(q, v).rays;
         } catch (const std::exception& e) {
             errors[i] = QString::fromStdString(e.what());
             if (firstError.isEmpty()) firstError = errors[i];

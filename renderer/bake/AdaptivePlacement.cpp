@@ -347,6 +347,7 @@ struct BakedProbe {
     sh::ShRgb sh;
     float standardError = 0.0f;
     float fromBelow = 0.0f;
+    uint32_t rays = 0;
 };
 
 // Bakes, through `baker`, every probe of `L` that `store` lacks at its position.
@@ -364,14 +365,14 @@ uint64_t bakeMissing(const ProbeLayout& L, const ProbeBaker& baker,
     if (positions.empty()) return 0;
     const ProbeBake b = baker(positions, keys);
     for (size_t i = 0; i < positions.size(); ++i)
-        store[keys[i]] = {positions[i], b.sh[i], b.standardError[i], b.fromBelowShare[i]};
+        store[keys[i]] = {positions[i], b.sh[i], b.standardError[i], b.fromBelowShare[i], b.raysPerProbe[i]};
     return b.rays;
 }
 
 }  // namespace
 
 ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
-                       int rays, uint64_t seed, const BakeControl& control, bool reference) {
+                       const ProbeRays& rays, uint64_t seed, const BakeControl& control, bool reference) {
     return [&lighting, cache, bounces, rays, seed, control, reference](
                const std::vector<glm::vec3>& positions, const std::vector<uint64_t>& keys) {
         std::vector<uint64_t> seeds(keys.size());
@@ -529,6 +530,7 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
         out.bake.sh[i] = b.sh;
         out.bake.standardError[i] = b.standardError;
         out.bake.fromBelowShare[i] = b.fromBelow;
+        out.bake.raysPerProbe[i] = b.rays;
     }
     out.bake.rays = rays;
     return out;

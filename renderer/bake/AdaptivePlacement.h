@@ -74,7 +74,7 @@ using ProbeBaker = std::function<ProbeBake(const std::vector<glm::vec3>& positio
 // (bakeProbesSeeded) or, for `reference`, the path-traced reference (referenceProbesSeeded).
 // `lighting` and `cache` must outlive the baker.
 ProbeBaker seededBaker(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
-                       int rays, uint64_t seed, const BakeControl& control, bool reference = false);
+                       const ProbeRays& rays, uint64_t seed, const BakeControl& control, bool reference = false);
 
 // `baker` whose probes get the deringing window when `dering` (bake.deringing), as the probes a
 // bake writes do: a truth baked with it differs from those probes by interpolation alone. `rays`

@@ -9,11 +9,13 @@
 // recursive rays per probe.
 
 #include <array>
+#include <cmath>
 #include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -26,13 +28,43 @@
 
 namespace terralux {
 
+// The rays one probe traces (docs/lighting.md "Rays per probe"): `rays`, or, with a target, at
+// least `rays` and as many more, doubling up to `maxRays`, as its first half says the probe needs
+// for a standard error of `target`. Open ground stops at `rays`; probes whose light varies more
+// (valleys, slopes below bright snow) trace on.
+struct ProbeRays {
+    int rays = 256;        // all of them when fixed; the least a probe traces with a target
+    float target = 0.0f;   // relative standard error a probe's rays are chosen for; 0: fixed
+    int maxRays = 0;       // no probe traces more
+
+    ProbeRays() = default;
+    ProbeRays(int fixed) : rays(fixed) {}  // NOLINT(google-explicit-constructor): a count is a fixed schedule
+    ProbeRays(int least, float target, int maxRays) : rays(least), target(target), maxRays(maxRays) {}
+    bool adaptive() const { return target > 0.0f && rays >= 4 && maxRays >= rays; }
+    int most() const { return adaptive() ? maxRays : rays; }
+    // What a bake plans for before it knows, which sizes the irradiance cache: the count, or with
+    // a target twice the least (what a probe that traces on gets at least).
+    int planned() const { return adaptive() ? std::min(2 * rays, maxRays) : rays; }
+};
+
 struct BakeQuality {
-    int rays = 256;            // per probe, whole sphere
+    int rays = 256;            // per probe, whole sphere: the least with a target
     int bounces = 2;           // 0 = sky visibility only
     int cacheResolution = 128; // irradiance-cache points along the longer footprint side
     int cacheRays = 64;        // hemisphere rays per cache point
     int sunSamples = 4;        // shadow rays per cache point across the sun's disk
+    float targetError = 0.0f;  // each probe's standard error to reach (0: `rays` exactly)
+    int maxRays = 0;           // the most rays a probe traces for targetError
+
+    ProbeRays probeRays() const { return {rays, targetError, maxRays}; }
 };
+// "256 rays", or "0.40 % standard error per probe (256 to 4096 rays)".
+std::string raysDescription(const ProbeRays& rays);
+
+// A volume's rays: its ray_count as a fixed count, else the bake's schedule `q`.
+inline ProbeRays volumeRays(const BakeQuality& q, const ProbeVolumeSettings& v) {
+    return v.rayCount ? ProbeRays(*v.rayCount) : q.probeRays();
+}
 BakeQuality qualityPreset(QualityPreset preset);
 // The preset of bake.quality with bake.rays and bake.bounces applied where set.
 BakeQuality qualityOf(const BakeSettings& bake);
@@ -129,23 +161,31 @@ struct ProbeBake {
     // from below (dot(dir, normal) > 0; the surface normals face up). A heightfield can only be
     // reached from below by a probe inside it, so any valid probe has 0.
     std::vector<float> fromBelowShare;
+    std::vector<uint32_t> raysPerProbe; // rays each probe traced (0 when invalid)
     uint64_t rays = 0;                  // rays traced for the probes themselves
 
     ProbeBake() = default;
     // n probes, all zero.
-    explicit ProbeBake(size_t n) : sh(n), standardError(n, 0.0f), fromBelowShare(n, 0.0f) {}
+    explicit ProbeBake(size_t n) : sh(n), standardError(n, 0.0f), fromBelowShare(n, 0.0f), raysPerProbe(n, 0) {}
 };
 
+// Rays per valid probe over a bake: what a target's rounds spent, probe by probe.
+struct RaySpread {
+    uint32_t min = 0, median = 0, max = 0;
+    double mean = 0.0;
+};
+RaySpread raySpreadOf(const ProbeBake& bake, const std::vector<uint8_t>& valid);
+
 // Bakes the probes at `positions` (skipping those with valid[i] == 0). Deterministic: each probe's
-// directions depend only on its index and `seed`.
+// directions and rounds depend only on its index and `seed`.
 ProbeBake bakeProbes(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
-                     int rays, uint64_t seed, const BakeControl& control);
+                     const ProbeRays& rays, uint64_t seed, const BakeControl& control);
 // The same with one seed per probe (seeds[i]), for probes whose identity is not their index (an
 // octree leaf keeps its seed whatever order the leaves are baked in).
 ProbeBake bakeProbesSeeded(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                            const std::vector<glm::vec3>& positions,
-                           const std::vector<uint8_t>& valid, int rays,
+                           const std::vector<uint8_t>& valid, const ProbeRays& rays,
                            const std::vector<uint64_t>& seeds, const BakeControl& control);
 
 // Brute-force reference: path tracing from each probe, sun by shadow rays at every vertex, bounces
@@ -153,11 +193,11 @@ ProbeBake bakeProbesSeeded(const BakeLighting& lighting, const IrradianceCache* 
 // visibility only, the same model as such a bake).
 ProbeBake referenceProbes(const BakeLighting& lighting, int bounces,
                           const std::vector<glm::vec3>& positions,
-                          const std::vector<uint8_t>& valid, int rays, uint64_t seed,
+                          const std::vector<uint8_t>& valid, const ProbeRays& rays, uint64_t seed,
                           const BakeControl& control);
 ProbeBake referenceProbesSeeded(const BakeLighting& lighting, int bounces,
                                 const std::vector<glm::vec3>& positions,
-                                const std::vector<uint8_t>& valid, int rays,
+                                const std::vector<uint8_t>& valid, const ProbeRays& rays,
                                 const std::vector<uint64_t>& seeds, const BakeControl& control);
 int referencePathLength(const glm::vec3& albedo);
 

@@ -1,7 +1,8 @@
 // The reported Monte Carlo standard error against the sampling error it stands for, on every
 // shared DEM and the embedded sample, with the project's default lighting (physical sky, the
-// height ramp's albedo, the terrain's own bounce): a 16 x 16 terrain grid baked at each preset's
-// rays and again at 16 384 rays over the same irradiance cache, so the difference is the probes'
+// height ramp's albedo, the terrain's own bounce): a 16 x 16 terrain grid baked with each preset's
+// rounds (each probe to the preset's standard error) and again at 16 384 rays over the same
+// irradiance cache, so the difference is the probes'
 // own sampling, measured with the metric every error figure uses (relative RMS of irradiance over
 // 256 normals, docs/lighting.md "Metrics"). Counters: the reported and measured RMS and mean over
 // the valid probes, their ratios, and the ratio of the 95th percentiles (what bake.target_error
@@ -52,7 +53,9 @@ void BM_StandardError(benchmark::State& state) {
     std::vector<float> reportedAll, fullAll;
     for (auto _ : state) {
         const IrradianceCache cache(L, q.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1, {});
-        const ProbeBake bake = bakeProbes(L, &cache, q.bounces, layout.positions, layout.valid, q.rays, 5, {});
+        const ProbeBake bake =
+            bakeProbes(L, &cache, q.bounces, layout.positions, layout.valid, q.probeRays(), 5, {});
+        state.counters["rays_per_probe_mean"] = raySpreadOf(bake, layout.valid).mean;
         const ProbeBake fine = bakeProbes(L, &cache, q.bounces, layout.positions, layout.valid, 16384, 6, {});
         for (size_t i = 0; i < layout.positions.size(); ++i) {
             if (!layout.valid[i]) continue;

@@ -363,6 +363,12 @@ private slots:
         QCOMPARE(figure("Probes"), QLocale().toString(volume["probes"].get<double>(), 'f', 0));
         QCOMPARE(figure("Invalid (in terrain)"), QLocale().toString(volume["invalid_probes"].get<double>(), 'f', 0));
         QCOMPARE(figure("Rays"), QLocale().toString(volume["rays"].get<double>(), 'f', 0));
+        // What each probe traced for the preset's standard error: min / median / max.
+        const nlohmann::json& perProbe = volume["rays_per_probe"];
+        QCOMPARE(figure("Rays per probe (min / median / max)"),
+                 QLocale().toString(perProbe["min"].get<double>(), 'f', 0) + " / " +
+                     QLocale().toString(perProbe["median"].get<double>(), 'f', 0) + " / " +
+                     QLocale().toString(perProbe["max"].get<double>(), 'f', 0));
         QCOMPARE(figure("Interpolation error (p95)"),
                  QString("%1 %").arg(volume["error_map"]["p95"].get<double>() * 100.0, 0, 'f', 2));
         QCOMPARE(figure("Standard error (mean)"),
