@@ -1507,6 +1507,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
     e.threads = threads;
     e.quality = qualityName(scene.bake.quality);
     e.rays = q.rays;
+    e.raysText = raysDescription(q.probeRays());
     e.bounces = q.bounces;
     e.lpvIni = scene.lpv.enabled;
     e.lights = scene.lights.size();
@@ -1548,6 +1549,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
                                 : bakeProbes(setup.lighting, cache.get(), q.bounces, sample, valid, q.probeRays(), 1,
                                              BakeControl{});
         meanRays = raySpreadOf(b, valid).mean;
+        e.meanRays = meanRays;
         secondsPerProbeRay = secondsSince(t) / (double(n) * meanRays);
         e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
     }

@@ -139,6 +139,8 @@ struct BakeEstimate {
     int threads = 0;
     std::string quality;
     int rays = 0, bounces = 0;
+    std::string raysText;             // "256 rays" or the preset's target and range (raysDescription)
+    double meanRays = 0.0;            // per probe, as the sampled probes traced
     double cacheSeconds = 0.0;
     double probeRaysPerSecond = 0.0;  // measured on this terrain, with this lighting
     double seconds = 0.0;             // everything, with error-driven volumes at their minimum

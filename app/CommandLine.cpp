@@ -81,8 +81,9 @@ int commandInfo(const Args& a) {
 }
 
 int printEstimate(const BakeEstimate& e) {
-    std::cout << "dry run: nothing baked, nothing written (" << e.quality << ", " << e.rays
-              << " rays, " << e.bounces << " bounces, " << e.threads << " threads)\n";
+    std::cout << "dry run: nothing baked, nothing written (" << e.quality << ", " << e.raysText;
+    if (e.meanRays > e.rays) std::cout << ", about " << std::lround(e.meanRays) << " on the probes sampled";
+    std::cout << ", " << e.bounces << (e.bounces == 1 ? " bounce, " : " bounces, ") << e.threads << " threads)\n";
     if (e.sampling) {
         const SamplingChoice& t = *e.sampling;
         std::cout << "  bake.target_error " << fixed(100.0 * t.target, 1) << " %: " << t.summary << " on "
@@ -206,7 +207,9 @@ int commandBake(const Args& a) {
         std::cout << "each probe to " << fixed(100.0 * quality["target_standard_error"].get<double>(), 2)
                   << " % standard error in " << quality["rays"].get<int>() << " to " << quality["max_rays"].get<int>()
                   << " rays";
-    std::cout << ", " << quality["bounces"].get<int>() << " bounces, " << r["threads"].get<int>() << " threads)\n";
+    const int bounces = quality["bounces"].get<int>();
+    std::cout << ", " << bounces << (bounces == 1 ? " bounce, " : " bounces, ") << r["threads"].get<int>()
+              << " threads)\n";
     if (r.contains("sampling_target")) {
         const auto& t = r["sampling_target"];
         std::cout << "  bake.target_error " << fixed(100.0 * t["target"].get<double>(), 1) << " %: "
