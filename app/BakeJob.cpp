@@ -251,7 +251,7 @@ void requireProbes(const SceneDescription& scene, const ProbeVolumeSettings& v, 
     if (layout.validCount() > 0) return;
     const std::string at = "probe_volumes[" + std::to_string(&v - scene.probeVolumes.data()) + "]";
     std::ostringstream fix;
-    if (v.placement == ProbePlacement::Terrain)
+    if (followsSurface(v.placement))
         fix << "raise " << at << ".height_offset (now " << v.heightOffset << " m)";
     else
         fix << "move " << at << ".origin up or enlarge the volume";
@@ -429,8 +429,8 @@ std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup&
         const std::string at = "probe_volumes[" + std::to_string(index) + "]";
         if (v.placement == ProbePlacement::Box)
             throw ProjectError(at + ".target_error = " + nlohmann::json(*v.targetError).dump() +
-                               ": applies to terrain and adaptive placements; a box volume takes " + at +
-                               ".grid_dims (or set " + at + ".placement=adaptive)");
+                               ": applies to terrain, surface and adaptive placements; a box volume takes " + at +
+                               ".grid_dims (or set " + at + ".placement=surface)");
         phase("choosing placement '" + v.name + "'");
         const auto start = Clock::now();
         if (!cache) cache = searchCache(setup);
@@ -479,11 +479,11 @@ std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup&
         c.met = search.met;
         c.capped = search.capped;
         c.trials = search.trials.size();
-        if (v.placement == ProbePlacement::Adaptive) c.tolerance = search.chosen.tolerance;
+        if (refinedByError(v.placement)) c.tolerance = search.chosen.tolerance;
         if (v.placement == ProbePlacement::Terrain && c.capped) {
-            // Past the cap: what meets the target instead, at the adaptive volume's cost.
+            // Past the cap: what meets the target instead, at a surface volume's cost.
             ProbeVolumeSettings a = v;
-            a.placement = ProbePlacement::Adaptive;
+            a.placement = ProbePlacement::Surface;
             // Within a box grid's limit: the largest volume an engine allocates for.
             if (!a.adaptive.maxProbes) a.adaptive.maxProbes = kOfferMaxProbes;
             const auto offerStart = Clock::now();
@@ -504,18 +504,18 @@ std::map<size_t, TargetChoice> chooseTargets(SceneDescription& scene, BakeSetup&
               << " probes a terrain grid may hold: baking the densest allowed, grid_dims " << c.value << " (p95 "
               << percent(c.p95) << ")";
             if (as.met) {
-                c.offer = {{"set", {at + ".placement=adaptive", at + ".target_error=" + nlohmann::json(c.target).dump()}},
+                c.offer = {{"set", {at + ".placement=surface", at + ".target_error=" + nlohmann::json(c.target).dump()}},
                            {"tolerance", as.chosen.tolerance},
                            {"probes", as.chosen.probes},
                            {"bytes", as.chosen.bytes},
                            {"p95", as.chosen.p95},
                            {"estimated_time_s", offerSeconds}};
-                w << "; an adaptive volume meets it: --set " << at << ".placement=adaptive (tolerance "
+                w << "; a surface volume meets it: --set " << at << ".placement=surface (tolerance "
                   << tol.str() << ", " << grouped(as.chosen.probes) << " probes, " << grouped(as.chosen.bytes)
                   << " bytes, about " << std::setprecision(2) << offerSeconds << " s, p95 " << percent(as.chosen.p95)
                   << ")";
             } else {
-                w << "; no adaptive volume within " << *a.adaptive.maxProbes << " probes meets it either";
+                w << "; no surface volume within " << *a.adaptive.maxProbes << " probes meets it either";
                 if (std::isfinite(as.chosen.p95)) w << " (best p95 " << percent(as.chosen.p95) << ")";
                 w << ": raise the target or split the terrain into several volumes";
             }
@@ -596,7 +596,8 @@ nlohmann::json adaptiveReport(const AdaptiveOctree& t, const std::optional<Adapt
         edge << t.minCell * double(1u << l);
         byEdge[edge.str()] = counts[l];
     }
-    nlohmann::json j = {{"min_cell_size", t.minCell},
+    nlohmann::json j = {{"tree", t.surface ? "quadtree" : "octree"},
+                        {"min_cell_size", t.minCell},
                         {"max_cell_size", t.maxCell},
                         {"surface_band", t.surfaceBand},
                         {"surface_cell_size", t.surfaceCell},
@@ -829,7 +830,7 @@ VolumeTrace traceVolume(const BakeSetup& setup, const IrradianceCache* cache, co
     const Heightfield& hf = setup.terrain.heightfield;
     const ProbeRays rays = raysOf(setup, v);
     VolumeTrace t;
-    if (v.placement != ProbePlacement::Adaptive) {
+    if (!refinedByError(v.placement)) {
         t.bake = setup.referenceMode
                      ? referenceProbes(setup.lighting, setup.q.bounces, layout.positions, layout.valid, rays, seed, c)
                      : bakeProbes(setup.lighting, cache, setup.q.bounces, layout.positions, layout.valid, rays, seed, c);
@@ -1612,10 +1613,12 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
             if (v.adaptive.tolerance) {
                 ve.refines = true;
                 ve.tolerance = *v.adaptive.tolerance;
-                // Every leaf larger than the minimum bakes its 8 octants at least once.
+                // Every leaf larger than the minimum bakes its children's probes (8 octants, 4
+                // quadrants) at least once.
+                const double children = t.surface ? 4.0 : 8.0;
                 size_t coarse = 0;
                 for (const OctreeLeaf& l : t.leaves) coarse += l.level > 0;
-                probes += 8.0 * double(coarse);
+                probes += children * double(coarse);
                 // At most: every cell split down to the minimum, or the budget.
                 size_t cap = t.uniformProbes + t.moved;
                 ve.cap = "a uniform grid at the minimum cell size";
@@ -1634,8 +1637,8 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
                 }
                 ve.probesMax = std::max(ve.probes, cap);
                 ve.bytesMax = 48 + 160 * uint64_t(ve.probesMax) + 4 * uint64_t(L.cellProbe.size());
-                // Each split bakes 8 octants for 7 more probes.
-                probesMax = probes + double(ve.probesMax - ve.probes) * (1.0 + 8.0 / 7.0);
+                // Each split bakes its children for children - 1 more probes.
+                probesMax = probes + double(ve.probesMax - ve.probes) * (1.0 + children / (children - 1.0));
             } else {
                 probesMax = probes;
             }

@@ -97,11 +97,16 @@ int printEstimate(const BakeEstimate& e) {
         if (v.placement == ProbePlacement::Adaptive)
             std::cout << "adaptive, cells " << fixed(v.minCell, 2) << " to " << fixed(v.maxCell, 2)
                       << " m, ";
+        else if (v.placement == ProbePlacement::Surface)
+            std::cout << "surface quadtree, squares " << fixed(v.minCell, 2) << " to " << fixed(v.maxCell, 2)
+                      << " m, ";
         else
             std::cout << (v.placement == ProbePlacement::Box ? "box" : "terrain") << " grid, ";
         std::cout << v.grid[0] << " x " << v.grid[1] << " x " << v.grid[2] << " cells of "
                   << fixed(v.cellSize, 2) << " m: " << v.probes << " probes";
-        if (v.placement == ProbePlacement::Adaptive)
+        if (v.placement == ProbePlacement::Surface)
+            std::cout << " (a uniform grid of the smallest squares would need " << v.uniformProbes << ")";
+        else if (v.placement == ProbePlacement::Adaptive)
             std::cout << " (" << v.moved << " moved up, " << v.borrowed
                       << " cells borrow the probe above; a uniform grid would need "
                       << v.uniformProbes << ")";

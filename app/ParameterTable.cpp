@@ -566,8 +566,15 @@ std::vector<ParameterSpec> buildTable() {
     const auto isBox = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Box;
     };
+    // Adaptive and surface volumes: refined by error, their adaptive.* settings read.
     const auto isAdaptive = [](const SceneDescription& s, size_t i) {
+        return refinedByError(s.probeVolumes.at(i).placement);
+    };
+    const auto isOctree = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Adaptive;
+    };
+    const auto isSurface = [](const SceneDescription& s, size_t i) {
+        return s.probeVolumes.at(i).placement == ProbePlacement::Surface;
     };
     // A terrain or box grid as the bake places it, for the values "auto" resolves to.
     const auto placedGrid = [=](const SceneDescription& s, const Heightfield& hf, size_t i) -> std::optional<ProbeLayout> {
@@ -584,12 +591,12 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kNothing).noUiRow().volume(&ProbeVolumeSettings::name);
     add(Row("probe_volumes[].enabled", T::Boolean)).label("Enabled")
         .about("Baked, exported and drawn").redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::enabled);
-    add(Row("probe_volumes[].placement", T::Choice)).choices({"terrain", "box", "adaptive"}).label("Placement")
-        .about("terrain: a grid following the ground; box: a 3-D grid of cells; adaptive: an octree, fine near the ground")
+    add(Row("probe_volumes[].placement", T::Choice)).choices({"terrain", "box", "adaptive", "surface"}).label("Placement")
+        .about("terrain: a grid following the ground; box: a 3-D grid of cells; adaptive: an octree, fine near the ground; surface: a quadtree following the ground, fine where the error is")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::placement);
     add(Row("probe_volumes[].grid_dims", T::IntegerList)).items(2, 3).range(1, kMaxBoxGridProbes)
         .label("Grid (probes)")
-        .about("terrain: [nx, nz] probes (product <= 4096); box: [nx, ny, nz] cells (product <= 65536); adaptive volumes ignore it")
+        .about("terrain: [nx, nz] probes (product <= 4096); box: [nx, ny, nz] cells (product <= 65536); adaptive and surface volumes ignore it")
         .redoes(kReplace | kRebake)
         .count([=](const SceneDescription& s, size_t i) { return isAdaptive(s, i) ? -1 : isBox(s, i) ? 3 : 2; })
         .custom(
@@ -614,9 +621,9 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("probe_volumes[].origin", T::NumberList)).items(2, 3).range(-1.0e7, 1.0e7).unit("m")
         .autoMeans("auto-span: the grid spans the terrain footprint (adaptive: its min corner at the lowest terrain)")
         .label("Origin")
-        .about("terrain: (x, z) of the first probe; box and adaptive: (x, y, z) of the min corner; engine space")
+        .about("terrain: (x, z) of the first probe; box and adaptive: (x, y, z) of the min corner; engine space; surface volumes cover the footprint and ignore it")
         .redoes(kReplace | kRebake)
-        .count([=](const SceneDescription& s, size_t i) { return isBox(s, i) || isAdaptive(s, i) ? 3 : 2; })
+        .count([=](const SceneDescription& s, size_t i) { return isSurface(s, i) ? -1 : isBox(s, i) || isAdaptive(s, i) ? 3 : 2; })
         .custom(
             [=](const SceneDescription& s, size_t i) {
                 const auto& o = s.probeVolumes.at(i).origin;
@@ -637,7 +644,7 @@ std::vector<ParameterSpec> buildTable() {
         });
     add(Row("probe_volumes[].spacing", T::NumberList)).items(2, 2).scalarToo().above(0.0, 1.0e6).unit("m")
         .autoMeans("auto-span: the end probes sit on the terrain edges").label("Spacing")
-        .about("terrain: [sx, sz] between probes; box: the cube edge, one number; adaptive volumes ignore it")
+        .about("terrain: [sx, sz] between probes; box: the cube edge, one number; adaptive and surface volumes ignore it")
         .redoes(kReplace | kRebake)
         .count([=](const SceneDescription& s, size_t i) { return isAdaptive(s, i) ? -1 : isBox(s, i) ? 0 : 2; })
         .custom(
@@ -660,11 +667,9 @@ std::vector<ParameterSpec> buildTable() {
             return json{shortest(L->spacing.x), shortest(L->spacing.z)};
         });
     add(Row("probe_volumes[].height_offset", T::Number)).range(-1.0e4, 1.0e4).unit("m").label("Height offset")
-        .about("terrain placement: probes sit this far above the triangle surface the bake traces; 0 or less leaves them on or in it, unbaked")
+        .about("terrain and surface placement: probes sit this far above the triangle surface the bake traces; 0 or less leaves them on or in it, unbaked (surface volumes refuse it)")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::heightOffset)
-        .onlyWhen([](const SceneDescription& s, size_t i) {
-            return s.probeVolumes.at(i).placement == ProbePlacement::Terrain;
-        });
+        .onlyWhen([](const SceneDescription& s, size_t i) { return followsSurface(s.probeVolumes.at(i).placement); });
     add(Row("probe_volumes[].ray_count", T::Integer)).range(1, 1 << 20).autoMeans("preset: the bake quality preset decides")
         .label("Rays per probe").about("Rays traced per probe by the bake, the same for every probe of the volume").redoes(kRebake)
         .volume(&ProbeVolumeSettings::rayCount);
@@ -677,12 +682,12 @@ std::vector<ParameterSpec> buildTable() {
             return L ? json(shortest(L->fallbackBlendDistance)) : json(nullptr);
         });
     add(Row("probe_volumes[].adaptive.min_cell_size", T::Number)).above(0.0, 1.0e6).unit("m")
-        .autoMeans("auto: the DEM's cell size, or 1/128 of the box's longer horizontal side when larger").label("Adaptive: min cell")
-        .about("Smallest octree cell and the .shprobe grid spacing").redoes(kReplace | kRebake)
+        .autoMeans("auto: the DEM's cell size, or when larger 1/128 of the box's longer horizontal side (surface: half the DEM cell, coarsened until the occupancy grid holds at most 4 Mi cells)").label("Adaptive: min cell")
+        .about("Smallest octree cell (surface: quadtree square) and the .shprobe grid spacing").redoes(kReplace | kRebake)
         .adaptive(&AdaptiveVolumeSettings::minCellSize);
     add(Row("probe_volumes[].adaptive.max_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
-        .autoMeans("16 × min: 16 × min_cell_size").label("Adaptive: max cell")
-        .about("Largest octree cell; must be min_cell_size × 2^k, k in [0, 16]").redoes(kReplace | kRebake)
+        .autoMeans("16 × min: 16 × min_cell_size (surface: the largest min × 2^k within 1/8 of the footprint's longer side)").label("Adaptive: max cell")
+        .about("Largest octree cell (surface: quadtree square); must be min_cell_size × 2^k, k in [0, 16]").redoes(kReplace | kRebake)
         .custom([](const SceneDescription& s, size_t i) {
                     const auto& m = s.probeVolumes.at(i).adaptive.maxCellSize;
                     return m ? json(*m) : json(nullptr);
@@ -703,22 +708,22 @@ std::vector<ParameterSpec> buildTable() {
                 });
     add(Row("probe_volumes[].adaptive.height_range", T::Number)).range(0.0, 1.0e5).unit("m").decimals(1)
         .label("Adaptive: above terrain").about("Auto box: from the lowest terrain up to the highest plus this")
-        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::heightRange);
+        .redoes(kReplace | kRebake).onlyWhen(isOctree).adaptive(&AdaptiveVolumeSettings::heightRange);
     add(Row("probe_volumes[].adaptive.size", T::NumberList)).items(3, 3).above(0.0, 1.0e7).unit("m")
         .autoMeans("the auto box over the terrain footprint").label("Adaptive: box size")
         .about("Explicit box edges (x, y, z) from the origin; grows to whole min cells")
-        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::size);
+        .redoes(kReplace | kRebake).onlyWhen(isOctree).adaptive(&AdaptiveVolumeSettings::size);
     add(Row("probe_volumes[].adaptive.surface_band", T::Number)).range(0.0, 1.0e6).unit("m")
         .autoMeans("one min cell").label("Adaptive: surface band")
         .about("A cell this close above the surface goes down to the minimum size").redoes(kReplace | kRebake)
-        .adaptive(&AdaptiveVolumeSettings::surfaceBand);
+        .onlyWhen(isOctree).adaptive(&AdaptiveVolumeSettings::surfaceBand);
     add(Row("probe_volumes[].adaptive.surface_cell_size", T::Number)).above(0.0, 1.0e7).unit("m")
         .autoMeans("min cell: the band is all minimum cells").label("Adaptive: surface cell")
         .about("The size the surface band forces cells down to; below it the error tolerance alone splits them. At least min_cell_size; the largest min_cell_size × 2^k at or below it applies (max_cell_size at most)")
-        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::surfaceCellSize);
+        .redoes(kReplace | kRebake).onlyWhen(isOctree).adaptive(&AdaptiveVolumeSettings::surfaceCellSize);
     add(Row("probe_volumes[].adaptive.tolerance", T::Number)).above(0.0, 1.0).decimals(3)
         .autoMeans("none: geometric refinement only").label("Adaptive: error tolerance")
-        .about("Relative interpolation error that splits a leaf (error-driven refinement)")
+        .about("Relative interpolation error that splits a leaf (error-driven refinement); unset, a surface volume keeps its largest squares")
         .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::tolerance);
     add(Row("probe_volumes[].adaptive.max_probes", T::Integer)).range(1, kMaxVolumeProbes)
         .autoMeans("the limit of 65536").label("Adaptive: max probes")
@@ -729,12 +734,12 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kReplace | kRebake).noUiRow().adaptive(&AdaptiveVolumeSettings::maxBytes);
     add(Row("probe_volumes[].target_error", T::Number)).above(0.0, 1.0).openAbove().decimals(3)
         .autoMeans("none: grid_dims or adaptive.tolerance stand").label("Target error")
-        .about("Relative interpolation error to meet at the error map's 95th percentile: chooses grid_dims (terrain) or adaptive.tolerance (adaptive), replacing them; box volumes refuse it")
+        .about("Relative interpolation error to meet at the error map's 95th percentile: chooses grid_dims (terrain) or adaptive.tolerance (adaptive, surface), replacing them; box volumes refuse it")
         .redoes(kReplace | kRebake).volume(&ProbeVolumeSettings::targetError);
     add(Row("probe_volumes[].adaptive.max_move_share", T::Number)).range(0.0, 0.5).unit("of a cell")
         .label("Adaptive: max move")
         .about("A minimum leaf whose centre is inside the terrain moves its probe up at most this share of its edge")
-        .redoes(kReplace | kRebake).adaptive(&AdaptiveVolumeSettings::maxMoveShare);
+        .redoes(kReplace | kRebake).onlyWhen(isOctree).adaptive(&AdaptiveVolumeSettings::maxMoveShare);
 
     // Reflection probes (docs/lighting.md, "Reflection probes"): the preview bakes them again on
     // every edit but strength's, which the renderer applies live.
@@ -1012,7 +1017,7 @@ std::vector<ParameterSpec> buildTable() {
     std::vector<ParameterSpec> table;
     table.reserve(rows.size());
     for (Row& r : rows) {
-        // The adaptive section is read by adaptive volumes only (placeAdaptive).
+        // The adaptive section is read by adaptive and surface volumes only (placeAdaptive).
         if (r.s_.path.rfind("probe_volumes[].adaptive.", 0) == 0 && !r.s_.readWhen) r.onlyWhen(isAdaptive);
         table.push_back(std::move(r.s_));
     }

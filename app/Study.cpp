@@ -402,7 +402,7 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
     for (int b = 0; b <= 4; ++b)
         if (b != q.bounces) add("bounces", "bounces " + std::to_string(b), {"bake.bounces=" + std::to_string(b)});
 
-    if (v.placement == ProbePlacement::Adaptive) {
+    if (refinedByError(v.placement)) {
         for (double t : {0.2, 0.1, 0.05, 0.02, 0.01})
             if (!v.adaptive.tolerance || std::abs(*v.adaptive.tolerance - t) > 1e-9)
                 add("tolerance", "tolerance " + fmt("%g", t), {volumePath() + "adaptive.tolerance=" + fmt("%g", t)});
@@ -529,9 +529,9 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
                 const BakeQuality cq = qualityOf(cs.bake);
                 const double rays = expectedRays(volumeRays(cq, cv));
                 double probes;
-                if (cv.placement == ProbePlacement::Adaptive) {
-                    // The refinement bakes each tested leaf's 8 octants: up to about three times the
-                    // geometric octree's probes at the tolerances swept.
+                if (refinedByError(cv.placement)) {
+                    // The refinement bakes each tested leaf's children (8 octants, 4 quadrants): up to
+                    // about three times the geometric tree's probes at the tolerances swept.
                     probes = 3.0 * double(cur.validCount());
                 } else {
                     probes = double(placeProbes(cv, hf()).validCount());
@@ -601,13 +601,13 @@ StudyPoint Study::measureProbes(const Candidate& c) {
     uint64_t traced = 0;
     if (q.bounces > 0) {
         uint64_t planned = uint64_t(layout.validCount()) * uint64_t(rays.planned());
-        if (v.placement == ProbePlacement::Adaptive) planned *= 3;
+        if (refinedByError(v.placement)) planned *= 3;
         baked->cache = std::make_unique<IrradianceCache>(lighting, cacheResolutionFor(hf(), q, planned), q.cacheRays,
                                                          q.sunSamples, q.bounces - 1, control());
         traced += baked->cache->rays();
     }
     ProbeBake bake;
-    if (v.placement == ProbePlacement::Adaptive) {
+    if (refinedByError(v.placement)) {
         const ProbeBaker baker = seededBaker(lighting, baked->cache.get(), q.bounces, rays, kStudySeed, control());
         AdaptiveBake a = bakeAdaptive(v, hf(), baker);
         layout = std::move(a.layout);

@@ -52,11 +52,56 @@ double autoMinCellSize(const Heightfield& hf, const glm::dvec3& box) {
                      std::max(box.x, box.z) / kAutoMinCellsAlongBox});
 }
 
+double autoSurfaceMinCell(const Heightfield& hf, double heightOffset) {
+    const double sx = double(hf.maxX()) - hf.minX(), sz = double(hf.maxZ()) - hf.minZ();
+    const double tall = double(hf.maxHeight()) - hf.minHeight() + std::max(heightOffset, 0.0);
+    auto cells = [&](double m) {
+        return std::max(1.0, std::ceil(sx / m)) * std::max(1.0, std::ceil(sz / m)) * (std::ceil(tall / m) + 1.0);
+    };
+    double m = 0.5 * std::max(hf.cellSizeX(), hf.cellSizeZ());
+    while (cells(m) > kAutoSurfaceCells) m *= 1.02;
+    return m;
+}
+
+double autoSurfaceMaxCell(const Heightfield& hf, double minCell) {
+    const double side = std::max(double(hf.maxX()) - hf.minX(), double(hf.maxZ()) - hf.minZ());
+    const int k = std::clamp(int(std::floor(std::log2(side / 8.0 / minCell) + 1e-9)), 0, kMaxLevels);
+    return minCell * std::exp2(k);
+}
+
 namespace {
+
+// Throws PlacementError when a layout of an error-refined volume exceeds its budgets (`what`
+// names the part of the layout that does; `raise` the settings that make it smaller).
+void checkRefinementBudget(const ProbeVolumeSettings& v, const ProbeLayout& L, const char* what, const std::string& raise) {
+    const std::string where = "probe_volumes '" + v.name + "': " + what + " needs ";
+    const AdaptiveVolumeSettings& a = v.adaptive;
+    if (a.maxProbes && L.validCount() > size_t(*a.maxProbes))
+        throw PlacementError(where + std::to_string(L.validCount()) + " probes, more than adaptive.max_probes = " +
+                             std::to_string(*a.maxProbes) + "; raise it, " + raise);
+    if (L.validCount() > size_t(kMaxVolumeProbes))
+        throw PlacementError(where + std::to_string(L.validCount()) + " probes, more than an adaptive volume's limit of " +
+                             std::to_string(kMaxVolumeProbes) + "; raise " + raise);
+    if (a.maxBytes && L.fileBytes() > uint64_t(*a.maxBytes))
+        throw PlacementError(where + std::to_string(L.fileBytes()) + " bytes, more than adaptive.max_bytes = " +
+                             std::to_string(*a.maxBytes) + "; raise it, " + raise);
+}
+
+// k with max = min x 2^k, k in [0, kMaxLevels] (cells halve), or PlacementError.
+int levelsBetween(const std::string& where, double min, double max, bool minSet) {
+    const double ratio = max / min;
+    const double k = std::round(std::log2(ratio));
+    if (!(ratio >= 1.0) || k > kMaxLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
+        throw PlacementError(where + ": adaptive.max_cell_size = " + num(max) + " must be min_cell_size (" + num(min) +
+                             (minSet ? "" : ", the auto size") + ") times 2^k, k in [0, " +
+                             std::to_string(kMaxLevels) + "]");
+    return int(k);
+}
 
 // The octree of one volume: resolved settings, box and the surface ranges of its columns.
 class Octree {
 public:
+    static constexpr size_t kChildren = 8;
     Octree(const ProbeVolumeSettings& v, const Heightfield& hf) : hf_(hf), v_(v) {
         const std::string where = "probe_volumes '" + v.name + "'";
         const AdaptiveVolumeSettings& a = v.adaptive;
@@ -74,15 +119,7 @@ public:
                               double(hf.maxZ()) - hf.minZ());
         }
         m_ = a.minCellSize ? *a.minCellSize : autoMinCellSize(hf, size);
-        const double maxCell = a.maxCellSize ? *a.maxCellSize : 16.0 * m_;
-        const double ratio = maxCell / m_;
-        const double k = std::round(std::log2(ratio));
-        if (!(ratio >= 1.0) || k > kMaxLevels || std::abs(ratio - std::exp2(k)) > 1e-9 * ratio)
-            throw PlacementError(where + ": adaptive.max_cell_size = " + num(maxCell) +
-                                 " must be min_cell_size (" + num(m_) +
-                                 (a.minCellSize ? "" : ", the auto size") + ") times 2^k, k in [0, " +
-                                 std::to_string(kMaxLevels) + "]");
-        levels_ = int(k);
+        levels_ = levelsBetween(where, m_, a.maxCellSize ? *a.maxCellSize : 16.0 * m_, a.minCellSize.has_value());
         if (a.surfaceCellSize) {
             // The largest octree cell size at or below it: a size set in metres stays valid when
             // an auto min cell moves with the box. 1e-5 forgives a size written to 6 digits.
@@ -132,6 +169,9 @@ public:
                     uint8_t(n.level - 1)};
         return c;
     }
+
+    // The probe the refinement bakes for a child: at its centre.
+    glm::vec3 trial(const OctreeLeaf& c) const { return centre(c); }
 
     // Applies the geometric rules to one cell, appending the leaves it becomes.
     void visit(const OctreeLeaf& n, std::vector<OctreeLeaf>& out, size_t& splitForInside) const {
@@ -276,23 +316,7 @@ public:
     }
 
     void checkBudget(const ProbeLayout& L, const char* what) const {
-        const std::string where = "probe_volumes '" + v_.name + "'";
-        const AdaptiveVolumeSettings& a = v_.adaptive;
-        if (a.maxProbes && L.validCount() > size_t(*a.maxProbes))
-            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.validCount()) +
-                                 " probes, more than adaptive.max_probes = " +
-                                 std::to_string(*a.maxProbes) +
-                                 "; raise it, adaptive.min_cell_size or adaptive.surface_cell_size");
-        if (L.validCount() > size_t(kMaxVolumeProbes))
-            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.validCount()) +
-                                 " probes, more than an adaptive volume's limit of " +
-                                 std::to_string(kMaxVolumeProbes) +
-                                 "; raise adaptive.min_cell_size or adaptive.surface_cell_size");
-        if (a.maxBytes && L.fileBytes() > uint64_t(*a.maxBytes))
-            throw PlacementError(where + ": " + what + " needs " + std::to_string(L.fileBytes()) +
-                                 " bytes, more than adaptive.max_bytes = " +
-                                 std::to_string(*a.maxBytes) +
-                                 "; raise it, adaptive.min_cell_size or adaptive.surface_cell_size");
+        checkRefinementBudget(v_, L, what, "adaptive.min_cell_size or adaptive.surface_cell_size");
     }
 
 private:
@@ -340,6 +364,154 @@ private:
     std::array<uint32_t, 3> dims_{1, 1, 1};
     std::vector<std::vector<Range>> pyramid_;
     std::vector<std::array<uint32_t, 2>> pyramidDims_;
+};
+
+// The surface quadtree of one volume (docs/lighting.md, "Surface placement"): squares from
+// max_cell_size down to min_cell_size tiling the terrain footprint, one probe per leaf
+// height_offset above the triangle surface at its centre (probeAboveSurface, as a terrain grid
+// places its probes). Leaves are OctreeLeaf squares with y = 0. The .shprobe grid is the
+// footprint in minimum cells from the lowest ground to above the highest probe; each column's
+// cells with any part above the terrain name the probe of the leaf over it, as a terrain grid's
+// columns name their nearest probe.
+class Quadtree {
+public:
+    static constexpr size_t kChildren = 4;
+    Quadtree(const ProbeVolumeSettings& v, const Heightfield& hf) : hf_(hf), v_(v) {
+        const std::string where = "probe_volumes '" + v.name + "'";
+        const AdaptiveVolumeSettings& a = v.adaptive;
+        if (!(v.heightOffset > 0.0))
+            throw PlacementError(where + ": height_offset = " + num(v.heightOffset) +
+                                 " must be above 0 for surface placement (its probes stand that far above the ground)");
+        origin_ = glm::dvec3(hf.minX(), hf.minHeight(), hf.minZ());
+        m_ = a.minCellSize ? *a.minCellSize : autoSurfaceMinCell(hf, v.heightOffset);
+        levels_ = levelsBetween(where, m_, a.maxCellSize ? *a.maxCellSize : autoSurfaceMaxCell(hf, m_),
+                                a.minCellSize.has_value());
+        const double spanX = double(hf.maxX()) - hf.minX(), spanZ = double(hf.maxZ()) - hf.minZ();
+        const double nx = std::max(1.0, std::ceil(spanX / m_ - 1e-6)), nz = std::max(1.0, std::ceil(spanZ / m_ - 1e-6));
+        const double ny = std::ceil((double(hf.maxHeight()) + v.heightOffset - origin_.y) / m_ - 1e-4) + 1.0;
+        if (nx * ny * nz > double(kMaxOccupancyCells))
+            throw PlacementError(where + ": occupancy grid of " + whole(nx * ny * nz) + " cells (" + whole(nx) + " x " +
+                                 whole(ny) + " x " + whole(nz) + " of " + num(m_) + " m) exceeds " +
+                                 std::to_string(kMaxOccupancyCells) + "; raise adaptive.min_cell_size");
+        dims_ = {uint32_t(nx), 1, uint32_t(nz)};
+        lowest_.resize(size_t(dims_[0]) * dims_[2]);
+        tbb::parallel_for(uint32_t(0), dims_[2], [&](uint32_t z) {
+            for (uint32_t x = 0; x < dims_[0]; ++x) {
+                const double x0 = origin_.x + m_ * x, z0 = origin_.z + m_ * z;
+                lowest_[size_t(z) * dims_[0] + x] = surfaceRange(hf_, x0, x0 + m_, z0, z0 + m_).lo;
+            }
+        });
+    }
+
+    double maxCell() const { return m_ * std::exp2(levels_); }
+
+    // The probe of a leaf (and the refinement's trial for a child): over its centre.
+    glm::vec3 trial(const OctreeLeaf& n) const {
+        const double h = 0.5 * double(n.edge());
+        float lift = 0.0f;
+        return probeAboveSurface(hf_, float(origin_.x + m_ * (n.x + h)), float(origin_.z + m_ * (n.z + h)),
+                                 v_.heightOffset, lift);
+    }
+    bool aboveSurface(const glm::vec3& p) const { return p.y > hf_.surfaceHeight(p.x, p.z); }
+    std::array<OctreeLeaf, 4> children(const OctreeLeaf& n) const {
+        std::array<OctreeLeaf, 4> c;
+        const uint32_t h = n.edge() / 2;
+        for (uint32_t i = 0; i < 4; ++i) c[i] = {n.x + (i & 1) * h, 0, n.z + ((i >> 1) & 1) * h, uint8_t(n.level - 1)};
+        return c;
+    }
+    // A square sticking out of the footprint splits (never at the minimum: the footprint is
+    // whole minimum cells); one wholly outside is none.
+    void visit(const OctreeLeaf& n, std::vector<OctreeLeaf>& out, size_t& split) const {
+        if (n.x >= dims_[0] || n.z >= dims_[2]) return;
+        if (n.x + n.edge() > dims_[0] || n.z + n.edge() > dims_[2]) {
+            for (const OctreeLeaf& c : children(n)) visit(c, out, split);
+            return;
+        }
+        out.push_back(n);
+    }
+    std::vector<OctreeLeaf> build(size_t& split) const {
+        const uint32_t root = 1u << levels_;
+        std::vector<OctreeLeaf> leaves;
+        for (uint32_t z = 0; z < dims_[2]; z += root)
+            for (uint32_t x = 0; x < dims_[0]; x += root) visit(OctreeLeaf{x, 0, z, uint8_t(levels_)}, leaves, split);
+        return leaves;
+    }
+    LeafProbe resolve(const OctreeLeaf& n, glm::vec3& p) const {
+        p = trial(n);
+        return aboveSurface(p) ? LeafProbe::Centre : LeafProbe::Dropped;
+    }
+
+    ProbeLayout layout(std::vector<OctreeLeaf> leaves, size_t) const {
+        std::sort(leaves.begin(), leaves.end(), [&](const OctreeLeaf& a, const OctreeLeaf& b) {
+            return flatIndex(a, dims_) < flatIndex(b, dims_);
+        });
+        ProbeLayout L;
+        const size_t n = leaves.size();
+        L.positions.resize(n);
+        L.valid.resize(n);
+        L.probeKeys.resize(n);
+        AdaptiveOctree t;
+        t.surface = true;
+        t.heightOffset = v_.heightOffset;
+        t.minCell = m_;
+        t.maxCell = maxCell();
+        t.surfaceCell = m_;
+        t.levels = levels_;
+        t.probe.resize(n);
+        std::vector<float> lifts(n, 0.0f);
+        tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            const double h = 0.5 * double(leaves[i].edge());
+            L.positions[i] = probeAboveSurface(hf_, float(origin_.x + m_ * (leaves[i].x + h)),
+                                               float(origin_.z + m_ * (leaves[i].z + h)), v_.heightOffset, lifts[i]);
+            t.probe[i] = aboveSurface(L.positions[i]) ? LeafProbe::Centre : LeafProbe::Dropped;
+            L.valid[i] = t.probe[i] != LeafProbe::Dropped;
+            L.probeKeys[i] = octreeLeafKey(leaves[i]);
+        });
+        float top = hf_.maxHeight() + float(v_.heightOffset);
+        for (size_t i = 0; i < n; ++i) {
+            top = std::max(top, L.positions[i].y);
+            L.liftedForClearance += lifts[i] > 0.0f;
+            L.maxLift = std::max(L.maxLift, lifts[i]);
+            t.dropped += !L.valid[i];
+        }
+        const uint32_t ny = uint32_t(std::ceil((double(top) - origin_.y) / m_ - 1e-4) + 1.0);
+        L.cellDims = {dims_[0], std::max(ny, 1u), dims_[2]};
+        L.probeDims = {int(L.cellDims[0]), int(L.cellDims[1]), int(L.cellDims[2])};
+        L.spacing = glm::vec3(float(m_));
+        L.fallbackBlendDistance = v_.fallbackBlendDistance ? float(*v_.fallbackBlendDistance) : 2.0f * float(m_);
+        L.cellSize = float(m_);
+        L.cellOrigin = glm::vec3(origin_);
+        const size_t layer = size_t(L.cellDims[0]) * L.cellDims[1];
+        L.cellProbe.assign(layer * L.cellDims[2], -1);
+        for (size_t i = 0; i < n; ++i) {
+            if (!L.valid[i]) continue;
+            const OctreeLeaf& l = leaves[i];
+            for (uint32_t z = l.z; z < l.z + l.edge(); ++z)
+                for (uint32_t x = l.x; x < l.x + l.edge(); ++x) {
+                    const float lowest = lowest_[size_t(z) * dims_[0] + x];
+                    for (uint32_t y = 0; y < L.cellDims[1]; ++y)
+                        if (origin_.y + m_ * double(y + 1) > double(lowest))
+                            L.cellProbe[x + size_t(y) * L.cellDims[0] + size_t(z) * layer] = int32_t(i);
+                }
+        }
+        t.uniformProbes = size_t(dims_[0]) * dims_[2];
+        t.leaves = std::move(leaves);
+        L.octree = std::move(t);
+        return L;
+    }
+
+    void checkBudget(const ProbeLayout& L, const char* what) const {
+        checkRefinementBudget(v_, L, what, "adaptive.min_cell_size or adaptive.max_cell_size");
+    }
+
+private:
+    const Heightfield& hf_;
+    const ProbeVolumeSettings& v_;
+    double m_ = 1.0;
+    int levels_ = 0;
+    glm::dvec3 origin_{0.0};
+    std::array<uint32_t, 3> dims_{1, 1, 1};  // footprint in minimum cells (y unused)
+    std::vector<float> lowest_;              // lowest surface over each minimum-cell column
 };
 
 struct BakedProbe {
@@ -400,24 +572,24 @@ uint64_t octreeLeafKey(const OctreeLeaf& l) {
     return splitmix64(k ^ l.level);
 }
 
-ProbeLayout placeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf) {
-    const Octree tree(v, hf);
-    size_t split = 0;
+namespace {
+
+// The first layout of a tree (no refinement), checked against the budgets.
+template <class Tree>
+ProbeLayout firstLayout(const Tree& tree, size_t& split) {
     std::vector<OctreeLeaf> leaves = tree.build(split);
     ProbeLayout L = tree.layout(std::move(leaves), split);
-    tree.checkBudget(L, "the surface band alone");
+    tree.checkBudget(L, Tree::kChildren == 8 ? "the surface band alone" : "the largest squares alone");
     return L;
 }
 
-AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
-                          const ProbeBaker& baker,
-                          const std::function<void(int, size_t)>& onRound) {
-    const Octree tree(v, hf);
+// Bakes a tree's probes and, with a tolerance, refines it by error (bakeAdaptive).
+template <class Tree>
+AdaptiveBake bakeTree(const Tree& tree, const ProbeVolumeSettings& v, const ProbeBaker& baker,
+                      const std::function<void(int, size_t)>& onRound) {
     size_t split = 0;
-    std::vector<OctreeLeaf> leaves = tree.build(split);
     AdaptiveBake out;
-    out.layout = tree.layout(leaves, split);
-    tree.checkBudget(out.layout, "the surface band alone");
+    out.layout = firstLayout(tree, split);
     std::unordered_map<uint64_t, BakedProbe> store;
     uint64_t rays = bakeMissing(out.layout, baker, store);
 
@@ -443,7 +615,7 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
             std::vector<uint64_t> keys;
             for (size_t i : candidates)
                 for (const OctreeLeaf& c : tree.children(current[i])) {
-                    positions.push_back(tree.centre(c));
+                    positions.push_back(tree.trial(c));
                     keys.push_back(octreeLeafKey(c));
                 }
             const ProbeBake octants = baker(positions, keys);
@@ -461,9 +633,9 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
                 double error = 0.0;
                 // An octant whose centre is in the terrain sees it from inside: no light an
                 // interpolated point above the surface receives, so it is not a test of the leaf.
-                for (size_t o = 0; o < 8; ++o)
-                    if (tree.aboveSurface(positions[8 * k + o]))
-                        error = std::max(error, double(relativeIrradianceError(own, octants.sh[8 * k + o])));
+                for (size_t o = 0; o < Tree::kChildren; ++o)
+                    if (tree.aboveSurface(positions[Tree::kChildren * k + o]))
+                        error = std::max(error, double(relativeIrradianceError(own, octants.sh[Tree::kChildren * k + o])));
                 if (error > ref.tolerance) {
                     failing.push_back({k, error});
                 } else {
@@ -503,10 +675,11 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
                 ref.octantProbesKept += octantsKept;
                 split += unused;
                 // The octant bakes become the children's probes.
-                for (size_t o = 0; o < 8; ++o)
-                    store[keys[8 * k + o]] = {positions[8 * k + o], octants.sh[8 * k + o],
-                                              octants.standardError[8 * k + o],
-                                              octants.fromBelowShare[8 * k + o]};
+                for (size_t o = 0; o < Tree::kChildren; ++o)
+                    store[keys[Tree::kChildren * k + o]] = {positions[Tree::kChildren * k + o], octants.sh[Tree::kChildren * k + o],
+                                              octants.standardError[Tree::kChildren * k + o],
+                                              octants.fromBelowShare[Tree::kChildren * k + o],
+                                              octants.raysPerProbe[Tree::kChildren * k + o]};
                 added.insert(added.end(), children.begin(), children.end());
             }
             if (!added.empty()) {
@@ -534,6 +707,19 @@ AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf,
     }
     out.bake.rays = rays;
     return out;
+}
+
+}  // namespace
+
+ProbeLayout placeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    size_t split = 0;
+    return v.placement == ProbePlacement::Surface ? firstLayout(Quadtree(v, hf), split) : firstLayout(Octree(v, hf), split);
+}
+
+AdaptiveBake bakeAdaptive(const ProbeVolumeSettings& v, const Heightfield& hf, const ProbeBaker& baker,
+                          const std::function<void(int, size_t)>& onRound) {
+    if (v.placement == ProbePlacement::Surface) return bakeTree(Quadtree(v, hf), v, baker, onRound);
+    return bakeTree(Octree(v, hf), v, baker, onRound);
 }
 
 bool interpolateProbes(const ProbeLayout& L, const std::vector<sh::ShRgb>& shs, const glm::vec3& p,
@@ -576,8 +762,11 @@ InterpolationError measureInterpolationError(const ProbeLayout& L, const std::ve
                               glm::dvec3(L.cellDims[0], L.cellDims[1], L.cellDims[2]);
     Rng rng(seed ^ 0x1E7E5A4D5A3Dull);
     std::vector<glm::vec3> points;
+    const bool layer = L.octree && L.octree->surface;
     for (int attempt = 0; attempt < 64 * count && int(points.size()) < count; ++attempt) {
-        const glm::vec3 p(lo + extent * glm::dvec3(rng.next(), rng.next(), rng.next()));
+        glm::vec3 p(lo + extent * glm::dvec3(rng.next(), rng.next(), rng.next()));
+        // A surface volume models the layer its probes stand in: up to twice their height.
+        if (layer) p.y = hf.surfaceHeight(p.x, p.z) + float(2.0 * L.octree->heightOffset * rng.next());
         if (p.y > hf.surfaceHeight(p.x, p.z)) points.push_back(p);
     }
     if (points.empty()) return e;

@@ -1,7 +1,16 @@
 #pragma once
 // Adaptive octree placement of SH probes over a terrain (seed 001's adaptive octree, written as
-// docs/formats.md's .shprobe grid at the minimum cell size), its error-driven refinement, and the
+// docs/formats.md's .shprobe grid at the minimum cell size), the surface quadtree (its 2-D
+// counterpart over the terrain-following layer), their error-driven refinement, and the
 // interpolation model that the refinement and the reported interpolation error share.
+//
+// Surface placement. Squares from max_cell_size down to min_cell_size tile the terrain footprint
+// (whole minimum cells; a square sticking out splits); each leaf holds one probe height_offset
+// above the triangle surface over its centre, placed as a terrain grid places its probes. The
+// .shprobe grid spans the footprint in minimum cells from the lowest ground to above the highest
+// probe; a column's cells with any part above the terrain name its leaf's probe. Refinement tests
+// a leaf's 4 quadrant centres (at height_offset above the ground there) as the octree tests its
+// 8 octants, and splits it above the tolerance.
 //
 // Geometry. The box (auto: the terrain footprint from the lowest terrain point up to the highest
 // + height_range) is made of whole minimum cells and tiled by root cells of max_cell_size. A cell
@@ -56,6 +65,16 @@ namespace terralux {
 // the box keep every DEM in the tens of thousands of probes, a few seconds of bake.
 inline constexpr double kAutoMinCellsAlongBox = 128.0;
 double autoMinCellSize(const Heightfield& hf, const glm::dvec3& boxSize);
+
+// A surface volume's squares when adaptive.min_cell_size / max_cell_size are unset. The smallest
+// is half the DEM cell (the light a few metres above rough ground changes within one cell: on the
+// Rainier crop probes at every cell leave a 13 % p95, at half cells 9 %), coarsened until the
+// occupancy grid over the footprint and its relief holds at most kAutoSurfaceCells (16 MiB; on a
+// 110 km SRTM tile that is about 190 m). The largest is the largest min x 2^k at most 1/8 of the
+// footprint's longer side, so the unrefined quadtree is about seed 000's 8 x 8 terrain grid.
+inline constexpr double kAutoSurfaceCells = double(4 << 20);
+double autoSurfaceMinCell(const Heightfield& hf, double heightOffset);
+double autoSurfaceMaxCell(const Heightfield& hf, double minCell);
 
 // Geometric adaptive placement (no refinement). Throws PlacementError for settings that only
 // the terrain can check (auto sizes), an occupancy grid over kMaxOccupancyCells, or a budget the
@@ -121,7 +140,8 @@ struct InterpolationError {
 };
 
 // docs/lighting.md interpolation error: at `count` points drawn uniformly (deterministically from
-// `seed`) from the part of the layout's grid box above the terrain, the relative irradiance error
+// `seed`) from the part of the layout's grid box above the terrain (a surface volume's: from the
+// ground up to twice its height_offset), the relative irradiance error
 // of the interpolated probes against a probe baked at the point with `baker`.
 InterpolationError measureInterpolationError(const ProbeLayout& layout,
                                              const std::vector<sh::ShRgb>& sh,

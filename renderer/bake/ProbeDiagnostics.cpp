@@ -31,16 +31,20 @@ ProbeDiagnostics describeProbes(const ProbeLayout& L) {
         d.moved.push_back(L.octree && L.octree->probe[i] == LeafProbe::Moved ? 1 : 0);
     }
     if (L.octree)
-        for (const OctreeLeaf& leaf : L.octree->leaves)
-            d.leaves.emplace_back(L.cellOrigin.x + L.cellSize * float(leaf.x),
-                                  L.cellOrigin.y + L.cellSize * float(leaf.y),
-                                  L.cellOrigin.z + L.cellSize * float(leaf.z),
-                                  L.cellSize * float(leaf.edge()));
+        for (size_t i = 0; i < L.octree->leaves.size(); ++i) {
+            const OctreeLeaf& leaf = L.octree->leaves[i];
+            const float edge = L.cellSize * float(leaf.edge());
+            // A surface square has no height of its own: its cube is centred on its probe.
+            const float y = L.octree->surface ? L.positions[i].y - 0.5f * edge
+                                              : L.cellOrigin.y + L.cellSize * float(leaf.y);
+            d.leaves.emplace_back(L.cellOrigin.x + L.cellSize * float(leaf.x), y,
+                                  L.cellOrigin.z + L.cellSize * float(leaf.z), edge);
+        }
     return d;
 }
 
 float errorMapHeight(const ProbeVolumeSettings& v, const ProbeLayout& L) {
-    if (v.placement == ProbePlacement::Terrain && v.heightOffset > 0.0) return float(v.heightOffset);
+    if (followsSurface(v.placement) && v.heightOffset > 0.0) return float(v.heightOffset);
     return 0.02f * L.cellSize;
 }
 

@@ -53,8 +53,8 @@ struct ProbeDiagnostics {
 // Positions, moves, rejections and leaves of a layout (no error map).
 ProbeDiagnostics describeProbes(const ProbeLayout& layout);
 
-// How far above the ground a volume's error map measures: a terrain-following grid's own probe
-// height (so the map shows the horizontal interpolation alone), otherwise 2 % of a cell, the
+// How far above the ground a volume's error map measures: a terrain grid's or surface volume's own
+// probe height (so the map shows the horizontal interpolation alone), otherwise 2 % of a cell, the
 // clearance of a moved probe.
 float errorMapHeight(const ProbeVolumeSettings& volume, const ProbeLayout& layout);
 

@@ -109,18 +109,12 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
     for (int k = 0; k < nz; ++k)
         for (int i = 0; i < nx; ++i) {
             const float x = first.x + spacing.x * float(i), z = first.z + spacing.z * float(k);
-            const float ground = hf.surfaceHeight(x, z);
-            glm::vec3 p(x, ground + float(v.heightOffset), z);
-            // An offset below the float spacing at this height would round onto the surface.
-            if (v.heightOffset > 0.0 && !(p.y > ground)) p.y = std::nextafter(ground, INFINITY);
-            if (p.y > ground) {
-                const float clear = liftClearOfSelfHits(hf, p);
-                L.liftedForClearance += clear > p.y;
-                L.maxLift = std::max(L.maxLift, clear - p.y);
-                p.y = clear;
-            }
+            float lift = 0.0f;
+            const glm::vec3 p = probeAboveSurface(hf, x, z, v.heightOffset, lift);
+            L.liftedForClearance += lift > 0.0f;
+            L.maxLift = std::max(L.maxLift, lift);
             L.positions.push_back(p);
-            L.valid.push_back(p.y > ground ? 1 : 0);
+            L.valid.push_back(p.y > hf.surfaceHeight(x, z) ? 1 : 0);
         }
 
     // Occupancy: cubic cells of the smaller probe spacing (or, for a single probe, of the
@@ -254,10 +248,24 @@ float liftClearOfSelfHits(const Heightfield& hf, const glm::vec3& p) {
     return clear > p.y ? std::nextafter(clear, INFINITY) : p.y;
 }
 
+glm::vec3 probeAboveSurface(const Heightfield& hf, float x, float z, double offset, float& lift) {
+    const float ground = hf.surfaceHeight(x, z);
+    glm::vec3 p(x, ground + float(offset), z);
+    // An offset below the float spacing at this height would round onto the surface.
+    if (offset > 0.0 && !(p.y > ground)) p.y = std::nextafter(ground, INFINITY);
+    lift = 0.0f;
+    if (p.y > ground) {
+        const float clear = liftClearOfSelfHits(hf, p);
+        lift = clear - p.y;
+        p.y = clear;
+    }
+    return p;
+}
+
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {
-    ProbeLayout L = v.placement == ProbePlacement::Box        ? placeBoxGrid(v, hf)
-                    : v.placement == ProbePlacement::Adaptive ? placeAdaptive(v, hf)
-                                                              : placeTerrainGrid(v, hf);
+    ProbeLayout L = v.placement == ProbePlacement::Box ? placeBoxGrid(v, hf)
+                    : refinedByError(v.placement)    ? placeAdaptive(v, hf)
+                                                     : placeTerrainGrid(v, hf);
     if (v.fallbackBlendDistance) {
         L.fallbackBlendDistance = float(*v.fallbackBlendDistance);
     } else if (v.placement == ProbePlacement::Terrain) {

@@ -41,8 +41,11 @@ enum class LeafProbe : uint8_t {
     Dropped,   // the same with no probe above it in the box: its cell holds -1
 };
 
-// The adaptive octree behind a layout, with its resolved settings.
+// The adaptive octree behind a layout, with its resolved settings; or, for a surface volume,
+// its quadtree (`surface`: leaves are squares with y = 0, no band, no moves).
 struct AdaptiveOctree {
+    bool surface = false;
+    double heightOffset = 0.0;         // surface: the probes' height above the ground
     double minCell = 1.0, maxCell = 1.0, surfaceBand = 0.0;
     double surfaceCell = 1.0;          // the size the surface band forces cells down to
     int levels = 0;                    // maxCell = minCell * 2^levels
@@ -53,7 +56,7 @@ struct AdaptiveOctree {
     // surface band too, so the band rule alone would have split them).
     size_t splitForInside = 0;
     // Probes a uniform grid at the minimum cell size over the same box would hold: every cell
-    // whose centre is above the terrain.
+    // whose centre is above the terrain (surface: every minimum square of the footprint).
     size_t uniformProbes = 0;
 };
 
@@ -114,6 +117,12 @@ SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0
 // horizontally is exact (surfaceRange), so the ball of that radius around the result holds no
 // surface.
 float liftClearOfSelfHits(const Heightfield& hf, const glm::vec3& p);
+
+// A terrain-following probe: `offset` above the triangle surface at (x, z) the bake traces (a
+// bilinear height can be metres below it), then lifted clear of self-hits (liftClearOfSelfHits);
+// `lift` gets the metres of that lift. An offset of 0 or less leaves it on or in the surface,
+// where it is not valid (y not above the surface).
+glm::vec3 probeAboveSurface(const Heightfield& hf, float x, float z, double offset, float& lift);
 
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;

@@ -87,7 +87,14 @@ struct SkySettings {
     double turbidity = 3.0;              // mode physical: haze, [1.7, 10]
 };
 
-enum class ProbePlacement { Terrain, Box, Adaptive };
+// Surface: a quadtree over the terrain-following layer, refined where the interpolation error is
+// high (docs/lighting.md, "Surface placement"); it shares the adaptive settings that refine it.
+enum class ProbePlacement { Terrain, Box, Adaptive, Surface };
+
+// Placements whose leaves an error tolerance refines (the adaptive.* settings apply).
+inline bool refinedByError(ProbePlacement p) { return p == ProbePlacement::Adaptive || p == ProbePlacement::Surface; }
+// Placements whose probes stand height_offset above the surface.
+inline bool followsSurface(ProbePlacement p) { return p == ProbePlacement::Terrain || p == ProbePlacement::Surface; }
 
 // The project-file spelling of a placement.
 inline const char* placementName(ProbePlacement p) {
@@ -95,6 +102,7 @@ inline const char* placementName(ProbePlacement p) {
         case ProbePlacement::Terrain: return "terrain";
         case ProbePlacement::Box: return "box";
         case ProbePlacement::Adaptive: return "adaptive";
+        case ProbePlacement::Surface: return "surface";
     }
     return "terrain";
 }
@@ -102,6 +110,9 @@ inline const char* placementName(ProbePlacement p) {
 // Adaptive octree placement (seed 001): cubic cells from max_cell_size down to min_cell_size over
 // a box; cells that overlap the terrain surface band go down to the minimum, open air stays
 // coarse, one probe per leaf at its centre. The .shprobe grid is the box at the minimum cell size.
+// Surface volumes read min_cell_size, max_cell_size (the quadtree's squares; unset: 1/256 and
+// 1/8 of the footprint's longer side, the DEM cell at least), tolerance and the budgets; the box,
+// band and move settings are the octree's alone.
 struct AdaptiveVolumeSettings {
     // Unset = the DEM's cell size (the larger axis), but at least 1/128 of the box's longer
     // horizontal side (autoMinCellSize). Probes closer than the terrain samples see no lighting
@@ -136,15 +147,16 @@ struct ProbeVolumeSettings {
     std::string name = "probes";     // file stem of its .shprobe: [A-Za-z0-9_-]+
     bool enabled = true;
     ProbePlacement placement = ProbePlacement::Terrain;
-    // Terrain: (nx, nz) probes; Box: (nx, ny, nz) cells, one probe at each centre. Adaptive
-    // volumes ignore grid_dims, spacing and height_offset.
+    // Terrain: (nx, nz) probes; Box: (nx, ny, nz) cells, one probe at each centre. Adaptive and
+    // surface volumes ignore grid_dims and spacing; adaptive volumes height_offset too.
     std::array<int, 3> gridDims{8, 1, 8};
     // Terrain: (x, z) of the first probe; Box and Adaptive: (x, y, z) of the min corner.
-    // Unset = auto-span (Adaptive: the footprint's min corner at the lowest terrain).
+    // Unset = auto-span (Adaptive: the footprint's min corner at the lowest terrain). Surface
+    // volumes always cover the footprint.
     std::optional<glm::vec3> origin;
     // Terrain: (sx, sz) between probes; Box: cube edge in .x. Unset = auto-span.
     std::optional<glm::vec3> spacing;
-    double heightOffset = 5.0;       // terrain placement: metres above the triangle surface
+    double heightOffset = 5.0;       // terrain and surface placement: metres above the triangle surface
     std::optional<int> rayCount;     // unset = the bake quality preset decides
     std::optional<double> fallbackBlendDistance;  // unset = 2 * min(spacing)
     AdaptiveVolumeSettings adaptive;

@@ -2,8 +2,8 @@
 # target_checks.sh CASE TERRALUX WORKDIR DEM
 # probe_volumes[].target_error end to end on a committed DEM crop: the bake meets the target on
 # its own error map and says why it chose what it did; the dry run says the same and writes
-# nothing; a target past the terrain-grid limit is one plain warning; an adaptive volume's target
-# chooses its tolerance the same way.
+# nothing; a target past the terrain-grid limit is one plain warning whose surface-volume offer
+# delivers; an adaptive or surface volume's target chooses its tolerance the same way.
 set -u
 case_=$1 terralux=$2 work=$3 dem=$4
 rm -rf "$work" && mkdir -p "$work"
@@ -46,7 +46,7 @@ PY
     "$terralux" --bake --quiet --quality draft --dem "$dem" --out "$work/out" \
       --set 'probe_volumes[0].target_error=0.05' >"$work/stdout" 2>"$work/stderr" || fail "bake exited $?"
     [ "$(wc -l <"$work/stderr")" = 1 ] || fail "want one stderr line, got: $(cat "$work/stderr")"
-    grep -Eq "^terralux: warning: probe_volumes\[0\].target_error 5.0 % needs more than the 4096 probes a terrain grid may hold: baking the densest allowed, grid_dims [0-9]+,[0-9]+ \(p95 [0-9.]+ %\); (an adaptive volume meets it: --set probe_volumes\[0\].placement=adaptive \(tolerance [0-9.e-]+, [0-9 ]+ probes, [0-9 ]+ bytes, about [0-9.]+ s|no adaptive volume within 65536 probes meets it)" \
+    grep -Eq "^terralux: warning: probe_volumes\[0\].target_error 5.0 % needs more than the 4096 probes a terrain grid may hold: baking the densest allowed, grid_dims [0-9]+,[0-9]+ \(p95 [0-9.]+ %\); a surface volume meets it: --set probe_volumes\[0\].placement=surface \(tolerance [0-9.e-]+, [0-9 ]+ probes, [0-9 ]+ bytes, about [0-9.]+ s, p95 [0-9.]+ %\)$" \
       "$work/stderr" || fail "no plain warning: $(cat "$work/stderr")"
     python3 - "$work/out/bake_report.json" <<'PY' || fail "bake_report.json"
 import json, sys
@@ -55,6 +55,37 @@ v = r["volumes"][0]
 assert v["probes"] <= 4096 and v["probes"] > 3500, v["probes"]
 assert v["target"]["capped"] is True and v["target"]["met"] is False, v["target"]
 assert len(r["warnings"]) == 1 and "4096 probes" in r["warnings"][0], r["warnings"]
+assert v["target"]["offer"]["set"] == ["probe_volumes[0].placement=surface", "probe_volumes[0].target_error=0.05"], v["target"]
+PY
+    # The offer delivers: baked as it says, the surface volume meets 5 % on its own map.
+    "$terralux" --bake --quiet --quality draft --dem "$dem" --out "$work/offer" \
+      --set 'probe_volumes[0].placement=surface' --set 'probe_volumes[0].target_error=0.05' \
+      >"$work/offer_stdout" 2>"$work/offer_stderr" || fail "the offered bake exited $?"
+    python3 - "$work/offer/bake_report.json" <<'PY' || fail "the offered bake's report"
+import json, sys
+v = json.load(open(sys.argv[1]))["volumes"][0]
+assert v["placement"] == "surface" and v["adaptive"]["tree"] == "quadtree", v["placement"]
+assert v["target"]["met"] is True and v["error_map"]["p95"] <= 0.05, (v["target"], v["error_map"])
+PY
+    ;;
+  surface)
+    # A surface volume: the dry run names the quadtree and its squares, the bake meets its target
+    # at its probes' height with fewer probes than a uniform grid of its smallest squares.
+    set -- --quality draft --dem "$dem" --set 'probe_volumes[0].placement=surface' \
+      --set 'probe_volumes[0].target_error=0.1'
+    "$terralux" --bake --dry-run --quiet --out "$work/dry" "$@" >"$work/dry_stdout" 2>"$work/dry_stderr" \
+      || fail "dry run exited $?"
+    grep -Eq "^  probes: surface quadtree, squares [0-9.]+ to [0-9.]+ m, [0-9]+ x [0-9]+ x [0-9]+ cells of [0-9.]+ m: [0-9]+ probes \(a uniform grid of the smallest squares would need [0-9]+\)" \
+      "$work/dry_stdout" || fail "no quadtree in the dry run: $(cat "$work/dry_stdout")"
+    "$terralux" --bake --quiet --out "$work/out" "$@" >"$work/stdout" 2>"$work/stderr" || fail "bake exited $?"
+    [ -s "$work/stderr" ] && fail "stderr not empty: $(cat "$work/stderr")"
+    python3 - "$work/out/bake_report.json" <<'PY' || fail "bake_report.json"
+import json, sys
+v = json.load(open(sys.argv[1]))["volumes"][0]
+t, m, a = v["target"], v["error_map"], v["adaptive"]
+assert t["setting"] == "adaptive.tolerance" and t["met"] is True, t
+assert m["height_m"] == 5.0 and m["p95"] <= 0.1, m
+assert a["tree"] == "quadtree" and v["probes"] < a["uniform_grid_probes"] / 2, (v["probes"], a)
 PY
     ;;
   adaptive)

@@ -1,9 +1,13 @@
 #pragma once
 // Scenes the bake tests and benchmarks share.
 
+#include <cmath>
 #include <functional>
 #include <numbers>
 #include <vector>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
 
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
@@ -27,6 +31,27 @@ inline ProbeBaker fieldBaker(std::function<float(const glm::vec3&)> f, size_t* b
         if (baked) *baked += p.size();
         return b;
     };
+}
+
+// A Gaussian bump of light: 1 at c, falling off over `radius`.
+inline float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
+    const glm::vec3 d = (p - c) / radius;
+    return std::exp(-glm::dot(d, d));
+}
+
+// An unbudgeted error-driven refinement that split something, kept every tested leaf within the
+// tolerance, and baked nothing beyond the geometric layout's probes and its children trials: each
+// split adds its `children` (8 octants, 4 quadrants), all baked already as trials.
+inline void expectRefinementKeptItsTrials(const AdaptiveBake& a, size_t geometricProbes, size_t baked,
+                                          size_t children, double tolerance) {
+    ASSERT_TRUE(a.refinement.has_value());
+    const AdaptiveRefinement& r = *a.refinement;
+    EXPECT_GT(r.leavesSplit, 0u);
+    EXPECT_FALSE(r.budgetReached);
+    EXPECT_LE(r.worstKeptError, tolerance);
+    EXPECT_EQ(a.layout.validCount(), geometricProbes + (children - 1) * r.leavesSplit);
+    EXPECT_EQ(r.octantProbesKept, children * r.leavesSplit);
+    EXPECT_EQ(baked, geometricProbes + r.octantProbes);
 }
 
 // A uniform sky (0.6, 0.75, 1.0), a sun of illuminance (3, 2.88, 2.7) from azimuth 135° at 35°

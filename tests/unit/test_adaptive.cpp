@@ -23,6 +23,8 @@
 #include "bake/SphereSampling.h"
 
 using namespace terralux;
+using terralux::test::bump;
+using terralux::test::expectRefinementKeptItsTrials;
 using terralux::test::fieldBaker;
 using terralux::test::flat;
 namespace fs = std::filesystem;
@@ -459,11 +461,6 @@ TEST(AdaptivePlacement, SurfaceCellSizeStopsTheBandAtItsSize) {
     EXPECT_EQ(open.validCount(), 25u * (1 + 3));
 }
 
-float bump(const glm::vec3& p, const glm::vec3& c, float radius) {
-    const glm::vec3 d = (p - c) / radius;
-    return std::exp(-glm::dot(d, d));
-}
-
 }  // namespace
 
 TEST(Refinement, SplitsWhereLightingVariesAndReusesTheOctantBakes) {
@@ -475,15 +472,7 @@ TEST(Refinement, SplitsWhereLightingVariesAndReusesTheOctantBakes) {
     size_t baked = 0;
     const AdaptiveBake a = bakeAdaptive(v, hf, fieldBaker(field, &baked));
     const ProbeLayout geometric = placeProbes(v, hf);
-    ASSERT_TRUE(a.refinement.has_value());
-    const AdaptiveRefinement& r = *a.refinement;
-    EXPECT_GT(r.leavesSplit, 0u);
-    EXPECT_FALSE(r.budgetReached);
-    EXPECT_LE(r.worstKeptError, 0.05);
-    // Each split adds its 8 children, all baked already as octants: nothing else was baked.
-    EXPECT_EQ(a.layout.validCount(), geometric.validCount() + 7 * r.leavesSplit);
-    EXPECT_EQ(r.octantProbesKept, 8 * r.leavesSplit);
-    EXPECT_EQ(baked, geometric.validCount() + r.octantProbes);
+    expectRefinementKeptItsTrials(a, geometric.validCount(), baked, 8, 0.05);
     expectPlacementRules(a.layout, hf, v.adaptive.maxMoveShare);
     // Splits happen near the bump only; far from it the air keeps the largest cells: every
     // 160 m root above the ground band whose centre is over 350 m away is still one leaf.

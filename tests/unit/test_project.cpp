@@ -86,7 +86,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"probe_volumes[0].spacing=[10,-1]", "p.json: probe_volumes[0].spacing[1] = -1: must be in (0, 1000000]"},
         Rule{"probe_volumes[0].fallback_blend_distance=-1", "p.json: probe_volumes[0].fallback_blend_distance = -1: must be in [0, 10000000] or null"},
         Rule{"probe_volumes[0].name=a/b", "p.json: probe_volumes[0].name = \"a/b\": must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)"},
-        Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box | adaptive"},
+        Rule{"probe_volumes[0].placement=cone", "p.json: probe_volumes[0].placement = \"cone\": must be one of terrain | box | adaptive | surface"},
         Rule{"probe_volumes[0].adaptive.min_cell_size=0", "p.json: probe_volumes[0].adaptive.min_cell_size = 0: must be in (0, 1000000] or null"},
         Rule{"probe_volumes[0].adaptive.max_cell_size=-4", "p.json: probe_volumes[0].adaptive.max_cell_size = -4: must be in (0, 10000000] or null"},
         Rule{"probe_volumes[0].adaptive={\"min_cell_size\":30,\"max_cell_size\":100}", "p.json: probe_volumes[0].adaptive.max_cell_size = 100: must be min_cell_size (30) times 2^k, k in [0, 16]"},
