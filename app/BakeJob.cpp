@@ -46,6 +46,11 @@
 #endif
 
 namespace terralux {
+
+bool errorIsHigh(const ErrorMapStats& m) {
+    return m.points > 0 && (m.mean > kSuggestAboveMeanError || m.p95 > kSuggestAboveP95Error);
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -91,6 +96,7 @@ struct BakeSetup {
     BakeQuality q;
     bool referenceMode = false;
     std::vector<const ProbeVolumeSettings*> volumes;
+    double prepareSeconds = 0.0;  // loading the terrain, sky and albedo
 };
 
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
@@ -100,6 +106,7 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     // take it through them, so a bake refuses what loading the project would (a grid past
     // its probe limit, a value out of range) instead of baking it.
     (void)sceneFromJson(sceneToJson(scene), "project", nullptr);
+    const auto start = Clock::now();
     report("loading terrain", 0.0);
     b.terrain = loadProjectTerrain(project);
     if (cancelled()) throw BakeCancelled();
@@ -114,22 +121,23 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         if (v.enabled) b.volumes.push_back(&v);
     if (b.volumes.empty() && !scene.reflectionProbes.enabled)
         throw ProjectError("probe_volumes: no enabled volume; enable one or add one (or reflection probes) to bake");
+    b.prepareSeconds = secondsSince(start);
 }
 
 uint64_t volumeSeed(size_t index) { return splitmix64(0x7E77A1ABull + index); }
 
 // estimateBake on a prepared setup: what a suggestion reuses instead of loading the terrain,
 // albedo and tracer a second time (which doubled a bake's peak memory).
-BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads);
+// `full` (the dry run): the bake's own cache built and timed, and a terrain grid's map baked to
+// know whether the bake will measure a suggestion. Otherwise (a suggestion's estimate, inside a
+// bake) the cache is a small one scaled by its points and no suggestion is counted.
+BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads, bool full);
 
 // The mean error a suggested terrain grid aims at.
 constexpr double kSuggestTargetMeanError = 0.02;
 // Trial grids a suggestion may measure before it settles.
 constexpr int kSuggestTrials = 3;
 
-bool errorIsHigh(const ErrorMapStats& m) {
-    return m.points > 0 && (m.mean > kSuggestAboveMeanError || m.p95 > kSuggestAboveP95Error);
-}
 
 // A denser terrain grid for a volume whose interpolation error is high, measured, not modelled:
 // each trial grid is placed and baked like the volume (same rays, seed, cache and deringing) and
@@ -148,6 +156,20 @@ struct GridSuggestion {
     uint64_t rays = 0;
 };
 
+// The grid a suggestion tries next from an ax x az grid of `side` probes a side (geometric mean)
+// whose map errs `error` on average: each side grown by (error / target)^(1 / exponent) (bilinear
+// error falls with the square of the spacing, exponent 2, until trials measure another), then
+// shrunk to the terrain-grid limit (`capped`).
+std::array<double, 2> grownGrid(int ax, int az, double side, double error, double exponent, bool& capped) {
+    const double grow = std::pow(error / kSuggestTargetMeanError, 1.0 / exponent);
+    double nx = std::ceil(ax * side / std::sqrt(double(ax) * az) * grow);
+    double nz = std::ceil(az * side / std::sqrt(double(ax) * az) * grow);
+    const double fit = std::sqrt(double(kMaxTerrainGridProbes) / (nx * nz));
+    capped = fit < 1.0;
+    if (capped) nx = std::floor(nx * fit), nz = std::floor(nz * fit);
+    return {nx, nz};
+}
+
 std::optional<GridSuggestion> denserGrid(
     const ProbeVolumeSettings& v, size_t index, const ProbeLayout& layout, const ErrorMapStats& now,
     const std::function<std::optional<ErrorMapStats>(const ProbeVolumeSettings&, size_t&, uint64_t&)>& measure) {
@@ -159,11 +181,8 @@ std::optional<GridSuggestion> denserGrid(
     int trials = 0;
     uint64_t rays = 0;
     for (; trials < kSuggestTrials; ++trials) {
-        const double grow = std::pow(error / kSuggestTargetMeanError, 1.0 / exponent);
-        double nx = std::ceil(ax * side / std::sqrt(double(ax) * az) * grow);
-        double nz = std::ceil(az * side / std::sqrt(double(ax) * az) * grow);
-        const double fit = std::sqrt(double(kMaxTerrainGridProbes) / (nx * nz));
-        if (fit < 1.0) nx = std::floor(nx * fit), nz = std::floor(nz * fit);
+        bool capped = false;
+        const auto [nx, nz] = grownGrid(ax, az, side, error, exponent, capped);
         if (nx * nz <= side * side + 0.5) break;  // no denser grid left to try
         ProbeVolumeSettings candidate = v;
         candidate.gridDims = {int(nx), 1, int(nz)};
@@ -190,7 +209,7 @@ std::optional<GridSuggestion> denserGrid(
             exponent = std::clamp(std::log(error / m->mean) / std::log(newSide / side), 0.25, 2.0);
         side = newSide;
         error = m->mean;
-        if (fit < 1.0) {
+        if (capped) {
             ++trials;
             break;  // at the limit: nothing denser to measure
         }
@@ -234,7 +253,7 @@ nlohmann::json suggestions(const BakeRequest& request, size_t index, const std::
     for (const auto& candidate : r.project.scene.probeVolumes)
         if (candidate.enabled) setup.volumes.push_back(&candidate);
     try {
-        const BakeEstimate e = estimateWith(r, setup, threads);
+        const BakeEstimate e = estimateWith(r, setup, threads, false);
         setup.volumes = own;
         for (const auto& x : e.volumes)
             if (x.name == v.name) out.push_back(suggestionReport(*grid, e, x));
@@ -1466,7 +1485,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; });
     const std::optional<SamplingChoice> sampling = chooseSampling(chosen.project.scene, setup, [](const std::string&) {});
     const std::map<size_t, TargetChoice> targets = chooseTargets(chosen.project.scene, setup, [](const std::string&) {});
-    BakeEstimate e = estimateWith(chosen, setup, threads);
+    BakeEstimate e = estimateWith(chosen, setup, threads, true);
     e.sampling = sampling;
     for (auto& ve : e.volumes)
         for (const auto& [index, c] : targets)
@@ -1498,7 +1517,29 @@ Project resolveTargets(const Project& project, int threads) {
 
 namespace {
 
-BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads) {
+// A terrain grid's error map as the bake will measure it: the grid's probes and its map, baked as
+// the bake bakes them (same rays, seeds, cache, window and points). Whether it is high
+// (errorIsHigh), and so whether the bake measures a suggestion, is then the bake's own answer.
+struct PlannedMap {
+    ErrorMapStats stats;
+    double secondsPerPoint = 0.0;  // the map's truths, interpolation and all, per point
+};
+PlannedMap plannedErrorMap(const BakeSetup& setup, const IrradianceCache* cache, const BakeSettings& bake,
+                           const ProbeVolumeSettings& v, const ProbeLayout& L, uint64_t seed) {
+    ProbeBake b = bakeProbes(setup.lighting, cache, setup.q.bounces, L.positions, L.valid, raysOf(setup, v), seed, BakeControl{});
+    if (bake.deringing) sh::deringProbes(b.sh, L.valid);
+    const ProbeBaker truth =
+        deringedBaker(keyedBaker(setup, cache, ProbeRays(raysOf(setup, v).rays), seed, BakeControl{}), bake.deringing);
+    const auto start = Clock::now();
+    const ErrorMap m = measureErrorMap(L, b.sh, setup.terrain.heightfield, truth, bake.errorMapResolution,
+                                       errorMapHeight(v, L), seed);
+    PlannedMap out;
+    out.stats = errorMapStats(m);
+    out.secondsPerPoint = secondsSince(start) / double(std::max<size_t>(m.error.size(), 1));
+    return out;
+}
+
+BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int threads, bool full) {
     const Project& project = request.project;
     const SceneDescription& scene = project.scene;
     const Heightfield& hf = setup.terrain.heightfield;
@@ -1520,17 +1561,16 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         for (size_t i = 0; i < layout.positions.size(); ++i)
             if (layout.valid[i]) all.push_back(layout.positions[i]);
 
-    // The cache: a small one with the real ray counts, scaled by the point count.
+    // The cache: in full, the bake's own, built and timed (the map below then reads what the
+    // bake's will); otherwise a small one with the real ray counts, scaled by the point count.
     std::unique_ptr<IrradianceCache> cache;
     if (!setup.referenceMode && q.bounces > 0) {
         constexpr int kCalibrationResolution = 16;
         const auto t = Clock::now();
-        cache = std::make_unique<IrradianceCache>(setup.lighting, kCalibrationResolution,
-                                                  q.cacheRays, q.sunSamples, q.bounces - 1,
-                                                  BakeControl{});
-        const double seconds = secondsSince(t);
-        const std::array<int, 2> full = IrradianceCache::gridPoints(hf, plan.cacheResolution);
-        e.cacheSeconds = seconds * double(full[0]) * double(full[1]) /
+        cache = std::make_unique<IrradianceCache>(setup.lighting, full ? plan.cacheResolution : kCalibrationResolution,
+                                                  q.cacheRays, q.sunSamples, q.bounces - 1, BakeControl{});
+        const std::array<int, 2> points = IrradianceCache::gridPoints(hf, plan.cacheResolution);
+        e.cacheSeconds = secondsSince(t) * double(points[0]) * double(points[1]) /
                          double(cache->pointsX() * cache->pointsZ());
     }
 
@@ -1555,7 +1595,43 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
     }
 
-    e.seconds = e.secondsMax = e.cacheSeconds;
+    // Loading is what this estimate's own setup took; writing, the glTF mesh (whose buffers grow
+    // with the vertices) exported from a flat terrain of kWriteSide² samples into a scratch
+    // folder, scaled by the vertex count.
+    e.loadSeconds = setup.prepareSeconds;
+    if (scene.exportSettings.gltf && hf.width() > 1 && hf.depth() > 1) {
+        constexpr int kWriteSide = 256;
+        const Heightfield small(kWriteSide, kWriteSide, hf.cellSizeX(), hf.cellSizeZ(),
+                                std::vector<float>(size_t(kWriteSide) * kWriteSide, 0.0f));
+        GltfSceneInput in;
+        in.heightfield = &small;
+        in.generatorVersion = TERRALUX_VERSION;
+        // An albedo texture is encoded as PNG: a block of its own texels, so it compresses alike.
+        SurfaceAlbedo texture;
+        double scale = double(hf.width()) * double(hf.depth());
+        if (const SurfaceAlbedo* a = setup.lighting.surface.get(); a && !a->empty()) {
+            texture.resize(kWriteSide, kWriteSide);
+            for (int r = 0; r < kWriteSide; ++r)
+                for (int c = 0; c < kWriteSide; ++c) {
+                    const size_t from = 3 * (size_t(std::min(r, a->height - 1)) * a->width + size_t(std::min(c, a->width - 1)));
+                    std::copy_n(a->srgb.begin() + std::ptrdiff_t(from), 3, texture.srgb.begin() + std::ptrdiff_t(3 * (size_t(r) * kWriteSide + c)));
+                }
+            in.albedoTexture = &texture;
+            scale = std::max(scale, double(a->texels()));
+        }
+        const std::filesystem::path scratch = std::filesystem::temp_directory_path() /
+                                              ("terralux-estimate-" + std::to_string(splitmix64(uint64_t(Clock::now().time_since_epoch().count()))));
+        const auto t = Clock::now();
+        try {
+            exportGltfScene(scratch, in);
+            e.writeSeconds = secondsSince(t) * scale / double(kWriteSide * kWriteSide);
+        } catch (const std::exception&) {
+            // No scratch space: the estimate goes without writing.
+        }
+        std::error_code ignored;
+        std::filesystem::remove_all(scratch, ignored);
+    }
+    e.seconds = e.secondsMax = e.cacheSeconds + e.loadSeconds + e.writeSeconds;
     if (plan.reflections) {
         const ReflectionProbeSettings& rs = scene.reflectionProbes;
         const ReflectionLayout& layout = *plan.reflections;
@@ -1599,8 +1675,17 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         ve.raysPerProbe = v.rayCount ? *v.rayCount : int(std::lround(meanRays));
         ve.borrowed = L.borrowedCells;
         const double perProbe = double(ve.raysPerProbe) * secondsPerProbeRay;
-        // Error-map points trace the least rays only (measureVolumeErrorMap).
-        const double perMapPoint = double(raysOf(setup, v).rays) * secondsPerProbeRay;
+        // Error-map points trace the least rays only (measureVolumeErrorMap). A terrain grid
+        // without a target, in full, bakes its map here as the bake will (plannedErrorMap): its
+        // time per point, fixed costs included, stands for the map's and the suggestion trials'.
+        double perMapPoint = double(raysOf(setup, v).rays) * secondsPerProbeRay;
+        const bool suggests = v.placement == ProbePlacement::Terrain && !v.targetError && plan.mapPoints[vi] > 0 &&
+                              !setup.referenceMode;
+        std::optional<PlannedMap> planned;
+        if (full && suggests) {
+            planned = plannedErrorMap(setup, cache.get(), scene.bake, v, L, volumeSeed(vi));
+            perMapPoint = planned->secondsPerPoint;
+        }
         double probes = double(ve.probes), probesMax = probes;
         if (L.octree) {
             const AdaptiveOctree& t = *L.octree;
@@ -1646,7 +1731,26 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         ve.errorMapPoints = plan.mapPoints[vi];
         const double mapSeconds = double(ve.errorMapPoints) * perMapPoint;
         ve.seconds = probes * perProbe + mapSeconds;
-        ve.secondsMax = std::max(probesMax, probes) * perProbe + mapSeconds;
+        // measureVolumeErrorMap's suggestion: its trial grids (at most kSuggestTrials, each within
+        // the terrain-grid limit) trace the least rays and reuse the map's truths. When the map
+        // will be high, the first trial is the grid grownGrid makes of its mean; one that stops
+        // short of the limit is taken to be followed by one at it (the exponent the two measure
+        // is far below 2 on real terrain, which sends the next grid past the limit).
+        if (planned) {
+            const ErrorMapStats& m = planned->stats;
+            ve.plannedMap = m;
+            const int ax = L.probeDims[0], az = L.probeDims[2];
+            bool capped = false;
+            const auto [nx, nz] = grownGrid(ax, az, std::sqrt(double(ax) * az), m.mean, 2.0, capped);
+            // At the limit already: no denser grid to measure (denserGrid stops).
+            ve.suggestionLikely = errorIsHigh(m) && nx * nz > double(ax) * az + 0.5;
+            if (ve.suggestionLikely) {
+                ve.suggestionSecondsMax = double(kSuggestTrials) * double(kMaxTerrainGridProbes) * perMapPoint;
+                const double trials = nx * nz + (capped ? 0.0 : double(kMaxTerrainGridProbes));
+                ve.seconds += std::min(trials * perMapPoint, ve.suggestionSecondsMax);
+            }
+        }
+        ve.secondsMax = std::max(probesMax, probes) * perProbe + mapSeconds + ve.suggestionSecondsMax;
         e.seconds += ve.seconds;
         e.secondsMax += ve.secondsMax;
         e.volumes.push_back(std::move(ve));

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "Project.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/ReflectionBake.h"
 #include "bake/TargetSearch.h"
 
@@ -45,6 +46,8 @@ std::vector<std::string> bakeInputDifferences(const nlohmann::json& baked, const
 // denser probes ("suggestions").
 inline constexpr double kSuggestAboveMeanError = 0.05;
 inline constexpr double kSuggestAboveP95Error = 0.10;
+// The bake's test for a high map: it then says so and, for a terrain grid, suggests a denser one.
+bool errorIsHigh(const ErrorMapStats& m);
 
 // What a volume's target_error chose (docs/lighting.md, "Asking for an accuracy"): the search's
 // trials bake with a small irradiance cache and a coarse error map; the bake then measures its
@@ -120,6 +123,13 @@ struct VolumeEstimate {
     int raysPerProbe = 0;                   // fixed, or the mean a target's rounds reached on sampled probes
     size_t errorMapPoints = 0;              // probes baked for the interpolation-error map (at most)
     double seconds = 0.0;
+    // A terrain grid without a target whose map comes out high measures denser grids: at most
+    // kSuggestTrials grids of the terrain-grid limit at the least rays (in secondsMax). Set by the
+    // dry run when its map of the grid says the bake will.
+    double suggestionSecondsMax = 0.0;
+    // Its map, baked by the dry run as the bake will, is high: the expected trials count in `seconds`.
+    bool suggestionLikely = false;
+    std::optional<ErrorMapStats> plannedMap;  // that map (dry run, terrain grids without a target)
     // Adaptive volumes.
     double minCell = 0.0, maxCell = 0.0;
     size_t moved = 0, borrowed = 0;
@@ -142,6 +152,8 @@ struct BakeEstimate {
     std::string raysText;             // "256 rays" or the preset's target and range (raysDescription)
     double meanRays = 0.0;            // per probe, as the sampled probes traced
     double cacheSeconds = 0.0;
+    double loadSeconds = 0.0;         // the terrain, sky and albedo, as this estimate loaded them
+    double writeSeconds = 0.0;        // the glTF scene's mesh, timed on a small one and scaled
     double probeRaysPerSecond = 0.0;  // measured on this terrain, with this lighting
     double seconds = 0.0;             // everything, with error-driven volumes at their minimum
     double secondsMax = 0.0;          // with error-driven volumes at their cap

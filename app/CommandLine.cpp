@@ -123,6 +123,13 @@ int printEstimate(const BakeEstimate& e) {
                       << (t.met ? "meets it" : "misses it") << "; " << t.trials << " trials, "
                       << duration(t.seconds) << ")\n";
         }
+        if (v.plannedMap)
+            std::cout << "    its error map, baked here as the bake will: mean " << fixed(100.0 * v.plannedMap->mean, 2)
+                      << " % / p95 " << fixed(100.0 * v.plannedMap->p95, 2) << " %"
+                      << (v.suggestionLikely ? ", high: the bake measures denser grids for a suggestion (counted above)"
+                          : errorIsHigh(*v.plannedMap) ? ", high, with no denser grid within the limit to suggest"
+                                                       : "")
+                      << "\n";
         if (v.refines)
             std::cout << "    error-driven refinement to " << fixed(100.0 * v.tolerance, 2)
                       << " %: up to " << v.probesMax << " probes (" << v.cap << "), "
@@ -136,6 +143,9 @@ int printEstimate(const BakeEstimate& e) {
     if (e.lights)
         std::cout << "  local lights: " << e.lights << " in KHR_lights_punctual\n";
     if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
+    std::cout << "  loading the terrain, sky and albedo: " << duration(e.loadSeconds) << " (as measured here)";
+    if (e.writeSeconds > 0.0) std::cout << "; writing the scene: about " << duration(e.writeSeconds);
+    std::cout << "\n";
     std::cout << "estimated bake time: about " << duration(e.seconds);
     if (e.secondsMax > e.seconds) std::cout << ", up to " << duration(e.secondsMax);
     std::cout << " (" << fixed(e.probeRaysPerSecond / 1e6, 2) << " M probe rays/s measured here)\n";

@@ -294,6 +294,41 @@ TEST(BakeTargetError, CachesByGathersAreTheCachesOfEachGatherCount) {
     EXPECT_GT(levels[3].at(hit).y, levels[0].at(hit).y);
 }
 
+// The dry run counts what the bake will do beyond the probes: loading (its own, measured), writing
+// the scene when export.gltf is on, and the suggestion a high error map triggers, which the dry
+// run predicts by baking that map as the bake will (docs/lighting.md, "Dry run").
+TEST(BakeEstimate, CountsLoadingWritingAndTheSuggestionAHighMapTriggers) {
+    const fs::path dir = tempDir("estimate_parts");
+    Project p = cropProject(dir, 8);
+    p.scene.bake.errorMapResolution = 32;
+    BakeEstimate e = estimateBake(BakeRequest{p, 0, false});
+    EXPECT_GT(e.loadSeconds, 0.0);
+    EXPECT_EQ(e.writeSeconds, 0.0) << "export.gltf is off";
+    ASSERT_EQ(e.volumes.size(), 1u);
+    const VolumeEstimate& coarse = e.volumes[0];
+    EXPECT_GT(coarse.suggestionSecondsMax, 0.0);
+    // 8 x 8 over the Big Tujunga crop: the bake's map is far over 5 % mean (it suggests a grid),
+    // so the expected trials count in `seconds`, at most their bound.
+    EXPECT_TRUE(coarse.suggestionLikely);
+    EXPECT_GT(coarse.secondsMax, coarse.seconds);
+    EXPECT_LE(coarse.secondsMax - coarse.seconds, coarse.suggestionSecondsMax);
+    EXPECT_NEAR(e.seconds, e.cacheSeconds + e.loadSeconds + e.writeSeconds + coarse.seconds, 1e-9);
+    BakeRequest bake{p, 0, false};
+    const BakeOutcome o = runBake(bake, {}, nullptr);
+    EXPECT_FALSE(o.report["volumes"][0]["suggestions"].empty()) << "the coarse map's prediction holds";
+
+    // A grid dense enough that the map is low: no suggestion counted, but still its bound.
+    p.scene.probeVolumes[0].gridDims = {64, 1, 43};
+    p.scene.exportSettings.gltf = true;
+    e = estimateBake(BakeRequest{p, 0, false});
+    EXPECT_GT(e.writeSeconds, 0.0);
+    EXPECT_FALSE(e.volumes[0].suggestionLikely);
+    EXPECT_NEAR(e.volumes[0].secondsMax - e.volumes[0].seconds, e.volumes[0].suggestionSecondsMax, 1e-9);
+    const BakeOutcome dense = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    EXPECT_TRUE(!dense.report["volumes"][0].contains("suggestions") || dense.report["volumes"][0]["suggestions"].empty());
+    fs::remove_all(dir);
+}
+
 TEST(BakeTargetError, TighterTargetsTraceMoreAndTheReferencePresetRefusesIt) {
     const fs::path dir = tempDir("sampling_target_order");
     Project p = cropProject(dir, 8);
