@@ -1220,7 +1220,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
 
         // The interpolation-error map of the probes as the engine will read them (the
         // interpolation-error debug view).
-        ProbeDiagnostics diagnostics = describeProbes(layout);
+        ProbeDiagnostics diagnostics = describeProbes(layout, bake.standardError);
         if (scene.bake.errorMapResolution > 0) {
             phase = "error map '" + v.name + "'";
             const BakeControl mc{[&](double f) {

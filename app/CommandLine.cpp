@@ -76,6 +76,10 @@ int commandInfo(const Args& a) {
       << fixed((hf.maxZ() - hf.minZ()) / 1000.0, 3) << " km; north is -z)\n";
     o << "origin:       easting " << fixed(hf.geo.easting, 3) << ", northing "
       << fixed(hf.geo.northing, 3) << " (footprint centre, engine x = z = 0)\n";
+    if (hf.geo.located())
+        o << "on earth:     latitude " << fixed(hf.geo.latitudeDeg, 6) << ", longitude " << fixed(hf.geo.longitudeDeg, 6)
+          << " (WGS 84); grid north is " << fixed(std::abs(hf.geo.gridConvergenceDeg), 3) << "° "
+          << (hf.geo.gridConvergenceDeg < 0.0 ? "west" : "east") << " of true north\n";
     std::cout << o.str();
     return kExitOk;
 }

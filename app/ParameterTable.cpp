@@ -300,12 +300,61 @@ std::vector<ParameterSpec> buildTable() {
     const auto sunFromSky = [](const SceneDescription& s, size_t) {
         return s.sky.mode == SkyMode::Physical && s.sun.followSky;
     };
+    const auto manualSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::Manual; };
+    const auto datedSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::DateTime; };
+    add(Row("sun.mode", T::Choice)).choices({"manual", "date_time"}).label("Sun position")
+        .about("manual: sun.azimuth_deg and sun.elevation_deg; date_time: where the sun stands over the terrain at sun.date and sun.time_h (NOAA's solar position, refracted, turned from true to the DEM grid's north)")
+        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::mode);
     add(Row("sun.azimuth_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
         .label("Sun azimuth").about("Direction of the sun, clockwise from north (-Z) toward east (+X)")
-        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::azimuthDeg);
+        .redoes(kUpload | kRebake).onlyWhen(manualSun).field(&SceneDescription::sun, &SunSettings::azimuthDeg);
     add(Row("sun.elevation_deg", T::Number)).range(-90.0, 90.0).unit("°").decimals(1).slider()
         .label("Sun elevation").about("Angle of the sun above the horizon")
-        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::elevationDeg);
+        .redoes(kUpload | kRebake).onlyWhen(manualSun).field(&SceneDescription::sun, &SunSettings::elevationDeg);
+    const std::string dateRule = "must be a calendar date from " + std::to_string(kSolarFirstYear) + "-01-01 to " +
+                                 std::to_string(kSolarLastYear) + "-12-31, YYYY-MM-DD";
+    add(Row("sun.date", T::String)).pattern("[0-9]{4}-[0-9]{2}-[0-9]{2}", dateRule).label("Date")
+        .about("Day of the sun's position, Gregorian, on the local clock")
+        .redoes(kUpload | kRebake).onlyWhen(datedSun)
+        .custom([](const SceneDescription& s, size_t) { return json(s.sun.date); },
+                [dateRule](SceneDescription& s, size_t, const json& v) {
+                    const std::string text = v.get<std::string>();
+                    if (!parseCivilDate(text)) throw ParameterRejection{dateRule, ""};
+                    s.sun.date = text;
+                });
+    add(Row("sun.time_h", T::Number)).range(0.0, 24.0).unit("h").decimals(2).slider().label("Local time")
+        .about("Hours after local midnight on the clock sun.utc_offset_h gives (13.5 is 13:30; 24 is the next midnight)")
+        .redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, &SunSettings::timeH);
+    // The place the sun is computed for, as sunAnglesOf resolves it.
+    const auto placeOf = [](const SceneDescription& s, const Heightfield& hf) -> std::optional<std::array<double, 2>> {
+        if (s.sun.latitudeDeg && s.sun.longitudeDeg) return std::array{*s.sun.latitudeDeg, *s.sun.longitudeDeg};
+        if (!hf.geo.located()) return std::nullopt;
+        return std::array{s.sun.latitudeDeg.value_or(hf.geo.latitudeDeg), s.sun.longitudeDeg.value_or(hf.geo.longitudeDeg)};
+    };
+    add(Row("sun.utc_offset_h", T::Number)).range(-12.0, 14.0).unit("h").decimals(2).label("UTC offset")
+        .autoMeans("the longitude's nominal zone: the whole hours nearest longitude / 15")
+        .resolvedBy([placeOf](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
+            const auto place = placeOf(s, hf);
+            return place ? json(nominalUtcOffsetHours((*place)[1])) : json(nullptr);
+        })
+        .about("How far the local clock is ahead of UTC, daylight saving included (Central European Summer Time: 2)")
+        .redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, &SunSettings::utcOffsetH);
+    // Latitude (axis 0) and longitude (axis 1) of the place, alike but for their range and words.
+    const auto placeRow = [&](const char* path, int axis, double limit, const char* label, const char* about,
+                              std::optional<double> SunSettings::*member) {
+        add(Row(path, T::Number)).range(-limit, limit).unit("°").decimals(4).label(label)
+            .autoMeans("the DEM's centre: its footprint centre, from its CRS, in WGS 84")
+            .resolvedBy([placeOf, axis](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
+                const auto place = placeOf(s, hf);
+                return place ? json((*place)[size_t(axis)]) : json(nullptr);
+            })
+            .about(about).redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, member);
+    };
+    placeRow("sun.latitude_deg", 0, 90.0, "Latitude",
+             "Where the sun is computed for, north positive; set it (with sun.longitude_deg) for a DEM without a CRS",
+             &SunSettings::latitudeDeg);
+    placeRow("sun.longitude_deg", 1, 180.0, "Longitude", "Where the sun is computed for, east positive",
+             &SunSettings::longitudeDeg);
     add(Row("sun.follow_sky", T::Boolean)).label("Sun from sky model")
         .about("Sky mode physical: the sun's colour and illuminance come from the sky model (sun.color and sun.illuminance are not read)")
         .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sun, &SunSettings::followSky);
@@ -444,7 +493,7 @@ std::vector<ParameterSpec> buildTable() {
             if (s.sky.mode == SkyMode::Hdr) return nullptr;
             Project p;
             p.scene = s;
-            const glm::vec3 c = *resolvedFog(s.fog, skyOf(p), hf).color;
+            const glm::vec3 c = *resolvedFog(s.fog, skyOf(p, hf), hf).color;
             return json{c.x, c.y, c.z};
         })
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::color);

@@ -41,7 +41,7 @@ PreviewBake previewBake(const Project& project, const Heightfield& hf, const std
         const ProbeBake bake = bakeProbes(lighting, &cache, q.bounces, layout.positions, layout.valid,
                                           q.rays, seed, control);
         // Diagnostics as the bake writes them, with a coarser error map.
-        ProbeDiagnostics d = describeProbes(layout);
+        ProbeDiagnostics d = describeProbes(layout, bake.standardError);
         const ProbeBaker baker = seededBaker(lighting, &cache, q.bounces, q.rays, seed, control);
         d.errorMap = measureErrorMap(layout, bake.sh, hf, baker,
                                      std::min(scene.bake.errorMapResolution, kPreviewErrorMapResolution),

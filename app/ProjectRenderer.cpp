@@ -46,7 +46,7 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
 void ProjectRenderer::setProject(const Project& project) {
     project_ = project;
     const SceneDescription& scene = project_.scene;
-    const BakeLighting lighting = lightingOf(project_);
+    const BakeLighting lighting = lightingOf(project_, terrain_.heightfield);
     base_.albedo = lighting.albedo;
     base_.terrain = scene.terrain;
     base_.detail = scene.detail;
@@ -137,6 +137,7 @@ void ProjectRenderer::setAmbientOcclusion(const HorizonAoSettings& settings, con
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
+    boundVolumeData_ = std::make_shared<const std::vector<GpuProbeVolume>>(volumes);
     boundProbes_ = 0;
     for (const auto& v : volumes) boundProbes_ += v.coeffs.size();
     bound_.clear();
@@ -312,7 +313,7 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     LpvJob job;
     job.settings = lpv::resolvedOn(scene.lpv, terrain_.heightfield);
     job.lights = scene.lights;
-    job.lighting = lightingOf(project_);
+    job.lighting = lightingOf(project_, terrain_.heightfield);
     job.lighting.surface = albedo_;
     job.tracer = tracer_;
     job.lighting.tracer = tracer_.get();

@@ -99,6 +99,8 @@ public:
     const std::shared_ptr<const ReflectionProbeSet>& reflectionProbes() const { return reflections_; }
     // Probes of the bound volumes (what the viewport lights with), whatever the settings say now.
     size_t boundProbeCount() const { return boundProbes_; }
+    // The bound volumes themselves, coefficients and diagnostics (the probe inspector reads them).
+    std::shared_ptr<const std::vector<GpuProbeVolume>> boundVolumes() const { return boundVolumeData_; }
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
@@ -155,6 +157,7 @@ private:
 
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name
+    std::shared_ptr<const std::vector<GpuProbeVolume>> boundVolumeData_ = std::make_shared<const std::vector<GpuProbeVolume>>();
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     std::string placedVolumes_;  // probe_volumes JSON of placed_
     size_t placements_ = 0;

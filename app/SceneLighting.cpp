@@ -18,6 +18,7 @@
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "scene/ShadowCascades.h"
+#include "scene/SolarPosition.h"
 #include "water/Water.h"
 
 namespace terralux {
@@ -50,12 +51,13 @@ struct PhysicalKey {
 std::list<std::pair<PhysicalKey, Sky>> physicalCache;  // most recent first, under skyMutex
 std::atomic<size_t> physicalBuilds{0};
 
-glm::vec3 sunDirectionOf(const SceneDescription& scene) {
-    return sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
+glm::vec3 sunDirectionOf(const SceneDescription& scene, const Heightfield& hf) {
+    const SunAngles a = sunAnglesOf(scene, hf);
+    return sunDirection(a.azimuthDeg, a.elevationDeg);
 }
 
-Sky physicalSkyOf(const SceneDescription& scene) {
-    const PhysicalKey key{sunDirectionOf(scene), scene.sky.turbidity};
+Sky physicalSkyOf(const SceneDescription& scene, const Heightfield& hf) {
+    const PhysicalKey key{sunDirectionOf(scene, hf), scene.sky.turbidity};
     {
         std::lock_guard lock(skyMutex);
         for (auto it = physicalCache.begin(); it != physicalCache.end(); ++it)
@@ -77,11 +79,40 @@ Sky physicalSkyOf(const SceneDescription& scene) {
 size_t hdrSkyReads() { return skyReads.load(); }
 size_t physicalSkyBuilds() { return physicalBuilds.load(); }
 
-Sky skyOf(const Project& p) {
+SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf) {
+    const SunSettings& s = scene.sun;
+    SunAngles a{s.azimuthDeg, s.elevationDeg, std::nullopt};
+    if (s.mode == SunMode::Manual) return a;
+    // Validation gave the date's pattern; the calendar and the year range are checked here
+    // too, so a scene built in code fails with the same rule.
+    const std::optional<CivilDate> date = parseCivilDate(s.date);
+    if (!date)
+        throw ProjectError("sun.date: \"" + s.date + "\" is not a date from " + std::to_string(kSolarFirstYear) +
+                           "-01-01 to " + std::to_string(kSolarLastYear) + "-12-31 (YYYY-MM-DD)");
+    if ((!s.latitudeDeg || !s.longitudeDeg) && !hf.geo.located())
+        throw ProjectError("sun.mode: date_time places the sun over the DEM, which carries no CRS: set "
+                           "sun.latitude_deg and sun.longitude_deg");
+    SunPlace place;
+    place.latitudeDeg = s.latitudeDeg.value_or(hf.geo.latitudeDeg);
+    place.longitudeDeg = s.longitudeDeg.value_or(hf.geo.longitudeDeg);
+    place.utcOffsetH = s.utcOffsetH.value_or(nominalUtcOffsetHours(place.longitudeDeg));
+    // The engine's north is the DEM grid's; a place given by hand over a DEM without a CRS has
+    // none to turn by.
+    place.gridConvergenceDeg = hf.geo.located() ? hf.geo.gridConvergenceDeg : 0.0;
+    place.position = solarPosition(*date, s.timeH, place.utcOffsetH, place.latitudeDeg, place.longitudeDeg);
+    double az = std::fmod(place.position.azimuthDeg - place.gridConvergenceDeg + 360.0, 360.0);
+    a.azimuthDeg = az;
+    // The sun as seen: refraction lifts it (0.48° at the geometric horizon).
+    a.elevationDeg = place.position.apparentElevationDeg;
+    a.place = place;
+    return a;
+}
+
+Sky skyOf(const Project& p, const Heightfield& hf) {
     const SkySettings& s = p.scene.sky;
     if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
     // sky.color is not read: the model gives the colour; intensity exposes sky and sun alike.
-    if (s.mode == SkyMode::Physical) return physicalSkyOf(p.scene).scaled(glm::vec3(float(s.intensity)));
+    if (s.mode == SkyMode::Physical) return physicalSkyOf(p.scene, hf).scaled(glm::vec3(float(s.intensity)));
     const std::string path = p.hdrPath().string();
     SkyKey key{path, {}, 0, float(s.rotationDeg)};
     // The image's colour is the sky (sky.color is the uniform sky's); intensity scales it.
@@ -124,11 +155,11 @@ SunLight sunOf(const SunSettings& s) {
     return sun;
 }
 
-BakeLighting lightingOf(const Project& p) {
+BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
     const SceneDescription& scene = p.scene;
     BakeLighting l;
-    l.sky = skyOf(p);
-    l.sun.direction = sunDirectionOf(scene);
+    l.sky = skyOf(p, hf);
+    l.sun.direction = sunDirectionOf(scene, hf);
     if (scene.sky.mode == SkyMode::Physical && scene.sun.followSky)
         l.sun.illuminance = PhysicalSky(l.sun.direction, scene.sky.turbidity).sunIlluminance() *
                             float(scene.sky.intensity);
@@ -149,7 +180,7 @@ std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
 
 BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable) {
     BakeScene b;
-    b.lighting = lightingOf(project);
+    b.lighting = lightingOf(project, hf);
     b.tracer = std::make_unique<HeightfieldTracer>(hf, HeightfieldTracer::Options{project.scene.terrain.skirt});
     b.lighting.tracer = b.tracer.get();
     b.lighting.water = bakeWaterOf(project, hf);
@@ -186,6 +217,15 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     nlohmann::json& sun = ext["sun"] = authored.at("sun");
     const SunLight asAuthored = sunOf(scene.sun);
     sun["direction"] = shortest(l.sun.direction);
+    // A date and a time: where they put the sun, so an engine need not repeat the ephemeris.
+    if (const SunAngles a = sunAnglesOf(scene, hf); a.place) {
+        sun["resolved_azimuth_deg"] = a.azimuthDeg;
+        sun["resolved_elevation_deg"] = a.elevationDeg;
+        sun["resolved_true_azimuth_deg"] = a.place->position.azimuthDeg;
+        sun["resolved_latitude_deg"] = a.place->latitudeDeg;
+        sun["resolved_longitude_deg"] = a.place->longitudeDeg;
+        sun["resolved_utc_offset_h"] = a.place->utcOffsetH;
+    }
     if (l.sun.illuminance != asAuthored.illuminance) {
         // The authored scalar where there is one; the colour carries the rest.
         const double e = scene.sun.illuminance > 0.0 ? scene.sun.illuminance : 1.0;
@@ -265,7 +305,7 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
 }
 
 nlohmann::json lightingExtension(const Project& project, const Heightfield& hf) {
-    return lightingExtension(project, hf, lightingOf(project));
+    return lightingExtension(project, hf, lightingOf(project, hf));
 }
 
 }  // namespace terralux

@@ -6,6 +6,7 @@
 
 #include "Project.h"
 #include "bake/DiffuseBake.h"
+#include "scene/SolarPosition.h"
 
 namespace terralux {
 
@@ -13,14 +14,32 @@ namespace terralux {
 // sky (× intensity). Throws ImageError for an unreadable HDR. HDR skies are cached by path, file
 // time and size, and rotation; physical skies by sun direction and turbidity. Tint and intensity
 // scale the cached environment, so edits of them and of anything else reuse it.
-Sky skyOf(const Project& project);
+Sky skyOf(const Project& project, const Heightfield& hf);
 // How many times an HDR was read and filtered since start (for tests of the cache).
 size_t hdrSkyReads();
 // How many times a physical sky was sampled and filtered since start.
 size_t physicalSkyBuilds();
 // Sun, sky and albedo; the caller sets the tracer. In sky mode physical with sun.follow_sky the
 // sun's colour and illuminance are the model's, × sky.intensity.
-BakeLighting lightingOf(const Project& project);
+BakeLighting lightingOf(const Project& project, const Heightfield& hf);
+
+// Where sun.mode date_time puts the sun over `hf`: the place (latitude and longitude as set, or
+// the DEM's footprint centre), the clock's offset (as set, or the longitude's nominal zone), the
+// solar position there, and the grid convergence that turns its true azimuth into the engine's.
+struct SunPlace {
+    double latitudeDeg = 0.0, longitudeDeg = 0.0, utcOffsetH = 0.0;
+    double gridConvergenceDeg = 0.0;
+    SolarPosition position;
+};
+// The sun's azimuth (engine space: clockwise from -Z) and elevation as the scene lights with
+// them: sun.azimuth_deg and sun.elevation_deg in mode manual; in mode date_time the solar
+// position turned by the grid convergence, at its apparent (refracted) elevation, with `place`.
+// Throws ProjectError for a date outside the calendar or a place the DEM cannot give.
+struct SunAngles {
+    double azimuthDeg = 0.0, elevationDeg = 0.0;
+    std::optional<SunPlace> place;
+};
+SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf);
 
 // The fog as the renderer draws it: base height and colour resolved (unset base height = the lowest
 // terrain; unset colour = the sky's mean radiance over the sphere).

@@ -490,10 +490,14 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
         add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
     }
     // The renderer draws no shadow maps once the sun is more than about 3° below the horizon.
-    const bool sunUp = std::sin(glm::radians(s.sun.elevationDeg)) > -0.05;
+    const double sunElevation = sunAnglesOf(s, hf()).elevationDeg;
+    const bool sunUp = std::sin(glm::radians(sunElevation)) > -0.05;
     if (s.shadows.enabled && !sunUp)
-        result.notStudied.push_back("shadows: the sun is below the horizon (sun.elevation_deg = " +
-                                    fmt("%g", s.sun.elevationDeg) + "), so no shadow maps are drawn");
+        result.notStudied.push_back(
+            "shadows: the sun is below the horizon (" +
+            (s.sun.mode == SunMode::Manual ? "sun.elevation_deg = " + fmt("%g", sunElevation)
+                                           : "sun.date and sun.time_h put it at " + fmt("%.1f", sunElevation) + "°") +
+            "), so no shadow maps are drawn");
     if (s.shadows.enabled && sunUp) {
         const ShadowSettings& sh = s.shadows;
         const std::string filter = shadowFilterName(sh.filter);

@@ -173,6 +173,33 @@ MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::v
     }
 }
 
+namespace {
+
+// The footprint centre in WGS 84 longitude and latitude, and the true azimuth of grid north
+// there: the initial bearing from the centre to a point 1 km up the grid (the sun's azimuth
+// from a date and a time is true, the engine's is grid). Left unlocated when PROJ cannot
+// transform: the DEM still imports, only the date-and-time sun needs the place.
+void locateOnEarth(GeoOrigin& geo, double unit) {
+    OGRSpatialReference crs, wgs84;
+    if (crs.importFromWkt(geo.crsWkt.c_str()) != OGRERR_NONE) return;
+    crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    wgs84.SetWellKnownGeogCS("WGS84");
+    wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    std::unique_ptr<OGRCoordinateTransformation> toGeo(OGRCreateCoordinateTransformation(&crs, &wgs84));
+    if (!toGeo) return;
+    double x[2] = {geo.easting / unit, geo.easting / unit};
+    double y[2] = {geo.northing / unit, (geo.northing + 1000.0) / unit};
+    if (!toGeo->Transform(2, x, y) || !std::isfinite(x[0] + y[0] + x[1] + y[1])) return;
+    constexpr double d = 3.14159265358979323846 / 180.0;
+    const double p1 = y[0] * d, p2 = y[1] * d, dl = (x[1] - x[0]) * d;
+    geo.longitudeDeg = x[0];
+    geo.latitudeDeg = y[0];
+    geo.gridConvergenceDeg =
+        std::atan2(std::sin(dl) * std::cos(p2), std::cos(p1) * std::sin(p2) - std::sin(p1) * std::cos(p2) * std::cos(dl)) / d;
+}
+
+}  // namespace
+
 int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
     double lon = std::fmod(longitudeDeg + 180.0, 360.0);
     if (lon < 0) lon += 360.0;
@@ -562,6 +589,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     geo.crsWkt = crsWkt;
     geo.crsName = crsName;
     geo.epsg = epsg;
+    if (!crsWkt.empty()) locateOnEarth(geo, unit);
     return result;
 }
 

@@ -119,6 +119,11 @@ std::string encodeProbeDiagnostics(const ProbeDiagnostics& d, const std::string&
           {"height", m.height},
           {"error", error}}},
     };
+    if (!d.standardError.empty()) {
+        json se = json::array();
+        for (float e : d.standardError) se.push_back(rounded(e, 1e-6));
+        doc["standard_error"] = std::move(se);
+    }
     return doc.dump() + "\n";
 }
 
@@ -164,6 +169,14 @@ ProbeDiagnostics decodeProbeDiagnostics(const std::string& text, const std::stri
             fail(name, "'moved' holds " + i.dump() + ", not a probe index below " +
                            std::to_string(probeCount));
         d.moved[i.get<size_t>()] = 1;
+    }
+    if (j.contains("standard_error")) {
+        d.standardError = numbers(j, "standard_error", name, 1);
+        if (d.standardError.size() != probeCount)
+            fail(name, "standard_error holds " + std::to_string(d.standardError.size()) + " values, expected " +
+                           std::to_string(probeCount));
+        for (float e : d.standardError)
+            if (!(e >= 0.0f)) fail(name, "standard_error holds " + std::to_string(e) + ", must be >= 0");
     }
     d.rejected = points(numbers(j, "rejected", name, 3));
     const std::vector<float> leaves = numbers(j, "leaves", name, 4);

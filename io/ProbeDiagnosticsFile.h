@@ -10,6 +10,7 @@
 //     "shprobe_fnv1a64": "<16 hex digits>"     FNV-1a 64 of the .shprobe's bytes (the same check)
 //     "positions": [x, y, z, ...]              3N numbers, metres, engine space (mm precision)
 //     "moved": [i, ...]                        probe indices moved up out of the terrain
+//     "standard_error": [e, ...]               optional: N relative standard errors (1e-6)
 //     "rejected": [x, y, z, ...]               probes placed inside the terrain (not in the file)
 //     "leaves": [x, y, z, edge, ...]           adaptive octree leaves, min corner and edge
 //     "error_map": {"size": [nx, nz], "origin": [x0, z0], "step": s, "height": h,

@@ -18,6 +18,7 @@
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
+#include <QGroupBox>
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QKeyEvent>
@@ -42,6 +43,12 @@
 #include <QVBoxLayout>
 
 #include "CascadeSplitChart.h"
+#include "ProbeInspector.h"
+#include "bake/HeightfieldTracer.h"
+
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+#include "SceneLighting.h"
 #include "DemImport.h"
 #include "ParameterPanels.h"
 #include "WaterPanel.h"
@@ -211,11 +218,27 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateOutputPath);
     connect(doc_, &ProjectDocument::parametersChanged, this, &MainWindow::updateOutputPath);
     connect(viewport_, &ViewportWindow::clicked, this, [this](QPointF at) {
-        const int probe = reflectionProbeAt(at);
-        if (probe < 0) return;
-        reflectionPanel_->inspect(probe);
-        findChild<QDockWidget*>("dock.reflectionProbes")->raise();
-        statusBar()->showMessage(QString("reflection probe %1").arg(probe), 4000);
+        if (const int probe = reflectionProbeAt(at); probe >= 0) {
+            reflectionPanel_->inspect(probe);
+            findChild<QDockWidget*>("dock.reflectionProbes")->raise();
+            statusBar()->showMessage(QString("reflection probe %1").arg(probe), 4000);
+            return;
+        }
+        if (const auto probe = diffuseProbeAt(at)) {
+            probeInspector_->showPoint(std::nullopt);
+            probeInspector_->inspect(probe->first, probe->second);
+            findChild<QDockWidget*>("dock.probeVolumes")->raise();
+            statusBar()->showMessage(QString("probe %1 of '%2'")
+                                         .arg(probe->second)
+                                         .arg(QString::fromStdString((*renderer_->boundVolumes())[size_t(probe->first)].name)),
+                                     4000);
+            return;
+        }
+        // The terrain under the click: which probes light it.
+        if (const auto point = terrainPointAt(at)) {
+            probeInspector_->showPoint(point);
+            findChild<QDockWidget*>("dock.probeVolumes")->raise();
+        }
     });
     connect(viewport_, &ViewportWindow::frameRendered, this, [this](double ms) {
         // The wall time of the frame on this thread; the GPU's time from the frame graph's
@@ -267,7 +290,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             probeSource_ = withStaleness(own && *own == bakeOutDir_
                                              ? QString("last bake")
                                              : "export in " + QString::fromStdString(bakeOutDir_.string()));
-            reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
+            showBoundProbes();
             viewport_->renderNow();
             updateStatus();
         }
@@ -353,6 +376,27 @@ QDockWidget* MainWindow::buildTerrainDock() {
 QDockWidget* MainWindow::buildSunSkyDock() {
     auto* sky = new ParameterForm(doc_);
     sky->addParameters("sun.");
+    // Where the date and time put the sun, so the slider's effect reads in degrees.
+    auto* position = statusLabel("sun.position");
+    sky->addWidget("", position);
+    auto showPosition = [this, position] {
+        const SceneDescription& scene = doc_->project().scene;
+        position->setVisible(scene.sun.mode == SunMode::DateTime);
+        if (scene.sun.mode != SunMode::DateTime) return;
+        try {
+            const SunAngles a = sunAnglesOf(scene, doc_->terrain().heightfield);
+            position->setText(QString("Sun at azimuth %1° (%2° from true north), %3° above the horizon%4")
+                                  .arg(a.azimuthDeg, 0, 'f', 1)
+                                  .arg(a.place->position.azimuthDeg, 0, 'f', 1)
+                                  .arg(a.elevationDeg, 0, 'f', 1)
+                                  .arg(a.elevationDeg < 0.0 ? ": night" : ""));
+        } catch (const std::exception& e) {
+            position->setText(QString::fromStdString(e.what()));
+        }
+    };
+    connect(doc_, &ProjectDocument::parametersChanged, position, showPosition);
+    connect(doc_, &ProjectDocument::terrainChanged, position, showPosition);
+    showPosition();
     sky->addParameters("sky.");
     auto* importHdr = new QPushButton("Import HDR…");
     importHdr->setObjectName("sky.import");
@@ -492,10 +536,21 @@ QDockWidget* MainWindow::buildLpvDock() {
 
 // Probe Volumes.
 QDockWidget* MainWindow::buildVolumesDock() {
+    auto* page = new QWidget;
+    auto* v = new QVBoxLayout(page);
+    v->setContentsMargins(0, 0, 0, 0);
     auto* volumes = new ProbeVolumesPanel(doc_);
     volumesPanel_ = volumes;
     reportRejections(volumes);
-    return addDock("Probe Volumes", "dock.probeVolumes", volumes);
+    v->addWidget(volumes);
+    auto* inspect = new QGroupBox("Probe inspector");
+    inspect->setObjectName("probeInspector.group");
+    auto* iv = new QVBoxLayout(inspect);
+    probeInspector_ = new ProbeInspector(doc_);
+    iv->addWidget(probeInspector_);
+    v->addWidget(inspect);
+    v->addStretch(1);
+    return addDock("Probe Volumes", "dock.probeVolumes", page);
 }
 
 // Bake & Export: the settings, the button, progress, the last report and its suggestions.
@@ -1020,7 +1075,7 @@ void MainWindow::rebuildRenderer() {
     const auto folder = bakeFolder();
     const size_t baked = folder ? renderer_->loadProbes(false, nullptr, nullptr, *folder) : 0;
     probeSource_ = baked ? withStaleness("last bake") : QString();
-    reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
+    showBoundProbes();
     viewport_->setRenderer(renderer_.get());
     const Heightfield& hf = doc_->terrain().heightfield;
     const DemSourceInfo& s = doc_->terrain().source;
@@ -1123,7 +1178,7 @@ void MainWindow::startPreview() {
             renderer_->setProject(doc_->project());
             renderer_->loadProbes(false, nullptr, nullptr, *folder);
             probeSource_ = withStaleness("last bake");
-            reflectionPanel_->setProbes(renderer_->reflectionProbes(), probeSource_);
+            showBoundProbes();
             viewport_->renderNow();
             updateStatus();
         }
@@ -1140,7 +1195,7 @@ void MainWindow::startPreview() {
                 renderer_->setProbes(preview->volumes);
                 renderer_->setReflectionProbes(preview->reflections);
                 probeSource_ = "draft preview";
-                reflectionPanel_->setProbes(preview->reflections, probeSource_);
+                showBoundProbes();
                 viewport_->renderNow();
                 updateStatus();
             });
@@ -1152,7 +1207,7 @@ void MainWindow::startPreview() {
                 renderer_->setProbes({});
                 renderer_->setReflectionProbes(nullptr);
                 probeSource_ = "no preview: placement failed";
-                reflectionPanel_->setProbes(nullptr, probeSource_);
+                showBoundProbes();
                 viewport_->renderNow();
                 updateStatus();
             });
@@ -1229,19 +1284,17 @@ QString MainWindow::withStaleness(const QString& source) const {
            (stale.size() > 1 ? QString(" and %1 more").arg(stale.size() - 1) : QString());
 }
 
-int MainWindow::reflectionProbeAt(QPointF at) const {
-    if (!renderer_ || !renderer_->reflectionProbes() || viewport_->width() <= 0 || viewport_->height() <= 0) return -1;
+int MainWindow::nearestMarker(const std::vector<glm::vec3>& points, QPointF at) const {
+    if (!renderer_ || viewport_->width() <= 0 || viewport_->height() <= 0) return -1;
     const Heightfield& hf = renderer_->heightfield();
     // The projection the renderer draws with (TerrainRenderer: the extent is the terrain box's
     // largest side).
     const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
     const glm::mat4 vp = viewport_->camera().viewProjection(float(viewport_->width()) / float(viewport_->height()), extent);
-    // The nearest marker within 12 pixels of the click.
     int best = -1;
     double bestDistance = 12.0;
-    const auto& probes = renderer_->reflectionProbes()->probes;
-    for (size_t i = 0; i < probes.size(); ++i) {
-        const glm::vec4 c = vp * glm::vec4(probes[i].position, 1.0f);
+    for (size_t i = 0; i < points.size(); ++i) {
+        const glm::vec4 c = vp * glm::vec4(points[i], 1.0f);
         if (c.w <= 0.0f) continue;
         const QPointF screen((c.x / c.w * 0.5 + 0.5) * viewport_->width(), (c.y / c.w * 0.5 + 0.5) * viewport_->height());
         const double d = std::hypot(screen.x() - at.x(), screen.y() - at.y());
@@ -1251,6 +1304,53 @@ int MainWindow::reflectionProbeAt(QPointF at) const {
         }
     }
     return best;
+}
+
+std::optional<glm::vec3> MainWindow::terrainPointAt(QPointF at) const {
+    if (!renderer_ || viewport_->width() <= 0 || viewport_->height() <= 0) return std::nullopt;
+    const Heightfield& hf = renderer_->heightfield();
+    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+    const glm::mat4 inverse = glm::inverse(
+        viewport_->camera().viewProjection(float(viewport_->width()) / float(viewport_->height()), extent));
+    // The pixel's ray from the near to the far plane (Vulkan clip space: depth 0 to 1).
+    const float x = float(2.0 * at.x() / viewport_->width() - 1.0), y = float(2.0 * at.y() / viewport_->height() - 1.0);
+    const glm::vec4 n = inverse * glm::vec4(x, y, 0.0f, 1.0f), f = inverse * glm::vec4(x, y, 1.0f, 1.0f);
+    const glm::vec3 from = glm::vec3(n) / n.w, to = glm::vec3(f) / f.w;
+    const float length = glm::length(to - from);
+    if (!(length > 0.0f)) return std::nullopt;
+    const HeightfieldTracer tracer(hf);
+    RayHit hit;
+    if (!tracer.intersect(from, (to - from) / length, length, hit)) return std::nullopt;
+    return hit.position;
+}
+
+int MainWindow::reflectionProbeAt(QPointF at) const {
+    if (!renderer_ || !renderer_->reflectionProbes()) return -1;
+    std::vector<glm::vec3> points;
+    for (const auto& p : renderer_->reflectionProbes()->probes) points.push_back(p.position);
+    return nearestMarker(points, at);
+}
+
+std::optional<std::pair<int, int>> MainWindow::diffuseProbeAt(QPointF at) const {
+    if (!renderer_) return std::nullopt;
+    // All volumes' markers at once, so the nearest wins whichever volume holds it.
+    std::vector<glm::vec3> points;
+    std::vector<std::pair<int, int>> owner;
+    const auto volumes = renderer_->boundVolumes();
+    for (size_t v = 0; v < volumes->size(); ++v)
+        if (const auto& d = (*volumes)[v].diagnostics)
+            for (size_t i = 0; i < d->positions.size(); ++i) {
+                points.push_back(d->positions[i]);
+                owner.emplace_back(int(v), int(i));
+            }
+    const int hit = nearestMarker(points, at);
+    if (hit < 0) return std::nullopt;
+    return owner[size_t(hit)];
+}
+
+void MainWindow::showBoundProbes() {
+    probeInspector_->setVolumes(renderer_ ? renderer_->boundVolumes() : nullptr, probeSource_);
+    reflectionPanel_->setProbes(renderer_ ? renderer_->reflectionProbes() : nullptr, probeSource_);
 }
 
 void MainWindow::updateStatus() {

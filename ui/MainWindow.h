@@ -31,6 +31,7 @@ class ParameterForm;
 class ProbeVolumesPanel;
 class WaterPanel;
 class ReflectionPanel;
+class ProbeInspector;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -53,6 +54,13 @@ public:
     // The reflection probe whose marker is nearest to `at` (viewport pixels), within 12 pixels;
     // -1 when none (or no reflection probes are bound).
     int reflectionProbeAt(QPointF at) const;
+    // The diffuse probe (bound volume, record) whose marker is nearest to `at`, within 12
+    // pixels; nullopt when none (or the bound volumes carry no positions).
+    std::optional<std::pair<int, int>> diffuseProbeAt(QPointF at) const;
+    ProbeInspector* probeInspector() { return probeInspector_; }
+    // The terrain point under `at` (viewport pixels): the pixel's ray traced against the
+    // heightfield; nullopt over the sky.
+    std::optional<glm::vec3> terrainPointAt(QPointF at) const;
     // Probes the viewport lights with now (the bound preview or bake).
     size_t boundProbeCount() const;
     // Draft previews started so far: edits that change no probes start none.
@@ -123,6 +131,10 @@ private:
     void updateEstimate();
     void updateTitle();
     void updateStatus();
+    // The probe panels (reflection and diffuse inspectors) show what the renderer has bound.
+    void showBoundProbes();
+    // Index of the point whose projection is nearest to `at` within 12 pixels, or -1.
+    int nearestMarker(const std::vector<glm::vec3>& points, QPointF at) const;
     // "last bake" or "last bake, stale: <what differs>" for the bake the renderer just loaded.
     QString withStaleness(const QString& source) const;
     void addRecent(const QString& file);
@@ -160,6 +172,7 @@ private:
     ProbeVolumesPanel* volumesPanel_ = nullptr;
     WaterPanel* waterPanel_ = nullptr;
     ReflectionPanel* reflectionPanel_ = nullptr;
+    ProbeInspector* probeInspector_ = nullptr;
     QProxyStyle* tabStyle_ = nullptr;
     std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;

@@ -176,6 +176,7 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
             startTerrainEdit(edited, before, at(next, edited), candidate);
             return true;
         }
+        if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);  // a place the DEM can give
         undo_.push(new SetParameterCommand(this, edited, before, at(next, edited)));
         return true;
     } catch (const std::exception& e) {
@@ -198,6 +199,7 @@ bool ProjectDocument::setParameters(const std::vector<std::pair<std::string, nlo
         }
         Project candidate = project_;
         candidate.scene = sceneFromJson(next, "project", nullptr);
+        if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);
         SetParametersCommand::Values before, after;
         QStringList names;
         for (const std::string& e : edited) {
@@ -261,6 +263,8 @@ void ProjectDocument::startTerrainLoad(Project candidate,
         QString error;
         try {
             terrain = std::make_shared<DemImportResult>(loadProjectTerrain(candidate));
+            // A date-and-time sun needs the new DEM to say where it is (or a place set by hand).
+            (void)sunAnglesOf(candidate.scene, terrain->heightfield);
         } catch (const std::exception& e) {
             error = QString::fromStdString(e.what());
         }
@@ -361,7 +365,7 @@ bool ProjectDocument::importHdr(const QString& file, QString* error) {
         Project candidate = project_;
         candidate.scene.sky.mode = SkyMode::Hdr;
         candidate.scene.sky.hdr = abs;
-        (void)skyOf(candidate);
+        (void)skyOf(candidate, terrain_->heightfield);
     } catch (const std::exception& e) {
         if (error) *error = QString::fromStdString(e.what());
         return false;

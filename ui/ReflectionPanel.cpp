@@ -11,16 +11,10 @@
 #include <QVBoxLayout>
 
 #include "ProjectDocument.h"
-#include "ShaderMath.h"
+#include "DisplayEncoding.h"
 
 namespace terralux {
 namespace {
-
-// The viewport's display encoding (shaders/display_math.glsl): the ACES fit, then sRGB.
-int displayByte(float linear) {
-    const float c = glsl::srgbEncode(glsl::acesFit(std::max(linear, 0.0f)));
-    return std::clamp(int(std::lround(255.0f * c)), 0, 255);
-}
 
 const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
 

@@ -18,7 +18,7 @@ ErrorMapStats errorMapStats(const ErrorMap& map) {
     return s;
 }
 
-ProbeDiagnostics describeProbes(const ProbeLayout& L) {
+ProbeDiagnostics describeProbes(const ProbeLayout& L, std::span<const float> standardError) {
     ProbeDiagnostics d;
     for (size_t i = 0; i < L.positions.size(); ++i) {
         if (!L.valid[i]) {
@@ -28,6 +28,7 @@ ProbeDiagnostics describeProbes(const ProbeLayout& L) {
             continue;
         }
         d.positions.push_back(L.positions[i]);
+        if (!standardError.empty()) d.standardError.push_back(standardError[i]);
         d.moved.push_back(L.octree && L.octree->probe[i] == LeafProbe::Moved ? 1 : 0);
     }
     if (L.octree)

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -42,6 +43,9 @@ struct ProbeDiagnostics {
     // Per probe of the .shprobe file, in its record order (valid probes in placement order).
     std::vector<glm::vec3> positions;
     std::vector<uint8_t> moved;         // 1: moved up out of the terrain (adaptive minimum leaves)
+    // Per probe, the bake's relative standard error of its irradiance (docs/lighting.md,
+    // "Standard error"); empty when not known (a sidecar written before it was kept).
+    std::vector<float> standardError;
     // Probes placed inside the terrain and left out of the file.
     std::vector<glm::vec3> rejected;
     // Adaptive volumes: every octree leaf, min corner xyz and edge (metres).
@@ -50,8 +54,9 @@ struct ProbeDiagnostics {
 
 };
 
-// Positions, moves, rejections and leaves of a layout (no error map).
-ProbeDiagnostics describeProbes(const ProbeLayout& layout);
+// Positions, moves, rejections and leaves of a layout (no error map), and the valid probes'
+// standard errors when `standardError` holds one per placed probe (ProbeBake::standardError).
+ProbeDiagnostics describeProbes(const ProbeLayout& layout, std::span<const float> standardError = {});
 
 // How far above the ground a volume's error map measures: a terrain grid's or surface volume's own
 // probe height (so the map shows the horizontal interpolation alone), otherwise 2 % of a cell, the

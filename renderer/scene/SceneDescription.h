@@ -63,9 +63,22 @@ struct DetailSettings {
     double albedoVariation = 0.1;    // ± share of the albedo, [0, 0.5]
 };
 
+// Manual: azimuth and elevation as authored. DateTime: the sun where it stands over the terrain
+// at a date and a local time (renderer/scene/SolarPosition.h).
+enum class SunMode { Manual, DateTime };
+
 struct SunSettings {
-    double azimuthDeg = 135.0;       // clockwise from north (−Z) toward east (+X)
-    double elevationDeg = 35.0;      // above the horizon, [−90, 90]
+    SunMode mode = SunMode::Manual;
+    double azimuthDeg = 135.0;       // clockwise from north (−Z) toward east (+X); mode manual
+    double elevationDeg = 35.0;      // above the horizon, [−90, 90]; mode manual
+    // Mode date_time: a Gregorian date "YYYY-MM-DD", hours after local midnight on a clock
+    // utcOffsetH ahead of UTC (unset: the longitude's nominal zone), at latitude / longitude
+    // (unset: the DEM's footprint centre).
+    std::string date = "2026-06-21";
+    double timeH = 10.0;
+    std::optional<double> utcOffsetH;
+    std::optional<double> latitudeDeg;
+    std::optional<double> longitudeDeg;
     double illuminance = 3.0;        // E_sun on a surface facing the sun, scene-linear, >= 0
     glm::vec3 color{1.0f, 0.96f, 0.9f};
     double angularRadiusDeg = 0.27;  // [0, 45]

@@ -9,7 +9,9 @@
 //   triangle B = (c, r), (c + 1, r + 1), (c + 1, r)   covers fx >  fz
 // where fx, fz in [0, 1] are the position inside the cell along +X and +Z.
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,13 @@ struct GeoOrigin {
     std::string crsWkt;     // empty: the DEM carried no CRS
     std::string crsName;    // short human-readable name, e.g. "WGS 84 / UTM zone 31N"
     int epsg = 0;           // 0 when unknown
+    // The footprint centre on the WGS 84 ellipsoid, degrees (north, east positive), and the true
+    // azimuth of grid north (-Z) there, clockwise: a direction's true azimuth minus this is its
+    // azimuth in engine space. NaN / 0 when the DEM carried no CRS.
+    double latitudeDeg = std::numeric_limits<double>::quiet_NaN();
+    double longitudeDeg = std::numeric_limits<double>::quiet_NaN();
+    double gridConvergenceDeg = 0.0;
+    bool located() const { return std::isfinite(latitudeDeg) && std::isfinite(longitudeDeg); }
 };
 
 class Heightfield {

@@ -31,7 +31,7 @@ double seconds(std::chrono::steady_clock::time_point t0) {
 void run(const char* name, Project project) {
     const DemImportResult terrain = loadProjectTerrain(project);
     const Heightfield& hf = terrain.heightfield;
-    BakeLighting lighting = lightingOf(project);
+    BakeLighting lighting = lightingOf(project, hf);
     const HeightfieldTracer tracer(hf);
     lighting.tracer = &tracer;
     lighting.surface = surfaceAlbedoOf(project, hf);

@@ -40,7 +40,7 @@ void BM_StandardError(benchmark::State& state) {
     const DemImportResult terrain = loadProjectTerrain(p);
     const Heightfield& hf = terrain.heightfield;
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{p.scene.terrain.skirt});
-    BakeLighting L = lightingOf(p);
+    BakeLighting L = lightingOf(p, hf);
     L.tracer = &tracer;
     L.water = bakeWaterOf(p, hf);
     L.surface = surfaceAlbedoOf(p, hf);

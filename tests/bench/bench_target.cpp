@@ -98,7 +98,7 @@ CommonPoints commonPoints(const Project& project, const Heightfield& hf) {
             const float x = hf.minX() + (float(i) + 0.5f) * stepX, z = hf.minZ() + (float(j) + 0.5f) * stepZ;
             c.points.emplace_back(x, hf.surfaceHeight(x, z) + kHeight, z);
         }
-    BakeLighting lighting = lightingOf(project);
+    BakeLighting lighting = lightingOf(project, hf);
     const HeightfieldTracer tracer(hf, HeightfieldTracer::Options{project.scene.terrain.skirt});
     lighting.tracer = &tracer;
     lighting.water = bakeWaterOf(project, hf);

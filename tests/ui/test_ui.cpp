@@ -42,6 +42,7 @@
 #include "LpvConsoleVariables.h"
 #include "LpvPanel.h"
 #include "MainWindow.h"
+#include "ProbeInspector.h"
 #include "ReflectionPanel.h"
 #include "TradeoffPanel.h"
 #include "bake/ReflectionBake.h"
@@ -50,6 +51,7 @@
 #include "bake/ProbePlacement.h"
 #include "BakeJob.h"
 #include "ProjectRenderer.h"
+#include "SceneLighting.h"
 #include "TerrainLoading.h"
 #include "scene/DebugViews.h"
 #include "water/Water.h"
@@ -671,6 +673,60 @@ private slots:
         auto* atmosphereDock = w_->findChild<QDockWidget*>("dock.atmosphere");
         QVERIFY(!rowOf(w_->findChild<QWidget*>("param.fog.density"))->isVisibleTo(atmosphereDock));
         QVERIFY(rowOf(w_->findChild<QWidget*>("param.camera.exposure_ev"))->isVisibleTo(atmosphereDock));
+    }
+
+    // sun.mode date_time: the Sun & Sky dock trades the angles for a date, a time of day on a
+    // slider and a place that says where the DEM is; the slider moves the sun through the day.
+    void dateAndTimePlaceTheSun() {
+        ProjectDocument& doc = *w_->document();
+        auto* dock = w_->findChild<QDockWidget*>("dock.sunSky");
+        QVERIFY(dock);
+        dock->raise();
+        auto* mode = w_->findChild<QComboBox*>("param.sun.mode");
+        QVERIFY(mode);
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sun.time_h"))->isVisibleTo(dock));
+        mode->setCurrentText("date_time");
+        QCOMPARE(doc.project().scene.sun.mode, SunMode::DateTime);
+        QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sun.azimuth_deg"))->isVisibleTo(dock));
+        for (const char* name : {"param.sun.date", "param.sun.time_h", "param.sun.utc_offset_h", "param.sun.latitude_deg"})
+            QVERIFY2(rowOf(w_->findChild<QWidget*>(name))->isVisibleTo(dock), name);
+        // "auto" names the sample's place and its nominal zone.
+        const QString latitude = w_->findChild<QDoubleSpinBox*>("param.sun.latitude_deg")->text();
+        QVERIFY2(latitude.contains(QLocale().toString(doc.terrain().heightfield.geo.latitudeDeg, 'f', 4)), qPrintable(latitude));
+        QVERIFY2(w_->findChild<QDoubleSpinBox*>("param.sun.utc_offset_h")->text().contains(QLocale().toString(-8.0, 'f', 2)),
+                 qPrintable(w_->findChild<QDoubleSpinBox*>("param.sun.utc_offset_h")->text()));
+        auto* slider = w_->findChild<QSlider*>("param.sun.time_h.slider");
+        QVERIFY(slider);
+        slider->setValue(250);  // 06:00
+        QCOMPARE(doc.project().scene.sun.timeH, 6.0);
+        const SunAngles morning = sunAnglesOf(doc.project().scene, doc.terrain().heightfield);
+        slider->setValue(750);  // 18:00
+        QCOMPARE(doc.project().scene.sun.timeH, 18.0);
+        const SunAngles evening = sunAnglesOf(doc.project().scene, doc.terrain().heightfield);
+        QVERIFY(morning.azimuthDeg < 90.0 && evening.azimuthDeg > 270.0);
+        QVERIFY(evening.elevationDeg > 0.0 && evening.elevationDeg < 20.0);
+        auto* position = w_->findChild<QLabel*>("sun.position");
+        QVERIFY(position && position->isVisibleTo(dock));
+        QVERIFY2(position->text().startsWith(QString("Sun at azimuth %1°").arg(evening.azimuthDeg, 0, 'f', 1)),
+                 qPrintable(position->text()));
+        w_->viewport()->renderNow();
+        QTest::qWait(300);
+        QVERIFY(w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height())
+                    .save(QString::fromStdString((kOut / "sun_date_time.png").string())));
+        // A date the calendar does not have is refused and leaves the project as it was.
+        auto* date = w_->findChild<QLineEdit*>("param.sun.date");
+        QVERIFY(date);
+        date->setText("2026-02-30");
+        QMetaObject::invokeMethod(date, "editingFinished");
+        QCOMPARE(doc.project().scene.sun.date, std::string("2026-06-21"));
+        date->setText("2026-12-21");
+        QMetaObject::invokeMethod(date, "editingFinished");
+        QCOMPARE(doc.project().scene.sun.date, std::string("2026-12-21"));
+        QVERIFY(sunAnglesOf(doc.project().scene, doc.terrain().heightfield).elevationDeg < evening.elevationDeg);
+        while (doc.undoStack()->canUndo()) doc.undoStack()->undo();
+        QCOMPARE(doc.project().scene.sun.mode, SunMode::Manual);
+        QVERIFY(rowOf(w_->findChild<QWidget*>("param.sun.azimuth_deg"))->isVisibleTo(dock));
+        QVERIFY(!position->isVisibleTo(dock));
     }
 
     // Shadow, fog and exposure edits draw the next frame with the new value and bake nothing; undo
@@ -1411,6 +1467,96 @@ private slots:
         selector->setCurrentIndex(selector->findData(kViewBeauty));
         enabled->setChecked(false);
         QTRY_VERIFY_WITH_TIMEOUT(status->text() == "Reflection probes are off.", 5000);
+    }
+
+    // The diffuse-probe inspector: a click on a probe marker shows that probe of the bound
+    // preview, its numbers the bound coefficients themselves, its ball lit from the sky above.
+    void probeInspectorShowsAClickedProbe() {
+        auto* group = w_->findChild<QWidget*>("probeInspector.group");
+        auto* probe = w_->findChild<QSpinBox*>("probeInspector.probe");
+        auto* info = w_->findChild<QLabel*>("probeInspector.info");
+        auto* inspector = w_->findChild<ProbeInspector*>();
+        QVERIFY(group && probe && info && inspector);
+        QVERIFY(w_->findChild<QLabel*>("probeInspector.status")->text().startsWith("64 probes (draft preview)"));
+        QCOMPARE(probe->maximum(), 63);
+
+        const auto volumes = w_->viewport()->renderer()->boundVolumes();
+        QCOMPARE(volumes->size(), size_t(1));
+        const GpuProbeVolume& g = volumes->front();
+        QVERIFY(g.diagnostics && g.diagnostics->standardError.size() == 64);
+        const Heightfield& hf = w_->document()->terrain().heightfield;
+        const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
+        const glm::mat4 vp = w_->viewport()->camera().viewProjection(
+            float(w_->viewport()->width()) / float(w_->viewport()->height()), extent);
+        // A probe in the middle of the grid, in view.
+        const int target = 3 * 8 + 4;
+        const glm::vec4 c = vp * glm::vec4(g.diagnostics->positions[size_t(target)], 1.0f);
+        const QPoint at(int((c.x / c.w * 0.5f + 0.5f) * float(w_->viewport()->width())),
+                        int((c.y / c.w * 0.5f + 0.5f) * float(w_->viewport()->height())));
+        QCOMPARE(w_->diffuseProbeAt(at), std::optional(std::pair(0, target)));
+        QTest::mouseClick(w_->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+        QTRY_COMPARE(probe->value(), target);
+        QVERIFY(w_->findChild<QDockWidget*>("dock.probeVolumes")->isVisible());
+
+        // The numbers are the bound probe's: its position, its standard error, its DC term.
+        const glm::vec3 p = g.diagnostics->positions[size_t(target)];
+        const QString text = info->text();
+        QVERIFY2(text.startsWith(QString("at (%1, ").arg(p.x, 0, 'f', 1)), qPrintable(text));
+        QVERIFY2(text.contains(QString("standard error %1 %").arg(100.0 * g.diagnostics->standardError[size_t(target)], 0, 'f', 2)),
+                 qPrintable(text));
+        const glm::vec3 dc = g.coeffs[size_t(target)][0];
+        QVERIFY2(text.contains(QString("%1 %2 %3").arg(dc.x, 8, 'f', 4).arg(dc.y, 8, 'f', 4).arg(dc.z, 8, 'f', 4)), qPrintable(text));
+        QVERIFY2(text.contains("interpolation error within"), qPrintable(text));
+        // E up is the irradiance the viewport evaluates for a level surface.
+        const glm::vec3 up = probeIrradiance(g, size_t(target), glm::vec3(0, 1, 0));
+        QVERIFY(text.contains(QString("E up   %1").arg(up.x, 8, 'f', 4)));
+        QVERIFY(up.y > probeIrradiance(g, size_t(target), glm::vec3(0, -1, 0)).y);
+        // The ball: its top (sky) brighter than its bottom (ground); grey off the ball.
+        const QImage& ball = inspector->ballImage();
+        QCOMPARE(ball.size(), QSize(128, 128));
+        QVERIFY(QColor(ball.pixel(64, 8)).lightness() > QColor(ball.pixel(64, 120)).lightness());
+        QCOMPARE(QColor(ball.pixel(1, 1)), QColor(40, 40, 40));
+        for (QWidget* p = group; p; p = p->parentWidget())
+            if (auto* scroll = qobject_cast<QScrollArea*>(p)) scroll->ensureWidgetVisible(group);
+        QTest::qWait(100);
+        QVERIFY(w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height())
+                    .save(QString::fromStdString((kOut / "probe_inspector.png").string())));
+        QVERIFY(group->grab().save(QString::fromStdString((kOut / "probe_inspector_group.png").string())));
+        // A click on the terrain between probes 28 and 29 says which probes light it, and how much.
+        const glm::vec3 other = g.diagnostics->positions[size_t(target + 1)];
+        const float mx = 0.5f * (p.x + other.x), mz = p.z;
+        const glm::vec3 ground(mx, hf.surfaceHeight(mx, mz), mz);
+        const glm::vec4 gc = vp * glm::vec4(ground, 1.0f);
+        const QPoint onGround(int((gc.x / gc.w * 0.5f + 0.5f) * float(w_->viewport()->width())),
+                              int((gc.y / gc.w * 0.5f + 0.5f) * float(w_->viewport()->height())));
+        QVERIFY(!w_->diffuseProbeAt(onGround));
+        const std::optional<glm::vec3> picked = w_->terrainPointAt(onGround);
+        QVERIFY(picked && glm::length(*picked - ground) < 60.0f);  // within about two 30 m cells
+        QTest::mouseClick(w_->viewport(), Qt::LeftButton, Qt::NoModifier, onGround);
+        auto* point = w_->findChild<QLabel*>("probeInspector.point");
+        QTRY_VERIFY(point->isVisibleTo(group));
+        const ProbeWeights weights = probeWeightsAt(*volumes, *picked);
+        QCOMPARE(weights.volume, 0);
+        float total = 0.0f;
+        for (const auto& [record, weight] : weights.probes) total += weight;
+        QVERIFY(std::abs(total - 1.0f) < 1e-5f);
+        std::vector<int> firstTwo{weights.probes[0].first, weights.probes[1].first};
+        std::sort(firstTwo.begin(), firstTwo.end());
+        QCOMPARE(firstTwo, (std::vector<int>{target, target + 1}));
+        QVERIFY(weights.probes[1].second > 0.3f);
+        QVERIFY2(point->text().contains(QString("probe %1 × %2").arg(weights.probes[0].first).arg(weights.probes[0].second, 0, 'f', 3)),
+                 qPrintable(point->text()));
+        QCOMPARE(probe->value(), weights.probes[0].first);  // the heaviest is inspected
+        // A marker click afterwards hides the point's line again.
+        QTest::mouseClick(w_->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+        QTRY_VERIFY(!point->isVisibleTo(group));
+
+        // Exposure follows the viewport's.
+        const int before = QColor(ball.pixel(64, 64)).lightness();
+        QString error;
+        QVERIFY(w_->document()->setParameter("camera.exposure_ev", 2.0, &error));
+        QVERIFY(QColor(inspector->ballImage().pixel(64, 64)).lightness() > before);
+        w_->document()->undoStack()->undo();
     }
 
     // Load: a thousand edits through the docks' editors, back to back with no waits. Nothing

@@ -46,6 +46,7 @@ std::vector<SceneDescription> coveringScenes(json doc = defaultProjectJson(), co
     with("/sky/mode", "uniform");
     with("/sky/mode", "physical");
     with("/sky/mode", "hdr");
+    with("/sun/mode", "date_time");
     with("/probe_volumes/0/placement", "box");
     docs.back()["probe_volumes"][0]["grid_dims"] = {4, 2, 4};
     with("/probe_volumes/0/placement", "adaptive");
@@ -85,7 +86,7 @@ std::vector<json> candidatesFor(const ParameterSpec& spec, const json& v) {
     case ParamType::Choice:
         for (const std::string& c : spec.choices) out.push_back(c);
         break;
-    case ParamType::String: out = {json("other"), json("renamed volume")}; break;
+    case ParamType::String: out = {json("other"), json("renamed volume"), json("2024-12-21")}; break;
     case ParamType::Number:
     case ParamType::Integer:
         for (double c : numbers(v.is_number() ? v.get<double>() : 1.0))

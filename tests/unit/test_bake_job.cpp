@@ -92,7 +92,7 @@ TEST(StandardError, MatchesTheMeasuredSamplingErrorOfEachPreset) {
         const Project project = loadEffectiveProject("", {}, crop.string(), nullptr);
         const DemImportResult dem = importDem(crop.string());
         const HeightfieldTracer tracer(dem.heightfield);
-        BakeLighting defaults = lightingOf(project);
+        BakeLighting defaults = lightingOf(project, dem.heightfield);
         defaults.tracer = &tracer;
         defaults.surface = surfaceAlbedoOf(project, dem.heightfield);
         BakeLighting uniform = test::skyAndSun(tracer);
@@ -150,7 +150,7 @@ TEST(PresetRounds, EachProbeTracesWhatItsFirstRaysAskWithinTheCap) {
     const Project project = loadEffectiveProject("", {}, crop.string(), nullptr);
     const DemImportResult dem = importDem(crop.string());
     const HeightfieldTracer tracer(dem.heightfield);
-    BakeLighting L = lightingOf(project);
+    BakeLighting L = lightingOf(project, dem.heightfield);
     L.tracer = &tracer;
     L.surface = surfaceAlbedoOf(project, dem.heightfield);
     ProbeVolumeSettings v;

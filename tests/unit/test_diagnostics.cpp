@@ -62,8 +62,17 @@ TEST(DescribeProbes, AdaptiveLayoutGivesFileOrderMovesAndLeaves) {
     v.placement = ProbePlacement::Adaptive;
     v.adaptive.maxMoveShare = 0.5;
     const ProbeLayout L = placeProbes(v, hf);
-    const ProbeDiagnostics d = describeProbes(L);
+    // Standard errors by placed probe: the file order keeps those of the valid ones.
+    std::vector<float> se(L.positions.size());
+    for (size_t i = 0; i < se.size(); ++i) se[i] = float(i);
+    const ProbeDiagnostics d = describeProbes(L, se);
     ASSERT_GT(L.octree->moved, 0u) << "the fixture must exercise moved probes";
+    ASSERT_EQ(d.standardError.size(), L.validCount());
+    for (size_t i = 0, k = 0; i < L.positions.size(); ++i)
+        if (L.valid[i]) {
+            EXPECT_EQ(d.standardError[k++], float(i));
+        }
+    EXPECT_LT(L.validCount(), L.positions.size()) << "the fixture must leave some leaves without a probe";
     // One entry per .shprobe record, in record order: the valid probes in placement order.
     ASSERT_EQ(d.positions.size(), L.validCount());
     ASSERT_EQ(d.moved.size(), L.validCount());
@@ -219,6 +228,15 @@ TEST(ProbeDiagnosticsFile, ReadsBackWhatItWrites) {
         }
     }
 
+    // The standard errors are optional: absent, none come back; present, each does.
+    EXPECT_TRUE(back.standardError.empty());
+    EXPECT_EQ(text.find("standard_error"), std::string::npos);
+    d.standardError = {0.0125f, 0.5f, 0.0f};
+    const ProbeDiagnostics withSe =
+        decodeProbeDiagnostics(encodeProbeDiagnostics(d, "valley", grid), "valley.probes.json", grid, digestOf(grid));
+    EXPECT_EQ(withSe.standardError, d.standardError);
+    d.standardError.clear();
+
     const fs::path file = fs::temp_directory_path() / probeDiagnosticsFileName("terralux_diag_test");
     EXPECT_EQ(file.filename(), "terralux_diag_test.probes.json");
     std::ofstream(file) << text;
@@ -269,6 +287,8 @@ TEST(ProbeDiagnosticsFile, RejectsWhatDoesNotBelongToTheShProbe) {
     EXPECT_EQ(error(edited("version", 2)), "v.probes.json: version 2 is not supported (this build reads 1)");
     EXPECT_EQ(error(edited("positions", {1, 2})), "v.probes.json: 'positions' must hold a multiple of 3 numbers (holds 2)");
     EXPECT_EQ(error(edited("moved", {5})), "v.probes.json: 'moved' holds 5, not a probe index below 2");
+    EXPECT_EQ(error(edited("standard_error", {0.1})), "v.probes.json: standard_error holds 1 values, expected 2");
+    EXPECT_EQ(error(edited("standard_error", {0.1, -1})), "v.probes.json: standard_error holds -1.000000, must be >= 0");
     EXPECT_EQ(error(edited("leaves", {0, 0, 0, 0})), "v.probes.json: leaf 0 has edge 0.000000, must be > 0");
     EXPECT_EQ(error(edited("error_map.error", {0.1})), "v.probes.json: error_map: error holds 1 values, size [2,1] needs 2");
     EXPECT_EQ(error(edited("error_map.error", {0.1, -0.5})), "v.probes.json: error_map: error holds -0.500000, must be >= 0");

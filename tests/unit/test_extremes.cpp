@@ -448,7 +448,7 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
         const DemImportResult terrain = loadProjectTerrain(request.project);
         const Heightfield& hf = terrain.heightfield;
         const HeightfieldTracer tracer(hf);
-        BakeLighting lighting = lightingOf(request.project);
+        BakeLighting lighting = lightingOf(request.project, hf);
         lighting.tracer = &tracer;
         const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, hf);
         const lpv::Volumes v(lpv::resolvedOn(request.project.scene.lpv, hf), {&lighting, &request.project.scene.lights},

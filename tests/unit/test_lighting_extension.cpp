@@ -115,7 +115,7 @@ TEST(LightingExtension, TheSunIsTheOneTheBakeLightsWith) {
     EXPECT_GT(d.y, 0.0f);
 
     // Whatever lights the bake is what is written, the authored angles beside it.
-    BakeLighting l = lightingOf(p);
+    BakeLighting l = lightingOf(p, hf);
     l.sun.direction = sunDirection(200.0, 40.0);
     l.sun.illuminance = glm::vec3(6.0f, 4.5f, 3.0f);
     l.sun.angularRadius = 0.01f;

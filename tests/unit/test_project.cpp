@@ -348,13 +348,19 @@ TEST(Project, PhysicalSkyRoundTrips) {
     EXPECT_EQ(sceneToJson(sceneFromJson(written, "again", nullptr)), written);
 }
 
+// A terrain for the lighting calls whose sun is manual: they do not read it.
+const Heightfield& flatGround() {
+    static const Heightfield hf(4, 4, 10.0, 10.0, std::vector<float>(16, 0.0f));
+    return hf;
+}
+
 TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
     Project p;
     p.scene.sky.mode = SkyMode::Physical;
     p.scene.sky.turbidity = 3.0;
     p.scene.sky.color = glm::vec3(5.0f, 0.0f, 0.0f);  // not read in mode physical
     const size_t before = physicalSkyBuilds();
-    const BakeLighting a = lightingOf(p);
+    const BakeLighting a = lightingOf(p, flatGround());
     EXPECT_EQ(physicalSkyBuilds(), before + 1);
     EXPECT_FALSE(a.sky.isUniform());
     EXPECT_GT(a.sky.openIrradianceUp().z, a.sky.openIrradianceUp().x) << "a clear sky is blue";
@@ -364,7 +370,7 @@ TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
     // Intensity exposes sky and sun alike and reuses the cached sky; so does any other edit.
     p.scene.sky.intensity = 2.0;
     p.scene.terrain.albedo = glm::vec3(0.5f);
-    const BakeLighting b = lightingOf(p);
+    const BakeLighting b = lightingOf(p, flatGround());
     EXPECT_EQ(physicalSkyBuilds(), before + 1);
     for (int c = 0; c < 3; ++c) {
         EXPECT_FLOAT_EQ(b.sky.openIrradianceUp()[c], 2.0f * a.sky.openIrradianceUp()[c]);
@@ -372,18 +378,18 @@ TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
     }
     // The sun's direction and the turbidity shape it.
     p.scene.sun.elevationDeg = 20.0;
-    skyOf(p);
+    skyOf(p, flatGround());
     EXPECT_EQ(physicalSkyBuilds(), before + 2);
     p.scene.sky.turbidity = 6.0;
-    skyOf(p);
+    skyOf(p, flatGround());
     EXPECT_EQ(physicalSkyBuilds(), before + 3);
 
     // Without follow_sky the sun is the project's own.
     p.scene.sun.followSky = false;
-    EXPECT_EQ(lightingOf(p).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
+    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
     p.scene.sky.mode = SkyMode::Uniform;
     p.scene.sun.followSky = true;  // read only in mode physical
-    EXPECT_EQ(lightingOf(p).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
+    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
 }
 
 TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
@@ -396,18 +402,18 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
     p.scene.sky.mode = SkyMode::Hdr;
     p.scene.sky.hdr = hdr.string();
     const size_t before = hdrSkyReads();
-    const Sky first = skyOf(p);
+    const Sky first = skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 1);
     p.scene.sun.elevationDeg = 7.0;
     p.scene.camera.azimuthDeg = 10.0;
-    const Sky again = skyOf(p);
+    const Sky again = skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 1) << "a sun or camera edit read the HDR again";
     EXPECT_EQ(first.sh().c[0], again.sh().c[0]);
     // Intensity scales the cached environment exactly as filtering the scaled image would; the
     // uniform sky's colour does not touch an HDR sky.
     p.scene.sky.color = glm::vec3(1.0f, 0.5f, 0.25f);
     p.scene.sky.intensity = 4.0;
-    const Sky tinted = skyOf(p);
+    const Sky tinted = skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 1) << "an intensity edit read the HDR again";
     std::vector<float> rgb(16 * 8 * 3);
     for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = 4.0f;
@@ -422,12 +428,12 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
         EXPECT_NEAR(tinted.openIrradianceUp()[ch], direct.openIrradianceUp()[ch], 1e-4f);
     }
     p.scene.sky.rotationDeg = 90.0;
-    skyOf(p);
+    skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 2) << "a rotation is a new environment";
     // The file rewritten on disk (other size) is read again even with the same settings.
     rgba.assign(32 * 16 * 4, 2.0f);
     writeImage(hdr, 32, 16, rgba);
-    const Sky rewritten = skyOf(p);
+    const Sky rewritten = skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 3);
     EXPECT_GT(rewritten.sh().c[0].x, 1.5f * first.sh().c[0].x);
     fs::remove_all(dir);

@@ -265,10 +265,12 @@ TEST(SurfaceParameters, TheOctreeOnlySettingsAreNotReadByASurfaceVolume) {
         const bool read = p.isRead(s, 0);
         if (p.path == "probe_volumes[].adaptive.surface_band" || p.path == "probe_volumes[].adaptive.size" ||
             p.path == "probe_volumes[].adaptive.height_range" || p.path == "probe_volumes[].adaptive.max_move_share" ||
-            p.path == "probe_volumes[].adaptive.surface_cell_size")
+            p.path == "probe_volumes[].adaptive.surface_cell_size") {
             EXPECT_FALSE(read) << p.path;
+        }
         if (p.path == "probe_volumes[].adaptive.tolerance" || p.path == "probe_volumes[].adaptive.min_cell_size" ||
-            p.path == "probe_volumes[].height_offset")
+            p.path == "probe_volumes[].height_offset") {
             EXPECT_TRUE(read) << p.path;
+        }
     }
 }
