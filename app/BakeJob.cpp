@@ -1361,6 +1361,16 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         out.warnings = reflections->warnings;
     }
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
+    // A date and a time: where they put the sun the bake lit with.
+    if (const SunAngles sun = sunAnglesOf(scene, hf); sun.place)
+        out.report["sun"] = {{"date", scene.sun.date},
+                             {"time_h", scene.sun.timeH},
+                             {"utc_offset_h", sun.place->utcOffsetH},
+                             {"latitude_deg", sun.place->latitudeDeg},
+                             {"longitude_deg", sun.place->longitudeDeg},
+                             {"azimuth_deg", sun.azimuthDeg},
+                             {"true_azimuth_deg", sun.place->position.azimuthDeg},
+                             {"elevation_deg", sun.elevationDeg}};
     if (scene.water.enabled && !lighting.water)
         out.warnings.push_back("water.level auto: " + water::autoLevel(hf).summary +
                                "; no water is baked or exported; set water.level to place it");

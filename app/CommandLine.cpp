@@ -229,6 +229,20 @@ int commandBake(const Args& a) {
     const int bounces = quality["bounces"].get<int>();
     std::cout << ", " << bounces << (bounces == 1 ? " bounce, " : " bounces, ") << r["threads"].get<int>()
               << " threads)\n";
+    if (r.contains("sun")) {
+        const auto& sun = r["sun"];
+        const double lat = sun["latitude_deg"].get<double>(), lon = sun["longitude_deg"].get<double>();
+        const double hours = sun["time_h"].get<double>();
+        const int minutes = int(std::lround(hours * 60.0));
+        char clock[16];
+        std::snprintf(clock, sizeof clock, "%02d:%02d", minutes / 60, minutes % 60);
+        std::cout << "  sun: " << sun["date"].get<std::string>() << " " << clock << " at UTC"
+                  << (sun["utc_offset_h"].get<double>() < 0.0 ? "" : "+") << fixed(sun["utc_offset_h"].get<double>(), 2)
+                  << " over " << fixed(std::abs(lat), 4) << (lat < 0.0 ? "° S, " : "° N, ") << fixed(std::abs(lon), 4)
+                  << (lon < 0.0 ? "° W" : "° E") << ": azimuth " << fixed(sun["azimuth_deg"].get<double>(), 1) << "° ("
+                  << fixed(sun["true_azimuth_deg"].get<double>(), 1) << "° from true north), elevation "
+                  << fixed(sun["elevation_deg"].get<double>(), 1) << "°\n";
+    }
     if (r.contains("sampling_target")) {
         const auto& t = r["sampling_target"];
         std::cout << "  bake.target_error " << fixed(100.0 * t["target"].get<double>(), 1) << " %: "

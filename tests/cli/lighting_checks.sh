@@ -47,7 +47,15 @@ for key in ("azimuth_deg", "elevation_deg", "illuminance"):
     expect(sun[key] == psun[key], f"sun.{key}: {sun[key]} != {psun[key]}")
 expect(close(sun["angular_radius_deg"], psun["angular_radius_deg"]), "sun.angular_radius_deg differs")
 expect(all(close(a, b) for a, b in zip(sun["color"], psun["color"])), "sun.color differs")
-a, e = math.radians(psun["azimuth_deg"]), math.radians(psun["elevation_deg"])
+if psun["mode"] == "date_time":
+    # The direction follows where the date and time put the sun, which the extension states.
+    for key in ("resolved_azimuth_deg", "resolved_elevation_deg", "resolved_true_azimuth_deg",
+                "resolved_latitude_deg", "resolved_longitude_deg", "resolved_utc_offset_h"):
+        expect(key in sun, f"sun.{key} missing in mode date_time")
+    a, e = math.radians(sun.get("resolved_azimuth_deg", 0)), math.radians(sun.get("resolved_elevation_deg", 0))
+else:
+    expect(not any(k.startswith("resolved_") for k in sun), "resolved sun keys in mode manual")
+    a, e = math.radians(psun["azimuth_deg"]), math.radians(psun["elevation_deg"])
 toward = (math.sin(a) * math.cos(e), math.sin(e), -math.cos(a) * math.cos(e))
 expect(all(close(x, y) for x, y in zip(sun["direction"], toward)),
        f"sun.direction {sun['direction']} is not toward azimuth/elevation {toward}")
@@ -202,4 +210,36 @@ grep -q "^terralux: warning: water.level auto: the DEM shows no water surface" "
   fail "no warning for auto water on a dry DEM: $(cat "$work/dry.err")"
 check "$work/dry.json" "$work/dry/scene.gltf" 4 0.09,0.11,0.15 || fail "dry: the water was exported where auto found none"
 validate "$work/dry/scene.gltf"
+
+# The sun from a date and a time over the sample (UTM 11N, 34.34° N 118.21° W): the extension's
+# direction is the resolved one, and the bake says where the sun stood.
+sets=(--set sun.mode=date_time --set sun.date=2026-06-21 --set sun.time_h=7.5 --set sun.utc_offset_h=-7
+      --set bake.error_map_resolution=0)
+"$terralux" --print-project "${sets[@]}" >"$work/dated.json" || fail "--print-project of the dated sun exited $?"
+"$terralux" --bake --quality draft "${sets[@]}" --out "$work/dated" >"$work/dated.out" 2>&1 || fail "bake of the dated sun exited $?"
+check "$work/dated.json" "$work/dated/scene.gltf" 4 0.09,0.11,0.15 || fail "dated sun: TERRALUX_lighting disagrees"
+grep -q "^  sun: 2026-06-21 07:30 at UTC-7.00 over 34.3374° N, 118.2142° W: azimuth " "$work/dated.out" ||
+  fail "the bake does not say where the sun stood: $(cat "$work/dated.out")"
+python3 - "$work/dated/bake_report.json" <<'EOF' || fail "bake_report.json: sun"
+import json, sys
+sun = json.load(open(sys.argv[1]))["sun"]
+# Morning in June at 34° N: north of east, about 20° up.
+assert 70 < sun["true_azimuth_deg"] < 80 and 18 < sun["elevation_deg"] < 22, sun
+assert abs(sun["azimuth_deg"] - sun["true_azimuth_deg"] - 0.68) < 0.02, sun  # grid north 0.68° west of true
+EOF
+# A DEM without a CRS has no place on the Earth: the mode needs one set by hand.
+python3 - "$work/nocrs.asc" <<'EOF'
+import sys
+with open(sys.argv[1], "w") as f:
+    f.write("ncols 8\nnrows 8\nxllcorner 0\nyllcorner 0\ncellsize 30\n")
+    for r in range(8):
+        f.write(" ".join(str(100 + 10 * r + c) for c in range(8)) + "\n")
+EOF
+"$terralux" --bake --quality draft --dem "$work/nocrs.asc" --set sun.mode=date_time --out "$work/nocrs" \
+  >/dev/null 2>"$work/nocrs.err" && fail "date_time over a DEM without a CRS was baked"
+grep -q "sun.mode: date_time places the sun over the DEM, which carries no CRS: set sun.latitude_deg and sun.longitude_deg" \
+  "$work/nocrs.err" || fail "no place, no clear error: $(cat "$work/nocrs.err")"
+"$terralux" --bake --quiet --quality draft --dem "$work/nocrs.asc" --set sun.mode=date_time --set sun.latitude_deg=47.9 \
+  --set sun.longitude_deg=102.8 --set bake.error_map_resolution=0 --out "$work/nocrs" >/dev/null ||
+  fail "date_time with a place set by hand exited $?"
 echo "ok"
