@@ -357,6 +357,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.linearOutput = r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
+    s.gizmos = r.gizmos;
     s.time = r.time;
     return s;
 }

@@ -29,6 +29,7 @@ struct RenderRequest {
     bool probePositions = false;  // overlay of the enabled volumes' probe positions
     bool leaves = false;          // overlay of the adaptive volumes' octree leaves
     double time = 0.0;            // seconds: the phase of the water's waves
+    std::vector<GizmoLine> gizmos;  // the viewport's volume bounds and handles
 };
 
 class ProjectRenderer;

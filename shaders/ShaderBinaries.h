@@ -26,6 +26,7 @@ std::span<const uint32_t> lpvPropagateComp();  // propagation steps of the bound
 std::span<const uint32_t> markersVert();
 std::span<const uint32_t> markersFrag();
 std::span<const uint32_t> leavesVert();
+std::span<const uint32_t> gizmosVert();       // volume bounds and handles: one line per instance
 std::span<const uint32_t> waterVert();
 std::span<const uint32_t> waterFrag();        // the sun unshadowed
 std::span<const uint32_t> waterShadowFrag();  // with the shadow cascades bound

@@ -28,6 +28,7 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QProgressBar>
+#include <QToolButton>
 #include <QProxyStyle>
 #include <QPushButton>
 #include <QScrollArea>
@@ -44,6 +45,7 @@
 
 #include "CascadeSplitChart.h"
 #include "ProbeInspector.h"
+#include "ViewportGizmos.h"
 #include "bake/HeightfieldTracer.h"
 
 #include <glm/geometric.hpp>
@@ -178,6 +180,14 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
 
     bake_ = new BakeController(this);
     viewport_ = new ViewportWindow(*ctx_, &vulkan_);
+    gizmos_ = new ViewportGizmos(doc_, this);
+    viewport_->setInteraction(gizmos_);
+    connect(gizmos_, &ViewportGizmos::redraw, viewport_, &QWindow::requestUpdate);
+    connect(gizmos_, &ViewportGizmos::rejected, this, &MainWindow::showRejection);
+    connect(gizmos_, &ViewportGizmos::selectionChanged, this, [this](const QString& name) {
+        if (name.isEmpty()) return;
+        statusBar()->showMessage(name + " selected: drag its handles (Esc cancels a drag, Ctrl+Z undoes it)", 6000);
+    });
     auto* container = QWidget::createWindowContainer(viewport_, this);
     container->setObjectName("viewport");
     container->setMinimumSize(480, 320);
@@ -218,6 +228,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     connect(doc_, &ProjectDocument::fileChanged, this, &MainWindow::updateOutputPath);
     connect(doc_, &ProjectDocument::parametersChanged, this, &MainWindow::updateOutputPath);
     connect(viewport_, &ViewportWindow::clicked, this, [this](QPointF at) {
+        const QSizeF size(viewport_->width(), viewport_->height());
+        // Right on a bound's edge or handle, the bound; near one, a probe marker comes first
+        // (the outer probes of a terrain grid stand on its edges), then the bound.
+        if (gizmos_->select(at, viewport_->camera(), size, 3.0, true)) {
+            raiseDockOf(gizmos_->selected()->kind);
+            return;
+        }
         if (const int probe = reflectionProbeAt(at); probe >= 0) {
             reflectionPanel_->inspect(probe);
             findChild<QDockWidget*>("dock.reflectionProbes")->raise();
@@ -232,6 +249,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
                                          .arg(probe->second)
                                          .arg(QString::fromStdString((*renderer_->boundVolumes())[size_t(probe->first)].name)),
                                      4000);
+            return;
+        }
+        if (gizmos_->select(at, viewport_->camera(), size)) {
+            raiseDockOf(gizmos_->selected()->kind);
             return;
         }
         // The terrain under the click: which probes light it.
@@ -666,6 +687,29 @@ void MainWindow::buildViewportToolbar() {
     positions->setObjectName("viewport.probePositions");
     bar->addWidget(positions);
     connect(positions, &QCheckBox::toggled, viewport_, &ViewportWindow::setProbePositions);
+    // Which bounds the viewport draws (each kind on its own; View > Bounds holds the same).
+    auto* boundsButton = new QToolButton;
+    boundsButton->setObjectName("viewport.bounds");
+    boundsButton->setText("Bounds");
+    boundsButton->setToolTip("Draw the volumes' bounds over the view; click one to select it and drag its handles");
+    boundsButton->setPopupMode(QToolButton::InstantPopup);
+    boundsMenu_ = new QMenu("&Bounds", this);
+    boundsMenu_->setObjectName("menu.bounds");
+    const std::pair<BoundsKind, const char*> kinds[] = {{BoundsKind::ProbeVolume, "probeVolumes"},
+                                                        {BoundsKind::ReflectionGrid, "reflectionProbes"},
+                                                        {BoundsKind::LpvCascade, "lpvCascades"},
+                                                        {BoundsKind::Water, "water"},
+                                                        {BoundsKind::Sun, "sun"}};
+    const char* titles[] = {"Probe volumes", "Reflection probes", "LPV cascades", "Water level", "Sun"};
+    for (const auto& [kind, name] : kinds) {
+        auto* a = boundsMenu_->addAction(titles[int(kind)]);
+        a->setObjectName(QString("viewport.bounds.") + name);
+        a->setCheckable(true);
+        a->setChecked(gizmos_->shown(kind));
+        connect(a, &QAction::toggled, this, [this, kind](bool on) { gizmos_->setShown(kind, on); });
+    }
+    boundsButton->setMenu(boundsMenu_);
+    bar->addWidget(boundsButton);
     auto* leaves = new QCheckBox("Octree leaves");
     leaves->setObjectName("viewport.leaves");
     leaves->setToolTip("The leaves of adaptive volumes, bright at the minimum cell size; leaves under "
@@ -788,6 +832,7 @@ void MainWindow::buildMenus() {
         const int index = views->actions().size() - 1;
         connect(a, &QAction::triggered, this, [this, index] { viewSelector_->setCurrentIndex(index); });
     }
+    view->addMenu(boundsMenu_);
     QMenu* panels = view->addMenu("&Panels");
     for (auto* d : findChildren<QDockWidget*>()) {
         // Menu text marks mnemonics with '&'; the title's own '&' is doubled to show as one.
@@ -1282,6 +1327,20 @@ QString MainWindow::withStaleness(const QString& source) const {
     if (stale.empty()) return source;
     return source + ", stale: " + QString::fromStdString(stale.front()) +
            (stale.size() > 1 ? QString(" and %1 more").arg(stale.size() - 1) : QString());
+}
+
+void MainWindow::raiseDockOf(BoundsKind kind) {
+    const char* dock = "dock.probeVolumes";
+    switch (kind) {
+        case BoundsKind::ProbeVolume: dock = "dock.probeVolumes"; break;
+        case BoundsKind::ReflectionGrid: dock = "dock.reflectionProbes"; break;
+        case BoundsKind::LpvCascade: dock = "dock.lpv"; break;
+        case BoundsKind::Water: dock = "dock.water"; break;
+        case BoundsKind::Sun: dock = "dock.sunSky"; break;
+    }
+    if (auto* d = findChild<QDockWidget*>(dock)) d->raise();
+    // The dock edits the volume the viewport selected.
+    if (kind == BoundsKind::ProbeVolume && gizmos_->selected()) volumesPanel_->selectVolume(gizmos_->selected()->index);
 }
 
 int MainWindow::nearestMarker(const std::vector<glm::vec3>& points, QPointF at) const {

@@ -15,6 +15,7 @@
 #include "ProjectDocument.h"
 #include "ProjectRenderer.h"
 #include "ViewportWindow.h"
+#include "VolumeHandles.h"
 
 class QComboBox;
 class QLabel;
@@ -32,6 +33,7 @@ class ProbeVolumesPanel;
 class WaterPanel;
 class ReflectionPanel;
 class ProbeInspector;
+class ViewportGizmos;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -58,6 +60,8 @@ public:
     // pixels; nullopt when none (or the bound volumes carry no positions).
     std::optional<std::pair<int, int>> diffuseProbeAt(QPointF at) const;
     ProbeInspector* probeInspector() { return probeInspector_; }
+    // The volumes' bounds and handles drawn over the viewport.
+    ViewportGizmos* gizmos() { return gizmos_; }
     // The terrain point under `at` (viewport pixels): the pixel's ray traced against the
     // heightfield; nullopt over the sky.
     std::optional<glm::vec3> terrainPointAt(QPointF at) const;
@@ -135,6 +139,8 @@ private:
     void showBoundProbes();
     // Index of the point whose projection is nearest to `at` within 12 pixels, or -1.
     int nearestMarker(const std::vector<glm::vec3>& points, QPointF at) const;
+    // Brings the dock that edits what `kind` bounds to the front.
+    void raiseDockOf(BoundsKind kind);
     // "last bake" or "last bake, stale: <what differs>" for the bake the renderer just loaded.
     QString withStaleness(const QString& source) const;
     void addRecent(const QString& file);
@@ -173,6 +179,8 @@ private:
     WaterPanel* waterPanel_ = nullptr;
     ReflectionPanel* reflectionPanel_ = nullptr;
     ProbeInspector* probeInspector_ = nullptr;
+    ViewportGizmos* gizmos_ = nullptr;
+    QMenu* boundsMenu_ = nullptr;
     QProxyStyle* tabStyle_ = nullptr;
     std::filesystem::path bakeOutDir_;  // where the running (or last) bake writes
     QMenu* recentMenu_ = nullptr;

@@ -185,38 +185,86 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
     }
 }
 
+nlohmann::json ProjectDocument::checkedEdit(const std::vector<std::pair<std::string, nlohmann::json>>& values,
+                                            std::vector<std::string>& edited) const {
+    nlohmann::json next = json_;
+    for (const auto& [path, value] : values) {
+        applyOverride(next, path + "=" + value.dump());
+        const std::string e = fitSplits(path, next) ? std::string("shadows") : path;
+        if (touchesTerrain(e))
+            throw ProjectError(e + ": a terrain edit re-imports the DEM and is made on its own");
+        if (std::find(edited.begin(), edited.end(), e) == edited.end()) edited.push_back(e);
+    }
+    Project candidate = project_;
+    candidate.scene = sceneFromJson(next, "project", nullptr);
+    if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);
+    return next;
+}
+
+void ProjectDocument::pushEdit(const std::vector<std::string>& edited, const nlohmann::json& from,
+                               const nlohmann::json& to, const QString& label) {
+    SetParametersCommand::Values before, after;
+    QStringList names;
+    for (const std::string& e : edited) {
+        if (at(from, e) == at(to, e)) continue;
+        before.emplace_back(e, at(from, e));
+        after.emplace_back(e, at(to, e));
+        names << QString::fromStdString(editLabel(e, from));
+    }
+    if (after.empty()) return;
+    // Undo restores in reverse, so a section and a path inside it land as they were.
+    std::reverse(before.begin(), before.end());
+    undo_.push(new SetParametersCommand(this, label.isEmpty() ? "Set " + names.join(", ") : label, std::move(before),
+                                        std::move(after)));
+}
+
 bool ProjectDocument::setParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values,
-                                    QString* error) {
+                                    QString* error, const QString& label) {
     try {
-        nlohmann::json next = json_;
         std::vector<std::string> edited;
-        for (const auto& [path, value] : values) {
-            applyOverride(next, path + "=" + value.dump());
-            const std::string e = fitSplits(path, next) ? std::string("shadows") : path;
-            if (touchesTerrain(e))
-                throw ProjectError(e + ": a terrain edit re-imports the DEM and is made on its own");
-            if (std::find(edited.begin(), edited.end(), e) == edited.end()) edited.push_back(e);
-        }
-        Project candidate = project_;
-        candidate.scene = sceneFromJson(next, "project", nullptr);
-        if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);
-        SetParametersCommand::Values before, after;
-        QStringList names;
-        for (const std::string& e : edited) {
-            if (at(json_, e) == at(next, e)) continue;
-            before.emplace_back(e, at(json_, e));
-            after.emplace_back(e, at(next, e));
-            names << QString::fromStdString(editLabel(e, json_));
-        }
-        if (after.empty()) return true;
-        // Undo restores in reverse, so a section and a path inside it land as they were.
-        std::reverse(before.begin(), before.end());
-        undo_.push(new SetParametersCommand(this, "Set " + names.join(", "), std::move(before), std::move(after)));
+        const nlohmann::json next = checkedEdit(values, edited);
+        pushEdit(edited, json_, next, label);
         return true;
     } catch (const std::exception& e) {
         if (error) *error = QString::fromStdString(e.what());
         return false;
     }
+}
+
+void ProjectDocument::beginLiveEdit() {
+    live_ = LiveEdit{json_, {}};
+}
+
+bool ProjectDocument::previewParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values,
+                                        QString* error) {
+    if (!live_) beginLiveEdit();
+    try {
+        std::vector<std::string> edited;
+        (void)checkedEdit(values, edited);
+        for (const std::string& e : edited)
+            if (std::find(live_->paths.begin(), live_->paths.end(), e) == live_->paths.end()) live_->paths.push_back(e);
+        apply(values);
+        return true;
+    } catch (const std::exception& e) {
+        if (error) *error = QString::fromStdString(e.what());
+        return false;
+    }
+}
+
+void ProjectDocument::endLiveEdit(const QString& label) {
+    if (!live_) return;
+    const LiveEdit live = std::move(*live_);
+    live_.reset();
+    pushEdit(live.paths, live.before, json_, label);
+}
+
+void ProjectDocument::cancelLiveEdit() {
+    if (!live_) return;
+    const LiveEdit live = std::move(*live_);
+    live_.reset();
+    std::vector<std::pair<std::string, nlohmann::json>> before;
+    for (const std::string& e : live.paths) before.emplace_back(e, at(live.before, e));
+    if (!before.empty()) apply(before);
 }
 
 std::pair<std::string, nlohmann::json> ProjectDocument::assignmentValue(const nlohmann::json& base,

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,7 +47,18 @@ public:
     bool setParameter(const std::string& path, const nlohmann::json& value, QString* error);
     // Several values as one undoable edit, all validated together first: a rejected value (or
     // one that would re-import the terrain, which setParameter does on its own) changes nothing.
-    bool setParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values, QString* error);
+    // `label` names the undo step (empty: "Set" and the parameters' labels).
+    bool setParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values, QString* error,
+                       const QString& label = {});
+    // A drag in the viewport: each previewParameters validates its values as setParameters does
+    // and applies them at once, not undoable (the docks and the viewport follow the pointer);
+    // endLiveEdit makes everything since beginLiveEdit one undo step named `label` (none when
+    // nothing changed), cancelLiveEdit puts it back as it was.
+    void beginLiveEdit();
+    bool previewParameters(const std::vector<std::pair<std::string, nlohmann::json>>& values, QString* error);
+    void endLiveEdit(const QString& label);
+    void cancelLiveEdit();
+    bool liveEditing() const { return live_.has_value(); }
     // `--set` assignments ("bake.rays=128", "probe_volumes[0].grid_dims=16,16") as one edit.
     bool setAssignments(const std::vector<std::string>& assignments, QString* error);
     // The path and JSON value an assignment gives, parsed as `--set` parses it against `base`.
@@ -110,6 +122,18 @@ private:
     void reset(const Project& project, std::shared_ptr<DemImportResult> terrain);
     // setParameter's companion edit of shadows.splits: whether it changed `next`.
     bool fitSplits(const std::string& path, nlohmann::json& next) const;
+    // The document with `values` applied, validated as a whole (throws ProjectError); `edited`
+    // gets the paths the edit changes (a section where fitSplits widened it).
+    nlohmann::json checkedEdit(const std::vector<std::pair<std::string, nlohmann::json>>& values,
+                               std::vector<std::string>& edited) const;
+    // One undo step taking `edited` from their values in `from` to those in `to`.
+    void pushEdit(const std::vector<std::string>& edited, const nlohmann::json& from, const nlohmann::json& to,
+                  const QString& label);
+    struct LiveEdit {
+        nlohmann::json before;
+        std::vector<std::string> paths;
+    };
+    std::optional<LiveEdit> live_;
     Project project_;
     nlohmann::json json_;
     std::shared_ptr<DemImportResult> terrain_;

@@ -138,13 +138,16 @@ void ViewportWindow::renderNow() {
         if (!surface) return;
         swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
     }
+    request_.gizmos = interaction_ ? interaction_->gizmos(camera_, QSizeF(width(), height())) : std::vector<GizmoLine>{};
     if (!renderer_->present(request_, camera_, *swapchain_)) return;
     emit frameRendered(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
 }
 
-RenderedImage ViewportWindow::grabImage() {
+RenderedImage ViewportWindow::grabImage(bool gizmos) {
     if (!renderer_) return {};
     updateSize();
+    request_.gizmos = gizmos && interaction_ ? interaction_->gizmos(camera_, QSizeF(width(), height()))
+                                             : std::vector<GizmoLine>{};
     return renderer_->render(request_, camera_);
 }
 
@@ -173,16 +176,40 @@ void ViewportWindow::zoom(float factor) {
     requestUpdate();
 }
 
+void ViewportWindow::setInteraction(ViewportInteraction* interaction) {
+    if (grabbing_ && interaction_) interaction_->release(true);
+    grabbing_ = false;
+    interaction_ = interaction;
+    requestUpdate();
+}
+
 void ViewportWindow::mousePressEvent(QMouseEvent* e) {
     lastMouse_ = pressedAt_ = e->position();
     dragged_ = false;
+    grabbing_ = e->button() == Qt::LeftButton && !(e->modifiers() & Qt::ShiftModifier) && interaction_ &&
+                interaction_->grab(e->position(), camera_, QSizeF(width(), height()));
+    if (grabbing_) requestUpdate();
 }
 
 void ViewportWindow::mouseReleaseEvent(QMouseEvent* e) {
+    if (grabbing_ && e->button() == Qt::LeftButton) {
+        grabbing_ = false;
+        interaction_->release(false);
+        requestUpdate();
+        // A press on a handle that did not move is still a click (it selects what is under it).
+        if (!dragged_) emit clicked(e->position());
+        return;
+    }
     if (e->button() == Qt::LeftButton && !dragged_) emit clicked(e->position());
 }
 
 void ViewportWindow::mouseMoveEvent(QMouseEvent* e) {
+    if (grabbing_) {
+        if ((e->position() - pressedAt_).manhattanLength() > 4.0) dragged_ = true;
+        if (dragged_) interaction_->drag(e->position(), camera_, QSizeF(width(), height()));
+        requestUpdate();
+        return;
+    }
     // A few pixels of jitter in a click are not an orbit.
     if ((e->position() - pressedAt_).manhattanLength() > 4.0) dragged_ = true;
     const QPointF d = e->position() - lastMouse_;
@@ -198,6 +225,12 @@ void ViewportWindow::wheelEvent(QWheelEvent* e) {
 }
 
 void ViewportWindow::keyPressEvent(QKeyEvent* e) {
+    if (grabbing_ && e->key() == Qt::Key_Escape) {
+        grabbing_ = false;
+        interaction_->release(true);
+        requestUpdate();
+        return;
+    }
     switch (e->key()) {
         case Qt::Key_Left: orbit(-5.0f, 0.0f); break;
         case Qt::Key_Right: orbit(5.0f, 0.0f); break;

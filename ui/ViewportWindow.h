@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <QWindow>
 
@@ -20,6 +21,19 @@ class QVulkanInstance;
 
 namespace terralux {
 
+// What the pointer can grab before it orbits (ViewportGizmos): a left press that grab() takes
+// drags it until release instead of moving the camera, and Escape cancels that drag. Its lines
+// are drawn over every frame.
+class ViewportInteraction {
+public:
+    virtual ~ViewportInteraction() = default;
+    // `size`: the viewport in logical pixels.
+    virtual bool grab(QPointF at, const OrbitCamera& camera, QSizeF size) = 0;
+    virtual void drag(QPointF at, const OrbitCamera& camera, QSizeF size) = 0;
+    virtual void release(bool cancelled) = 0;
+    virtual std::vector<GizmoLine> gizmos(const OrbitCamera& camera, QSizeF size) const = 0;
+};
+
 class ViewportWindow : public QWindow {
     Q_OBJECT
 public:
@@ -28,6 +42,9 @@ public:
 
     // The renderer to draw with (owned by the caller; may be replaced or cleared).
     void setRenderer(ProjectRenderer* renderer);
+    // Handles the pointer may grab and lines drawn over the frame (owned by the caller; null: none).
+    void setInteraction(ViewportInteraction* interaction);
+    bool grabbing() const { return grabbing_; }
     void setCamera(const OrbitCamera& camera);
     const OrbitCamera& camera() const { return camera_; }
     void setDebugView(int view);
@@ -39,8 +56,9 @@ public:
     void setWaterTime(double seconds);
     double waterTime() const { return request_.time; }
     // Draws the current view again and reads it back (row 0 at the top), waiting for the GPU:
-    // for tests and screenshots, never per frame.
-    RenderedImage grabImage();
+    // for tests and screenshots, never per frame. Without `gizmos`, the frame alone, as
+    // `terralux --render` draws it; with them, the bounds and handles over it as on screen.
+    RenderedImage grabImage(bool gizmos = false);
     // Records and submits a frame now instead of at the next update.
     void renderNow();
     // The light propagation volumes: each frame that draws them asks the schedule
@@ -86,6 +104,8 @@ private:
     RenderRequest request_;
     QPointF lastMouse_, pressedAt_;
     bool dragged_ = false;
+    ViewportInteraction* interaction_ = nullptr;
+    bool grabbing_ = false;  // a left drag the interaction took
     lpv::UpdateSchedule lpvSchedule_;
     LatestJob lpvJob_{this};
     bool lpvBusy_ = false;  // UI thread only: set when a worker starts, cleared when its result lands

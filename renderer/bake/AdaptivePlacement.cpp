@@ -105,19 +105,9 @@ public:
     Octree(const ProbeVolumeSettings& v, const Heightfield& hf) : hf_(hf), v_(v) {
         const std::string where = "probe_volumes '" + v.name + "'";
         const AdaptiveVolumeSettings& a = v.adaptive;
-        glm::dvec3 size;
-        if (v.origin) {
-            origin_ = glm::dvec3(*v.origin);
-        } else {
-            origin_ = glm::dvec3(hf.minX(), hf.minHeight(), hf.minZ());
-        }
-        if (a.size) {
-            size = glm::dvec3(*a.size);
-        } else {
-            size = glm::dvec3(double(hf.maxX()) - hf.minX(),
-                              double(hf.maxHeight()) + a.heightRange - origin_.y,
-                              double(hf.maxZ()) - hf.minZ());
-        }
+        const AdaptiveBox box = adaptiveBox(v, hf);
+        origin_ = box.origin;
+        const glm::dvec3 size = box.size;
         m_ = a.minCellSize ? *a.minCellSize : autoMinCellSize(hf, size);
         levels_ = levelsBetween(where, m_, a.maxCellSize ? *a.maxCellSize : 16.0 * m_, a.minCellSize.has_value());
         if (a.surfaceCellSize) {

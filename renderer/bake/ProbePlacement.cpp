@@ -90,21 +90,9 @@ ProbeLayout placeTerrainGrid(const ProbeVolumeSettings& v, const Heightfield& hf
     const int nx = v.gridDims[0], nz = v.gridDims[2];
     L.probeDims = {nx, 1, nz};
     const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
-    glm::vec3 spacing(0.0f);
-    glm::vec3 first(0.0f);
-    if (v.spacing) {
-        spacing = glm::vec3(v.spacing->x, 0.0f, v.spacing->z);
-    } else {
-        spacing.x = nx > 1 ? spanX / float(nx - 1) : 0.0f;
-        spacing.z = nz > 1 ? spanZ / float(nz - 1) : 0.0f;
-    }
-    if (v.origin) {
-        first = glm::vec3(v.origin->x, 0.0f, v.origin->z);
-    } else {
-        // Centred: auto-span reaches the edges exactly; explicit spacing is centred on the terrain.
-        first.x = -0.5f * spacing.x * float(nx - 1);
-        first.z = -0.5f * spacing.z * float(nz - 1);
-    }
+    const TerrainGridFrame frame = terrainGridFrame(v, hf);
+    const glm::vec3 spacing(frame.spacing.x, 0.0f, frame.spacing.y);
+    const glm::vec3 first(frame.first.x, 0.0f, frame.first.y);
     L.spacing = spacing;
     for (int k = 0; k < nz; ++k)
         for (int i = 0; i < nx; ++i) {
@@ -181,16 +169,9 @@ ProbeLayout placeBoxGrid(const ProbeVolumeSettings& v, const Heightfield& hf) {
     ProbeLayout L;
     const int nx = v.gridDims[0], ny = v.gridDims[1], nz = v.gridDims[2];
     L.probeDims = {nx, ny, nz};
-    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
-    float cell = v.spacing ? v.spacing->x
-                           : std::max({spanX / float(nx), spanZ / float(nz), 1e-3f});
-    glm::vec3 origin;
-    if (v.origin) {
-        origin = *v.origin;
-    } else {
-        // Centred on the footprint, from the lowest ground up.
-        origin = glm::vec3(-0.5f * cell * float(nx), hf.minHeight(), -0.5f * cell * float(nz));
-    }
+    const BoxGridFrame frame = boxGridFrame(v, hf);
+    const float cell = frame.cell;
+    const glm::vec3 origin = frame.origin;
     L.spacing = glm::vec3(cell);
     L.cellSize = cell;
     L.cellOrigin = origin;
@@ -260,6 +241,46 @@ glm::vec3 probeAboveSurface(const Heightfield& hf, float x, float z, double offs
         p.y = clear;
     }
     return p;
+}
+
+TerrainGridFrame terrainGridFrame(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    const int nx = v.gridDims[0], nz = v.gridDims[2];
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    TerrainGridFrame f;
+    if (v.spacing) {
+        f.spacing = glm::vec2(v.spacing->x, v.spacing->z);
+    } else {
+        f.spacing.x = nx > 1 ? spanX / float(nx - 1) : 0.0f;
+        f.spacing.y = nz > 1 ? spanZ / float(nz - 1) : 0.0f;
+    }
+    if (v.origin) {
+        f.first = glm::vec2(v.origin->x, v.origin->z);
+    } else {
+        // Centred: auto-span reaches the edges exactly; explicit spacing is centred on the terrain.
+        f.first = -0.5f * f.spacing * glm::vec2(float(nx - 1), float(nz - 1));
+    }
+    return f;
+}
+
+BoxGridFrame boxGridFrame(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    const int nx = v.gridDims[0], nz = v.gridDims[2];
+    const float spanX = hf.maxX() - hf.minX(), spanZ = hf.maxZ() - hf.minZ();
+    BoxGridFrame f;
+    f.cell = v.spacing ? v.spacing->x : std::max({spanX / float(nx), spanZ / float(nz), 1e-3f});
+    // Unset: centred on the footprint, from the lowest ground up.
+    f.origin = v.origin ? *v.origin
+                        : glm::vec3(-0.5f * f.cell * float(nx), hf.minHeight(), -0.5f * f.cell * float(nz));
+    return f;
+}
+
+AdaptiveBox adaptiveBox(const ProbeVolumeSettings& v, const Heightfield& hf) {
+    AdaptiveBox b;
+    b.origin = v.origin ? glm::dvec3(*v.origin) : glm::dvec3(hf.minX(), hf.minHeight(), hf.minZ());
+    b.size = v.adaptive.size ? glm::dvec3(*v.adaptive.size)
+                             : glm::dvec3(double(hf.maxX()) - hf.minX(),
+                                          double(hf.maxHeight()) + v.adaptive.heightRange - b.origin.y,
+                                          double(hf.maxZ()) - hf.minZ());
+    return b;
 }
 
 ProbeLayout placeProbes(const ProbeVolumeSettings& v, const Heightfield& hf) {

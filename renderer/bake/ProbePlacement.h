@@ -124,6 +124,26 @@ float liftClearOfSelfHits(const Heightfield& hf, const glm::vec3& p);
 // where it is not valid (y not above the surface).
 glm::vec3 probeAboveSurface(const Heightfield& hf, float x, float z, double offset, float& lift);
 
+// Where a volume's grid stands, resolved from its settings as the placement resolves them (one
+// rule: the placement calls these too), without placing a probe: the viewport's bounds and handles.
+// A terrain grid: the first probe's (x, z) and the spacing (0 on a one-probe axis is never used:
+// auto-span gives 0 there, an explicit spacing is kept).
+struct TerrainGridFrame {
+    glm::vec2 first{0.0f}, spacing{0.0f};
+};
+TerrainGridFrame terrainGridFrame(const ProbeVolumeSettings& v, const Heightfield& hf);
+// A box grid: its min corner and cubic cell edge.
+struct BoxGridFrame {
+    glm::vec3 origin{0.0f};
+    float cell = 1.0f;
+};
+BoxGridFrame boxGridFrame(const ProbeVolumeSettings& v, const Heightfield& hf);
+// An adaptive volume's box before the octree grows it to whole minimum cells: min corner, edges.
+struct AdaptiveBox {
+    glm::dvec3 origin{0.0}, size{0.0};
+};
+AdaptiveBox adaptiveBox(const ProbeVolumeSettings& v, const Heightfield& hf);
+
 // Largest occupancy grid a volume may write (cells); bigger layouts are refused with a message.
 inline constexpr uint64_t kMaxOccupancyCells = uint64_t(64) << 20;
 // A terrain grid's occupancy cells per probe at most (a grid over a square footprint has a few).

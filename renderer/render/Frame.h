@@ -124,6 +124,9 @@ struct FrameSlot {
     uint32_t timestampsWritten = 0;
     std::vector<std::string> timedPasses;
     double recordMilliseconds = 0.0;
+    // The gizmo lines of the frame drawn in this slot (RenderSettings::gizmos), grown as needed.
+    vk::Buffer gizmos;
+    size_t gizmoCapacity = 0;
 };
 
 struct RenderTarget {
@@ -184,7 +187,7 @@ struct RendererGpu {
     // kReflectionVariant | kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV
     // shaders and layout).
     std::map<int, vk::UniquePipeline> terrain;
-    vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, probePass;
+    vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, gizmoPipeline, probePass;
     FrameGraph graph;
     ~RendererGpu();
 };
@@ -212,10 +215,10 @@ struct Frame {
     bool sunVisibility = false;   // the per-vertex attribute holds the traced sun visibility
     bool waterShading = false;    // the view shades the water (reflection, refraction)
     bool planarReflection = false;
-    bool drawMarkers = false, drawReflectionMarkers = false, drawLeaves = false;
+    bool drawMarkers = false, drawReflectionMarkers = false, drawLeaves = false, drawGizmos = false;
 
     // The terrain mesh and the overlays' instances.
-    uint32_t vertexCount = 0, indexCount = 0, markerCount = 0, leafCount = 0;
+    uint32_t vertexCount = 0, indexCount = 0, markerCount = 0, leafCount = 0, gizmoCount = 0;
     // The cascades' light projections this frame (empty without shadows).
     std::vector<glm::mat4> lightMatrices;
 

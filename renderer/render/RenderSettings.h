@@ -14,6 +14,13 @@
 
 namespace terralux {
 
+// A line drawn over the frame in front of everything (the viewport's volume bounds and their
+// handles), in the display's colour.
+struct GizmoLine {
+    glm::vec3 a{0.0f}, b{0.0f};
+    glm::vec3 color{1.0f};
+};
+
 struct RenderSettings {
     uint32_t width = 640, height = 360;
     int debugView = 0;
@@ -41,6 +48,7 @@ struct RenderSettings {
     bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves
+    std::vector<GizmoLine> gizmos;    // drawn last, unlit, never hidden by the terrain
     // reflection_probes.strength, [0, 1]: how far bound reflection probes replace the sky's
     // specular (0 draws the image without them, bit for bit).
     float reflectionStrength = 1.0f;

@@ -768,6 +768,15 @@ void TerrainRenderer::writeBlocks(Frame& f) {
             slot.lpvSetKey = key;
         }
     }
+    if (f.drawGizmos) {
+        if (slot.gizmoCapacity < s.gizmos.size()) {
+            slot.gizmos = vk::Buffer::hostVisible(ctx_, s.gizmos.size() * sizeof(features::GizmoInstance),
+                                                  VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+            slot.gizmoCapacity = s.gizmos.size();
+        }
+        const std::vector<features::GizmoInstance> lines = features::packGizmos(s.gizmos);
+        slot.gizmos.write(lines.data(), lines.size() * sizeof(lines[0]));
+    }
     if (f.drawMarkers || f.drawReflectionMarkers || f.drawLeaves) {
         const blocks::OverlayBlock overlay = features::packOverlay(s, smallestLeaf_, kSmallestLeafPixels);
         slot.overlay.write(&overlay, sizeof overlay);
@@ -808,6 +817,8 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
     f.drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
     f.drawLeaves = s.showLeaves && leafCount_ > 0;
+    f.drawGizmos = !s.gizmos.empty();
+    f.gizmoCount = uint32_t(s.gizmos.size());
     f.fog = s.fog.enabled;
     f.sunVisibility = view.needs.sunVisibility;
     f.sky = view.needs.sky;

@@ -42,6 +42,7 @@
 #include "LpvConsoleVariables.h"
 #include "LpvPanel.h"
 #include "MainWindow.h"
+#include "ViewportGizmos.h"
 #include "ProbeInspector.h"
 #include "ReflectionPanel.h"
 #include "TradeoffPanel.h"
@@ -1471,6 +1472,139 @@ private slots:
 
     // The diffuse-probe inspector: a click on a probe marker shows that probe of the bound
     // preview, its numbers the bound coefficients themselves, its ball lit from the sky above.
+    // Volumes in the viewport: the bounds are drawn, a click on an edge selects the volume, a drag
+    // of a handle edits it live (the dock shows the value while the pointer moves) and lands as
+    // one undo step with a human label; Escape cancels a drag; the water level and the sun drag
+    // the same way.
+    void boundsAndHandlesEditVolumes() {
+        ViewportGizmos* gizmos = w_->gizmos();
+        ViewportWindow* vp = w_->viewport();
+        QVERIFY(gizmos);
+        QVERIFY(w_->findChild<QAction*>("viewport.bounds.probeVolumes")->isChecked());
+        const QSizeF size(vp->width(), vp->height());
+        auto screen = [&](const glm::vec3& p) {
+            const auto at = ScreenProjection(vp->camera(), size, w_->document()->terrain().heightfield).toScreen(p);
+            return at ? at->toPoint() : QPoint(-1, -1);
+        };
+        auto volumeBounds = [&] {
+            for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+                if (b.kind == BoundsKind::ProbeVolume) return b;
+            return VolumeBounds{};
+        };
+        const VolumeBounds box = volumeBounds();
+        QCOMPARE(QString::fromStdString(box.name), QString("volume 'probes'"));
+
+        // Drawn: the edge's pixel differs with the bounds shown and hidden.
+        const glm::vec3 edgePoint(0.5f * (box.min.x + box.max.x), box.max.y, box.max.z);
+        const QPoint edge = screen(edgePoint);
+        QVERIFY(QRect(QPoint(0, 0), vp->size()).contains(edge));
+        const RenderedImage shown = vp->grabImage(true);
+        w_->findChild<QAction*>("viewport.bounds.probeVolumes")->setChecked(false);
+        const RenderedImage hidden = vp->grabImage(true);
+        w_->findChild<QAction*>("viewport.bounds.probeVolumes")->setChecked(true);
+        const qreal dpr = vp->devicePixelRatio();
+        double most = 0.0;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const size_t i = (size_t(int(edge.y() * dpr) + dy) * shown.width + size_t(int(edge.x() * dpr) + dx)) * 4;
+                most = std::max(most, double(std::abs(shown.rgba[i + 2] - hidden.rgba[i + 2])));
+            }
+        QVERIFY2(most > 0.2, qPrintable(QString("edge pixel changed by %1").arg(most)));
+
+        // A click on the edge selects the volume.
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, edge);
+        QTRY_VERIFY(gizmos->selected().has_value());
+        QCOMPARE(gizmos->selected()->kind, BoundsKind::ProbeVolume);
+        QVERIFY(w_->statusBar()->currentMessage().startsWith("volume 'probes' selected"));
+
+        // Drag the move handle: live, then one undo step.
+        QUndoStack* undo = w_->document()->undoStack();
+        const int steps = undo->count();
+        Handle move;
+        for (const Handle& h : gizmos->handles())
+            if (h.role == HandleRole::Move) move = h;
+        const QPoint from = screen(move.at), to = from + QPoint(60, 25);
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, from);
+        QVERIFY(vp->grabbing());
+        for (int i = 1; i <= 6; ++i) QTest::mouseMove(vp, from + (to - from) * i / 6);
+        QTRY_VERIFY(!w_->document()->value("probe_volumes[0].origin").is_null());
+        const nlohmann::json live = w_->document()->value("probe_volumes[0].origin");
+        auto* originX = w_->findChild<QDoubleSpinBox*>("param.volume.origin.0");
+        QVERIFY(originX);
+        QCOMPARE(originX->value(), live[0].get<double>());  // the dock follows the drag
+        QCOMPARE(undo->count(), steps);                    // nothing on the stack yet
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, to);
+        QCOMPARE(undo->count(), steps + 1);
+        QCOMPARE(undo->undoText(), QString("Move volume 'probes'"));
+        // The handle ends under the pointer.
+        Handle moved;
+        for (const Handle& h : gizmos->handles())
+            if (h.role == HandleRole::Move) moved = h;
+        const QPoint landed = screen(moved.at);
+        QVERIFY2((landed - to).manhattanLength() <= 3, qPrintable(QString("handle at %1,%2, pointer at %3,%4")
+                                                                      .arg(landed.x()).arg(landed.y()).arg(to.x()).arg(to.y())));
+        undo->undo();
+        QVERIFY(w_->document()->value("probe_volumes[0].origin").is_null());
+        QCOMPARE(volumeBounds(), box);
+
+        // The height handle; Escape puts it back and leaves no step.
+        Handle height;
+        for (const Handle& h : gizmos->handles())
+            if (h.role == HandleRole::Height) height = h;
+        const double offset = w_->document()->value("probe_volumes[0].height_offset").get<double>();
+        const QPoint top = screen(height.at);
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, top);
+        for (int i = 1; i <= 4; ++i) QTest::mouseMove(vp, top - QPoint(0, 10 * i));
+        QTRY_VERIFY(w_->document()->value("probe_volumes[0].height_offset").get<double>() > offset + 1.0);
+        QTest::keyClick(vp, Qt::Key_Escape);
+        QCOMPARE(w_->document()->value("probe_volumes[0].height_offset").get<double>(), offset);
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, top - QPoint(0, 40));
+        QCOMPARE(undo->count(), steps + 1);  // the undone move is still there to redo; nothing new
+        QCOMPARE(undo->index(), steps);
+
+        // The water level: select the water's outline (the probe volume's bounds, which share the
+        // footprint's edges, hidden), drag its handle up.
+        w_->findChild<QAction*>("viewport.bounds.probeVolumes")->setChecked(false);
+        QVERIFY(!gizmos->selected());
+        QString error;
+        QVERIFY(w_->document()->setParameters({{"water.enabled", true}, {"water.level", 500.0}}, &error));
+        VolumeBounds water;
+        for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+            if (b.kind == BoundsKind::Water) water = b;
+        QCOMPARE(water.min.y, 500.0f);
+        // Right on the edge: the water, even where a probe marker lies within a few pixels.
+        const QPoint shore = screen(glm::vec3(water.min.x, 500.0f, water.min.z + 3.5f / 7.0f * (water.max.z - water.min.z)));
+        QVERIFY(QRect(QPoint(0, 0), vp->size()).contains(shore));
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, shore);
+        QTRY_VERIFY(gizmos->selected() && gizmos->selected()->kind == BoundsKind::Water);
+        const QPoint level = screen(gizmos->handles().front().at);
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, level);
+        for (int i = 1; i <= 4; ++i) QTest::mouseMove(vp, level - QPoint(0, 8 * i));
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, level - QPoint(0, 32));
+        QCOMPARE(undo->undoText(), QString("Set the water level"));
+        QVERIFY(w_->document()->value("water.level").get<double>() > 500.0);
+        // The dock shows it to its one decimal.
+        QVERIFY(std::abs(w_->findChild<QDoubleSpinBox*>("param.water.level")->value() -
+                         w_->document()->value("water.level").get<double>()) <= 0.05 + 1e-9);
+
+        // The sun: its point, dragged, turns azimuth and elevation.
+        VolumeBounds sun;
+        for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+            if (b.kind == BoundsKind::Sun) sun = b;
+        const QPoint sunAt = screen(sun.min);
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, sunAt);
+        QTRY_VERIFY(gizmos->selected() && gizmos->selected()->kind == BoundsKind::Sun);
+        const double azimuth = w_->document()->value("sun.azimuth_deg").get<double>();
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, sunAt);
+        for (int i = 1; i <= 5; ++i) QTest::mouseMove(vp, sunAt + QPoint(8 * i, 0));
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, sunAt + QPoint(40, 0));
+        QCOMPARE(undo->undoText(), QString("Move the sun"));
+        QVERIFY(std::abs(w_->document()->value("sun.azimuth_deg").get<double>() - azimuth) > 1.0);
+        QTest::qWait(200);
+        QVERIFY(w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height())
+                    .save(QString::fromStdString((kOut / "viewport_bounds.png").string())));
+    }
+
     void probeInspectorShowsAClickedProbe() {
         auto* group = w_->findChild<QWidget*>("probeInspector.group");
         auto* probe = w_->findChild<QSpinBox*>("probeInspector.probe");

@@ -18,6 +18,13 @@ blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, fl
     return overlay;
 }
 
+std::vector<GizmoInstance> packGizmos(const std::vector<GizmoLine>& lines) {
+    std::vector<GizmoInstance> out;
+    out.reserve(lines.size());
+    for (const GizmoLine& l : lines) out.push_back({glm::vec4(l.a, 1.0f), glm::vec4(l.b, 1.0f), glm::vec4(l.color, 1.0f)});
+    return out;
+}
+
 namespace {
 
 // An overlay pipeline: one vec4 per instance (a marker: xyz, w its kind; a leaf: min corner,
@@ -40,12 +47,27 @@ void ensurePipelines(Frame& f) {
     // The 12 edges of each leaf box as a line list.
     if (f.drawLeaves && !g.leafPipeline)
         g.leafPipeline = overlayPipeline(f, shaders::leavesVert(), VK_PRIMITIVE_TOPOLOGY_LINE_LIST);
+    // Gizmos: two vertices per line instance, drawn whatever the depth says, so a volume's bounds
+    // and handles stay in sight behind a ridge.
+    if (f.drawGizmos && !g.gizmoPipeline) {
+        vk::GraphicsPipelineDesc d;
+        d.vert = shaders::gizmosVert();
+        d.frag = shaders::markersFrag();
+        d.bindings = {{0, sizeof(GizmoInstance), VK_VERTEX_INPUT_RATE_INSTANCE}};
+        d.attributes = {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0},
+                        {1, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 16},
+                        {2, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 32}};
+        d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
+        d.depthWrite = false;
+        d.depthCompare = VK_COMPARE_OP_ALWAYS;
+        g.gizmoPipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.overlayLayout.handle(), d);
+    }
 }
 
 }  // namespace
 
 void addOverlayPass(Frame& f) {
-    if (!f.drawMarkers && !f.drawReflectionMarkers && !f.drawLeaves) return;
+    if (!f.drawMarkers && !f.drawReflectionMarkers && !f.drawLeaves && !f.drawGizmos) return;
     ensurePipelines(f);
     RendererGpu& g = f.g;
     PassInfo info{"overlays",
@@ -63,11 +85,13 @@ void addOverlayPass(Frame& f) {
         info.uses.push_back({kReflectionMarkers, Access::VertexAttributeRead});
         info.bindings.push_back(std::string("vertex:") + kReflectionMarkers);
     }
+    if (f.drawGizmos) info.bindings.push_back("vertex:gizmos");
     const uint32_t leafCount = f.drawLeaves ? f.leafCount : 0, markerCount = f.drawMarkers ? f.markerCount : 0;
+    const uint32_t gizmoCount = f.drawGizmos ? f.gizmoCount : 0;
     const vk::Buffer* reflectionMarkers = f.drawReflectionMarkers ? &g.reflections->markers : nullptr;
     const uint32_t reflectionMarkerCount = f.drawReflectionMarkers ? g.reflections->markerCount : 0;
-    g.graph.addPass(std::move(info), [&f, leafCount, markerCount, reflectionMarkers,
-                                      reflectionMarkerCount](VkCommandBuffer c) {
+    g.graph.addPass(std::move(info), [&f, leafCount, markerCount, reflectionMarkers, reflectionMarkerCount,
+                                      gizmoCount](VkCommandBuffer c) {
         RendererGpu& g = f.g;
         f.beginDrawing(c);
         const VkDescriptorSet view = f.slot.view.handle(), overlay = f.slot.overlays.handle();
@@ -85,6 +109,7 @@ void addOverlayPass(Frame& f) {
         if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
         if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
         if (reflectionMarkerCount > 0) draw(g.markerPipeline.get(), *reflectionMarkers, 6, reflectionMarkerCount);
+        if (gizmoCount > 0) draw(g.gizmoPipeline.get(), f.slot.gizmos, 2, gizmoCount);
         vkCmdEndRenderPass(c);
     });
 }
