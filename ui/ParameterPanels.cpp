@@ -10,6 +10,7 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
+#include <QGridLayout>
 #include <QHBoxLayout>
 #include <QInputDialog>
 #include <QLabel>
@@ -336,12 +337,11 @@ void ParameterForm::addChoice(const ParameterSpec& spec) {
 namespace {
 
 // Linear RGB in a colour button: the swatch (values above 1, sky radiance, clipped) and the numbers.
-// A swatch alone (a ramp's stops side by side) carries the numbers in its tooltip.
-void showColor(QPushButton* button, double r, double g, double b, bool swatchOnly = false) {
+void showColor(QPushButton* button, double r, double g, double b) {
     const QColor c = QColor::fromRgbF(float(std::min(1.0, r)), float(std::min(1.0, g)), float(std::min(1.0, b)));
     const QString numbers = QString("%1, %2, %3").arg(r, 0, 'g', 3).arg(g, 0, 'g', 3).arg(b, 0, 'g', 3);
-    if (swatchOnly) button->setToolTip(numbers);
-    else button->setText(numbers);
+    button->setText(numbers);
+    button->setToolTip(numbers);
     button->setStyleSheet(QString("QPushButton { background: %1; color: %2 }")
                               .arg(c.name(), c.lightnessF() > 0.5 ? "black" : "white"));
 }
@@ -388,20 +388,21 @@ void ParameterForm::addColor(const ParameterSpec& spec) {
     addRow(spec, button);
 }
 
-// One colour button per RGB triple of the list (a ramp's stops), as many as the scene holds.
+// One colour button per RGB triple of the list (a ramp's stops), as many as the scene holds,
+// three to a row, each as wide as its numbers (the dock widens to them).
 void ParameterForm::addColorList(const ParameterSpec& spec) {
     auto* row = new QWidget(this);
-    auto* h = new QHBoxLayout(row);
+    auto* h = new QGridLayout(row);
     h->setContentsMargins(0, 0, 0, 0);
+    constexpr int kPerRow = 3;
     const QString name = QString::fromStdString(uiObjectName(spec));
     std::vector<QPushButton*> buttons;
     for (int stop = 0; stop < spec.maxItems / 3; ++stop) {
         auto* button = new QPushButton(row);
         button->setObjectName(name + "." + QString::number(stop));
-        button->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
-        button->setMinimumWidth(40);
+        button->setSizePolicy(QSizePolicy::Preferred, QSizePolicy::Fixed);
         button->setVisible(stop < std::max(spec.minItems / 3, 1));
-        h->addWidget(button, 1);
+        h->addWidget(button, stop / kPerRow, stop % kPerRow);
         buttons.push_back(button);
         const QString title = QString::fromStdString(spec.label) + " " + QString::number(stop + 1);
         connect(button, &QPushButton::clicked, this, [=, this] {
@@ -420,7 +421,7 @@ void ParameterForm::addColorList(const ParameterSpec& spec) {
             const size_t at = 3 * stop;
             const bool shown = v.is_array() && v.size() >= at + 3;
             buttons[stop]->setVisible(shown);
-            if (shown) showColor(buttons[stop], v[at].get<double>(), v[at + 1].get<double>(), v[at + 2].get<double>(), true);
+            if (shown) showColor(buttons[stop], v[at].get<double>(), v[at + 1].get<double>(), v[at + 2].get<double>());
         }
     });
     addRow(spec, row);

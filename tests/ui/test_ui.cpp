@@ -847,6 +847,18 @@ private slots:
             QCOMPARE(button->isVisibleTo(dock), k < stops);
         }
         const nlohmann::json colorsBefore = w_->document()->value("terrain.ramp_colors");
+        // Each stop shows its numbers, whole, on its swatch (they were only in the tooltip).
+        for (size_t k = 0; k < stops; ++k) {
+            auto* button = w_->findChild<QPushButton*>(QString("param.terrain.ramp_colors.%1").arg(k));
+            const QString numbers = QString("%1, %2, %3")
+                                        .arg(colorsBefore[3 * k].get<double>(), 0, 'g', 3)
+                                        .arg(colorsBefore[3 * k + 1].get<double>(), 0, 'g', 3)
+                                        .arg(colorsBefore[3 * k + 2].get<double>(), 0, 'g', 3);
+            QCOMPARE(button->text(), numbers);
+            QTRY_VERIFY2(button->fontMetrics().horizontalAdvance(numbers) <= button->contentsRect().width(),
+                         qPrintable(QString("stop %1: %2 px of text on a %3 px button").arg(k)
+                                        .arg(button->fontMetrics().horizontalAdvance(numbers)).arg(button->contentsRect().width())));
+        }
         QTimer::singleShot(200, [] {
             auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
             if (!dialog) return;
