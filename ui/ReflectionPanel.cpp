@@ -125,6 +125,9 @@ void ReflectionPanel::refresh() {
     if (set_ && index < count) {
         cross_ = reflectionCross(*set_, size_t(index), 48, doc_->project().scene.camera.exposureEv);
         image_->setPixmap(QPixmap::fromImage(cross_));
+        // Held at the cross's size, so the dock's scrolled page makes room for all of it at once
+        // (until its layout caught up, the label kept the height it had empty).
+        image_->setMinimumSize(cross_.size());
         const ReflectionProbe& p = set_->probes[size_t(index)];
         QString faces;
         for (int f = 0; f < 6; ++f)
@@ -147,6 +150,7 @@ void ReflectionPanel::refresh() {
     } else {
         cross_ = QImage();
         image_->clear();
+        image_->setMinimumSize(0, 0);
         info_->clear();
         inSimvx_->setChecked(false);
         inSimvx_->setEnabled(false);

@@ -939,8 +939,14 @@ private slots:
         auto* blend = w_->findChild<QDoubleSpinBox*>("param.volume.fallback_blend_distance");
         QVERIFY(blend);
         QCOMPARE(blend->text(), QString("2 × spacing (%1 m)").arg(QLocale().toString(2.0 * span / 7.0, 'f', 1)));
-        // The reflection grid's likewise (4 x 4 over the footprint).
+        // Typed 32 x 8, the grid spans the square footprint in uneven steps; the dock shows both
+        // (they were only in the bake's probes.json).
         QString error;
+        QVERIFY2(doc.setParameter("probe_volumes[0].grid_dims", nlohmann::json{32, 8}, &error), qPrintable(error));
+        QCOMPARE(spacing->text(), QString::number(span / 31.0, 'f', spacing->decimals()) + " m");
+        QCOMPARE(spacingZ->text(), QString::number((hf.maxZ() - hf.minZ()) / 7.0, 'f', spacingZ->decimals()) + " m");
+        w_->findChild<QAction*>("action.undo")->trigger();
+        // The reflection grid's likewise (4 x 4 over the footprint).
         QVERIFY2(doc.setParameter("reflection_probes.enabled", true, &error), qPrintable(error));
         auto* reflection = w_->findChild<QDoubleSpinBox*>("param.reflection_probes.spacing.0");
         QVERIFY(reflection);
@@ -1448,6 +1454,27 @@ private slots:
         QVERIFY(w_->findChild<QLabel*>("reflection.probeInfo")->text().startsWith("id 9 at ("));
         auto* panel = w_->findChild<ReflectionPanel*>();
         QCOMPARE(panel->crossImage().size(), QSize(4 * 48, 3 * 48));
+        {
+            // The whole cross comes into view in its dock, not cut at the dock's bottom.
+            auto* dock = w_->findChild<QDockWidget*>("dock.reflectionProbes");
+            dock->raise();
+            auto* image = w_->findChild<QLabel*>("reflection.inspector");
+            auto* area = dock->findChild<QScrollArea*>();
+            QVERIFY(image && area);
+            // The page grows to hold the cross (it kept the height it had with the label empty),
+            // and scrolled to the cross's bottom edge, the whole cross is in view.
+            auto bottom = [&] { return image->mapTo(area->widget(), QPoint(0, image->height())).y(); };
+            QTRY_VERIFY(image->height() >= 3 * 48 &&
+                        area->verticalScrollBar()->maximum() >= bottom() - area->viewport()->height());
+            area->verticalScrollBar()->setValue(bottom() - area->viewport()->height());
+            QTest::qWait(50);
+            const QRect shown(image->mapTo(area->viewport(), QPoint(0, 0)), image->size());
+            const QRect pixmap(shown.topLeft() + image->contentsRect().topLeft(), image->pixmap().size());
+            QVERIFY(w_->grab().save(QString::fromStdString((kOut / "reflection_inspector.png").string())));
+            QVERIFY2(image->height() >= 3 * 48 && area->viewport()->rect().contains(pixmap),
+                     qPrintable(QString("label %1x%2 at %3,%4 in a %5x%6 view").arg(image->width()).arg(image->height())
+                                    .arg(shown.x()).arg(shown.y()).arg(area->viewport()->width()).arg(area->viewport()->height())));
+        }
         // The +Y face (the sky, above) is brighter than the -Y face (the ground, below).
         const QColor up = panel->crossImage().pixelColor(48 + 24, 24), down = panel->crossImage().pixelColor(48 + 24, 2 * 48 + 24);
         QVERIFY2(up.lightness() > down.lightness(), qPrintable(QString("%1 vs %2").arg(up.lightness()).arg(down.lightness())));
