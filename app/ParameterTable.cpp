@@ -311,8 +311,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("sun.elevation_deg", T::Number)).range(-90.0, 90.0).unit("°").decimals(1).slider()
         .label("Sun elevation").about("Angle of the sun above the horizon")
         .redoes(kUpload | kRebake).onlyWhen(manualSun).field(&SceneDescription::sun, &SunSettings::elevationDeg);
-    const std::string dateRule = "must be a calendar date from " + std::to_string(kSolarFirstYear) + "-01-01 to " +
-                                 std::to_string(kSolarLastYear) + "-12-31, YYYY-MM-DD";
+    const std::string dateRule = "must be " + civilDateRule();
     add(Row("sun.date", T::String)).pattern("[0-9]{4}-[0-9]{2}-[0-9]{2}", dateRule).label("Date")
         .about("Day of the sun's position, Gregorian, on the local clock")
         .redoes(kUpload | kRebake).onlyWhen(datedSun)

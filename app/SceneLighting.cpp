@@ -87,11 +87,11 @@ SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf) {
     // too, so a scene built in code fails with the same rule.
     const std::optional<CivilDate> date = parseCivilDate(s.date);
     if (!date)
-        throw ProjectError("sun.date: \"" + s.date + "\" is not a date from " + std::to_string(kSolarFirstYear) +
-                           "-01-01 to " + std::to_string(kSolarLastYear) + "-12-31 (YYYY-MM-DD)");
+        throw ProjectError("sun.date: \"" + s.date + "\" is not " + civilDateRule());
     if ((!s.latitudeDeg || !s.longitudeDeg) && !hf.geo.located())
-        throw ProjectError("sun.mode: date_time places the sun over the DEM, which carries no CRS: set "
-                           "sun.latitude_deg and sun.longitude_deg");
+        throw ProjectError("sun.mode: date_time places the sun over the DEM" +
+                           (scene.terrain.dem.empty() ? std::string() : " " + scene.terrain.dem) +
+                           ", which carries no CRS: set sun.latitude_deg and sun.longitude_deg");
     SunPlace place;
     place.latitudeDeg = s.latitudeDeg.value_or(hf.geo.latitudeDeg);
     place.longitudeDeg = s.longitudeDeg.value_or(hf.geo.longitudeDeg);

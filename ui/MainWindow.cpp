@@ -1345,18 +1345,14 @@ void MainWindow::raiseDockOf(BoundsKind kind) {
 
 int MainWindow::nearestMarker(const std::vector<glm::vec3>& points, QPointF at) const {
     if (!renderer_ || viewport_->width() <= 0 || viewport_->height() <= 0) return -1;
-    const Heightfield& hf = renderer_->heightfield();
-    // The projection the renderer draws with (TerrainRenderer: the extent is the terrain box's
-    // largest side).
-    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
-    const glm::mat4 vp = viewport_->camera().viewProjection(float(viewport_->width()) / float(viewport_->height()), extent);
+    const ScreenProjection view(viewport_->camera(), QSizeF(viewport_->width(), viewport_->height()),
+                                renderer_->heightfield());
     int best = -1;
     double bestDistance = 12.0;
     for (size_t i = 0; i < points.size(); ++i) {
-        const glm::vec4 c = vp * glm::vec4(points[i], 1.0f);
-        if (c.w <= 0.0f) continue;
-        const QPointF screen((c.x / c.w * 0.5 + 0.5) * viewport_->width(), (c.y / c.w * 0.5 + 0.5) * viewport_->height());
-        const double d = std::hypot(screen.x() - at.x(), screen.y() - at.y());
+        const std::optional<QPointF> screen = view.toScreen(points[i]);
+        if (!screen) continue;
+        const double d = std::hypot(screen->x() - at.x(), screen->y() - at.y());
         if (d < bestDistance) {
             bestDistance = d;
             best = int(i);
@@ -1368,18 +1364,12 @@ int MainWindow::nearestMarker(const std::vector<glm::vec3>& points, QPointF at) 
 std::optional<glm::vec3> MainWindow::terrainPointAt(QPointF at) const {
     if (!renderer_ || viewport_->width() <= 0 || viewport_->height() <= 0) return std::nullopt;
     const Heightfield& hf = renderer_->heightfield();
-    const float extent = std::max({hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), hf.maxHeight() - hf.minHeight(), 1.0f});
-    const glm::mat4 inverse = glm::inverse(
-        viewport_->camera().viewProjection(float(viewport_->width()) / float(viewport_->height()), extent));
-    // The pixel's ray from the near to the far plane (Vulkan clip space: depth 0 to 1).
-    const float x = float(2.0 * at.x() / viewport_->width() - 1.0), y = float(2.0 * at.y() / viewport_->height() - 1.0);
-    const glm::vec4 n = inverse * glm::vec4(x, y, 0.0f, 1.0f), f = inverse * glm::vec4(x, y, 1.0f, 1.0f);
-    const glm::vec3 from = glm::vec3(n) / n.w, to = glm::vec3(f) / f.w;
-    const float length = glm::length(to - from);
-    if (!(length > 0.0f)) return std::nullopt;
+    const ScreenProjection::Ray ray =
+        ScreenProjection(viewport_->camera(), QSizeF(viewport_->width(), viewport_->height()), hf).ray(at);
+    if (!(ray.length > 0.0f)) return std::nullopt;
     const HeightfieldTracer tracer(hf);
     RayHit hit;
-    if (!tracer.intersect(from, (to - from) / length, length, hit)) return std::nullopt;
+    if (!tracer.intersect(ray.origin, ray.direction, ray.length, hit)) return std::nullopt;
     return hit.position;
 }
 

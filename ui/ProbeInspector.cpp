@@ -207,10 +207,6 @@ void ProbeInspector::showPoint(std::optional<glm::vec3> point) {
     inspect(w.volume, w.probes.front().first);
 }
 
-int ProbeInspector::inspectedVolume() const { return volume_->currentIndex(); }
-
-int ProbeInspector::inspectedProbe() const { return probe_->value(); }
-
 void ProbeInspector::refresh() {
     refreshing_ = true;
     const int vi = volume_->currentIndex();

@@ -35,8 +35,6 @@ public:
     void setVolumes(std::shared_ptr<const std::vector<GpuProbeVolume>> volumes, const QString& source);
     // Shows probe `probe` (record order of its .shprobe) of bound volume `volume`; clamped.
     void inspect(int volume, int probe);
-    int inspectedVolume() const;
-    int inspectedProbe() const;
     // The lit ball of the inspected probe (null image without probes).
     const QImage& ballImage() const { return ball_; }
     // A terrain point clicked in the viewport: says which probes light it with their weights and

@@ -37,6 +37,11 @@ double wrap360(double a) {
 
 }  // namespace
 
+std::string civilDateRule() {
+    return "a calendar date from " + std::to_string(kSolarFirstYear) + "-01-01 to " + std::to_string(kSolarLastYear) +
+           "-12-31, YYYY-MM-DD";
+}
+
 std::optional<CivilDate> parseCivilDate(const std::string& text) {
     CivilDate d;
     char tail = 0;

@@ -22,6 +22,8 @@ inline constexpr int kSolarLastYear = 2099;
 // "YYYY-MM-DD" (Gregorian) within kSolarFirstYear..kSolarLastYear; nullopt for anything else,
 // a 29 February of a common year included.
 std::optional<CivilDate> parseCivilDate(const std::string& text);
+// What parseCivilDate accepts, as a rule for messages: "a calendar date from 1901-01-01 to ...".
+std::string civilDateRule();
 
 struct SolarPosition {
     double azimuthDeg = 0.0;           // clockwise from true north, [0, 360)

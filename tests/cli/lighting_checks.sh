@@ -237,7 +237,7 @@ with open(sys.argv[1], "w") as f:
 EOF
 "$terralux" --bake --quality draft --dem "$work/nocrs.asc" --set sun.mode=date_time --out "$work/nocrs" \
   >/dev/null 2>"$work/nocrs.err" && fail "date_time over a DEM without a CRS was baked"
-grep -q "sun.mode: date_time places the sun over the DEM, which carries no CRS: set sun.latitude_deg and sun.longitude_deg" \
+grep -q "sun.mode: date_time places the sun over the DEM $work/nocrs.asc, which carries no CRS: set sun.latitude_deg and sun.longitude_deg" \
   "$work/nocrs.err" || fail "no place, no clear error: $(cat "$work/nocrs.err")"
 "$terralux" --bake --quiet --quality draft --dem "$work/nocrs.asc" --set sun.mode=date_time --set sun.latitude_deg=47.9 \
   --set sun.longitude_deg=102.8 --set bake.error_map_resolution=0 --out "$work/nocrs" >/dev/null ||
