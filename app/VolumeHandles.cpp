@@ -240,6 +240,23 @@ std::optional<VolumeBounds> sunBounds(const SceneDescription& scene, const Heigh
     }
 }
 
+std::vector<glm::vec3> sunPath(const SceneDescription& scene, const Heightfield& hf, const OrbitCamera& camera,
+                               float distance) {
+    std::vector<glm::vec3> path;
+    if (scene.sun.mode != SunMode::DateTime) return path;
+    SceneDescription at = scene;
+    try {
+        for (int q = 0; q <= 96; ++q) {
+            at.sun.timeH = q / 4.0;
+            const SunAngles a = sunAnglesOf(at, hf);
+            path.push_back(camera.target + distance * sunDirection(a.azimuthDeg, a.elevationDeg));
+        }
+    } catch (const std::exception&) {
+        path.clear();  // no place to stand the sun over
+    }
+    return path;
+}
+
 std::vector<Handle> handlesOf(const VolumeBounds& b, const SceneDescription& scene) {
     const glm::vec3 centre = 0.5f * (b.min + b.max);
     const glm::vec3 top(centre.x, b.max.y, centre.z);
@@ -294,10 +311,26 @@ HandleEdit dragHandle(const SceneDescription& scene, const Heightfield& hf, cons
             return {{{"water.level", tidy(*level + d.y)}}, "Set the water level"};
         }
         case BoundsKind::Sun: {
-            if (scene.sun.mode == SunMode::DateTime)
-                throw std::invalid_argument("the sun stands where sun.date and sun.time_h put it (sun.mode date_time); "
-                                            "set sun.mode to manual to drag it");
             const glm::dvec3 to = glm::normalize(d);
+            if (scene.sun.mode == SunMode::DateTime) {
+                // Along the day: the minute whose sun is nearest the direction, coarse then fine.
+                SceneDescription at = scene;
+                auto closeness = [&](double hours) {
+                    at.sun.timeH = hours;
+                    const SunAngles a = sunAnglesOf(at, hf);
+                    return glm::dot(glm::dvec3(sunDirection(a.azimuthDeg, a.elevationDeg)), to);
+                };
+                double best = scene.sun.timeH, bestDot = -2.0;
+                for (int m = 0; m <= 24 * 60; m += 10)
+                    if (const double c = closeness(m / 60.0); c > bestDot) bestDot = c, best = m / 60.0;
+                const double coarse = best;
+                for (int m = -10; m <= 10; ++m) {
+                    const double hours = std::clamp(coarse + m / 60.0, 0.0, 24.0);
+                    if (const double c = closeness(hours); c > bestDot) bestDot = c, best = hours;
+                }
+                // To the hundredth of an hour the Local time slider shows.
+                return {{{"sun.time_h", std::round(best * 100.0) / 100.0}}, "Set the time of day"};
+            }
             // Sky.h's sunDirection inverted: azimuth clockwise from north (-z) toward east (+x).
             double azimuth = std::atan2(to.x, -to.z) * 180.0 / std::numbers::pi;
             if (azimuth < 0.0) azimuth += 360.0;

@@ -41,6 +41,11 @@ std::vector<VolumeBounds> lpvBounds(const SceneDescription& scene, const Heightf
 std::optional<VolumeBounds> sunBounds(const SceneDescription& scene, const Heightfield& hf,
                                       const OrbitCamera& camera, float distance);
 
+// A date_time sun's path over its day, the point every quarter hour from 00:00 to 24:00 at
+// `distance` from the camera's target (97 points); empty for a manual sun or one without a place.
+std::vector<glm::vec3> sunPath(const SceneDescription& scene, const Heightfield& hf, const OrbitCamera& camera,
+                               float distance);
+
 // What dragging a handle changes.
 enum class HandleRole {
     Move,       // the box across the ground (x, z)
@@ -62,7 +67,9 @@ std::vector<Handle> handlesOf(const VolumeBounds& b, const SceneDescription& sce
 // (horizontal handles use x and z, Height uses y), against the scene as it was when the drag
 // began, with a label for the undo step ("Move volume 'probes'"). Values are those of the
 // project file (the same paths as `--set`); they keep the grid's other corner, count and
-// spacing as the role says. For the sun, `delta` is the new direction toward it (unit).
+// spacing as the role says. For the sun, `delta` is the new direction toward it (unit): a
+// manual sun takes it as its azimuth and elevation, a date_time sun moves along its day to the
+// local time whose direction is nearest (sun.time_h, to 0.01 h).
 struct HandleEdit {
     std::vector<std::pair<std::string, nlohmann::json>> values;
     std::string label;

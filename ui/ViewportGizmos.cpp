@@ -297,6 +297,12 @@ std::vector<GizmoLine> ViewportGizmos::gizmos(const OrbitCamera& camera, QSizeF 
                 out.push_back({camera.target + radius * glm::vec3(std::sin(a0), 0.0f, -std::cos(a0)),
                                camera.target + radius * glm::vec3(std::sin(a1), 0.0f, -std::cos(a1)), 0.5f * color});
             }
+            // A dated sun moves along its day: the path, bright above the horizon.
+            const std::vector<glm::vec3> path = sunPath(doc_->project().scene, heightfield(), camera, radius);
+            for (size_t i = 1; i < path.size(); ++i) {
+                const bool up = path[i - 1].y > camera.target.y || path[i].y > camera.target.y;
+                out.push_back({path[i - 1], path[i], up ? 0.9f * color : 0.35f * color});
+            }
             out.push_back({camera.target, b.min, color});
             out.push_back({camera.target, glm::vec3(b.min.x, camera.target.y, b.min.z), 0.5f * color});
             square(b.min, 7.0f, color);

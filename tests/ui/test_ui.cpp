@@ -1639,6 +1639,19 @@ private slots:
         QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, sunAt + QPoint(40, 0));
         QCOMPARE(undo->undoText(), QString("Move the sun"));
         QVERIFY(std::abs(w_->document()->value("sun.azimuth_deg").get<double>() - azimuth) > 1.0);
+        // A sun placed by a date and a time moves along its day: the drag sets the local time.
+        QVERIFY(w_->document()->setParameters({{"sun.mode", "date_time"}, {"sun.date", "2026-06-21"}, {"sun.time_h", 9.0}},
+                                              &error));
+        for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+            if (b.kind == BoundsKind::Sun) sun = b;
+        const QPoint morning = screen(sun.min);
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, morning);
+        QTRY_VERIFY(gizmos->selected() && gizmos->selected()->kind == BoundsKind::Sun);
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, morning);
+        for (int i = 1; i <= 5; ++i) QTest::mouseMove(vp, morning + QPoint(8 * i, -6 * i));
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, morning + QPoint(40, -30));
+        QCOMPARE(undo->undoText(), QString("Set the time of day"));
+        QVERIFY(std::abs(w_->document()->value("sun.time_h").get<double>() - 9.0) >= 0.25);
         QTest::qWait(200);
         QVERIFY(w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height())
                     .save(QString::fromStdString((kOut / "viewport_bounds.png").string())));

@@ -10,6 +10,7 @@
 
 #include "DemImport.h"
 #include "Project.h"
+#include "SceneLighting.h"
 #include "SampleTerrain.h"
 #include "VolumeHandles.h"
 #include "bake/ProbePlacement.h"
@@ -214,8 +215,28 @@ TEST(VolumeHandles, ReflectionGridWaterAndSun) {
     const SceneDescription moved = applied(scene, dragHandle(scene, sample(), *sun, HandleRole::Sun, to));
     EXPECT_NEAR(moved.sun.azimuthDeg, 281.3, 1e-9);
     EXPECT_NEAR(moved.sun.elevationDeg, 17.6, 1e-9);
-    const SceneDescription dated = sceneWith({"sun.mode=date_time"});
-    EXPECT_THROW(dragHandle(dated, sample(), *sun, HandleRole::Sun, to), std::invalid_argument);
+    EXPECT_TRUE(sunPath(scene, sample(), camera, 500.0f).empty());
+
+    // A dated sun moves along its day: a direction on the path gives back its time, and the
+    // path runs from midnight to midnight through the sun where it stands.
+    const SceneDescription dated = sceneWith({"sun.mode=date_time", "sun.date=2026-06-21", "sun.time_h=9.5"});
+    const std::vector<glm::vec3> path = sunPath(dated, sample(), camera, 500.0f);
+    ASSERT_EQ(path.size(), 97u);
+    const std::optional<VolumeBounds> datedSun = sunBounds(dated, sample(), camera, 500.0f);
+    ASSERT_TRUE(datedSun);
+    EXPECT_LT(glm::distance(path[38], datedSun->min), 0.05f);  // 09:30 is the 38th quarter hour
+    EXPECT_LT(path[0].y, camera.target.y);                      // below the horizon at midnight
+    EXPECT_GT(path[48].y, camera.target.y + 400.0f);            // high at noon in June at 34° N
+    for (double hours : {6.25, 11.0, 16.75}) {
+        SceneDescription at = dated;
+        at.sun.timeH = hours;
+        const SunAngles a = sunAnglesOf(at, sample());
+        const HandleEdit e = dragHandle(dated, sample(), *datedSun, HandleRole::Sun, sunDirection(a.azimuthDeg, a.elevationDeg));
+        EXPECT_EQ(e.label, "Set the time of day");
+        ASSERT_EQ(e.values.size(), 1u);
+        EXPECT_EQ(e.values[0].first, "sun.time_h");
+        EXPECT_NEAR(e.values[0].second.get<double>(), hours, 0.0101) << hours;
+    }
 }
 
 TEST(VolumeBounds, LpvCascadesSurroundTheCamera) {
