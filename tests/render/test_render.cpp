@@ -608,6 +608,37 @@ TEST_F(RenderTest, LeafOverlayDrawsTheBoundLeaves) {
     EXPECT_EQ(test::compareImages(r.render(q).rgba, plain.rgba, kW, kH).maxAbs, 0.0);
 }
 
+// The viewport's gizmo lines (volume bounds and handles): drawn in their colour in front of the
+// terrain even where they run beneath it, a larger list the next frame grows the slot's buffer,
+// and none leaves the frame as it was.
+TEST_F(RenderTest, GizmoLinesDrawInFrontOfTheTerrain) {
+    ProjectRenderer r(*ctx_, sampleProject("gizmos", 4, 4));
+    const Heightfield& hf = r.heightfield();
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    const RenderedImage plain = r.render(q);
+    auto magenta = [](const RenderedImage& img) {
+        size_t n = 0;
+        for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+            n += img.rgba[i * 4] > 0.95f && img.rgba[i * 4 + 1] < 0.05f && img.rgba[i * 4 + 2] > 0.95f;
+        return n;
+    };
+    ASSERT_EQ(magenta(plain), 0u);
+    // 100 m below the lowest ground, across the footprint: hidden by the terrain if depth counted.
+    const float below = hf.minHeight() - 100.0f;
+    q.gizmos = {{glm::vec3(hf.minX(), below, 0.0f), glm::vec3(hf.maxX(), below, 0.0f), glm::vec3(1.0f, 0.0f, 1.0f)}};
+    const size_t one = magenta(r.render(q));
+    EXPECT_GT(one, size_t(kW) / 4);
+    for (int k = 1; k <= 8; ++k) {
+        const float z = hf.minZ() + (hf.maxZ() - hf.minZ()) * float(k) / 9.0f;
+        q.gizmos.push_back({glm::vec3(hf.minX(), below, z), glm::vec3(hf.maxX(), below, z), glm::vec3(1.0f, 0.0f, 1.0f)});
+    }
+    EXPECT_GT(magenta(r.render(q)), 4 * one);
+    q.gizmos.clear();
+    EXPECT_EQ(test::compareImages(r.render(q).rgba, plain.rgba, kW, kH).maxAbs, 0.0);
+}
+
 TEST_F(RenderTest, EditsThatDoNotTouchTheVolumesPlaceNothing) {
     Project p = sampleProject("placements", 6, 6);
     ProjectRenderer r(*ctx_, p);
