@@ -1657,6 +1657,98 @@ private slots:
                     .save(QString::fromStdString((kOut / "viewport_bounds.png").string())));
     }
 
+    // A whole session as a user drives it: import a DEM, select the probe volume in the viewport
+    // and resize it by a handle, place the sun by a date and a time, bake, inspect a probe of the
+    // bake, then undo everything; the baked files say what the session set.
+    void aFullSessionFromImportToUndo() {
+        ProjectDocument& doc = *w_->document();
+        ViewportWindow* vp = w_->viewport();
+        ViewportGizmos* gizmos = w_->gizmos();
+        const nlohmann::json initialDem = doc.value("terrain.dem");
+        quickBakeSettings(doc);
+        const int setupSteps = doc.undoStack()->index();
+
+        // Import.
+        const fs::path dem = fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif";
+        QVERIFY(w_->importDemFile(QString::fromStdString(dem.string())));
+        QTRY_VERIFY_WITH_TIMEOUT(!doc.terrainLoading() && doc.value("terrain.dem").get<std::string>().ends_with("rainier_crop.tif"),
+                                 30000);
+        // The viewport draws the new terrain (Mount Rainier) with its own preview.
+        QTRY_VERIFY_WITH_TIMEOUT(w_->probeSource() == "draft preview" &&
+                                     std::abs(vp->renderer()->heightfield().geo.latitudeDeg - 46.85) < 0.5, 30000);
+        const Heightfield& hf = doc.terrain().heightfield;
+
+        // Select the volume by its edge and drag its max corner back by a third of the footprint.
+        const QSizeF size(vp->width(), vp->height());
+        auto screen = [&](const glm::vec3& p) {
+            const auto at = ScreenProjection(vp->camera(), size, doc.terrain().heightfield).toScreen(p);
+            return at ? at->toPoint() : QPoint(-1, -1);
+        };
+        VolumeBounds box;
+        for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+            if (b.kind == BoundsKind::ProbeVolume) box = b;
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, screen(glm::vec3(0.5f * (box.min.x + box.max.x), box.max.y, box.max.z)));
+        QTRY_VERIFY(gizmos->selected() && gizmos->selected()->kind == BoundsKind::ProbeVolume);
+        Handle corner;
+        for (const Handle& h : gizmos->handles())
+            if (h.role == HandleRole::MaxCorner) corner = h;
+        const glm::vec3 goal = corner.at - glm::vec3((box.max.x - box.min.x) / 3.0f, 0.0f, (box.max.z - box.min.z) / 3.0f);
+        const QPoint from = screen(corner.at), to = screen(goal);
+        QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, from);
+        for (int i = 1; i <= 8; ++i) QTest::mouseMove(vp, from + (to - from) * i / 8);
+        QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, to);
+        QCOMPARE(doc.undoStack()->undoText(), QString("Resize volume 'probes'"));
+        const nlohmann::json origin = doc.value("probe_volumes[0].origin"), spacing = doc.value("probe_volumes[0].spacing");
+        QVERIFY(origin.is_array() && spacing.is_array());
+        const double sx = spacing[0].get<double>(), sz = spacing[1].get<double>();
+        const double autoStep = (hf.maxX() - hf.minX()) / 7.0;
+        QVERIFY2(sx < 0.8 * autoStep && sx > 0.55 * autoStep, qPrintable(QString("%1 vs %2").arg(sx).arg(autoStep)));
+
+        // The sun by a date and a time, through the Sun & Sky dock.
+        w_->findChild<QDockWidget*>("dock.sunSky")->raise();
+        w_->findChild<QComboBox*>("param.sun.mode")->setCurrentText("date_time");
+        auto* date = w_->findChild<QLineEdit*>("param.sun.date");
+        date->setText("2026-08-14");
+        QMetaObject::invokeMethod(date, "editingFinished");
+        w_->findChild<QSlider*>("param.sun.time_h.slider")->setValue(375);  // 09:00
+        QCOMPARE(doc.project().scene.sun.timeH, 9.0);
+        QCOMPARE(doc.project().scene.sun.date, std::string("2026-08-14"));
+
+        // Bake, and read what it wrote.
+        w_->startBake();
+        QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 90000));
+        const fs::path out = kOut / "bake";
+        std::ifstream reportFile(out / "bake_report.json");
+        const nlohmann::json report = nlohmann::json::parse(reportFile);
+        QCOMPARE(report["sun"]["date"].get<std::string>(), std::string("2026-08-14"));
+        QCOMPARE(report["sun"]["time_h"].get<double>(), 9.0);
+        std::ifstream sidecar(out / "sh_coeffs" / "probes.probes.json");
+        const nlohmann::json probes = nlohmann::json::parse(sidecar);
+        const std::vector<double> positions = probes["positions"].get<std::vector<double>>();
+        QCOMPARE(positions.size(), size_t(64 * 3));
+        QVERIFY(std::abs(positions[0] - origin[0].get<double>()) < 0.01);
+        QVERIFY(std::abs(positions[2] - origin[1].get<double>()) < 0.01);
+        QVERIFY(std::abs(positions[63 * 3] - (origin[0].get<double>() + 7.0 * sx)) < 0.05);
+        QVERIFY(std::abs(positions[63 * 3 + 2] - (origin[1].get<double>() + 7.0 * sz)) < 0.05);
+
+        // Inspect a probe of the bake by its marker.
+        const auto volumes = vp->renderer()->boundVolumes();
+        QVERIFY(volumes->size() == 1 && volumes->front().diagnostics);
+        const int target = 2 * 8 + 5;
+        const QPoint marker = screen(volumes->front().diagnostics->positions[size_t(target)]);
+        QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, marker);
+        QTRY_COMPARE(w_->findChild<QSpinBox*>("probeInspector.probe")->value(), target);
+        QVERIFY(w_->findChild<QLabel*>("probeInspector.status")->text().contains("last bake"));
+
+        // Undo everything this session did: the sample, the auto grid and the manual sun again.
+        while (doc.undoStack()->index() > setupSteps) doc.undoStack()->undo();
+        QTRY_VERIFY_WITH_TIMEOUT(!doc.terrainLoading(), 30000);
+        QCOMPARE(doc.value("terrain.dem"), initialDem);
+        QVERIFY(doc.value("probe_volumes[0].origin").is_null() && doc.value("probe_volumes[0].spacing").is_null());
+        QCOMPARE(doc.project().scene.sun.mode, SunMode::Manual);
+        QVERIFY(std::abs(doc.terrain().heightfield.geo.latitudeDeg - 34.34) < 0.01);
+    }
+
     void probeInspectorShowsAClickedProbe() {
         auto* group = w_->findChild<QWidget*>("probeInspector.group");
         auto* probe = w_->findChild<QSpinBox*>("probeInspector.probe");
