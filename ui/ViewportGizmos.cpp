@@ -148,8 +148,16 @@ void ViewportGizmos::clearSelection() {
     emit redraw();
 }
 
-std::vector<Handle> ViewportGizmos::handles() const {
-    return selected_ ? handlesOf(*selected_, doc_->project().scene) : std::vector<Handle>{};
+std::optional<VolumeBounds> ViewportGizmos::selectedFor(const OrbitCamera& camera) const {
+    if (!selected_ || (selected_->kind != BoundsKind::Sun && selected_->kind != BoundsKind::LpvCascade)) return selected_;
+    for (const VolumeBounds& b : bounds(camera))
+        if (b.kind == selected_->kind && b.index == selected_->index) return b;
+    return std::nullopt;
+}
+
+std::vector<Handle> ViewportGizmos::handles(const OrbitCamera& camera) const {
+    const std::optional<VolumeBounds> b = selectedFor(camera);
+    return b ? handlesOf(*b, doc_->project().scene) : std::vector<Handle>{};
 }
 
 bool ViewportGizmos::select(QPointF at, const OrbitCamera& camera, QSizeF size, double pixels, bool keepOnMiss) {
@@ -160,9 +168,9 @@ bool ViewportGizmos::select(QPointF at, const OrbitCamera& camera, QSizeF size, 
         if (d < bestDistance) bestDistance = d, best = b;
     };
     // The selected bounds' handles first: a click on one keeps the selection.
-    if (selected_)
-        for (const Handle& h : handles())
-            if (const auto p = view.toScreen(h.at)) consider(*selected_, std::hypot(p->x() - at.x(), p->y() - at.y()));
+    if (const std::optional<VolumeBounds> current = selectedFor(camera))
+        for (const Handle& h : handlesOf(*current, doc_->project().scene))
+            if (const auto p = view.toScreen(h.at)) consider(*current, std::hypot(p->x() - at.x(), p->y() - at.y()));
     for (const VolumeBounds& b : bounds(camera)) {
         if (b.kind == BoundsKind::Sun) {
             if (const auto p = view.toScreen(b.min)) consider(b, std::hypot(p->x() - at.x(), p->y() - at.y()));
@@ -187,22 +195,18 @@ bool ViewportGizmos::select(QPointF at, const OrbitCamera& camera, QSizeF size, 
 }
 
 bool ViewportGizmos::grab(QPointF at, const OrbitCamera& camera, QSizeF size) {
-    if (!selected_) return false;
+    const std::optional<VolumeBounds> current = selectedFor(camera);
+    if (!current) return false;
     const ScreenProjection view(camera, size, heightfield());
     std::optional<Handle> hit;
     double bestDistance = kHandlePixels;
-    for (const Handle& h : handles())
+    for (const Handle& h : handlesOf(*current, doc_->project().scene))
         if (const auto p = view.toScreen(h.at)) {
             const double d = std::hypot(p->x() - at.x(), p->y() - at.y());
             if (d < bestDistance) bestDistance = d, hit = h;
         }
     if (!hit) return false;
-    VolumeBounds bounds = *selected_;
-    if (bounds.kind == BoundsKind::Sun) {
-        // The sun's point stands where the camera puts it; the selection may be from another view.
-        if (const auto sun = sunBounds(doc_->project().scene, heightfield(), camera, sunDistance(camera))) bounds = *sun;
-    }
-    drag_ = Drag{bounds, *hit, doc_->project().scene, hit->at, {}};
+    drag_ = Drag{*current, *hit, doc_->project().scene, hit->at, {}};
     doc_->beginLiveEdit();
     emit redraw();
     return true;

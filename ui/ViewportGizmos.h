@@ -57,8 +57,10 @@ public:
     // something was hit.
     bool select(QPointF at, const OrbitCamera& camera, QSizeF size, double pixels = 8.0, bool keepOnMiss = false);
     void clearSelection();
-    // The selected bounds' handles, where they stand now.
-    std::vector<Handle> handles() const;
+    // The selected bounds as `camera` sees them now (the sun and the LPV cascades move with the
+    // camera), and their handles.
+    std::optional<VolumeBounds> selectedFor(const OrbitCamera& camera) const;
+    std::vector<Handle> handles(const OrbitCamera& camera) const;
 
     // ViewportInteraction: a press on one of the selected bounds' handles starts a drag.
     bool grab(QPointF at, const OrbitCamera& camera, QSizeF size) override;
