@@ -701,7 +701,9 @@ void MainWindow::buildViewportToolbar() {
                                                         {BoundsKind::Water, "water"},
                                                         {BoundsKind::Sun, "sun"}};
     const char* titles[] = {"Probe volumes", "Reflection probes", "LPV cascades", "Water level", "Sun"};
-    for (const auto& [kind, name] : kinds) {
+    for (const auto& entry : kinds) {
+        const BoundsKind kind = entry.first;  // a plain variable: lambdas capture it (not a binding)
+        const char* name = entry.second;
         auto* a = boundsMenu_->addAction(titles[int(kind)]);
         a->setObjectName(QString("viewport.bounds.") + name);
         a->setCheckable(true);
