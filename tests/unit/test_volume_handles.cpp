@@ -151,7 +151,8 @@ TEST(VolumeHandles, TerrainGridMovesAndResizesAsDragged) {
 
     // A corner dragged past the other leaves at least a DEM cell between probes.
     const HandleEdit collapsed = dragHandle(scene, sample(), b, HandleRole::MaxCorner, glm::vec3(-1e6f, 0.0f, -1e6f));
-    const ProbeVolumeSettings& v = applied(scene, collapsed).probeVolumes[0];
+    const SceneDescription collapsedScene = applied(scene, collapsed);
+    const ProbeVolumeSettings& v = collapsedScene.probeVolumes[0];
     EXPECT_GE(v.spacing->x, sample().cellSizeX() - 1e-6);
 
     // Height: the offset above the surface.
