@@ -1085,7 +1085,7 @@ nlohmann::json samplingReport(const SamplingChoice& sampling, const nlohmann::js
 // together and committed with rollback, so a failed export leaves the earlier files, and an
 // earlier bake's files that this one does not write go. Fills the report's file list and time.
 std::vector<std::filesystem::path> writeBake(const Project& project, const BakeSetup& setup, std::vector<GltfProbeVolume> grids,
-                                   const nlohmann::json& bakeInfo, std::optional<ReflectionOutput>& reflections,
+                                   std::vector<GltfScenario> scenarios, const nlohmann::json& bakeInfo, std::optional<ReflectionOutput>& reflections,
                                    BakeOutcome& out, Clock::time_point start) {
     const SceneDescription& scene = project.scene;
     const BakeLighting& lighting = setup.lighting;
@@ -1098,6 +1098,8 @@ std::vector<std::filesystem::path> writeBake(const Project& project, const BakeS
     in.volumes = std::move(grids);
     in.bake = bakeInfo;
     in.lighting = lightingExtension(project, setup.terrain.heightfield, lighting);
+    in.scenarios = std::move(scenarios);
+    in.defaultLighting = {{"sun", in.lighting.at("sun")}, {"sky", in.lighting.at("sky")}};
     if (reflections) {
         for (const auto& [k, v] : reflections->gltf.items()) in.lighting["reflection_probes"][k] = v;
         in.reflectionFiles = std::move(reflections->files);
@@ -1161,10 +1163,15 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     removeStaleTemporaries(project.outDir());
 
     // Phase weights for one progress bar: cache, probes, reference.
-    const double cacheShare = (!referenceMode && q.bounces > 0) ? 0.35 : 0.0;
+    double cacheShare = (!referenceMode && q.bounces > 0) ? 0.35 : 0.0;
     const double refShare = request.compareReference && !referenceMode && !volumes.empty() ? 0.45 : 0.0;
     const double reflectionShare = !plan.reflections ? 0.0 : volumes.empty() ? 0.95 - cacheShare : 0.3;
-    const double probeShare = 0.97 - 0.02 - cacheShare - refShare - reflectionShare;
+    double probeShare = 0.97 - 0.02 - cacheShare - refShare - reflectionShare;
+    // Each lighting scenario costs about a cache and the probes again (no map, no reference).
+    const double lightings = double(1 + scene.scenarios.size());
+    const double scenarioShare = (cacheShare + probeShare) * (1.0 - 1.0 / lightings);
+    cacheShare /= lightings;
+    probeShare /= lightings;
     double base = 0.02;
 
     std::unique_ptr<IrradianceCache> cache;
@@ -1278,6 +1285,61 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     }
     if (cancelled()) throw BakeCancelled();
 
+    // Lighting scenarios: the layouts just baked, lit by each scenario's sun and sky, with an
+    // irradiance cache of its own; written as the default's are (deringing, encoding).
+    std::vector<GltfScenario> scenarioGrids;
+    nlohmann::json scenarioReports = nlohmann::json::array();
+    const double scenarioBase = 0.02 + (cacheShare + probeShare) + refShare;
+    for (size_t si = 0; si < scene.scenarios.size(); ++si) {
+        const std::string& name = scene.scenarios[si].name;
+        const auto scenarioStart = Clock::now();
+        const double n = double(scene.scenarios.size());
+        auto scenarioProgress = [&](double f) {
+            report("scenario '" + name + "'", scenarioBase + scenarioShare * (double(si) + f) / n);
+        };
+        Project litProject = project;
+        litProject.scene = scenarioScene(scene, name);
+        const BakeLighting lit = scenarioLightingOf(project, name, hf, lighting);
+        std::unique_ptr<IrradianceCache> litCache;
+        if (!referenceMode && q.bounces > 0)
+            litCache = std::make_unique<IrradianceCache>(
+                lit, plan.cacheResolution, q.cacheRays, q.sunSamples, q.bounces - 1,
+                BakeControl{[&](double f) { scenarioProgress(0.3 * f); }, cancel});
+        const nlohmann::json ext = lightingExtension(litProject, hf, lit);
+        GltfScenario out{name, {}, {{"sun", ext.at("sun")}, {"sky", ext.at("sky")}}};
+        nlohmann::json sr = {{"name", name}, {"cache_rays", litCache ? litCache->rays() : 0}};
+        uint64_t rays = 0;
+        for (size_t vi = 0; vi < volumes.size(); ++vi) {
+            const ProbeVolumeSettings& v = *volumes[vi];
+            const ProbeLayout& layout = plan.layouts[vi];
+            const BakeControl c{[&](double f) {
+                                    scenarioProgress(0.3 + 0.7 * (double(vi) + f) / double(volumes.size()));
+                                },
+                                cancel};
+            ProbeBake b = referenceMode ? referenceProbes(lit, q.bounces, layout.positions, layout.valid,
+                                                          raysOf(setup, v), volumeSeed(vi), c)
+                                        : bakeProbes(lit, litCache.get(), q.bounces, layout.positions, layout.valid,
+                                                     raysOf(setup, v), volumeSeed(vi), c);
+            rays += b.rays;
+            if (scene.bake.deringing) (void)sh::deringProbes(b.sh, layout.valid);
+            if (scene.bake.encoding == ShEncoding::Irradiance)
+                for (auto& probe : b.sh)
+                    for (int k = 0; k < sh::kCoeffCount; ++k) probe.c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
+            std::vector<float> se;
+            for (size_t i = 0; i < layout.valid.size(); ++i)
+                if (layout.valid[i]) se.push_back(b.standardError[i]);
+            sr["volumes"].push_back({{"name", v.name}, {"rays", b.rays}, {"standard_error", stats(se)}});
+            out.volumes.push_back({v.name, toGrid(layout, b.sh, scene.exportSettings), ""});
+        }
+        if (cancelled()) throw BakeCancelled();
+        sr["probe_rays"] = rays;
+        sr["file_stem"] = "scenarios/<volume>." + name + ".shprobe";
+        sr["time_s"] = secondsSince(scenarioStart);
+        totalRays += rays;
+        scenarioReports.push_back(std::move(sr));
+        scenarioGrids.push_back(std::move(out));
+    }
+
     std::optional<ReflectionOutput> reflections;
     if (plan.reflections) {
         const BakeControl rc{[&](double f) { report("reflection probes", 0.97 - reflectionShare * (1.0 - f)); },
@@ -1351,6 +1413,13 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         {"volumes", volumeReports},
         {"overlaps", overlapReport(grids)},
     };
+    if (!scenarioReports.empty()) {
+        uint64_t cacheRaysAll = 0;
+        for (const auto& sr : scenarioReports) cacheRaysAll += sr["cache_rays"].get<uint64_t>();
+        out.report["scenarios"] = scenarioReports;
+        out.report["cache_rays"] = cacheRays + cacheRaysAll;
+        out.report["rays"] = out.report["rays"].get<uint64_t>() + cacheRaysAll;
+    }
     if (reflections) {
         const nlohmann::json& rr = reflections->report;
         const uint64_t reflectionRays =
@@ -1379,7 +1448,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     volumeWarnings(scene, volumes, volumeReports, out.warnings);
     if (sampling) out.report["sampling_target"] = samplingReport(*sampling, volumeReports, out.warnings);
     out.report["warnings"] = out.warnings;
-    out.files = writeBake(project, setup, std::move(grids), bakeInfo, reflections, out, start);
+    out.files = writeBake(project, setup, std::move(grids), std::move(scenarioGrids), bakeInfo, reflections, out, start);
     report("done", 1.0);
     return out;
 }
@@ -1763,8 +1832,13 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         ve.secondsMax = std::max(probesMax, probes) * perProbe + mapSeconds + ve.suggestionSecondsMax;
         e.seconds += ve.seconds;
         e.secondsMax += ve.secondsMax;
+        e.scenarioSeconds += probes * perProbe;
         e.volumes.push_back(std::move(ve));
     }
+    e.scenarios = scene.scenarios.size();
+    e.scenarioSeconds += e.cacheSeconds;
+    e.seconds += double(e.scenarios) * e.scenarioSeconds;
+    e.secondsMax += double(e.scenarios) * e.scenarioSeconds;
     return e;
 }
 

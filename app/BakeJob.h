@@ -164,6 +164,10 @@ struct BakeEstimate {
         double seconds = 0.0;
     };
     std::optional<Reflection> reflection;
+    // Lighting scenarios: each bakes a cache and the probes of the same layouts again (no error
+    // map), scenarioSeconds each.
+    size_t scenarios = 0;
+    double scenarioSeconds = 0.0;
     bool lpvIni = false;   // lpv.enabled: the bake writes lpv.ini and TERRALUX_lighting.lpv
     size_t lights = 0;     // local lights: KHR_lights_punctual
     std::optional<SamplingChoice> sampling;  // bake.target_error chose rays and bounces

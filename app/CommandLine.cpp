@@ -147,6 +147,9 @@ int printEstimate(const BakeEstimate& e) {
     if (e.lights)
         std::cout << "  local lights: " << e.lights << " in KHR_lights_punctual\n";
     if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
+    if (e.scenarios > 0)
+        std::cout << "  lighting scenarios: " << e.scenarios << " beside the default, about "
+                  << duration(e.scenarioSeconds) << " each (a cache and the probes again)\n";
     std::cout << "  loading the terrain, sky and albedo: " << duration(e.loadSeconds) << " (as measured here)";
     if (e.writeSeconds > 0.0) std::cout << "; writing the scene: about " << duration(e.writeSeconds);
     std::cout << "\n";
@@ -325,6 +328,15 @@ int commandBake(const Args& a) {
                           << " %, cubemap mean " << fixed(100.0 * e["cubemap"]["mean"].get<double>(), 2)
                           << " % / max " << fixed(100.0 * e["cubemap"]["max"].get<double>(), 2) << " %\n";
     }
+    if (r.contains("scenarios"))
+        for (const auto& sc : r["scenarios"]) {
+            std::cout << "  scenario '" << sc["name"].get<std::string>() << "': " << fixed(sc["time_s"].get<double>(), 2)
+                      << " s";
+            for (const auto& v : sc["volumes"])
+                std::cout << ", '" << v["name"].get<std::string>() << "' standard error mean "
+                          << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " %";
+            std::cout << "\n";
+        }
     if (r.contains("lpv")) {
         const auto& lpv = r["lpv"];
         std::cout << "  light propagation volumes: " << lpv["cascades"].size() << " cascades (";

@@ -1062,6 +1062,47 @@ std::vector<ParameterSpec> buildTable() {
         if (r.s_.path.rfind("lpv.", 0) == 0 && r.s_.path != "lpv.indirect_intensity" && cvar < cvars.size())
             r.s_.consoleVariable = cvars[cvar++].first;
 
+    // Lighting scenarios: a name, and every sun and sky row again, bound to the scenario's own sun
+    // and sky, so a scenario's values meet the same rules as the project's.
+    bake = BakeUse::Reads;
+    add(Row("scenarios[].name", T::String))
+        .pattern("[A-Za-z0-9_-]{1,64}", "must be 1-64 letters, digits, '_' or '-' (it names the scenario's .shprobe files)")
+        .label("Scenario").about("Names the scenario's .shprobe files (scenarios/<volume>.<scenario>.shprobe); unique, and not \"default\" (the project's own sun and sky)")
+        .redoes(kUpload).noUiRow()
+        .custom([](const SceneDescription& s, size_t i) { return json(s.scenarios.at(i).name); },
+                [](SceneDescription& s, size_t i, const json& v) { s.scenarios.at(i).name = v.get<std::string>(); });
+    const auto lit = [](const SceneDescription& s, size_t i) {
+        SceneDescription t;
+        t.sun = s.scenarios.at(i).sun;
+        t.sky = s.scenarios.at(i).sky;
+        return t;
+    };
+    const size_t lightingRows = rows.size();
+    for (size_t r = 0; r < lightingRows; ++r) {
+        const ParameterSpec& original = rows[r].s_;
+        if (original.path.rfind("sun.", 0) != 0 && original.path.rfind("sky.", 0) != 0) continue;
+        ParameterSpec c = original;
+        c.path = "scenarios[]." + original.path;
+        c.get = [lit, g = original.get](const SceneDescription& s, size_t i) { return g(lit(s, i), 0); };
+        c.set = [lit, set = original.set](SceneDescription& s, size_t i, const json& v) {
+            SceneDescription t = lit(s, i);
+            set(t, 0, v);
+            s.scenarios.at(i).sun = t.sun;
+            s.scenarios.at(i).sky = t.sky;
+        };
+        if (original.items)
+            c.items = [lit, f = original.items](const SceneDescription& s, size_t i) { return f(lit(s, i), 0); };
+        if (original.readWhen)
+            c.readWhen = [lit, f = original.readWhen](const SceneDescription& s, size_t i) { return f(lit(s, i), 0); };
+        if (original.resolved)
+            c.resolved = [lit, f = original.resolved](const SceneDescription& s, const Heightfield& hf, size_t i) {
+                return f(lit(s, i), hf, 0);
+            };
+        Row copy("", T::Number);
+        copy.s_ = std::move(c);
+        rows.push_back(std::move(copy));
+    }
+
     std::vector<ParameterSpec> table;
     table.reserve(rows.size());
     for (Row& r : rows) {
@@ -1081,7 +1122,7 @@ double shortestDecimal(float f) {
 }
 
 const std::vector<std::string>& objectLists() {
-    static const std::vector<std::string> lists{"probe_volumes", "water.waves", "lights"};
+    static const std::vector<std::string> lists{"probe_volumes", "water.waves", "lights", "scenarios"};
     return lists;
 }
 
@@ -1105,6 +1146,7 @@ json ParameterSpec::defaultValue() const {
     SceneDescription scene;  // holds one default probe volume
     if (perWave()) scene.water.waves.emplace_back();
     if (perLight()) scene.lights.emplace_back();
+    if (perScenario()) scene.scenarios.emplace_back();
     return get(scene, 0);
 }
 
@@ -1163,7 +1205,7 @@ std::string editLabel(const std::string& path, const nlohmann::json& doc) {
         {"reflection_probes", "reflection probes"}, {"bake", "bake"}, {"camera", "camera"},
         {"export", "export"}, {"shadows", "shadows"}, {"fog", "fog"}, {"detail", "detail"},
         {"ao", "ambient occlusion"}, {"water", "water"}, {"lpv", "LPV"}, {"lighting", "lighting"},
-        {"lights", "lights"}};
+        {"lights", "lights"}, {"scenarios", "scenarios"}};
     std::string element;
     for (const std::string& list : objectLists()) {
         if (path.rfind(list + "[", 0) != 0) continue;
@@ -1183,6 +1225,13 @@ std::string editLabel(const std::string& path, const nlohmann::json& doc) {
             element = v && v->is_object() && v->contains("name") && (*v)["name"].is_string()
                           ? "volume '" + (*v)["name"].get<std::string>() + "'"
                           : "volume " + std::to_string(i + 1);
+        } else if (list == "scenarios") {
+            const nlohmann::json* v = nullptr;
+            if (doc.contains("scenarios") && doc["scenarios"].is_array() && i < doc["scenarios"].size())
+                v = &doc["scenarios"][i];
+            element = v && v->is_object() && v->contains("name") && (*v)["name"].is_string()
+                          ? "scenario '" + (*v)["name"].get<std::string>() + "'"
+                          : "scenario " + std::to_string(i + 1);
         } else {
             element = (list == "lights" ? "light " : "wave ") + std::to_string(i + 1);
         }
@@ -1318,7 +1367,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     const bool surface = spec.path.rfind("terrain.albedo", 0) == 0 || spec.path.rfind("terrain.ramp_", 0) == 0 ||
                          spec.path == "terrain.roughness" || spec.path == "terrain.specular_aa";
     if (section == "terrain" && !surface) return {"dock.terrain", "Terrain"};
-    if (section == "sun" || section == "sky") return {"dock.sunSky", "Sun & Sky"};
+    if (section == "sun" || section == "sky" || section == "scenarios") return {"dock.sunSky", "Sun & Sky"};
     if (section == "probe_volumes") return {"dock.probeVolumes", "Probe Volumes"};
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
     if (section == "shadows") return {"dock.shadows", "Shadows"};
@@ -1334,6 +1383,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
 std::string uiObjectName(const ParameterSpec& spec) {
     if (spec.perVolume()) return "param.volume." + spec.localPath();
     if (spec.perLight()) return "param.light." + spec.localPath();
+    if (spec.perScenario()) return "param.scenario." + spec.localPath();
     return "param." + spec.path;
 }
 
@@ -1360,11 +1410,12 @@ json projectSchema() {
     props["version"] = {{"type", "integer"}, {"minimum", 1}, {"maximum", kProjectVersion},
                         {"description", "Project format version; older versions are migrated on reading"},
                         {"default", kProjectVersion}};
-    json volume = objectSchema(), wave = objectSchema(), light = objectSchema();
+    json volume = objectSchema(), wave = objectSchema(), light = objectSchema(), scenario = objectSchema();
     for (const auto& s : parameterTable()) {
         if (s.perVolume()) insert(volume, s.localPath(), leafSchema(s));
         else if (s.perWave()) insert(wave, s.localPath(), leafSchema(s));
         else if (s.perLight()) insert(light, s.localPath(), leafSchema(s));
+        else if (s.perScenario()) insert(scenario, s.localPath(), leafSchema(s));
         else insert(schema, s.path, leafSchema(s));
     }
     props["probe_volumes"] = {{"type", "array"},
@@ -1382,6 +1433,11 @@ json projectSchema() {
                        {"description", "Point and spot lights: injected into the light propagation volumes and exported as KHR_lights_punctual; the diffuse bake leaves them out"},
                        {"items", light},
                        {"default", json::array()}};
+    props["scenarios"] = {{"type", "array"},
+                          {"maxItems", kMaxScenarios},
+                          {"description", "Lighting scenarios: a name and a sun and sky of their own, each baked into its own .shprobe set with the project's probe layout"},
+                          {"items", scenario},
+                          {"default", json::array()}};
     return schema;
 }
 
@@ -1391,6 +1447,7 @@ size_t elementCount(const SceneDescription& scene, const ParameterSpec& spec) {
     if (spec.perVolume()) return scene.probeVolumes.size();
     if (spec.perWave()) return scene.water.waves.size();
     if (spec.perLight()) return scene.lights.size();
+    if (spec.perScenario()) return scene.scenarios.size();
     return 1;
 }
 
@@ -1417,7 +1474,8 @@ json bakeReadSettings(const SceneDescription& scene,
             if (!spec.isRead(scene, e)) continue;
             const json value = spec.get(scene, e);
             if (spec.bake == BakeUse::File)
-                files[spec.path] = value.is_string() && !value.get<std::string>().empty()
+                files[spec.inList() ? spec.listPath() + "[" + std::to_string(e) + "]." + spec.localPath() : spec.path] =
+                    value.is_string() && !value.get<std::string>().empty()
                                        ? identity(spec, value.get<std::string>())
                                        : json(spec.zeroText);
             else

@@ -99,6 +99,7 @@ struct ParameterSpec {
     bool perVolume() const { return path.rfind("probe_volumes[].", 0) == 0; }
     bool perWave() const { return path.rfind("water.waves[].", 0) == 0; }
     bool perLight() const { return path.rfind("lights[].", 0) == 0; }
+    bool perScenario() const { return path.rfind("scenarios[].", 0) == 0; }
     // The list whose elements hold the row ("probe_volumes", "water.waves"); empty for the rest.
     std::string listPath() const;
     bool inList() const { return !listPath().empty(); }
@@ -123,7 +124,8 @@ struct ParameterRejection {
 
 const std::vector<ParameterSpec>& parameterTable();
 
-// The project's lists of objects, as JSON paths: "probe_volumes", "water.waves" and "lights". Each element
+// The project's lists of objects, as JSON paths: "probe_volumes", "water.waves", "lights" and
+// "scenarios". Each element
 // is an object whose keys are the rows "<list>[].<key>".
 const std::vector<std::string>& objectLists();
 

@@ -262,6 +262,7 @@ json sceneToJson(const SceneDescription& s) {
     place(doc, "probe_volumes", listToJson(s, "probe_volumes", s.probeVolumes.size()));
     place(doc, "water.waves", listToJson(s, "water.waves", s.water.waves.size()));
     place(doc, "lights", listToJson(s, "lights", s.lights.size()));
+    place(doc, "scenarios", listToJson(s, "scenarios", s.scenarios.size()));
     return doc;
 }
 
@@ -368,9 +369,43 @@ SceneDescription sceneFromJson(const json& original, const std::string& source,
         s.lights.assign(lights->size(), LocalLight{});
         readList("lights", *lights, s, source);
     }
+    if (const json* scenarios = lookup(doc, "scenarios")) {
+        if (scenarios->size() > size_t(kMaxScenarios))
+            reject(source, "scenarios", *scenarios,
+                   "must hold at most " + std::to_string(kMaxScenarios) + " scenarios (has " +
+                       std::to_string(scenarios->size()) + ")");
+        s.scenarios.assign(scenarios->size(), LightingScenario{});
+        readList("scenarios", *scenarios, s, source);
+        std::set<std::string> names{kDefaultScenario};
+        for (size_t i = 0; i < s.scenarios.size(); ++i)
+            if (!names.insert(s.scenarios[i].name).second)
+                reject(source, "scenarios[" + std::to_string(i) + "].name", s.scenarios[i].name,
+                       std::string("must be unique among scenarios and not \"") + kDefaultScenario +
+                           "\" (the project's own sun and sky)");
+    }
     for (const auto& spec : parameterTable())
         if (!spec.inList()) readRow(spec, doc, "", 0, s, source);
     return s;
+}
+
+std::vector<std::string> scenarioNames(const SceneDescription& scene) {
+    std::vector<std::string> names{kDefaultScenario};
+    for (const LightingScenario& l : scene.scenarios) names.push_back(l.name);
+    return names;
+}
+
+SceneDescription scenarioScene(const SceneDescription& scene, const std::string& name) {
+    SceneDescription lit = scene;
+    if (name == kDefaultScenario) return lit;
+    for (const LightingScenario& l : scene.scenarios)
+        if (l.name == name) {
+            lit.sun = l.sun;
+            lit.sky = l.sky;
+            return lit;
+        }
+    std::string known;
+    for (const std::string& n : scenarioNames(scene)) known += (known.empty() ? "" : ", ") + n;
+    throw ProjectError("scenario '" + name + "': the project has no such lighting scenario (it has " + known + ")");
 }
 
 void applyOverride(json& doc, const std::string& assignment) {

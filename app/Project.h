@@ -27,6 +27,9 @@ inline constexpr int kMaxBoxGridProbes = kMaxVolumeProbes;  // cells; docs/light
 inline constexpr int kMaxBounces = 16;
 inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights
 inline constexpr int kMaxLocalLights = 1024;         // lights: what one LPV update injects
+inline constexpr int kMaxScenarios = 16;             // scenarios: each costs a bake of its coefficients
+// The name of the project's own sun and sky among its lighting scenarios.
+inline constexpr const char* kDefaultScenario = "default";
 
 struct Project {
     SceneDescription scene;
@@ -66,6 +69,13 @@ SceneDescription sceneFromJson(const nlohmann::json& doc, const std::string& sou
 // (`probe_volumes[0].grid_dims`, `sun.elevation_deg`). The value is JSON, or a bare string, or a
 // comma list for array parameters and unset ones (`probe_volumes[0].origin=-100,500,-200`).
 void applyOverride(nlohmann::json& doc, const std::string& assignment);
+
+// The project's lighting scenarios by name, the default first: "default", then scenarios[].name.
+std::vector<std::string> scenarioNames(const SceneDescription& scene);
+// The scene lit as scenario `name` lights it: its sun and sky in place of the project's own
+// ("default": the scene as it is). Throws ProjectError naming the scenarios there are when no
+// scenario has that name.
+SceneDescription scenarioScene(const SceneDescription& scene, const std::string& name);
 
 Project loadProject(const std::filesystem::path& file, std::vector<std::string>* warnings);
 // Writes atomically (temporary file in the same directory, then rename).

@@ -170,6 +170,18 @@ BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
     return l;
 }
 
+BakeLighting scenarioLightingOf(const Project& project, const std::string& name, const Heightfield& hf,
+                                const BakeLighting& shared) {
+    Project lit = project;
+    lit.scene = scenarioScene(project.scene, name);
+    BakeLighting l = lightingOf(lit, hf);
+    l.tracer = shared.tracer;
+    l.albedo = shared.albedo;
+    l.surface = shared.surface;
+    l.water = shared.water;
+    return l;
+}
+
 std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
     const WaterSettings& w = p.scene.water;
     if (!w.enabled) return std::nullopt;

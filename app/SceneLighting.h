@@ -23,6 +23,11 @@ size_t physicalSkyBuilds();
 // sun's colour and illuminance are the model's, × sky.intensity.
 BakeLighting lightingOf(const Project& project, const Heightfield& hf);
 
+// The lighting of scenario `name` (scenarioScene): its sun and sky, with the tracer, albedo and
+// water of `shared` (the default's), so every scenario lights the same terrain.
+BakeLighting scenarioLightingOf(const Project& project, const std::string& name, const Heightfield& hf,
+                                const BakeLighting& shared);
+
 // Where sun.mode date_time puts the sun over `hf`: the place (latitude and longitude as set, or
 // the DEM's footprint centre), the clock's offset (as set, or the longitude's nominal zone), the
 // solar position there, and the grid convergence that turns its true azimuth into the engine's.

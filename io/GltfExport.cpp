@@ -50,6 +50,8 @@ constexpr const char* kBinName = "scene.bin";
 constexpr const char* kProbeDir = "sh_coeffs";
 constexpr const char* kProbeExt = ".shprobe";
 constexpr const char* kReflectionDir = "reflection";
+constexpr const char* kScenarioDir = "scenarios";
+constexpr const char* kDefaultScenarioName = "default";
 constexpr size_t kMaxVolumeName = 64;
 
 // glTF enumerations (glTF 2.0 specification, section 5).
@@ -448,6 +450,11 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     mesh.bytes = bin.size();
 }
 
+// scenarios/<volume>.<scenario>.shprobe: names hold no '.', so the two parts stay apart.
+fs::path scenarioFileName(const std::string& volume, const std::string& scenario) {
+    return fs::path(kScenarioDir) / (volume + "." + scenario + kProbeExt);
+}
+
 ojson probeGridEntry(const GltfProbeVolume& v) {
     const ShProbeGrid& g = v.grid;
     return ojson{
@@ -522,6 +529,28 @@ void checkInput(const fs::path& outDir, const GltfSceneInput& input,
                                  " metadata must be a JSON object or null, not " +
                                  input.lighting.type_name());
     }
+    if (!input.scenarios.empty() && !input.lighting.is_object())
+        throw std::runtime_error(gltfPath.string() + ": lighting scenarios need the " + kLightingExtension +
+                                 " object that lists them");
+    std::set<std::string> scenarioNames{kDefaultScenarioName};
+    for (const GltfScenario& sc : input.scenarios) {
+        const fs::path dir = outDir / kScenarioDir;
+        if (!validVolumeName(sc.name) || !scenarioNames.insert(sc.name).second)
+            throw std::runtime_error(dir.string() + ": scenario name '" + sc.name +
+                                     "' must be 1 to 64 of A-Z a-z 0-9 _ -, unique and not \"default\"");
+        if (!sc.lighting.is_object())
+            throw std::runtime_error(dir.string() + ": scenario '" + sc.name + "': its lighting must be a JSON object");
+        // The same layout as the default's: an engine blends two scenarios probe by probe.
+        bool same = sc.volumes.size() == input.volumes.size();
+        for (size_t i = 0; same && i < sc.volumes.size(); ++i) {
+            const ShProbeGrid &a = sc.volumes[i].grid, &b = input.volumes[i].grid;
+            same = sc.volumes[i].name == input.volumes[i].name && a.dims == b.dims && a.origin == b.origin &&
+                   a.spacing == b.spacing && a.occupancy == b.occupancy;
+        }
+        if (!same)
+            throw std::runtime_error(dir.string() + ": scenario '" + sc.name +
+                                     "' must hold the default's volumes with their layout (names, grids and occupancy)");
+    }
     for (size_t i = 0; i < sorted.size(); ++i) {
         const std::string& name = sorted[i]->name;
         if (!validVolumeName(name)) {
@@ -561,6 +590,29 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
             files.push_back({fs::path(kProbeDir) / probeDiagnosticsFileName(v->name),
                              std::vector<uint8_t>(v->diagnostics.begin(), v->diagnostics.end())});
         grids.push_back(probeGridEntry(*v));
+    }
+    // Each scenario's files in the default's order; TERRALUX_lighting.scenarios names them.
+    ojson scenarioEntries = ojson::array();
+    if (!input.scenarios.empty()) {
+        ojson defaults = {{"name", kDefaultScenarioName}};
+        for (const auto& [k, v] : input.defaultLighting.items()) defaults[k] = ojson(v);
+        defaults["shProbePaths"] = ojson::array();
+        for (const GltfProbeVolume* v : sorted)
+            defaults["shProbePaths"].push_back(std::string(kProbeDir) + "/" + v->name + kProbeExt);
+        scenarioEntries.push_back(std::move(defaults));
+    }
+    for (const GltfScenario& sc : input.scenarios) {
+        ojson entry = {{"name", sc.name}};
+        for (const auto& [k, v] : sc.lighting.items()) entry[k] = ojson(v);
+        entry["shProbePaths"] = ojson::array();
+        for (const GltfProbeVolume* d : sorted) {
+            const auto v = std::find_if(sc.volumes.begin(), sc.volumes.end(),
+                                        [&](const GltfProbeVolume& x) { return x.name == d->name; });
+            const fs::path relative = scenarioFileName(v->name, sc.name);
+            files.push_back({relative, encodeVolume(*v, outDir / relative)});
+            entry["shProbePaths"].push_back(relative.generic_string());
+        }
+        scenarioEntries.push_back(std::move(entry));
     }
     for (const auto& [name, bytes] : input.reflectionFiles) {
         if (name.empty() || fs::path(name).has_parent_path())
@@ -617,7 +669,10 @@ std::vector<PendingFile> buildFiles(const fs::path& outDir, const GltfSceneInput
               {"meshStride", mesh->stride}}},
             {kBakeExtension, ojson(input.bake)},
         };
-        if (input.lighting.is_object()) sceneExtensions[kLightingExtension] = ojson(input.lighting);
+        if (input.lighting.is_object()) {
+            sceneExtensions[kLightingExtension] = ojson(input.lighting);
+            if (!scenarioEntries.empty()) sceneExtensions[kLightingExtension]["scenarios"] = scenarioEntries;
+        }
         if (!input.lights.empty()) addLights(doc, input.lights);
         if (hasMesh) {
             auto write = [&hf, &input, gltfPath, mesh](BinStream& bin) {
@@ -743,7 +798,7 @@ std::vector<fs::path> staleOwnedFiles(const fs::path& outDir, const std::vector<
     for (const auto& f : files) writing.insert(f.relative);
     std::vector<fs::path> stale;
     std::error_code ec;
-    for (const char* dir : {kProbeDir, kReflectionDir})
+    for (const char* dir : {kProbeDir, kScenarioDir, kReflectionDir})
         for (const auto& e : fs::directory_iterator(outDir / dir, ec)) {
             const fs::path relative = fs::path(dir) / e.path().filename();
             if (e.is_regular_file(ec) && !writing.count(relative)) stale.push_back(relative);
@@ -816,7 +871,7 @@ void commit(const fs::path& outDir, const fs::path& staging, const std::vector<P
                 throw FileWriteError(target.string() + ": cannot replace (" + ec.message() + ")");
             done.push_back(std::move(step));
         }
-        for (const char* dir : {kProbeDir, kReflectionDir})
+        for (const char* dir : {kProbeDir, kScenarioDir, kReflectionDir})
             if (fs::is_directory(outDir / dir)) syncDirectory(outDir / dir);
         syncDirectory(outDir);
     } catch (...) {
@@ -846,6 +901,9 @@ std::vector<std::string> exportedFileNames(const GltfSceneInput& input) {
         if (!v->diagnostics.empty())
             names.push_back((fs::path(kProbeDir) / probeDiagnosticsFileName(v->name)).generic_string());
     }
+    for (const GltfScenario& sc : input.scenarios)
+        for (const auto* d : sortedVolumes(input))
+            names.push_back(scenarioFileName(d->name, sc.name).generic_string());
     for (const auto& f : input.reflectionFiles)
         names.push_back((fs::path(kReflectionDir) / f.first).generic_string());
     if (input.scene) {

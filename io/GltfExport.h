@@ -6,6 +6,8 @@
 //   <outDir>/scene.bin                    only when the terrain has triangles; also holds the
 //                                         terrain's albedo texture (a PNG) when it has one
 //   <outDir>/sh_coeffs/<volume>.shprobe   one file per probe volume
+//   <outDir>/scenarios/<volume>.<scenario>.shprobe
+//                                         each lighting scenario's grids, the layout of sh_coeffs/
 //   <outDir>/reflection/...               the reflection probes' files, when the caller gives them
 //
 // Engine space is glTF space (Y up, right-handed: X east, Y up, Z south), so nothing is converted.
@@ -16,7 +18,9 @@
 //                                    file name; every number equals that file's header exactly
 //   TERRALUX_geo                     CRS, origin, vertical scale, cell size, grid size, mesh stride
 //   TERRALUX_bake                    the caller's JSON object, verbatim
-//   TERRALUX_lighting                the caller's JSON object, verbatim, when it gives one
+//   TERRALUX_lighting                the caller's JSON object, verbatim, when it gives one; with
+//                                    lighting scenarios, plus "scenarios": the default's files and
+//                                    each scenario's, with its name and its lighting object
 // With water, a second node and mesh named `water`: a rectangle over the footprint at the water
 // level, whose material uses KHR_materials_transmission and KHR_materials_ior (both used, never
 // required). Local lights are KHR_lights_punctual lights (used, never required), one node each
@@ -48,6 +52,15 @@ struct GltfProbeVolume {
     std::string diagnostics;
 };
 
+// A lighting scenario of the scene (docs/formats.md, "Lighting scenarios"): the same volumes as
+// GltfSceneInput::volumes (names, dimensions, origin and spacing), lit otherwise.
+struct GltfScenario {
+    std::string name;  // 1 to 64 of [A-Za-z0-9_-], unique, not "default"
+    std::vector<GltfProbeVolume> volumes;
+    // Merged into its entry of TERRALUX_lighting.scenarios (the sun and sky it was lit with).
+    nlohmann::json lighting = nlohmann::json::object();
+};
+
 // The water plane of the scene (docs/formats.md, "glTF scene"): the footprint's rectangle at the
 // level, with a transmissive material of index of refraction 1.33.
 struct GltfWater {
@@ -66,6 +79,10 @@ struct GltfSceneInput {
     float roughness = 1.0f;  // the material's roughnessFactor (terrain.roughness), in [0, 1]
     double verticalScale = 1.0;  // recorded in TERRALUX_geo; the heights are exported as they are
     std::vector<GltfProbeVolume> volumes;
+    // Written as scenarios/<volume>.<scenario>.shprobe and listed in TERRALUX_lighting.scenarios
+    // (which then needs `lighting`); `defaultLighting` is the default scenario's entry's object.
+    std::vector<GltfScenario> scenarios;
+    nlohmann::json defaultLighting = nlohmann::json::object();
     nlohmann::json bake = nlohmann::json::object();  // TERRALUX_bake, must be an object
     // TERRALUX_lighting: an object (the bake writes the project's lighting, app/SceneLighting.h),
     // or null for no such extension.
@@ -102,7 +119,7 @@ struct GltfExportResult {
 // into place (the .shprobe files, then scene.bin, then scene.gltf). If any step fails, the files
 // already replaced are restored, the staging directory is removed, and the files in outDir stay
 // byte-identical to what they were before the call.
-// The export owns every file in outDir/sh_coeffs/ and outDir/reflection/, scene.gltf, scene.bin
+// The export owns every file in outDir/sh_coeffs/, outDir/scenarios/ and outDir/reflection/, scene.gltf, scene.bin
 // and the extra files, and replaces them as a whole: an owned file this export does not write (the .shprobe of a renamed
 // volume, scene.gltf when the scene is off) is removed in the same commit, and put back if the
 // commit fails. Nothing else in outDir is touched.

@@ -138,6 +138,7 @@ bool ParameterForm::isRead(const ParameterSpec& spec) const {
     const SceneDescription& scene = doc_->project().scene;
     if (spec.perVolume() && size_t(element_) >= scene.probeVolumes.size()) return false;
     if (spec.perLight() && size_t(element_) >= scene.lights.size()) return false;
+    if (spec.perScenario() && size_t(element_) >= scene.scenarios.size()) return false;
     return spec.isRead(scene, spec.inList() ? size_t(element_) : 0);
 }
 

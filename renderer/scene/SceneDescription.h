@@ -382,6 +382,15 @@ struct CameraSettings {
     double exposureEv = 0.0;          // stops: the display multiplies scene light by 2^EV
 };
 
+// A named lighting of the same probe layout (docs/lighting.md, "Lighting scenarios"): its own sun
+// and sky, baked into its own .shprobe set beside the project's own lighting (the scenario named
+// "default").
+struct LightingScenario {
+    std::string name = "scenario";  // 1 to 64 of [A-Za-z0-9_-], unique, never "default"
+    SunSettings sun;
+    SkySettings sky;
+};
+
 struct SceneDescription {
     TerrainSettings terrain;
     SunSettings sun;
@@ -399,6 +408,7 @@ struct SceneDescription {
     LightingSettings lighting;
     LpvSettings lpv;
     std::vector<LocalLight> lights;
+    std::vector<LightingScenario> scenarios;
 };
 
 }  // namespace terralux

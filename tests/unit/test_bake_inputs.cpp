@@ -31,6 +31,7 @@ std::vector<SceneDescription> coveringScenes(json doc = defaultProjectJson(), co
     doc["water"]["enabled"] = true;
     doc["water"]["waves"] = json::array({json{{"amplitude", 0.2}}});
     doc["lights"] = json::array({json{{"type", "spot"}}});
+    doc["scenarios"] = json::array({json{{"name", "dusk"}}});
     for (const char* section : {"reflection_probes", "shadows", "fog", "detail", "ao", "lpv"})
         doc[section]["enabled"] = true;
     std::vector<json> docs;
@@ -47,6 +48,9 @@ std::vector<SceneDescription> coveringScenes(json doc = defaultProjectJson(), co
     with("/sky/mode", "physical");
     with("/sky/mode", "hdr");
     with("/sun/mode", "date_time");
+    with("/scenarios/0/sky/mode", "physical");
+    with("/scenarios/0/sky/mode", "hdr");
+    with("/scenarios/0/sun/mode", "date_time");
     with("/probe_volumes/0/placement", "box");
     docs.back()["probe_volumes"][0]["grid_dims"] = {4, 2, 4};
     with("/probe_volumes/0/placement", "adaptive");
@@ -60,6 +64,7 @@ std::vector<SceneDescription> coveringScenes(json doc = defaultProjectJson(), co
     for (json& d : docs) {
         if (d["terrain"]["albedo_mode"] == "map") d["terrain"]["albedo_map"] = albedoMap;
         if (d["sky"]["mode"] == "hdr") d["sky"]["hdr"] = hdr;
+        if (d["scenarios"][0].value("sky", json::object()).value("mode", "") == "hdr") d["scenarios"][0]["sky"]["hdr"] = hdr;
         scenes.push_back(sceneFromJson(d, "covering scene", nullptr));
     }
     return scenes;
@@ -169,6 +174,7 @@ json quickBakeDocument() {
     doc["bake"]["rays"] = 32;
     doc["bake"]["bounces"] = 1;
     doc["bake"]["error_map_resolution"] = 16;
+    doc["scenarios"] = json::array({json{{"name", "dusk"}, {"sun", {{"elevation_deg", 10.0}}}}});
     return doc;
 }
 

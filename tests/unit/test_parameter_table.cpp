@@ -34,6 +34,10 @@ json baseFor(const ParameterSpec& spec) {
         doc["lights"] = json::array({json::object()});
         doc = sceneToJson(sceneFromJson(doc, "base", nullptr));
     }
+    if (spec.perScenario()) {
+        doc["scenarios"] = json::array({json::object()});
+        doc = sceneToJson(sceneFromJson(doc, "base", nullptr));
+    }
     return doc;
 }
 
@@ -92,7 +96,7 @@ TEST(ParameterTable, EveryDefaultValidatesAndRoundTrips) {
     for (const auto& spec : parameterTable()) {
         // The default written at its path reads back to the same default.
         EXPECT_EQ(errorFor(spec, spec.defaultValue()), "") << spec.path;
-        if (spec.perWave() || spec.perLight()) {
+        if (spec.perWave() || spec.perLight() || spec.perScenario()) {
             const SceneDescription w = sceneFromJson(baseFor(spec), "defaults", nullptr);
             EXPECT_EQ(spec.get(w, 0), spec.defaultValue()) << spec.path;
         } else {
