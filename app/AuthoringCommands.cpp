@@ -54,6 +54,22 @@ int commandRender(const Args& a) {
             throw UsageError("--time " + str(a.parser.value(a.time)) + ": expected seconds, a number in [0, 1000000]");
         request.time = t;
     }
+    std::optional<ScenarioView> scenario;
+    if (a.parser.isSet(a.scenario)) {
+        const std::string v = str(a.parser.value(a.scenario));
+        const QStringList parts = a.parser.value(a.scenario).split(',');
+        bool ok = parts.size() == 1 || parts.size() == 3;
+        ScenarioView view;
+        view.a = view.b = str(parts[0]);
+        if (ok && parts.size() == 3) {
+            view.b = str(parts[1]);
+            const double t = parts[2].toDouble(&ok);
+            ok = ok && std::isfinite(t) && t >= 0.0 && t <= 1.0;
+            view.blend = float(t);
+        }
+        if (!ok) throw UsageError("--scenario " + v + ": expected NAME, or NAME,TO,T with T in [0, 1]");
+        scenario = view;
+    }
     request.probes = !a.parser.isSet(a.noProbes);
     request.linearOutput = ext == ".exr";
     for (const QString& o : a.parser.values(a.overlay))
@@ -95,7 +111,12 @@ int commandRender(const Args& a) {
         std::cerr << programName() << ": " << e.what() << "; --bake works without one\n";
         return kExitRuntime;
     }
+    if (scenario) {
+        // A name the project lacks is refused by name, with the scenarios it has.
+        for (const std::string& name : {scenario->a, scenario->b}) (void)scenarioScene(project.scene, name);
+    }
     ProjectRenderer renderer(*ctx, project);
+    if (scenario) renderer.setScenarioView(*scenario);
     std::string note;
     std::vector<std::string> probeWarnings;
     const size_t volumes =

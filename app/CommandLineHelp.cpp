@@ -22,7 +22,8 @@ bool authoringOnly(const std::string& syntax) {
 
 const std::vector<std::string>& authoringOnlyOptions() {
     static const std::vector<std::string> names = {"render", "study",  "budget",  "size",      "debug-view", "overlay",
-                                                   "time",   "profile", "camera", "no-probes", "no-rebake",  "device"};
+                                                   "time",   "profile", "camera", "no-probes", "no-rebake",  "device",
+                                                   "scenario"};
     return names;
 }
 
@@ -87,6 +88,9 @@ CommandLineHelp commandLineHelp(Binary binary) {
          "--render: draw over the image, comma-separated: probes (probe positions: gold valid, cyan moved "
          "up, red rejected), leaves (adaptive octree leaves)."},
         {"--time T", "--render: seconds into the water's wave animation (default 0)."},
+        {"--scenario NAME[,TO,T]",
+         "--render: light with the bake's lighting scenario NAME (default: \"default\", the project's own sun "
+         "and sky), or blend from NAME toward TO by T in [0, 1] as an engine blends two scenarios."},
         {"--profile",
          "--render: draw the frame a second time, warm, and print what it cost: each pass's GPU time from "
          "timestamps (where the device writes them), the GPU total, and the host's recording and read-back "

@@ -42,12 +42,13 @@ struct Args {
     QCommandLineOption study{"study", "Study."};
     QCommandLineOption budget{"budget", "Seconds.", "SECONDS"};
     QCommandLineOption profile{"profile", "Per-pass GPU time."};
+    QCommandLineOption scenario{"scenario", "Lighting scenario.", "NAME[,TO,T]"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget, profile});
+                           device, dryRun, overlay, time, study, budget, profile, scenario});
     }
 };
 

@@ -43,10 +43,46 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
     setProject(project);
 }
 
+std::vector<GpuProbeVolume> blendProbeVolumes(const std::vector<GpuProbeVolume>& a,
+                                              const std::vector<GpuProbeVolume>& b, float t) {
+    std::vector<GpuProbeVolume> out = a;
+    for (size_t v = 0; v < out.size(); ++v) {
+        if (v >= b.size() || b[v].name != a[v].name || b[v].dims != a[v].dims || b[v].origin != a[v].origin ||
+            b[v].spacing != a[v].spacing || b[v].occupancy != a[v].occupancy || b[v].coeffs.size() != a[v].coeffs.size())
+            throw std::invalid_argument("probe volume '" + a[v].name + "': the two scenarios' layouts differ");
+        for (size_t i = 0; i < out[v].coeffs.size(); ++i)
+            for (size_t k = 0; k < 9; ++k) out[v].coeffs[i][k] = glm::mix(a[v].coeffs[i][k], b[v].coeffs[i][k], t);
+    }
+    return out;
+}
+
+ScenarioView ProjectRenderer::shownView() const {
+    const std::vector<std::string> names = scenarioNames(project_.scene);
+    auto known = [&](const std::string& n) {
+        return std::find(names.begin(), names.end(), n) != names.end() ? n : std::string(kDefaultScenario);
+    };
+    ScenarioView v{known(view_.a), known(view_.b), std::clamp(view_.blend, 0.0f, 1.0f)};
+    if (v.a == v.b) v.blend = 0.0f;
+    return v;
+}
+
+void ProjectRenderer::setScenarioView(const ScenarioView& view) {
+    view_ = view;
+    setProject(project_);
+}
+
 void ProjectRenderer::setProject(const Project& project) {
     project_ = project;
     const SceneDescription& scene = project_.scene;
-    const BakeLighting lighting = lightingOf(project_, terrain_.heightfield);
+    const Heightfield& hf = terrain_.heightfield;
+    const ScenarioView shown = shownView();
+    const std::string &a = shown.a, &b = shown.b;
+    const float t = shown.blend;
+    Project litA = project_, litB = project_;
+    litA.scene = scenarioScene(scene, a);
+    litB.scene = scenarioScene(scene, b);
+    const BakeLighting lighting = lightingOf(t < 0.5f ? litA : litB, hf);
+    shown_ = lighting;
     base_.albedo = lighting.albedo;
     base_.terrain = scene.terrain;
     base_.detail = scene.detail;
@@ -78,12 +114,28 @@ void ProjectRenderer::setProject(const Project& project) {
         const HorizonAoSettings wanted = *wantedAo();
         setAmbientOcclusion(wanted, horizonSkyVisibility(terrain_.heightfield, wanted));
     }
-    base_.sun = lighting.sun;
-    base_.skySh = lighting.sky.sh();
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
     base_.exposure = float(std::exp2(scene.camera.exposureEv));
     base_.shadows = scene.shadows;
-    base_.fog = resolvedFog(scene.fog, lighting.sky, terrain_.heightfield);
+    if (t == 0.0f || t == 1.0f) {
+        base_.sun = lighting.sun;
+        base_.skySh = lighting.sky.sh();
+        base_.fog = resolvedFog(scene.fog, lighting.sky, hf);
+    } else {
+        // Between two scenarios: the sun turns along the arc between its two directions (nlerp),
+        // its illuminance and size and the sky's SH mix linearly, as the probes do.
+        const BakeLighting la = lightingOf(litA, hf), lb = lightingOf(litB, hf);
+        const glm::vec3 d = glm::mix(la.sun.direction, lb.sun.direction, t);
+        base_.sun = la.sun;
+        base_.sun.direction = glm::length(d) > 1e-4f ? glm::normalize(d) : (t < 0.5f ? la.sun.direction : lb.sun.direction);
+        base_.sun.illuminance = glm::mix(la.sun.illuminance, lb.sun.illuminance, t);
+        base_.sun.angularRadius = glm::mix(la.sun.angularRadius, lb.sun.angularRadius, t);
+        const sh::ShRgb sa = la.sky.sh(), sb = lb.sky.sh();
+        for (size_t k = 0; k < sa.c.size(); ++k) base_.skySh.c[k] = glm::mix(sa.c[k], sb.c[k], t);
+        const FogSettings fa = resolvedFog(scene.fog, la.sky, hf), fb = resolvedFog(scene.fog, lb.sky, hf);
+        base_.fog = fa;
+        if (fa.color && fb.color) base_.fog.color = glm::mix(*fa.color, *fb.color, t);
+    }
     base_.skirt = scene.terrain.skirt;
     base_.reflectionStrength = float(scene.reflectionProbes.strength);
     const IndirectLighting indirect = scene.lighting.indirect;
@@ -239,11 +291,33 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
     const bool irradiance = report.is_object() && report.contains("sh_encoding")
                                 ? report["sh_encoding"] == "irradiance"
                                 : scene.bake.encoding == ShEncoding::Irradiance;
-    std::vector<GpuProbeVolume> volumes;
+    // The scenarios shown: the default's files are sh_coeffs/, another's scenarios/.
+    const ScenarioView shown = shownView();
+    const std::string &shownA = shown.a, &shownB = shown.b;
+    auto scenarioFile = [&](const std::string& volume, const std::string& scenario) {
+        return scenario == kDefaultScenario ? dir / (volume + ".shprobe")
+                                            : folder / "scenarios" / (volume + "." + scenario + ".shprobe");
+    };
+    auto coefficientsOf = [&](const std::string& volume, const std::string& scenario, const ShProbeGrid& layout) {
+        const ShProbeGrid g = readShProbeFile(scenarioFile(volume, scenario));
+        if (g.dims != layout.dims || g.occupancy != layout.occupancy)
+            throw ShProbeError(scenarioFile(volume, scenario).string() + ": not the layout of sh_coeffs/" + volume +
+                               ".shprobe (bake again)");
+        std::vector<std::array<glm::vec3, 9>> c;
+        for (const auto& r : g.probes) c.push_back(r.coeffs);
+        return c;
+    };
+    std::vector<GpuProbeVolume> volumes, towards;
     for (const auto& v : scene.probeVolumes) {
         if (!v.enabled) continue;
         const auto path = dir / (v.name + ".shprobe");
         if (!std::filesystem::exists(path)) continue;
+        if (!std::filesystem::exists(scenarioFile(v.name, shownA)) || !std::filesystem::exists(scenarioFile(v.name, shownB))) {
+            if (warnings)
+                warnings->push_back(scenarioFile(v.name, std::filesystem::exists(scenarioFile(v.name, shownA)) ? shownB : shownA).string() +
+                                    ": missing (bake again for the scenario)");
+            continue;
+        }
         std::vector<uint8_t> bytes;
         const ShProbeGrid g = readShProbeFile(path, &bytes);
         GpuProbeVolume gv;
@@ -258,7 +332,16 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
         // without one falls back to twice the file's cell edge, the grid's smallest spacing.
         gv.fallbackBlendDistance = v.fallbackBlendDistance ? float(*v.fallbackBlendDistance)
                                                            : reportedBlendDistance(report, v.name).value_or(2.0f * g.spacing);
-        for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);
+        if (shownA == kDefaultScenario)
+            for (const auto& r : g.probes) gv.coeffs.push_back(r.coeffs);
+        else
+            gv.coeffs = coefficientsOf(v.name, shownA, g);
+        if (shown.blends()) {
+            towards.push_back(gv);
+            towards.back().coeffs = coefficientsOf(v.name, shownB, g);
+        }
+        // The diagnostics (moved probes, the interpolation-error map) are the layout's, measured
+        // under the default's light.
         const auto sidecar = dir / probeDiagnosticsFileName(v.name);
         try {
             if (std::filesystem::exists(sidecar))
@@ -269,8 +352,9 @@ size_t ProjectRenderer::loadProbes(bool rebake, std::string* note, std::vector<s
             if (warnings) warnings->push_back(e.what());
         }
         volumes.push_back(std::move(gv));
+        if (shown.blends()) towards.back().diagnostics = volumes.back().diagnostics;
     }
-    setProbes(volumes);
+    setProbes(shown.blends() ? blendProbeVolumes(volumes, towards, shown.blend) : volumes);
     // The reflection probes the bake wrote, while the project has them on.
     std::shared_ptr<const ReflectionProbeSet> reflections;
     const auto rprobe = folder / "reflection" / kReflectionProbeFile;
@@ -313,7 +397,7 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     LpvJob job;
     job.settings = lpv::resolvedOn(scene.lpv, terrain_.heightfield);
     job.lights = scene.lights;
-    job.lighting = lightingOf(project_, terrain_.heightfield);
+    job.lighting = shown_;
     job.lighting.surface = albedo_;
     job.tracer = tracer_;
     job.lighting.tracer = tracer_.get();
@@ -322,7 +406,8 @@ std::optional<LpvJob> ProjectRenderer::lpvJob(const RenderRequest& r, const Orbi
     job.propagation = renderer_->propagatesLpv() ? lpv::Propagation::Renderer : lpv::Propagation::Cpu;
     const nlohmann::json sceneJson = sceneToJson(scene);
     nlohmann::json key = {{"albedo", reinterpret_cast<uintptr_t>(albedo_.get())}};
-    for (const char* section : {"lpv", "lights", "sun", "sky", "terrain"}) key[section] = sceneJson.value(section, nlohmann::json());
+    for (const char* section : {"lpv", "lights", "sun", "sky", "terrain", "scenarios"}) key[section] = sceneJson.value(section, nlohmann::json());
+    key["scenario"] = {view_.a, view_.b, view_.blend < 0.5f};
     for (const lpv::CascadeLayout& c : lpv::placeCascades(job.settings, job.eye, job.viewDir))
         key["cascades"].push_back({c.originCell[0], c.originCell[1], c.originCell[2]});
     job.key = key.dump();

@@ -34,6 +34,21 @@ struct RenderRequest {
 
 class ProjectRenderer;
 
+// Which lighting scenario a render shows (docs/lighting.md, "Lighting scenarios"): `a`, or a
+// blend from `a` toward `b` by `blend` in [0, 1] as an engine blends two baked scenarios: the
+// probes' coefficients and the sky's SH linearly, the sun's direction along the arc between them.
+// Names that the project no longer has show the default.
+struct ScenarioView {
+    std::string a = kDefaultScenario, b = kDefaultScenario;
+    float blend = 0.0f;
+    bool blends() const { return a != b && blend > 0.0f; }
+};
+
+// Coefficient by coefficient, (1 - t) a + t b: two bakes of the same layouts (names, grids and
+// occupancy). Throws std::invalid_argument naming the volume whose layouts differ.
+std::vector<GpuProbeVolume> blendProbeVolumes(const std::vector<GpuProbeVolume>& a,
+                                              const std::vector<GpuProbeVolume>& b, float t);
+
 // What one update of the light propagation volumes reads, held by value (the tracer and the albedo
 // field shared), so that a worker can compute it while the project changes on the UI thread.
 struct LpvJob {
@@ -102,6 +117,12 @@ public:
     size_t boundProbeCount() const { return boundProbes_; }
     // The bound volumes themselves, coefficients and diagnostics (the probe inspector reads them).
     std::shared_ptr<const std::vector<GpuProbeVolume>> boundVolumes() const { return boundVolumeData_; }
+    // The scenario the renderer lights with (the sun, the sky; loadProbes then reads its probes).
+    void setScenarioView(const ScenarioView& view);
+    const ScenarioView& scenarioView() const { return view_; }
+    // The view as drawn: names the project lacks replaced by the default, the blend in [0, 1]
+    // (0 when both ends are the same scenario).
+    ScenarioView shownView() const;
     // New lighting and camera settings of the same terrain (sun, sky, albedo, camera).
     // Also places the enabled volumes' probes again for the position overlay.
     void setProject(const Project& project);
@@ -174,6 +195,8 @@ private:
     bool computeAo_ = true;
     std::optional<HorizonAoSettings> boundAo_;  // the settings of the bound AO field
     RenderSettings base_;
+    ScenarioView view_;
+    BakeLighting shown_;  // the lighting of the scenario shown (the blend's nearer end)
     std::unique_ptr<TerrainRenderer> renderer_;
     std::shared_ptr<const HeightfieldTracer> tracer_;  // for the LPV, made on first use
     std::string lpvKey_;

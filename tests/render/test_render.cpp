@@ -876,6 +876,60 @@ TEST_F(RenderTest, AStaleBakeIsBakedAgainBeforeItIsDrawn) {
     EXPECT_EQ(readShProbeFile(p.outDir() / "sh_coeffs" / "probes.shprobe").probes.size(), 30u);
 }
 
+// A lighting scenario draws as a project lit that way draws, pixel for pixel; a blend between two
+// mixes their probes linearly (the probe-irradiance view halfway is the mean of its two ends).
+TEST_F(RenderTest, ScenariosSwitchAndBlendLikeTheirBakes) {
+    Project p = sampleProject("scenarios", 5, 5);
+    LightingScenario dusk;
+    dusk.name = "dusk";
+    dusk.sun = p.scene.sun;
+    dusk.sky = p.scene.sky;
+    dusk.sun.azimuthDeg = 250.0;
+    dusk.sun.elevationDeg = 8.0;
+    dusk.sun.illuminance = 1.5;
+    dusk.sky.intensity = 0.5;
+    p.scene.scenarios = {dusk};
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    RenderRequest q;
+    q.width = kW;
+    q.height = kH;
+    RenderRequest irradiance = q;
+    irradiance.debugView = 50;
+    irradiance.linearOutput = true;
+    const RenderedImage def = r.render(q), defProbes = r.render(irradiance);
+
+    r.setScenarioView({"dusk", "dusk", 0.0f});
+    ASSERT_EQ(r.loadProbes(false), 1u);
+    const RenderedImage shown = r.render(q), duskProbes = r.render(irradiance);
+    EXPECT_GT(test::compareImages(shown.rgba, def.rgba, kW, kH).meanAbs, 0.02);
+
+    Project lit = sampleProject("scenarios_lit", 5, 5);
+    lit.scene.sun = dusk.sun;
+    lit.scene.sky = dusk.sky;
+    ProjectRenderer l(*ctx_, lit);
+    ASSERT_EQ(l.loadProbes(true), 1u);
+    EXPECT_EQ(test::compareImages(shown.rgba, l.render(q).rgba, kW, kH).maxAbs, 0.0);
+
+    r.setScenarioView({"default", "dusk", 0.0f});
+    r.loadProbes(false);
+    EXPECT_EQ(test::compareImages(r.render(q).rgba, def.rgba, kW, kH).maxAbs, 0.0);
+    r.setScenarioView({"default", "dusk", 1.0f});
+    r.loadProbes(false);
+    EXPECT_EQ(test::compareImages(r.render(q).rgba, shown.rgba, kW, kH).maxAbs, 0.0);
+    r.setScenarioView({"default", "dusk", 0.5f});
+    r.loadProbes(false);
+    const RenderedImage half = r.render(irradiance);
+    std::vector<float> mean(half.rgba.size());
+    for (size_t i = 0; i < mean.size(); ++i) mean[i] = 0.5f * (defProbes.rgba[i] + duskProbes.rgba[i]);
+    const auto c = test::compareImages(half.rgba, mean, kW, kH);
+    EXPECT_LT(c.maxAbs, 2e-3) << "mean " << c.meanAbs;
+    // A scenario the project no longer has shows the default.
+    r.setScenarioView({"gone", "gone", 0.0f});
+    r.loadProbes(false);
+    EXPECT_EQ(test::compareImages(r.render(q).rgba, def.rgba, kW, kH).maxAbs, 0.0);
+}
+
 TEST_F(RenderTest, ShadowMapsAgreeWithTheTracedSunVisibilityAtTheDefaults) {
     Project p = sampleProject("shadow_agreement", 8, 8);
     ProjectRenderer r(*ctx_, p);
