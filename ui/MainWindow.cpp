@@ -40,6 +40,7 @@
 #include <QStyleOptionTab>
 #include <QTabBar>
 #include <QTableWidget>
+#include <QSlider>
 #include <QToolBar>
 #include <QVBoxLayout>
 
@@ -58,6 +59,7 @@
 #include "BakeJob.h"
 #include "PreviewBake.h"
 #include "LpvPanel.h"
+#include "ScenarioPanel.h"
 #include "ReflectionPanel.h"
 #include "TradeoffPanel.h"
 #include "ShProbeFile.h"
@@ -428,7 +430,15 @@ QDockWidget* MainWindow::buildSunSkyDock() {
     });
     reportRejections(sky);
     sky->refresh();
-    return addDock("Sun & Sky", "dock.sunSky", sky);
+    // The project's own sun and sky are the default scenario's: the panel shows these rows for it.
+    scenarioPanel_ = new ScenarioPanel(doc_, sky);
+    connect(scenarioPanel_, &ScenarioPanel::rejected, this, [this](const QString& m) { statusBar()->showMessage(m, 8000); });
+    connect(scenarioPanel_, &ScenarioPanel::currentScenarioChanged, this, [this](const QString& name) {
+        // What is edited is what is shown.
+        if (name.toStdString() != scenarioView_.a || scenarioView_.blends())
+            setScenarioView({name.toStdString(), name.toStdString(), 0.0f});
+    });
+    return addDock("Sun & Sky", "dock.sunSky", scenarioPanel_);
 }
 
 // Shadows: the table's rows with the cascade splits over the view below the split rows, and
@@ -664,6 +674,7 @@ void MainWindow::buildDocks() {
     resizeDocks({terrainDock, skyDock, volumesDock}, {26, 32, 42}, Qt::Vertical);
 
     buildViewportToolbar();
+    buildScenarioToolbar();
     buildStatusBar();
 }
 
@@ -739,6 +750,82 @@ void MainWindow::buildViewportToolbar() {
         showCascades_->setChecked(view == kViewCascades);
     });
 
+}
+
+// Lighting: which scenario the viewport shows, and a blend toward another, as an engine blends
+// two baked scenarios. Shown while the project has scenarios.
+void MainWindow::buildScenarioToolbar() {
+    scenarioBar_ = addToolBar("Lighting");
+    scenarioBar_->setObjectName("toolbar.scenarios");
+    scenarioFrom_ = new QComboBox;
+    scenarioFrom_->setObjectName("viewport.scenario");
+    scenarioFrom_->setToolTip("The lighting scenario the viewport shows");
+    scenarioTo_ = new QComboBox;
+    scenarioTo_->setObjectName("viewport.scenarioTo");
+    scenarioTo_->setToolTip("The scenario the slider blends toward");
+    scenarioBlend_ = new QSlider(Qt::Horizontal);
+    scenarioBlend_->setObjectName("viewport.scenarioBlend");
+    scenarioBlend_->setRange(0, 100);
+    scenarioBlend_->setMaximumWidth(140);
+    scenarioBlend_->setToolTip("Blend: the probes' coefficients and the sky mix linearly, the sun turns between the two");
+    scenarioBar_->addWidget(new QLabel(" Lighting "));
+    scenarioBar_->addWidget(scenarioFrom_);
+    scenarioBar_->addWidget(new QLabel(" blend to "));
+    scenarioBar_->addWidget(scenarioTo_);
+    scenarioBar_->addWidget(scenarioBlend_);
+    auto changed = [this] {
+        setScenarioView({scenarioFrom_->currentText().toStdString(), scenarioTo_->currentText().toStdString(),
+                         float(scenarioBlend_->value()) / 100.0f});
+    };
+    connect(scenarioFrom_, &QComboBox::currentIndexChanged, this, changed);
+    connect(scenarioTo_, &QComboBox::currentIndexChanged, this, changed);
+    connect(scenarioBlend_, &QSlider::valueChanged, this, changed);
+    connect(doc_, &ProjectDocument::parametersChanged, this, [this](const QString& path) {
+        if (path.isEmpty() || path.startsWith("scenarios")) refreshScenarioWidgets();
+    });
+    refreshScenarioWidgets();
+}
+
+void MainWindow::refreshScenarioWidgets() {
+    const std::vector<std::string> names = scenarioNames(doc_->project().scene);
+    // A scenario renamed or removed: the view falls back to the default, as the renderer does.
+    auto known = [&](const std::string& n) {
+        return std::find(names.begin(), names.end(), n) != names.end() ? n : std::string(kDefaultScenario);
+    };
+    ScenarioView v{known(scenarioView_.a), known(scenarioView_.b), scenarioView_.blend};
+    {
+        const QSignalBlocker b1(scenarioFrom_), b2(scenarioTo_);
+        scenarioFrom_->clear();
+        scenarioTo_->clear();
+        for (const std::string& n : names) {
+            scenarioFrom_->addItem(QString::fromStdString(n));
+            scenarioTo_->addItem(QString::fromStdString(n));
+        }
+    }
+    scenarioBar_->setVisible(names.size() > 1);
+    setScenarioView(v);
+}
+
+void MainWindow::setScenarioView(const ScenarioView& view) {
+    const bool same = view.a == scenarioView_.a && view.b == scenarioView_.b && view.blend == scenarioView_.blend;
+    scenarioView_ = view;
+    {
+        const QSignalBlocker b1(scenarioFrom_), b2(scenarioTo_), b3(scenarioBlend_);
+        scenarioFrom_->setCurrentText(QString::fromStdString(view.a));
+        scenarioTo_->setCurrentText(QString::fromStdString(view.b));
+        scenarioBlend_->setValue(int(std::lround(view.blend * 100.0f)));
+        scenarioBlend_->setEnabled(view.a != view.b);
+    }
+    if (scenarioPanel_ && !view.blends() && scenarioPanel_->currentScenario().toStdString() != view.a) {
+        const QSignalBlocker b(scenarioPanel_);
+        scenarioPanel_->selectScenario(QString::fromStdString(view.a));
+    }
+    if (same || !renderer_) return;
+    renderer_->setScenarioView(view);
+    // The probes of the scenarios shown: the bake's when current, else a draft of each.
+    probeSource_.clear();
+    startPreview();
+    viewport_->requestUpdate();
 }
 
 // The status bar: the legend, probes, frame time, the import's progress and the device.
@@ -1117,6 +1204,7 @@ void MainWindow::rebuildRenderer() {
     viewport_->setRenderer(nullptr);
     stopAmbientOcclusion();
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
+    renderer_->setScenarioView(scenarioView_);
     viewport_->setCamera(renderer_->defaultCamera());
     // An untitled project with a relative output folder has no bake of its own yet.
     const auto folder = bakeFolder();
@@ -1234,9 +1322,18 @@ void MainWindow::startPreview() {
     ++previewsStarted_;
     const Project project = doc_->project();
     auto terrain = doc_->terrainShared();
-    previewJob_.start([this, project, terrain](const LatestJob::Context& job) {
+    const ScenarioView shown = renderer_ ? renderer_->shownView() : ScenarioView{};
+    previewJob_.start([this, project, terrain, shown](const LatestJob::Context& job) {
         try {
-            auto preview = std::make_shared<PreviewBake>(previewBake(project, terrain->heightfield, job.cancelFlag()));
+            // The scenario shown, and the one it blends toward: a draft of each, mixed.
+            Project lit = project;
+            lit.scene = scenarioScene(project.scene, shown.a);
+            auto preview = std::make_shared<PreviewBake>(previewBake(lit, terrain->heightfield, job.cancelFlag()));
+            if (shown.blends()) {
+                lit.scene = scenarioScene(project.scene, shown.b);
+                const PreviewBake towards = previewBake(lit, terrain->heightfield, job.cancelFlag());
+                preview->volumes = blendProbeVolumes(preview->volumes, towards.volumes, shown.blend);
+            }
             job.post([this, preview] {
                 if (!renderer_) return;
                 renderer_->setProbes(preview->volumes);
@@ -1408,10 +1505,16 @@ void MainWindow::updateStatus() {
     if (!renderer_) return;
     // What the viewport holds, not what the settings would place (adaptive volumes ignore grids).
     const auto& reflections = renderer_->reflectionProbes();
-    probeLabel_->setText(QString("%1 probes%2 (%3), %4 on the GPU")
+    const ScenarioView shown = renderer_->shownView();
+    const QString scenario =
+        shown.blends() ? QString(", %1 → %2 %3 %").arg(QString::fromStdString(shown.a), QString::fromStdString(shown.b)).arg(int(std::lround(shown.blend * 100.0f)))
+        : shown.a != kDefaultScenario ? QString(", scenario '%1'").arg(QString::fromStdString(shown.a))
+                                      : QString();
+    probeLabel_->setText(QString("%1 probes%2 (%3%4), %5 on the GPU")
                              .arg(renderer_->boundProbeCount())
                              .arg(reflections ? QString(" + %1 reflection").arg(reflections->probes.size()) : QString())
                              .arg(probeSource_.isEmpty() ? "not baked" : probeSource_)
+                             .arg(scenario)
                              .arg(formatBytes(double(renderer_->renderer().probeBytes() +
                                                      renderer_->renderer().reflectionBytes()))));
 }

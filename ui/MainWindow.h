@@ -25,6 +25,8 @@ class QProxyStyle;
 class QTableWidget;
 class QMenu;
 class QCheckBox;
+class QSlider;
+class QToolBar;
 
 namespace terralux {
 
@@ -34,6 +36,7 @@ class WaterPanel;
 class ReflectionPanel;
 class ProbeInspector;
 class ViewportGizmos;
+class ScenarioPanel;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -53,6 +56,10 @@ public:
     // What the viewport's probes come from: "last bake" (the project's output folder),
     // "export in <folder>" (a bake written elsewhere), "draft preview" or "" (none yet).
     const QString& probeSource() const { return probeSource_; }
+    // Which lighting scenario the viewport shows, or the blend of two (the toolbar's Lighting
+    // switch and slider; selecting a scenario in the Sun & Sky dock shows it).
+    const ScenarioView& scenarioView() const { return scenarioView_; }
+    void setScenarioView(const ScenarioView& view);
     // The reflection probe whose marker is nearest to `at` (viewport pixels), within 12 pixels;
     // -1 when none (or no reflection probes are bound).
     int reflectionProbeAt(QPointF at) const;
@@ -193,6 +200,14 @@ private:
     QLabel* albedoStatus_ = nullptr;
     unsigned previewsStarted_ = 0;
     QString probeSource_;
+    // Lighting scenarios: the dock's list, the viewport's switch and blend, and what it shows.
+    ScenarioPanel* scenarioPanel_ = nullptr;
+    QToolBar* scenarioBar_ = nullptr;
+    QComboBox *scenarioFrom_ = nullptr, *scenarioTo_ = nullptr;
+    QSlider* scenarioBlend_ = nullptr;
+    ScenarioView scenarioView_;
+    void buildScenarioToolbar();
+    void refreshScenarioWidgets();
 };
 
 // Plain `terralux`: the window with the sample loaded (or FILE). Returns the exit code.

@@ -28,7 +28,9 @@
 #include <QPushButton>
 #include <QScrollArea>
 #include <QScrollBar>
+#include <QListWidget>
 #include <QSlider>
+#include <QToolBar>
 #include <QScreen>
 #include <QSignalSpy>
 #include <QSpinBox>
@@ -1719,6 +1721,13 @@ private slots:
         QCOMPARE(doc.project().scene.sun.timeH, 9.0);
         QCOMPARE(doc.project().scene.sun.date, std::string("2026-08-14"));
 
+        // An evening scenario of the same day: its own time of day, the same probes.
+        QTest::mouseClick(w_->findChild<QPushButton*>("scenarios.add"), Qt::LeftButton);
+        QCOMPARE(doc.undoStack()->undoText(), QString("Add scenario 'scenario-1'"));
+        w_->findChild<QSlider*>("param.scenario.sun.time_h.slider")->setValue(750);  // 18:00
+        QCOMPARE(doc.project().scene.scenarios[0].sun.timeH, 18.0);
+        QCOMPARE(doc.project().scene.scenarios[0].sun.date, std::string("2026-08-14"));
+
         // Bake, and read what it wrote.
         w_->startBake();
         QVERIFY(QTest::qWaitFor([&] { return !w_->bakes()->running() && w_->probeSource() == "last bake"; }, 90000));
@@ -1727,6 +1736,14 @@ private slots:
         const nlohmann::json report = nlohmann::json::parse(reportFile);
         QCOMPARE(report["sun"]["date"].get<std::string>(), std::string("2026-08-14"));
         QCOMPARE(report["sun"]["time_h"].get<double>(), 9.0);
+        QCOMPARE(report["scenarios"][0]["name"].get<std::string>(), std::string("scenario-1"));
+        QVERIFY(fs::exists(out / "scenarios" / "probes.scenario-1.shprobe"));
+        std::ifstream gltfFile(out / "scene.gltf");
+        const nlohmann::json gltf = nlohmann::json::parse(gltfFile);
+        const nlohmann::json& listed = gltf["scenes"][0]["extensions"]["TERRALUX_lighting"]["scenarios"];
+        QCOMPARE(listed.size(), size_t(2));
+        QCOMPARE(listed[1]["sun"]["time_h"].get<double>(), 18.0);
+        QCOMPARE(listed[1]["shProbePaths"][0].get<std::string>(), std::string("scenarios/probes.scenario-1.shprobe"));
         std::ifstream sidecar(out / "sh_coeffs" / "probes.probes.json");
         const nlohmann::json probes = nlohmann::json::parse(sidecar);
         const std::vector<double> positions = probes["positions"].get<std::vector<double>>();
@@ -1751,7 +1768,89 @@ private slots:
         QCOMPARE(doc.value("terrain.dem"), initialDem);
         QVERIFY(doc.value("probe_volumes[0].origin").is_null() && doc.value("probe_volumes[0].spacing").is_null());
         QCOMPARE(doc.project().scene.sun.mode, SunMode::Manual);
+        QVERIFY(doc.project().scene.scenarios.empty());
         QVERIFY(std::abs(doc.terrain().heightfield.geo.latitudeDeg - 34.34) < 0.01);
+    }
+
+    // Lighting scenarios: added, edited and renamed in the Sun & Sky dock, each one undo step; the
+    // viewport shows the one selected and blends toward another from its toolbar.
+    void scenariosAreEditedShownAndBlended() {
+        ProjectDocument& doc = *w_->document();
+        ViewportWindow* vp = w_->viewport();
+        const int start = doc.undoStack()->index();
+        auto* bar = w_->findChild<QToolBar*>("toolbar.scenarios");
+        auto* list = w_->findChild<QListWidget*>("scenarios.list");
+        QVERIFY(bar && list);
+        QVERIFY(!bar->isVisible());
+        QCOMPARE(list->count(), 1);
+        const RenderedImage defaultFrame = vp->grabImage();
+
+        w_->findChild<QDockWidget*>("dock.sunSky")->raise();
+        QTest::mouseClick(w_->findChild<QPushButton*>("scenarios.add"), Qt::LeftButton);
+        QCOMPARE(doc.undoStack()->undoText(), QString("Add scenario 'scenario-1'"));
+        QCOMPARE(doc.project().scene.scenarios.size(), size_t(1));
+        QCOMPARE(list->count(), 2);
+        QCOMPARE(list->currentItem()->data(Qt::UserRole).toString(), QString("scenario-1"));
+        QVERIFY(bar->isVisible());
+        // A copy of the default's light, shown in the viewport while it is edited.
+        QCOMPARE(doc.project().scene.scenarios[0].sun.elevationDeg, doc.project().scene.sun.elevationDeg);
+        QCOMPARE(w_->scenarioView().a, std::string("scenario-1"));
+        auto* elevation = w_->findChild<QDoubleSpinBox*>("param.scenario.sun.elevation_deg");
+        QVERIFY(elevation && elevation->isVisible());
+        QVERIFY(!w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg")->isVisible());
+        elevation->setValue(8.0);
+        QCOMPARE(doc.project().scene.scenarios[0].sun.elevationDeg, 8.0);
+        QCOMPARE(doc.project().scene.sun.elevationDeg, 35.0);
+        QCOMPARE(doc.undoStack()->undoText(), QString("Set Sun elevation of scenario 'scenario-1'"));
+        w_->findChild<QDoubleSpinBox*>("param.scenario.sun.azimuth_deg")->setValue(260.0);
+        QTRY_VERIFY_WITH_TIMEOUT(w_->probeSource() == "draft preview" &&
+                                     w_->findChild<QLabel*>("status.probes")->text().contains("scenario 'scenario-1'"),
+                                 30000);
+        QTRY_VERIFY_WITH_TIMEOUT(test::compareImages(vp->grabImage().rgba, defaultFrame.rgba, defaultFrame.width,
+                                                     defaultFrame.height).meanAbs > 0.02, 20000);
+
+        // Rename: a name the rules refuse is named and the old one stays.
+        auto* name = w_->findChild<QLineEdit*>("scenarios.name");
+        name->setText("default");
+        QMetaObject::invokeMethod(name, "editingFinished");
+        QVERIFY(w_->findChild<QLabel*>("scenarios.error")->text().contains("must be unique among scenarios and not \"default\""));
+        QCOMPARE(name->text(), QString("scenario-1"));
+        name->setText("dusk");
+        QMetaObject::invokeMethod(name, "editingFinished");
+        QCOMPARE(doc.project().scene.scenarios[0].name, std::string("dusk"));
+        QCOMPARE(doc.undoStack()->undoText(), QString("Rename scenario 'scenario-1' to 'dusk'"));
+        QCOMPARE(w_->scenarioView().a, std::string("dusk"));
+
+        // The toolbar: default blended halfway toward dusk.
+        w_->findChild<QComboBox*>("viewport.scenario")->setCurrentText("default");
+        QCOMPARE(w_->scenarioView().a, std::string("default"));
+        QCOMPARE(list->currentItem()->data(Qt::UserRole).toString(), QString("default"));
+        QVERIFY(w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg")->isVisible());
+        w_->findChild<QComboBox*>("viewport.scenarioTo")->setCurrentText("dusk");
+        w_->findChild<QSlider*>("viewport.scenarioBlend")->setValue(50);
+        QVERIFY(w_->scenarioView().blends());
+        QTRY_VERIFY_WITH_TIMEOUT(w_->probeSource() == "draft preview" &&
+                                     w_->findChild<QLabel*>("status.probes")->text().contains("default → dusk 50 %"),
+                                 30000);
+        QVERIFY(w_->findChild<QDockWidget*>("dock.sunSky")->grab().save(QString::fromStdString((kOut / "scenarios_dock.png").string())));
+        QVERIFY(w_->grab().save(QString::fromStdString((kOut / "scenarios_window.png").string())));
+        // Back to the default alone: the frame it drew before.
+        w_->findChild<QSlider*>("viewport.scenarioBlend")->setValue(0);
+        QTRY_VERIFY_WITH_TIMEOUT(test::compareImages(vp->grabImage().rgba, defaultFrame.rgba, defaultFrame.width,
+                                                     defaultFrame.height).maxAbs <= 1.0 / 255.0, 30000);
+
+        // Remove, then undo everything: no scenario, no toolbar.
+        list->setCurrentRow(1);
+        QTest::mouseClick(w_->findChild<QPushButton*>("scenarios.remove"), Qt::LeftButton);
+        QCOMPARE(doc.undoStack()->undoText(), QString("Remove scenario 'dusk'"));
+        QVERIFY(doc.project().scene.scenarios.empty());
+        QVERIFY(!bar->isVisible());
+        QCOMPARE(w_->scenarioView().a, std::string("default"));
+        doc.undoStack()->undo();
+        QCOMPARE(doc.project().scene.scenarios.size(), size_t(1));
+        while (doc.undoStack()->index() > start) doc.undoStack()->undo();
+        QVERIFY(doc.project().scene.scenarios.empty());
+        QCOMPARE(list->count(), 1);
     }
 
     void probeInspectorShowsAClickedProbe() {
