@@ -1672,6 +1672,15 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         e.meanRays = meanRays;
         secondsPerProbeRay = secondsSince(t) / (double(n) * meanRays);
         e.probeRaysPerSecond = secondsPerProbeRay > 0 ? 1.0 / secondsPerProbeRay : 0.0;
+        // The same probes under each scenario's sun and sky (the default's cache carries the
+        // bounces: the rays follow the direct light's variance).
+        for (const LightingScenario& sc : scene.scenarios) {
+            const BakeLighting lit = scenarioLightingOf(request.project, sc.name, hf, setup.lighting);
+            const ProbeBake sb = setup.referenceMode
+                                     ? referenceProbes(lit, q.bounces, sample, valid, q.probeRays(), 1, BakeControl{})
+                                     : bakeProbes(lit, cache.get(), q.bounces, sample, valid, q.probeRays(), 1, BakeControl{});
+            e.scenarios.push_back({sc.name, raySpreadOf(sb, valid).mean, 0.0});
+        }
     }
 
     // Loading is what this estimate's own setup took; writing, the glTF mesh (whose buffers grow
@@ -1832,13 +1841,15 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         ve.secondsMax = std::max(probesMax, probes) * perProbe + mapSeconds + ve.suggestionSecondsMax;
         e.seconds += ve.seconds;
         e.secondsMax += ve.secondsMax;
-        e.scenarioSeconds += probes * perProbe;
+        for (BakeEstimate::Scenario& sc : e.scenarios)
+            sc.seconds += probes * (v.rayCount ? perProbe : sc.meanRays * secondsPerProbeRay);
         e.volumes.push_back(std::move(ve));
     }
-    e.scenarios = scene.scenarios.size();
-    e.scenarioSeconds += e.cacheSeconds;
-    e.seconds += double(e.scenarios) * e.scenarioSeconds;
-    e.secondsMax += double(e.scenarios) * e.scenarioSeconds;
+    for (BakeEstimate::Scenario& sc : e.scenarios) {
+        sc.seconds += e.cacheSeconds;
+        e.seconds += sc.seconds;
+        e.secondsMax += sc.seconds;
+    }
     return e;
 }
 

@@ -165,9 +165,14 @@ struct BakeEstimate {
     };
     std::optional<Reflection> reflection;
     // Lighting scenarios: each bakes a cache and the probes of the same layouts again (no error
-    // map), scenarioSeconds each.
-    size_t scenarios = 0;
-    double scenarioSeconds = 0.0;
+    // map). A scenario's light changes how many rays its probes need (a low sun is noisier):
+    // the sampled probes are baked again under its light for its own mean.
+    struct Scenario {
+        std::string name;
+        double meanRays = 0.0;  // per probe, as the sampled probes traced under its light
+        double seconds = 0.0;
+    };
+    std::vector<Scenario> scenarios;
     bool lpvIni = false;   // lpv.enabled: the bake writes lpv.ini and TERRALUX_lighting.lpv
     size_t lights = 0;     // local lights: KHR_lights_punctual
     std::optional<SamplingChoice> sampling;  // bake.target_error chose rays and bounces

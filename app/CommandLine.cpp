@@ -147,9 +147,9 @@ int printEstimate(const BakeEstimate& e) {
     if (e.lights)
         std::cout << "  local lights: " << e.lights << " in KHR_lights_punctual\n";
     if (e.cacheSeconds > 0.0) std::cout << "  irradiance cache: about " << duration(e.cacheSeconds) << "\n";
-    if (e.scenarios > 0)
-        std::cout << "  lighting scenarios: " << e.scenarios << " beside the default, about "
-                  << duration(e.scenarioSeconds) << " each (a cache and the probes again)\n";
+    for (const BakeEstimate::Scenario& sc : e.scenarios)
+        std::cout << "  scenario '" << sc.name << "': a cache and the probes again, about " << duration(sc.seconds)
+                  << " (about " << std::lround(sc.meanRays) << " rays per probe under its light)\n";
     std::cout << "  loading the terrain, sky and albedo: " << duration(e.loadSeconds) << " (as measured here)";
     if (e.writeSeconds > 0.0) std::cout << "; writing the scene: about " << duration(e.writeSeconds);
     std::cout << "\n";

@@ -69,7 +69,11 @@ TEST(Scenarios, NamesAreUniqueAndNeverDefault) {
     doc["scenarios"] = json::array({json{{"name", "dusk.late"}}});
     EXPECT_NE(errorOf(doc).find("scenarios[0].name = \"dusk.late\": must be 1-64 letters"), std::string::npos);
     doc["scenarios"] = json::array();
-    for (int i = 0; i <= kMaxScenarios; ++i) doc["scenarios"].push_back(json{{"name", "s" + std::to_string(i)}});
+    for (int i = 0; i <= kMaxScenarios; ++i) {
+        std::string name = "s";
+        name += std::to_string(i);
+        doc["scenarios"].push_back(json{{"name", name}});
+    }
     EXPECT_NE(errorOf(doc).find("scenarios = "), std::string::npos);
     EXPECT_NE(errorOf(doc).find("must hold at most 16 scenarios (has 17)"), std::string::npos);
 }
