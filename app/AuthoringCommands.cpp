@@ -102,6 +102,11 @@ int commandRender(const Args& a) {
                                                  &warnings);
     for (const auto& w : warnings) std::cerr << programName() << ": warning: " << w << "\n";
 
+    if (scenario) {
+        // A name the project lacks is refused by name, with the scenarios it has.
+        for (const std::string& name : {scenario->a, scenario->b}) (void)scenarioScene(project.scene, name);
+    }
+
     vk::ContextOptions options;
     if (a.parser.isSet(a.device)) options.device = str(a.parser.value(a.device));
     std::unique_ptr<vk::VulkanContext> ctx;
@@ -110,10 +115,6 @@ int commandRender(const Args& a) {
     } catch (const vk::VulkanUnavailable& e) {
         std::cerr << programName() << ": " << e.what() << "; --bake works without one\n";
         return kExitRuntime;
-    }
-    if (scenario) {
-        // A name the project lacks is refused by name, with the scenarios it has.
-        for (const std::string& name : {scenario->a, scenario->b}) (void)scenarioScene(project.scene, name);
     }
     ProjectRenderer renderer(*ctx, project);
     if (scenario) renderer.setScenarioView(*scenario);

@@ -423,6 +423,8 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
             throw UsageError("--profile: only with --render");
         if (a.parser.isSet(a.noRebake) && !a.parser.isSet(a.render))
             throw UsageError("--no-rebake: only with --render");
+        if (a.parser.isSet(a.scenario) && !a.parser.isSet(a.render))
+            throw UsageError("--scenario: only with --render");
         if (a.parser.isSet(a.quality) && !a.parser.isSet(a.bake))
             throw UsageError("--quality: only with --bake (elsewhere: --set bake.quality=PRESET)");
         if (a.parser.isSet(a.budget) && !a.parser.isSet(a.study))

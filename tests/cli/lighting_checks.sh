@@ -192,6 +192,55 @@ mean=$(python3 -c 'print(",".join(str((m + 0.5) * 2.0 ** (130 - 136) * 0.5) for 
 check "$work/lit.json" "$work/lit/scene.gltf" 2 "$mean" || fail "project file: TERRALUX_lighting disagrees with --print-project"
 validate "$work/lit/scene.gltf"
 
+# Lighting scenarios: each listed after the default with its files, its sun and sky the project's
+# scenario as --print-project prints it (plus what the extension adds), its .shprobe the header
+# and occupancy of the default's with coefficients of its own; the validator accepts the scene.
+cat >"$work/scenarios.terralux.json" <<'EOF'
+{
+  "probe_volumes": [{"name": "valley", "grid_dims": [5, 4]}, {"name": "peaks", "grid_dims": [3, 3], "height_offset": 50}],
+  "scenarios": [{"name": "dusk", "sun": {"azimuth_deg": 250, "elevation_deg": 6, "illuminance": 1.2}, "sky": {"intensity": 0.4}},
+                {"name": "overcast", "sun": {"illuminance": 0}, "sky": {"intensity": 2.5, "color": [0.2, 0.2, 0.21]}}],
+  "bake": {"error_map_resolution": 0}
+}
+EOF
+"$terralux" --print-project "$work/scenarios.terralux.json" >"$work/scenarios.json" || fail "--print-project of the scenarios exited $?"
+"$terralux" --bake --quiet --quality draft "$work/scenarios.terralux.json" --out "$work/scenarios" >/dev/null ||
+  fail "bake of the scenarios exited $?"
+python3 - "$work/scenarios.json" "$work/scenarios" <<'PY' || fail "scenarios: TERRALUX_lighting.scenarios or the files disagree with the project"
+import json, os, sys
+project = json.load(open(sys.argv[1]))
+out = sys.argv[2]
+scene = json.load(open(os.path.join(out, "scene.gltf")))["scenes"][0]["extensions"]
+ext, grids = scene["TERRALUX_lighting"], scene["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"]
+errors = []
+names = [s["name"] for s in ext["scenarios"]]
+if names != ["default", "dusk", "overcast"]:
+    errors.append(f"scenario names {names}")
+if [g["shProbePath"] for g in grids] != ext["scenarios"][0]["shProbePaths"]:
+    errors.append("the default's files are not shProbeGrids'")
+for entry, authored in zip(ext["scenarios"][1:], project["scenarios"]):
+    for section in ("sun", "sky"):
+        plain = {k: v for k, v in entry[section].items() if k != "direction" and not k.startswith("resolved_")}
+        if plain != authored[section]:
+            errors.append(f"{entry['name']}.{section}: {plain} != {authored[section]}")
+    want = [p.replace("sh_coeffs/", "scenarios/").replace(".shprobe", "." + entry["name"] + ".shprobe")
+            for p in ext["scenarios"][0]["shProbePaths"]]
+    if entry["shProbePaths"] != want:
+        errors.append(f"{entry['name']} files {entry['shProbePaths']} != {want}")
+    for mine, default in zip(entry["shProbePaths"], ext["scenarios"][0]["shProbePaths"]):
+        a, b = open(os.path.join(out, mine), "rb").read(), open(os.path.join(out, default), "rb").read()
+        count = int.from_bytes(b[8:12], "little")
+        occupancy = 48 + 160 * count
+        if len(a) != len(b) or a[:48] != b[:48] or a[occupancy:] != b[occupancy:]:
+            errors.append(f"{mine}: not the layout of {default}")
+        elif a == b:
+            errors.append(f"{mine}: the default's coefficients")
+for e in errors:
+    print("FAIL:", e)
+sys.exit(1 if errors else 0)
+PY
+validate "$work/scenarios/scene.gltf"
+
 # The sample with a lake at 800 m (its valleys are at 529 m), two waves, and the albedo texture beside it.
 sets=(--set water.enabled=true --set water.level=800 --set water.roughness=0.2 --set water.depth_aware=true --set bake.error_map_resolution=0
       --set 'water.waves=[{"direction_deg":60,"wavelength":30,"steepness":0.2},{"wavelength":7,"amplitude":0.15,"phase":2}]')
