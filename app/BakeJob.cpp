@@ -115,6 +115,8 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     b.lighting = traced.lighting;
     b.tracer = std::move(traced.tracer);
     if (cancelled()) throw BakeCancelled();
+    // Every sun can be placed over this terrain, the scenarios' included, before any probe.
+    checkSunPlaces(scene, b.terrain.heightfield);
     b.q = qualityOf(scene.bake);
     b.referenceMode = scene.bake.quality == QualityPreset::Reference;
     for (const auto& v : scene.probeVolumes)

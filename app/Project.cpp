@@ -394,6 +394,12 @@ std::vector<std::string> scenarioNames(const SceneDescription& scene) {
     return names;
 }
 
+std::string knownScenario(const SceneDescription& scene, const std::string& name) {
+    for (const LightingScenario& l : scene.scenarios)
+        if (l.name == name) return name;
+    return kDefaultScenario;
+}
+
 SceneDescription scenarioScene(const SceneDescription& scene, const std::string& name) {
     SceneDescription lit = scene;
     if (name == kDefaultScenario) return lit;

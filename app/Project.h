@@ -72,6 +72,9 @@ void applyOverride(nlohmann::json& doc, const std::string& assignment);
 
 // The project's lighting scenarios by name, the default first: "default", then scenarios[].name.
 std::vector<std::string> scenarioNames(const SceneDescription& scene);
+// `name` when the scene has that scenario, else "default" (what a view of a renamed or removed
+// scenario falls back to).
+std::string knownScenario(const SceneDescription& scene, const std::string& name);
 // The scene lit as scenario `name` lights it: its sun and sky in place of the project's own
 // ("default": the scene as it is). Throws ProjectError naming the scenarios there are when no
 // scenario has that name.

@@ -57,11 +57,8 @@ std::vector<GpuProbeVolume> blendProbeVolumes(const std::vector<GpuProbeVolume>&
 }
 
 ScenarioView ProjectRenderer::shownView() const {
-    const std::vector<std::string> names = scenarioNames(project_.scene);
-    auto known = [&](const std::string& n) {
-        return std::find(names.begin(), names.end(), n) != names.end() ? n : std::string(kDefaultScenario);
-    };
-    ScenarioView v{known(view_.a), known(view_.b), std::clamp(view_.blend, 0.0f, 1.0f)};
+    ScenarioView v{knownScenario(project_.scene, view_.a), knownScenario(project_.scene, view_.b),
+                   std::clamp(view_.blend, 0.0f, 1.0f)};
     if (v.a == v.b) v.blend = 0.0f;
     return v;
 }

@@ -79,6 +79,17 @@ Sky physicalSkyOf(const SceneDescription& scene, const Heightfield& hf) {
 size_t hdrSkyReads() { return skyReads.load(); }
 size_t physicalSkyBuilds() { return physicalBuilds.load(); }
 
+void checkSunPlaces(const SceneDescription& scene, const Heightfield& hf) {
+    (void)sunAnglesOf(scene, hf);
+    for (const LightingScenario& l : scene.scenarios) {
+        try {
+            (void)sunAnglesOf(scenarioScene(scene, l.name), hf);
+        } catch (const ProjectError& e) {
+            throw ProjectError("scenario '" + l.name + "': " + e.what());
+        }
+    }
+}
+
 SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf) {
     const SunSettings& s = scene.sun;
     SunAngles a{s.azimuthDeg, s.elevationDeg, std::nullopt};

@@ -45,6 +45,9 @@ struct SunAngles {
     std::optional<SunPlace> place;
 };
 SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf);
+// sunAnglesOf for the project's sun and every scenario's, so an edit or a bake is refused before
+// any work when one of them cannot be placed; a scenario's message starts "scenario '<name>': ".
+void checkSunPlaces(const SceneDescription& scene, const Heightfield& hf);
 
 // The fog as the renderer draws it: base height and colour resolved (unset base height = the lowest
 // terrain; unset colour = the sky's mean radiance over the sphere).

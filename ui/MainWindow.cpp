@@ -787,12 +787,10 @@ void MainWindow::buildScenarioToolbar() {
 }
 
 void MainWindow::refreshScenarioWidgets() {
-    const std::vector<std::string> names = scenarioNames(doc_->project().scene);
+    const SceneDescription& scene = doc_->project().scene;
+    const std::vector<std::string> names = scenarioNames(scene);
     // A scenario renamed or removed: the view falls back to the default, as the renderer does.
-    auto known = [&](const std::string& n) {
-        return std::find(names.begin(), names.end(), n) != names.end() ? n : std::string(kDefaultScenario);
-    };
-    ScenarioView v{known(scenarioView_.a), known(scenarioView_.b), scenarioView_.blend};
+    ScenarioView v{knownScenario(scene, scenarioView_.a), knownScenario(scene, scenarioView_.b), scenarioView_.blend};
     {
         const QSignalBlocker b1(scenarioFrom_), b2(scenarioTo_);
         scenarioFrom_->clear();

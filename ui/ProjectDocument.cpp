@@ -176,7 +176,7 @@ bool ProjectDocument::setParameter(const std::string& path, const nlohmann::json
             startTerrainEdit(edited, before, at(next, edited), candidate);
             return true;
         }
-        if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);  // a place the DEM can give
+        if (terrain_) checkSunPlaces(candidate.scene, terrain_->heightfield);  // a place the DEM can give
         undo_.push(new SetParameterCommand(this, edited, before, at(next, edited)));
         return true;
     } catch (const std::exception& e) {
@@ -197,7 +197,7 @@ nlohmann::json ProjectDocument::checkedEdit(const std::vector<std::pair<std::str
     }
     Project candidate = project_;
     candidate.scene = sceneFromJson(next, "project", nullptr);
-    if (terrain_) (void)sunAnglesOf(candidate.scene, terrain_->heightfield);
+    if (terrain_) checkSunPlaces(candidate.scene, terrain_->heightfield);
     return next;
 }
 
@@ -312,7 +312,7 @@ void ProjectDocument::startTerrainLoad(Project candidate,
         try {
             terrain = std::make_shared<DemImportResult>(loadProjectTerrain(candidate));
             // A date-and-time sun needs the new DEM to say where it is (or a place set by hand).
-            (void)sunAnglesOf(candidate.scene, terrain->heightfield);
+            checkSunPlaces(candidate.scene, terrain->heightfield);
         } catch (const std::exception& e) {
             error = QString::fromStdString(e.what());
         }

@@ -11,6 +11,7 @@
 #include "GltfExport.h"
 #include "ParameterTable.h"
 #include "Project.h"
+#include "SceneLighting.h"
 #include "ShProbeFile.h"
 
 using namespace terralux;
@@ -187,6 +188,26 @@ TEST(Scenarios, AScenariosProbesAreABakeOfItsLighting) {
     std::ifstream again(dir / "with" / "scene.gltf");
     EXPECT_FALSE(json::parse(again)["scenes"][0]["extensions"]["TERRALUX_lighting"].contains("scenarios"));
     fs::remove_all(dir);
+}
+
+// A scenario's sun that the terrain cannot place (a date and a time over a DEM without a CRS) is
+// refused by its scenario's name, before any work.
+TEST(Scenarios, ASunThatCannotBePlacedIsRefusedByItsScenario) {
+    const Heightfield hf(4, 4, 10.0, 10.0, std::vector<float>(16, 100.0f));  // no CRS
+    SceneDescription s;
+    LightingScenario noon;
+    noon.name = "noon";
+    noon.sun.mode = SunMode::DateTime;
+    s.scenarios = {noon};
+    try {
+        checkSunPlaces(s, hf);
+        FAIL() << "a sun without a place was accepted";
+    } catch (const ProjectError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("scenario 'noon': ", 0), 0u) << e.what();
+    }
+    s.scenarios[0].sun.latitudeDeg = 46.0;
+    s.scenarios[0].sun.longitudeDeg = 7.0;
+    EXPECT_NO_THROW(checkSunPlaces(s, hf));
 }
 
 TEST(Scenarios, TheExportRefusesAScenarioOfAnotherLayout) {
