@@ -818,6 +818,8 @@ void MainWindow::setScenarioView(const ScenarioView& view) {
         const QSignalBlocker b(scenarioPanel_);
         scenarioPanel_->selectScenario(QString::fromStdString(view.a));
     }
+    // The sun handle is the shown scenario's (the nearer end of a blend).
+    if (gizmos_) gizmos_->setScenario(view.blend < 0.5f ? view.a : view.b);
     if (same || !renderer_) return;
     renderer_->setScenarioView(view);
     // The probes of the scenarios shown: the bake's when current, else a draft of each.

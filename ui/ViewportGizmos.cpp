@@ -105,6 +105,18 @@ ViewportGizmos::ViewportGizmos(ProjectDocument* doc, QObject* parent) : QObject(
 
 const Heightfield& ViewportGizmos::heightfield() const { return doc_->terrain().heightfield; }
 
+void ViewportGizmos::setScenario(const std::string& name) {
+    if (name == scenario_) return;
+    if (drag_) release(true);
+    scenario_ = name;
+    emit redraw();
+}
+
+SceneDescription ViewportGizmos::litScene() const {
+    const SceneDescription& scene = doc_->project().scene;
+    return scenarioScene(scene, knownScenario(scene, scenario_));
+}
+
 void ViewportGizmos::refresh() {
     try {
         scene_ = sceneBounds(doc_->project().scene, heightfield());
@@ -133,7 +145,7 @@ std::vector<VolumeBounds> ViewportGizmos::bounds(const OrbitCamera& camera) cons
     std::vector<VolumeBounds> out;
     for (const VolumeBounds& b : scene_)
         if (shown(b.kind)) out.push_back(b);
-    const SceneDescription& scene = doc_->project().scene;
+    const SceneDescription scene = litScene();
     if (shown(BoundsKind::LpvCascade))
         for (const VolumeBounds& b : lpvBounds(scene, heightfield(), camera)) out.push_back(b);
     if (shown(BoundsKind::Sun))
@@ -157,7 +169,7 @@ std::optional<VolumeBounds> ViewportGizmos::selectedFor(const OrbitCamera& camer
 
 std::vector<Handle> ViewportGizmos::handles(const OrbitCamera& camera) const {
     const std::optional<VolumeBounds> b = selectedFor(camera);
-    return b ? handlesOf(*b, doc_->project().scene) : std::vector<Handle>{};
+    return b ? handlesOf(*b, litScene()) : std::vector<Handle>{};
 }
 
 bool ViewportGizmos::select(QPointF at, const OrbitCamera& camera, QSizeF size, double pixels, bool keepOnMiss) {
@@ -169,7 +181,7 @@ bool ViewportGizmos::select(QPointF at, const OrbitCamera& camera, QSizeF size, 
     };
     // The selected bounds' handles first: a click on one keeps the selection.
     if (const std::optional<VolumeBounds> current = selectedFor(camera))
-        for (const Handle& h : handlesOf(*current, doc_->project().scene))
+        for (const Handle& h : handlesOf(*current, litScene()))
             if (const auto p = view.toScreen(h.at)) consider(*current, std::hypot(p->x() - at.x(), p->y() - at.y()));
     for (const VolumeBounds& b : bounds(camera)) {
         if (b.kind == BoundsKind::Sun) {
@@ -200,13 +212,13 @@ bool ViewportGizmos::grab(QPointF at, const OrbitCamera& camera, QSizeF size) {
     const ScreenProjection view(camera, size, heightfield());
     std::optional<Handle> hit;
     double bestDistance = kHandlePixels;
-    for (const Handle& h : handlesOf(*current, doc_->project().scene))
+    for (const Handle& h : handlesOf(*current, litScene()))
         if (const auto p = view.toScreen(h.at)) {
             const double d = std::hypot(p->x() - at.x(), p->y() - at.y());
             if (d < bestDistance) bestDistance = d, hit = h;
         }
     if (!hit) return false;
-    drag_ = Drag{*current, *hit, doc_->project().scene, hit->at, {}};
+    drag_ = Drag{*current, *hit, litScene(), hit->at, {}};
     doc_->beginLiveEdit();
     emit redraw();
     return true;
@@ -251,7 +263,13 @@ void ViewportGizmos::drag(QPointF at, const OrbitCamera& camera, QSizeF size) {
         delta = glm::vec3(p.x - h.at.x, 0.0f, p.z - h.at.z);
     }
     try {
-        const HandleEdit edit = dragHandle(drag_->scene, heightfield(), drag_->bounds, h.role, delta);
+        HandleEdit edit = dragHandle(drag_->scene, heightfield(), drag_->bounds, h.role, delta);
+        // A scenario's sun is its own rows.
+        const SceneDescription& scene = doc_->project().scene;
+        for (size_t i = 0; i < scene.scenarios.size(); ++i)
+            if (scene.scenarios[i].name == scenario_)
+                for (auto& value : edit.values)
+                    if (value.first.rfind("sun.", 0) == 0) value.first = "scenarios[" + std::to_string(i) + "]." + value.first;
         QString error;
         if (!doc_->previewParameters(edit.values, &error)) {
             emit rejected(error);
@@ -302,7 +320,7 @@ std::vector<GizmoLine> ViewportGizmos::gizmos(const OrbitCamera& camera, QSizeF 
                                camera.target + radius * glm::vec3(std::sin(a1), 0.0f, -std::cos(a1)), 0.5f * color});
             }
             // A dated sun moves along its day: the path, bright above the horizon.
-            const std::vector<glm::vec3> path = sunPath(doc_->project().scene, heightfield(), camera, radius);
+            const std::vector<glm::vec3> path = sunPath(litScene(), heightfield(), camera, radius);
             for (size_t i = 1; i < path.size(); ++i) {
                 const bool up = path[i - 1].y > camera.target.y || path[i].y > camera.target.y;
                 out.push_back({path[i - 1], path[i], up ? 0.9f * color : 0.35f * color});
@@ -315,7 +333,7 @@ std::vector<GizmoLine> ViewportGizmos::gizmos(const OrbitCamera& camera, QSizeF 
         }
         if (!selected) continue;
         const glm::vec3 top(0.5f * (b.min.x + b.max.x), b.max.y, 0.5f * (b.min.z + b.max.z));
-        for (const Handle& h : handlesOf(b, doc_->project().scene)) {
+        for (const Handle& h : handlesOf(b, litScene())) {
             const bool active = drag_ && drag_->handle.role == h.role;
             const glm::vec3 hc = active ? kActiveHandle : kHandle;
             if (h.role == HandleRole::Height && b.kind != BoundsKind::Water) out.push_back({top, h.at, hc});

@@ -47,6 +47,9 @@ class ViewportGizmos : public QObject, public ViewportInteraction {
 public:
     explicit ViewportGizmos(ProjectDocument* doc, QObject* parent = nullptr);
 
+    // The lighting scenario the viewport shows: the sun drawn and dragged is its sun, and a drag
+    // writes that scenario's sun rows ("default": the project's own).
+    void setScenario(const std::string& name);
     void setShown(BoundsKind kind, bool shown);
     bool shown(BoundsKind kind) const { return shown_[size_t(kind)]; }
     // What is drawn now: the shown kinds' bounds (LPV cascades around `camera`).
@@ -81,7 +84,10 @@ private:
     const Heightfield& heightfield() const;
     std::optional<VolumeBounds> find(BoundsKind kind, int index) const;
     float sunDistance(const OrbitCamera& camera) const { return 0.35f * camera.radius; }
+    // The project lit as the shown scenario (scenarioScene); the volumes are the project's.
+    SceneDescription litScene() const;
     ProjectDocument* doc_;
+    std::string scenario_ = "default";
     std::array<bool, kBoundsKinds> shown_{true, true, false, true, true};
     std::vector<VolumeBounds> scene_;  // sceneBounds of the document
     std::optional<VolumeBounds> selected_;

@@ -1190,7 +1190,8 @@ private slots:
                 const SceneDescription& scene = w_->document()->project().scene;
                 int hidden = 0;
                 for (const ParameterSpec& spec : parameterTable()) {
-                    if (!spec.uiRow || parameterDock(spec).objectName != "dock.sunSky") continue;
+                    // The scenarios' rows: scenariosAreEditedShownAndBlended.
+                    if (!spec.uiRow || spec.perScenario() || parameterDock(spec).objectName != "dock.sunSky") continue;
                     const QString name = QString::fromStdString(uiObjectName(spec));
                     QWidget* editor = w_->findChild<QWidget*>(name);
                     QVERIFY2(editor, qPrintable(name));
@@ -1803,11 +1804,59 @@ private slots:
         QCOMPARE(doc.project().scene.sun.elevationDeg, 35.0);
         QCOMPARE(doc.undoStack()->undoText(), QString("Set Sun elevation of scenario 'scenario-1'"));
         w_->findChild<QDoubleSpinBox*>("param.scenario.sun.azimuth_deg")->setValue(260.0);
+        // The scenario's rows hide as its own sky mode says, not the default's.
+        auto* scenarioDock = w_->findChild<QDockWidget*>("dock.sunSky");
+        auto rowShown = [&](const char* name) {
+            QWidget* w = w_->findChild<QWidget*>(name);
+            return w && rowOf(w)->isVisibleTo(scenarioDock);
+        };
+        QVERIFY(rowShown("param.scenario.sky.color") && !rowShown("param.scenario.sky.turbidity"));
+        w_->findChild<QComboBox*>("param.scenario.sky.mode")->setCurrentText("physical");
+        QCOMPARE(doc.project().scene.scenarios[0].sky.mode, SkyMode::Physical);
+        QCOMPARE(doc.project().scene.sky.mode, SkyMode::Uniform);
+        QVERIFY(!rowShown("param.scenario.sky.color") && rowShown("param.scenario.sky.turbidity"));
+        doc.undoStack()->undo();
+        QCOMPARE(doc.project().scene.scenarios[0].sky.mode, SkyMode::Uniform);
         QTRY_VERIFY_WITH_TIMEOUT(w_->probeSource() == "draft preview" &&
                                      w_->findChild<QLabel*>("status.probes")->text().contains("scenario 'scenario-1'"),
                                  30000);
         QTRY_VERIFY_WITH_TIMEOUT(test::compareImages(vp->grabImage().rgba, defaultFrame.rgba, defaultFrame.width,
                                                      defaultFrame.height).meanAbs > 0.02, 20000);
+
+        // The sun handle is the shown scenario's: its drag moves that scenario's sun, not the project's.
+        {
+            ViewportGizmos* gizmos = w_->gizmos();
+            const QSizeF size(vp->width(), vp->height());
+            auto screen = [&](const glm::vec3& p) {
+                const auto at = ScreenProjection(vp->camera(), size, doc.terrain().heightfield).toScreen(p);
+                return at ? at->toPoint() : QPoint(-1, -1);
+            };
+            VolumeBounds sun;
+            for (const VolumeBounds& b : gizmos->bounds(vp->camera()))
+                if (b.kind == BoundsKind::Sun) sun = b;
+            const SunAngles shown = sunAnglesOf(scenarioScene(doc.project().scene, "scenario-1"), doc.terrain().heightfield);
+            const glm::vec3 toward = glm::normalize(sun.min - vp->camera().target);
+            QVERIFY(std::abs(std::asin(double(toward.y)) * 180.0 / std::numbers::pi - shown.elevationDeg) < 0.5);
+            const QPoint at = screen(sun.min);
+            QTest::mouseClick(vp, Qt::LeftButton, Qt::NoModifier, at);
+            QTRY_VERIFY(gizmos->selected() && gizmos->selected()->kind == BoundsKind::Sun);
+            // Toward the view's target on screen: the point crosses the sphere's near side.
+            const QPoint centre = screen(vp->camera().target), to = at + (centre - at) / 2;
+            QSignalSpy refusals(gizmos, &ViewportGizmos::rejected);
+            QTest::mousePress(vp, Qt::LeftButton, Qt::NoModifier, at);
+            QVERIFY(vp->grabbing());
+            for (int i = 1; i <= 8; ++i) QTest::mouseMove(vp, at + (to - at) * i / 8);
+            QCOMPARE(refusals.count(), 0);
+            QTest::mouseRelease(vp, Qt::LeftButton, Qt::NoModifier, to);
+            QCOMPARE(doc.undoStack()->undoText(), QString("Move the sun"));
+            QVERIFY(std::abs(doc.project().scene.scenarios[0].sun.azimuthDeg - 260.0) > 1.0 ||
+                    std::abs(doc.project().scene.scenarios[0].sun.elevationDeg - 8.0) > 1.0);
+            QCOMPARE(doc.project().scene.sun.azimuthDeg, 135.0);
+            QCOMPARE(doc.project().scene.sun.elevationDeg, 35.0);
+            doc.undoStack()->undo();
+            QCOMPARE(doc.project().scene.scenarios[0].sun.azimuthDeg, 260.0);
+            QCOMPARE(doc.project().scene.scenarios[0].sun.elevationDeg, 8.0);
+        }
 
         // Rename: a name the rules refuse is named and the old one stays.
         auto* name = w_->findChild<QLineEdit*>("scenarios.name");
@@ -1833,7 +1882,9 @@ private slots:
                                      w_->findChild<QLabel*>("status.probes")->text().contains("default → dusk 50 %"),
                                  30000);
         QVERIFY(w_->findChild<QDockWidget*>("dock.sunSky")->grab().save(QString::fromStdString((kOut / "scenarios_dock.png").string())));
-        QVERIFY(w_->grab().save(QString::fromStdString((kOut / "scenarios_window.png").string())));
+        QTest::qWait(100);
+        QVERIFY(w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height())
+                    .save(QString::fromStdString((kOut / "scenarios_window.png").string())));
         // Back to the default alone: the frame it drew before.
         w_->findChild<QSlider*>("viewport.scenarioBlend")->setValue(0);
         QTRY_VERIFY_WITH_TIMEOUT(test::compareImages(vp->grabImage().rgba, defaultFrame.rgba, defaultFrame.width,
