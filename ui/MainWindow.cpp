@@ -807,7 +807,7 @@ void MainWindow::refreshScenarioWidgets() {
 void MainWindow::setScenarioView(const ScenarioView& view) {
     const bool same = view.a == scenarioView_.a && view.b == scenarioView_.b && view.blend == scenarioView_.blend;
     scenarioView_ = view;
-    {
+    if (scenarioFrom_) {
         const QSignalBlocker b1(scenarioFrom_), b2(scenarioTo_), b3(scenarioBlend_);
         scenarioFrom_->setCurrentText(QString::fromStdString(view.a));
         scenarioTo_->setCurrentText(QString::fromStdString(view.b));
