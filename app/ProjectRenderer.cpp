@@ -460,7 +460,7 @@ ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width
     a.shadowMilliseconds = mapped.milliseconds;
     const uint32_t tilesX = (width + kShadowTile - 1) / kShadowTile, tilesY = (height + kShadowTile - 1) / kShadowTile;
     std::vector<uint32_t> tileTerrain(size_t(tilesX) * tilesY, 0), tileOff(tileTerrain.size(), 0);
-    size_t off = 0;
+    size_t off = 0, acne = 0;
     double sum = 0.0;
     // Both views write the value in red and 1 in green on terrain.
     for (uint32_t y = 0; y < height; ++y)
@@ -473,7 +473,12 @@ ShadowAgreement measureShadowAgreement(ProjectRenderer& renderer, uint32_t width
             const size_t t = size_t(y / kShadowTile) * tilesX + x / kShadowTile;
             ++tileTerrain[t];
             if (d > 0.5) ++off, ++tileOff[t];
+            if (traced.rgba[i] >= 0.95f) {
+                ++a.tracedLitPixels;
+                if (mapped.rgba[i] < 0.9f) ++acne;
+            }
         }
+    if (a.tracedLitPixels > 0) a.acne = double(acne) / double(a.tracedLitPixels);
     if (a.terrainPixels > 0) {
         a.disagreeing = double(off) / double(a.terrainPixels);
         a.meanAbsDifference = sum / double(a.terrainPixels);

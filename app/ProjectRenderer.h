@@ -74,6 +74,10 @@ struct ShadowAgreement {
     size_t terrainPixels = 0;
     double disagreeing = 0.0;     // share of terrain pixels where the two differ by more than 0.5
     double meanAbsDifference = 0.0;
+    // Acne: of the pixels the tracer sees fully lit (at least 0.95), the share the maps darken
+    // below 0.9. Self-shadowing shows here first, where the agreement barely moves.
+    size_t tracedLitPixels = 0;
+    double acne = 0.0;
     // The frame time of view 31 with its maps drawn in that frame (as a moving camera draws them).
     double shadowMilliseconds = 0.0;
     // Per screen tile of kShadowTile² pixels at least a quarter terrain: its share of disagreeing

@@ -49,6 +49,7 @@ void main() {
     vec3 mapAlbedo = surface.albedoFromMap > 0.5 ? texture(surfaceAlbedoMap, surfaceUv(t, surface.albedoMapSize)).rgb : vec3(1.0);
     s.filled = inside && camera.debugView == kViewFilled ? texture(surfaceFilled, uv).r : 0.0;
     float pixelMetres = length(fwidth(worldPos));
+    s.faceNormal = faceNormal(worldPos, worldNormal);
     float distance = length(worldPos - camera.position);
 
     float meanLength = length(normalAo.xyz);

@@ -49,6 +49,7 @@ void main() {
     vec2 field = waterFieldAt(restPos.xz);
     float depth = max(field.x, 0.0);  // metres of water over the bed
     float pixelMetres = length(fwidth(worldPos));
+    vec3 face = faceNormal(worldPos, vec3(0.0, 1.0, 0.0));
     vec3 displacement, n;
     gerstner(restPos.xz, depth, shoreFade(field.y), pixelMetres, displacement, n);
     vec2 screen = gl_FragCoord.xy * camera.invViewportSize;
@@ -86,7 +87,7 @@ void main() {
     }
 
     vec3 l = normalize(sunSky.sunDirection);
-    float shadowed = sunShadow(worldPos, n);
+    float shadowed = sunShadow(worldPos, n, face);
     vec3 sun = sunSky.sunIlluminance * shadowed;
     vec3 highlight = ggxSpecularF0(n, v, l, water.roughness, kWaterF0) * sun;
 

@@ -167,7 +167,7 @@ struct RendererGpu {
     std::vector<FrameSlot> slots;
     std::unique_ptr<RenderTarget> target;
     vk::RenderPass clearPass, drawPass, shadowPass;
-    vk::Sampler compareSampler, depthSampler;
+    vk::Sampler depthSampler;
     vk::UniqueSetLayout emptySet;
     std::array<vk::UniqueSetLayout, 4> lightsLayouts;     // by lights variant
     std::array<vk::PipelineLayout, 4> terrainLayouts;     // view and lights, by lights variant
@@ -219,6 +219,7 @@ struct Frame {
 
     // The terrain mesh and the overlays' instances.
     uint32_t vertexCount = 0, indexCount = 0, markerCount = 0, leafCount = 0, gizmoCount = 0;
+    uint32_t skirtIndexCount = 0;  // drawn after indexCount by the shadow pass alone (terrain.skirt)
     // The cascades' light projections this frame (empty without shadows).
     std::vector<glm::mat4> lightMatrices;
 

@@ -77,8 +77,6 @@ vk::DescriptorSetBuilder lightsBuilder(int variant, const FrameSlot& f, const Gp
         .uniform(blocks::AtmosphereBlock::kBinding, "atmosphere", f.atmosphere, frag);
     if (variant & kShadowedLights)
         b.uniform(blocks::ShadowBlock::kBinding, "shadow", f.shadow, frag)
-            .image(TLX_SHADOW_MAP_COMPARE_BINDING, std::string(kShadowMaps) + "(compare)", maps,
-                   g.compareSampler.handle(), frag)
             .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
                    g.depthSampler.handle(), frag);
     if (variant & kReflectedLights) {
@@ -127,6 +125,50 @@ vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
     return l;
 }
 
+// The skirt (terrain.skirt: beyond the footprint the ground keeps its border's height) as the
+// shadow maps draw it, so the preview's sun is shadowed by the world the bake traces: each border
+// edge of the drawn mesh extruded outward, and a level square at the corner height in each corner
+// quadrant. It reaches 100 footprints out: a border ridge's shadow from further falls on the
+// footprint only below a sun of about atan(relief / 100 footprints), well under a degree. Appended
+// after the terrain's own vertices and indices; only the shadow pass draws its indices.
+void appendSkirt(std::vector<float>& vertices, std::vector<uint32_t>& indices, const std::vector<int>& cols,
+                 const std::vector<int>& rows) {
+    const uint32_t nc = uint32_t(cols.size()), nr = uint32_t(rows.size());
+    auto at = [&](uint32_t c, uint32_t r) {
+        const size_t i = (size_t(r) * nc + c) * 6;
+        return glm::vec3(vertices[i], vertices[i + 1], vertices[i + 2]);
+    };
+    const glm::vec3 lo = at(0, 0), hi = at(nc - 1, nr - 1);
+    const float reach = 100.0f * std::max({hi.x - lo.x, hi.z - lo.z, 1.0f});
+    auto add = [&](glm::vec3 p) {
+        vertices.insert(vertices.end(), {p.x, p.y, p.z, 0.0f, 1.0f, 0.0f});
+        return uint32_t(vertices.size() / 6 - 1);
+    };
+    auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+        const uint32_t ia = add(a), ib = add(b), ic = add(c), id = add(d);
+        indices.insert(indices.end(), {ia, ib, ic, ia, ic, id});
+    };
+    // One border edge: n + 1 vertices from `edge(i)`, pushed out along `out`.
+    auto extrude = [&](uint32_t n, auto edge, glm::vec3 out) {
+        for (uint32_t i = 0; i + 1 < n; ++i) {
+            const glm::vec3 a = edge(i), b = edge(i + 1);
+            quad(a, b, b + out * reach, a + out * reach);
+        }
+    };
+    const glm::vec3 west(-1, 0, 0), east(1, 0, 0), north(0, 0, -1), south(0, 0, 1);
+    extrude(nr, [&](uint32_t r) { return at(0, r); }, west);
+    extrude(nr, [&](uint32_t r) { return at(nc - 1, r); }, east);
+    extrude(nc, [&](uint32_t c) { return at(c, 0); }, north);
+    extrude(nc, [&](uint32_t c) { return at(c, nr - 1); }, south);
+    auto corner = [&](glm::vec3 p, glm::vec3 a, glm::vec3 b) {
+        quad(p, p + a * reach, p + (a + b) * reach, p + b * reach);
+    };
+    corner(at(0, 0), west, north);
+    corner(at(nc - 1, 0), east, north);
+    corner(at(0, nr - 1), west, south);
+    corner(at(nc - 1, nr - 1), east, south);
+}
+
 }  // namespace
 
 TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget)
@@ -159,6 +201,8 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     vertexCount_ = vertices.size() / 6;
     indexCount_ = indices.size();
     meshVertices_ = vertices;
+    appendSkirt(vertices, indices, cols, rows);
+    skirtIndexCount_ = indices.size() - indexCount_;
 
     RendererGpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
@@ -209,8 +253,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     g.clearPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, true, true});
     g.drawPass = vk::RenderPass(ctx_, {colorFormats, vk::kDepthFormat, false, true});
     g.shadowPass = vk::RenderPass(ctx_, {{}, vk::kDepthFormat, true, true});
-    g.compareSampler = vk::Sampler::depthCompare(ctx_);
-    g.depthSampler = vk::Sampler::nearestClamp(ctx_);
+    g.depthSampler = vk::Sampler::depthBorder(ctx_);
     g.shadowDepthLayout = vk::PipelineLayout(ctx_, {}, sizeof(glm::mat4), VK_SHADER_STAGE_VERTEX_BIT);
     g.linear = vk::Sampler::linearClamp(ctx_);
     static const vk::Buffer noBuffer;
@@ -837,6 +880,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     if (f.water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
     f.vertexCount = uint32_t(vertexCount_);
     f.indexCount = uint32_t(indexCount_);
+    f.skirtIndexCount = s.skirt ? uint32_t(skirtIndexCount_) : 0;
     f.markerCount = markerCount_;
     f.leafCount = leafCount_;
     f.width = s.width;

@@ -192,7 +192,7 @@ private:
     const Heightfield& hf_;
     std::unique_ptr<RendererGpu> gpu_;
     int stride_ = 1;
-    size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
+    size_t vertexCount_ = 0, indexCount_ = 0, skirtIndexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
     int volumeCount_ = 0;
     bool anyErrorMap_ = false;
     uint32_t markerCount_ = 0, leafCount_ = 0;

@@ -33,6 +33,7 @@ UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pas
     vp.scissorCount = 1;
     VkPipelineRasterizationStateCreateInfo rs{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     rs.polygonMode = VK_POLYGON_MODE_FILL;
+    rs.depthClampEnable = desc.depthClamp ? VK_TRUE : VK_FALSE;
     rs.cullMode = VK_CULL_MODE_NONE;  // the terrain is seen from below too, near cliffs
     rs.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
     rs.lineWidth = 1.0f;

@@ -23,6 +23,7 @@ struct GraphicsPipelineDesc {
     // The camera's passes use reversed Z (near 1, far 0: float depth keeps its precision out to
     // the far plane, so water meets the shore without fighting); shadow maps keep 0 near.
     VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
+    bool depthClamp = false;  // needs VulkanContext::depthClamp()
 };
 
 UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pass,

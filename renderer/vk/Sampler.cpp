@@ -30,12 +30,10 @@ Sampler Sampler::trilinearClamp(const VulkanContext& ctx) {
 
 Sampler Sampler::nearestClamp(const VulkanContext& ctx) { return Sampler(ctx, clampInfo(VK_FILTER_NEAREST)); }
 
-Sampler Sampler::depthCompare(const VulkanContext& ctx) {
-    VkSamplerCreateInfo si = clampInfo(VK_FILTER_LINEAR);
+Sampler Sampler::depthBorder(const VulkanContext& ctx) {
+    VkSamplerCreateInfo si = clampInfo(VK_FILTER_NEAREST);
     si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER;
     si.borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE;
-    si.compareEnable = VK_TRUE;
-    si.compareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
     return Sampler(ctx, si);
 }
 

@@ -18,9 +18,9 @@ public:
     static Sampler trilinearClamp(const VulkanContext& ctx);
     // Nearest texel, clamped to the edge (data images, debug reads).
     static Sampler nearestClamp(const VulkanContext& ctx);
-    // Depth compare (reference <= stored gives 1), bilinear, clamped to a white border: a point
-    // outside the shadow map is lit.
-    static Sampler depthCompare(const VulkanContext& ctx);
+    // Stored depths, nearest, clamped to a white border (depth 1): a texel outside the shadow map
+    // blocks nothing. The shadows gather and compare them themselves (shaders/shadows.glsl).
+    static Sampler depthBorder(const VulkanContext& ctx);
 
     VkSampler handle() const { return sampler_.get(); }
 

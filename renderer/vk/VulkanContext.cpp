@@ -155,6 +155,8 @@ void VulkanContext::create(const ContextOptions& options) {
     vkGetPhysicalDeviceFeatures(physical_, &available);
     features.imageCubeArray = available.imageCubeArray;
     cubeArrays_ = available.imageCubeArray == VK_TRUE;
+    features.depthClamp = available.depthClamp;
+    depthClamp_ = available.depthClamp == VK_TRUE;
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;

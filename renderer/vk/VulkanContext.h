@@ -59,6 +59,9 @@ public:
     // Whether the device samples cube-map arrays (imageCubeArray, enabled when present): the
     // reflection probes' cubes are one.
     bool cubeArrays() const { return cubeArrays_; }
+    // Whether a pipeline may clamp depth instead of clipping at the near and far planes
+    // (depthClamp, enabled when present): the shadow maps' skirt.
+    bool depthClamp() const { return depthClamp_; }
     VkPhysicalDeviceType deviceType() const { return deviceType_; }
     // Nanoseconds a timestamp tick, 0 where the queue writes no timestamps; the bits a timestamp
     // holds (the rest are undefined).
@@ -97,6 +100,7 @@ private:
     VkFence fence_ = VK_NULL_HANDLE;
     std::string deviceName_;
     bool cubeArrays_ = false;
+    bool depthClamp_ = false;
     double timestampPeriod_ = 0.0;
     uint32_t timestampBits_ = 0;
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;

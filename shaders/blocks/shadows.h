@@ -1,5 +1,5 @@
 // Cascaded sun shadows (docs/lighting.md, "Shadows"): bound only by the shadowed terrain pipeline,
-// with the cascades' depth maps (a 2D array, one layer per cascade) at the two bindings below.
+// with the cascades' depth maps (a 2D array, one layer per cascade) at the binding below.
 TLX_BLOCK_BEGIN(ShadowBlock, TLX_SET_LIGHTS, 2)
     TLX_MAT4_ARRAY(lightViewProj, 4)  // world to each cascade's clip space
     TLX_VEC4(ends)        // per cascade: view depth (m) where it ends
@@ -11,5 +11,4 @@ TLX_BLOCK_BEGIN(ShadowBlock, TLX_SET_LIGHTS, 2)
                           // (texels); tan(sun angular radius); map resolution (texels)
     TLX_INT2(cascadeCount, filterMode)  // cascades; 0 pcss, 1 pcf, 2 hard
 TLX_BLOCK_END(shadow)
-#define TLX_SHADOW_MAP_COMPARE_BINDING 3  // sampler2DArrayShadow (depth compare)
-#define TLX_SHADOW_MAP_DEPTH_BINDING 4    // sampler2DArray (the stored depths: blocker search)
+#define TLX_SHADOW_MAP_DEPTH_BINDING 3  // sampler2DArray: the stored depths, gathered and compared

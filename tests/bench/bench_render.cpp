@@ -147,6 +147,7 @@ void BM_ShadowAgreement(benchmark::State& state) {
     }
     state.SetLabel(std::to_string(cascades) + " cascades, " + std::to_string(resolution) + "², " + kFilters[filter]);
     state.counters["disagree_pct"] = 100.0 * a.disagreeing;
+    state.counters["acne_pct"] = 100.0 * a.acne;
     state.counters["mean_abs_diff"] = a.meanAbsDifference;
     state.counters["shadow_view_ms"] = a.shadowMilliseconds;
     state.counters["beauty_ms"] = ms / double(state.iterations());
@@ -161,6 +162,43 @@ void shadowSettings(benchmark::internal::Benchmark* b) {
     b->Args({3, 2048, 0});
 }
 BENCHMARK(BM_ShadowAgreement)->Apply(shadowSettings)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+
+// Acne and agreement at low, middle and high suns (azimuth 135°) on the embedded sample and the
+// shared mountain tiles, from the default framing (far) and from a camera a third as far at 15°
+// elevation (near): the cases RenderTest.ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns holds on the
+// committed crops, at 1280 x 720 and the default shadow settings.
+void BM_ShadowCases(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.ctx) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    const char* dems[] = {"", "N42E001.hgt", "mt_rainier_90m.tif"};
+    const int dem = int(state.range(0)), sun = int(state.range(1));
+    const bool near = state.range(2) != 0;
+    const std::string path = dem == 0 ? std::string() : (std::filesystem::path(TERRALUX_SHARED_DATA) / "dem" / dems[dem]).string();
+    std::vector<std::string> sets = {"bake.quality=draft", "sun.mode=\"manual\"", "sun.azimuth_deg=135",
+                                     "sun.elevation_deg=" + std::to_string(sun), "camera.azimuth_deg=210"};
+    if (near) sets.push_back("camera.elevation_deg=15");
+    Project p = loadEffectiveProject("", sets, path, nullptr);
+    p.scene.exportSettings.outDir = (std::filesystem::temp_directory_path() / "terralux_bench_shadow_cases").string();
+    ProjectRenderer r(*f.ctx, p);
+    if (near) {
+        p.scene.camera.radius = double(r.defaultCamera().radius) / 3.0;
+        r.setProject(p);
+    }
+    ShadowAgreement a;
+    for (auto _ : state) a = measureShadowAgreement(r, 1280, 720);
+    state.SetLabel(std::string(dem == 0 ? "sample" : dems[dem]) + ", sun " + std::to_string(sun) + "°, " + (near ? "near" : "far"));
+    state.counters["acne_pct"] = 100.0 * a.acne;
+    state.counters["disagree_pct"] = 100.0 * a.disagreeing;
+    state.counters["mean_abs_diff"] = a.meanAbsDifference;
+}
+BENCHMARK(BM_ShadowCases)
+    ->ArgsProduct({{0, 1, 2}, {5, 12, 35}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 // Beauty at 1280 x 720 with shadows and fog each on or off (the defaults otherwise).
 void BM_BeautyShadowsFog(benchmark::State& state) {

@@ -792,7 +792,7 @@ TEST_F(RenderTest, DeviceLayerTargetsSamplersAndImageBindings) {
     EXPECT_EQ(cascades.desc().layers, 4u);
     EXPECT_EQ(cube.desc().layers, 6u);
     EXPECT_EQ(depth.aspect(), VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT));
-    const vk::Sampler shadow = vk::Sampler::depthCompare(ctx), linear = vk::Sampler::linearClamp(ctx),
+    const vk::Sampler shadow = vk::Sampler::depthBorder(ctx), linear = vk::Sampler::linearClamp(ctx),
                       nearest = vk::Sampler::nearestClamp(ctx);
     vk::Buffer block = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     vk::Buffer data = vk::Buffer::hostVisible(ctx, 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -944,6 +944,58 @@ TEST_F(RenderTest, ShadowMapsAgreeWithTheTracedSunVisibilityAtTheDefaults) {
     r.setProject(p);
     draw(r, kViewSunVisibility, false, true);
     EXPECT_EQ(r.renderer().sunVisibilityTraces(), traces + 1);
+}
+
+// Shadow maps against the traced sun at low, middle and high suns, from the default framing
+// (far) and from a camera a third as far and low over the terrain (near), where a cascade texel
+// is smallest and the low sun's slope across it steepest: acne (exactly lit pixels the maps
+// darken) and agreement.
+struct ShadowCase {
+    std::string dem;  // empty: the embedded sample
+    double sunDeg;
+    bool near;
+};
+
+ShadowAgreement shadowCase(vk::VulkanContext& ctx, const ShadowCase& c, uint32_t w, uint32_t h) {
+    std::vector<std::string> sets = {"probe_volumes[0].enabled=false", "sun.mode=\"manual\"",
+                                     "sun.azimuth_deg=135", "sun.elevation_deg=" + std::to_string(c.sunDeg),
+                                     "camera.azimuth_deg=210"};
+    if (c.near) sets.push_back("camera.elevation_deg=15");
+    Project p = loadEffectiveProject("", sets, c.dem, nullptr);
+    p.scene.exportSettings.outDir = (kOut / "bake_shadow_cases").string();
+    ProjectRenderer r(ctx, p);
+    if (c.near) {
+        Project q = p;
+        q.scene.camera.radius = double(r.defaultCamera().radius) / 3.0;
+        r.setProject(q);
+    }
+    return measureShadowAgreement(r, w, h);
+}
+
+std::string describe(const ShadowCase& c) {
+    return (c.dem.empty() ? std::string("sample") : fs::path(c.dem).filename().string()) + " sun " +
+           std::to_string(int(c.sunDeg)) + "° " + (c.near ? "near" : "far");
+}
+
+TEST_F(RenderTest, ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns) {
+    // Before the receiver plane, 5 to 17 % of the exactly lit pixels were acne in every case, and
+    // without the skirt in the maps up to 13 % of the pixels disagreed at a 5° sun, far.
+    const fs::path dems = fs::path(TERRALUX_SOURCE_DIR) / "tests" / "data" / "dem";
+    for (const std::string& dem : {std::string(), (dems / "n42e001_voids_crop.tif").string(), (dems / "rainier_crop.tif").string()})
+        for (double sun : {5.0, 12.0, 35.0})
+            for (bool near : {false, true}) {
+                const ShadowCase c{dem, sun, near};
+                const ShadowAgreement a = shadowCase(*ctx_, c, 480, 270);
+                const std::string what = describe(c) + ": acne " + std::to_string(100.0 * a.acne) + " % of " +
+                                         std::to_string(a.tracedLitPixels) + " lit pixels, disagreeing " +
+                                         std::to_string(100.0 * a.disagreeing) + " %, mean |difference| " +
+                                         std::to_string(a.meanAbsDifference);
+                std::cout << what << "\n";
+                EXPECT_GT(a.tracedLitPixels, 480u * 270u / 50) << what;
+                EXPECT_LE(a.acne, 0.005) << what;
+                EXPECT_LE(a.disagreeing, 0.035) << what;
+                EXPECT_LE(a.meanAbsDifference, 0.06) << what;
+            }
 }
 
 TEST_F(RenderTest, ARidgeShadowsTheValleyBehindItAtALowSun) {

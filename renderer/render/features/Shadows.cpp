@@ -56,6 +56,9 @@ void addShadowPass(Frame& f) {
         d.attributes = {kMeshPosition};
         d.colorAttachments = 0;
         d.depthCompare = VK_COMPARE_OP_LESS_OR_EQUAL;
+        // The skirt reaches past the map's near plane toward the sun: clamped there, it still
+        // blocks (where the device clamps depth).
+        d.depthClamp = f.ctx.depthClamp();
         g.shadowDepth = vk::createGraphicsPipeline(f.ctx, g.shadowPass.handle(), g.shadowDepthLayout.handle(), d);
     }
     PassInfo info{"shadow",
@@ -63,7 +66,7 @@ void addShadowPass(Frame& f) {
                    {kVertices, Access::VertexAttributeRead},
                    {kIndices, Access::IndexRead}},
                   {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
-    const uint32_t indexCount = f.indexCount, res = uint32_t(shadows->resolution);
+    const uint32_t indexCount = f.indexCount + f.skirtIndexCount, res = uint32_t(shadows->resolution);
     g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, res](VkCommandBuffer c) {
         for (size_t i = 0; i < lightMatrices.size(); ++i) {
             VkClearValue clear{};
