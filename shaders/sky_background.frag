@@ -1,8 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The sky behind the terrain: its radiance toward each pixel's view ray (from the sky's SH, the
-// horizon's below the horizon), the sun's disc, and the fog between (docs/lighting.md, "Height
-// fog": the sky is fogged at the far plane, so the horizon blends into the haze).
+// The sky behind the terrain: its radiance toward each pixel's view ray (from the sky's SH), the
+// sun's disc, and the fog between (docs/lighting.md, "Height fog": the sky is fogged at the far
+// plane). Below the horizon, with the skirt on, the ground the bake traces beyond the footprint:
+// level ground at the border's mean height and albedo, lit as the bake lights its skirt, fogged
+// over its own distance, so it fades into the haze toward the horizon. With the skirt off (or a
+// camera below that ground) the horizon's radiance, as rays that escape the footprint see.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"
 #include "blocks/surface.h"
@@ -19,12 +22,20 @@ layout(location = 0) out vec4 outColor;
 void main() {
     vec4 far = camera.invViewProj * vec4(ndc, 0.0, 1.0);  // reversed Z: depth 0 is the far plane
     vec3 dir = normalize(far.xyz / far.w - camera.position);
-    vec3 radiance = skyRadiance(dir);
-    // The sun's disc: its illuminance spread over the disc's solid angle π·r².
-    float r = sunSky.sunAngularRadius;
     vec3 l = normalize(sunSky.sunDirection);
-    if (r > 0.0 && dir.y > 0.0 && dot(dir, l) >= cos(r))
-        radiance += sunSky.sunIlluminance / (PI * r * r);
-    radiance = applyFog(radiance, dir, camera.farPlane);
+    float above = camera.position.y - surface.groundHeight;
+    vec3 radiance;
+    if (surface.ground > 0.5 && dir.y < 0.0 && above > 0.0) {
+        // Open level ground: the sky's irradiance on a level surface plus the sun, unshadowed.
+        vec3 irradiance = skyIrradiance(vec3(0.0, 1.0, 0.0)) + sunSky.sunIlluminance * max(l.y, 0.0);
+        radiance = applyFog(surface.groundAlbedo / PI * irradiance, dir, above / -dir.y);
+    } else {
+        radiance = skyRadiance(dir);
+        // The sun's disc: its illuminance spread over the disc's solid angle π·r².
+        float r = sunSky.sunAngularRadius;
+        if (r > 0.0 && dir.y > 0.0 && dot(dir, l) >= cos(r))
+            radiance += sunSky.sunIlluminance / (PI * r * r);
+        radiance = applyFog(radiance, dir, camera.farPlane);
+    }
     outColor = vec4(display(radiance), 1.0);
 }

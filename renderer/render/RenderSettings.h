@@ -44,7 +44,8 @@ struct RenderSettings {
     ShadowSettings shadows;       // the sun's cascades (shadows.enabled false: no shadow pass)
     // Height fog with base height and colour resolved (fog.enabled false: no fog code runs).
     FogSettings fog;
-    bool skirt = true;            // the traced surface of the sun-visibility view (terrain.skirt)
+    bool skirt = true;            // terrain.skirt: the traced surface of the sun-visibility view, drawn
+                                  // into the shadow maps and, below the horizon, by the sky pass
     bool showProbePositions = false;  // the overlay of setProbePositions (probe-validity always marks
                                       // moved and rejected probes)
     bool showLeaves = false;          // the overlay of setProbeLeaves

@@ -202,6 +202,14 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     indexCount_ = indices.size();
     meshVertices_ = vertices;
     appendSkirt(vertices, indices, cols, rows);
+    {
+        double sum = 0.0;
+        size_t n = 0;
+        for (int r = 0; r < hf.depth(); ++r)
+            for (int c = 0; c < hf.width(); ++c)
+                if (r == 0 || r == hf.depth() - 1 || c == 0 || c == hf.width() - 1) sum += hf.vertex(c, r).y, ++n;
+        borderHeight_ = float(sum / double(std::max<size_t>(n, 1)));
+    }
     skirtIndexCount_ = indices.size() - indexCount_;
 
     RendererGpu& g = *gpu_;
@@ -374,6 +382,19 @@ void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint
     ctx_.waitIdle();  // no frame may still read the old map
     g.surface.albedo = std::move(image);
     hasAlbedoMap_ = map;
+    if (map) {
+        // The ring of border texels, the albedo the skirt takes (it is clamped to the footprint).
+        glm::dvec3 sum(0.0);
+        size_t n = 0;
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+                if (y == 0 || y == height - 1 || x == 0 || x == width - 1) {
+                    const size_t i = 3 * (size_t(y) * size_t(width) + size_t(x));
+                    sum += glm::dvec3(linearOfSrgb8(srgb[i]), linearOfSrgb8(srgb[i + 1]), linearOfSrgb8(srgb[i + 2]));
+                    ++n;
+                }
+        borderAlbedo_ = glm::vec3(sum / double(n));
+    }
     albedoMapSize_ = map ? glm::ivec2(width, height) : glm::ivec2(1, 1);
     buildViewSets();
 }
@@ -755,6 +776,8 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     surfaceIn.albedoMap = hasAlbedoMap_;
     surfaceIn.ao = hasAo_;
     surfaceIn.probeAoLevel = probeLevel;
+    surfaceIn.borderHeight = borderHeight_;
+    if (hasAlbedoMap_) surfaceIn.borderAlbedo = borderAlbedo_;
     const blocks::SurfaceBlock surface = features::packSurface(s, surfaceIn);
     slot.surface.write(&surface, sizeof surface);
     const blocks::SunSkyBlock sunSky = features::packSunSky(s);

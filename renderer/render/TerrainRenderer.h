@@ -201,6 +201,8 @@ private:
     std::vector<Cascade> cascades_;
     size_t sunTraces_ = 0;
     bool hasAo_ = false, hasAlbedoMap_ = false;
+    float borderHeight_ = 0.0f;        // the DEM border's mean height: the skirt's, as the sky draws it
+    glm::vec3 borderAlbedo_{1.0f};     // the albedo map's border ring, mean linear
     glm::ivec2 surfaceMapSize_{1, 1}, albedoMapSize_{1, 1};
     float finestProbeSpacing_ = 0.0f;  // of the bound volumes; 0 without
     FrameTimings timings_;

@@ -12,6 +12,9 @@ TLX_BLOCK_BEGIN(SurfaceBlock, TLX_SET_VIEW, 1)
                          // probes are as fine)
     TLX_FLOAT4(detailStrength, detailScale, detailFade, albedoVariation)  // detail normal strength
                          // (0 off); metres per repeat; fade distance (m); albedo variation (±, 0 off)
+    TLX_VEC3_FLOAT(groundAlbedo, groundHeight)  // the skirt as the sky pass draws it: the border's
+                         // mean linear albedo and mean height (engine space)
+    TLX_FLOAT1(ground)   // 1 = the skirt is on: below the horizon the sky pass draws the ground
 TLX_BLOCK_END(surface)
 #define TLX_SURFACE_NORMAL_AO_BINDING 2  // sampler2D: xyz mean normal, w sky visibility, mipped
 #define TLX_SURFACE_ALBEDO_BINDING 3     // sampler2D: linear albedo (sRGB texels), mipped

@@ -998,6 +998,33 @@ TEST_F(RenderTest, ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns) {
             }
 }
 
+TEST_F(RenderTest, BelowTheHorizonTheSkyPassDrawsTheSkirtsGround) {
+    // Fog off, a uniform sky L, a constant albedo ρ: below the horizon beyond the terrain the
+    // skirt is level ground, ρ/π·(π·L + E_sun·sin(elevation)); with the skirt off, the horizon's L.
+    Project p = sampleProject("ground", 4, 4);
+    p.scene.fog.enabled = false;
+    p.scene.terrain.albedoMode = AlbedoMode::Constant;
+    p.scene.terrain.albedo = glm::vec3(0.25f, 0.3f, 0.35f);
+    p.scene.sun.elevationDeg = 30.0;
+    ProjectRenderer r(*ctx_, p);
+    const RenderedImage on = draw(r, kViewBeauty, false, true);
+    p.scene.terrain.skirt = false;
+    r.setProject(p);
+    const RenderedImage off = draw(r, kViewBeauty, false, true);
+    const glm::vec3 sky = p.scene.sky.color * float(p.scene.sky.intensity);
+    const glm::vec3 sun = p.scene.sun.color * float(p.scene.sun.illuminance);
+    const glm::vec3 ground = p.scene.terrain.albedo / std::numbers::pi_v<float> *
+                             (std::numbers::pi_v<float> * sky + sun * float(std::sin(30.0 * std::numbers::pi / 180.0)));
+    // The bottom corners lie below the horizon, beside the terrain at the default framing.
+    for (const uint32_t x : {1u, kW - 2}) {
+        const size_t i = (size_t(kH - 2) * kW + x) * 4;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(on.rgba[i + size_t(c)], ground[c], 1e-3f * ground[c] + 1e-6f) << "x " << x << " channel " << c;
+            EXPECT_NEAR(off.rgba[i + size_t(c)], sky[c], 1e-3f * sky[c] + 1e-6f) << "x " << x << " channel " << c;
+        }
+    }
+}
+
 TEST_F(RenderTest, ARidgeShadowsTheValleyBehindItAtALowSun) {
     // The U valley with the sun low in the east: the east wall's shadow falls on the floor's east
     // side; the west wall faces the sun.

@@ -64,6 +64,9 @@ blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& i
     surface.detailScale = d.enabled ? float(d.scale) : 1.0f;
     surface.detailFade = d.enabled ? float(d.fadeDistance) : 0.0f;
     surface.albedoVariation = d.enabled ? float(d.albedoVariation) : 0.0f;
+    surface.groundAlbedo = in.borderAlbedo.value_or(s.albedo);
+    surface.groundHeight = in.borderHeight;
+    surface.ground = s.skirt ? 1.0f : 0.0f;
     return surface;
 }
 

@@ -5,6 +5,7 @@
 // reflection.
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -20,6 +21,10 @@ struct SurfaceInputs {
     bool albedoMap = false;  // the albedo map holds the albedo (else s.albedo)
     bool ao = false;         // the normal-AO map holds the horizon AO
     float probeAoLevel = 0.0f;  // the normal-AO mip level as coarse as the finest probes (0: none)
+    // The skirt beyond the footprint as the sky pass draws it: the border's mean height and, with
+    // an albedo map, its mean linear albedo (else s.albedo).
+    float borderHeight = 0.0f;
+    std::optional<glm::vec3> borderAlbedo;
 };
 
 // Camera and frame: the view-projection for `extent` (the terrain's largest span, which sets the
