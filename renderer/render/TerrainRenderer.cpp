@@ -202,6 +202,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     indexCount_ = indices.size();
     meshVertices_ = vertices;
     appendSkirt(vertices, indices, cols, rows);
+    skirtIndexCount_ = indices.size() - indexCount_;
     {
         double sum = 0.0;
         size_t n = 0;
@@ -210,7 +211,6 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
                 if (r == 0 || r == hf.depth() - 1 || c == 0 || c == hf.width() - 1) sum += hf.vertex(c, r).y, ++n;
         borderHeight_ = float(sum / double(std::max<size_t>(n, 1)));
     }
-    skirtIndexCount_ = indices.size() - indexCount_;
 
     RendererGpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,

@@ -998,6 +998,33 @@ TEST_F(RenderTest, ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns) {
             }
 }
 
+TEST_F(RenderTest, TheSkirtShadowsTheBorderAtALowSunAndGoesWithIt) {
+    // A 5° sun from the south-east: the border profile extruded beyond the footprint shades the
+    // footprint's edges, as the bake's tracer has it. Turning the skirt off redraws the maps
+    // without it: the frame equals a renderer made with the skirt off.
+    Project p = sampleProject("skirt_shadow", 4, 4);
+    p.scene.sun.azimuthDeg = 135.0;
+    p.scene.sun.elevationDeg = 5.0;
+    ProjectRenderer r(*ctx_, p);
+    const RenderedImage with = draw(r, kViewShadow, false, true);
+    p.scene.terrain.skirt = false;
+    r.setProject(p);
+    const RenderedImage toggled = draw(r, kViewShadow, false, true);
+    ProjectRenderer fresh(*ctx_, p);
+    const RenderedImage without = draw(fresh, kViewShadow, false, true);
+    EXPECT_EQ(test::compareImages(toggled.rgba, without.rgba, kW, kH).maxAbs, 0.0);
+    // Red holds the factor, green 1 on terrain: the skirt only darkens.
+    size_t terrain = 0, darker = 0, lighter = 0;
+    for (size_t i = 0; i + 3 < with.rgba.size(); i += 4) {
+        if (with.rgba[i + 1] < 0.5f) continue;
+        ++terrain;
+        if (with.rgba[i] < without.rgba[i] - 0.5f) ++darker;
+        if (with.rgba[i] > without.rgba[i] + 0.5f) ++lighter;
+    }
+    EXPECT_GT(darker, terrain / 100) << terrain << " terrain pixels";
+    EXPECT_LE(lighter, terrain / 1000) << terrain << " terrain pixels";
+}
+
 TEST_F(RenderTest, BelowTheHorizonTheSkyPassDrawsTheSkirtsGround) {
     // Fog off, a uniform sky L, a constant albedo ρ: below the horizon beyond the terrain the
     // skirt is level ground, ρ/π·(π·L + E_sun·sin(elevation)); with the skirt off, the horizon's L.

@@ -47,7 +47,8 @@ std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const R
 
 void addShadowPass(Frame& f) {
     ShadowResources* shadows = f.shadows;
-    if (!shadows || shadows->drawn == f.lightMatrices) return;
+    const bool skirt = f.skirtIndexCount > 0;
+    if (!shadows || (shadows->drawn == f.lightMatrices && shadows->drawnSkirt == skirt)) return;
     RendererGpu& g = f.g;
     if (!g.shadowDepth) {
         vk::GraphicsPipelineDesc d;
@@ -93,6 +94,7 @@ void addShadowPass(Frame& f) {
         }
     });
     shadows->drawn = f.lightMatrices;
+    shadows->drawnSkirt = skirt;
 }
 
 }  // namespace terralux::features

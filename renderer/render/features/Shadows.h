@@ -15,6 +15,7 @@ struct ShadowResources {
     std::vector<vk::Framebuffer> framebuffers;
     int resolution = 0, cascades = 0;
     std::vector<glm::mat4> drawn;  // the light projections the maps hold now (empty: none yet)
+    bool drawnSkirt = false;       // whether they hold the skirt (terrain.skirt when drawn)
 };
 
 namespace features {
