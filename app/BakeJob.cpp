@@ -724,6 +724,22 @@ ReflectionLighting reflectionLightingOf(const BakeLighting& lighting, const Bake
 
 namespace {
 
+// The valid probes' values (their standard errors, for the report's statistics).
+std::vector<float> ofValidProbes(const std::vector<uint8_t>& valid, const std::vector<float>& values) {
+    std::vector<float> out;
+    for (size_t i = 0; i < valid.size(); ++i)
+        if (valid[i]) out.push_back(values[i]);
+    return out;
+}
+
+// The coefficients as the .shprobe holds them: radiance projections, or pre-convolved irradiance
+// (Â_l L_k) for the irradiance encoding. Last, after every comparison that reads radiance.
+void encodeForExport(ShEncoding encoding, std::vector<sh::ShRgb>& sh) {
+    if (encoding != ShEncoding::Irradiance) return;
+    for (auto& probe : sh)
+        for (int k = 0; k < sh::kCoeffCount; ++k) probe.c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
+}
+
 ReflectionOutput bakeReflections(const BakeSetup& b, const ReflectionProbeSettings& settings,
                                  const ReflectionLayout& layout, const IrradianceCache* sharedCache,
                                  int cacheResolution, bool compareReference, const BakeControl& control) {
@@ -938,9 +954,7 @@ nlohmann::json referenceReport(const BakeSetup& setup, const ProbeLayout& layout
                                uint64_t& referenceRays) {
     if (setup.referenceMode)
         return {{"mean", nullptr}, {"p95", nullptr}, {"max", nullptr}, {"note", kReferenceNote}};
-    std::vector<float> se;
-    for (size_t i = 0; i < layout.valid.size(); ++i)
-        if (layout.valid[i]) se.push_back(bake.standardError[i]);
+    std::vector<float> se = ofValidProbes(layout.valid, bake.standardError);
     std::nth_element(se.begin(), se.begin() + ptrdiff_t(se.size() / 2), se.end());
     const float median = se.empty() ? 0.0f : se[se.size() / 2];
     const ProbeRays schedule(qualityPreset(QualityPreset::Reference).rays, median / 3.0f, kReferenceMaxRays);
@@ -949,9 +963,7 @@ nlohmann::json referenceReport(const BakeSetup& setup, const ProbeLayout& layout
                                           seed ^ 0xF00Dull, c);
     referenceRays += ref.rays;
     const ErrorStats err = compareToReference(sh, ref.sh, layout.valid);
-    std::vector<float> refSe;
-    for (size_t i = 0; i < layout.valid.size(); ++i)
-        if (layout.valid[i]) refSe.push_back(ref.standardError[i]);
+    const std::vector<float> refSe = ofValidProbes(layout.valid, ref.standardError);
     const RaySpread spread = raySpreadOf(ref, layout.valid);
     return {{"mean", err.mean},
             {"p95", err.p95},
@@ -1264,11 +1276,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
             }
         }
 
-        // Pre-convolved irradiance (Â_l L_k) when asked for.
-        if (scene.bake.encoding == ShEncoding::Irradiance)
-            for (size_t i = 0; i < bake.sh.size(); ++i)
-                for (int k = 0; k < sh::kCoeffCount; ++k)
-                    bake.sh[i].c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
+        encodeForExport(scene.bake.encoding, bake.sh);
         if (scene.bake.deringing)
             vr["deringing"] = {{"window", "lanczos-sigma"},
                                {"probes_windowed", dering.windowed},
@@ -1324,13 +1332,10 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                                                      raysOf(setup, v), volumeSeed(vi), c);
             rays += b.rays;
             if (scene.bake.deringing) (void)sh::deringProbes(b.sh, layout.valid);
-            if (scene.bake.encoding == ShEncoding::Irradiance)
-                for (auto& probe : b.sh)
-                    for (int k = 0; k < sh::kCoeffCount; ++k) probe.c[size_t(k)] *= sh::kCosineLobe[size_t(sh::bandOf(k))];
-            std::vector<float> se;
-            for (size_t i = 0; i < layout.valid.size(); ++i)
-                if (layout.valid[i]) se.push_back(b.standardError[i]);
-            sr["volumes"].push_back({{"name", v.name}, {"rays", b.rays}, {"standard_error", stats(se)}});
+            encodeForExport(scene.bake.encoding, b.sh);
+            sr["volumes"].push_back({{"name", v.name},
+                                     {"rays", b.rays},
+                                     {"standard_error", stats(ofValidProbes(layout.valid, b.standardError))}});
             out.volumes.push_back({v.name, toGrid(layout, b.sh, scene.exportSettings), ""});
         }
         if (cancelled()) throw BakeCancelled();
