@@ -141,7 +141,8 @@ HandleEdit dragProbeVolume(const SceneDescription& scene, const Heightfield& hf,
         }
         case ProbePlacement::Surface: break;
     }
-    throw std::invalid_argument(volumeName(v) + " covers the whole footprint (placement surface): only its height moves");
+    throw std::invalid_argument(at + "placement = \"surface\": " + volumeName(v) +
+                                " covers the whole footprint, so only its height (" + at + "height_offset) moves");
 }
 
 }  // namespace
@@ -307,7 +308,10 @@ HandleEdit dragHandle(const SceneDescription& scene, const Heightfield& hf, cons
         }
         case BoundsKind::Water: {
             const std::optional<double> level = water::waterLevel(scene.water, hf);
-            if (!level) throw std::invalid_argument("the water has no level to move");
+            if (!level)
+                throw std::invalid_argument(
+                    "water.level = null: auto found no water surface on this terrain, so there is no level to move "
+                    "(set water.level)");
             return {{{"water.level", tidy(*level + d.y)}}, "Set the water level"};
         }
         case BoundsKind::Sun: {

@@ -187,7 +187,14 @@ TEST(VolumeHandles, BoxAndAdaptiveVolumesKeepTheirCells) {
     const SceneDescription surface = sceneWith({"probe_volumes[0].placement=surface"});
     const VolumeBounds s = boundsOf(surface, BoundsKind::ProbeVolume);
     EXPECT_EQ(handlesOf(s, surface).size(), 1u);
-    EXPECT_THROW(dragHandle(surface, sample(), s, HandleRole::Move, {10.0f, 0.0f, 0.0f}), std::invalid_argument);
+    try {
+        dragHandle(surface, sample(), s, HandleRole::Move, {10.0f, 0.0f, 0.0f});
+        ADD_FAILURE() << "a surface volume moved";
+    } catch (const std::invalid_argument& e) {
+        // The refusal names the setting, its value and what may move.
+        EXPECT_EQ(std::string(e.what()), "probe_volumes[0].placement = \"surface\": volume 'probes' covers the whole "
+                                         "footprint, so only its height (probe_volumes[0].height_offset) moves");
+    }
 }
 
 TEST(VolumeHandles, ReflectionGridWaterAndSun) {
@@ -205,6 +212,15 @@ TEST(VolumeHandles, ReflectionGridWaterAndSun) {
     const HandleEdit level = dragHandle(scene, sample(), w, HandleRole::Height, {0.0f, -7.25f, 0.0f});
     EXPECT_EQ(level.label, "Set the water level");
     EXPECT_DOUBLE_EQ(*applied(scene, level).water.level, 412.75);
+    // Auto water that finds no surface has no level to move; the refusal names the setting.
+    const SceneDescription dry = sceneWith({"water.enabled=true"});
+    ASSERT_FALSE(water::waterLevel(dry.water, sample()));
+    try {
+        dragHandle(dry, sample(), w, HandleRole::Height, {0.0f, 5.0f, 0.0f});
+        ADD_FAILURE() << "a water level moved where there is none";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("water.level = null: ", 0), 0u) << e.what();
+    }
 
     // The sun: the direction dragged to becomes the azimuth and elevation that point there.
     OrbitCamera camera = OrbitCamera::fromSettings(scene.camera, sample());
