@@ -213,8 +213,8 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
     const Heightfield& hf = *hf_;
     const int w = hf.width(), d = hf.depth();
     GridRay ray;
-    ray.u0 = double(o.x) * invCellX_ + 0.5 * (w - 1);
-    ray.v0 = double(o.z) * invCellZ_ + 0.5 * (d - 1);
+    ray.u0 = double(o.x) * invCellX_ + hf.originCol();
+    ray.v0 = double(o.z) * invCellZ_ + hf.originRow();
     ray.y0 = o.y;
     ray.du = double(dir.x) * invCellX_;
     ray.dv = double(dir.z) * invCellZ_;
@@ -372,8 +372,8 @@ bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& ori
     if (!(tLo < best))
         return false;
     const dvec3 O(origin), D(dir);
-    auto X = [&](int c) { return (c - 0.5 * (w - 1)) * cellX; };
-    auto Z = [&](int r) { return (r - 0.5 * (d - 1)) * cellZ; };
+    auto X = [&](int c) { return (c - hf.originCol()) * cellX; };
+    auto Z = [&](int r) { return (r - hf.originRow()) * cellZ; };
     auto V = [&](int c, int r) { return dvec3(X(c), double(hf.at(c, r)), Z(r)); };
     constexpr double e = kEdgeSlack;
 
@@ -485,7 +485,7 @@ bool intersectRayMarch(const Heightfield& hf, const glm::vec3& origin, const glm
         // Level ray inside the slab: march until well past the footprint.
         const double ex = hf.maxX() - hf.minX(), ez = hf.maxZ() - hf.minZ();
         const double diag = std::sqrt(ex * ex + ez * ez);
-        tEnd = std::min(tEnd, std::hypot(O.x, O.z) + 2 * diag + step);
+        tEnd = std::min(tEnd, std::hypot(O.x - 0.5 * (hf.minX() + hf.maxX()), O.z - 0.5 * (hf.minZ() + hf.maxZ())) + 2 * diag + step);
     }
     if (!(t0 <= tEnd))
         return false;

@@ -27,10 +27,10 @@ size_t ProbeLayout::validCount() const {
 SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0, double z1) {
     const int w = hf.width(), d = hf.depth();
     auto gu = [&](double x) {
-        return std::clamp(x / hf.cellSizeX() + 0.5 * (w - 1), 0.0, double(w - 1));
+        return std::clamp(hf.colOf(x), 0.0, double(w - 1));
     };
     auto gv = [&](double z) {
-        return std::clamp(z / hf.cellSizeZ() + 0.5 * (d - 1), 0.0, double(d - 1));
+        return std::clamp(hf.rowOf(z), 0.0, double(d - 1));
     };
     // Beyond the footprint the skirt repeats the border (Heightfield::surfaceHeight): clamp.
     const double u0 = gu(x0), u1 = gu(x1), v0 = gv(z0), v1 = gv(z1);
@@ -257,7 +257,8 @@ TerrainGridFrame terrainGridFrame(const ProbeVolumeSettings& v, const Heightfiel
         f.first = glm::vec2(v.origin->x, v.origin->z);
     } else {
         // Centred: auto-span reaches the edges exactly; explicit spacing is centred on the terrain.
-        f.first = -0.5f * f.spacing * glm::vec2(float(nx - 1), float(nz - 1));
+        const glm::vec2 centre(0.5f * (hf.minX() + hf.maxX()), 0.5f * (hf.minZ() + hf.maxZ()));
+        f.first = centre - 0.5f * f.spacing * glm::vec2(float(nx - 1), float(nz - 1));
     }
     return f;
 }
@@ -269,7 +270,8 @@ BoxGridFrame boxGridFrame(const ProbeVolumeSettings& v, const Heightfield& hf) {
     f.cell = v.spacing ? v.spacing->x : std::max({spanX / float(nx), spanZ / float(nz), 1e-3f});
     // Unset: centred on the footprint, from the lowest ground up.
     f.origin = v.origin ? *v.origin
-                        : glm::vec3(-0.5f * f.cell * float(nx), hf.minHeight(), -0.5f * f.cell * float(nz));
+                        : glm::vec3(0.5f * (hf.minX() + hf.maxX()) - 0.5f * f.cell * float(nx), hf.minHeight(),
+                                    0.5f * (hf.minZ() + hf.maxZ()) - 0.5f * f.cell * float(nz));
     return f;
 }
 

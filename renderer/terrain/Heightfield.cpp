@@ -11,7 +11,7 @@ namespace terralux {
 Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSizeZ,
                          std::vector<float> heights)
     : width_(width), depth_(depth), cellSizeX_(cellSizeX), cellSizeZ_(cellSizeZ),
-      heights_(std::move(heights)) {
+      originCol_(0.5 * (width - 1)), originRow_(0.5 * (depth - 1)), heights_(std::move(heights)) {
     if (width < 1 || depth < 1)
         throw std::invalid_argument("heightfield: size " + std::to_string(width) + "x" +
                                     std::to_string(depth) + " must be at least 1x1");
@@ -32,8 +32,8 @@ Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSize
 }
 
 float Heightfield::surfaceHeight(float x, float z) const {
-    const double gx = std::clamp(double(x) / cellSizeX_ + 0.5 * (width_ - 1), 0.0, double(width_ - 1));
-    const double gz = std::clamp(double(z) / cellSizeZ_ + 0.5 * (depth_ - 1), 0.0, double(depth_ - 1));
+    const double gx = std::clamp(colOf(x), 0.0, double(width_ - 1));
+    const double gz = std::clamp(rowOf(z), 0.0, double(depth_ - 1));
     const int c = std::min(int(gx), std::max(width_ - 2, 0));
     const int r = std::min(int(gz), std::max(depth_ - 2, 0));
     if (width_ == 1 && depth_ == 1) return at(0, 0);
@@ -53,8 +53,8 @@ float Heightfield::surfaceHeight(float x, float z) const {
 
 glm::vec3 Heightfield::surfaceNormal(float x, float z) const {
     if (!contains(x, z) || width_ < 2 || depth_ < 2) return {0.0f, 1.0f, 0.0f};
-    const double gx = double(x) / cellSizeX_ + 0.5 * (width_ - 1);
-    const double gz = double(z) / cellSizeZ_ + 0.5 * (depth_ - 1);
+    const double gx = colOf(x);
+    const double gz = rowOf(z);
     const int c = std::min(int(gx), width_ - 2);
     const int r = std::min(int(gz), depth_ - 2);
     const double fx = gx - c, fz = gz - r;
@@ -76,6 +76,29 @@ glm::vec3 Heightfield::vertexNormal(int col, int row) const {
     const double dhdx = c1 > c0 ? (at(c1, row) - at(c0, row)) / ((c1 - c0) * cellSizeX_) : 0.0;
     const double dhdz = r1 > r0 ? (at(col, r1) - at(col, r0)) / ((r1 - r0) * cellSizeZ_) : 0.0;
     return glm::normalize(glm::vec3(float(-dhdx), 1.0f, float(-dhdz)));
+}
+
+Heightfield Heightfield::window(int col0, int row0, int width, int depth) const {
+    if (width < 1 || depth < 1 || col0 < 0 || row0 < 0 || col0 + width > width_ || row0 + depth > depth_)
+        throw std::invalid_argument("heightfield: window " + std::to_string(width) + "x" + std::to_string(depth) +
+                                    " at (" + std::to_string(col0) + ", " + std::to_string(row0) +
+                                    ") must lie inside the " + std::to_string(width_) + "x" +
+                                    std::to_string(depth_) + " grid");
+    std::vector<float> h(size_t(width) * size_t(depth));
+    std::vector<uint8_t> mask(nodataMask_.empty() ? 0 : h.size());
+    for (int r = 0; r < depth; ++r) {
+        const size_t from = size_t(row0 + r) * size_t(width_) + size_t(col0), to = size_t(r) * size_t(width);
+        std::copy_n(heights_.begin() + std::ptrdiff_t(from), width, h.begin() + std::ptrdiff_t(to));
+        if (!mask.empty())
+            std::copy_n(nodataMask_.begin() + std::ptrdiff_t(from), width, mask.begin() + std::ptrdiff_t(to));
+    }
+    Heightfield w(width, depth, cellSizeX_, cellSizeZ_, std::move(h));
+    // Half-integers: the shifted origin is exact, so xOf gives the parent's coordinates exactly.
+    w.originCol_ = originCol_ - col0;
+    w.originRow_ = originRow_ - row0;
+    if (std::find(mask.begin(), mask.end(), uint8_t(1)) != mask.end()) w.nodataMask_ = std::move(mask);
+    w.geo = geo;
+    return w;
 }
 
 void Heightfield::setNodataMask(std::vector<uint8_t> mask) {

@@ -52,9 +52,20 @@ public:
     const std::vector<float>& heights() const { return heights_; }
     float at(int col, int row) const { return heights_[size_t(row) * size_t(width_) + size_t(col)]; }
 
-    // Engine-space coordinate of a vertex column / row.
-    float xOf(double col) const { return float((col - 0.5 * (width_ - 1)) * cellSizeX_); }
-    float zOf(double row) const { return float((row - 0.5 * (depth_ - 1)) * cellSizeZ_); }
+    // Engine-space coordinate of a vertex column / row, and back (fractional, unclamped). The
+    // engine origin lies at column originCol(), row originRow(): the grid's centre for a whole
+    // DEM, elsewhere for a window of one (window()), which keeps its region's engine space.
+    float xOf(double col) const { return float((col - originCol_) * cellSizeX_); }
+    float zOf(double row) const { return float((row - originRow_) * cellSizeZ_); }
+    double colOf(double x) const { return x / cellSizeX_ + originCol_; }
+    double rowOf(double z) const { return z / cellSizeZ_ + originRow_; }
+    double originCol() const { return originCol_; }
+    double originRow() const { return originRow_; }
+
+    // Columns [col0, col0 + width) and rows [row0, row0 + depth) of this grid, in this grid's
+    // engine space (a vertex keeps its position to the bit), with their nodata marks and geo.
+    // Throws std::invalid_argument when the window is empty or leaves the grid.
+    Heightfield window(int col0, int row0, int width, int depth) const;
     glm::vec3 vertex(int col, int row) const { return {xOf(col), at(col, row), zOf(row)}; }
 
     // Footprint in engine space (the vertex grid's extent).
@@ -88,6 +99,7 @@ private:
     int depth_ = 0;
     double cellSizeX_ = 1.0;
     double cellSizeZ_ = 1.0;
+    double originCol_ = 0.0, originRow_ = 0.0;
     std::vector<float> heights_;
     std::vector<uint8_t> nodataMask_;
     float minHeight_ = 0.0f;

@@ -316,8 +316,8 @@ float horizonSkyVisibilityAt(const Heightfield& terrain, const HorizonAoSettings
     const int W = terrain.width(), D = terrain.depth(), K = settings.directions;
     const glm::vec3 n = terrain.surfaceNormal(x, z);
     const double h0 = terrain.surfaceHeight(x, z);
-    const double gx = double(x) / terrain.cellSizeX() + 0.5 * (W - 1);
-    const double gz = double(z) / terrain.cellSizeZ() + 0.5 * (D - 1);
+    const double gx = terrain.colOf(x);
+    const double gz = terrain.rowOf(z);
     double sum = 0.0;
     for (int k = 0; k < K; ++k) {
         const SweepDir s = sweepDir(k, K, terrain.cellSizeX(), terrain.cellSizeZ());
