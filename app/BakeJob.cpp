@@ -90,7 +90,14 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
 
 // What a bake needs before it places a probe: terrain, lighting, tracer, quality, volumes.
 struct BakeSetup {
-    DemImportResult terrain;
+    DemImportResult terrain;  // a tile's core when tiled
+    // A tiled bake: the terrain within the halo, which the tracer holds (by address: heap).
+    std::unique_ptr<Heightfield> tracedTerrain;
+    // ... and the whole region, which the exported lighting (fog base, shadow range, LPV, water
+    // level) describes, the same for every tile.
+    std::unique_ptr<Heightfield> region;
+    std::optional<TileWindow> tileWindow;
+    nlohmann::json tileReport;
     BakeLighting lighting;
     std::unique_ptr<HeightfieldTracer> tracer;  // bakeSceneOf's, which `lighting` points at
     BakeQuality q;
@@ -100,7 +107,7 @@ struct BakeSetup {
 };
 
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
-             const std::function<bool()>& cancelled) {
+             const std::function<bool()>& cancelled, const std::optional<TileSpec>& tile = std::nullopt) {
     const SceneDescription& scene = project.scene;
     // A scene built in code has not met the parameter table's rules, as a file or --set has:
     // take it through them, so a bake refuses what loading the project would (a grid past
@@ -109,11 +116,28 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     const auto start = Clock::now();
     report("loading terrain", 0.0);
     b.terrain = loadProjectTerrain(project);
+    if (tile) {
+        const Heightfield& region = b.terrain.heightfield;
+        try {
+            b.tileWindow = tileWindow(region, *tile);
+        } catch (const std::invalid_argument& e) {
+            throw ProjectError(e.what());
+        }
+        const TileWindow& w = *b.tileWindow;
+        b.tileReport = tileReport(*tile, w, region);
+        b.tracedTerrain = std::make_unique<Heightfield>(
+            region.window(w.tracedCol0, w.tracedRow0, w.tracedCols, w.tracedRows));
+        Heightfield core = region.window(w.col0, w.row0, w.cols, w.rows);
+        b.region = std::make_unique<Heightfield>(std::move(b.terrain.heightfield));
+        b.terrain.heightfield = std::move(core);
+    }
     if (cancelled()) throw BakeCancelled();
     report("loading sky and albedo", 0.01);
-    BakeScene traced = bakeSceneOf(project, b.terrain.heightfield);
+    BakeScene traced = bakeSceneOf(project, b.tracedTerrain ? *b.tracedTerrain : b.terrain.heightfield);
     b.lighting = traced.lighting;
     b.tracer = std::move(traced.tracer);
+    // Water that "auto" finds sits at the region's level, not a tile's own.
+    if (b.region) b.lighting.water = bakeWaterOf(project, *b.region);
     if (cancelled()) throw BakeCancelled();
     // Every sun can be placed over this terrain, the scenarios' included, before any probe.
     checkSunPlaces(scene, b.terrain.heightfield);
@@ -847,7 +871,8 @@ BakePlan planBake(const SceneDescription& scene, const BakeSetup& setup) {
         p.plannedRays += uint64_t(p.reflections->count()) * 6 * uint64_t(rs.resolution) * uint64_t(rs.resolution) *
                          uint64_t(rs.rayCount);
     }
-    p.cacheResolution = cacheResolutionFor(hf, setup.q, p.plannedRays);
+    // The cache covers what the tracer holds: a tile's halo too.
+    p.cacheResolution = cacheResolutionFor(setup.tracer->heightfield(), setup.q, p.plannedRays);
     return p;
 }
 
@@ -1105,13 +1130,15 @@ std::vector<std::filesystem::path> writeBake(const Project& project, const BakeS
     const BakeLighting& lighting = setup.lighting;
     GltfSceneInput in;
     in.heightfield = &setup.terrain.heightfield;
+    in.surroundings = setup.tracedTerrain.get();
+    const Heightfield& whole = setup.region ? *setup.region : setup.terrain.heightfield;
     in.albedo = scene.terrain.albedo;
     in.albedoTexture = lighting.surface.get();
     in.roughness = float(scene.terrain.roughness);
     in.verticalScale = scene.terrain.verticalScale;
     in.volumes = std::move(grids);
     in.bake = bakeInfo;
-    in.lighting = lightingExtension(project, setup.terrain.heightfield, lighting);
+    in.lighting = lightingExtension(project, whole, lighting);
     in.scenarios = std::move(scenarios);
     in.defaultLighting = {{"sun", in.lighting.at("sun")}, {"sky", in.lighting.at("sky")}};
     if (reflections) {
@@ -1123,7 +1150,7 @@ std::vector<std::filesystem::path> writeBake(const Project& project, const BakeS
     // lpv.ini is the bake's whenever the LPV is on; a bake with it off removes an earlier one.
     in.ownedFiles.push_back(kLpvIniName);
     if (scene.lpv.enabled)
-        in.extraFiles.push_back({kLpvIniName, lpvIni(lpv::resolvedOn(scene.lpv, setup.terrain.heightfield))});
+        in.extraFiles.push_back({kLpvIniName, lpvIni(lpv::resolvedOn(scene.lpv, whole))});
     in.generatorVersion = TERRALUX_VERSION;
     in.scene = scene.exportSettings.gltf;
     // The report lists every file of the bake, itself included, in the order written.
@@ -1157,7 +1184,11 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     auto cancelled = [&] { return cancel && cancel->load(); };
 
     BakeSetup setup;
-    prepare(project, setup, report, cancelled);
+    prepare(project, setup, report, cancelled, request.tile);
+    if (setup.tileWindow) {
+        // Placed from here on: each volume over the tile's share (setup.volumes point into it).
+        scaleSceneToTile(request.project.scene, *setup.tileWindow);
+    }
     const std::optional<SamplingChoice> sampling =
         chooseSampling(request.project.scene, setup, [&](const std::string& p) { report(p, 0.02); });
     const std::map<size_t, TargetChoice> targets =
@@ -1420,6 +1451,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         {"volumes", volumeReports},
         {"overlaps", overlapReport(grids)},
     };
+    if (setup.tileWindow) out.report["tile"] = setup.tileReport;
     if (!scenarioReports.empty()) {
         uint64_t cacheRaysAll = 0;
         for (const auto& sr : scenarioReports) cacheRaysAll += sr["cache_rays"].get<uint64_t>();
@@ -1568,7 +1600,8 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     BakeSetup setup;
     BakeRequest chosen = request;
-    prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; });
+    prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; }, chosen.tile);
+    if (setup.tileWindow) scaleSceneToTile(chosen.project.scene, *setup.tileWindow);
     const std::optional<SamplingChoice> sampling = chooseSampling(chosen.project.scene, setup, [](const std::string&) {});
     const std::map<size_t, TargetChoice> targets = chooseTargets(chosen.project.scene, setup, [](const std::string&) {});
     BakeEstimate e = estimateWith(chosen, setup, threads, true);
@@ -1655,7 +1688,7 @@ BakeEstimate estimateWith(const BakeRequest& request, BakeSetup& setup, int thre
         const auto t = Clock::now();
         cache = std::make_unique<IrradianceCache>(setup.lighting, full ? plan.cacheResolution : kCalibrationResolution,
                                                   q.cacheRays, q.sunSamples, q.bounces - 1, BakeControl{});
-        const std::array<int, 2> points = IrradianceCache::gridPoints(hf, plan.cacheResolution);
+        const std::array<int, 2> points = IrradianceCache::gridPoints(setup.tracer->heightfield(), plan.cacheResolution);
         e.cacheSeconds = secondsSince(t) * double(points[0]) * double(points[1]) /
                          double(cache->pointsX() * cache->pointsZ());
     }

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "Project.h"
+#include "Tiling.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ReflectionBake.h"
 #include "bake/TargetSearch.h"
@@ -25,6 +26,10 @@ struct BakeRequest {
     Project project;
     int threads = 0;                          // 0 = all cores
     bool compareReference = false;            // also run the reference and report the error
+    // One tile of a region (docs/farm.md): the tile's share of the terrain is placed, baked and
+    // exported; the terrain within its halo is traced. The project's export.out_dir is the tile's
+    // own folder.
+    std::optional<TileSpec> tile;
 };
 
 struct BakeOutcome {

@@ -25,6 +25,8 @@
 #include "Project.h"
 #include "SampleTerrain.h"
 #include "TerrainLoading.h"
+#include "TileMerge.h"
+#include "Tiling.h"
 
 #ifndef TERRALUX_VERSION
 #define TERRALUX_VERSION "0.0.0"
@@ -187,6 +189,32 @@ int commandBake(const Args& a) {
     for (const auto& w : warnings) std::cerr << programName() << ": warning: " << w << "\n";
     request.threads = a.parser.isSet(a.threads) ? a.parser.value(a.threads).toInt() : 0;
     request.compareReference = a.parser.isSet(a.compareReference);
+
+    if (a.parser.isSet(a.tile) != a.parser.isSet(a.tiles))
+        throw UsageError(a.parser.isSet(a.tile) ? "--tile: needs --tiles NX,NZ" : "--tiles: needs --tile I/N or IX,IZ");
+    if (a.parser.isSet(a.tile)) {
+        std::optional<double> halo;
+        if (a.parser.isSet(a.halo)) {
+            bool ok = false;
+            halo = a.parser.value(a.halo).toDouble(&ok);
+            if (!ok || !(std::isfinite(*halo) && *halo >= 0.0))
+                throw UsageError("--halo " + str(a.parser.value(a.halo)) + ": must be a distance in metres >= 0");
+        }
+        try {
+            request.tile = parseTiles(str(a.parser.value(a.tiles)), str(a.parser.value(a.tile)), halo);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(e.what());
+        }
+        // Each tile in a folder of its own under the region's: what --merge reads.
+        request.project.scene.exportSettings.outDir =
+            (request.project.outDir() / kTilesFolder / tileName(*request.tile)).string();
+        if (!a.parser.isSet(a.dryRun)) {
+            if (const std::optional<std::string> why = unchangedTile(request)) {
+                std::cout << tileName(*request.tile) << ": " << *why << "; skipped\n";
+                return kExitOk;
+            }
+        }
+    }
 
     const std::filesystem::path outDir = request.project.outDir();
     std::error_code ec;
@@ -354,6 +382,17 @@ int commandBake(const Args& a) {
     return kExitOk;
 }
 
+int commandMerge(const Args& a) {
+    if (!a.parser.positionalArguments().isEmpty())
+        throw UsageError("unexpected argument '" + str(a.parser.positionalArguments()[0]) + "' (--merge takes DIR)");
+    const std::string dir = str(a.parser.value(a.merge));
+    if (dir.empty()) throw UsageError("--merge: must name the folder the tiles were baked into (--out)");
+    const MergeOutcome m = mergeTiles(dir);
+    std::cout << "merged " << m.tiles << " tiles (" << m.grids << " probe grids) in " << m.dir.string() << ":\n";
+    for (const auto& f : m.files) std::cout << "  " << f.filename().string() << "\n";
+    return kExitOk;
+}
+
 int commandPrintProject(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
     if (positional.size() > 1) throw UsageError("--print-project takes one PROJECT");
@@ -415,6 +454,10 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
         }
         if (a.parser.isSet(a.dryRun) && !a.parser.isSet(a.bake))
             throw UsageError("--dry-run: only with --bake");
+        for (const QCommandLineOption* o : {&a.tiles, &a.tile, &a.halo})
+            if (a.parser.isSet(*o) && !a.parser.isSet(a.bake))
+                throw UsageError("--" + str(o->names().first()) + ": only with --bake");
+        if (a.parser.isSet(a.halo) && !a.parser.isSet(a.tile)) throw UsageError("--halo: only with --tile");
         if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
             throw UsageError("--overlay: only with --render");
         if (a.parser.isSet(a.time) && !a.parser.isSet(a.render))
@@ -434,6 +477,7 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
         if (a.parser.isSet(a.info)) return commandInfo(a);
         if (a.parser.isSet(a.study)) return authoring.study(a);
         if (a.parser.isSet(a.bake)) return commandBake(a);
+        if (a.parser.isSet(a.merge)) return commandMerge(a);
         if (a.parser.isSet(a.render)) return authoring.render(a);
         if (a.parser.isSet(a.printProject)) return commandPrintProject(a);
         if (a.parser.isSet(a.printSchema) || a.parser.isSet(a.printReference)) {

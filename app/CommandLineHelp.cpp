@@ -47,6 +47,10 @@ CommandLineHelp commandLineHelp(Binary binary) {
         {"--bake [PROJECT]",
          "Bake every enabled probe volume and export .shprobe files, a glTF scene and bake_report.json into "
          "the output folder."},
+        {"--merge DIR",
+         "Merge the tiles baked into DIR/tiles (--bake --tile) into one scene: DIR/scene.gltf lists every "
+         "tile's probe grids and meshes, DIR/tiles.json indexes them, DIR/bake_report.json sums their reports. "
+         "Refuses an incomplete set of tiles or tiles of different inputs, naming them."},
         {"--render [PROJECT]",
          "Render the terrain lit by the probes of the last bake in the output folder (baking first when "
          "there is none or it is stale) into --out IMAGE (.png display-encoded, .exr scene-linear), on the "
@@ -109,6 +113,16 @@ CommandLineHelp commandLineHelp(Binary binary) {
         {"--dry-run",
          "With --bake: place the probes and print, per volume, the probe count, the .shprobe bytes and the "
          "estimated bake time; bake and write nothing."},
+        {"--tiles NX,NZ",
+         "With --bake --tile: cut the terrain into NX tiles west to east and NZ north to south (a farm's job "
+         "array, docs/farm.md)."},
+        {"--tile I/N | IX,IZ",
+         "With --bake and --tiles: bake tile I of N (row-major, from 0; a batch engine's task index) or the "
+         "tile in column IX, row IZ, into OUT/tiles/tile_IZ_IX; a tile whose inputs are unchanged since its "
+         "bake is skipped."},
+        {"--halo METRES",
+         "With --tile: the terrain traced around the tile (default: derived from the relief, so terrain "
+         "beyond it changes a probe's light by under 1 %)."},
         {"--set KEY.PATH=VALUE",
          "Override a project parameter by its JSON path; repeatable.\n"
          "Examples: --set sun.elevation_deg=12\n"

@@ -43,12 +43,16 @@ struct Args {
     QCommandLineOption budget{"budget", "Seconds.", "SECONDS"};
     QCommandLineOption profile{"profile", "Per-pass GPU time."};
     QCommandLineOption scenario{"scenario", "Lighting scenario.", "NAME[,TO,T]"};
+    QCommandLineOption tiles{"tiles", "Tile cut.", "NX,NZ"};
+    QCommandLineOption tile{"tile", "One tile.", "I/N|IX,IZ"};
+    QCommandLineOption halo{"halo", "Halo metres.", "METRES"};
+    QCommandLineOption merge{"merge", "Merge tiles.", "DIR"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget, profile, scenario});
+                           device, dryRun, overlay, time, study, budget, profile, scenario, tiles, tile, halo, merge});
     }
 };
 

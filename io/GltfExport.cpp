@@ -328,9 +328,15 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
         }
     }
     const size_t normalOffset = bin.size();
+    // Vertex (c, r) of hf is (c + dc, r + dr) of its surroundings: window origins are exact.
+    const Heightfield& around = input.surroundings ? *input.surroundings : hf;
+    const int dc = int(std::lround(around.originCol() - hf.originCol()));
+    const int dr = int(std::lround(around.originRow() - hf.originRow()));
+    if (dc < 0 || dr < 0 || dc + hf.width() > around.width() || dr + hf.depth() > around.depth())
+        throw std::invalid_argument("glTF export: the surroundings do not hold the heightfield's window");
     for (int r : rows) {
         for (int c : cols) {
-            const glm::vec3 n = hf.vertexNormal(c, r);
+            const glm::vec3 n = around.vertexNormal(c + dc, r + dr);
             putF32(bin, n.x);
             putF32(bin, n.y);
             putF32(bin, n.z);
@@ -341,7 +347,8 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const size_t uvOffset = bin.size();
     for (int r : rows) {
         for (int c : cols) {
-            const double u = double(c) / double(hf.width() - 1), v = double(r) / double(hf.depth() - 1);
+            const double u = double(c + dc) / double(std::max(around.width() - 1, 1));
+            const double v = double(r + dr) / double(std::max(around.depth() - 1, 1));
             if (texture) {
                 // Texel centres span the footprint corner to corner (SurfaceAlbedo.h), and glTF
                 // addresses texel i's centre at (i + 0.5) / size: corners land on corner texels.
@@ -945,6 +952,22 @@ GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const Gltf
     for (const auto& name : input.ownedFiles) owned.push_back(name);
     commit(outDir, staging.path(), files, staleOwnedFiles(outDir, files, owned));
     return result;
+}
+
+void writeFilesTogether(const std::filesystem::path& outDir,
+                        const std::vector<std::pair<std::string, std::string>>& files) {
+    std::vector<PendingFile> pending;
+    for (const auto& [name, text] : files)
+        pending.push_back({fs::path(name), std::vector<uint8_t>(text.begin(), text.end())});
+    std::error_code ec;
+    fs::create_directories(outDir, ec);
+    if (ec || !fs::is_directory(outDir)) {
+        throw FileWriteError(outDir.string() + ": cannot create the output directory (" +
+                             (ec ? ec.message() : std::string("exists, not a directory")) + ")");
+    }
+    const StagingDirectory staging(outDir);
+    for (const PendingFile& f : pending) writeStaged(staging.path() / f.relative, outDir / f.relative, f);
+    commit(outDir, staging.path(), pending, {});
 }
 
 nlohmann::json readShProbeGridEntries(const std::filesystem::path& gltfFile) {

@@ -71,6 +71,10 @@ struct GltfWater {
 
 struct GltfSceneInput {
     const Heightfield* heightfield = nullptr;
+    // A tile's traced terrain (a larger window of the same grid as `heightfield`,
+    // Heightfield::window), or null: the mesh's vertex normals are taken there, so a tile's border
+    // vertices get the normals its neighbour's get, and `albedoTexture` is over it.
+    const Heightfield* surroundings = nullptr;
     glm::vec3 albedo{0.3f};  // base colour factor, each channel in [0, 1]
     // When set and not empty: the terrain's base colour texture instead (docs/formats.md), an
     // sRGB-encoded 8-bit PNG embedded in scene.bin, with TEXCOORD_0 on its texel centres and a
@@ -128,6 +132,11 @@ struct GltfExportResult {
 // Throws FileWriteError for filesystem failures, ShProbeError for a grid that cannot be encoded and
 // std::runtime_error for other invalid input, each with a one-line message naming the file.
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input);
+// Top-level files of `outDir` (name, contents), written as exportGltfScene writes its own: staged,
+// then committed together, or not at all (earlier files put back). Throws FileWriteError.
+void writeFilesTogether(const std::filesystem::path& outDir,
+                        const std::vector<std::pair<std::string, std::string>>& files);
+
 // The files exportGltfScene writes for `input`, relative to outDir, in the order it commits them.
 std::vector<std::string> exportedFileNames(const GltfSceneInput& input);
 

@@ -1,0 +1,346 @@
+#include "TileMerge.h"
+
+#include <fstream>
+
+namespace terralux {
+
+namespace {
+
+std::optional<nlohmann::json> readJson(const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return std::nullopt;
+    try {
+        return nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception&) {
+        return std::nullopt;
+    }
+}
+
+// What makes two bakes of a tile the same tile: the cut, its place and the halo asked for.
+nlohmann::json tileKey(const nlohmann::json& tile) {
+    return {tile.value("tiles", nlohmann::json()), tile.value("ix", -1), tile.value("iz", -1),
+            tile.value("halo_setting_m", nlohmann::json())};
+}
+
+}  // namespace
+
+std::optional<std::string> unchangedTile(const BakeRequest& request) {
+    if (!request.tile) return std::nullopt;
+    const std::filesystem::path dir = request.project.outDir();
+    const std::optional<nlohmann::json> report = readJson(dir / "bake_report.json");
+    if (!report || !report->contains("tile") || !report->contains("inputs") || !report->contains("files"))
+        return std::nullopt;
+    const TileSpec& t = *request.tile;
+    const nlohmann::json now = {{"tiles", {t.nx, t.nz}}, {"ix", t.ix}, {"iz", t.iz},
+                                {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()}};
+    if (tileKey((*report)["tile"]) != tileKey(now)) return std::nullopt;
+    if (!bakeInputDifferences((*report)["inputs"], bakeInputs(request.project)).empty()) return std::nullopt;
+    std::error_code ec;
+    for (const auto& f : (*report)["files"])
+        if (!f.is_string() || !std::filesystem::is_regular_file(dir / f.get<std::string>(), ec)) return std::nullopt;
+    return "its inputs are unchanged since its bake in " + dir.string();
+}
+
+}  // namespace terralux
+
+#include <QCryptographicHash>
+#include <QFile>
+
+#include <algorithm>
+#include <map>
+
+#include "GltfExport.h"
+#include "OutputFolder.h"
+
+namespace terralux {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BakedTile {
+    std::string name;
+    fs::path dir;
+    nlohmann::json report, gltf;
+};
+
+std::string sha256Of(const fs::path& file) {
+    QFile f(QString::fromStdString(file.string()));
+    if (!f.open(QIODevice::ReadOnly)) throw ProjectError(file.string() + ": cannot read it to hash it");
+    QCryptographicHash h(QCryptographicHash::Sha256);
+    h.addData(&f);
+    return h.result().toHex().toStdString();
+}
+
+// Adds `offset` to the integer at `key` of `o`, when there is one.
+void shift(nlohmann::json& o, const char* key, size_t offset) {
+    if (o.is_object() && o.contains(key) && o[key].is_number_integer()) o[key] = o[key].get<size_t>() + offset;
+}
+
+// A material's texture references: every object under a "...Texture" key holds an "index".
+void shiftTextures(nlohmann::json& j, size_t offset) {
+    if (j.is_object()) {
+        for (auto it = j.begin(); it != j.end(); ++it) {
+            const std::string& key = it.key();
+            if (key.size() >= 7 && key.compare(key.size() - 7, 7, "Texture") == 0) shift(it.value(), "index", offset);
+            else shiftTextures(it.value(), offset);
+        }
+    }
+}
+
+size_t sizeOf(const nlohmann::json& doc, const char* key) { return doc.contains(key) ? doc[key].size() : 0; }
+
+// The tiles' glTF documents as one: each tile's nodes, meshes, materials and buffers appended with
+// their indices moved, buffers and images addressed through the tile's folder, and the probe
+// grids of every tile listed in the scene's VULKAN_SCHNEE_engine_properties, sorted by file name.
+nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::json& region) {
+    nlohmann::json out = {{"asset", tiles.front().gltf["asset"]}, {"scene", 0}};
+    nlohmann::json used = nlohmann::json::array(), grids = nlohmann::json::array(), roots = nlohmann::json::array();
+    nlohmann::json sceneExt = tiles.front().gltf["scenes"][0].value("extensions", nlohmann::json::object());
+    static const char* kArrays[] = {"nodes", "meshes", "materials", "samplers", "images", "textures",
+                                    "accessors", "bufferViews", "buffers"};
+    for (const char* a : kArrays) out[a] = nlohmann::json::array();
+    for (size_t t = 0; t < tiles.size(); ++t) {
+        const nlohmann::json& g = tiles[t].gltf;
+        const std::string prefix = std::string(kTilesFolder) + "/" + tiles[t].name + "/";
+        std::map<std::string, size_t> off;
+        for (const char* a : kArrays) off[a] = out[a].size();
+        for (const auto& e : g.value("extensionsUsed", nlohmann::json::array()))
+            if (std::find(used.begin(), used.end(), e) == used.end()) used.push_back(e);
+        const nlohmann::json& scene = g["scenes"][g.value("scene", 0)];
+        for (const auto& i : scene["nodes"]) roots.push_back(i.get<size_t>() + off["nodes"]);
+        for (nlohmann::json n : g.value("nodes", nlohmann::json::array())) {
+            shift(n, "mesh", off["meshes"]);
+            if (n.contains("children"))
+                for (auto& c : n["children"]) c = c.get<size_t>() + off["nodes"];
+            n["name"] = tiles[t].name + "/" + n.value("name", std::string("node"));
+            out["nodes"].push_back(n);
+        }
+        for (nlohmann::json m : g.value("meshes", nlohmann::json::array())) {
+            for (auto& p : m["primitives"]) {
+                for (auto& [k, v] : p["attributes"].items()) v = v.get<size_t>() + off["accessors"];
+                shift(p, "indices", off["accessors"]);
+                shift(p, "material", off["materials"]);
+            }
+            out["meshes"].push_back(m);
+        }
+        for (nlohmann::json m : g.value("materials", nlohmann::json::array())) {
+            shiftTextures(m, off["textures"]);
+            out["materials"].push_back(m);
+        }
+        for (const auto& s : g.value("samplers", nlohmann::json::array())) out["samplers"].push_back(s);
+        for (nlohmann::json i : g.value("images", nlohmann::json::array())) {
+            shift(i, "bufferView", off["bufferViews"]);
+            if (i.contains("uri")) i["uri"] = prefix + i["uri"].get<std::string>();
+            out["images"].push_back(i);
+        }
+        for (nlohmann::json x : g.value("textures", nlohmann::json::array())) {
+            shift(x, "sampler", off["samplers"]);
+            shift(x, "source", off["images"]);
+            out["textures"].push_back(x);
+        }
+        for (nlohmann::json x : g.value("accessors", nlohmann::json::array())) {
+            shift(x, "bufferView", off["bufferViews"]);
+            out["accessors"].push_back(x);
+        }
+        for (nlohmann::json x : g.value("bufferViews", nlohmann::json::array())) {
+            shift(x, "buffer", off["buffers"]);
+            out["bufferViews"].push_back(x);
+        }
+        for (nlohmann::json x : g.value("buffers", nlohmann::json::array())) {
+            if (x.contains("uri")) x["uri"] = prefix + x["uri"].get<std::string>();
+            out["buffers"].push_back(x);
+        }
+        const nlohmann::json ext = scene.value("extensions", nlohmann::json::object());
+        if (ext.contains("VULKAN_SCHNEE_engine_properties"))
+            for (nlohmann::json grid : ext["VULKAN_SCHNEE_engine_properties"].value("shProbeGrids", nlohmann::json::array())) {
+                grid["shProbePath"] = prefix + grid["shProbePath"].get<std::string>();
+                grids.push_back(grid);
+            }
+    }
+    // The seed's rule: grids sorted by file name; the first that holds a point wins.
+    std::stable_sort(grids.begin(), grids.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
+        return a["shProbePath"].get<std::string>() < b["shProbePath"].get<std::string>();
+    });
+    sceneExt["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"] = grids;
+    // The region's grid and stride, not the first tile's.
+    if (sceneExt.contains("TERRALUX_geo")) {
+        sceneExt["TERRALUX_geo"]["gridSize"] = region["region_grid"];
+        sceneExt["TERRALUX_geo"].erase("meshStride");
+        sceneExt["TERRALUX_geo"]["tiles"] = region["tiles"];
+    }
+    sceneExt.erase("TERRALUX_bake");  // per tile; the merged report sums them
+    out["extensionsUsed"] = used;
+    out["scenes"] = nlohmann::json::array({{{"name", "region"}, {"nodes", roots}, {"extensions", sceneExt}}});
+    for (const char* a : kArrays)
+        if (out[a].empty()) out.erase(a);
+    return out;
+}
+
+// The tiles' reports summed: rays and time, and per volume its probes and their error.
+nlohmann::json mergedReport(const std::vector<BakedTile>& tiles, const nlohmann::json& region) {
+    double time = 0.0, longest = 0.0;
+    uint64_t rays = 0, probeRays = 0;
+    struct Volume {
+        size_t probes = 0, mapPoints = 0;
+        double seSum = 0.0, seMax = 0.0, mapSum = 0.0, mapMax = 0.0;
+    };
+    std::map<std::string, Volume> volumes;
+    nlohmann::json perTile = nlohmann::json::array();
+    for (const BakedTile& t : tiles) {
+        const nlohmann::json& r = t.report;
+        const double s = r.value("time_s", 0.0);
+        time += s;
+        longest = std::max(longest, s);
+        rays += r.value("rays", uint64_t(0));
+        probeRays += r.value("probe_rays", uint64_t(0));
+        for (const auto& v : r.value("volumes", nlohmann::json::array())) {
+            Volume& m = volumes[v.value("name", std::string())];
+            const size_t n = v.value("probes", size_t(0));
+            m.probes += n;
+            if (v.contains("standard_error")) {
+                m.seSum += v["standard_error"].value("mean", 0.0) * double(n);
+                m.seMax = std::max(m.seMax, v["standard_error"].value("max", 0.0));
+            }
+            if (v.contains("error_map") && v["error_map"].value("points", 0) > 0) {
+                const size_t p = v["error_map"]["points"].get<size_t>();
+                m.mapPoints += p;
+                m.mapSum += v["error_map"].value("mean", 0.0) * double(p);
+                m.mapMax = std::max(m.mapMax, v["error_map"].value("max", 0.0));
+            }
+        }
+        perTile.push_back({{"name", t.name}, {"time_s", s}, {"rays", r.value("rays", uint64_t(0))}});
+    }
+    nlohmann::json vs = nlohmann::json::array();
+    for (const auto& [name, m] : volumes) {
+        nlohmann::json v = {{"name", name},
+                            {"probes", m.probes},
+                            {"standard_error", {{"mean", m.probes ? m.seSum / double(m.probes) : 0.0}, {"max", m.seMax}}}};
+        if (m.mapPoints)
+            v["error_map"] = {{"points", m.mapPoints}, {"mean", m.mapSum / double(m.mapPoints)}, {"max", m.mapMax}};
+        vs.push_back(v);
+    }
+    return {{"generator", tiles.front().report.value("generator", std::string())},
+            {"region", region},
+            {"inputs", tiles.front().report["inputs"]},
+            {"tiles", perTile},
+            {"time_s", time},
+            {"longest_tile_time_s", longest},
+            {"rays", rays},
+            {"probe_rays", probeRays},
+            {"volumes", vs},
+            {"failures", nlohmann::json::array()}};
+}
+
+}  // namespace
+
+MergeOutcome mergeTiles(const fs::path& dirIn) {
+    const fs::path dir = fs::absolute(dirIn).lexically_normal();
+    const fs::path tilesDir = dir / kTilesFolder;
+    std::error_code ec;
+    std::vector<BakedTile> tiles;
+    for (const auto& e : fs::directory_iterator(tilesDir, ec)) {
+        if (!e.is_directory(ec) || e.path().filename().string().rfind("tile_", 0) != 0) continue;
+        BakedTile t{e.path().filename().string(), e.path(), {}, {}};
+        const std::optional<nlohmann::json> r = readJson(t.dir / "bake_report.json");
+        if (!r || !r->contains("tile") || !r->contains("inputs"))
+            throw ProjectError((t.dir / "bake_report.json").string() +
+                               ": missing or not a tile's bake report; bake the tile again (--bake --tile)");
+        t.report = *r;
+        if ((*r)["tile"].value("name", std::string()) != t.name)
+            throw ProjectError(t.dir.string() + ": holds the bake of " + (*r)["tile"].value("name", std::string("?")) +
+                               ", not of " + t.name);
+        tiles.push_back(std::move(t));
+    }
+    if (tiles.empty())
+        throw ProjectError(tilesDir.string() + ": no baked tiles; bake them first with --bake --tiles NX,NZ --tile I/N --out " +
+                           dir.string());
+    std::sort(tiles.begin(), tiles.end(), [](const BakedTile& a, const BakedTile& b) { return a.name < b.name; });
+
+    // One cut, one set of inputs: every tile must agree with the first.
+    const nlohmann::json& first = tiles.front().report;
+    auto sameInputs = [&](const nlohmann::json& inputs) {
+        for (const std::string& d : bakeInputDifferences(first["inputs"], inputs))
+            if (d.rfind("export.out_dir", 0) != 0) return d;
+        return std::string();
+    };
+    std::vector<std::string> mismatched;
+    for (const BakedTile& t : tiles) {
+        const nlohmann::json& tile = t.report["tile"];
+        std::string why;
+        if (tile["tiles"] != first["tile"]["tiles"]) why = "cut " + tile["tiles"].dump() + ", not " + first["tile"]["tiles"].dump();
+        else if (tile.value("halo_setting_m", nlohmann::json()) != first["tile"].value("halo_setting_m", nlohmann::json()))
+            why = "halo " + tile.value("halo_setting_m", nlohmann::json()).dump();
+        else if (tile["region_grid"] != first["tile"]["region_grid"]) why = "region grid " + tile["region_grid"].dump();
+        else why = sameInputs(t.report["inputs"]);
+        if (!why.empty()) mismatched.push_back(t.name + " (" + why + ")");
+    }
+    if (!mismatched.empty()) {
+        std::string list;
+        for (const auto& m : mismatched) list += (list.empty() ? "" : ", ") + m;
+        throw ProjectError(tilesDir.string() + ": tiles baked from other inputs than " + tiles.front().name + ": " + list +
+                           "; bake them again");
+    }
+    const int nx = first["tile"]["tiles"][0].get<int>(), nz = first["tile"]["tiles"][1].get<int>();
+    std::vector<std::string> missing;
+    for (int iz = 0; iz < nz; ++iz)
+        for (int ix = 0; ix < nx; ++ix) {
+            TileSpec s;
+            s.nx = nx, s.nz = nz, s.ix = ix, s.iz = iz;
+            const std::string name = tileName(s);
+            if (!std::any_of(tiles.begin(), tiles.end(), [&](const BakedTile& t) { return t.name == name; }))
+                missing.push_back(name);
+        }
+    if (!missing.empty()) {
+        std::string list;
+        for (size_t i = 0; i < missing.size() && i < 16; ++i) list += (i ? ", " : "") + missing[i];
+        if (missing.size() > 16) list += ", ... (" + std::to_string(missing.size()) + " in all)";
+        throw ProjectError(tilesDir.string() + ": " + std::to_string(missing.size()) + " of " + std::to_string(nx * nz) +
+                           " tiles missing: " + list + "; bake them first");
+    }
+    if (int(tiles.size()) != nx * nz)
+        throw ProjectError(tilesDir.string() + ": " + std::to_string(tiles.size()) + " tile folders for a " +
+                           std::to_string(nx) + " x " + std::to_string(nz) + " cut; remove the others");
+
+    nlohmann::json index = nlohmann::json::array();
+    for (BakedTile& t : tiles) {
+        const std::optional<nlohmann::json> g = readJson(t.dir / "scene.gltf");
+        if (!g) throw ProjectError((t.dir / "scene.gltf").string() + ": missing or unreadable; bake the tile with export.gltf on");
+        const nlohmann::json lighting = (*g)["scenes"][0].value("extensions", nlohmann::json::object()).value("TERRALUX_lighting", nlohmann::json::object());
+        if (lighting.contains("scenarios") || lighting.contains("reflection_probes"))
+            throw ProjectError(t.dir.string() + ": a tile with lighting scenarios or reflection probes; --merge lists "
+                               "diffuse probe grids and meshes only, so bake the tiles without them");
+        t.gltf = *g;
+        nlohmann::json files = nlohmann::json::array();
+        for (const auto& f : t.report.value("files", nlohmann::json::array())) {
+            const fs::path p = t.dir / f.get<std::string>();
+            files.push_back({{"path", (fs::path(kTilesFolder) / t.name / f.get<std::string>()).generic_string()},
+                             {"bytes", fs::file_size(p, ec)},
+                             {"sha256", sha256Of(p)}});
+        }
+        index.push_back({{"name", t.name},
+                         {"ix", t.report["tile"]["ix"]},
+                         {"iz", t.report["tile"]["iz"]},
+                         {"bounds_m", t.report["tile"]["bounds_m"]},
+                         {"files", files}});
+    }
+    const nlohmann::json& ft = first["tile"];
+    const nlohmann::json region = {{"tiles", ft["tiles"]}, {"region_grid", ft["region_grid"]}, {"halo", ft["halo"]}};
+    MergeOutcome out;
+    out.dir = dir;
+    out.tiles = int(tiles.size());
+    const nlohmann::json gltf = mergedGltf(tiles, region);
+    out.grids = gltf["scenes"][0]["extensions"]["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"].size();
+    out.report = mergedReport(tiles, region);
+    const nlohmann::json tilesJson = {{"region", region}, {"tiles", index}};
+
+    const OutputFolderLock lock(dir);
+    removeStaleTemporaries(dir);
+    writeFilesTogether(dir, {{"tiles.json", tilesJson.dump(2) + "\n"},
+                             {"scene.gltf", gltf.dump(2) + "\n"},
+                             {"bake_report.json", out.report.dump(2) + "\n"}});
+    out.files = {dir / "tiles.json", dir / "scene.gltf", dir / "bake_report.json"};
+    return out;
+}
+
+}  // namespace terralux

@@ -1,0 +1,160 @@
+#include "Tiling.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace terralux {
+
+namespace {
+
+// Whole integers only: "2", not "2.5" or "2x".
+bool parseInt(std::string_view s, int& out) {
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && end == s.data() + s.size();
+}
+
+bool parsePair(const std::string& s, char sep, int& a, int& b) {
+    const size_t at = s.find(sep);
+    return at != std::string::npos && parseInt(std::string_view(s).substr(0, at), a) &&
+           parseInt(std::string_view(s).substr(at + 1), b);
+}
+
+}  // namespace
+
+TileSpec parseTiles(const std::string& tiles, const std::string& tile, const std::optional<double>& haloMetres) {
+    TileSpec t;
+    constexpr int kMaxTilesPerAxis = 1024;
+    if (!parsePair(tiles, ',', t.nx, t.nz) || t.nx < 1 || t.nz < 1 || t.nx > kMaxTilesPerAxis ||
+        t.nz > kMaxTilesPerAxis)
+        throw std::invalid_argument("--tiles " + tiles + ": must be NX,NZ, two whole numbers from 1 to " +
+                                    std::to_string(kMaxTilesPerAxis));
+    int a = 0, b = 0;
+    if (parsePair(tile, '/', a, b)) {
+        if (b != t.count())
+            throw std::invalid_argument("--tile " + tile + ": N must be the tile count of --tiles " + tiles + " (" +
+                                        std::to_string(t.count()) + ")");
+        if (a < 0 || a >= b)
+            throw std::invalid_argument("--tile " + tile + ": I must lie in [0, " + std::to_string(b) + ")");
+        t.ix = a % t.nx;
+        t.iz = a / t.nx;
+    } else if (parsePair(tile, ',', a, b)) {
+        if (a < 0 || a >= t.nx || b < 0 || b >= t.nz)
+            throw std::invalid_argument("--tile " + tile + ": IX must lie in [0, " + std::to_string(t.nx) +
+                                        ") and IZ in [0, " + std::to_string(t.nz) + ")");
+        t.ix = a;
+        t.iz = b;
+    } else {
+        throw std::invalid_argument("--tile " + tile + ": must be I/N (I from 0) or IX,IZ");
+    }
+    if (haloMetres && !(std::isfinite(*haloMetres) && *haloMetres >= 0.0))
+        throw std::invalid_argument("--halo " + std::to_string(*haloMetres) + ": must be a distance in metres >= 0");
+    t.haloMetres = haloMetres;
+    return t;
+}
+
+Halo haloFor(const Heightfield& region, const std::optional<double>& metres) {
+    Halo h;
+    h.relief = double(region.maxHeight()) - double(region.minHeight());
+    h.derived = !metres;
+    h.metres = metres ? *metres : h.relief * std::sqrt((1.0 - kHaloShare) / kHaloShare);
+    constexpr double kDegrees = 57.29577951308232;
+    h.sunBelowDeg = h.metres > 0.0 ? std::atan(h.relief / h.metres) * kDegrees : 90.0;
+    return h;
+}
+
+TileWindow tileWindow(const Heightfield& region, const TileSpec& t) {
+    const int cellsX = region.width() - 1, cellsZ = region.depth() - 1;
+    if (cellsX < 2 * t.nx || cellsZ < 2 * t.nz)
+        throw std::invalid_argument("--tiles " + std::to_string(t.nx) + "," + std::to_string(t.nz) + ": the " +
+                                    std::to_string(region.width()) + "x" + std::to_string(region.depth()) +
+                                    " grid must give every tile at least 2 cells a side");
+    TileWindow w;
+    // Integer cuts of the cells: each tile's share differs from another's by at most one cell.
+    const int c1 = int((long long)(t.ix + 1) * cellsX / t.nx), r1 = int((long long)(t.iz + 1) * cellsZ / t.nz);
+    w.col0 = int((long long)t.ix * cellsX / t.nx);
+    w.row0 = int((long long)t.iz * cellsZ / t.nz);
+    w.cols = c1 - w.col0 + 1;
+    w.rows = r1 - w.row0 + 1;
+    w.regionCols = region.width();
+    w.regionRows = region.depth();
+    w.halo = haloFor(region, t.haloMetres);
+    const double hx = std::ceil(w.halo.metres / region.cellSizeX()), hz = std::ceil(w.halo.metres / region.cellSizeZ());
+    const int gx = int(std::min(hx, double(cellsX))), gz = int(std::min(hz, double(cellsZ)));
+    w.tracedCol0 = std::max(0, w.col0 - gx);
+    w.tracedRow0 = std::max(0, w.row0 - gz);
+    w.tracedCols = std::min(cellsX, c1 + gx) - w.tracedCol0 + 1;
+    w.tracedRows = std::min(cellsZ, r1 + gz) - w.tracedRow0 + 1;
+    return w;
+}
+
+std::string tileName(const TileSpec& t) {
+    char name[32];
+    std::snprintf(name, sizeof name, "tile_%03d_%03d", t.iz, t.ix);
+    return name;
+}
+
+nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const Heightfield& region) {
+    const float x0 = region.xOf(w.col0), x1 = region.xOf(w.col0 + w.cols - 1);
+    const float z0 = region.zOf(w.row0), z1 = region.zOf(w.row0 + w.rows - 1);
+    return {{"name", tileName(t)},
+            {"tiles", {t.nx, t.nz}},
+            {"index", t.index()},
+            {"ix", t.ix},
+            {"iz", t.iz},
+            {"region_grid", {region.width(), region.depth()}},
+            {"core", {{"col0", w.col0}, {"row0", w.row0}, {"cols", w.cols}, {"rows", w.rows}}},
+            {"traced", {{"col0", w.tracedCol0}, {"row0", w.tracedRow0}, {"cols", w.tracedCols}, {"rows", w.tracedRows}}},
+            {"bounds_m", {{"min", {x0, z0}}, {"max", {x1, z1}}}},
+            {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()},
+            {"halo",
+             {{"metres", w.halo.metres},
+              {"derived", w.halo.derived},
+              {"relief_m", w.halo.relief},
+              {"share", kHaloShare},
+              {"sun_below_deg", w.halo.sunBelowDeg}}}};
+}
+
+}  // namespace terralux
+
+#include "Project.h"
+
+namespace terralux {
+
+void scaleSceneToTile(SceneDescription& scene, const TileWindow& w) {
+    const double shareX = double(w.cols - 1) / double(w.regionCols - 1);
+    const double shareZ = double(w.rows - 1) / double(w.regionRows - 1);
+    // Probes along an axis, the region's n over its span: the first and last on the tile's edges.
+    auto probes = [](int n, double share) { return n <= 1 ? n : std::max(2, int(std::lround((n - 1) * share)) + 1); };
+    auto cells = [](int n, double share) { return std::max(1, int(std::lround(n * share))); };
+    for (size_t i = 0; i < scene.probeVolumes.size(); ++i) {
+        ProbeVolumeSettings& v = scene.probeVolumes[i];
+        if (!v.enabled) continue;
+        const std::string at = "probe_volumes[" + std::to_string(i) + "]";
+        if (v.origin)
+            throw ProjectError(at + ".origin: a tiled bake places each tile's probes over its own share of the "
+                                    "terrain; leave the origin unset");
+        if (refinedByError(v.placement) && v.adaptive.size)
+            throw ProjectError(at + ".adaptive.size: a tiled bake places each tile's probes over its own share "
+                                    "of the terrain; leave the size unset");
+        if (v.placement == ProbePlacement::Terrain) {
+            v.gridDims[0] = probes(v.gridDims[0], shareX);
+            v.gridDims[2] = probes(v.gridDims[2], shareZ);
+        } else if (v.placement == ProbePlacement::Box) {
+            v.gridDims[0] = cells(v.gridDims[0], shareX);
+            v.gridDims[2] = cells(v.gridDims[2], shareZ);
+        }
+    }
+    ReflectionProbeSettings& r = scene.reflectionProbes;
+    if (r.enabled) {
+        if (r.origin)
+            throw ProjectError("reflection_probes.origin: a tiled bake places each tile's probes over its own "
+                               "share of the terrain; leave the origin unset");
+        r.gridDims[0] = probes(r.gridDims[0], shareX);
+        r.gridDims[1] = probes(r.gridDims[1], shareZ);
+    }
+}
+
+}  // namespace terralux

@@ -1,0 +1,76 @@
+#pragma once
+// A region cut into tiles for a farm (docs/farm.md): each tile bakes its own share of the terrain
+// as a complete bake, seeing the terrain within a halo around it, in the region's engine space,
+// so a merge lists the tiles' grids side by side with no transform.
+
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "terrain/Heightfield.h"
+
+namespace terralux {
+
+// The folder under a region's output folder that holds one folder per tile.
+inline constexpr const char* kTilesFolder = "tiles";
+
+// One tile of an nx × nz cut: column ix (west to east), row iz (north to south).
+struct TileSpec {
+    int nx = 1, nz = 1;
+    int ix = 0, iz = 0;
+    std::optional<double> haloMetres;  // unset: haloFor() derives it from the relief
+    int index() const { return iz * nx + ix; }
+    int count() const { return nx * nz; }
+};
+
+// "--tiles NX,NZ" and "--tile I/N" (I in [0, N), row-major: I = iz·NX + ix) or "--tile IX,IZ".
+// Throws std::invalid_argument with a one-line message naming the option, the value and the rule.
+TileSpec parseTiles(const std::string& tiles, const std::string& tile, const std::optional<double>& haloMetres);
+
+// The share of an upward receiver's irradiance that terrain beyond the halo may change: the
+// halo's rule (haloFor).
+inline constexpr double kHaloShare = 0.01;
+
+// How far beyond a tile the terrain can still change its light by more than kHaloShare: terrain
+// at a distance d beyond the tile, at most `relief` above the lowest ground, stands at most
+// atan(relief / d) above a receiver's horizon; the cosine-weighted share of the hemisphere below
+// that elevation is sin²(atan(relief / d)), which is kHaloShare at d = relief·√((1 − s) / s)
+// (≈ 9.95 × the relief). Such terrain can shade the sun only below atan(relief / d) (5.7°).
+struct Halo {
+    double metres = 0.0;
+    bool derived = true;
+    double relief = 0.0;           // metres, highest minus lowest ground of the region
+    double sunBelowDeg = 0.0;      // terrain beyond the halo can shade only a sun lower than this
+};
+Halo haloFor(const Heightfield& region, const std::optional<double>& metres);
+
+// A tile's vertex windows in the region's grid. The core: columns [col0, col0 + cols); tiles
+// share their border column and row, so their meshes and probe grids meet without a gap or an
+// overlap. The traced window: the core grown by the halo, clipped to the region.
+struct TileWindow {
+    int col0 = 0, row0 = 0, cols = 0, rows = 0;
+    int tracedCol0 = 0, tracedRow0 = 0, tracedCols = 0, tracedRows = 0;
+    int regionCols = 0, regionRows = 0;  // the region's vertex grid
+    Halo halo;
+};
+// Throws std::invalid_argument when the region has fewer than 2 cells a tile along an axis.
+TileWindow tileWindow(const Heightfield& region, const TileSpec& tile);
+
+// "tile_003_001": sorts as the seed's merge lists grids (by file name), west to east in a row.
+std::string tileName(const TileSpec& tile);
+
+// What a tile's bake_report.json records under "tile": the cut, the windows and the halo rule.
+nlohmann::json tileReport(const TileSpec& tile, const TileWindow& w, const Heightfield& region);
+
+}  // namespace terralux
+
+namespace terralux {
+struct SceneDescription;
+// The scene a tile bakes: each terrain and box volume's grid_dims, and the reflection grid's,
+// scaled to the tile's share of the region's cells (a terrain grid over auto-span keeps the
+// region's spacing when the tile's cells are a whole number of it), so the tiles together place
+// what the region would. Throws ProjectError for what cannot be cut: an explicit origin, or an
+// adaptive volume's explicit size (each tile places over its own footprint).
+void scaleSceneToTile(SceneDescription& scene, const TileWindow& w);
+}  // namespace terralux

@@ -1,0 +1,222 @@
+// A region cut into tiles (docs/farm.md): the windows, the halo rule, a tile's bake against the
+// untiled bake of the same terrain along the borders, the skip of an unchanged tile, and the merge.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "BakeJob.h"
+#include "ProbeDiagnosticsFile.h"
+#include "ShProbeFile.h"
+#include "TerrainLoading.h"
+#include "TileMerge.h"
+#include "Tiling.h"
+#include "bake/HeightfieldTracer.h"
+#include "bake/SphericalHarmonics.h"
+
+using namespace terralux;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kCrop = fs::path(TERRALUX_TEST_DATA) / "dem" / "bigtujunga_utm11_crop.tif";
+
+Heightfield ramp(int w, int d) {
+    std::vector<float> h(size_t(w) * d);
+    for (int r = 0; r < d; ++r)
+        for (int c = 0; c < w; ++c) h[size_t(r) * w + c] = float(100.0 * std::sin(0.3 * c) * std::cos(0.2 * r) + 3.0 * c);
+    return Heightfield(w, d, 30.0, 25.0, h);
+}
+
+fs::path freshDir(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("terralux_tiles_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    return dir;
+}
+
+// The region the bake tests cut: the crop at 65 x 43 vertices (64 x 42 cells), whose 9 x 7 terrain
+// grid puts a probe every 8 x 7 cells, so a 2 x 2 cut's tiles (32 x 21 cells) hold the same probes.
+Project regionProject(const fs::path& out) {
+    Project p;
+    p.scene.terrain.dem = kCrop.string();
+    p.scene.terrain.maxResolution = 65;
+    p.scene.probeVolumes[0].gridDims = {9, 1, 7};
+    p.scene.bake.quality = QualityPreset::Draft;
+    p.scene.exportSettings.outDir = out.string();
+    return p;
+}
+
+struct Probe {
+    glm::vec3 position;
+    float irradiance = 0.0f;  // luminance of the upward irradiance
+    float se = 0.0f;
+};
+
+std::vector<Probe> probesIn(const fs::path& dir) {
+    std::vector<uint8_t> bytes;
+    const ShProbeGrid g = readShProbeFile(dir / "sh_coeffs" / "probes.shprobe", &bytes);
+    const ProbeDiagnostics d = readProbeDiagnosticsFile(dir / "sh_coeffs" / "probes.probes.json", g, shProbeDigest(bytes));
+    std::vector<Probe> out;
+    for (size_t i = 0; i < g.probes.size(); ++i) {
+        sh::ShRgb s;
+        s.c = g.probes[i].coeffs;
+        const glm::vec3 e = sh::evalIrradiance(s, glm::vec3(0, 1, 0));
+        out.push_back({d.positions[i], 0.2126f * e.r + 0.7152f * e.g + 0.0722f * e.b, d.standardError.at(i)});
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST(Tiles, AWindowKeepsItsVerticesAndItsSurfaceToTheBit) {
+    const Heightfield region = ramp(41, 33);
+    const Heightfield w = region.window(7, 5, 20, 17);
+    EXPECT_EQ(w.width(), 20);
+    for (int r = 0; r < w.depth(); ++r)
+        for (int c = 0; c < w.width(); ++c) {
+            ASSERT_EQ(w.vertex(c, r), region.vertex(c + 7, r + 5));
+            // Inside the window, where central differences see the same neighbours.
+            if (c > 0 && r > 0 && c + 1 < w.width() && r + 1 < w.depth())
+                ASSERT_EQ(w.vertexNormal(c, r), region.vertexNormal(c + 7, r + 5));
+        }
+    for (float fx : {0.1f, 0.5f, 0.93f})
+        for (float fz : {0.2f, 0.77f}) {
+            const float x = w.minX() + fx * (w.maxX() - w.minX()), z = w.minZ() + fz * (w.maxZ() - w.minZ());
+            EXPECT_EQ(w.surfaceHeight(x, z), region.surfaceHeight(x, z));
+            EXPECT_EQ(w.surfaceNormal(x, z), region.surfaceNormal(x, z));
+        }
+    // A ray inside the window meets the same triangle in both grids, at the same distance.
+    const HeightfieldTracer a(region), b(w);
+    const glm::vec3 o(0.5f * (w.minX() + w.maxX()), 600.0f, 0.5f * (w.minZ() + w.maxZ()));
+    const glm::vec3 dir = glm::normalize(glm::vec3(0.2f, -1.0f, 0.1f));
+    RayHit ha, hb;
+    ASSERT_TRUE(a.intersect(o, dir, 1e6f, ha));
+    ASSERT_TRUE(b.intersect(o, dir, 1e6f, hb));
+    EXPECT_EQ(ha.t, hb.t);
+    EXPECT_THROW((void)region.window(30, 0, 12, 5), std::invalid_argument);
+}
+
+TEST(Tiles, CoresCoverTheRegionSharingTheirBordersAndTheHaloFollowsTheRelief) {
+    const Heightfield region = ramp(101, 57);
+    const TileSpec any = parseTiles("3,2", "0/6", std::nullopt);
+    const Halo h = haloFor(region, std::nullopt);
+    EXPECT_NEAR(h.metres, h.relief * std::sqrt(99.0), 1e-6);
+    // sin²(atan(relief / halo)) is the share of an upward receiver's hemisphere the terrain beyond can hold.
+    EXPECT_NEAR(std::pow(std::sin(std::atan(h.relief / h.metres)), 2.0), kHaloShare, 1e-12);
+    for (int iz = 0; iz < 2; ++iz) {
+        int nextCol = 0;
+        for (int ix = 0; ix < 3; ++ix) {
+            TileSpec t = any;
+            t.ix = ix, t.iz = iz, t.haloMetres = 100.0;
+            const TileWindow w = tileWindow(region, t);
+            EXPECT_EQ(w.col0, nextCol) << "tiles share their border column";
+            nextCol = w.col0 + w.cols - 1;
+            EXPECT_LE(w.tracedCol0, w.col0);
+            EXPECT_GE(w.tracedCol0 + w.tracedCols, w.col0 + w.cols);
+            EXPECT_EQ(w.col0 - w.tracedCol0, ix == 0 ? 0 : 4);  // ceil(100 m / 30 m)
+        }
+        EXPECT_EQ(nextCol, region.width() - 1);
+    }
+    EXPECT_EQ(parseTiles("3,2", "4/6", std::nullopt).ix, 1);
+    EXPECT_EQ(parseTiles("3,2", "4/6", std::nullopt).iz, 1);
+    EXPECT_THROW(parseTiles("3,2", "6/6", std::nullopt), std::invalid_argument);
+    EXPECT_THROW(parseTiles("3,2", "1/4", std::nullopt), std::invalid_argument);
+    EXPECT_THROW(parseTiles("3,2", "3,0", std::nullopt), std::invalid_argument);
+    EXPECT_THROW(parseTiles("0,2", "0/0", std::nullopt), std::invalid_argument);
+    TileSpec tooMany = parseTiles("60,2", "0/120", std::nullopt);
+    EXPECT_THROW(tileWindow(region, tooMany), std::invalid_argument);
+}
+
+TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
+    const fs::path whole = freshDir("whole"), tiled = freshDir("tiled");
+    const BakeOutcome w = runBake(BakeRequest{regionProject(whole), 2, false}, {}, nullptr);
+    const std::vector<Probe> reference = probesIn(whole);
+    ASSERT_EQ(reference.size(), 63u);
+
+    // The halo is derived (about 10 km here, so each tile traces the whole crop) and then set to
+    // 300 m, so that each tile traces a window of its own.
+    for (const std::optional<double> halo : {std::optional<double>(), std::optional<double>(300.0)}) {
+        fs::remove_all(tiled);
+        for (int i = 0; i < 4; ++i) {
+            BakeRequest r{regionProject(tiled), 2, false};
+            r.tile = parseTiles("2,2", std::to_string(i) + "/4", halo);
+            r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
+            const BakeOutcome o = runBake(r, {}, nullptr);
+            EXPECT_EQ(o.report["tile"]["halo"]["derived"].get<bool>(), !halo);
+            EXPECT_FALSE(unchangedTile(r) == std::nullopt) << "a tile baked is one left alone";
+            r.project.scene.sun.elevationDeg = 20.0;
+            EXPECT_EQ(unchangedTile(r), std::nullopt) << "a changed input bakes the tile again";
+        }
+        // Every probe of every tile sits on a probe of the untiled grid; along the borders (where
+        // two tiles hold the same probe) they differ from it by their sampling noise, no more.
+        double sum = 0.0, worst = 0.0;
+        size_t matched = 0, border = 0;
+        for (const auto& e : fs::directory_iterator(tiled / kTilesFolder)) {
+            for (const Probe& p : probesIn(e.path())) {
+                const Probe* q = nullptr;
+                for (const Probe& r : reference)
+                    if (glm::distance(r.position, p.position) < 0.05f) q = &r;
+                ASSERT_NE(q, nullptr) << "tile probe at " << p.position.x << ", " << p.position.z;
+                ++matched;
+                const double sigma = std::hypot(p.se, q->se) * q->irradiance;
+                const double z = std::abs(p.irradiance - q->irradiance) / sigma;
+                const bool onBorder = std::abs(p.position.x - reference[4].position.x) < 0.05f ||
+                                      std::abs(p.position.z - reference[27].position.z) < 0.05f;
+                if (onBorder) {
+                    ++border;
+                    sum += z;
+                    worst = std::max(worst, z);
+                }
+            }
+        }
+        EXPECT_EQ(matched, 4u * 5 * 4);
+        EXPECT_EQ(border, 2u * 5 * 2 + 2u * 4 * 2 - 4);
+        std::cout << "halo " << (halo ? std::to_string(*halo) + " m" : std::string("derived")) << ": " << border
+                  << " border probes, |difference| / its standard error mean " << sum / double(border) << ", max "
+                  << worst << "\n";
+        // Within twice the standard error of their difference, every one (without a halo, the
+        // skirt standing in for the terrain beyond: mean 0.74, max 2.9).
+        EXPECT_LT(sum / double(border), 0.5) << "halo " << (halo ? *halo : -1.0);
+        EXPECT_LT(worst, 2.0) << "halo " << (halo ? *halo : -1.0);
+    }
+
+    // The merge lists the four tiles' grids, sorted by file name, and their meshes.
+    const MergeOutcome m = mergeTiles(tiled);
+    EXPECT_EQ(m.tiles, 4);
+    EXPECT_EQ(m.grids, 4u);
+    std::ifstream in(tiled / "scene.gltf");
+    const nlohmann::json g = nlohmann::json::parse(in);
+    const auto& grids = g["scenes"][0]["extensions"]["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"];
+    EXPECT_EQ(grids[0]["shProbePath"], "tiles/tile_000_000/sh_coeffs/probes.shprobe");
+    EXPECT_EQ(grids[3]["shProbePath"], "tiles/tile_001_001/sh_coeffs/probes.shprobe");
+    EXPECT_EQ(g["nodes"].size(), 4u);
+    EXPECT_EQ(g["buffers"][2]["uri"], "tiles/tile_001_000/scene.bin");
+    EXPECT_TRUE(fs::exists(tiled / "tiles.json"));
+    EXPECT_EQ(m.report["volumes"][0]["probes"].get<size_t>(), 80u);
+
+    // A tile missing, or one baked from other inputs, is refused by name.
+    fs::rename(tiled / kTilesFolder / "tile_001_000", tiled / "aside");
+    try {
+        mergeTiles(tiled);
+        ADD_FAILURE() << "merged an incomplete set";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("1 of 4 tiles missing: tile_001_000"), std::string::npos) << e.what();
+    }
+    BakeRequest other{regionProject(tiled), 2, false};
+    other.project.scene.sun.elevationDeg = 20.0;
+    other.tile = parseTiles("2,2", "2/4", std::optional<double>(300.0));
+    other.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*other.tile)).string();
+    runBake(other, {}, nullptr);
+    try {
+        mergeTiles(tiled);
+        ADD_FAILURE() << "merged tiles of different inputs";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("tile_001_000 (sun.elevation_deg"), std::string::npos) << e.what();
+    }
+    fs::remove_all(whole);
+    fs::remove_all(tiled);
+}
