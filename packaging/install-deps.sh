@@ -33,6 +33,8 @@ packages=(
   # binaries, and the checks of the package tests (lintian, the desktop entry, AppStream, the
   # MIME database, the manual pages)
   librsvg2-bin dpkg-dev lintian desktop-file-utils appstream shared-mime-info man-db
+  # the farm test: a one-node Slurm cluster that the test starts and stops itself
+  slurm-wlm munge
   # the glTF validator is an npm package, installed by the test set-up
   nodejs
 )
