@@ -106,6 +106,9 @@ struct BakeSetup {
     double prepareSeconds = 0.0;  // loading the terrain, sky and albedo
 };
 
+// The samples a side of the region a tiled bake's exported lighting is resolved on.
+constexpr int kRegionOverview = 1024;
+
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
              const std::function<bool()>& cancelled, const std::optional<TileSpec>& tile = std::nullopt) {
     const SceneDescription& scene = project.scene;
@@ -115,21 +118,30 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     (void)sceneFromJson(sceneToJson(scene), "project", nullptr);
     const auto start = Clock::now();
     report("loading terrain", 0.0);
-    b.terrain = loadProjectTerrain(project);
     if (tile) {
-        const Heightfield& region = b.terrain.heightfield;
+        // Out of core where the DEM allows it: the grid from its header and one streamed pass,
+        // then only the tile's traced window read (DemImportOptions::window).
+        const DemGrid grid = loadProjectGrid(project);
         try {
-            b.tileWindow = tileWindow(region, *tile);
+            b.tileWindow = tileWindow(grid, *tile);
         } catch (const std::invalid_argument& e) {
             throw ProjectError(e.what());
         }
         const TileWindow& w = *b.tileWindow;
-        b.tileReport = tileReport(*tile, w, region);
-        b.tracedTerrain = std::make_unique<Heightfield>(
-            region.window(w.tracedCol0, w.tracedRow0, w.tracedCols, w.tracedRows));
-        Heightfield core = region.window(w.col0, w.row0, w.cols, w.rows);
-        b.region = std::make_unique<Heightfield>(std::move(b.terrain.heightfield));
-        b.terrain.heightfield = std::move(core);
+        b.tileReport = tileReport(*tile, w, grid);
+        b.terrain = loadProjectTerrain(project, GridWindow{w.tracedCol0, w.tracedRow0, w.tracedCols, w.tracedRows});
+        b.tileReport["window_read"] = b.terrain.source.windowRead;
+        b.tracedTerrain = std::make_unique<Heightfield>(std::move(b.terrain.heightfield));
+        b.terrain.heightfield =
+            b.tracedTerrain->window(w.col0 - w.tracedCol0, w.row0 - w.tracedRow0, w.cols, w.rows);
+        // The region as the exported lighting sees it, the same in every tile: the whole grid at
+        // most kRegionOverview samples a side (area-averaged), so its memory stays bounded.
+        Project overview = project;
+        int& maxRes = overview.scene.terrain.maxResolution;
+        maxRes = maxRes > 0 ? std::min(maxRes, kRegionOverview) : kRegionOverview;
+        b.region = std::make_unique<Heightfield>(loadProjectTerrain(overview).heightfield);
+    } else {
+        b.terrain = loadProjectTerrain(project);
     }
     if (cancelled()) throw BakeCancelled();
     report("loading sky and albedo", 0.01);

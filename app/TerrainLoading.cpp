@@ -43,15 +43,30 @@ Project loadEffectiveProject(const std::string& projectFile, const std::vector<s
     return p;
 }
 
-DemImportResult loadProjectTerrain(const Project& project) {
+namespace {
+DemImportOptions importOptions(const Project& project) {
     DemImportOptions options;
     options.maxResolution = project.scene.terrain.maxResolution;
     options.verticalScale = project.scene.terrain.verticalScale;
+    return options;
+}
+}  // namespace
+
+DemImportResult loadProjectTerrain(const Project& project, const std::optional<GridWindow>& window) {
+    DemImportOptions options = importOptions(project);
+    options.window = window;
     const std::filesystem::path dem = project.demPath();
     if (dem.empty())
         return importDemFromMemory(kSampleTerrainName, sampleTerrainBytes(), sampleTerrainSize(),
                                    options);
     return importDem(dem.string(), options);
+}
+
+DemGrid loadProjectGrid(const Project& project) {
+    const std::filesystem::path dem = project.demPath();
+    if (dem.empty())
+        return demGridFromMemory(kSampleTerrainName, sampleTerrainBytes(), sampleTerrainSize(), importOptions(project));
+    return demGrid(dem.string(), importOptions(project));
 }
 
 namespace {

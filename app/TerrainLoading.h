@@ -16,8 +16,11 @@ namespace terralux {
 Project loadEffectiveProject(const std::string& projectFile, const std::vector<std::string>& sets,
                              const std::string& demOverride, std::vector<std::string>* warnings);
 
-// The project's DEM, or the embedded sample when it names none.
-DemImportResult loadProjectTerrain(const Project& project);
+// The project's DEM, or the embedded sample when it names none; `window`: only that window of its
+// grid (DemImportOptions::window).
+DemImportResult loadProjectTerrain(const Project& project, const std::optional<GridWindow>& window = std::nullopt);
+// The grid loadProjectTerrain makes, without holding the DEM where it can (demGrid).
+DemGrid loadProjectGrid(const Project& project);
 
 // The project's terrain albedo over `terrain` (its DEM's import), as the bake, the preview, the
 // renderer and the glTF export all use it: null in mode constant (terrain.albedo everywhere), the

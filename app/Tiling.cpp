@@ -55,9 +55,9 @@ TileSpec parseTiles(const std::string& tiles, const std::string& tile, const std
     return t;
 }
 
-Halo haloFor(const Heightfield& region, const std::optional<double>& metres) {
+Halo haloFor(const DemGrid& region, const std::optional<double>& metres) {
     Halo h;
-    h.relief = double(region.maxHeight()) - double(region.minHeight());
+    h.relief = region.maxHeight - region.minHeight;
     h.derived = !metres;
     h.metres = metres ? *metres : h.relief * std::sqrt((1.0 - kHaloShare) / kHaloShare);
     constexpr double kDegrees = 57.29577951308232;
@@ -65,11 +65,11 @@ Halo haloFor(const Heightfield& region, const std::optional<double>& metres) {
     return h;
 }
 
-TileWindow tileWindow(const Heightfield& region, const TileSpec& t) {
-    const int cellsX = region.width() - 1, cellsZ = region.depth() - 1;
+TileWindow tileWindow(const DemGrid& region, const TileSpec& t) {
+    const int cellsX = region.width - 1, cellsZ = region.depth - 1;
     if (cellsX < 2 * t.nx || cellsZ < 2 * t.nz)
         throw std::invalid_argument("--tiles " + std::to_string(t.nx) + "," + std::to_string(t.nz) + ": the " +
-                                    std::to_string(region.width()) + "x" + std::to_string(region.depth()) +
+                                    std::to_string(region.width) + "x" + std::to_string(region.depth) +
                                     " grid must give every tile at least 2 cells a side");
     TileWindow w;
     // Integer cuts of the cells: each tile's share differs from another's by at most one cell.
@@ -78,10 +78,10 @@ TileWindow tileWindow(const Heightfield& region, const TileSpec& t) {
     w.row0 = int((long long)t.iz * cellsZ / t.nz);
     w.cols = c1 - w.col0 + 1;
     w.rows = r1 - w.row0 + 1;
-    w.regionCols = region.width();
-    w.regionRows = region.depth();
+    w.regionCols = region.width;
+    w.regionRows = region.depth;
     w.halo = haloFor(region, t.haloMetres);
-    const double hx = std::ceil(w.halo.metres / region.cellSizeX()), hz = std::ceil(w.halo.metres / region.cellSizeZ());
+    const double hx = std::ceil(w.halo.metres / region.cellX), hz = std::ceil(w.halo.metres / region.cellZ);
     const int gx = int(std::min(hx, double(cellsX))), gz = int(std::min(hz, double(cellsZ)));
     w.tracedCol0 = std::max(0, w.col0 - gx);
     w.tracedRow0 = std::max(0, w.row0 - gz);
@@ -96,15 +96,18 @@ std::string tileName(const TileSpec& t) {
     return name;
 }
 
-nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const Heightfield& region) {
-    const float x0 = region.xOf(w.col0), x1 = region.xOf(w.col0 + w.cols - 1);
-    const float z0 = region.zOf(w.row0), z1 = region.zOf(w.row0 + w.rows - 1);
+nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const DemGrid& region) {
+    // As Heightfield::xOf places the region's vertices.
+    auto xOf = [&](int c) { return float((c - 0.5 * (region.width - 1)) * region.cellX); };
+    auto zOf = [&](int r) { return float((r - 0.5 * (region.depth - 1)) * region.cellZ); };
+    const float x0 = xOf(w.col0), x1 = xOf(w.col0 + w.cols - 1);
+    const float z0 = zOf(w.row0), z1 = zOf(w.row0 + w.rows - 1);
     return {{"name", tileName(t)},
             {"tiles", {t.nx, t.nz}},
             {"index", t.index()},
             {"ix", t.ix},
             {"iz", t.iz},
-            {"region_grid", {region.width(), region.depth()}},
+            {"region_grid", {region.width, region.depth}},
             {"core", {{"col0", w.col0}, {"row0", w.row0}, {"cols", w.cols}, {"rows", w.rows}}},
             {"traced", {{"col0", w.tracedCol0}, {"row0", w.tracedRow0}, {"cols", w.tracedCols}, {"rows", w.tracedRows}}},
             {"bounds_m", {{"min", {x0, z0}}, {"max", {x1, z1}}}},

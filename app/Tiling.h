@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "DemImport.h"
 #include "terrain/Heightfield.h"
 
 namespace terralux {
@@ -43,7 +44,12 @@ struct Halo {
     double relief = 0.0;           // metres, highest minus lowest ground of the region
     double sunBelowDeg = 0.0;      // terrain beyond the halo can shade only a sun lower than this
 };
-Halo haloFor(const Heightfield& region, const std::optional<double>& metres);
+Halo haloFor(const DemGrid& region, const std::optional<double>& metres);
+
+// The grid of a heightfield already in memory, as demGrid describes a DEM's.
+inline DemGrid gridOf(const Heightfield& hf) {
+    return {hf.width(), hf.depth(), hf.cellSizeX(), hf.cellSizeZ(), hf.minHeight(), hf.maxHeight(), false};
+}
 
 // A tile's vertex windows in the region's grid. The core: columns [col0, col0 + cols); tiles
 // share their border column and row, so their meshes and probe grids meet without a gap or an
@@ -55,13 +61,13 @@ struct TileWindow {
     Halo halo;
 };
 // Throws std::invalid_argument when the region has fewer than 2 cells a tile along an axis.
-TileWindow tileWindow(const Heightfield& region, const TileSpec& tile);
+TileWindow tileWindow(const DemGrid& region, const TileSpec& tile);
 
 // "tile_003_001": sorts as the seed's merge lists grids (by file name), west to east in a row.
 std::string tileName(const TileSpec& tile);
 
 // What a tile's bake_report.json records under "tile": the cut, the windows and the halo rule.
-nlohmann::json tileReport(const TileSpec& tile, const TileWindow& w, const Heightfield& region);
+nlohmann::json tileReport(const TileSpec& tile, const TileWindow& w, const DemGrid& region);
 
 }  // namespace terralux
 

@@ -207,7 +207,11 @@ int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
     return (latitudeDeg >= 0.0 ? 32600 : 32700) + zone;
 }
 
-DemImportResult importDem(const std::string& path, const DemImportOptions& options) {
+namespace {
+
+// importDem, and demGrid (`gridOnly` set): that returns as soon as the grid is known without a
+// whole read, or fills it from the whole import otherwise.
+DemImportResult importDemImpl(const std::string& path, const DemImportOptions& options, DemGrid* gridOnly) {
     registerDriversOnce();
     QuietGdalErrors quiet;
 
@@ -426,7 +430,28 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     } else {
         int outW, outH;
         reducedSize(info.sourceWidth, info.sourceHeight, outW, outH);
-        if (double(outW) * outH > maxCells)
+        if (outW == info.sourceWidth && outH == info.sourceHeight && gridOnly) {
+            // The source's cells are the grid's: the header and one streamed pass say it all.
+            double minMax[2] = {0.0, 0.0};
+            if (GDALComputeRasterMinMax(GDALGetRasterBand(heightSource, 1), FALSE, minMax) != CE_None)
+                fail(path, withGdalReason("cannot read band 1"));
+            double u = 1.0;
+            if (hasCrs) u = srcSrs->GetLinearUnits() > 0.0 ? srcSrs->GetLinearUnits() : 1.0;
+            *gridOnly = {outW, outH, std::abs(gt[1]) * u, std::abs(gt[5]) * u,
+                         minMax[0] * options.verticalScale, minMax[1] * options.verticalScale, true};
+            return result;
+        }
+        const bool direct = outW == info.sourceWidth && outH == info.sourceHeight;
+        if (options.window && direct) {
+            const GridWindow& win = *options.window;
+            if (win.cols < 2 || win.rows < 2 || win.col0 < 0 || win.row0 < 0 || win.col0 + win.cols > outW ||
+                win.row0 + win.rows > outH)
+                fail(path, "window " + std::to_string(win.cols) + "x" + std::to_string(win.rows) + " at (" +
+                               std::to_string(win.col0) + ", " + std::to_string(win.row0) + ") must lie inside the " +
+                               std::to_string(outW) + "x" + std::to_string(outH) + " grid, 2 x 2 at least");
+            info.windowRead = true;
+        }
+        if (double(outW) * outH > maxCells && !info.windowRead)
             fail(path, "raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
@@ -459,6 +484,15 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     auto* rd = static_cast<GDALDataset*>(readFrom);
     int w = rd->GetRasterXSize();
     int h = rd->GetRasterYSize();
+    // A window read alone: its first cell and the whole grid's size place it.
+    const int wholeW = w, wholeH = h;
+    int readX = 0, readY = 0;
+    if (info.windowRead) {
+        readX = options.window->col0;
+        readY = options.window->row0;
+        w = options.window->cols;
+        h = options.window->rows;
+    }
     double rgt[6] = {0, 1, 0, 0, 0, -1};
     if (hasGeoTransform) {
         rd->GetGeoTransform(rgt);
@@ -477,7 +511,7 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
         fail(path, "raster " + std::to_string(w) + "x" + std::to_string(h) +
                        " is too large to hold in memory; set terrain.max_resolution");
     }
-    if (rband->RasterIO(GF_Read, 0, 0, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
+    if (rband->RasterIO(GF_Read, readX, readY, w, h, heights.data(), w, h, GDT_Float32, 0, 0, nullptr) !=
         CE_None)
         fail(path, withGdalReason("cannot read band 1"));
 
@@ -582,23 +616,53 @@ DemImportResult importDem(const std::string& path, const DemImportOptions& optio
     } catch (const std::invalid_argument& e) {
         fail(path, e.what());
     }
+    if (info.windowRead) result.heightfield.placeInGrid(wholeW, wholeH, readX, readY);
     GeoOrigin& geo = result.heightfield.geo;
-    geo.easting = (rgt[0] + rgt[1] * (x0 + w * 0.5)) * unit;
-    geo.northing = (rgt[3] + rgt[5] * (y0 + h * 0.5)) * unit;
+    // The footprint centre: the whole grid's, for a window read alone.
+    geo.easting = (rgt[0] + rgt[1] * (info.windowRead ? wholeW * 0.5 : x0 + w * 0.5)) * unit;
+    geo.northing = (rgt[3] + rgt[5] * (info.windowRead ? wholeH * 0.5 : y0 + h * 0.5)) * unit;
     geo.height = 0.0;
     geo.crsWkt = crsWkt;
     geo.crsName = crsName;
     geo.epsg = epsg;
     if (!crsWkt.empty()) locateOnEarth(geo, unit);
+    if (gridOnly) {
+        const Heightfield& hf = result.heightfield;
+        *gridOnly = {hf.width(), hf.depth(), hf.cellSizeX(), hf.cellSizeZ(), hf.minHeight(), hf.maxHeight(), false};
+    } else if (options.window && !info.windowRead) {
+        const GridWindow& win = *options.window;
+        try {
+            result.heightfield = result.heightfield.window(win.col0, win.row0, win.cols, win.rows);
+        } catch (const std::invalid_argument& e) {
+            fail(path, e.what());
+        }
+    }
     return result;
+}
+
+}  // namespace
+
+DemImportResult importDem(const std::string& path, const DemImportOptions& options) {
+    return importDemImpl(path, options, nullptr);
+}
+
+DemGrid demGrid(const std::string& path, const DemImportOptions& options) {
+    DemImportOptions whole = options;
+    whole.window.reset();
+    DemGrid g;
+    importDemImpl(path, whole, &g);
+    return g;
 }
 
 }  // namespace terralux
 
 namespace terralux {
 
-DemImportResult importDemFromMemory(const std::string& name, const unsigned char* bytes,
-                                    size_t size, const DemImportOptions& options) {
+namespace {
+
+// Runs `read` on the path GDAL sees for an embedded raster, messages naming `name`.
+template <class Read>
+auto onMemoryRaster(const std::string& name, const unsigned char* bytes, size_t size, const Read& read) {
     registerDriversOnce();
     static std::atomic<unsigned> counter{0};
     const std::string vsiPath =
@@ -613,14 +677,28 @@ DemImportResult importDemFromMemory(const std::string& name, const unsigned char
         ~Unlink() { VSIUnlink(p.c_str()); }
     } unlink{vsiPath};
     try {
-        DemImportResult r = importDem(vsiPath, options);
-        r.source.path = name;
-        return r;
+        return read(vsiPath);
     } catch (const DemError& e) {
         std::string msg = e.what();
         if (msg.rfind(vsiPath, 0) == 0) msg = name + msg.substr(vsiPath.size());
         throw DemError(msg);
     }
+}
+
+}  // namespace
+
+DemImportResult importDemFromMemory(const std::string& name, const unsigned char* bytes,
+                                    size_t size, const DemImportOptions& options) {
+    return onMemoryRaster(name, bytes, size, [&](const std::string& path) {
+        DemImportResult r = importDem(path, options);
+        r.source.path = name;
+        return r;
+    });
+}
+
+DemGrid demGridFromMemory(const std::string& name, const unsigned char* bytes, size_t size,
+                          const DemImportOptions& options) {
+    return onMemoryRaster(name, bytes, size, [&](const std::string& path) { return demGrid(path, options); });
 }
 
 }  // namespace terralux

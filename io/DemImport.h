@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -19,6 +20,11 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// Vertices [col0, col0 + cols) x [row0, row0 + rows) of the grid an import makes.
+struct GridWindow {
+    int col0 = 0, row0 = 0, cols = 0, rows = 0;
+};
+
 struct DemImportOptions {
     // 0 = keep the source resolution; otherwise the longer side is reduced to at most this many
     // samples by area averaging.
@@ -27,6 +33,12 @@ struct DemImportOptions {
     // read: 4 bytes per cell for heights plus the working copies GDAL needs.
     double maxCells = 256.0 * 1024 * 1024;
     double verticalScale = 1.0;
+    // Set: the import returns only this window of the grid it would make, in that grid's engine
+    // space (as Heightfield::window cuts it), with the whole grid's geo origin. A source whose
+    // cells are the grid's (projected, north up, not reduced) is read only there: memory follows
+    // the window, not the raster. Any other is imported whole, then cut (DemSourceInfo::windowRead
+    // says which). Nodata holes are filled from the window's own cells.
+    std::optional<GridWindow> window;
 };
 
 // What the source was, before reprojection; what `terralux --info` prints.
@@ -45,6 +57,7 @@ struct DemSourceInfo {
     std::string sourcePixelUnit = "m";  // of sourcePixelX/Y: "deg" for a geographic CRS, else the
                                         // CRS's linear unit ("m", "ft", "US survey foot")
     std::vector<std::string> warnings;  // e.g. no CRS: cells taken as metres
+    bool windowRead = false;            // DemImportOptions::window was read alone from the source
 };
 
 struct DemImportResult {
@@ -73,6 +86,20 @@ MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::v
 
 // Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.
 DemImportResult importDem(const std::string& path, const DemImportOptions& options = {});
+
+// The grid importDem makes of `path`: its size, cell sizes and height range (valid cells, after the
+// vertical scale). Where the source's cells are the grid's, from its header and one streamed pass
+// over its blocks (GDAL's exact minimum and maximum), never holding the raster; otherwise from a
+// whole import (`streamed` false). Throws DemError as importDem does.
+struct DemGrid {
+    int width = 0, depth = 0;
+    double cellX = 0.0, cellZ = 0.0;
+    double minHeight = 0.0, maxHeight = 0.0;
+    bool streamed = false;
+};
+DemGrid demGrid(const std::string& path, const DemImportOptions& options = {});
+DemGrid demGridFromMemory(const std::string& name, const unsigned char* bytes, size_t size,
+                          const DemImportOptions& options = {});
 
 // The UTM zone EPSG code (WGS 84) for a geographic position: 326zz north, 327zz south.
 int utmEpsgFor(double longitudeDeg, double latitudeDeg);

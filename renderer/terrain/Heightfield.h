@@ -66,6 +66,12 @@ public:
     // engine space (a vertex keeps its position to the bit), with their nodata marks and geo.
     // Throws std::invalid_argument when the window is empty or leaves the grid.
     Heightfield window(int col0, int row0, int width, int depth) const;
+    // Places this grid as the window at (col0, row0) of a wholeWidth x wholeDepth grid centred on
+    // the engine origin: what window() would have cut from it (a tile read alone from its DEM).
+    void placeInGrid(int wholeWidth, int wholeDepth, int col0, int row0) {
+        originCol_ = 0.5 * (wholeWidth - 1) - col0;
+        originRow_ = 0.5 * (wholeDepth - 1) - row0;
+    }
     glm::vec3 vertex(int col, int row) const { return {xOf(col), at(col, row), zOf(row)}; }
 
     // Footprint in engine space (the vertex grid's extent).

@@ -21,10 +21,15 @@
 
 #include <malloc.h>
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <benchmark/benchmark.h>
+
+#include <optional>
+
+#include <gdal_priv.h>
 
 #include "BakeJob.h"
 #include "DemImport.h"
@@ -60,11 +65,13 @@ double heapInUse() {
 
 struct Measured {
     double peak = 0, heapPeak = 0, probeBytes = 0, raster = 0;
+    double maxRss = 0;  // the process's resident high-water mark, start-up included (getrusage)
     char error[240] = {};
 };
 
-// In the child: the warm-up, the bake, and what it measured.
-Measured measureBake(const fs::path& dem, bool gltf) {
+// In the child: the warm-up, the bake, and what it measured. `tile`: bake that tile of the DEM
+// (its probes scaled to it, the glTF off: a 1 m tile's mesh is its own question).
+Measured measureBake(const fs::path& dem, bool gltf, const std::optional<TileSpec>& tile = std::nullopt) {
     Measured m;
     const fs::path out = fs::temp_directory_path() / ("terralux_bench_bake_memory_" + std::to_string(::getpid()));
     try {
@@ -76,6 +83,7 @@ Measured measureBake(const fs::path& dem, bool gltf) {
         request.project.scene.exportSettings.gltf = gltf;
         request.project.scene.exportSettings.outDir = out.string();
         request.threads = 2;
+        request.tile = tile;
         if (!resetPeak()) throw std::runtime_error("/proc/self/clear_refs cannot reset the peak");
         const double before = statusBytes("VmRSS");
         const double heapBefore = heapInUse();
@@ -98,11 +106,18 @@ Measured measureBake(const fs::path& dem, bool gltf) {
         done = true;
         sampler.join();
         m.peak = statusBytes("VmHWM") - before;
+        struct rusage usage {};
+        if (::getrusage(RUSAGE_SELF, &usage) == 0) m.maxRss = 1024.0 * double(usage.ru_maxrss);
         m.heapPeak = heapPeak - heapBefore;
         for (const fs::path& f : outcome.files)
             if (f.extension() == ".shprobe") m.probeBytes += double(fs::file_size(f));
-        const DemImportResult imported = importDem(dem.string());
-        m.raster = 4.0 * imported.heightfield.width() * imported.heightfield.depth();
+        if (tile) {
+            const auto& t = outcome.report["tile"]["traced"];
+            m.raster = 4.0 * t["cols"].get<double>() * t["rows"].get<double>();
+        } else {
+            const DemImportResult imported = importDem(dem.string());
+            m.raster = 4.0 * imported.heightfield.width() * imported.heightfield.depth();
+        }
     } catch (const std::exception& e) {
         std::snprintf(m.error, sizeof m.error, "%s", e.what());
     }
@@ -156,6 +171,109 @@ void BM_BakePeakMemory(benchmark::State& state) {
     state.counters["heap_per_budget"] = m.heapPeak / budget;
 }
 BENCHMARK(BM_BakePeakMemory)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+
+// A 20 000 x 20 000 DEM at 1 m (a lidar tile of 20 km): the committed Big Tujunga crop resampled
+// (bilinear) onto that grid, written once as a tiled, deflated GeoTIFF in the temporary folder.
+fs::path syntheticLidar() {
+    const fs::path path = fs::temp_directory_path() / "terralux_bench_lidar_20000.tif";
+    if (fs::exists(path)) return path;
+    GDALAllRegister();
+    GDALDataset* src = static_cast<GDALDataset*>(
+        GDALOpen((fs::path(TERRALUX_TEST_DATA) / "dem" / "bigtujunga_utm11_crop.tif").c_str(), GA_ReadOnly));
+    if (!src) throw std::runtime_error("cannot open the committed crop");
+    double gt[6];
+    src->GetGeoTransform(gt);
+    const int n = 20000;
+    GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+    char** opts = nullptr;
+    opts = CSLSetNameValue(opts, "TILED", "YES");
+    opts = CSLSetNameValue(opts, "COMPRESS", "DEFLATE");
+    opts = CSLSetNameValue(opts, "BIGTIFF", "YES");
+    const fs::path partial = path.string() + ".part";
+    GDALDataset* dst = gtiff->Create(partial.c_str(), n, n, 1, GDT_Float32, opts);
+    CSLDestroy(opts);
+    const double out[6] = {gt[0], 1.0, 0.0, gt[3], 0.0, -1.0};
+    dst->SetGeoTransform(const_cast<double*>(out));
+    dst->SetSpatialRef(src->GetSpatialRef());
+    // Row bands: the crop read whole once (it is small), each output row band resampled from it.
+    const int sw = src->GetRasterXSize(), sh = src->GetRasterYSize();
+    std::vector<float> crop(size_t(sw) * sh);
+    if (src->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, sw, sh, crop.data(), sw, sh, GDT_Float32, 0, 0, nullptr) != CE_None)
+        throw std::runtime_error("cannot read the committed crop");
+    std::vector<float> band(size_t(n) * 256);
+    for (int y0 = 0; y0 < n; y0 += 256) {
+        const int rows = std::min(256, n - y0);
+        for (int y = 0; y < rows; ++y) {
+            const double v = (y0 + y + 0.5) * (sh - 1) / double(n);
+            const int r = std::min(int(v), sh - 2);
+            const double fy = v - r;
+            for (int x = 0; x < n; ++x) {
+                const double u = (x + 0.5) * (sw - 1) / double(n);
+                const int c = std::min(int(u), sw - 2);
+                const double fx = u - c;
+                auto at = [&](int cc, int rr) { return double(crop[size_t(rr) * sw + cc]); };
+                band[size_t(y) * n + x] = float((1 - fy) * ((1 - fx) * at(c, r) + fx * at(c + 1, r)) +
+                                                fy * ((1 - fx) * at(c, r + 1) + fx * at(c + 1, r + 1)));
+            }
+        }
+        if (dst->GetRasterBand(1)->RasterIO(GF_Write, 0, y0, n, rows, band.data(), n, rows, GDT_Float32, 0, 0, nullptr) != CE_None)
+            throw std::runtime_error("cannot write the synthetic DEM");
+    }
+    GDALClose(dst);
+    GDALClose(src);
+    fs::rename(partial, path);
+    return path;
+}
+
+// One tile of a 4 x 4 cut of the 20 000² DEM, its halo state.range(0) metres (0: derived from the
+// relief, about 10 km here, so the traced window is the whole DEM). Peak memory against the
+// raster the tile traces (rss_per_traced) and against the whole DEM's 1.6 GB.
+void BM_TilePeakMemory(benchmark::State& state) {
+    fs::path dem;
+    try {
+        dem = syntheticLidar();
+    } catch (const std::exception& e) {
+        state.SkipWithError(e.what());
+        return;
+    }
+    TileSpec tile = parseTiles("4,4", "5/16", state.range(0) > 0 ? std::optional<double>(double(state.range(0))) : std::nullopt);
+    Measured m;
+    for (auto _ : state) {
+        int fds[2];
+        if (::pipe(fds) != 0) {
+            state.SkipWithError("pipe failed");
+            return;
+        }
+        const pid_t child = ::fork();
+        if (child == 0) {
+            ::close(fds[0]);
+            const Measured r = measureBake(dem, false, tile);
+            const bool sent = ::write(fds[1], &r, sizeof r) == ssize_t(sizeof r);
+            ::_exit(sent ? 0 : 1);
+        }
+        ::close(fds[1]);
+        const bool received = child > 0 && ::read(fds[0], &m, sizeof m) == ssize_t(sizeof m);
+        ::close(fds[0]);
+        int status = 0;
+        if (child > 0) ::waitpid(child, &status, 0);
+        if (!received) {
+            state.SkipWithError("the measuring child process failed");
+            return;
+        }
+    }
+    if (m.error[0]) {
+        state.SkipWithError(m.error);
+        return;
+    }
+    state.SetLabel(state.range(0) ? "halo " + std::to_string(state.range(0)) + " m" : "derived halo");
+    state.counters["traced_MB"] = megabytes(m.raster);
+    state.counters["whole_MB"] = megabytes(4.0 * 20000.0 * 20000.0);
+    state.counters["heap_MB"] = megabytes(m.heapPeak);
+    // What a batch engine sees of the task: the whole process's high-water mark.
+    state.counters["rss_MB"] = megabytes(m.maxRss);
+    state.counters["rss_per_traced"] = m.maxRss / m.raster;
+}
+BENCHMARK(BM_TilePeakMemory)->Arg(500)->Arg(2000)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
 
 }  // namespace
 

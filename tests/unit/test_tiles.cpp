@@ -100,10 +100,41 @@ TEST(Tiles, AWindowKeepsItsVerticesAndItsSurfaceToTheBit) {
     EXPECT_THROW((void)region.window(30, 0, 12, 5), std::invalid_argument);
 }
 
+TEST(Tiles, AWindowReadAloneFromTheDemEqualsTheWholeImportCut) {
+    // Projected, north up: read alone (windowRead); geographic: imported whole, then cut. Either
+    // way the window is the whole import's, vertex for vertex, in its engine space.
+    for (const char* name : {"bigtujunga_utm11_crop.tif", "n42e001_voids_crop.tif"}) {
+        const std::string path = (fs::path(TERRALUX_TEST_DATA) / "dem" / name).string();
+        const DemImportResult whole = importDem(path);
+        const DemGrid grid = demGrid(path);
+        EXPECT_EQ(grid.streamed, std::string(name).find("utm") != std::string::npos) << name;
+        EXPECT_EQ(grid.width, whole.heightfield.width());
+        EXPECT_EQ(grid.depth, whole.heightfield.depth());
+        EXPECT_DOUBLE_EQ(grid.cellX, whole.heightfield.cellSizeX());
+        EXPECT_FLOAT_EQ(float(grid.minHeight), whole.heightfield.minHeight());
+        EXPECT_FLOAT_EQ(float(grid.maxHeight), whole.heightfield.maxHeight());
+        DemImportOptions o;
+        o.window = GridWindow{9, 5, 30, 21};
+        const DemImportResult part = importDem(path, o);
+        EXPECT_EQ(part.source.windowRead, grid.streamed) << name;
+        const Heightfield cut = whole.heightfield.window(9, 5, 30, 21);
+        ASSERT_EQ(part.heightfield.width(), 30);
+        ASSERT_EQ(part.heightfield.depth(), 21);
+        EXPECT_EQ(part.heightfield.geo.easting, whole.heightfield.geo.easting);
+        EXPECT_EQ(part.heightfield.geo.northing, whole.heightfield.geo.northing);
+        for (int r = 0; r < 21; ++r)
+            for (int c = 0; c < 30; ++c) {
+                ASSERT_EQ(part.heightfield.vertex(c, r), cut.vertex(c, r)) << name << " " << c << ", " << r;
+            }
+        o.window = GridWindow{grid.width - 3, 0, 4, 4};
+        EXPECT_THROW(importDem(path, o), DemError) << name;
+    }
+}
+
 TEST(Tiles, CoresCoverTheRegionSharingTheirBordersAndTheHaloFollowsTheRelief) {
     const Heightfield region = ramp(101, 57);
     const TileSpec any = parseTiles("3,2", "0/6", std::nullopt);
-    const Halo h = haloFor(region, std::nullopt);
+    const Halo h = haloFor(gridOf(region), std::nullopt);
     EXPECT_NEAR(h.metres, h.relief * std::sqrt(99.0), 1e-6);
     // sin²(atan(relief / halo)) is the share of an upward receiver's hemisphere the terrain beyond can hold.
     EXPECT_NEAR(std::pow(std::sin(std::atan(h.relief / h.metres)), 2.0), kHaloShare, 1e-12);
@@ -112,7 +143,7 @@ TEST(Tiles, CoresCoverTheRegionSharingTheirBordersAndTheHaloFollowsTheRelief) {
         for (int ix = 0; ix < 3; ++ix) {
             TileSpec t = any;
             t.ix = ix, t.iz = iz, t.haloMetres = 100.0;
-            const TileWindow w = tileWindow(region, t);
+            const TileWindow w = tileWindow(gridOf(region), t);
             EXPECT_EQ(w.col0, nextCol) << "tiles share their border column";
             nextCol = w.col0 + w.cols - 1;
             EXPECT_LE(w.tracedCol0, w.col0);
@@ -128,7 +159,7 @@ TEST(Tiles, CoresCoverTheRegionSharingTheirBordersAndTheHaloFollowsTheRelief) {
     EXPECT_THROW(parseTiles("3,2", "3,0", std::nullopt), std::invalid_argument);
     EXPECT_THROW(parseTiles("0,2", "0/0", std::nullopt), std::invalid_argument);
     TileSpec tooMany = parseTiles("60,2", "0/120", std::nullopt);
-    EXPECT_THROW(tileWindow(region, tooMany), std::invalid_argument);
+    EXPECT_THROW(tileWindow(gridOf(region), tooMany), std::invalid_argument);
 }
 
 TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
