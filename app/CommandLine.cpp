@@ -238,7 +238,7 @@ int commandBake(const Args& a) {
     } cleanup{outDir, existed};
 
     installInterruptHandlers();
-    ProgressPrinter printer(a.parser.isSet(a.quiet));
+    ProgressPrinter printer(a.parser.isSet(a.quiet), a.parser.value(a.progress) == "json");
     BakeOutcome outcome;
     try {
         outcome = runBake(request, std::ref(printer), &gInterrupted);
@@ -458,6 +458,12 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
             if (a.parser.isSet(*o) && !a.parser.isSet(a.bake))
                 throw UsageError("--" + str(o->names().first()) + ": only with --bake");
         if (a.parser.isSet(a.halo) && !a.parser.isSet(a.tile)) throw UsageError("--halo: only with --tile");
+        if (a.parser.isSet(a.progress)) {
+            const QString mode = a.parser.value(a.progress);
+            if (mode != "text" && mode != "json")
+                throw UsageError("--progress " + str(mode) + ": must be text or json");
+            if (!a.parser.isSet(a.bake)) throw UsageError("--progress: only with --bake");
+        }
         if (a.parser.isSet(a.overlay) && !a.parser.isSet(a.render))
             throw UsageError("--overlay: only with --render");
         if (a.parser.isSet(a.time) && !a.parser.isSet(a.render))

@@ -131,6 +131,9 @@ CommandLineHelp commandLineHelp(Binary binary) {
          "An unknown path is an error."},
         {"--threads N", "Worker threads (default: all cores)."},
         {"--quiet", "No progress on stderr."},
+        {"--progress text|json",
+         "With --bake: progress on stderr as text (default) or as one JSON object a line, for a farm to "
+         "read: {\"phase\", \"fraction\", \"elapsed_s\", \"eta_s\"}."},
     };
     if (!authoring) {
         std::erase_if(h.commands, [](const HelpEntry& e) { return authoringOnly(e.syntax); });

@@ -1,5 +1,9 @@
 #include "CommandLineSupport.h"
 
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
 #include <csignal>
 #include <cstdio>
 
@@ -36,13 +40,28 @@ void installInterruptHandlers() {
     std::signal(SIGTERM, onInterrupt);
 }
 
-ProgressPrinter::ProgressPrinter(bool quiet) : quiet_(quiet), tty_(::isatty(2)) {}
+ProgressPrinter::ProgressPrinter(bool quiet, bool json) : quiet_(quiet), tty_(::isatty(2) && !json), json_(json) {}
 
 void ProgressPrinter::operator()(const std::string& phase, double f) {
     if (quiet_) return;
     const std::lock_guard lock(mutex_);
     const int percent = int(f * 100.0);
     const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+    if (json_) {
+        if (phase == phase_ && (percent == last_ || (elapsed - lastDraw_ < 0.5 && percent != 100))) return;
+        last_ = percent;
+        phase_ = phase;
+        lastDraw_ = elapsed;
+        nlohmann::json line = {{"phase", phase},
+                               {"fraction", std::round(f * 1000.0) / 1000.0},
+                               {"elapsed_s", std::round(elapsed * 100.0) / 100.0},
+                               {"eta_s", nullptr}};
+        if (f > 0.02 && f < 1.0) line["eta_s"] = std::round(elapsed * (1.0 - f) / f * 10.0) / 10.0;
+        if (f >= 1.0) line["eta_s"] = 0.0;
+        std::fprintf(stderr, "%s\n", line.dump().c_str());
+        std::fflush(stderr);
+        return;
+    }
     if (!tty_ && percent / 10 == last_ / 10 && phase == phase_ && percent != 100) return;
     if (tty_ && percent == last_ && phase == phase_ && elapsed - lastDraw_ < 0.2) return;
     last_ = percent;

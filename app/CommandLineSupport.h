@@ -47,12 +47,13 @@ struct Args {
     QCommandLineOption tile{"tile", "One tile.", "I/N|IX,IZ"};
     QCommandLineOption halo{"halo", "Halo metres.", "METRES"};
     QCommandLineOption merge{"merge", "Merge tiles.", "DIR"};
+    QCommandLineOption progress{"progress", "Progress format.", "text|json"};
 
     Args() {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget, profile, scenario, tiles, tile, halo, merge});
+                           device, dryRun, overlay, time, study, budget, profile, scenario, tiles, tile, halo, merge, progress});
     }
 };
 
@@ -75,15 +76,18 @@ extern std::atomic<bool> gInterrupted;
 void installInterruptHandlers();
 
 // Percent, phase and ETA on stderr: redrawn in place on a terminal, a line per 10 % otherwise.
+// `json` (--progress json, for a farm): one JSON object a line instead, at each new phase and
+// each whole percent, at most two a second within a phase:
+//   {"phase":"probes","fraction":0.42,"elapsed_s":3.1,"eta_s":4.3}   (eta_s null until known)
 class ProgressPrinter {
 public:
-    explicit ProgressPrinter(bool quiet);
+    explicit ProgressPrinter(bool quiet, bool json = false);
     // Called from the bake's worker threads: one at a time.
     void operator()(const std::string& phase, double f);
 
 private:
     using Clock = std::chrono::steady_clock;
-    bool quiet_, tty_;
+    bool quiet_, tty_, json_;
     std::mutex mutex_;
     Clock::time_point start_ = Clock::now();
     int last_ = -1;
