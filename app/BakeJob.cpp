@@ -106,9 +106,6 @@ struct BakeSetup {
     double prepareSeconds = 0.0;  // loading the terrain, sky and albedo
 };
 
-// The samples a side of the region a tiled bake's exported lighting is resolved on.
-constexpr int kRegionOverview = 1024;
-
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
              const std::function<bool()>& cancelled, const std::optional<TileSpec>& tile = std::nullopt) {
     const SceneDescription& scene = project.scene;
@@ -121,7 +118,9 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     if (tile) {
         // Out of core where the DEM allows it: the grid from its header and one streamed pass,
         // then only the tile's traced window read (DemImportOptions::window).
-        const DemGrid grid = loadProjectGrid(project);
+        // The region's grid and overview: computed by the first tile, read by the others.
+        RegionSummary region = regionSummary(project, project.outDir().parent_path());
+        const DemGrid& grid = region.grid;
         try {
             b.tileWindow = tileWindow(grid, *tile);
         } catch (const std::invalid_argument& e) {
@@ -134,12 +133,9 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         b.tracedTerrain = std::make_unique<Heightfield>(std::move(b.terrain.heightfield));
         b.terrain.heightfield =
             b.tracedTerrain->window(w.col0 - w.tracedCol0, w.row0 - w.tracedRow0, w.cols, w.rows);
-        // The region as the exported lighting sees it, the same in every tile: the whole grid at
-        // most kRegionOverview samples a side (area-averaged), so its memory stays bounded.
-        Project overview = project;
-        int& maxRes = overview.scene.terrain.maxResolution;
-        maxRes = maxRes > 0 ? std::min(maxRes, kRegionOverview) : kRegionOverview;
-        b.region = std::make_unique<Heightfield>(loadProjectTerrain(overview).heightfield);
+        b.tileReport["region_summary"] = region.cached ? "read" : "computed";
+        // The region as the exported lighting sees it, the same in every tile.
+        b.region = std::make_unique<Heightfield>(std::move(region.overview));
     } else {
         b.terrain = loadProjectTerrain(project);
     }

@@ -161,3 +161,101 @@ void scaleSceneToTile(SceneDescription& scene, const TileWindow& w) {
 }
 
 }  // namespace terralux
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+
+#include "AtomicFile.h"
+#include "TerrainLoading.h"
+
+namespace terralux {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "region.f32 holds little-endian floats");
+
+nlohmann::json regionKey(const Project& project) {
+    const std::filesystem::path dem = project.demPath();
+    nlohmann::json key = {{"format", 1},
+                          {"dem", dem.empty() ? std::string("(sample)") : std::filesystem::absolute(dem).string()},
+                          {"max_resolution", project.scene.terrain.maxResolution},
+                          {"vertical_scale", project.scene.terrain.verticalScale}};
+    std::error_code ec;
+    if (!dem.empty()) {
+        key["size"] = std::filesystem::file_size(dem, ec);
+        key["mtime_ns"] = std::filesystem::last_write_time(dem, ec).time_since_epoch().count();
+    }
+    return key;
+}
+
+std::optional<RegionSummary> readSummary(const std::filesystem::path& dir, const nlohmann::json& key) {
+    std::ifstream in(dir / "region.json");
+    if (!in) return std::nullopt;
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(in);
+        if (j.at("key") != key) return std::nullopt;
+        RegionSummary s;
+        const auto& g = j.at("grid");
+        s.grid = {g.at("width"), g.at("depth"), g.at("cell_x"), g.at("cell_z"), g.at("min_height"), g.at("max_height"),
+                  g.at("streamed")};
+        const auto& o = j.at("overview");
+        const int w = o.at("width"), d = o.at("depth");
+        std::vector<float> h(size_t(w) * size_t(d));
+        std::ifstream bin(dir / "region.f32", std::ios::binary);
+        if (!bin.read(reinterpret_cast<char*>(h.data()), std::streamsize(h.size() * sizeof(float)))) return std::nullopt;
+        s.overview = Heightfield(w, d, o.at("cell_x").get<double>(), o.at("cell_z").get<double>(), std::move(h));
+        GeoOrigin& geo = s.overview.geo;
+        const auto& gj = o.at("geo");
+        geo.easting = gj.at("easting");
+        geo.northing = gj.at("northing");
+        geo.height = gj.at("height");
+        geo.crsWkt = gj.at("crs_wkt");
+        geo.crsName = gj.at("crs_name");
+        geo.epsg = gj.at("epsg");
+        if (!gj.at("latitude_deg").is_null()) geo.latitudeDeg = gj.at("latitude_deg");
+        if (!gj.at("longitude_deg").is_null()) geo.longitudeDeg = gj.at("longitude_deg");
+        geo.gridConvergenceDeg = gj.at("grid_convergence_deg");
+        s.cached = true;
+        return s;
+    } catch (const std::exception&) {
+        return std::nullopt;  // unreadable or from another version: computed again
+    }
+}
+
+}  // namespace
+
+RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir) {
+    const nlohmann::json key = regionKey(project);
+    if (std::optional<RegionSummary> s = readSummary(cacheDir, key)) return std::move(*s);
+    RegionSummary s;
+    s.grid = loadProjectGrid(project);
+    Project overview = project;
+    int& maxRes = overview.scene.terrain.maxResolution;
+    maxRes = maxRes > 0 ? std::min(maxRes, kRegionOverview) : kRegionOverview;
+    s.overview = loadProjectTerrain(overview).heightfield;
+    const Heightfield& o = s.overview;
+    const GeoOrigin& geo = o.geo;
+    auto orNull = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    const nlohmann::json j = {
+        {"key", key},
+        {"grid",
+         {{"width", s.grid.width}, {"depth", s.grid.depth}, {"cell_x", s.grid.cellX}, {"cell_z", s.grid.cellZ},
+          {"min_height", s.grid.minHeight}, {"max_height", s.grid.maxHeight}, {"streamed", s.grid.streamed}}},
+        {"overview",
+         {{"width", o.width()}, {"depth", o.depth()}, {"cell_x", o.cellSizeX()}, {"cell_z", o.cellSizeZ()},
+          {"geo",
+           {{"easting", geo.easting}, {"northing", geo.northing}, {"height", geo.height}, {"crs_wkt", geo.crsWkt},
+            {"crs_name", geo.crsName}, {"epsg", geo.epsg}, {"latitude_deg", orNull(geo.latitudeDeg)},
+            {"longitude_deg", orNull(geo.longitudeDeg)}, {"grid_convergence_deg", geo.gridConvergenceDeg}}}}}};
+    std::error_code ec;
+    std::filesystem::create_directories(cacheDir, ec);
+    // The heights first: a region.json is only ever beside the heights it describes.
+    const auto* bytes = reinterpret_cast<const uint8_t*>(o.heights().data());
+    writeFileAtomically(cacheDir / "region.f32", std::span<const uint8_t>(bytes, o.heights().size() * sizeof(float)));
+    writeFileAtomically(cacheDir / "region.json", j.dump(1) + "\n");
+    return s;
+}
+
+}  // namespace terralux

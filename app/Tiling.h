@@ -3,6 +3,7 @@
 // as a complete bake, seeing the terrain within a halo around it, in the region's engine space,
 // so a merge lists the tiles' grids side by side with no transform.
 
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -79,4 +80,21 @@ struct SceneDescription;
 // what the region would. Throws ProjectError for what cannot be cut: an explicit origin, or an
 // adaptive volume's explicit size (each tile places over its own footprint).
 void scaleSceneToTile(SceneDescription& scene, const TileWindow& w);
+}  // namespace terralux
+
+namespace terralux {
+struct Project;
+// What every tile of a region needs of the whole region: its grid (demGrid) and an overview of
+// at most kRegionOverview samples a side (area-averaged) on which the exported lighting resolves.
+// Each is a pass over the whole raster, so the first tile computes them and leaves them in
+// `cacheDir` (region.json, region.f32), keyed by the DEM's identity (path, size, modification
+// time) and the import settings; the other tiles read them. Written atomically: tiles that
+// compute them at once write the same bytes.
+inline constexpr int kRegionOverview = 1024;
+struct RegionSummary {
+    DemGrid grid;
+    Heightfield overview;
+    bool cached = false;  // read from cacheDir
+};
+RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir);
 }  // namespace terralux

@@ -97,7 +97,7 @@ done
 "$bake" --merge "$local" > /dev/null
 # Everything but the reports (their times) and tiles.json (which hashes the reports) is the same.
 (cd "$out" && find tiles scene.gltf -type f ! -name bake_report.json | sort) > "$work/files"
-[ "$(wc -l < "$work/files")" -eq 17 ] || { echo "FAIL: farm files:"; cat "$work/files"; exit 1; }
+[ "$(wc -l < "$work/files")" -eq 19 ] || { echo "FAIL: farm files:"; cat "$work/files"; exit 1; }
 while read -r f; do
   cmp -s "$out/$f" "$local/$f" || { echo "FAIL: $f differs between the farm and the local bake"; exit 1; }
 done < "$work/files"

@@ -16,6 +16,7 @@
 #include "TileMerge.h"
 #include "Tiling.h"
 #include "bake/HeightfieldTracer.h"
+#include "bake/ProbeDiagnostics.h"
 #include "bake/SphericalHarmonics.h"
 
 using namespace terralux;
@@ -48,6 +49,25 @@ Project regionProject(const fs::path& out) {
     p.scene.bake.quality = QualityPreset::Draft;
     p.scene.exportSettings.outDir = out.string();
     return p;
+}
+
+// Mean interpolation error of a volume's map over its points within `band` metres of x = bx or
+// z = bz (near), and over the others (far).
+std::pair<double, double> mapMeans(const fs::path& dir, float bx, float bz, float band) {
+    std::vector<uint8_t> bytes;
+    const ShProbeGrid g = readShProbeFile(dir / "sh_coeffs" / "probes.shprobe", &bytes);
+    const ErrorMap m = readProbeDiagnosticsFile(dir / "sh_coeffs" / "probes.probes.json", g, shProbeDigest(bytes)).errorMap;
+    double near = 0.0, far = 0.0;
+    size_t nn = 0, nf = 0;
+    for (uint32_t k = 0; k < m.nz; ++k)
+        for (uint32_t i = 0; i < m.nx; ++i) {
+            const float e = m.error[size_t(k) * m.nx + i];
+            if (!std::isfinite(e)) continue;
+            const float x = m.x0 + float(i) * m.step, z = m.z0 + float(k) * m.step;
+            if (std::abs(x - bx) < band || std::abs(z - bz) < band) near += e, ++nn;
+            else far += e, ++nf;
+        }
+    return {nn ? near / double(nn) : 0.0, nf ? far / double(nf) : 0.0};
 }
 
 struct Probe {
@@ -187,6 +207,7 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         double sum = 0.0, worst = 0.0;
         size_t matched = 0, border = 0;
         for (const auto& e : fs::directory_iterator(tiled / kTilesFolder)) {
+            if (!e.is_directory()) continue;  // the region's summary (region.json, region.f32)
             for (const Probe& p : probesIn(e.path())) {
                 const Probe* q = nullptr;
                 for (const Probe& r : reference)
@@ -205,6 +226,22 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
             }
         }
         EXPECT_EQ(matched, 4u * 5 * 4);
+        // The interpolation error along the borders, within one probe spacing of them: the tiles'
+        // maps against the untiled bake's over the same band, and against the tiles' interiors.
+        const float bx = reference[4].position.x, bz = reference[27].position.z;
+        const float band = reference[1].position.x - reference[0].position.x;
+        double tilesNear = 0.0, tilesFar = 0.0;
+        int maps = 0;
+        for (const auto& e : fs::directory_iterator(tiled / kTilesFolder)) {
+            if (!e.is_directory()) continue;
+            const auto [n, f] = mapMeans(e.path(), bx, bz, band);
+            tilesNear += n, tilesFar += f, ++maps;
+        }
+        tilesNear /= maps, tilesFar /= maps;
+        const double wholeNear = mapMeans(whole, bx, bz, band).first;
+        std::cout << "interpolation error within " << band << " m of the borders: tiles " << tilesNear
+                  << " (their interiors " << tilesFar << "), untiled " << wholeNear << "\n";
+        EXPECT_LT(tilesNear, 1.25 * wholeNear);
         EXPECT_EQ(border, 2u * 5 * 2 + 2u * 4 * 2 - 4);
         std::cout << "halo " << (halo ? std::to_string(*halo) + " m" : std::string("derived")) << ": " << border
                   << " border probes, |difference| / its standard error mean " << sum / double(border) << ", max "
@@ -213,6 +250,26 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         // skirt standing in for the terrain beyond: mean 0.74, max 2.9).
         EXPECT_LT(sum / double(border), 0.5) << "halo " << (halo ? *halo : -1.0);
         EXPECT_LT(worst, 2.0) << "halo " << (halo ? *halo : -1.0);
+    }
+
+    // The first tile computed the region's summary, the others read it: a tile baked either way
+    // writes the same probes, byte for byte.
+    {
+        const fs::path folder = tiled / kTilesFolder / "tile_001_000";
+        auto bytesOf = [](const fs::path& f) {
+            std::ifstream in(f, std::ios::binary);
+            return std::string(std::istreambuf_iterator<char>(in), {});
+        };
+        const std::string read = bytesOf(folder / "sh_coeffs" / "probes.shprobe");
+        fs::remove(tiled / kTilesFolder / "region.json");
+        fs::remove_all(folder);
+        BakeRequest r{regionProject(tiled), 1, false};
+        r.tile = parseTiles("2,2", "2/4", std::optional<double>(300.0));
+        r.project.scene.exportSettings.outDir = folder.string();
+        const BakeOutcome o = runBake(r, {}, nullptr);
+        EXPECT_EQ(o.report["tile"]["region_summary"], "computed");
+        EXPECT_EQ(bytesOf(folder / "sh_coeffs" / "probes.shprobe"), read);
+        EXPECT_TRUE(fs::exists(tiled / kTilesFolder / "region.json"));
     }
 
     // The merge lists the four tiles' grids, sorted by file name, and their meshes.
