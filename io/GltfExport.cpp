@@ -922,16 +922,23 @@ std::vector<std::string> exportedFileNames(const GltfSceneInput& input) {
     return names;
 }
 
-GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input) {
-    // Everything is encoded before the filesystem is touched.
-    const std::vector<PendingFile> files = buildFiles(outDir, input);
-
+namespace {
+void createOutputDirectory(const fs::path& outDir) {
     std::error_code ec;
     fs::create_directories(outDir, ec);
     if (ec || !fs::is_directory(outDir)) {
         throw FileWriteError(outDir.string() + ": cannot create the output directory (" +
                              (ec ? ec.message() : std::string("exists, not a directory")) + ")");
     }
+}
+}  // namespace
+
+GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input) {
+    // Everything is encoded before the filesystem is touched.
+    const std::vector<PendingFile> files = buildFiles(outDir, input);
+
+    std::error_code ec;
+    createOutputDirectory(outDir);
 
     const StagingDirectory staging(outDir);
     for (const fs::path& dir : subdirectories(files)) {
@@ -959,12 +966,7 @@ void writeFilesTogether(const std::filesystem::path& outDir,
     std::vector<PendingFile> pending;
     for (const auto& [name, text] : files)
         pending.push_back({fs::path(name), std::vector<uint8_t>(text.begin(), text.end())});
-    std::error_code ec;
-    fs::create_directories(outDir, ec);
-    if (ec || !fs::is_directory(outDir)) {
-        throw FileWriteError(outDir.string() + ": cannot create the output directory (" +
-                             (ec ? ec.message() : std::string("exists, not a directory")) + ")");
-    }
+    createOutputDirectory(outDir);
     const StagingDirectory staging(outDir);
     for (const PendingFile& f : pending) writeStaged(staging.path() / f.relative, outDir / f.relative, f);
     commit(outDir, staging.path(), pending, {});

@@ -126,6 +126,31 @@ Measured measureBake(const fs::path& dem, bool gltf, const std::optional<TileSpe
     return m;
 }
 
+// Runs `measure` in a fresh child process and receives what it measured; false (the benchmark
+// skipped) when the child failed.
+template <class Measure>
+bool inChild(benchmark::State& state, Measured& m, const Measure& measure) {
+    int fds[2];
+    if (::pipe(fds) != 0) {
+        state.SkipWithError("pipe failed");
+        return false;
+    }
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::close(fds[0]);
+        const Measured r = measure();
+        const bool sent = ::write(fds[1], &r, sizeof r) == ssize_t(sizeof r);
+        ::_exit(sent ? 0 : 1);
+    }
+    ::close(fds[1]);
+    const bool received = child > 0 && ::read(fds[0], &m, sizeof m) == ssize_t(sizeof m);
+    ::close(fds[0]);
+    int status = 0;
+    if (child > 0) ::waitpid(child, &status, 0);
+    if (!received) state.SkipWithError("the measuring child process failed");
+    return received;
+}
+
 // state.range(0): 1 with the glTF scene, 0 without.
 void BM_BakePeakMemory(benchmark::State& state) {
     const fs::path dem = fs::path(TERRALUX_SHARED_DATA) / "dem" / "N42E001.hgt";
@@ -134,29 +159,8 @@ void BM_BakePeakMemory(benchmark::State& state) {
         return;
     }
     Measured m;
-    for (auto _ : state) {
-        int fds[2];
-        if (::pipe(fds) != 0) {
-            state.SkipWithError("pipe failed");
-            return;
-        }
-        const pid_t child = ::fork();
-        if (child == 0) {
-            ::close(fds[0]);
-            const Measured r = measureBake(dem, state.range(0) != 0);
-            const bool sent = ::write(fds[1], &r, sizeof r) == ssize_t(sizeof r);
-            ::_exit(sent ? 0 : 1);
-        }
-        ::close(fds[1]);
-        const bool received = child > 0 && ::read(fds[0], &m, sizeof m) == ssize_t(sizeof m);
-        ::close(fds[0]);
-        int status = 0;
-        if (child > 0) ::waitpid(child, &status, 0);
-        if (!received) {
-            state.SkipWithError("the measuring child process failed");
-            return;
-        }
-    }
+    for (auto _ : state)
+        if (!inChild(state, m, [&] { return measureBake(dem, state.range(0) != 0); })) return;
     if (m.error[0]) {
         state.SkipWithError(m.error);
         return;
@@ -238,29 +242,8 @@ void BM_TilePeakMemory(benchmark::State& state) {
     }
     TileSpec tile = parseTiles("4,4", "5/16", state.range(0) > 0 ? std::optional<double>(double(state.range(0))) : std::nullopt);
     Measured m;
-    for (auto _ : state) {
-        int fds[2];
-        if (::pipe(fds) != 0) {
-            state.SkipWithError("pipe failed");
-            return;
-        }
-        const pid_t child = ::fork();
-        if (child == 0) {
-            ::close(fds[0]);
-            const Measured r = measureBake(dem, false, tile);
-            const bool sent = ::write(fds[1], &r, sizeof r) == ssize_t(sizeof r);
-            ::_exit(sent ? 0 : 1);
-        }
-        ::close(fds[1]);
-        const bool received = child > 0 && ::read(fds[0], &m, sizeof m) == ssize_t(sizeof m);
-        ::close(fds[0]);
-        int status = 0;
-        if (child > 0) ::waitpid(child, &status, 0);
-        if (!received) {
-            state.SkipWithError("the measuring child process failed");
-            return;
-        }
-    }
+    for (auto _ : state)
+        if (!inChild(state, m, [&] { return measureBake(dem, false, tile); })) return;
     if (m.error[0]) {
         state.SkipWithError(m.error);
         return;
