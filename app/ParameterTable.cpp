@@ -1037,6 +1037,12 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("camera.exposure_ev", T::Number)).range(-16.0, 16.0).unit("EV").decimals(1).slider().label("Exposure")
         .about("Exposure compensation in stops before the ACES tone curve: +1 doubles the displayed light")
         .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::exposureEv);
+    add(Row("camera.antialiasing", T::Choice))
+        .choices({antialiasingName(Antialiasing::Off), antialiasingName(Antialiasing::Fxaa), antialiasingName(Antialiasing::Ssaa)})
+        .label("Anti-aliasing")
+        .about("Edges of the picture views: fxaa filters the finished frame along luminance edges (one full-screen pass); "
+               "ssaa draws at 2x2 the pixels and averages them (4x the cost); off: one sample a pixel. Data views stay exact")
+        .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::antialiasing);
 
     // Export.
     bake = BakeUse::Reads;  // the exporters' settings; where the files go is not an input
@@ -1372,7 +1378,7 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
     if (section == "shadows") return {"dock.shadows", "Shadows"};
     if (section == "detail" || surface) return {"dock.surface", "Surface"};
-    if (section == "fog" || spec.path == "camera.exposure_ev") return {"dock.atmosphere", "Atmosphere"};
+    if (section == "fog" || spec.path == "camera.exposure_ev" || spec.path == "camera.antialiasing") return {"dock.atmosphere", "Atmosphere"};
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     if (section == "water") return {"dock.water", "Water"};
     if (section == "reflection_probes") return {"dock.reflectionProbes", "Reflection Probes"};

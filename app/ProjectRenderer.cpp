@@ -113,6 +113,7 @@ void ProjectRenderer::setProject(const Project& project) {
     }
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
     base_.exposure = float(std::exp2(scene.camera.exposureEv));
+    base_.antialiasing = scene.camera.antialiasing;
     base_.shadows = scene.shadows;
     if (t == 0.0f || t == 1.0f) {
         base_.sun = lighting.sun;

@@ -88,8 +88,6 @@ void shiftTextures(nlohmann::json& j, size_t offset) {
     }
 }
 
-size_t sizeOf(const nlohmann::json& doc, const char* key) { return doc.contains(key) ? doc[key].size() : 0; }
-
 // The tiles' glTF documents as one: each tile's nodes, meshes, materials and buffers appended with
 // their indices moved, buffers and images addressed through the tile's folder, and the probe
 // grids of every tile listed in the scene's VULKAN_SCHNEE_engine_properties, sorted by file name.

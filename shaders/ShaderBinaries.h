@@ -19,6 +19,7 @@ std::span<const uint32_t> terrainReflectionLpvFrag();
 std::span<const uint32_t> terrainShadowReflectionLpvFrag();
 std::span<const uint32_t> fullscreenVert();
 std::span<const uint32_t> skyBackgroundFrag();
+std::span<const uint32_t> antialiasFrag();  // the picture views' fxaa or 2x2 average (camera.antialiasing)
 std::span<const uint32_t> shadowDepthVert();
 std::span<const uint32_t> probeVerticesComp();
 std::span<const uint32_t> lpvSampleComp();  // Volumes::evaluate at given points (TerrainRenderer::sampleLpv)

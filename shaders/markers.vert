@@ -14,7 +14,7 @@ void main() {
     const vec2 corners[6] = vec2[](vec2(-1, -1), vec2(1, -1), vec2(1, 1),
                                    vec2(-1, -1), vec2(1, 1), vec2(-1, 1));
     vec4 clip = camera.viewProj * vec4(inProbe.xyz, 1.0);
-    clip.xy += corners[gl_VertexIndex % 6] * 3.0 / camera.viewportSize * 2.0 * clip.w;
+    clip.xy += corners[gl_VertexIndex % 6] * overlay.markerPixels / camera.viewportSize * 2.0 * clip.w;
     gl_Position = clip;
     bool reflection = inProbe.w > 2.5;
     bool valid = reflection || (inProbe.w > 0.5 && inProbe.w < 1.5);

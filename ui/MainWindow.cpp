@@ -472,11 +472,12 @@ QDockWidget* MainWindow::buildShadowsDock() {
     return addDock("Shadows", "dock.shadows", shadows);
 }
 
-// Atmosphere: height fog and the exposure of the whole image.
+// Atmosphere: height fog, and the exposure and anti-aliasing of the whole image.
 QDockWidget* MainWindow::buildAtmosphereDock() {
     auto* atmosphere = new ParameterForm(doc_);
     atmosphere->addParameters("fog.");
     atmosphere->addParameter("camera.exposure_ev");
+    atmosphere->addParameter("camera.antialiasing");
     reportRejections(atmosphere);
     atmosphere->refresh();
     return addDock("Atmosphere", "dock.atmosphere", atmosphere);

@@ -41,6 +41,7 @@ namespace frame {
 // Frame-graph resource names.
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kDepth = "depth";
+inline constexpr const char* kOutput = "output";  // the anti-aliased picture (features/Antialiasing.h)
 inline constexpr const char* kReadback = "readback";
 inline constexpr const char* kSwapchain = "swapchain";
 inline constexpr const char* kVertices = "terrain-vertices";
@@ -129,10 +130,17 @@ struct FrameSlot {
     size_t gizmoCapacity = 0;
 };
 
+// The frame's colour and depth, drawn at `scale` x the output's width and height, and, when a
+// pass anti-aliases the picture, the output image it writes and the set that reads the colour.
+// The read-back holds the output's pixels.
 struct RenderTarget {
     vk::Image color, depth;
     vk::Framebuffer framebuffer;
     vk::Readback readback;
+    uint32_t width = 0, height = 0, scale = 1;
+    vk::Image output;
+    vk::Framebuffer outputFramebuffer;
+    vk::DescriptorSet source;
 };
 
 // The surface maps the view set binds (SurfaceMaps.h), always present: a terrain without AO or
@@ -188,6 +196,12 @@ struct RendererGpu {
     // shaders and layout).
     std::map<int, vk::UniquePipeline> terrain;
     vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, gizmoPipeline, probePass;
+    // The anti-aliasing pass: its colour-only render pass, layout and pipelines by
+    // (ssaa ? 2 : 0) + (scene-linear output ? 1 : 0).
+    vk::RenderPass outputPass;
+    vk::UniqueSetLayout antialiasSetLayout;
+    vk::PipelineLayout antialiasLayout;
+    std::array<vk::UniquePipeline, 4> antialias;
     FrameGraph graph;
     ~RendererGpu();
 };

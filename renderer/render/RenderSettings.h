@@ -41,6 +41,8 @@ struct RenderSettings {
     SunLight sun;
     sh::ShRgb skySh;
     float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
+    // camera.antialiasing: applied to the picture views only (those drawn with the sky behind).
+    Antialiasing antialiasing = Antialiasing::Off;
     ShadowSettings shadows;       // the sun's cascades (shadows.enabled false: no shadow pass)
     // Height fog with base height and colour resolved (fog.enabled false: no fog code runs).
     FogSettings fog;

@@ -18,6 +18,7 @@
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
 #include "render/Frame.h"
+#include "render/features/Antialiasing.h"
 #include "render/features/Atmosphere.h"
 #include "render/features/Lpv.h"
 #include "render/features/Overlays.h"
@@ -58,6 +59,7 @@ constexpr float kSmallestLeafPixels = 6.0f;
 
 struct TerrainRenderer::Output {
     bool readback = true;
+    features::AntialiasingPlan antialiasing;
     VkImage swapchainImage = VK_NULL_HANDLE;
     VkExtent2D extent{0, 0};
 };
@@ -675,29 +677,60 @@ void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
     gpu_->graph.importBuffer(kLeaves, gpu_->leaves.handle(), true);
 }
 
-void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height) {
+void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
     RendererGpu& g = *gpu_;
-    if (g.target && g.target->color.width() == width && g.target->color.height() == height) return;
+    // A view without the pass keeps the output image it does not use: switching between a
+    // picture and a data view allocates nothing.
+    if (g.target && g.target->width == width && g.target->height == height && g.target->scale == plan.scale &&
+        (g.target->source || !plan.pass))
+        return;
     ctx_.waitIdle();  // frames in flight may still draw into the old target
-    for (const char* name : {kColor, kDepth, kReadback}) g.graph.forget(name);
+    for (const char* name : {kColor, kDepth, kReadback, kOutput}) g.graph.forget(name);
     g.target.reset();
+    const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
     auto t = std::make_unique<RenderTarget>(RenderTarget{
-        vk::Image::colorTarget(ctx_, width, height), vk::Image::depthTarget(ctx_, width, height), {},
-        vk::Readback(ctx_, width, height)});
+        vk::Image::colorTarget(ctx_, drawnWidth, drawnHeight), vk::Image::depthTarget(ctx_, drawnWidth, drawnHeight),
+        {}, vk::Readback(ctx_, width, height)});
+    t->width = width;
+    t->height = height;
+    t->scale = plan.scale;
     const VkImageView views[] = {t->color.view(), t->depth.view()};
-    t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, width, height);
+    t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, drawnWidth, drawnHeight);
     g.graph.importImage(kColor, t->color.handle(), t->color.aspect());
     g.graph.importImage(kDepth, t->depth.handle(), t->depth.aspect());
     g.graph.importBuffer(kReadback, t->readback.buffer());
+    if (plan.pass) {
+        features::buildAntialiasingTarget(ctx_, g, *t);
+        g.graph.importImage(kOutput, t->output.handle(), t->output.aspect());
+    }
     g.target = std::move(t);
+}
+
+features::AntialiasingPlan TerrainRenderer::antialiasingOf(const RenderSettings& s) const {
+    return features::antialiasingPlan(s.antialiasing,
+                                      findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)));
+}
+
+// The settings the passes draw with: the output's size times the anti-aliasing's samples a side.
+const RenderSettings& TerrainRenderer::drawnSettings(const RenderSettings& s, const features::AntialiasingPlan& plan,
+                                                     RenderSettings& scaled) {
+    if (plan.scale == 1) return s;
+    scaled = s;
+    scaled.width *= plan.scale;
+    scaled.height *= plan.scale;
+    return scaled;
 }
 
 RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
-    ensureTarget(s.width, s.height);
+    Output out;
+    out.antialiasing = antialiasingOf(s);
+    ensureTarget(s.width, s.height, out.antialiasing);
+    RenderSettings scaled;
+    const RenderSettings& drawn = drawnSettings(s, out.antialiasing, scaled);
     // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
     ctx_.waitIdle();
-    ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, s, Output{}); });
+    ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, drawn, out); });
     readFrameTimings(0);
     RenderedImage img;
     img.width = s.width;
@@ -734,16 +767,18 @@ void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
 }
 
 bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain) {
-    ensureTarget(s.width, s.height);
+    Output out;
+    out.antialiasing = antialiasingOf(s);
+    ensureTarget(s.width, s.height, out.antialiasing);
     const std::optional<vk::SwapchainFrame> frame = swapchain.begin();
     if (!frame) return false;
-    Output out;
     out.readback = false;
     out.swapchainImage = frame->image;
     out.extent = frame->extent;
     // begin() waited for this slot's fence: the frame drawn in it before is done.
     readFrameTimings(frame->slot);
-    recordFrame(frame->cb, frame->slot, s, out);
+    RenderSettings scaled;
+    recordFrame(frame->cb, frame->slot, drawnSettings(s, out.antialiasing, scaled), out);
     swapchain.submitAndPresent(*frame);
     return true;
 }
@@ -844,7 +879,8 @@ void TerrainRenderer::writeBlocks(Frame& f) {
         slot.gizmos.write(lines.data(), lines.size() * sizeof(lines[0]));
     }
     if (f.drawMarkers || f.drawReflectionMarkers || f.drawLeaves) {
-        const blocks::OverlayBlock overlay = features::packOverlay(s, smallestLeaf_, kSmallestLeafPixels);
+        const blocks::OverlayBlock overlay =
+            features::packOverlay(s, smallestLeaf_, kSmallestLeafPixels, float(g.target->scale));
         slot.overlay.write(&overlay, sizeof overlay);
     }
 
@@ -920,18 +956,22 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     features::addSkyPass(f);
     features::addWaterPasses(f);
     features::addOverlayPass(f);
+    features::addAntialiasPass(f, out.antialiasing);
+    // What leaves the frame: the anti-aliased output where a pass wrote it, else the colour.
+    RenderTarget& t = *g.target;
+    const char* final = out.antialiasing.pass ? kOutput : kColor;
+    const VkImage source = out.antialiasing.pass ? t.output.handle() : t.color.handle();
     if (out.readback) {
-        RenderTarget& t = *g.target;
-        g.graph.addPass({"readback", {{kColor, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
-                        [&t](VkCommandBuffer c) { t.readback.recordCopy(c, t.color.handle()); });
+        g.graph.addPass({"readback", {{final, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
+                        [&t, source](VkCommandBuffer c) { t.readback.recordCopy(c, source); });
         g.graph.addFinalUse({kReadback, Access::HostRead});
     } else {
         g.graph.importImage(kSwapchain, out.swapchainImage, VK_IMAGE_ASPECT_COLOR_BIT, 1,
                             VK_PIPELINE_STAGE_TRANSFER_BIT);
-        const VkImage source = g.target->color.handle(), dest = out.swapchainImage;
+        const VkImage dest = out.swapchainImage;
         const VkExtent2D dstExtent = out.extent;
-        const uint32_t w = s.width, h = s.height;
-        g.graph.addPass({"present", {{kColor, Access::TransferRead}, {kSwapchain, Access::TransferWrite}}, {}},
+        const uint32_t w = t.width, h = t.height;
+        g.graph.addPass({"present", {{final, Access::TransferRead}, {kSwapchain, Access::TransferWrite}}, {}},
                         [source, dest, w, h, dstExtent](VkCommandBuffer c) {
                             VkImageBlit blit{};
                             blit.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};

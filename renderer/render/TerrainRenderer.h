@@ -34,6 +34,9 @@ namespace terralux {
 struct RendererGpu;  // render/Frame.h
 struct Frame;
 struct ReflectionProbeSet;  // bake/ReflectionBake.h
+namespace features {
+struct AntialiasingPlan;  // render/features/Antialiasing.h
+}  // namespace features
 namespace lpv {
 class Volumes;  // lpv/Lpv.h
 struct Sample;
@@ -179,7 +182,10 @@ private:
     struct Output;
     void recordFrame(VkCommandBuffer cb, uint32_t slot, const RenderSettings& s, const Output& out);
     void writeBlocks(Frame& f);
-    void ensureTarget(uint32_t width, uint32_t height);
+    void ensureTarget(uint32_t width, uint32_t height, const features::AntialiasingPlan& plan);
+    features::AntialiasingPlan antialiasingOf(const RenderSettings& s) const;
+    static const RenderSettings& drawnSettings(const RenderSettings& s, const features::AntialiasingPlan& plan,
+                                               RenderSettings& scaled);
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
     void uploadSurfaceMaps(const std::vector<float>& ao);

@@ -371,6 +371,16 @@ struct LocalLight {
     double outerConeDeg = 30.0;               // spot: nothing outside, (inner, 90]
 };
 
+// How the picture views (beauty, filled, linear) smooth their edges (docs/lighting.md,
+// "Anti-aliasing"): fxaa filters the finished frame along its luminance edges (one full-screen
+// pass); ssaa draws every pass at twice the width and height and averages each 2 x 2 block (four
+// samples a pixel, four times the shading). The data views always keep one exact sample a pixel.
+enum class Antialiasing { Off, Fxaa, Ssaa };
+// A mode's project-file name.
+inline const char* antialiasingName(Antialiasing a) {
+    return a == Antialiasing::Off ? "off" : a == Antialiasing::Fxaa ? "fxaa" : "ssaa";
+}
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -380,6 +390,7 @@ struct CameraSettings {
     double elevationDeg = 35.0;       // (-90, 90)
     double fovDeg = 45.0;             // vertical, (1, 150)
     double exposureEv = 0.0;          // stops: the display multiplies scene light by 2^EV
+    Antialiasing antialiasing = Antialiasing::Fxaa;
 };
 
 // A named lighting of the same probe layout (docs/lighting.md, "Lighting scenarios"): its own sun

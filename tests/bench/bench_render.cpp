@@ -231,6 +231,38 @@ void BM_BeautyShadowsFog(benchmark::State& state) {
 BENCHMARK(BM_BeautyShadowsFog)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
     ->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
 
+// Beauty at 1920 x 1080 with each camera.antialiasing mode: the frame and the antialias pass's
+// own GPU time (aa_gpu_ms, where the device writes timestamps).
+void BM_Antialiasing(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    Project p = fixtureProject();
+    p.scene.camera.antialiasing = Antialiasing(state.range(0));
+    f.renderer->setProject(p);
+    RenderRequest q;
+    q.width = 1920;
+    q.height = 1080;
+    f.renderer->render(q);  // the pipeline and targets of this mode
+    double ms = 0, pass = 0;
+    int timed = 0;
+    FrameCost cost;
+    for (auto _ : state) {
+        ms += f.renderer->render(q).milliseconds;
+        cost.add(f.renderer->renderer());
+        for (const auto& t : f.renderer->renderer().lastFrameTimings().passes)
+            if (t.name == "antialias") pass += t.gpuMilliseconds, ++timed;
+    }
+    state.SetLabel(std::string(antialiasingName(p.scene.camera.antialiasing)) + " on " + f.ctx->deviceName());
+    state.counters["frame_ms"] = ms / double(state.iterations());
+    if (timed > 0) state.counters["aa_gpu_ms"] = pass / timed;
+    cost.report(state);
+    f.renderer->setProject(fixtureProject());
+}
+BENCHMARK(BM_Antialiasing)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
 // Beauty at 1280 x 720 with the terrain surface's parts each on or off: horizon AO, the
 // normal-variance specular and the micro-detail (shadows and fog off, so only these differ).
 void BM_BeautySurface(benchmark::State& state) {

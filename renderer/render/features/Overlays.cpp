@@ -9,10 +9,12 @@ namespace terralux::features {
 
 using namespace frame;
 
-blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels) {
+blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels,
+                                 float pixelScale) {
     blocks::OverlayBlock overlay;
     overlay.smallestLeaf = smallestLeaf;
-    overlay.smallestLeafPixels = smallestLeafPixels;
+    overlay.smallestLeafPixels = smallestLeafPixels * pixelScale;
+    overlay.markerPixels = kMarkerPixels * pixelScale;
     overlay.drawValid = s.showProbePositions ? 1 : 0;
     overlay.drawMovedRejected = 1;
     return overlay;

@@ -15,7 +15,11 @@ struct GizmoInstance {
 };
 std::vector<GizmoInstance> packGizmos(const std::vector<GizmoLine>& lines);
 
-blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels);
+// A probe marker's half width on screen, in output pixels.
+inline constexpr float kMarkerPixels = 3.0f;
+// `pixelScale`: the drawn frame's pixels per output pixel along a side (2 under ssaa).
+blocks::OverlayBlock packOverlay(const RenderSettings& s, float smallestLeaf, float smallestLeafPixels,
+                                 float pixelScale);
 void addOverlayPass(Frame& f);
 
 }  // namespace terralux::features
