@@ -107,7 +107,8 @@ struct BakeSetup {
 };
 
 void prepare(const Project& project, BakeSetup& b, const std::function<void(const std::string&, double)>& report,
-             const std::function<bool()>& cancelled, const std::optional<TileSpec>& tile = std::nullopt) {
+             const std::function<bool()>& cancelled, const std::optional<TileSpec>& tile = std::nullopt,
+             bool writesSummary = true) {
     const SceneDescription& scene = project.scene;
     // A scene built in code has not met the parameter table's rules, as a file or --set has:
     // take it through them, so a bake refuses what loading the project would (a grid past
@@ -117,9 +118,10 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     report("loading terrain", 0.0);
     if (tile) {
         // Out of core where the DEM allows it: the grid from its header and one streamed pass,
-        // then only the tile's traced window read (DemImportOptions::window).
-        // The region's grid and overview: computed by the first tile, read by the others.
-        RegionSummary region = regionSummary(project, project.outDir().parent_path());
+        // then only the tile's traced window read (DemImportOptions::window). The region's grid
+        // and overview are computed by the first tile and read by the others; a dry run writes
+        // nothing.
+        RegionSummary region = regionSummary(project, project.outDir().parent_path(), writesSummary);
         const DemGrid& grid = region.grid;
         try {
             b.tileWindow = tileWindow(grid, *tile);
@@ -1608,7 +1610,7 @@ BakeEstimate estimateBake(const BakeRequest& request) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     BakeSetup setup;
     BakeRequest chosen = request;
-    prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; }, chosen.tile);
+    prepare(chosen.project, setup, [](const std::string&, double) {}, [] { return false; }, chosen.tile, false);
     if (setup.tileWindow) scaleSceneToTile(chosen.project.scene, *setup.tileWindow);
     const std::optional<SamplingChoice> sampling = chooseSampling(chosen.project.scene, setup, [](const std::string&) {});
     const std::map<size_t, TargetChoice> targets = chooseTargets(chosen.project.scene, setup, [](const std::string&) {});

@@ -167,7 +167,9 @@ nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::j
         sceneExt["TERRALUX_geo"].erase("meshStride");
         sceneExt["TERRALUX_geo"]["tiles"] = region["tiles"];
     }
-    sceneExt.erase("TERRALUX_bake");  // per tile; the merged report sums them
+    // Per tile, on the tile's scene only; the merged report sums them.
+    sceneExt.erase("TERRALUX_bake");
+    used.erase(std::remove(used.begin(), used.end(), nlohmann::json("TERRALUX_bake")), used.end());
     out["extensionsUsed"] = used;
     out["scenes"] = nlohmann::json::array({{{"name", "region"}, {"nodes", roots}, {"extensions", sceneExt}}});
     for (const char* a : kArrays)

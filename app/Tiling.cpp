@@ -132,16 +132,30 @@ void scaleSceneToTile(SceneDescription& scene, const TileWindow& w) {
     // Probes along an axis, the region's n over its span: the first and last on the tile's edges.
     auto probes = [](int n, double share) { return n <= 1 ? n : std::max(2, int(std::lround((n - 1) * share)) + 1); };
     auto cells = [](int n, double share) { return std::max(1, int(std::lround(n * share))); };
+    auto list = [](std::initializer_list<float> v) {
+        std::string out;
+        for (float x : v) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%g", double(x));
+            out += (out.empty() ? "[" : ",") + std::string(buf);
+        }
+        return out + "]";
+    };
     for (size_t i = 0; i < scene.probeVolumes.size(); ++i) {
         ProbeVolumeSettings& v = scene.probeVolumes[i];
         if (!v.enabled) continue;
         const std::string at = "probe_volumes[" + std::to_string(i) + "]";
         if (v.origin)
-            throw ProjectError(at + ".origin: a tiled bake places each tile's probes over its own share of the "
-                                    "terrain; leave the origin unset");
+            throw ProjectError(at + ".origin " +
+                               (v.placement == ProbePlacement::Terrain ? list({v.origin->x, v.origin->z})
+                                                                       : list({v.origin->x, v.origin->y, v.origin->z})) +
+                               ": a tiled bake places each tile's probes over its own share of the terrain; leave "
+                               "the origin unset");
         if (refinedByError(v.placement) && v.adaptive.size)
-            throw ProjectError(at + ".adaptive.size: a tiled bake places each tile's probes over its own share "
-                                    "of the terrain; leave the size unset");
+            throw ProjectError(at + ".adaptive.size " +
+                               list({v.adaptive.size->x, v.adaptive.size->y, v.adaptive.size->z}) +
+                               ": a tiled bake places each tile's probes over its own share of the terrain; leave "
+                               "the size unset");
         if (v.placement == ProbePlacement::Terrain) {
             v.gridDims[0] = probes(v.gridDims[0], shareX);
             v.gridDims[2] = probes(v.gridDims[2], shareZ);
@@ -153,8 +167,9 @@ void scaleSceneToTile(SceneDescription& scene, const TileWindow& w) {
     ReflectionProbeSettings& r = scene.reflectionProbes;
     if (r.enabled) {
         if (r.origin)
-            throw ProjectError("reflection_probes.origin: a tiled bake places each tile's probes over its own "
-                               "share of the terrain; leave the origin unset");
+            throw ProjectError("reflection_probes.origin " + list({r.origin->x, r.origin->y}) +
+                               ": a tiled bake places each tile's probes over its own share of the terrain; leave "
+                               "the origin unset");
         r.gridDims[0] = probes(r.gridDims[0], shareX);
         r.gridDims[1] = probes(r.gridDims[1], shareZ);
     }
@@ -226,7 +241,7 @@ std::optional<RegionSummary> readSummary(const std::filesystem::path& dir, const
 
 }  // namespace
 
-RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir) {
+RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir, bool write) {
     const nlohmann::json key = regionKey(project);
     if (std::optional<RegionSummary> s = readSummary(cacheDir, key)) return std::move(*s);
     RegionSummary s;
@@ -249,6 +264,7 @@ RegionSummary regionSummary(const Project& project, const std::filesystem::path&
            {{"easting", geo.easting}, {"northing", geo.northing}, {"height", geo.height}, {"crs_wkt", geo.crsWkt},
             {"crs_name", geo.crsName}, {"epsg", geo.epsg}, {"latitude_deg", orNull(geo.latitudeDeg)},
             {"longitude_deg", orNull(geo.longitudeDeg)}, {"grid_convergence_deg", geo.gridConvergenceDeg}}}}}};
+    if (!write) return s;
     std::error_code ec;
     std::filesystem::create_directories(cacheDir, ec);
     // The heights first: a region.json is only ever beside the heights it describes.

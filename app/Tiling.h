@@ -96,5 +96,6 @@ struct RegionSummary {
     Heightfield overview;
     bool cached = false;  // read from cacheDir
 };
-RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir);
+// `write` false (a dry run): computed when absent but not left in cacheDir.
+RegionSummary regionSummary(const Project& project, const std::filesystem::path& cacheDir, bool write = true);
 }  // namespace terralux

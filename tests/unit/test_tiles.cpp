@@ -283,6 +283,11 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
     EXPECT_EQ(grids[3]["shProbePath"], "tiles/tile_001_001/sh_coeffs/probes.shprobe");
     EXPECT_EQ(g["nodes"].size(), 4u);
     EXPECT_EQ(g["buffers"][2]["uri"], "tiles/tile_001_000/scene.bin");
+    // Every extension it declares is one it carries: the tiles' TERRALUX_bake stays in the tiles.
+    EXPECT_FALSE(g["scenes"][0]["extensions"].contains("TERRALUX_bake"));
+    for (const auto& e : g["extensionsUsed"]) EXPECT_NE(e, "TERRALUX_bake");
+    EXPECT_NE(std::find(g["extensionsUsed"].begin(), g["extensionsUsed"].end(), "VULKAN_SCHNEE_engine_properties"),
+              g["extensionsUsed"].end());
     EXPECT_TRUE(fs::exists(tiled / "tiles.json"));
     EXPECT_EQ(m.report["volumes"][0]["probes"].get<size_t>(), 80u);
 
