@@ -313,3 +313,55 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
     fs::remove_all(whole);
     fs::remove_all(tiled);
 }
+
+TEST(Tiles, TheDerivedHaloHoldsEveryProbeOfAMountainTileWithinItsShare) {
+    // A corner tile of N42E001 (Pyrenees, 2 800 m of relief) cut 3 x 3: the derived halo (about
+    // 28 km) leaves out the terrain beyond it, which the rule says can change an upward receiver's
+    // light by at most kHaloShare. The same tile baked again with a halo over the whole region
+    // traces the same rays from the same probes: the difference is that terrain's, and nothing else.
+    const fs::path dem = fs::path(TERRALUX_SHARED_DATA) / "dem" / "N42E001.hgt";
+    if (!fs::exists(dem)) GTEST_SKIP() << "shared DEM N42E001.hgt not present";
+    const fs::path dir = freshDir("mountain_halo");
+    std::map<bool, std::vector<Probe>> probes;
+    double derivedHalo = 0.0, relief = 0.0;
+    for (const bool whole : {false, true}) {
+        BakeRequest r{Project{}, 2, false};
+        r.project.scene.terrain.dem = dem.string();
+        r.project.scene.terrain.maxResolution = 301;
+        r.project.scene.probeVolumes[0].gridDims = {13, 1, 13};
+        r.project.scene.bake.quality = QualityPreset::Draft;
+        r.tile = parseTiles("3,3", "0/9", whole ? std::optional<double>(1.0e7) : std::nullopt);
+        r.project.scene.exportSettings.outDir = (dir / (whole ? "whole" : "derived") / kTilesFolder / "tile_000_000").string();
+        const BakeOutcome o = runBake(r, {}, nullptr);
+        const nlohmann::json& halo = o.report["tile"]["halo"];
+        const nlohmann::json& traced = o.report["tile"]["traced"];
+        const int regionCols = o.report["tile"]["region_grid"][0].get<int>(), regionRows = o.report["tile"]["region_grid"][1].get<int>();
+        if (!whole) {
+            derivedHalo = halo["metres"].get<double>();
+            relief = halo["relief_m"].get<double>();
+            // The derived halo leaves terrain out on both axes; the other tile traces all of it.
+            EXPECT_LT(traced["cols"].get<int>(), regionCols);
+            EXPECT_LT(traced["rows"].get<int>(), regionRows);
+        } else {
+            EXPECT_EQ(traced["cols"].get<int>(), regionCols);
+            EXPECT_EQ(traced["rows"].get<int>(), regionRows);
+        }
+        probes[whole] = probesIn(r.project.scene.exportSettings.outDir);
+    }
+    ASSERT_FALSE(probes[false].empty());
+    ASSERT_EQ(probes[false].size(), probes[true].size());
+    double worst = 0.0, mean = 0.0;
+    for (size_t i = 0; i < probes[false].size(); ++i) {
+        ASSERT_LT(glm::distance(probes[false][i].position, probes[true][i].position), 0.05f);
+        const double d = std::abs(probes[false][i].irradiance - probes[true][i].irradiance) / probes[true][i].irradiance;
+        worst = std::max(worst, d);
+        mean += d / double(probes[false].size());
+    }
+    std::cout << "N42E001 corner tile of 3 x 3: relief " << relief << " m, derived halo " << derivedHalo << " m, "
+              << probes[false].size() << " probes; upward irradiance against the whole region's: mean "
+              << 100.0 * mean << " %, max " << 100.0 * worst << " %\n";
+    EXPECT_GT(relief, 2000.0);
+    EXPECT_NEAR(derivedHalo, relief * std::sqrt(99.0), 1.0);
+    EXPECT_LE(worst, kHaloShare);
+    fs::remove_all(dir);
+}
