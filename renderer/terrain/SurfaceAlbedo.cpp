@@ -109,6 +109,47 @@ SurfaceAlbedo rampAlbedo(const Heightfield& terrain, const AlbedoRampSettings& r
                                  180.0 / std::numbers::pi;
             out.setTexel(size_t(j) * size_t(out.width) + size_t(i), rampColor(ramp, elevation, slope));
         }
+    // Cells the DEM left as nodata: the import's fill is smooth, so their slope and often their
+    // height are not the ground's (a filled radar shadow on a rock face turns flat and takes snow).
+    // They take the colour of the ground around them instead: filled from the edge of each void
+    // inward, a ring at a time, each texel the mean of its already coloured 8 neighbours (a ring is
+    // computed from the rings before it only, so the result does not depend on the order).
+    const std::vector<uint8_t>& mask = terrain.nodataMask();
+    if (mask.empty()) return out;
+    const size_t n = out.texels();
+    std::vector<uint8_t> coloured(n, 1);
+    std::vector<size_t> pending;
+    for (int j = 0; j < out.height; ++j)
+        for (int i = 0; i < out.width; ++i)
+            if (mask[size_t(vertexOf(j, out.height, d)) * size_t(w) + size_t(vertexOf(i, out.width, w))]) {
+                coloured[size_t(j) * size_t(out.width) + size_t(i)] = 0;
+                pending.push_back(size_t(j) * size_t(out.width) + size_t(i));
+            }
+    std::vector<std::pair<size_t, glm::vec3>> ring;
+    while (!pending.empty()) {
+        ring.clear();
+        std::vector<size_t> later;
+        for (size_t t : pending) {
+            const int i = int(t % size_t(out.width)), j = int(t / size_t(out.width));
+            glm::vec3 sum(0.0f);
+            int count = 0;
+            for (int dj = -1; dj <= 1; ++dj)
+                for (int di = -1; di <= 1; ++di) {
+                    const int x = i + di, y = j + dj;
+                    if ((di == 0 && dj == 0) || x < 0 || y < 0 || x >= out.width || y >= out.height) continue;
+                    const size_t u = size_t(y) * size_t(out.width) + size_t(x);
+                    if (coloured[u]) sum += out.texel(u), ++count;
+                }
+            if (count > 0) ring.emplace_back(t, sum / float(count));
+            else later.push_back(t);
+        }
+        if (ring.empty()) break;  // a terrain that is all void keeps the ramp's own colours
+        for (const auto& [t, c] : ring) {
+            out.setTexel(t, c);
+            coloured[t] = 1;
+        }
+        pending = std::move(later);
+    }
     return out;
 }
 

@@ -151,6 +151,36 @@ TEST(Ramp, SnowAboveTheLineRockOnSteepSlopesGroundBelow) {
     }
 }
 
+TEST(Ramp, FilledVoidsTakeTheColourOfTheGroundAroundThem) {
+    // A 60-degree rock face below the snow line whose middle was nodata and was filled flat at
+    // 3000 m: by its own height and slope the fill would be snow, a pale blob on grey rock.
+    const AlbedoRampSettings ramp;
+    const int n = 24;
+    const double cell = 10.0;
+    std::vector<float> h(size_t(n) * n);
+    std::vector<uint8_t> mask(size_t(n) * n, 0);
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+            const bool hole = c >= 8 && c < 16 && r >= 8 && r < 16;
+            h[size_t(r) * n + c] = hole ? 3000.0f : float(1000.0 + c * cell * std::tan(60.0 * M_PI / 180.0));
+            mask[size_t(r) * n + c] = hole ? 1 : 0;
+        }
+    Heightfield hf(n, n, cell, cell, h);
+    const SurfaceAlbedo unmarked = rampAlbedo(hf, ramp, 1.0, glm::vec3(0.3f));
+    EXPECT_EQ(unmarked.at(hf, hf.xOf(12), hf.zOf(12)), stored(ramp.colors.back())) << "without the mask, snow";
+    hf.setNodataMask(mask);
+    const SurfaceAlbedo a = rampAlbedo(hf, ramp, 1.0, glm::vec3(0.3f));
+    for (int r = 8; r < 16; ++r)
+        for (int c = 8; c < 16; ++c) {
+            const glm::vec3 got = a.texel(size_t(r) * size_t(n) + size_t(c));
+            EXPECT_NEAR(got.x, ramp.rockColor.x, 0.01f) << c << ", " << r;
+            EXPECT_NEAR(got.z, ramp.rockColor.z, 0.01f) << c << ", " << r;
+        }
+    // Outside the void nothing changes.
+    for (size_t t = 0; t < a.texels(); ++t)
+        if (!mask[t]) EXPECT_EQ(a.texel(t), unmarked.texel(t)) << t;
+}
+
 TEST(Ramp, LargeTerrainsGetAtMostTheLargestFieldSide) {
     // 5000 x 3 vertices climbing from 0 to 4999 m eastward: 4096 texels across, and the corner
     // texels are the corner vertices' colours (the first stop, and snow).
