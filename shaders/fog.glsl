@@ -26,6 +26,16 @@ vec3 fogInscatter(vec3 dir, float t) {
     return (1.0 - t) * (atmosphere.fogColor + sun);
 }
 
+// Scene-linear light of the sky toward `dir` seen through the fog (fogSkyOpticalDepth).
+vec3 applySkyFog(vec3 radiance, vec3 dir) {
+    if (!kFog) return radiance;
+    // Past a depth of 80 the transmittance is 0 in float; the horizon's depth is unbounded.
+    float depth = fogSkyOpticalDepth(atmosphere.fogDensity, atmosphere.fogFalloff,
+                                     camera.position.y - atmosphere.fogBase, dir.y, camera.farPlane);
+    float t = exp(-min(depth, 80.0));
+    return radiance * t + fogInscatter(dir, t);
+}
+
 // Scene-linear light of a point seen through the fog.
 vec3 applyFog(vec3 radiance, vec3 dir, float distance) {
     if (!kFog) return radiance;

@@ -19,6 +19,18 @@ TLX_SHARED float fogOpticalDepth(float density, float falloff, float startAboveB
     return density * exp(max(-falloff * startAboveBase, -80.0f)) * distance * g;
 }
 
+// Optical depth toward the sky: a rising ray in fog that thins with height leaves it for good, so
+// its depth is the whole ray's, the limit of fogOpticalDepth as D → ∞: σ(h₀) / (falloff · dirY).
+// It grows without bound toward the horizon, as the depth to level ground below the horizon does,
+// so the sky meets the fogged ground there without a seam. Uniform fog (no falloff) has no top,
+// and a ray that does not rise meets the far plane: `farDistance` for those.
+TLX_SHARED float fogSkyOpticalDepth(float density, float falloff, float startAboveBase, float dirY, float farDistance) {
+    float rise = falloff * dirY;
+    float whole = density * exp(max(-falloff * startAboveBase, -80.0f)) / max(rise, 1.0e-30f);
+    float toFar = fogOpticalDepth(density, falloff, startAboveBase, dirY, farDistance);
+    return rise > 0.0f ? whole : toFar;
+}
+
 // Henyey–Greenstein phase function (Henyey & Greenstein 1941), normalised over the sphere;
 // cosTheta between the direction light travels and the direction it scatters into.
 TLX_SHARED float henyeyGreenstein(float g, float cosTheta) {

@@ -1,10 +1,11 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The sky behind the terrain: its radiance toward each pixel's view ray (from the sky's SH), the
-// sun's disc, and the fog between (docs/lighting.md, "Height fog": the sky is fogged at the far
-// plane). Below the horizon, with the skirt on, the ground the bake traces beyond the footprint:
-// level ground at the border's mean height and albedo, lit as the bake lights its skirt, fogged
-// over its own distance, so it fades into the haze toward the horizon. With the skirt off (or a
+// sun's disc, and the fog between (docs/lighting.md, "Height fog": the sky through all the fog a
+// rising ray crosses; the far plane's share where the fog has no top). Below the horizon, with
+// the skirt on, the ground the bake traces beyond the footprint: level ground at the border's
+// mean height and albedo, lit as the bake lights its skirt, fogged over its own distance, so it
+// fades into the haze toward the horizon, where the sky's fog meets it. With the skirt off (or a
 // camera below that ground) the horizon's radiance, as rays that escape the footprint see.
 #include "blocks/glsl.h"
 #include "blocks/camera.h"
@@ -35,7 +36,7 @@ void main() {
         float r = sunSky.sunAngularRadius;
         if (r > 0.0 && dir.y > 0.0 && dot(dir, l) >= cos(r))
             radiance += sunSky.sunIlluminance / (PI * r * r);
-        radiance = applyFog(radiance, dir, camera.farPlane);
+        radiance = applySkyFog(radiance, dir);
     }
     outColor = vec4(display(radiance), 1.0);
 }

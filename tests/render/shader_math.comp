@@ -14,7 +14,7 @@ layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Outputs { float outputs[]; };
 layout(push_constant) uniform Push { ivec4 count; } push;
 
-const int kOutputs = 16;
+const int kOutputs = 17;
 
 void main() {
     int i = int(gl_GlobalInvocationID.x);
@@ -29,4 +29,5 @@ void main() {
     outputs[o + 13] = fogOpticalDepth(0.002, 0.001, a.z, b.y, b.w);
     outputs[o + 14] = henyeyGreenstein(a.w, b.y);
     outputs[o + 15] = srgbEncode(acesFit(a.x));
+    outputs[o + 16] = fogSkyOpticalDepth(0.002, 0.001, a.z, b.y, b.w);
 }

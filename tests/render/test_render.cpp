@@ -2328,3 +2328,28 @@ TEST_F(RenderTest, AntialiasingLowersTheEdgeErrorAgainstASupersampledFrame) {
             for (float v : linearFxaa.rgba) ASSERT_TRUE(std::isfinite(v)) << what;
         }
 }
+
+TEST_F(RenderTest, TheSkyMeetsTheFoggedGroundAtTheHorizonWithoutAStep) {
+    // A low camera over the sample, looking past the terrain at the level ground beyond it. The
+    // sky used to be fogged to the far plane only while the ground just below the horizon took the
+    // fog's full colour: a step of 0.21 in luminance between two rows at 480 x 270; with the sky
+    // fogged along the whole rising ray the largest step is 0.058, the haze's own gradient.
+    Project p = sampleProject("horizon", 2, 2);
+    p.scene.camera.elevationDeg = 8.0;
+    p.scene.camera.antialiasing = Antialiasing::Off;
+    ProjectRenderer r(*ctx_, p);
+    const uint32_t w = 480, h = 270;
+    const RenderedImage img = draw(r, kViewBeauty, false, false, w, h);
+    // The level ground's horizon: view rays with d_y = 0, tan(8°) / tan(22.5°) of the half height
+    // above the centre.
+    const double horizon = 0.5 * h - std::tan(8.0 * M_PI / 180.0) / std::tan(22.5 * M_PI / 180.0) * 0.5 * h;
+    double worst = 0.0;
+    for (uint32_t x : {10u, w - 10}) {
+        for (int y = int(horizon) - 15; y < int(horizon) + 15; ++y)
+            worst = std::max(worst, std::abs(lumaOf(img, x, size_t(y + 1)) - lumaOf(img, x, size_t(y))));
+    }
+    std::cout << "largest step between rows within 15 of the horizon (row " << horizon << "): " << worst << "\n";
+    EXPECT_LT(worst, 0.08);
+    // And it is a horizon: the haze there is brighter than the sky well above it.
+    EXPECT_GT(lumaOf(img, 10, size_t(horizon)), lumaOf(img, 10, size_t(horizon) - 40) + 0.02);
+}

@@ -207,3 +207,22 @@ TEST(ShadowSettingsFile, SectionsRoundTrip) {
     EXPECT_EQ(back["fog"]["color"], json({0.5, 0.6, 0.7}));
     EXPECT_EQ(sceneFromJson(back, "p.json", nullptr).shadows.mapResolution, 1024);
 }
+
+TEST(HeightFog, TheSkysDepthIsTheWholeRisingRayAndMeetsTheGroundsAtTheHorizon) {
+    const float density = 2e-5f, falloff = 1.0f / 1200.0f, h0 = 900.0f;
+    // Rising: the limit of the depth over ever longer distances.
+    for (float dirY : {0.5f, 0.05f, 0.005f}) {
+        const double whole = fogmath::fogSkyOpticalDepth(density, falloff, h0, dirY, 1.0e4f);
+        const double far = numericDepth(density, falloff, h0, dirY, 60.0f / (falloff * dirY));
+        EXPECT_NEAR(whole / far, 1.0, 1e-4) << dirY;
+        EXPECT_GT(whole, fogmath::fogOpticalDepth(density, falloff, h0, dirY, 1.0e4f)) << dirY;
+    }
+    // Toward the horizon it grows without bound, as the depth to level ground below it does: the
+    // two meet in the fog's own colour.
+    EXPECT_GT(fogmath::fogSkyOpticalDepth(density, falloff, h0, 1e-6f, 1.0e4f), 50.0f);
+    EXPECT_GT(fogmath::fogOpticalDepth(density, falloff, h0, -1e-6f, h0 / 1e-6f), 50.0f);
+    // Uniform fog has no top, and a falling ray meets the far plane: the depth over that distance.
+    EXPECT_FLOAT_EQ(fogmath::fogSkyOpticalDepth(1e-3f, 0.0f, 50.0f, 0.7f, 1000.0f), 1.0f);
+    EXPECT_FLOAT_EQ(fogmath::fogSkyOpticalDepth(density, falloff, h0, -0.2f, 5000.0f),
+                    fogmath::fogOpticalDepth(density, falloff, h0, -0.2f, 5000.0f));
+}
