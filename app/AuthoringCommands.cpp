@@ -150,6 +150,10 @@ int commandRender(const Args& a) {
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    if (project.scene.camera.exposureMode != ExposureMode::Manual && std::isfinite(renderer.meteredEv100()))
+        std::cout << "exposure: EV100 " << fixed(renderer.meteredEv100(), 2) << " metered ("
+                  << exposureModeName(project.scene.camera.exposureMode) << "), compensation "
+                  << fixed(project.scene.camera.exposureEv, 1) << " EV\n";
     if (warm) {
         const FrameTimings& t = renderer.renderer().lastFrameTimings();
         std::cout << "profile (the frame drawn again, warm):\n";

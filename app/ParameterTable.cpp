@@ -1034,9 +1034,25 @@ std::vector<ParameterSpec> buildTable() {
         .about("Vertical field of view").redoes(kRedraw).noUiRow()
         .field(&SceneDescription::camera, &CameraSettings::fovDeg);
 
+    const auto metered = [](const SceneDescription& s, size_t) { return s.camera.exposureMode != ExposureMode::Manual; };
+    add(Row("camera.exposure_mode", T::Choice))
+        .choices({exposureModeName(ExposureMode::Manual), exposureModeName(ExposureMode::Average),
+                  exposureModeName(ExposureMode::Histogram)})
+        .label("Exposure mode")
+        .about("manual: the camera at camera.ev100; average: metered on the geometric mean luminance of the frame; "
+               "histogram: metered on the frame's 10th to 90th percentiles of luminance (deep shadow and glints ignored)")
+        .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::exposureMode);
+    add(Row("camera.ev100", T::Number)).range(-6.0, 24.0).unit("EV100").decimals(2).label("EV100")
+        .about("Manual exposure at ISO 100: a luminance of 1.2 x 2^EV100 cd/m2 displays as white before the tone curve; "
+               "15 is a clear day (sunny 16), the default 14.76 the exposure the defaults were set for")
+        .redoes(kUpload).onlyWhen(std::not_fn(metered)).field(&SceneDescription::camera, &CameraSettings::ev100);
     add(Row("camera.exposure_ev", T::Number)).range(-16.0, 16.0).unit("EV").decimals(1).slider().label("Exposure")
-        .about("Exposure compensation in stops before the ACES tone curve: +1 doubles the displayed light")
+        .about("Exposure compensation in stops before the ACES tone curve, in every mode: +1 doubles the displayed light")
         .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::exposureEv);
+    add(Row("camera.adaptation_s", T::Number)).range(0.0, 60.0).unit("s").decimals(2).label("Adaptation")
+        .about("Metered modes, in the viewport: the time constant with which the exposure follows the meter (0: at once); "
+               "renders and exports use the metered exposure itself")
+        .redoes(kUpload).onlyWhen(metered).field(&SceneDescription::camera, &CameraSettings::adaptationSeconds);
     add(Row("camera.antialiasing", T::Choice))
         .choices({antialiasingName(Antialiasing::Off), antialiasingName(Antialiasing::Fxaa), antialiasingName(Antialiasing::Ssaa)})
         .label("Anti-aliasing")
@@ -1378,7 +1394,11 @@ ParameterDock parameterDock(const ParameterSpec& spec) {
     if (section == "bake" || section == "export") return {"dock.bakeExport", "Bake & Export"};
     if (section == "shadows") return {"dock.shadows", "Shadows"};
     if (section == "detail" || surface) return {"dock.surface", "Surface"};
-    if (section == "fog" || spec.path == "camera.exposure_ev" || spec.path == "camera.antialiasing") return {"dock.atmosphere", "Atmosphere"};
+    // The camera's settings that form the picture (its placement has no row).
+    const bool picture = spec.path == "camera.exposure_mode" || spec.path == "camera.ev100" ||
+                         spec.path == "camera.exposure_ev" || spec.path == "camera.adaptation_s" ||
+                         spec.path == "camera.antialiasing";
+    if (section == "fog" || picture) return {"dock.atmosphere", "Atmosphere"};
     if (section == "ao") return {"dock.ao", "Ambient Occlusion"};
     if (section == "water") return {"dock.water", "Water"};
     if (section == "reflection_probes") return {"dock.reflectionProbes", "Reflection Probes"};

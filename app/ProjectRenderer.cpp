@@ -1,9 +1,10 @@
 #include "ProjectRenderer.h"
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
-
 #include <numbers>
+#include <sstream>
 
 #include "AlbedoImport.h"
 #include "BakeJob.h"
@@ -13,6 +14,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "bake/ProbePlacement.h"
+#include "scene/Exposure.h"
 #include "lpv/Lpv.h"
 #include "scene/DebugViews.h"
 #include "scene/OrbitCamera.h"
@@ -70,6 +72,7 @@ void ProjectRenderer::setScenarioView(const ScenarioView& view) {
 
 void ProjectRenderer::setProject(const Project& project) {
     project_ = project;
+    ++revision_;
     const SceneDescription& scene = project_.scene;
     const Heightfield& hf = terrain_.heightfield;
     const ScenarioView shown = shownView();
@@ -80,6 +83,18 @@ void ProjectRenderer::setProject(const Project& project) {
     litB.scene = scenarioScene(scene, b);
     const BakeLighting lighting = lightingOf(t < 0.5f ? litA : litB, hf);
     shown_ = lighting;
+    // The sky behind the terrain at full resolution (the shown scenario's, for a blend the nearer
+    // end's); uploaded when the image is another one, not for an edit of its intensity.
+    int skyWidth = 0, skyHeight = 0;
+    const std::vector<glm::vec3>* skyImage = lighting.sky.image(&skyWidth, &skyHeight);
+    int heldWidth = 0, heldHeight = 0;
+    if (skyImage != (heldSky_ ? heldSky_->image(&heldWidth, &heldHeight) : nullptr)) {
+        renderer_->setSkyImage(skyImage ? skyWidth : 0, skyImage ? skyHeight : 0,
+                               skyImage ? *skyImage : std::vector<glm::vec3>{});
+        heldSky_ = lighting.sky;  // holds the texels, so no other image can take their address
+    }
+    base_.skyImageScale = lighting.sky.scale();
+    base_.skyImageRotation = lighting.sky.rotationTurns();
     base_.albedo = lighting.albedo;
     base_.terrain = scene.terrain;
     base_.detail = scene.detail;
@@ -112,7 +127,8 @@ void ProjectRenderer::setProject(const Project& project) {
         setAmbientOcclusion(wanted, horizonSkyVisibility(terrain_.heightfield, wanted));
     }
     base_.camera = OrbitCamera::fromSettings(scene.camera, terrain_.heightfield);
-    base_.exposure = float(std::exp2(scene.camera.exposureEv));
+    // Metered modes replace this per frame (exposed).
+    base_.exposure = float(exposureScale(scene.camera.ev100, scene.camera.exposureEv));
     base_.antialiasing = scene.camera.antialiasing;
     base_.shadows = scene.shadows;
     if (t == 0.0f || t == 1.0f) {
@@ -183,10 +199,12 @@ bool ProjectRenderer::aoCurrent() const {
 void ProjectRenderer::setAmbientOcclusion(const HorizonAoSettings& settings, const std::vector<float>& field) {
     renderer_->setAmbientOcclusion(field);
     boundAo_ = settings;
+    ++revision_;
 }
 
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
+    ++revision_;
     boundVolumeData_ = std::make_shared<const std::vector<GpuProbeVolume>>(volumes);
     boundProbes_ = 0;
     for (const auto& v : volumes) boundProbes_ += v.coeffs.size();
@@ -203,6 +221,7 @@ void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
 
 void ProjectRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
     reflections_ = set;
+    ++revision_;
     renderer_->setReflectionProbes(std::move(set));
 }
 
@@ -375,7 +394,51 @@ RenderedImage ProjectRenderer::render(const RenderRequest& r) { return render(r,
 RenderedImage ProjectRenderer::render(const RenderRequest& r, const OrbitCamera& camera) {
     if (!drawsLpv(r)) setLpv(nullptr, "");
     else if (const std::optional<LpvJob> job = lpvJob(r, camera); job && job->key != lpvKey_) setLpv(job->run(), job->key);
-    return renderer_->render(settingsOf(r, camera));
+    RenderSettings s = settingsOf(r, camera);
+    if (meters(r)) {
+        // A render shows the metered exposure itself, as an adapted eye would; the viewport
+        // adapts from there.
+        meteredEv100_ = shownEv100_ = meter(r, camera);
+        meterKey_ = meterKey(r, camera);
+        shownAt_ = std::chrono::steady_clock::now();
+        s.exposure = float(exposureScale(shownEv100_, project_.scene.camera.exposureEv));
+    }
+    return renderer_->render(s);
+}
+
+bool ProjectRenderer::meters(const RenderRequest& r) const {
+    // Scene-linear output (EXR) is not exposed.
+    if (project_.scene.camera.exposureMode == ExposureMode::Manual || r.linearOutput) return false;
+    const std::optional<DebugView> view = findDebugView(r.debugView);
+    return view && view->background != ViewBackground::Black;
+}
+
+std::string ProjectRenderer::meterKey(const RenderRequest& r, const OrbitCamera& camera) const {
+    std::ostringstream key;
+    key << revision_ << ' ' << r.debugView << ' ' << r.probes << ' ' << double(r.width) / double(std::max(1u, r.height))
+        << ' ' << camera.target.x << ' ' << camera.target.y << ' ' << camera.target.z << ' ' << camera.radius << ' '
+        << camera.azimuthDeg << ' ' << camera.elevationDeg << ' ' << camera.fovDeg;
+    return key.str();
+}
+
+double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera) {
+    // The meter reads the frame's own scene-linear light at a small size: a mean over ten
+    // thousand pixels moves by far less than the 0.1 EV a viewer notices.
+    RenderRequest q = r;
+    q.width = std::min(r.width, kMeterWidth);
+    q.height = std::max(1u, uint32_t(std::lround(double(r.height) * q.width / std::max(1u, r.width))));
+    q.linearOutput = true;
+    q.probePositions = q.leaves = false;
+    q.gizmos.clear();
+    RenderSettings s = settingsOf(q, camera);
+    s.antialiasing = Antialiasing::Off;
+    const RenderedImage img = renderer_->render(s);
+    ++meterings_;
+    return meterEv100(img.rgba, img.width, img.height, project_.scene.camera.exposureMode);
+}
+
+double ProjectRenderer::shownEv100() const {
+    return project_.scene.camera.exposureMode == ExposureMode::Manual ? project_.scene.camera.ev100 : shownEv100_;
 }
 
 bool ProjectRenderer::drawsLpv(const RenderRequest& r) const {
@@ -418,13 +481,32 @@ std::shared_ptr<const lpv::Volumes> LpvJob::run(lpv::Propagation where) const {
 
 void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const std::string& key) {
     if (volumes) ++lpvUpdates_;
+    ++revision_;
     lpvKey_ = volumes ? key : std::string();
     renderer_->setLpv(std::move(volumes));
 }
 
 bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera, vk::Swapchain& swapchain) {
     if (!drawsLpv(r)) setLpv(nullptr, "");  // volumes no frame draws hold no memory
-    return renderer_->present(settingsOf(r, camera), swapchain);
+    RenderSettings s = settingsOf(r, camera);
+    if (!meters(r)) adapting_ = false;
+    else {
+        // Metered again only when what the frame shows changed; the shown exposure follows the
+        // meter with the authored time constant, frame after frame.
+        if (const std::string key = meterKey(r, camera); key != meterKey_) {
+            meteredEv100_ = meter(r, camera);
+            meterKey_ = key;
+        }
+        // An adapted eye starts adapting at the first frame of a change, however long the
+        // viewport was idle before it.
+        const auto now = std::chrono::steady_clock::now();
+        const double seconds = adapting_ ? std::chrono::duration<double>(now - shownAt_).count() : 0.0;
+        shownEv100_ = adaptEv100(shownEv100_, meteredEv100_, seconds, project_.scene.camera.adaptationSeconds);
+        shownAt_ = now;
+        adapting_ = std::abs(shownEv100_ - meteredEv100_) > kAdaptedEv;
+        s.exposure = float(exposureScale(shownEv100_, project_.scene.camera.exposureEv));
+    }
+    return renderer_->present(s, swapchain);
 }
 
 RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCamera& camera) const {

@@ -3,7 +3,9 @@
 // (baking first when that folder has none for the enabled volumes). `terralux --render`, the
 // render tests and the UI viewport all come through here, so they draw the same image.
 
+#include <chrono>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -139,6 +141,18 @@ public:
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
+    // The exposure the last frame showed, EV100: camera.ev100 in mode manual; in the metered modes
+    // what the meter read (render) or the viewport's adaptation toward it (present); NaN before a
+    // metered frame.
+    double shownEv100() const;
+    // The meter's last reading, EV100 (NaN before one).
+    double meteredEv100() const { return meteredEv100_; }
+    // Whether the last present() showed an exposure still adapting toward the meter (the
+    // viewport draws another frame then).
+    bool exposureAdapting() const { return adapting_; }
+    // How often a frame was metered (edits and camera moves meter again; adaptation does not).
+    size_t meterings() const { return meterings_; }
+
     // Whether a frame of `request` draws the LPV; a frame that does not frees bound volumes.
     bool drawsLpv(const RenderRequest& request) const;
     // The LPV update a frame of `request` from `camera` wants; nullopt when it draws no LPV.
@@ -180,6 +194,14 @@ private:
     // baked from the current probe-volume settings; otherwise the placement of those settings.
     void updateOverlays();
     RenderSettings settingsOf(const RenderRequest& request, const OrbitCamera& camera) const;
+    // Whether a frame of `request` is metered (a metered mode, a picture view, display output).
+    bool meters(const RenderRequest& request) const;
+    // The EV100 the meter reads from `request`'s frame, drawn scene-linear kMeterWidth wide.
+    double meter(const RenderRequest& request, const OrbitCamera& camera);
+    // What a metering depends on: the bound inputs' revision, the view and the camera.
+    std::string meterKey(const RenderRequest& request, const OrbitCamera& camera) const;
+    static constexpr uint32_t kMeterWidth = 128;
+    static constexpr double kAdaptedEv = 0.02;  // closer than this to the meter is adapted
 
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name
@@ -201,10 +223,18 @@ private:
     RenderSettings base_;
     ScenarioView view_;
     BakeLighting shown_;  // the lighting of the scenario shown (the blend's nearer end)
+    std::optional<Sky> heldSky_;  // the sky whose image the renderer holds
     std::unique_ptr<TerrainRenderer> renderer_;
     std::shared_ptr<const HeightfieldTracer> tracer_;  // for the LPV, made on first use
     std::string lpvKey_;
     size_t lpvUpdates_ = 0;
+    size_t revision_ = 0;  // bumped by every change of what a frame shows but the camera
+    std::string meterKey_;
+    double meteredEv100_ = std::numeric_limits<double>::quiet_NaN();
+    double shownEv100_ = std::numeric_limits<double>::quiet_NaN();
+    std::chrono::steady_clock::time_point shownAt_;
+    bool adapting_ = false;
+    size_t meterings_ = 0;
 };
 
 // Why the bake in `folder` is not `project`'s: the differences between its recorded inputs and the

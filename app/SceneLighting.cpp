@@ -231,7 +231,10 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     nlohmann::json ext = nlohmann::json::object();
     // Sections an engine takes as authored; a later feature's section is one more name here.
     for (const char* section : {"sky", "shadows", "fog"}) ext[section] = authored.at(section);
-    ext["exposure_ev"] = authored.at("camera").at("exposure_ev");
+    // The camera's exposure as authored, and the scale of the units every light here is in, so an
+    // engine exposes the same way: display = scene × 2^exposure_ev / (1.2 × 2^ev100 × scene_units_per_lux).
+    for (const char* key : {"exposure_mode", "ev100", "exposure_ev", "adaptation_s"}) ext[key] = authored.at("camera").at(key);
+    ext["scene_units_per_lux"] = shortestDecimal(kSceneUnitsPerLux);
 
     // The sun as the bake and the renderer light with it (BakeLighting), so a sky model that
     // moves or tints the sun shows here, beside the authored azimuth and elevation; illuminance ×

@@ -1,7 +1,8 @@
 #pragma once
 // The rules C++ and GLSL share, each written once in the common subset of the two languages:
-// height-fog optics (fog_math.glsl), the display encoding (display_math.glsl) and the SH basis
-// (sh_basis.glsl), and the Gerstner waves (water_math.glsl). C++ sees them here as inline float
+// height-fog optics (fog_math.glsl), the display encoding (display_math.glsl), the SH basis
+// (sh_basis.glsl), the equirectangular sky (sky_math.glsl), and the Gerstner waves
+// (water_math.glsl). C++ sees them here as inline float
 // functions in terralux::glsl (the waves in double, in terralux::glsl::dbl), with the GLSL
 // built-ins they call; tests/render/test_shader_math.cpp holds each against the shaders' own
 // evaluation on the device.
@@ -17,17 +18,21 @@
 namespace terralux::glsl {
 
 using std::abs;
+using std::acos;
 using std::exp;
+using std::floor;
 using std::pow;
 using std::sqrt;
 inline float max(float a, float b) { return std::max(a, b); }
 inline float min(float a, float b) { return std::min(a, b); }
 inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }  // GLSL's definition
+inline float atan(float y, float x) { return std::atan2(y, x); }  // GLSL's two-argument atan
 
 #define TLX_SHARED inline
 #include "fog_math.glsl"
 #include "display_math.glsl"
 #include "sh_basis.glsl"
+#include "sky_math.glsl"
 #undef TLX_SHARED
 
 }  // namespace terralux::glsl

@@ -271,10 +271,16 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             const FrameTimings& t = viewport_->renderer()->renderer().lastFrameTimings();
             if (t.gpuTimed()) text += QString(" · GPU %1 ms").arg(t.gpuMilliseconds, 0, 'f', 2);
             if (t.recordMilliseconds > 0.0) text += QString(" · host %1 ms").arg(t.recordMilliseconds, 0, 'f', 1);
+            // A metered exposure is shown as it adapts: what the camera is at now.
+            const double ev = viewport_->renderer()->shownEv100();
+            if (std::isfinite(ev)) text += QString(" · EV100 %1").arg(ev, 0, 'f', 2);
+            probeInspector_->setShownEv100(ev);
+            reflectionPanel_->setShownEv100(ev);
         }
         frameLabel_->setText(text);
         frameLabel_->setToolTip("Wall time of the last frame; GPU: its passes' time from timestamps; host: "
-                                "recording it (the per-pass times: terralux --render --profile)");
+                                "recording it (the per-pass times: terralux --render --profile); EV100: the "
+                                "camera's exposure (metered in modes average and histogram)");
     });
     connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {
         statusBar()->showMessage(QString("light propagation volumes updated in %1 ms").arg(ms, 0, 'f', 0), 3000);
@@ -476,8 +482,9 @@ QDockWidget* MainWindow::buildShadowsDock() {
 QDockWidget* MainWindow::buildAtmosphereDock() {
     auto* atmosphere = new ParameterForm(doc_);
     atmosphere->addParameters("fog.");
-    atmosphere->addParameter("camera.exposure_ev");
-    atmosphere->addParameter("camera.antialiasing");
+    for (const char* path : {"camera.exposure_mode", "camera.ev100", "camera.exposure_ev", "camera.adaptation_s",
+                             "camera.antialiasing"})
+        atmosphere->addParameter(path);
     reportRejections(atmosphere);
     atmosphere->refresh();
     return addDock("Atmosphere", "dock.atmosphere", atmosphere);

@@ -14,6 +14,7 @@
 #include "ProjectDocument.h"
 #include "DisplayEncoding.h"
 #include "bake/SphericalHarmonics.h"
+#include "scene/Exposure.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -37,11 +38,11 @@ glm::vec3 probeIrradiance(const GpuProbeVolume& v, size_t probe, const glm::vec3
     return glm::max(e * v.scale, glm::vec3(0.0f));
 }
 
-QImage irradianceBall(const GpuProbeVolume& v, size_t probe, int size, double exposureEv) {
+QImage irradianceBall(const GpuProbeVolume& v, size_t probe, int size, double exposureScale) {
     QImage img(size, size, QImage::Format_RGB32);
     img.fill(QColor(40, 40, 40));
     if (probe >= v.coeffs.size()) return img;
-    const float exposure = float(std::exp2(exposureEv));
+    const float exposure = float(exposureScale);
     const float r = 0.5f * float(size);
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
@@ -207,6 +208,13 @@ void ProbeInspector::showPoint(std::optional<glm::vec3> point) {
     inspect(w.volume, w.probes.front().first);
 }
 
+void ProbeInspector::setShownEv100(double ev100) {
+    // Redrawn only for a change a viewer could see, not for each adapting frame's hundredth of a stop.
+    if (std::isfinite(ev100) == std::isfinite(shownEv100_) && (!std::isfinite(ev100) || std::abs(ev100 - shownEv100_) < 0.05)) return;
+    shownEv100_ = ev100;
+    refresh();
+}
+
 void ProbeInspector::refresh() {
     refreshing_ = true;
     const int vi = volume_->currentIndex();
@@ -219,7 +227,7 @@ void ProbeInspector::refresh() {
     if (!volumes_ || volumes_->empty()) status_->setText("No probes yet: bake, or wait for the draft preview.");
     else status_->setText(QString("%1 probes (%2)").arg(count).arg(source_));
     if (g && index < count) {
-        ball_ = irradianceBall(*g, size_t(index), 128, doc_->project().scene.camera.exposureEv);
+        ball_ = irradianceBall(*g, size_t(index), 128, cameraExposureScale(doc_->project().scene.camera, shownEv100_));
         image_->setPixmap(QPixmap::fromImage(ball_));
         const glm::vec3 up = probeIrradiance(*g, size_t(index), glm::vec3(0, 1, 0));
         const glm::vec3 down = probeIrradiance(*g, size_t(index), glm::vec3(0, -1, 0));

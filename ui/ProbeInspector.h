@@ -1,4 +1,6 @@
 #pragma once
+
+#include <limits>
 // The Probe Volumes dock's inspector of one diffuse probe of the volumes the viewport lights with
 // (the last bake or the draft preview): its irradiance on a white diffuse ball and as numbers
 // (the nine SH coefficients, E on level ground facing up and facing down), its standard error,
@@ -41,9 +43,14 @@ public:
     // inspects the heaviest; nullopt clears the line (a marker was clicked instead).
     void showPoint(std::optional<glm::vec3> point);
 
+    // The viewport's exposure as shown now (ProjectRenderer::shownEv100), which a metered mode
+    // moves: the image follows it.
+    void setShownEv100(double ev100);
+
 private:
     void refresh();
     ProjectDocument* doc_;
+    double shownEv100_ = std::numeric_limits<double>::quiet_NaN();
     std::shared_ptr<const std::vector<GpuProbeVolume>> volumes_;
     QString source_;
     QComboBox* volume_;
@@ -61,7 +68,7 @@ glm::vec3 probeIrradiance(const GpuProbeVolume& v, size_t probe, const glm::vec3
 // A white diffuse ball of `size` pixels lit by the probe alone: radiance E(n)/π at the normal n
 // of each pixel, seen from the south (+Z) with east (+X) to the right and up (+Y) up, exposed by
 // 2^exposureEv and display-encoded as the viewport encodes. Pixels off the ball are dark grey.
-QImage irradianceBall(const GpuProbeVolume& v, size_t probe, int size, double exposureEv);
+QImage irradianceBall(const GpuProbeVolume& v, size_t probe, int size, double exposure);
 
 // The probes the viewport blends at `p` (shaders/probes.glsl, probeIrradiance, mirrored here):
 // the first volume whose fallback fade is above 0; the 8 cell centres around p clamped into its

@@ -12,6 +12,7 @@
 
 #include "ProjectDocument.h"
 #include "DisplayEncoding.h"
+#include "scene/Exposure.h"
 
 namespace terralux {
 namespace {
@@ -20,12 +21,12 @@ const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
 
 }  // namespace
 
-QImage reflectionCross(const ReflectionProbeSet& set, size_t index, int faceSize, double exposureEv) {
+QImage reflectionCross(const ReflectionProbeSet& set, size_t index, int faceSize, double exposureScale) {
     QImage img(4 * faceSize, 3 * faceSize, QImage::Format_RGB32);
     img.fill(QColor(40, 40, 40));
     if (index >= set.probes.size()) return img;
     const ReflectionProbe& p = set.probes[index];
-    const float exposure = float(std::exp2(exposureEv));
+    const float exposure = float(exposureScale);
     // Cell (column, row) of each face in the cross; the faces meet seamlessly in this layout.
     const int cell[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {3, 1}};
     const bool cube = set.encoding == ReflectionEncoding::Cubemap && !p.texels.empty();
@@ -112,6 +113,13 @@ void ReflectionPanel::inspect(int index) { probe_->setValue(index); }
 
 int ReflectionPanel::inspected() const { return probe_->value(); }
 
+void ReflectionPanel::setShownEv100(double ev100) {
+    // Redrawn only for a change a viewer could see, not for each adapting frame's hundredth of a stop.
+    if (std::isfinite(ev100) == std::isfinite(shownEv100_) && (!std::isfinite(ev100) || std::abs(ev100 - shownEv100_) < 0.05)) return;
+    shownEv100_ = ev100;
+    refresh();
+}
+
 void ReflectionPanel::refresh() {
     refreshing_ = true;
     const ReflectionProbeSettings& s = doc_->project().scene.reflectionProbes;
@@ -123,7 +131,7 @@ void ReflectionPanel::refresh() {
     else if (!set_) status_->setText("No probes yet: the preview is baking them.");
     else status_->setText(QString("%1 probes (%2)").arg(count).arg(source_));
     if (set_ && index < count) {
-        cross_ = reflectionCross(*set_, size_t(index), 48, doc_->project().scene.camera.exposureEv);
+        cross_ = reflectionCross(*set_, size_t(index), 48, cameraExposureScale(doc_->project().scene.camera, shownEv100_));
         image_->setPixmap(QPixmap::fromImage(cross_));
         // Held at the cross's size, so the dock's scrolled page makes room for all of it at once
         // (until its layout caught up, the label kept the height it had empty).

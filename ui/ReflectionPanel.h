@@ -1,4 +1,6 @@
 #pragma once
+
+#include <limits>
 // The Reflection Probes dock's own editors beyond the parameter rows: the probe inspector. A probe
 // chosen by number, or by a click on its marker in the viewport, shows its six faces as a cube
 // cross (mip 0 of a cube map, the face colours of the faces encoding) in the viewport's display
@@ -31,6 +33,9 @@ public:
     int inspected() const;
     // The cube cross of the inspected probe (null image without probes).
     const QImage& crossImage() const { return cross_; }
+    // The viewport's exposure as shown now (ProjectRenderer::shownEv100), which a metered mode
+    // moves: the image follows it.
+    void setShownEv100(double ev100);
 
 signals:
     void rejected(const QString& message);
@@ -38,6 +43,7 @@ signals:
 private:
     void refresh();
     ProjectDocument* doc_;
+    double shownEv100_ = std::numeric_limits<double>::quiet_NaN();
     std::shared_ptr<const ReflectionProbeSet> set_;
     QString source_;
     QSpinBox* probe_;
@@ -48,8 +54,8 @@ private:
 };
 
 // The six faces of probe `index` as a horizontal cross (−X +Z +X −Z in the middle row, +Y above
-// and −Y below +Z), `faceSize` pixels a face, exposed by 2^`exposureEv` and display-encoded as
+// and −Y below +Z), `faceSize` pixels a face, exposed by `exposure` (cameraExposureScale) and display-encoded as
 // the viewport encodes (ACES fit, sRGB).
-QImage reflectionCross(const ReflectionProbeSet& set, size_t index, int faceSize, double exposureEv);
+QImage reflectionCross(const ReflectionProbeSet& set, size_t index, int faceSize, double exposure);
 
 }  // namespace terralux

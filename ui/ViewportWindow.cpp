@@ -140,6 +140,7 @@ void ViewportWindow::renderNow() {
     }
     request_.gizmos = interaction_ ? interaction_->gizmos(camera_, QSizeF(width(), height())) : std::vector<GizmoLine>{};
     if (!renderer_->present(request_, camera_, *swapchain_)) return;
+    if (renderer_->exposureAdapting()) requestUpdate();  // the eye has not yet adapted
     emit frameRendered(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
 }
 

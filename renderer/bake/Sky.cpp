@@ -9,6 +9,7 @@
 #include <glm/common.hpp>
 #include <tbb/parallel_for.h>
 
+#include "ShaderMath.h"
 #include "bake/PhysicalSky.h"
 
 namespace terralux {
@@ -101,6 +102,13 @@ Sky Sky::physical(const PhysicalSky& model, int width, int height) {
     return equirect(std::move(rgb), width, height, 1.0f, 0.0f);
 }
 
+const std::vector<glm::vec3>* Sky::image(int* width, int* height) const {
+    if (!levels_) return nullptr;
+    *width = levels_->front().width;
+    *height = levels_->front().height;
+    return &levels_->front().texels;
+}
+
 Sky Sky::scaled(const glm::vec3& factor) const {
     if (!levels_) return uniform(uniform_ * factor);
     Sky s = *this;
@@ -148,10 +156,7 @@ glm::vec3 Sky::sample(const Level& level, float u, float v) const {
 
 glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
     if (!levels_) return uniform_;
-    const float phi = std::atan2(dir.x, -dir.z);
-    float u = 0.5f + phi / (2.0f * kPi) - rotation_;
-    u -= std::floor(u);
-    const float v = std::acos(std::clamp(dir.y, -1.0f, 1.0f)) / kPi;
+    const float u = glsl::equirectU(dir.x, dir.z, rotation_), v = glsl::equirectV(dir.y);
     const Level& base = levels_->front();
     // Level whose texel (at the equator) covers about `solidAngle`; blend the two nearest.
     const float texel0 = 2.0f * kPi * kPi / float(base.width * base.height);

@@ -44,6 +44,12 @@ public:
     Sky scaled(const glm::vec3& factor) const;
 
     bool isUniform() const { return !levels_; }
+    // The image of an hdr or physical sky at full resolution, row 0 at the zenith, before scale()
+    // and rotationTurns(): what the sky pass draws behind the terrain. Null for a uniform sky;
+    // copies of a sky share it.
+    const std::vector<glm::vec3>* image(int* width, int* height) const;
+    glm::vec3 scale() const { return scale_; }
+    float rotationTurns() const { return rotation_; }
     // Radiance toward `dir`, averaged over about `solidAngle` steradians around it (the share of
     // the sphere one sample stands for). Prefiltering a peaky HDR this way removes most of the
     // variance of a few hundred samples at the cost of blur below the SH's own resolution.

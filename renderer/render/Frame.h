@@ -72,6 +72,7 @@ inline constexpr const char* kLpvScales = "lpv-scales";
 inline constexpr const char* kSurfaceNormalAo = "surface-normal-ao";
 inline constexpr const char* kSurfaceAlbedo = "surface-albedo";
 inline constexpr const char* kSurfaceFilled = "surface-filled";
+inline constexpr const char* kSkyImage = "sky-image";
 
 // Pipeline variants of the terrain (all bits) and water (shadow, fog, reflection) passes.
 inline constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8,
@@ -147,6 +148,7 @@ struct RenderTarget {
 // an albedo map binds neutral ones.
 struct SurfaceTextures {
     vk::Image normalAo, albedo, filled;
+    vk::Image sky;  // the sky's equirectangular radiance (a 1 x 1 placeholder without one)
 };
 
 // What the renderer holds on the GPU for its lifetime: the terrain mesh, the frame slots and

@@ -40,6 +40,10 @@ struct RenderSettings {
     double time = 0.0;            // seconds: the waves' phase
     SunLight sun;
     sh::ShRgb skySh;
+    // The sky image's radiance factor and rotation in turns (TerrainRenderer::setSkyImage holds
+    // its texels).
+    glm::vec3 skyImageScale{1.0f};
+    float skyImageRotation = 0.0f;
     float exposure = 1.0f;        // multiplies scene light before the tone curve (2^EV)
     // camera.antialiasing: applied to the picture views only (those drawn with the sky behind).
     Antialiasing antialiasing = Antialiasing::Off;

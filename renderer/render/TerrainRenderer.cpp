@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <numbers>
 
 #include <glm/gtc/packing.hpp>
 #include <glm/packing.hpp>
@@ -101,7 +102,8 @@ vk::DescriptorSetBuilder viewSetBuilder(const FrameSlot& f, const vk::Buffer& ca
         .uniform(blocks::SurfaceBlock::kBinding, "surface", f.surface, kVertexFragment)
         .image(TLX_SURFACE_NORMAL_AO_BINDING, kSurfaceNormalAo, t ? t->normalAo.view() : VK_NULL_HANDLE, sampler, frag)
         .image(TLX_SURFACE_ALBEDO_BINDING, kSurfaceAlbedo, t ? t->albedo.view() : VK_NULL_HANDLE, sampler, frag)
-        .image(TLX_SURFACE_FILLED_BINDING, kSurfaceFilled, t ? t->filled.view() : VK_NULL_HANDLE, sampler, frag);
+        .image(TLX_SURFACE_FILLED_BINDING, kSurfaceFilled, t ? t->filled.view() : VK_NULL_HANDLE, sampler, frag)
+        .image(TLX_SKY_IMAGE_BINDING, kSkyImage, t ? t->sky.view() : VK_NULL_HANDLE, sampler, frag);
 }
 
 
@@ -252,6 +254,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     g.trilinear = vk::Sampler::trilinearClamp(ctx_);
     g.viewLayout = viewSetBuilder(g.slots[0], g.slots[0].camera, nullptr, g.trilinear.handle()).buildLayout(ctx_);
     uploadSurfaceMaps({});
+    setSkyImage(0, 0, {});
     setAlbedoMap(0, 0, {});
     g.emptySet = vk::DescriptorSetBuilder().buildLayout(ctx_);
     static_assert(TLX_SET_VIEW == 0 && TLX_SET_LIGHTS == 1 && TLX_SET_SUBSYSTEM == 2);
@@ -339,6 +342,40 @@ void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
     g.surface.filled = std::move(next.filled);
     surfaceMapSize_ = {maps.width, maps.height};
     hasAo_ = !ao.empty();
+    if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
+}
+
+void TerrainRenderer::setSkyImage(int width, int height, const std::vector<glm::vec3>& radiance) {
+    RendererGpu& g = *gpu_;
+    const bool image = width > 0 && height > 0 && radiance.size() == size_t(width) * size_t(height);
+    // A full mip chain of box means, so that a sky image many times the pixels it covers is drawn
+    // from the level a pixel spans (no sparkle); half floats, clamped to their largest value.
+    std::vector<glm::vec4> level(image ? radiance.size() : 1, glm::vec4(0.0f));
+    if (image)
+        for (size_t i = 0; i < level.size(); ++i) level[i] = glm::vec4(glm::min(radiance[i], glm::vec3(65000.0f)), 1.0f);
+    std::vector<vk::MipLevel> levels;
+    int w = image ? width : 1, h = image ? height : 1;
+    while (true) {
+        levels.push_back(halfLevel(w, h, level));
+        if (w == 1 && h == 1) break;
+        const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+        std::vector<glm::vec4> next(size_t(nw) * size_t(nh));
+        for (int j = 0; j < nh; ++j)
+            for (int i = 0; i < nw; ++i) {
+                const int x0 = i * w / nw, x1 = (i + 1) * w / nw, y0 = j * h / nh, y1 = (j + 1) * h / nh;
+                glm::vec4 sum(0.0f);
+                for (int y = y0; y < y1; ++y)
+                    for (int x = x0; x < x1; ++x) sum += level[size_t(y) * size_t(w) + size_t(x)];
+                next[size_t(j) * size_t(nw) + size_t(i)] = sum / float((x1 - x0) * (y1 - y0));
+            }
+        level = std::move(next);
+        w = nw;
+        h = nh;
+    }
+    vk::Image texture = vk::Image::texture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
+    ctx_.waitIdle();  // no frame may still read the old image
+    g.surface.sky = std::move(texture);
+    skyImageHeight_ = image ? height : 0;
     if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
 }
 
@@ -812,6 +849,13 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     surfaceIn.ao = hasAo_;
     surfaceIn.probeAoLevel = probeLevel;
     surfaceIn.borderHeight = borderHeight_;
+    if (skyImageHeight_ > 0) {
+        // The level whose texels span what a pixel spans: π / height radians a texel against
+        // the vertical field of view over the pixels drawn.
+        const double pixel = glm::radians(double(s.camera.fovDeg)) / (double(std::max(1u, f.height)) * g.target->scale);
+        surfaceIn.skyImageLod = float(std::max(0.0, std::log2(pixel / (std::numbers::pi / skyImageHeight_))));
+        surfaceIn.skyImage = true;
+    }
     if (hasAlbedoMap_) surfaceIn.borderAlbedo = borderAlbedo_;
     const blocks::SurfaceBlock surface = features::packSurface(s, surfaceIn);
     slot.surface.write(&surface, sizeof surface);

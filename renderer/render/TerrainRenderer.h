@@ -139,6 +139,10 @@ public:
     // An albedo map over the footprint (texel centres corner to corner, row 0 north, 8-bit sRGB,
     // 3 bytes a texel: SurfaceAlbedo::srgb), or width 0 for the constant albedo of RenderSettings.
     void setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb);
+    // The sky the picture views draw behind the terrain at full resolution: an equirectangular
+    // radiance image, row 0 at the zenith (renderer/bake/Sky.h's mapping), drawn × the settings'
+    // skyImageScale turned by skyImageRotation. Empty: the sky's SH (a uniform sky).
+    void setSkyImage(int width, int height, const std::vector<glm::vec3>& radiance);
     bool hasAmbientOcclusion() const { return hasAo_; }
     // The water plane at `level` (engine y): the field of depth below the level and distance to
     // shore, and the mesh over every cell whose bed lies below level + `margin` (the highest a
@@ -207,6 +211,7 @@ private:
     std::vector<Cascade> cascades_;
     size_t sunTraces_ = 0;
     bool hasAo_ = false, hasAlbedoMap_ = false;
+    int skyImageHeight_ = 0;  // texels of the bound sky image, 0 without one
     float borderHeight_ = 0.0f;        // the DEM border's mean height: the skirt's, as the sky draws it
     glm::vec3 borderAlbedo_{1.0f};     // the albedo map's border ring, mean linear
     glm::ivec2 surfaceMapSize_{1, 1}, albedoMapSize_{1, 1};

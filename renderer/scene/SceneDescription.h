@@ -381,6 +381,18 @@ inline const char* antialiasingName(Antialiasing a) {
     return a == Antialiasing::Off ? "off" : a == Antialiasing::Fxaa ? "fxaa" : "ssaa";
 }
 
+// How the camera finds its exposure (docs/lighting.md, "Exposure"): manual at camera.ev100, or
+// metered from the frame: average (the geometric mean luminance of the whole frame) or histogram
+// (the mean log luminance between the frame's 10th and 90th percentiles).
+enum class ExposureMode { Manual, Average, Histogram };
+inline const char* exposureModeName(ExposureMode m) {
+    return m == ExposureMode::Manual ? "manual" : m == ExposureMode::Average ? "average" : "histogram";
+}
+
+// The EV100 at which one scene unit of luminance displays as 1/1.2 of saturation, the exposure the
+// defaults were set for: log2(1 / (1.2 kSceneUnitsPerLux)). The sunny-16 rule's clear day is 15.
+inline constexpr double kDefaultEv100 = 14.7616;
+
 // Orbit camera of the viewport and `terralux --render`. Unset target = the footprint centre at
 // the mean terrain height; unset radius = frames the whole footprint.
 struct CameraSettings {
@@ -389,7 +401,10 @@ struct CameraSettings {
     double azimuthDeg = 210.0;        // clockwise from north, where the camera stands
     double elevationDeg = 35.0;       // (-90, 90)
     double fovDeg = 45.0;             // vertical, (1, 150)
-    double exposureEv = 0.0;          // stops: the display multiplies scene light by 2^EV
+    ExposureMode exposureMode = ExposureMode::Histogram;
+    double ev100 = kDefaultEv100;     // manual exposure, EV at ISO 100
+    double exposureEv = 0.0;          // compensation in stops, every mode: 2^EV more displayed light
+    double adaptationSeconds = 1.0;   // metered modes, the viewport: time constant toward the meter
     Antialiasing antialiasing = Antialiasing::Fxaa;
 };
 

@@ -7,6 +7,7 @@ layout(local_size_x = 64) in;
 #include "display_math.glsl"
 #include "fog_math.glsl"
 #include "sh_basis.glsl"
+#include "sky_math.glsl"
 
 // Per sample two vec4: a = (scene-linear light, a value in [0, 1], height above the fog's base
 // (m), Henyey–Greenstein g); b = (unit direction xyz, distance (m)).
@@ -14,7 +15,7 @@ layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Outputs { float outputs[]; };
 layout(push_constant) uniform Push { ivec4 count; } push;
 
-const int kOutputs = 17;
+const int kOutputs = 19;
 
 void main() {
     int i = int(gl_GlobalInvocationID.x);
@@ -30,4 +31,6 @@ void main() {
     outputs[o + 14] = henyeyGreenstein(a.w, b.y);
     outputs[o + 15] = srgbEncode(acesFit(a.x));
     outputs[o + 16] = fogSkyOpticalDepth(0.002, 0.001, a.z, b.y, b.w);
+    outputs[o + 17] = equirectU(b.x, b.z, a.y);
+    outputs[o + 18] = equirectV(b.y);
 }

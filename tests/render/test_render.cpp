@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include <gdal_priv.h>
+#include <glm/matrix.hpp>
 #include <gtest/gtest.h>
 
 #include "ImageCompare.h"
@@ -19,8 +20,11 @@
 #include "ShaderMath.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
+#include "SceneLighting.h"
 #include "bake/ReflectionBake.h"
+#include "bake/SphericalHarmonics.h"
 #include "lpv/Lpv.h"
+#include "scene/Exposure.h"
 #include "scene/DebugViews.h"
 #include "render/FrameGraph.h"
 #include "vk/Descriptors.h"
@@ -722,7 +726,12 @@ TEST_F(RenderTest, FrameTimingsArePerPassMonotoneAndWithinTheFrame) {
 
 TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
     using Names = std::vector<std::string>;
-    ProjectRenderer without(*ctx_, sampleProject("novolumes", 8, 8));  // no probes loaded at all
+    // The passes of one frame each: a fixed exposure, no metering frame drawn before it.
+    const auto manual = [](Project p) {
+        p.scene.camera.exposureMode = ExposureMode::Manual;
+        return p;
+    };
+    ProjectRenderer without(*ctx_, manual(sampleProject("novolumes", 8, 8)));  // no probes loaded at all
     EXPECT_FALSE(without.renderer().hasProbeResources());
     for (const auto& v : debugViews()) {
         draw(without, v.number);
@@ -732,7 +741,7 @@ TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
     const RenderedImage none = draw(without, kViewBeauty);
     EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "sky", "antialias", "readback"}));
 
-    ProjectRenderer with(*ctx_, sampleProject("volumes", 8, 8));
+    ProjectRenderer with(*ctx_, manual(sampleProject("volumes", 8, 8)));
     ASSERT_EQ(with.loadProbes(true), 1u);
     EXPECT_TRUE(with.renderer().hasProbeResources());
     // Probes on: the probe pass runs once after the volumes changed; the terrain reads its light.
@@ -1141,6 +1150,7 @@ TEST_F(RenderTest, FarTerrainIsFoggierThanNearTerrain) {
 
 TEST_F(RenderTest, ShadowsOffDrawsNoShadowPassAndHoldsNoMaps) {
     Project p = sampleProject("no_shadows", 8, 8);
+    p.scene.camera.exposureMode = ExposureMode::Manual;  // the passes of one frame, no metering frame
     ProjectRenderer r(*ctx_, p);
     draw(r, kViewBeauty, false);
     EXPECT_TRUE(r.renderer().hasShadowResources());
@@ -1433,6 +1443,7 @@ TEST_F(RenderTest, WaterMaskIsTheCellsBelowTheLevel) {
 // The waves move the water between t = 0 and 1 s; the land away from the shore stays as it was.
 TEST_F(RenderTest, WavesMoveTheWaterAndLeaveTheLand) {
     Project p = sampleProject("water_time", 2, 2);
+    p.scene.camera.exposureMode = ExposureMode::Manual;  // a meter would follow the waves' light
     p.scene.terrain.dem = writeBasinDem().string();
     p.scene.camera.elevationDeg = 30.0;
     ProjectRenderer r(*ctx_, p);
@@ -2352,4 +2363,145 @@ TEST_F(RenderTest, TheSkyMeetsTheFoggedGroundAtTheHorizonWithoutAStep) {
     EXPECT_LT(worst, 0.08);
     // And it is a horizon: the haze there is brighter than the sky well above it.
     EXPECT_GT(lumaOf(img, 10, size_t(horizon)), lumaOf(img, 10, size_t(horizon) - 40) + 0.02);
+}
+
+TEST_F(RenderTest, TheMeteredExposurePutsTheTerrainNearMiddleGrey) {
+    // Histogram metering on three terrains and three suns under the default sky: the terrain's
+    // mean log luminance on the display (sRGB decoded) within a stop of middle grey (0.18), and
+    // the sky not clipped. Manual exposure at the default EV100 spans 0.1 to 0.5 there; snow on
+    // the Rainier crop at a high sun is the brightest.
+    const fs::path dems = fs::path(TERRALUX_SOURCE_DIR) / "tests" / "data" / "dem";
+    const uint32_t w = 320, h = 180;
+    for (const std::string& dem : {std::string(), (dems / "rainier_crop.tif").string(),
+                                   (dems / "bigtujunga_utm11_crop.tif").string()})
+        for (const char* elevation : {"12", "35", "60"}) {
+            Project p = loadEffectiveProject("", {"probe_volumes[0].enabled=false", "sun.mode=\"manual\"",
+                                                  std::string("sun.elevation_deg=") + elevation,
+                                                  "camera.exposure_mode=\"histogram\""},
+                                             dem, nullptr);
+            p.scene.exportSettings.outDir = (kOut / "bake_exposure").string();
+            ProjectRenderer r(*ctx_, p);
+            const RenderedImage terrain = draw(r, kViewSunVisibility, false, true, w, h);
+            // The terrain's geometric mean display luminance, its pixel count, the sky's pixels and
+            // how many of those are clipped.
+            struct Reading {
+                double mean = 0.0;
+                size_t terrain = 0, sky = 0, clipped = 0;
+            };
+            const auto read = [&](const RenderedImage& img) {
+                Reading m;
+                double logSum = 0.0;
+                for (size_t i = 0; i < size_t(w) * h; ++i) {
+                    double y = 0.0;
+                    for (int c = 0; c < 3; ++c) {
+                        const double e = img.rgba[i * 4 + size_t(c)];
+                        const double linear = e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+                        y += (c == 0 ? 0.2126 : c == 1 ? 0.7152 : 0.0722) * linear;
+                    }
+                    if (terrain.rgba[i * 4 + 1] > 0.5f) {
+                        logSum += std::log2(std::max(y, 1e-4));
+                        ++m.terrain;
+                    } else {
+                        ++m.sky;
+                        if (y > 0.95) ++m.clipped;
+                    }
+                }
+                m.mean = std::exp2(logSum / double(std::max<size_t>(m.terrain, 1)));
+                return m;
+            };
+            const RenderedImage img = draw(r, kViewBeauty, false, false, w, h);
+            const double ev = r.meteredEv100();
+            const Reading metered = read(img);
+            p.scene.camera.exposureMode = ExposureMode::Manual;
+            r.setProject(p);
+            const Reading manual = read(draw(r, kViewBeauty, false, false, w, h));
+            p.scene.camera.exposureMode = ExposureMode::Histogram;
+            r.setProject(p);
+            const size_t n = metered.terrain, sky = metered.sky, clipped = metered.clipped;
+            const double mean = metered.mean;
+            const std::string what = (dem.empty() ? std::string("sample") : fs::path(dem).filename().string()) +
+                                     " sun " + elevation + ": EV100 " + std::to_string(ev) + ", terrain " +
+                                     std::to_string(n) + " px at " + std::to_string(mean) + " (manual " +
+                                     std::to_string(manual.mean) + "), sky clipped " + std::to_string(clipped) +
+                                     " of " + std::to_string(sky) + " (manual " + std::to_string(manual.clipped) + ")";
+            std::cout << what << "\n";
+            ASSERT_GT(n, size_t(w) * h / 8) << what;
+            EXPECT_GT(mean, 0.18 / 2.0) << what;
+            EXPECT_LT(mean, 0.18 * 2.0) << what;
+            EXPECT_LE(double(clipped), 0.01 * double(sky)) << what;
+            EXPECT_TRUE(std::isfinite(ev) && std::abs(ev - r.shownEv100()) < 1e-12) << what;
+            // The meter's frame, 128 pixels wide, reads what the whole frame reads.
+            const RenderedImage whole = draw(r, kViewBeauty, false, true, w, h);
+            EXPECT_NEAR(meterEv100(whole.rgba, w, h, ExposureMode::Histogram), ev, 0.05) << what;
+
+            // The meter follows the light: all of it twice as bright reads one stop more and shows
+            // the same picture.
+            if (std::string(elevation) != "35") continue;
+            p.scene.sun.illuminance *= 2.0;
+            p.scene.sky.intensity *= 2.0;
+            r.setProject(p);
+            const RenderedImage brighter = draw(r, kViewBeauty, false, false, w, h);
+            EXPECT_NEAR(r.meteredEv100() - ev, 1.0, 0.01) << what;
+            double diff = 0.0;
+            for (size_t i = 0; i < img.rgba.size(); ++i) diff = std::max(diff, double(std::abs(img.rgba[i] - brighter.rgba[i])));
+            EXPECT_LT(diff, 3.0 / 255.0) << what;
+        }
+}
+
+TEST_F(RenderTest, AnHdrSkyIsDrawnBehindTheTerrainAtItsOwnResolution) {
+    // A checkered HDR of 16 x 8 cells (radiance 0.1 and 1.0), rotated: the sky pass must draw its
+    // texels through the bake's own mapping (Sky::radiance), not the SH's blur of them. Compared
+    // scene-linear on the sky pixels above the horizon, away from the sun.
+    const int iw = 256, ih = 128;
+    std::vector<float> rgba;
+    for (int y = 0; y < ih; ++y)
+        for (int x = 0; x < iw; ++x) {
+            const float v = ((x / 16) + (y / 16)) % 2 ? 1.0f : 0.1f;
+            rgba.insert(rgba.end(), {v, 0.5f * v, 0.25f + v, 1.0f});
+        }
+    const fs::path hdr = kOut / "checker_sky.exr";
+    writeImage(hdr, iw, ih, rgba);
+    Project p = loadEffectiveProject("", {"probe_volumes[0].enabled=false", "sky.hdr=\"" + hdr.string() + "\"",
+                                          "sky.mode=\"hdr\"", "sky.rotation_deg=30",
+                                          "sky.intensity=2", "fog.enabled=false", "sun.mode=\"manual\"",
+                                          "sun.azimuth_deg=30", "sun.elevation_deg=40", "camera.azimuth_deg=30",
+                                          "camera.elevation_deg=4", "camera.antialiasing=\"off\""},
+                                     "", nullptr);
+    p.scene.exportSettings.outDir = (kOut / "bake_hdr_background").string();
+    ProjectRenderer r(*ctx_, p);
+    const uint32_t w = 320, h = 180;
+    const RenderedImage img = draw(r, kViewBeauty, false, true, w, h);
+    const BakeLighting lighting = lightingOf(p, r.heightfield());
+    const OrbitCamera cam = r.defaultCamera();
+    const glm::mat4 inv = glm::inverse(cam.viewProjection(float(w) / float(h), 1000.0f));
+    double sumImage = 0.0, sumSh = 0.0, sumRef = 0.0;
+    size_t n = 0;
+    for (uint32_t y = 0; y < h; ++y)
+        for (uint32_t x = 0; x < w; ++x) {
+            const glm::vec4 far = inv * glm::vec4((x + 0.5f) / w * 2.0f - 1.0f, (y + 0.5f) / h * 2.0f - 1.0f, 0.0f, 1.0f);
+            const glm::vec3 dir = glm::normalize(glm::vec3(far) / far.w - cam.position());
+            if (dir.y < 0.05f || glm::dot(dir, lighting.sun.direction) > 0.99f) continue;
+            const glm::vec3 ref = lighting.sky.radiance(dir);
+            const glm::vec3 sh = glm::max(sh::evalRadiance(lighting.sky.sh(), dir), glm::vec3(0.0f));
+            const size_t i = (size_t(y) * w + x) * 4;
+            for (int c = 0; c < 3; ++c) {
+                sumImage += std::abs(double(img.rgba[i + size_t(c)]) - ref[c]);
+                sumSh += std::abs(double(sh[c]) - ref[c]);
+                sumRef += ref[c];
+            }
+            ++n;
+        }
+    const double image = sumImage / sumRef, shError = sumSh / sumRef;
+    std::cout << n << " sky pixels: mean |drawn - Sky::radiance| " << image << " of the radiance; the SH would be "
+              << shError << "\n";
+    ASSERT_GT(n, size_t(w) * h / 4);
+    EXPECT_LT(image, 0.02);
+    EXPECT_GT(shError, 0.2);
+
+    // A uniform sky keeps the SH (exact for it), and the image leaves with it.
+    p.scene.sky.mode = SkyMode::Uniform;
+    r.setProject(p);
+    const RenderedImage uniform = draw(r, kViewBeauty, false, true, w, h);
+    const glm::vec3 sky = glm::vec3(p.scene.sky.color) * float(p.scene.sky.intensity);
+    EXPECT_NEAR(uniform.rgba[(size_t(2) * w + w / 2) * 4], sky.x, 1e-3 * sky.x + 1e-5);
 }

@@ -3,6 +3,7 @@
 // samples spread over each function's domain; and the SH basis against the CPU bake's own
 // double-precision closed forms.
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <span>
 #include <vector>
@@ -31,7 +32,7 @@ using namespace terralux;
 
 namespace {
 
-constexpr int kOutputs = 17;
+constexpr int kOutputs = 19;
 
 struct Sample {
     glm::vec4 a, b;
@@ -67,12 +68,14 @@ std::array<float, kOutputs> onCpu(const Sample& s) {
     o[14] = glsl::henyeyGreenstein(s.a.w, s.b.y);
     o[15] = glsl::srgbEncode(glsl::acesFit(s.a.x));
     o[16] = glsl::fogSkyOpticalDepth(0.002f, 0.001f, s.a.z, s.b.y, s.b.w);
+    o[17] = glsl::equirectU(s.b.x, s.b.z, s.a.y);
+    o[18] = glsl::equirectV(s.b.y);
     return o;
 }
 
 const char* kNames[kOutputs] = {"acesFit", "srgbEncode", "srgbDecode", "acesFitInverse", "Y0", "Y1", "Y2",
                                 "Y3", "Y4", "Y5", "Y6", "Y7", "Y8", "fogOpticalDepth", "henyeyGreenstein",
-                                "display", "fogSkyOpticalDepth"};
+                                "display", "fogSkyOpticalDepth", "equirectU", "equirectV"};
 
 // A device with validation, or none (the test skips).
 std::unique_ptr<vk::VulkanContext> device(std::string& why) {
@@ -133,8 +136,10 @@ TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
     // (a fused multiply-add here or there): 2.5e-7, which a constant copied to six digits fails
     // (the SH basis's old 0.282095 was 7.4e-7 off). Vulkan lets pow be a few ulps off IEEE
     // (2e-6) and exp's error grows with its argument, up to 80 in the fog's optical depth (5e-5).
+    // atan and acos may be 4096 ulps off (2.4e-4 relative); lavapipe's acos is 1.2e-4 off near
+    // the zenith, a fortieth of a texel of a 2k sky (5e-4).
     const double bound[kOutputs] = {2.5e-7, 2e-6, 2e-6, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7,
-                                    2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6, 5e-5};
+                                    2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6, 5e-5, 5e-4, 5e-4};
     for (int f = 0; f < kOutputs; ++f) {
         double worst = 0.0;
         for (size_t i = 0; i < in.size(); ++i) {
@@ -144,6 +149,22 @@ TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
         EXPECT_LT(worst, bound[f]) << kNames[f];
     }
     EXPECT_EQ(ctx->validationMessageCount(), 0u);
+}
+
+// The shared equirectangular mapping inverts the directions the sky's SH projection gives its
+// texel centres (Sky::computeSh): the bake, the SH and the sky pass agree on where a texel is.
+TEST(ShaderMath, TheEquirectMappingFindsEachTexelOfTheSky) {
+    const int w = 64, h = 32;
+    for (const float rotation : {0.0f, 0.3f, 0.9f})
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const double u = (x + 0.5) / w, v = (y + 0.5) / h;
+                const double phi = (u - 0.5 + rotation) * 2.0 * std::numbers::pi, theta = v * std::numbers::pi;
+                const float dx = float(std::sin(theta) * std::sin(phi)), dy = float(std::cos(theta)),
+                            dz = float(-std::sin(theta) * std::cos(phi));
+                ASSERT_NEAR(glsl::equirectU(dx, dz, rotation), u, 1e-5) << x << "," << y << " rotation " << rotation;
+                ASSERT_NEAR(glsl::equirectV(dy), v, 1e-5) << x << "," << y;
+            }
 }
 
 // The shared float basis is the CPU bake's double-precision basis rounded once.

@@ -676,6 +676,17 @@ private slots:
         auto* atmosphereDock = w_->findChild<QDockWidget*>("dock.atmosphere");
         QVERIFY(!rowOf(w_->findChild<QWidget*>("param.fog.density"))->isVisibleTo(atmosphereDock));
         QVERIFY(rowOf(w_->findChild<QWidget*>("param.camera.exposure_ev"))->isVisibleTo(atmosphereDock));
+        // Exposure: metered by histogram by default, with its adaptation; manual trades that row
+        // for the camera's EV100.
+        auto* exposureMode = w_->findChild<QComboBox*>("param.camera.exposure_mode");
+        QVERIFY(exposureMode && atmosphereDock->isAncestorOf(exposureMode));
+        QCOMPARE(exposureMode->currentText(), QString("histogram"));
+        QWidget* ev100 = rowOf(w_->findChild<QWidget*>("param.camera.ev100"));
+        QWidget* adaptation = rowOf(w_->findChild<QWidget*>("param.camera.adaptation_s"));
+        QVERIFY(!ev100->isVisibleTo(atmosphereDock) && adaptation->isVisibleTo(atmosphereDock));
+        exposureMode->setCurrentText("manual");
+        QVERIFY(ev100->isVisibleTo(atmosphereDock) && !adaptation->isVisibleTo(atmosphereDock));
+        exposureMode->setCurrentText("histogram");
     }
 
     // sun.mode date_time: the Sun & Sky dock trades the angles for a date, a time of day on a
@@ -875,6 +886,48 @@ private slots:
         QCOMPARE(colorsAfter[5].get<double>(), 0.0);
         for (size_t i : {0, 1, 2, 6, 7, 8}) QCOMPARE(colorsAfter[i], colorsBefore[i]);
         QVERIFY(w_->findChild<QPushButton*>("param.terrain.ramp_colors.1")->toolTip() == "1, 0, 0");
+    }
+
+    // A metered exposure: an edit that darkens the frame meters again, and the viewport's shown
+    // exposure follows the meter over frames with the authored time constant, then stops drawing;
+    // the status bar shows the EV100 as it moves.
+    void meteredExposureAdaptsInTheViewport() {
+        QString error;
+        QVERIFY(w_->document()->setParameter("camera.exposure_mode", "histogram", &error));
+        QVERIFY(w_->document()->setParameter("camera.adaptation_s", 0.4, &error));
+        ProjectRenderer* r = w_->viewport()->renderer();
+        QVERIFY(r);
+        w_->viewport()->renderNow();
+        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 10000);
+        const double before = r->meteredEv100();
+        QVERIFY(std::isfinite(before));
+        QTRY_VERIFY_WITH_TIMEOUT(w_->findChild<QLabel*>("status.frame")->text().contains("EV100"), 5000);
+        // A quarter of the sun and the sky: all the light two stops down (a preview bake follows;
+        // the meter reads each new frame).
+        const size_t meterings = r->meterings();
+        const double sun = w_->document()->project().scene.sun.illuminance;
+        const double sky = w_->document()->project().scene.sky.intensity;
+        QVERIFY(w_->document()->setParameter("sun.illuminance", sun / 4.0, &error));
+        QVERIFY(w_->document()->setParameter("sky.intensity", sky / 4.0, &error));
+        QTRY_VERIFY_WITH_TIMEOUT(r->meterings() > meterings && r->exposureAdapting(), 10000);
+        // On the way: the shown exposure has not jumped to the new reading.
+        QVERIFY2(r->shownEv100() > r->meteredEv100() + 0.1,
+                 qPrintable(QString("shown %1, metered %2").arg(r->shownEv100()).arg(r->meteredEv100())));
+        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
+        QTRY_VERIFY_WITH_TIMEOUT(std::abs(r->meteredEv100() - (before - 2.0)) < 0.1, 15000);
+        QVERIFY(std::abs(r->shownEv100() - r->meteredEv100()) <= 0.02);
+        QVERIFY(w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)));
+        // Adapted: no frame without a change.
+        bool quiet = false;
+        for (int attempt = 0; attempt < 10 && !quiet; ++attempt) {
+            QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
+            QTest::qWait(300);
+            quiet = frames.count() == 0;
+        }
+        QVERIFY(quiet);
+        w_->document()->undoStack()->undo();
+        w_->document()->undoStack()->undo();
+        QCOMPARE(w_->document()->project().scene.sun.illuminance, sun);
     }
 
     // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).

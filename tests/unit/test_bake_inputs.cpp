@@ -57,6 +57,7 @@ std::vector<SceneDescription> coveringScenes(json doc = defaultProjectJson(), co
     with("/shadows/split_mode", "manual");
     docs.back()["shadows"]["splits"] = {100.0, 300.0, 1000.0};
     with("/shadows/split_mode", "practical");
+    with("/camera/exposure_mode", "manual");
     with("/lighting/indirect", "both");
     with("/lpv/quality", 2);
     with("/water/waves", json::array({json{{"steepness", 0.1}}}));

@@ -18,6 +18,7 @@
 #include "ParameterTable.h"
 #include "Project.h"
 #include "SceneLighting.h"
+#include "bake/PhysicalSky.h"
 #include "scene/ShadowCascades.h"
 #include "water/Water.h"
 
@@ -219,6 +220,38 @@ TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {
     ASSERT_EQ(model.scenes.size(), 1u);
     EXPECT_TRUE(model.scenes[0].extensions.count("TERRALUX_lighting"));
     EXPECT_FALSE(model.extensions.count("TERRALUX_lighting"));
+    fs::remove_all(dir);
+}
+
+TEST(LightingExtension, TheCameraExposureRoundTripsThroughTheProjectAndTheGltf) {
+    // A manual EV100 and a metered mode, saved, loaded and exported: scene.gltf carries what was
+    // authored, with the scale of the units its lights are in.
+    const fs::path dir = fs::temp_directory_path() / ("terralux_test_exposure_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const Heightfield hf = makeTerrain();
+    for (const char* mode : {"manual", "histogram"}) {
+        Project p = projectWith({std::string("camera.exposure_mode=\"") + mode + "\"", "camera.ev100=12.5",
+                                 "camera.exposure_ev=0.7", "camera.adaptation_s=2.5"});
+        saveProject(p, dir / "p.terralux.json");
+        std::vector<std::string> warnings;
+        const Project loaded = loadProject(dir / "p.terralux.json", &warnings);
+        EXPECT_EQ(exposureModeName(loaded.scene.camera.exposureMode), std::string(mode));
+        EXPECT_EQ(loaded.scene.camera.ev100, 12.5);
+        EXPECT_EQ(loaded.scene.camera.adaptationSeconds, 2.5);
+        GltfSceneInput in;
+        in.heightfield = &hf;
+        in.lighting = lightingExtension(loaded, hf);
+        exportGltfScene(dir / "out", in);
+        std::ifstream file(dir / "out" / "scene.gltf");
+        const json ext = json::parse(file)["scenes"][0]["extensions"]["TERRALUX_lighting"];
+        EXPECT_EQ(ext["exposure_mode"], mode);
+        EXPECT_EQ(ext["ev100"].get<double>(), 12.5);
+        EXPECT_EQ(ext["exposure_ev"].get<double>(), 0.7);
+        EXPECT_EQ(ext["adaptation_s"].get<double>(), 2.5);
+        // The rule docs/formats.md gives an engine: one scene unit is 1 / scene_units_per_lux lux.
+        EXPECT_FLOAT_EQ(ext["scene_units_per_lux"].get<float>(), kSceneUnitsPerLux);
+    }
     fs::remove_all(dir);
 }
 

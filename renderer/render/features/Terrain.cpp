@@ -67,6 +67,10 @@ blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& i
     surface.groundAlbedo = in.borderAlbedo.value_or(s.albedo);
     surface.groundHeight = in.borderHeight;
     surface.ground = s.skirt ? 1.0f : 0.0f;
+    surface.skyImage = in.skyImage ? 1.0f : 0.0f;
+    surface.skyImageLod = in.skyImageLod;
+    surface.skyImageScale = s.skyImageScale;
+    surface.skyImageRotation = s.skyImageRotation;
     return surface;
 }
 

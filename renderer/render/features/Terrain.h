@@ -24,6 +24,8 @@ struct SurfaceInputs {
     // The skirt beyond the footprint as the sky pass draws it: the border's mean height and, with
     // an albedo map, its mean linear albedo (else s.albedo).
     float borderHeight = 0.0f;
+    bool skyImage = false;    // a sky image is bound (TerrainRenderer::setSkyImage)
+    float skyImageLod = 0.0f; // its mip level a pixel spans
     std::optional<glm::vec3> borderAlbedo;
 };
 
