@@ -468,6 +468,10 @@ std::vector<ParameterSpec> buildTable() {
         .choices({shadowFilterName(ShadowFilter::Pcss), shadowFilterName(ShadowFilter::Pcf), shadowFilterName(ShadowFilter::Hard)}).label("Filter")
         .about("pcss: penumbrae from the sun's size that harden at contact (Fernando 2005); pcf: a fixed soft edge; hard: one comparison")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::filter);
+    add(Row("shadows.cascade_blend", T::Number)).range(0.0, 0.5).decimals(2).label("Cascade blend")
+        .about("Share of each cascade's depth slice, at its far end, over which its shadow blends into the next cascade's, "
+               "so the change of texel size leaves no seam; 0 switches at once")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::cascadeBlend);
 
     // Height fog.
     const auto fogOn = [](const SceneDescription& s, size_t) { return s.fog.enabled; };

@@ -94,27 +94,22 @@ float litFraction(TexelQuad t) { return dot(t.weight, step(t.plane, t.depth)); }
 // receiver tilted to the sun, would otherwise find the receiver itself in front of the point:
 // acne that grows with the kernel and as the sun sinks, which no constant bias removes without
 // also losing the shadows of low relief.
-// p: the point; n: its shading normal (which side of the terminator it is on); ng: the normal of
-// the drawn triangle, the surface the maps hold.
-float sunShadow(vec3 p, vec3 n, vec3 ng) {
-    int c = sunCascade(p);
-    if (c < 0) return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0;
-    vec3 l = normalize(sunSky.sunDirection);
-    // A surface facing away from the sun does not see it (as the traced visibility has it).
-    float ndotl = dot(n, l);
-    if (ndotl <= 0.0) return 0.0;
+// The lit fraction of p from cascade c's map. p: the point; ng: the normal of the drawn triangle,
+// the surface the maps hold; l: toward the sun. `partner`: -1 where p falls outside the map (the
+// next cascade's light-space box need not reach back into the slice before its own).
+float cascadeShadow(int c, vec3 p, vec3 ng, vec3 l, float rotation, bool partner) {
     float texelWorld = shadow.texel[c];
     // Normal offset grows as the surface turns from the sun (slopes facing away need more).
     float ngdotl = clamp(dot(ng, l), -1.0, 1.0);
     vec3 q = p + ng * (shadow.normalBias * texelWorld * sqrt(1.0 - ngdotl * ngdotl)) + l * (shadow.depthBias * texelWorld);
     vec4 lc = shadow.lightViewProj[c] * vec4(q, 1.0);
     vec2 uv = lc.xy * 0.5 + 0.5;
+    if (partner && (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))))) return -1.0;
     float texelUv = 1.0 / shadow.mapResolution;
     vec2 plane = receiverPlane(c, ng);
     float z = lc.z - kSlopeTexels * (abs(plane.x) + abs(plane.y)) * texelUv;
     float layer = float(c);
     if (shadow.filterMode == kFilterHard) return litFraction(texelQuad(uv, layer, z, plane));
-    float rotation = shadowNoise();
     float radiusTexels = 1.5;
     if (shadow.filterMode == kFilterPcss) {
         float tanR = shadow.tanSunRadius;
@@ -140,6 +135,32 @@ float sunShadow(vec3 p, vec3 n, vec3 ng) {
     return lit / float(kFilterTaps);
 }
 
+// The weight of the next cascade at p in cascade c's slice: 0 before the blend band, rising
+// smoothly to 1 at the slice's end; 0 in the last cascade.
+float cascadeBlendWeight(vec3 p, int c) {
+    if (c < 0 || c + 1 >= shadow.cascadeCount || shadow.cascadeBlend <= 0.0) return 0.0;
+    float d = dot(p - camera.position, shadow.forward);
+    float begin = c == 0 ? shadow.nearDepth : shadow.ends[c - 1], end = shadow.ends[c];
+    return smoothstep(end - shadow.cascadeBlend * (end - begin), end, d);
+}
+
+// Over the far shadows.cascade_blend of its slice, a cascade's shadow blends into the next one's
+// (smoothstep in view depth), so the step in texel size and penumbra is no seam (the transition
+// band of Engel, "Cascaded Shadow Maps", ShaderX5, 2006). The last cascade ends where it ends.
+// n: the shading normal (which side of the terminator p is on).
+float sunShadow(vec3 p, vec3 n, vec3 ng) {
+    int c = sunCascade(p);
+    if (c < 0) return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0;
+    vec3 l = normalize(sunSky.sunDirection);
+    // A surface facing away from the sun does not see it (as the traced visibility has it).
+    if (dot(n, l) <= 0.0) return 0.0;
+    float rotation = shadowNoise();
+    float lit = cascadeShadow(c, p, ng, l, rotation, false);
+    float t = cascadeBlendWeight(p, c);
+    float next = t > 0.0 ? cascadeShadow(c + 1, p, ng, l, rotation, true) : -1.0;
+    return next >= 0.0 ? mix(lit, next, t) : lit;
+}
+
 // Whether p lies within about a pixel of the boundary between two cascades (or of the shadow
 // distance), for the cascade overlay.
 bool nearCascadeBoundary(vec3 p) {
@@ -151,6 +172,7 @@ bool nearCascadeBoundary(vec3 p) {
 }
 #else
 float sunShadow(vec3 p, vec3 n, vec3 ng) { return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0; }
+float cascadeBlendWeight(vec3 p, int c) { return 0.0; }
 int sunCascade(vec3 p) { return -1; }
 bool nearCascadeBoundary(vec3 p) { return false; }
 #endif

@@ -101,12 +101,17 @@ vec3 viewSunVisibility(ShadingPoint s) { return scalarView(s.probe.x); }
 vec3 viewShadow(ShadingPoint s) { return scalarView(s.shadow); }
 vec3 viewFog(ShadingPoint s) { return scalarView(s.fogAmount); }
 
+vec3 cascadeColour(int c) {
+    return c == 0 ? vec3(0.90, 0.25, 0.20) : c == 1 ? vec3(0.25, 0.75, 0.25)
+         : c == 2 ? vec3(0.25, 0.45, 0.95) : c == 3 ? vec3(0.95, 0.85, 0.20) : vec3(0.45);
+}
+
 // Cascade index: red, green, blue, yellow for cascades 0-3, grey beyond the shadow distance, a
-// dark line where one cascade hands over to the next; shaded by N·L so the terrain stays legible.
+// dark line where one cascade hands over to the next and, before it, the two colours mixed where
+// the shadows blend (shadows.cascade_blend); shaded by N·L so the terrain stays legible.
 vec3 viewCascades(ShadingPoint s) {
     int c = sunCascade(s.position);
-    vec3 base = c == 0 ? vec3(0.90, 0.25, 0.20) : c == 1 ? vec3(0.25, 0.75, 0.25)
-              : c == 2 ? vec3(0.25, 0.45, 0.95) : c == 3 ? vec3(0.95, 0.85, 0.20) : vec3(0.45);
+    vec3 base = mix(cascadeColour(c), cascadeColour(c + 1), cascadeBlendWeight(s.position, c));
     if (nearCascadeBoundary(s.position)) return vec3(0.02);
     return base * (0.45 + 0.55 * sunNdotL(s));
 }

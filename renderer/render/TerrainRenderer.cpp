@@ -129,6 +129,30 @@ vk::MipLevel halfLevel(int w, int h, const std::vector<glm::vec4>& texels) {
     return l;
 }
 
+// The full mip chain of `level` (w x h texels), each texel of a level the box mean of the texels
+// it covers in the one before, down to 1 x 1; each level encoded by encode(w, h, texels).
+template <class Texel, class Encode>
+std::vector<vk::MipLevel> boxMipChain(std::vector<Texel> level, int w, int h, Encode encode) {
+    std::vector<vk::MipLevel> levels;
+    while (true) {
+        levels.push_back(encode(w, h, level));
+        if (w == 1 && h == 1) return levels;
+        const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
+        std::vector<Texel> next(size_t(nw) * size_t(nh));
+        for (int j = 0; j < nh; ++j)
+            for (int i = 0; i < nw; ++i) {
+                const int x0 = i * w / nw, x1 = (i + 1) * w / nw, y0 = j * h / nh, y1 = (j + 1) * h / nh;
+                Texel sum(0.0f);
+                for (int y = y0; y < y1; ++y)
+                    for (int x = x0; x < x1; ++x) sum += level[size_t(y) * size_t(w) + size_t(x)];
+                next[size_t(j) * size_t(nw) + size_t(i)] = sum / float((x1 - x0) * (y1 - y0));
+            }
+        level = std::move(next);
+        w = nw;
+        h = nh;
+    }
+}
+
 // The skirt (terrain.skirt: beyond the footprint the ground keeps its border's height) as the
 // shadow maps draw it, so the preview's sun is shadowed by the world the bake traces: each border
 // edge of the drawn mesh extruded outward, and a level square at the corner height in each corner
@@ -353,25 +377,7 @@ void TerrainRenderer::setSkyImage(int width, int height, const std::vector<glm::
     std::vector<glm::vec4> level(image ? radiance.size() : 1, glm::vec4(0.0f));
     if (image)
         for (size_t i = 0; i < level.size(); ++i) level[i] = glm::vec4(glm::min(radiance[i], glm::vec3(65000.0f)), 1.0f);
-    std::vector<vk::MipLevel> levels;
-    int w = image ? width : 1, h = image ? height : 1;
-    while (true) {
-        levels.push_back(halfLevel(w, h, level));
-        if (w == 1 && h == 1) break;
-        const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
-        std::vector<glm::vec4> next(size_t(nw) * size_t(nh));
-        for (int j = 0; j < nh; ++j)
-            for (int i = 0; i < nw; ++i) {
-                const int x0 = i * w / nw, x1 = (i + 1) * w / nw, y0 = j * h / nh, y1 = (j + 1) * h / nh;
-                glm::vec4 sum(0.0f);
-                for (int y = y0; y < y1; ++y)
-                    for (int x = x0; x < x1; ++x) sum += level[size_t(y) * size_t(w) + size_t(x)];
-                next[size_t(j) * size_t(nw) + size_t(i)] = sum / float((x1 - x0) * (y1 - y0));
-            }
-        level = std::move(next);
-        w = nw;
-        h = nh;
-    }
+    const std::vector<vk::MipLevel> levels = boxMipChain(std::move(level), image ? width : 1, image ? height : 1, halfLevel);
     vk::Image texture = vk::Image::texture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
     ctx_.waitIdle();  // no frame may still read the old image
     g.surface.sky = std::move(texture);
@@ -390,33 +396,19 @@ void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint
     const bool map = width > 0 && height > 0 && srgb.size() == size_t(width) * size_t(height) * 3;
     // A full mip chain of box means in linear light, stored sRGB-encoded (the hardware decodes);
     // level 0 holds the field's own codes.
-    std::vector<vk::MipLevel> levels;
     std::vector<glm::vec3> level(map ? srgb.size() / 3 : 1, glm::vec3(1.0f));
     if (map)
         for (size_t i = 0; i < level.size(); ++i)
             level[i] = {linearOfSrgb8(srgb[3 * i]), linearOfSrgb8(srgb[3 * i + 1]), linearOfSrgb8(srgb[3 * i + 2])};
-    int w = map ? width : 1, h = map ? height : 1;
-    while (true) {
-        vk::MipLevel l{uint32_t(w), uint32_t(h), std::vector<uint8_t>(level.size() * 4)};
-        for (size_t i = 0; i < level.size(); ++i)
-            for (int c = 0; c < 3; ++c) l.bytes[4 * i + size_t(c)] = srgb8(level[i][c]);
-        for (size_t i = 0; i < level.size(); ++i) l.bytes[4 * i + 3] = 255;
-        levels.push_back(std::move(l));
-        if (w == 1 && h == 1) break;
-        const int nw = std::max(w / 2, 1), nh = std::max(h / 2, 1);
-        std::vector<glm::vec3> next(size_t(nw) * size_t(nh));
-        for (int j = 0; j < nh; ++j)
-            for (int i = 0; i < nw; ++i) {
-                const int x0 = i * w / nw, x1 = (i + 1) * w / nw, y0 = j * h / nh, y1 = (j + 1) * h / nh;
-                glm::vec3 sum(0.0f);
-                for (int y = y0; y < y1; ++y)
-                    for (int x = x0; x < x1; ++x) sum += level[size_t(y) * size_t(w) + size_t(x)];
-                next[size_t(j) * size_t(nw) + size_t(i)] = sum / float((x1 - x0) * (y1 - y0));
+    const std::vector<vk::MipLevel> levels =
+        boxMipChain(std::move(level), map ? width : 1, map ? height : 1, [](int w, int h, const std::vector<glm::vec3>& texels) {
+            vk::MipLevel l{uint32_t(w), uint32_t(h), std::vector<uint8_t>(texels.size() * 4)};
+            for (size_t i = 0; i < texels.size(); ++i) {
+                for (int c = 0; c < 3; ++c) l.bytes[4 * i + size_t(c)] = srgb8(texels[i][c]);
+                l.bytes[4 * i + 3] = 255;
             }
-        level = std::move(next);
-        w = nw;
-        h = nh;
-    }
+            return l;
+        });
     vk::Image image = vk::Image::texture(ctx_, VK_FORMAT_R8G8B8A8_SRGB, levels);
     ctx_.waitIdle();  // no frame may still read the old map
     g.surface.albedo = std::move(image);

@@ -268,6 +268,9 @@ struct ShadowSettings {
     double depthBias = 1.5;                    // texels of the cascade, along the light
     double normalBias = 0.3;                   // texels of the cascade, along the surface normal
     ShadowFilter filter = ShadowFilter::Pcss;
+    // Share of each cascade's depth slice, at its far end, over which its shadow blends into the
+    // next cascade's (0: a hard switch).
+    double cascadeBlend = 0.1;
 };
 
 // Exponential height fog (docs/lighting.md, "Height fog"): extinction

@@ -72,6 +72,17 @@ std::string fileBytes(const fs::path& p) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// Whether the viewport, within ten tries, goes 300 ms without drawing a frame: a frame asked for
+// before may still land (slow under load), but a viewport that keeps drawing never goes quiet.
+bool settlesQuiet(ViewportWindow* viewport) {
+    for (int attempt = 0; attempt < 10; ++attempt) {
+        QSignalSpy frames(viewport, &ViewportWindow::frameRendered);
+        QTest::qWait(300);
+        if (frames.count() == 0) return true;
+    }
+    return false;
+}
+
 // Waits for the next draft preview or bake to reach the viewport.
 bool waitForProbes(MainWindow& w, const QString& source, int ms = 20000) {
     return QTest::qWaitFor([&] { return w.probeSource() == source; }, ms);
@@ -918,13 +929,7 @@ private slots:
         QVERIFY(std::abs(r->shownEv100() - r->meteredEv100()) <= 0.02);
         QVERIFY(w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)));
         // Adapted: no frame without a change.
-        bool quiet = false;
-        for (int attempt = 0; attempt < 10 && !quiet; ++attempt) {
-            QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
-            QTest::qWait(300);
-            quiet = frames.count() == 0;
-        }
-        QVERIFY(quiet);
+        QVERIFY(settlesQuiet(w_->viewport()));
         w_->document()->undoStack()->undo();
         w_->document()->undoStack()->undo();
         QCOMPARE(w_->document()->project().scene.sun.illuminance, sun);
@@ -1450,13 +1455,7 @@ private slots:
         QCOMPARE(w_->viewport()->waterTime(), stopped);
         // Paused: once a frame requested before the pause has landed (slow under load), no
         // frame without a change. A viewport that kept animating never has a quiet 300 ms.
-        bool quiet = false;
-        for (int attempt = 0; attempt < 10 && !quiet; ++attempt) {
-            QSignalSpy frames(w_->viewport(), &ViewportWindow::frameRendered);
-            QTest::qWait(300);
-            quiet = frames.count() == 0;
-        }
-        QVERIFY(quiet);
+        QVERIFY(settlesQuiet(w_->viewport()));
         w_->findChild<QCheckBox*>("param.water.enabled")->setChecked(false);
     }
 

@@ -28,6 +28,7 @@ blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Casca
     block.mapResolution = float(resolution);
     block.cascadeCount = int(cascades.size());
     block.filterMode = int(s.shadows.filter);
+    block.cascadeBlend = float(s.shadows.cascadeBlend);
     return block;
 }
 
