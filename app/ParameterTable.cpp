@@ -421,7 +421,8 @@ std::vector<ParameterSpec> buildTable() {
         .field(&SceneDescription::shadows, &ShadowSettings::splitLambda);
     add(Row("shadows.max_distance", T::Number)).above(0.0, 1.0e7).unit("m").decimals(0)
         .autoMeans("the farthest terrain in view").label("Shadow distance")
-        .about("Distance from the camera where the last cascade ends; farther terrain gets the sun unshadowed")
+        .about("Distance from the camera where the last cascade ends; farther terrain gets the sun unshadowed, the last "
+               "cascade fading into it over its far shadows.cascade_blend")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::maxDistance);
     add(Row("shadows.splits", T::NumberList)).items(1, 3).above(0.0, 1.0e7).unit("m").decimals(0)
         .autoMeans("none: practical mode computes them").label("Split distances")
@@ -470,7 +471,8 @@ std::vector<ParameterSpec> buildTable() {
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::filter);
     add(Row("shadows.cascade_blend", T::Number)).range(0.0, 0.5).decimals(2).label("Cascade blend")
         .about("Share of each cascade's depth slice, at its far end, over which its shadow blends into the next cascade's, "
-               "so the change of texel size leaves no seam; 0 switches at once")
+               "so the change of texel size leaves no seam, and the last one's into the unshadowed sun where the "
+               "shadow distance ends before the terrain; 0 switches at once")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::cascadeBlend);
 
     // Height fog.

@@ -271,6 +271,7 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     shadows["computed_splits"] = range.ends;
     shadows["computed_range"] = {range.nearDistance, range.farDistance};
     shadows["computed_for_aspect"] = kLightingExportAspect;
+    shadows["computed_fades_out"] = range.fadesOut;
 
     // What fog's unset ("auto") values stand for: the lowest terrain, and the sky's mean radiance,
     // L_0 · Y_0 (the DC term spread over 4π steradians; Y_0 = 1/(2√π), docs/lighting.md).

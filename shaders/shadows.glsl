@@ -135,10 +135,14 @@ float cascadeShadow(int c, vec3 p, vec3 ng, vec3 l, float rotation, bool partner
     return lit / float(kFilterTaps);
 }
 
-// The weight of the next cascade at p in cascade c's slice: 0 before the blend band, rising
-// smoothly to 1 at the slice's end; 0 in the last cascade.
+// The cascade after c, or -1 after the last (the unshadowed sun beyond the shadow distance).
+int nextCascade(int c) { return c + 1 < shadow.cascadeCount ? c + 1 : -1; }
+
+// The weight of what follows cascade c at p in its slice: 0 before the blend band, rising
+// smoothly to 1 at the slice's end. After the last cascade follows the unshadowed sun where
+// terrain lies beyond the shadow distance (shadow.fadeOut), else nothing (weight 0).
 float cascadeBlendWeight(vec3 p, int c) {
-    if (c < 0 || c + 1 >= shadow.cascadeCount || shadow.cascadeBlend <= 0.0) return 0.0;
+    if (c < 0 || shadow.cascadeBlend <= 0.0 || (nextCascade(c) < 0 && shadow.fadeOut <= 0.0)) return 0.0;
     float d = dot(p - camera.position, shadow.forward);
     float begin = c == 0 ? shadow.nearDepth : shadow.ends[c - 1], end = shadow.ends[c];
     return smoothstep(end - shadow.cascadeBlend * (end - begin), end, d);
@@ -146,7 +150,9 @@ float cascadeBlendWeight(vec3 p, int c) {
 
 // Over the far shadows.cascade_blend of its slice, a cascade's shadow blends into the next one's
 // (smoothstep in view depth), so the step in texel size and penumbra is no seam (the transition
-// band of Engel, "Cascaded Shadow Maps", ShaderX5, 2006). The last cascade ends where it ends.
+// band of Engel, "Cascaded Shadow Maps", ShaderX5, 2006). The last cascade blends the same way
+// into the unshadowed sun where the shadow distance ends before the terrain, so that end is no
+// line across the view either.
 // n: the shading normal (which side of the terminator p is on).
 float sunShadow(vec3 p, vec3 n, vec3 ng) {
     int c = sunCascade(p);
@@ -157,7 +163,7 @@ float sunShadow(vec3 p, vec3 n, vec3 ng) {
     float rotation = shadowNoise();
     float lit = cascadeShadow(c, p, ng, l, rotation, false);
     float t = cascadeBlendWeight(p, c);
-    float next = t > 0.0 ? cascadeShadow(c + 1, p, ng, l, rotation, true) : -1.0;
+    float next = t <= 0.0 ? -1.0 : nextCascade(c) < 0 ? 1.0 : cascadeShadow(c + 1, p, ng, l, rotation, true);
     return next >= 0.0 ? mix(lit, next, t) : lit;
 }
 
@@ -173,6 +179,7 @@ bool nearCascadeBoundary(vec3 p) {
 #else
 float sunShadow(vec3 p, vec3 n, vec3 ng) { return dot(n, sunSky.sunDirection) > 0.0 ? 1.0 : 0.0; }
 float cascadeBlendWeight(vec3 p, int c) { return 0.0; }
+int nextCascade(int c) { return -1; }
 int sunCascade(vec3 p) { return -1; }
 bool nearCascadeBoundary(vec3 p) { return false; }
 #endif

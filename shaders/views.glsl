@@ -108,10 +108,11 @@ vec3 cascadeColour(int c) {
 
 // Cascade index: red, green, blue, yellow for cascades 0-3, grey beyond the shadow distance, a
 // dark line where one cascade hands over to the next and, before it, the two colours mixed where
-// the shadows blend (shadows.cascade_blend); shaded by N·L so the terrain stays legible.
+// the shadows blend (shadows.cascade_blend), the last one's into grey where it fades out; shaded
+// by N·L so the terrain stays legible.
 vec3 viewCascades(ShadingPoint s) {
     int c = sunCascade(s.position);
-    vec3 base = mix(cascadeColour(c), cascadeColour(c + 1), cascadeBlendWeight(s.position, c));
+    vec3 base = mix(cascadeColour(c), cascadeColour(nextCascade(c)), cascadeBlendWeight(s.position, c));
     if (nearCascadeBoundary(s.position)) return vec3(0.02);
     return base * (0.45 + 0.55 * sunNdotL(s));
 }

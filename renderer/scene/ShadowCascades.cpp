@@ -58,6 +58,7 @@ CascadeRange cascadeRange(const ShadowSettings& s, const OrbitCamera& camera, fl
     r.nearDistance = std::clamp(nearest, double(planes.nearPlane), double(planes.farPlane));
     r.farDistance = std::clamp(s.maxDistance ? *s.maxDistance : farthest, r.nearDistance + 1e-3,
                                double(planes.farPlane));
+    r.fadesOut = r.farDistance < farthest;
     const int n = std::clamp(s.cascades, 1, 4);
     if (s.splitMode == SplitMode::Manual && s.splits && int(s.splits->size()) == n - 1) {
         double last = r.nearDistance;

@@ -24,6 +24,9 @@ std::vector<double> practicalSplits(double nearDistance, double farDistance, int
 struct CascadeRange {
     double nearDistance = 0.0, farDistance = 0.0;
     std::vector<double> ends;  // one per cascade, increasing; ends.back() == farDistance
+    // Whether terrain lies beyond the last cascade (shadows.max_distance ends before it): then the
+    // last cascade fades out over its far shadows.cascade_blend, so the shadow distance is no line.
+    bool fadesOut = false;
 };
 
 // The shadow range of a camera over the terrain box: from the box's least view depth (at least the near

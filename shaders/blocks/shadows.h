@@ -10,6 +10,8 @@ TLX_BLOCK_BEGIN(ShadowBlock, TLX_SET_LIGHTS, 2)
     TLX_FLOAT4(depthBias, normalBias, tanSunRadius, mapResolution)  // depth bias; normal bias
                           // (texels); tan(sun angular radius); map resolution (texels)
     TLX_INT2(cascadeCount, filterMode)  // cascades; 0 pcss, 1 pcf, 2 hard
-    TLX_FLOAT1(cascadeBlend)  // share of each slice's depth over which it hands over to the next
+    TLX_FLOAT2(cascadeBlend, fadeOut)  // share of each slice's depth over which it hands over to
+                          // the next; 1 where terrain lies beyond the last cascade, which then
+                          // fades to the unshadowed sun over the same share
 TLX_BLOCK_END(shadow)
 #define TLX_SHADOW_MAP_DEPTH_BINDING 3  // sampler2DArray: the stored depths, gathered and compared

@@ -2561,3 +2561,88 @@ TEST_F(RenderTest, CascadeBlendingHandsOverWithinTheBandAndKeepsTheAgreement) {
     EXPECT_LE(a1.disagreeing, a0.disagreeing + 0.002);
     EXPECT_LE(a1.acne, a0.acne + 0.001);
 }
+
+TEST_F(RenderTest, TheLastCascadeFadesIntoTheUnshadowedSunAtAShortShadowDistance) {
+    // The Rainier crop at a 12-degree sun with the shadow distance short of the orbit radius, so
+    // terrain lies beyond it; one cascade, so no hand-over between cascades moves a pixel. Over
+    // the cascade's far shadows.cascade_blend the shadow fades into the unshadowed sun: there each
+    // pixel's lit fraction is the hard cut's moved toward 1 by the weight view 34 shows as the
+    // cascade's colour mixed with grey; elsewhere nothing changes. Measured (480 x 270, lavapipe):
+    // 6 644 pixels fading, none off the rule. Without terrain beyond (the default distance) the
+    // cascade does not fade.
+    const fs::path dem = fs::path(TERRALUX_SOURCE_DIR) / "tests" / "data" / "dem" / "rainier_crop.tif";
+    Project p = loadEffectiveProject("", {"probe_volumes[0].enabled=false", "sun.mode=\"manual\"", "sun.azimuth_deg=135",
+                                          "sun.elevation_deg=12", "camera.elevation_deg=25",
+                                          "camera.antialiasing=\"off\"", "shadows.map_resolution=1024",
+                                          "shadows.cascades=1"},
+                                     dem.string(), nullptr);
+    p.scene.exportSettings.outDir = (kOut / "bake_shadow_fade").string();
+    ProjectRenderer r(*ctx_, p);
+    p.scene.shadows.maxDistance = 0.85 * double(r.defaultCamera().radius);
+    const uint32_t w = 480, h = 270;
+    auto frame = [&](int view, double blend) {
+        p.scene.shadows.cascadeBlend = blend;
+        r.setProject(p);
+        return draw(r, view, false, true, w, h);
+    };
+    const RenderedImage hard = frame(kViewShadow, 0.0), faded = frame(kViewShadow, 0.25);
+    const RenderedImage bands = frame(kViewCascades, 0.25);
+    const int last = p.scene.shadows.cascades - 1;
+    const glm::vec3 colours[4] = {{0.90f, 0.25f, 0.20f}, {0.25f, 0.75f, 0.25f}, {0.25f, 0.45f, 0.95f}, {0.95f, 0.85f, 0.20f}};
+    const glm::vec3 lastColour = colours[last], grey(0.45f);
+    size_t fading = 0, beyond = 0, moved = 0, wrong = 0, changedElsewhere = 0;
+    double lifted = 0.0;
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+        if (hard.rgba[i * 4 + 1] < 0.5f) continue;  // off the terrain
+        const glm::vec3 c(bands.rgba[i * 4], bands.rgba[i * 4 + 1], bands.rgba[i * 4 + 2]);
+        if (glm::length(c) < 0.05f) continue;  // the dark line at a split
+        // c = shade·(lastColour + t·(grey − lastColour)): least squares for shade and shade·t.
+        const glm::vec3 d = grey - lastColour;
+        const float aa = glm::dot(lastColour, lastColour), ad = glm::dot(lastColour, d), dd = glm::dot(d, d);
+        const float ac = glm::dot(lastColour, c), dc = glm::dot(d, c), det = aa * dd - ad * ad;
+        const float shade = (ac * dd - ad * dc) / det, shadeT = (aa * dc - ad * ac) / det;
+        const glm::vec3 fit = shade * lastColour + shadeT * d;
+        const float hardLit = hard.rgba[i * 4], fadedLit = faded.rgba[i * 4];
+        if (glm::length(fit - c) > 0.01f * glm::length(c) || !(shade > 1e-3f)) {
+            ++changedElsewhere;  // one cascade: every terrain pixel is its colour, grey or between
+            continue;
+        }
+        const float t = std::clamp(shadeT / shade, 0.0f, 1.0f);
+        // Shaded 0.45 + 0.55·N·L: at 0.45 the sun is behind the surface, unlit either way.
+        if (shade < 0.452f) continue;
+        if (t >= 0.999f) {
+            ++beyond;
+            if (std::abs(fadedLit - hardLit) > 1e-4f) ++changedElsewhere;
+            continue;
+        }
+        if (t <= 0.001f) {
+            if (std::abs(fadedLit - hardLit) > 0.03f) ++changedElsewhere;
+            continue;
+        }
+        ++fading;
+        const float expected = hardLit + t * (1.0f - hardLit);
+        if (std::abs(fadedLit - expected) > 0.03f) ++wrong;
+        if (fadedLit - hardLit > 0.03f) ++moved;
+        lifted += fadedLit - hardLit;
+    }
+    std::cout << fading << " pixels fading, " << beyond << " beyond the distance, " << moved << " lifted by more than 0.03 (mean "
+              << (fading ? lifted / double(fading) : 0.0) << "), " << wrong << " off the blend, " << changedElsewhere
+              << " changed elsewhere\n";
+    EXPECT_GT(fading, size_t(w) * h / 100);
+    EXPECT_GT(beyond, size_t(w) * h / 100);
+    EXPECT_GT(moved, size_t(20));
+    EXPECT_LE(wrong, fading / 200);
+    EXPECT_EQ(changedElsewhere, 0u);
+    // At the default distance no terrain lies beyond: the last cascade keeps its own shadow.
+    p.scene.shadows.maxDistance.reset();
+    const RenderedImage fullHard = frame(kViewShadow, 0.0), fullBlend = frame(kViewCascades, 0.25);
+    size_t greyish = 0;
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+        if (fullHard.rgba[i * 4 + 1] < 0.5f) continue;
+        const glm::vec3 c(fullBlend.rgba[i * 4], fullBlend.rgba[i * 4 + 1], fullBlend.rgba[i * 4 + 2]);
+        if (glm::length(c) < 0.05f) continue;
+        const glm::vec3 u = glm::normalize(c);
+        greyish += std::abs(u.x - u.y) < 0.02f && std::abs(u.y - u.z) < 0.02f;
+    }
+    EXPECT_EQ(greyish, 0u);
+}

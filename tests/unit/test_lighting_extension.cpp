@@ -167,6 +167,7 @@ TEST(LightingExtension, ComputedSplitsAreTheProjectCamerasCascades) {
                 p.scene.shadows, OrbitCamera::fromSettings(p.scene.camera, hf), 16.0f / 9.0f, lo, hi);
             EXPECT_EQ(splits, json(expected.ends));
             EXPECT_EQ(range, json({expected.nearDistance, expected.farDistance}));
+            EXPECT_EQ(shadows["computed_fades_out"].get<bool>(), mode == "max_distance");
             for (size_t i = 0; i < manual.size(); ++i) EXPECT_EQ(splits[i].get<double>(), manual[i]) << i;
             if (mode == "max_distance") {
                 EXPECT_EQ(range[1].get<double>(), inside(0.7));

@@ -48,8 +48,13 @@ TEST(ShadowSplits, RangeCoversTheTerrainAndManualSplitsAreUsed) {
     EXPECT_NEAR(r.farDistance, r.ends.back(), 1e-9);
     EXPECT_GT(r.farDistance, 5000.0);
     for (size_t i = 1; i < r.ends.size(); ++i) EXPECT_GT(r.ends[i], r.ends[i - 1]);
+    EXPECT_FALSE(r.fadesOut);  // the last cascade reaches the farthest corner
     s.maxDistance = 4000.0;
     EXPECT_NEAR(cascadeRange(s, cam, 1.0f, lo, hi).farDistance, 4000.0, 1e-9);
+    EXPECT_TRUE(cascadeRange(s, cam, 1.0f, lo, hi).fadesOut);  // terrain lies beyond 4 km
+    s.maxDistance = 1.0e6;
+    EXPECT_FALSE(cascadeRange(s, cam, 1.0f, lo, hi).fadesOut);  // a distance past the terrain
+    s.maxDistance = 4000.0;
     s.splitMode = SplitMode::Manual;
     s.cascades = 3;
     s.splits = std::vector<double>{3000.0, 3500.0};

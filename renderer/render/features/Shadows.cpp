@@ -29,6 +29,7 @@ blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Casca
     block.cascadeCount = int(cascades.size());
     block.filterMode = int(s.shadows.filter);
     block.cascadeBlend = float(s.shadows.cascadeBlend);
+    block.fadeOut = range.fadesOut ? 1.0f : 0.0f;
     return block;
 }
 
