@@ -357,8 +357,9 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("sun.follow_sky", T::Boolean)).label("Sun from sky model")
         .about("Sky mode physical: the sun's colour and illuminance come from the sky model (sun.color and sun.illuminance are not read)")
         .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sun, &SunSettings::followSky);
-    add(Row("sun.illuminance", T::Number)).range(0.0, 1.0e6).label("Sun illuminance")
-        .about("Illuminance on a surface facing the sun, scene-linear (the sky's radiance is in the same units); not read while the sun follows the physical sky")
+    add(Row("sun.illuminance", T::Number)).range(0.0, 1.0e7).unit("lx").decimals(0).label("Sun illuminance")
+        .about("Illuminance on a surface facing the sun: a clear day's sun is about 100 000 lx, an overcast one 0; "
+               "the bake lights with 3e-5 scene units per lux, the unit of the sky's radiance; not read while the sun follows the physical sky")
         .redoes(kUpload | kRebake).onlyWhen(std::not_fn(sunFromSky))
         .field(&SceneDescription::sun, &SunSettings::illuminance);
     add(Row("sun.color", T::Color)).range(0.0, kUnbounded).label("Sun colour")
@@ -976,7 +977,7 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("lights[].color", T::Color)).range(0.0, 1.0).label("Light colour")
         .about("Linear RGB tint of the intensity").redoes(kUpload).light(&LocalLight::color);
     add(Row("lights[].intensity", T::Number)).range(0.0, 1.0e12).label("Intensity")
-        .about("Irradiance on a surface facing the light 1 m away, in the sun's scene-linear units (E = intensity / d^2 inside the range); exported as candela, one scene-linear unit of illuminance to one lux")
+        .about("Irradiance on a surface facing the light 1 m away, in the sun's scene-linear units (E = intensity / d^2 inside the range); exported as candela: intensity / 3e-5, the scene units per lux")
         .redoes(kUpload).light(&LocalLight::intensity);
     add(Row("lights[].range", T::Number)).above(0.0, 1.0e6).unit("m").label("Range")
         .about("Distance where the light ends: its falloff is windowed by clamp(1 - (d/range)^4, 0, 1) (KHR_lights_punctual)")

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "AtomicFile.h"
+#include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "water/Water.h"
 
@@ -307,6 +308,26 @@ const std::vector<ProjectMigration>& projectMigrations() {
              const double f = falloff.get<double>();
              fog["scale_height"] = f > 0.0 ? 1.0 / f : f;
              notes.push_back("fog.height_falloff " + falloff.dump() + " is fog.scale_height " + fog["scale_height"].dump() + " m");
+         }},
+        {3,
+         "sun.illuminance became lux: a version-3 value in scene units is divided by kSceneUnitsPerLux "
+         "(3 became 100 000 lx), the same light; so are the scenarios' suns",
+         [](json& doc, std::vector<std::string>& notes) {
+             auto toLux = [&](json& section, const std::string& where) {
+                 if (!section.is_object() || !section.contains("sun") || !section["sun"].is_object()) return;
+                 json& sun = section["sun"];
+                 // Anything but a number is left for the check to name.
+                 if (!sun.contains("illuminance") || !sun["illuminance"].is_number()) return;
+                 const double before = sun["illuminance"].get<double>();
+                 // Whole millilux: the scene units' decimals give no more, and 3 gives 100000.
+                 const double lux = std::round(before / kSceneUnitsPerLux * 1000.0) / 1000.0;
+                 sun["illuminance"] = lux;
+                 notes.push_back(where + "sun.illuminance " + json(before).dump() + " is " + json(lux).dump() + " lx");
+             };
+             toLux(doc, "");
+             if (doc.contains("scenarios") && doc["scenarios"].is_array())
+                 for (size_t i = 0; i < doc["scenarios"].size(); ++i)
+                     toLux(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
          }},
     };
     return steps;

@@ -481,7 +481,9 @@ std::shared_ptr<const lpv::Volumes> LpvJob::run(lpv::Propagation where) const {
 
 void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const std::string& key) {
     if (volumes) ++lpvUpdates_;
-    ++revision_;
+    // Only a change of the volumes changes the frame; present() clears them on every frame that
+    // draws none, and that must not meter again.
+    if (volumes != renderer_->lpv()) ++revision_;
     lpvKey_ = volumes ? key : std::string();
     renderer_->setLpv(std::move(volumes));
 }

@@ -161,7 +161,7 @@ FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfiel
 SunLight sunOf(const SunSettings& s) {
     SunLight sun;
     sun.direction = sunDirection(s.azimuthDeg, s.elevationDeg);
-    sun.illuminance = s.color * float(s.illuminance);
+    sun.illuminance = s.color * sceneUnitsOfLux(s.illuminance);
     sun.angularRadius = float(s.angularRadiusDeg * std::numbers::pi / 180.0);
     return sun;
 }
@@ -175,7 +175,7 @@ BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
         l.sun.illuminance = PhysicalSky(l.sun.direction, scene.sky.turbidity).sunIlluminance() *
                             float(scene.sky.intensity);
     else
-        l.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
+        l.sun.illuminance = sunOf(scene.sun).illuminance;
     l.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
     l.albedo = scene.terrain.albedo;
     return l;
@@ -234,7 +234,7 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     // The camera's exposure as authored, and the scale of the units every light here is in, so an
     // engine exposes the same way: display = scene × 2^exposure_ev / (1.2 × 2^ev100 × scene_units_per_lux).
     for (const char* key : {"exposure_mode", "ev100", "exposure_ev", "adaptation_s"}) ext[key] = authored.at("camera").at(key);
-    ext["scene_units_per_lux"] = shortestDecimal(kSceneUnitsPerLux);
+    ext["scene_units_per_lux"] = kSceneUnitsPerLux;
 
     // The sun as the bake and the renderer light with it (BakeLighting), so a sky model that
     // moves or tints the sun shows here, beside the authored azimuth and elevation; illuminance ×
@@ -253,10 +253,10 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
         sun["resolved_utc_offset_h"] = a.place->utcOffsetH;
     }
     if (l.sun.illuminance != asAuthored.illuminance) {
-        // The authored scalar where there is one; the colour carries the rest.
+        // The authored scalar (lux) where there is one; the colour carries the rest.
         const double e = scene.sun.illuminance > 0.0 ? scene.sun.illuminance : 1.0;
         sun["illuminance"] = e;
-        sun["color"] = shortest(l.sun.illuminance / float(e));
+        sun["color"] = shortest(l.sun.illuminance / sceneUnitsOfLux(e));
     }
     if (l.sun.angularRadius != asAuthored.angularRadius)
         sun["angular_radius_deg"] =

@@ -2,6 +2,7 @@
 #include "FaultInjection.h"
 #include "ImageFile.h"
 #include "ProbeDiagnosticsFile.h"
+#include "bake/PhysicalSky.h"
 #include "water/Water.h"
 
 #include <algorithm>
@@ -255,7 +256,8 @@ void addLights(ojson& doc, const std::vector<LocalLight>& lights) {
         ojson light = {{"name", "light " + std::to_string(i)},
                        {"type", spot ? "spot" : "point"},
                        {"color", floats({l.color.r, l.color.g, l.color.b})},
-                       {"intensity", l.intensity},
+                       // Candela: the scene units' irradiance at 1 m, in lux, as the sun's.
+                       {"intensity", l.intensity / kSceneUnitsPerLux},
                        {"range", l.range}};
         if (spot)
             light["spot"] = {{"innerConeAngle", l.innerConeDeg * kDeg}, {"outerConeAngle", l.outerConeDeg * kDeg}};

@@ -9,9 +9,13 @@
 
 namespace terralux {
 
-// Scene units per lux, and per cd/m² of sky luminance: a clear-day sun of about 100 klx becomes
-// 3, the default sun.illuminance. The sun and the sky share it, so their ratio is the model's.
-inline constexpr float kSceneUnitsPerLux = 3.0e-5f;
+// Scene units per lux, and per cd/m² of sky luminance: the default sun.illuminance, a clear day's
+// 100 klx, lights with 3. The sun and the sky share it, so their ratio is the model's.
+inline constexpr double kSceneUnitsPerLux = 3.0e-5;
+
+// An illuminance authored in lux (sun.illuminance) in the scene units the bake and the renderer
+// light with.
+inline float sceneUnitsOfLux(double lux) { return float(lux * kSceneUnitsPerLux); }
 
 // The turbidities the paper fits; the model is clamped to them.
 inline constexpr double kMinTurbidity = 1.7;

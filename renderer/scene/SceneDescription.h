@@ -79,7 +79,7 @@ struct SunSettings {
     std::optional<double> utcOffsetH;
     std::optional<double> latitudeDeg;
     std::optional<double> longitudeDeg;
-    double illuminance = 3.0;        // E_sun on a surface facing the sun, scene-linear, >= 0
+    double illuminance = 100000.0;   // E_sun on a surface facing the sun, lux, >= 0 (a clear day)
     glm::vec3 color{1.0f, 0.96f, 0.9f};
     double angularRadiusDeg = 0.27;  // [0, 45]
     // Sky mode physical: the sun's colour and illuminance come from the sky model, and

@@ -17,6 +17,7 @@
 #include "DemImport.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
+#include "bake/PhysicalSky.h"
 #include "scene/SceneDescription.h"
 
 using namespace terralux;
@@ -42,7 +43,7 @@ void benchDem(const char* label, const std::filesystem::path& file) {
     L.tracer = &tracer;
     L.sky = Sky::uniform(scene.sky.color * float(scene.sky.intensity));
     L.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
-    L.sun.illuminance = scene.sun.color * float(scene.sun.illuminance);
+    L.sun.illuminance = scene.sun.color * sceneUnitsOfLux(scene.sun.illuminance);
     L.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
     L.albedo = scene.terrain.albedo;
     const BakeQuality q = qualityPreset(QualityPreset::Standard);

@@ -198,7 +198,7 @@ validate "$work/lit/scene.gltf"
 cat >"$work/scenarios.terralux.json" <<'EOF'
 {
   "probe_volumes": [{"name": "valley", "grid_dims": [5, 4]}, {"name": "peaks", "grid_dims": [3, 3], "height_offset": 50}],
-  "scenarios": [{"name": "dusk", "sun": {"azimuth_deg": 250, "elevation_deg": 6, "illuminance": 1.2}, "sky": {"intensity": 0.4}},
+  "scenarios": [{"name": "dusk", "sun": {"azimuth_deg": 250, "elevation_deg": 6, "illuminance": 40000}, "sky": {"intensity": 0.4}},
                 {"name": "overcast", "sun": {"illuminance": 0}, "sky": {"intensity": 2.5, "color": [0.2, 0.2, 0.21]}}],
   "bake": {"error_map_resolution": 0}
 }

@@ -74,7 +74,9 @@ nodes = {n["extensions"]["KHR_lights_punctual"]["light"]: (k, n) for k, n in enu
 in_scene = {x for sc in doc["scenes"] for x in sc["nodes"]}
 for i, (light, pl) in enumerate(zip(lights, project["lights"])):
     expect(light["type"] == pl["type"], f"light {i} type")
-    expect(light["intensity"] == pl["intensity"] and light["range"] == pl["range"], f"light {i} intensity/range")
+    # Candela: the scene units' lux at 1 m (ext scene_units_per_lux), as the sun's illuminance is lux.
+    expect(abs(light["intensity"] * 3e-5 - pl["intensity"]) <= 1e-9 * pl["intensity"] and light["range"] == pl["range"],
+           f"light {i} intensity/range")
     expect(all(abs(a - b) < 1e-6 for a, b in zip(light["color"], pl["color"])), f"light {i} colour")
     index, node = nodes.get(i, (None, {}))
     expect(node.get("translation") == pl["position"], f"light {i} node")

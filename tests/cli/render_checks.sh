@@ -10,6 +10,19 @@ rc=$?
 if [ $rc -eq 3 ] && grep -q "no Vulkan" stderr; then echo "SKIP: $(cat stderr)"; exit 77; fi
 [ $rc -eq 0 ] || fail "render exited $rc: $(cat stderr)"
 grep -q "view 0 beauty, 1 probe volume" stdout || fail "unexpected report: $(cat stdout)"
+# The metered exposure is printed, follows the light (four times the sun and sky: +2 EV) and is
+# not printed for a manual camera.
+ev() { sed -n 's/^exposure: EV100 \([0-9.-]*\) metered (histogram), compensation 0.0 EV$/\1/p' "$1"; }
+a=$(ev stdout)
+[ -n "$a" ] || fail "no metered exposure in the report: $(cat stdout)"
+"$terralux" --render --out bright.png --size 320x180 --quiet --set sun.illuminance=400000 --set sky.intensity=4 >stdout2 \
+  || fail "bright render exited $?"
+b=$(ev stdout2)
+awk -v a="$a" -v b="$b" 'BEGIN { d = b - a; exit !(d > 1.9 && d < 2.1) }' \
+  || fail "four times the light metered $a -> $b EV100, expected +2"
+"$terralux" --render --out manual.png --size 64x48 --quiet --set camera.exposure_mode=manual >stdout2 \
+  || fail "manual render exited $?"
+grep -q "^exposure:" stdout2 && fail "a manual camera printed a metered exposure: $(cat stdout2)"
 [ -f bake/sh_coeffs/probes.shprobe ] || fail "render did not bake first"
 head -c 8 beauty.png | od -An -tx1 | grep -q "89 50 4e 47" || fail "beauty.png is not a PNG"
 "$terralux" --render --out irr.exr --size 64x64 --debug-view 50 --quiet >stdout || fail "EXR render"

@@ -72,7 +72,7 @@ sinfo -h -o %t | grep -q idle || { echo "FAIL: the Slurm node never came up"; ca
 
 project=$work/region.json
 cat > "$project" <<JSON
-{"version": 3, "terrain": {"dem": "$dem", "max_resolution": 65},
+{"version": 4, "terrain": {"dem": "$dem", "max_resolution": 65},
  "probe_volumes": [{"name": "probes", "grid_dims": [9, 7]}], "bake": {"quality": "draft"}}
 JSON
 

@@ -21,6 +21,7 @@
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "SceneLighting.h"
+#include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
 #include "bake/SphericalHarmonics.h"
 #include "lpv/Lpv.h"
@@ -898,7 +899,7 @@ TEST_F(RenderTest, ScenariosSwitchAndBlendLikeTheirBakes) {
     dusk.sky = p.scene.sky;
     dusk.sun.azimuthDeg = 250.0;
     dusk.sun.elevationDeg = 8.0;
-    dusk.sun.illuminance = 1.5;
+    dusk.sun.illuminance = 50000.0;
     dusk.sky.intensity = 0.5;
     p.scene.scenarios = {dusk};
     ProjectRenderer r(*ctx_, p);
@@ -1051,7 +1052,7 @@ TEST_F(RenderTest, BelowTheHorizonTheSkyPassDrawsTheSkirtsGround) {
     r.setProject(p);
     const RenderedImage off = draw(r, kViewBeauty, false, true);
     const glm::vec3 sky = p.scene.sky.color * float(p.scene.sky.intensity);
-    const glm::vec3 sun = p.scene.sun.color * float(p.scene.sun.illuminance);
+    const glm::vec3 sun = p.scene.sun.color * sceneUnitsOfLux(p.scene.sun.illuminance);
     const glm::vec3 ground = p.scene.terrain.albedo / std::numbers::pi_v<float> *
                              (std::numbers::pi_v<float> * sky + sun * float(std::sin(30.0 * std::numbers::pi / 180.0)));
     // The bottom corners lie below the horizon, beside the terrain at the default framing.

@@ -928,8 +928,11 @@ private slots:
         QTRY_VERIFY_WITH_TIMEOUT(std::abs(r->meteredEv100() - (before - 2.0)) < 0.1, 15000);
         QVERIFY(std::abs(r->shownEv100() - r->meteredEv100()) <= 0.02);
         QVERIFY(w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)));
-        // Adapted: no frame without a change.
+        // Adapted: no frame without a change, and a redraw of the same view does not meter again.
         QVERIFY(settlesQuiet(w_->viewport()));
+        const size_t settled = r->meterings();
+        for (int i = 0; i < 3; ++i) w_->viewport()->renderNow();
+        QCOMPARE(r->meterings(), settled);
         w_->document()->undoStack()->undo();
         w_->document()->undoStack()->undo();
         QCOMPARE(w_->document()->project().scene.sun.illuminance, sun);

@@ -122,13 +122,15 @@ TEST(LightingExtension, TheSunIsTheOneTheBakeLightsWith) {
     l.sun.angularRadius = 0.01f;
     const json driven = lightingExtension(p, hf, l)["sun"];
     EXPECT_EQ(vec3Of(driven["direction"]), l.sun.direction);
-    EXPECT_EQ(vec3Of(driven["color"]) * float(driven["illuminance"].get<double>()), l.sun.illuminance);
+    // Illuminance in lux, as authored; times the scene units per lux, what the bake lit with.
+    const glm::vec3 drivenScene = vec3Of(driven["color"]) * sceneUnitsOfLux(driven["illuminance"].get<double>());
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(drivenScene[c], l.sun.illuminance[c], 1e-6f * l.sun.illuminance[c]);
     EXPECT_NEAR(driven["angular_radius_deg"].get<double>(), 0.01 * 180.0 / std::numbers::pi, 1e-6);
     EXPECT_EQ(driven["elevation_deg"], authored["elevation_deg"]);
     // An authored illuminance of 0 leaves the scale to the colour.
     const json dark = lightingExtension(projectWith({"sun.illuminance=0"}), hf, l)["sun"];
     EXPECT_EQ(dark["illuminance"].get<double>(), 1.0);
-    EXPECT_EQ(vec3Of(dark["color"]), l.sun.illuminance);
+    EXPECT_EQ(vec3Of(dark["color"]), l.sun.illuminance / sceneUnitsOfLux(1.0));
 }
 
 TEST(LightingExtension, ComputedSplitsAreTheProjectCamerasCascades) {

@@ -48,7 +48,7 @@ TEST(Project, DefaultsAreLightingMdDefaults) {
     EXPECT_DOUBLE_EQ(s.sky.intensity, 1.0);
     // A clear day: direct sun on level ground at the default elevation against the uniform sky's
     // irradiance π·L on it lands within the 4-10 : 1 of docs/lighting.md.
-    const double direct = s.sun.illuminance * std::sin(s.sun.elevationDeg * M_PI / 180.0);
+    const double direct = s.sun.illuminance * kSceneUnitsPerLux * std::sin(s.sun.elevationDeg * M_PI / 180.0);
     const double diffuse = M_PI * s.sky.intensity * (0.2126 * s.sky.color.x + 0.7152 * s.sky.color.y + 0.0722 * s.sky.color.z);
     EXPECT_GE(direct / diffuse, 4.0);
     EXPECT_LE(direct / diffuse, 10.0);
@@ -118,7 +118,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"reflection_probes.strength=1.5", "p.json: reflection_probes.strength = 1.5: must be in [0, 1]"},
         Rule{"reflection_probes.ground_color=[1,1,-0.1]", "p.json: reflection_probes.ground_color[2] = -0.1: three components, each in [0, 1]"},
         Rule{"sun.elevation_deg=91", "p.json: sun.elevation_deg = 91: must be in [-90, 90]"},
-        Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be in [0, 1000000]"},
+        Rule{"sun.illuminance=-1", "p.json: sun.illuminance = -1: must be in [0, 10000000]"},
         Rule{"sun.angular_radius_deg=50", "p.json: sun.angular_radius_deg = 50: must be in [0, 45]"},
         Rule{"terrain.vertical_scale=0", "p.json: terrain.vertical_scale = 0: must be in (0, 100]"},
         Rule{"terrain.albedo=[0.5,1.2,0.5]", "p.json: terrain.albedo[1] = 1.2: three components, each in [0, 1]"},
@@ -134,7 +134,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=4", "p.json: version = 4: is newer than this Terralux reads (3); open it with a newer Terralux"},
+        Rule{"version=5", "p.json: version = 5: is newer than this Terralux reads (4); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -386,10 +386,10 @@ TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
 
     // Without follow_sky the sun is the project's own.
     p.scene.sun.followSky = false;
-    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
+    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * sceneUnitsOfLux(p.scene.sun.illuminance));
     p.scene.sky.mode = SkyMode::Uniform;
     p.scene.sun.followSky = true;  // read only in mode physical
-    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * float(p.scene.sun.illuminance));
+    EXPECT_EQ(lightingOf(p, flatGround()).sun.illuminance, p.scene.sun.color * sceneUnitsOfLux(p.scene.sun.illuminance));
 }
 
 TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
@@ -573,4 +573,27 @@ TEST(Project, OverrideThatIsNotUtf8IsRefused) {
     EXPECT_NE(errorFor("terrain.dem=x\xE2\x82"), "");            // truncated
     EXPECT_EQ(errorFor("terrain.dem=caf\xC3\xA9.tif").find("not UTF-8"), std::string::npos);
     EXPECT_NE(errorFor("probe_volumes[99999999999999999999].name=a").find("bad index"), std::string::npos);
+}
+
+// Version 3 wrote the sun's illuminance in scene units (its default 3); version 4 writes lux, and
+// an older file, its scenarios' suns included, keeps its light.
+TEST(ProjectVersions, VersionThreeSunIlluminanceBecomesLux) {
+    const json v3 = {{"version", 3},
+                     {"sun", {{"illuminance", 3.0}}},
+                     {"scenarios", {{{"name", "dusk"}, {"sun", {{"illuminance", 1.2}}}}, {{"name", "grey"}, {"sky", {{"intensity", 2.0}}}}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v3, "old.json", &notes);
+    EXPECT_EQ(s.sun.illuminance, 100000.0);
+    ASSERT_EQ(s.scenarios.size(), 2u);
+    EXPECT_EQ(s.scenarios[0].sun.illuminance, 40000.0);
+    ASSERT_EQ(notes.size(), 2u);
+    EXPECT_EQ(notes[0], "old.json: version 3 migrated to 4: sun.illuminance 3.0 is 100000.0 lx");
+    EXPECT_EQ(notes[1], "old.json: version 3 migrated to 4: scenarios[0].sun.illuminance 1.2 is 40000.0 lx");
+    // The same light: the bake's scene units are what version 3 wrote.
+    EXPECT_EQ(sunOf(s.sun).illuminance, s.sun.color * 3.0f);
+    EXPECT_EQ(defaultProjectJson()["sun"]["illuminance"], 100000.0);
+    // A current file means lux.
+    json current = v3;
+    current["version"] = kProjectVersion;
+    EXPECT_EQ(sceneFromJson(current, "new.json", nullptr).sun.illuminance, 3.0);
 }

@@ -55,7 +55,7 @@ json cropDocument(const fs::path& out) {
 }
 
 const json kDusk = {{"name", "dusk"},
-                    {"sun", {{"azimuth_deg", 250.0}, {"elevation_deg", 6.0}, {"illuminance", 1.5}}},
+                    {"sun", {{"azimuth_deg", 250.0}, {"elevation_deg", 6.0}, {"illuminance", 50000.0}}},
                     {"sky", {{"intensity", 0.4}, {"color", {0.12, 0.09, 0.08}}}}};
 
 }  // namespace
