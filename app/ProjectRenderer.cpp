@@ -5,6 +5,8 @@
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "AlbedoImport.h"
 #include "BakeJob.h"
@@ -413,9 +415,21 @@ bool ProjectRenderer::meters(const RenderRequest& r) const {
     return view && view->background != ViewBackground::Black;
 }
 
+namespace {
+
+// The size the meter draws a request at: `maxWidth` wide at most, the request's shape. The
+// viewport's dynamic resolution draws the same view at several sizes, all of one meter size.
+std::pair<uint32_t, uint32_t> meterSize(const RenderRequest& r, uint32_t maxWidth) {
+    const uint32_t w = std::min(r.width, maxWidth);
+    return {w, std::max(1u, uint32_t(std::lround(double(r.height) * w / std::max(1u, r.width))))};
+}
+
+}  // namespace
+
 std::string ProjectRenderer::meterKey(const RenderRequest& r, const OrbitCamera& camera) const {
     std::ostringstream key;
-    key << revision_ << ' ' << r.debugView << ' ' << r.probes << ' ' << double(r.width) / double(std::max(1u, r.height))
+    const auto [w, h] = meterSize(r, kMeterWidth);
+    key << revision_ << ' ' << r.debugView << ' ' << r.probes << ' ' << w << 'x' << h
         << ' ' << camera.target.x << ' ' << camera.target.y << ' ' << camera.target.z << ' ' << camera.radius << ' '
         << camera.azimuthDeg << ' ' << camera.elevationDeg << ' ' << camera.fovDeg;
     return key.str();
@@ -425,8 +439,7 @@ double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera)
     // The meter reads the frame's own scene-linear light at a small size: a mean over ten
     // thousand pixels moves by far less than the 0.1 EV a viewer notices.
     RenderRequest q = r;
-    q.width = std::min(r.width, kMeterWidth);
-    q.height = std::max(1u, uint32_t(std::lround(double(r.height) * q.width / std::max(1u, r.width))));
+    std::tie(q.width, q.height) = meterSize(r, kMeterWidth);
     q.linearOutput = true;
     q.probePositions = q.leaves = false;
     q.gizmos.clear();

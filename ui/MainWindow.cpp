@@ -267,6 +267,9 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         // The wall time of the frame on this thread; the GPU's time from the frame graph's
         // timestamps and the host's recording, of the last frame known finished.
         QString text = QString("frame %1 ms").arg(ms, 0, 'f', 1);
+        // Drawn at fewer pixels while the view changes (dynamic resolution).
+        if (viewport_->presentedScale() < 1.0)
+            text += QString(" · %1 % res").arg(std::lround(100.0 * viewport_->presentedScale() * viewport_->presentedScale()));
         if (viewport_->renderer()) {
             const FrameTimings& t = viewport_->renderer()->renderer().lastFrameTimings();
             if (t.gpuTimed()) text += QString(" · GPU %1 ms").arg(t.gpuMilliseconds, 0, 'f', 2);
@@ -278,9 +281,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             reflectionPanel_->setShownEv100(ev);
         }
         frameLabel_->setText(text);
-        frameLabel_->setToolTip("Wall time of the last frame; GPU: its passes' time from timestamps; host: "
-                                "recording it (the per-pass times: terralux --render --profile); EV100: the "
-                                "camera's exposure (metered in modes average and histogram)");
+        frameLabel_->setToolTip("Wall time of the last frame; % res: the share of the window's pixels it was drawn "
+                                "at while the view changes (View > Dynamic resolution); GPU: its passes' time from "
+                                "timestamps; host: recording it (the per-pass times: terralux --render --profile); "
+                                "EV100: the camera's exposure (metered in modes average and histogram)");
     });
     connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {
         statusBar()->showMessage(QString("light propagation volumes updated in %1 ms").arg(ms, 0, 'f', 0), 3000);
@@ -930,6 +934,14 @@ void MainWindow::buildMenus() {
         connect(a, &QAction::triggered, this, [this, index] { viewSelector_->setCurrentIndex(index); });
     }
     view->addMenu(boundsMenu_);
+    QAction* dynamic = view->addAction("D&ynamic resolution");
+    dynamic->setObjectName("action.dynamicResolution");
+    dynamic->setCheckable(true);
+    dynamic->setChecked(viewport_->dynamicResolution());
+    dynamic->setToolTip(QString("While the view changes, draw at fewer pixels to keep a frame within %1 ms; "
+                                "the full resolution follows when it stops")
+                            .arg(viewport_->resolution().budgetMilliseconds(), 0, 'f', 0));
+    connect(dynamic, &QAction::toggled, viewport_, &ViewportWindow::setDynamicResolution);
     QMenu* panels = view->addMenu("&Panels");
     for (auto* d : findChildren<QDockWidget*>()) {
         // Menu text marks mnemonics with '&'; the title's own '&' is doubled to show as one.

@@ -18,9 +18,22 @@
 
 namespace terralux {
 
-ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance) : ctx_(ctx) {
+ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance)
+    : ctx_(ctx),
+      resolution_(ctx.deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuFrameBudgetMs : kGpuFrameBudgetMs) {
     setSurfaceType(QSurface::VulkanSurface);
     setVulkanInstance(instance);
+    refineTimer_.setSingleShot(true);
+    refineTimer_.setInterval(kRefineDelayMs);
+    connect(&refineTimer_, &QTimer::timeout, this, [this] {
+        refining_ = true;
+        requestUpdate();
+    });
+}
+
+void ViewportWindow::setDynamicResolution(bool on) {
+    dynamicResolution_ = on;
+    requestUpdate();
 }
 
 ViewportWindow::~ViewportWindow() {
@@ -139,9 +152,29 @@ void ViewportWindow::renderNow() {
         swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
     }
     request_.gizmos = interaction_ ? interaction_->gizmos(camera_, QSizeF(width(), height())) : std::vector<GizmoLine>{};
-    if (!renderer_->present(request_, camera_, *swapchain_)) return;
+    // A frame of a change draws at the scale that holds the budget; the full-resolution frame
+    // follows when the changes stop.
+    const double scale = dynamicResolution_ && !refining_ ? resolution_.interactiveScale() : 1.0;
+    refining_ = false;
+    RenderRequest drawn = request_;
+    const ScaledSize size = scaledSize(request_.width, request_.height, scale);
+    drawn.width = size.width;
+    drawn.height = size.height;
+    if (!renderer_->present(drawn, camera_, *swapchain_)) return;
+    presentedScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
+    if (presentedScale_ < 1.0) refineTimer_.start();
+    else refineTimer_.stop();
+    // The frame last known finished (this slot's previous one): its GPU time where timed, at the
+    // scale it was drawn at.
+    const auto ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const FrameTimings& t = renderer_->renderer().lastFrameTimings();
+    if (t.gpuTimed() && t.width > 0 && t.height > 0)
+        resolution_.frameFinished(t.gpuMilliseconds,
+                                  std::min(1.0, std::sqrt(double(t.width) * t.height / (double(request_.width) * request_.height))));
+    else if (!t.gpuTimed())
+        resolution_.frameFinished(ms, presentedScale_);
     if (renderer_->exposureAdapting()) requestUpdate();  // the eye has not yet adapted
-    emit frameRendered(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    emit frameRendered(ms);
 }
 
 RenderedImage ViewportWindow::grabImage(bool gizmos) {

@@ -9,11 +9,13 @@
 #include <optional>
 #include <vector>
 
+#include <QTimer>
 #include <QWindow>
 
 #include "LatestJob.h"
 #include "ProjectRenderer.h"
 #include "lpv/UpdateSchedule.h"
+#include "scene/DynamicResolution.h"
 #include "scene/OrbitCamera.h"
 #include "vk/Swapchain.h"
 
@@ -72,6 +74,21 @@ public:
     // Waits for the update under way and drops its result.
     void stopLpv();
 
+    // Dynamic resolution (docs/ARCHITECTURE.md, "Dynamic resolution"): while the view changes,
+    // frames are drawn at the scale that holds the frame budget (measured by the frame graph's
+    // GPU time, or the wall time where the device has no timestamps) and blitted up to the
+    // window; kRefineDelayMs after the last change one frame at full resolution follows. Off:
+    // every frame at full resolution.
+    static constexpr int kRefineDelayMs = 250;
+    // The budget: 100 ms on a CPU device (lavapipe), a 60 Hz frame on a GPU.
+    static constexpr double kCpuFrameBudgetMs = 100.0, kGpuFrameBudgetMs = 1000.0 / 60.0;
+    void setDynamicResolution(bool on);
+    bool dynamicResolution() const { return dynamicResolution_; }
+    void setFrameBudget(double milliseconds) { resolution_.setBudgetMilliseconds(milliseconds); }
+    const DynamicResolution& resolution() const { return resolution_; }
+    // The scale of the last frame presented: its pixels over the window's, square-rooted.
+    double presentedScale() const { return presentedScale_; }
+
 signals:
     // Wall time the frame took on this thread: recording, submitting and any wait for a free
     // frame slot (which, with every slot busy, is the GPU's frame time).
@@ -109,6 +126,11 @@ private:
     lpv::UpdateSchedule lpvSchedule_;
     LatestJob lpvJob_{this};
     bool lpvBusy_ = false;  // UI thread only: set when a worker starts, cleared when its result lands
+    DynamicResolution resolution_;
+    bool dynamicResolution_ = true;
+    bool refining_ = false;       // the next frame is the full-resolution one after the changes
+    double presentedScale_ = 1.0;
+    QTimer refineTimer_;
 };
 
 }  // namespace terralux

@@ -126,6 +126,7 @@ struct FrameSlot {
     uint32_t timestampsWritten = 0;
     std::vector<std::string> timedPasses;
     double recordMilliseconds = 0.0;
+    uint32_t width = 0, height = 0;  // the size the frame drawn in this slot was asked for
     // The gizmo lines of the frame drawn in this slot (RenderSettings::gizmos), grown as needed.
     vk::Buffer gizmos;
     size_t gizmoCapacity = 0;

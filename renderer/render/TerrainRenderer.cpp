@@ -760,6 +760,8 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
     ctx_.waitIdle();
     ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, drawn, out); });
+    gpu_->slots[0].width = s.width;
+    gpu_->slots[0].height = s.height;
     readFrameTimings(0);
     RenderedImage img;
     img.width = s.width;
@@ -776,6 +778,8 @@ void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
     FrameSlot& slot = gpu_->slots[slotIndex];
     timings_ = FrameTimings{};
     timings_.recordMilliseconds = slot.recordMilliseconds;
+    timings_.width = slot.width;
+    timings_.height = slot.height;
     const uint32_t n = slot.timestampsWritten;
     slot.timestampsWritten = 0;
     if (n < 2) return;
@@ -808,6 +812,8 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
     readFrameTimings(frame->slot);
     RenderSettings scaled;
     recordFrame(frame->cb, frame->slot, drawnSettings(s, out.antialiasing, scaled), out);
+    gpu_->slots[frame->slot].width = s.width;
+    gpu_->slots[frame->slot].height = s.height;
     swapchain.submitAndPresent(*frame);
     return true;
 }

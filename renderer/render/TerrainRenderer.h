@@ -75,6 +75,7 @@ struct FrameTimings {
     double gpuMilliseconds = 0.0;      // first timestamp to last: the passes summed
     double recordMilliseconds = 0.0;   // host: recording the frame (uniforms, passes, barriers)
     double readbackMilliseconds = 0.0; // host: converting the read-back pixels (render() only)
+    uint32_t width = 0, height = 0;    // the pixels asked for (the viewport's dynamic resolution)
     bool gpuTimed() const { return !passes.empty(); }
 };
 

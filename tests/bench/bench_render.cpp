@@ -17,6 +17,7 @@
 #include "ProjectRenderer.h"
 #include "TerrainLoading.h"
 #include "lpv/Lpv.h"
+#include "scene/DynamicResolution.h"
 #include "scene/DebugViews.h"
 
 using namespace terralux;
@@ -262,6 +263,49 @@ void BM_Antialiasing(benchmark::State& state) {
     f.renderer->setProject(fixtureProject());
 }
 BENCHMARK(BM_Antialiasing)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Iterations(5)->UseRealTime();
+
+// The viewport's dynamic resolution: beauty over N42E001 at a 1350 x 990 window (the size the
+// viewport had when it was measured on lavapipe) drawn at each of the scales it steps through,
+// GPU and wall time; the label names the step the rule picks from the full-resolution frame for
+// the device's budget (100 ms on a CPU device), and how close to it that step comes.
+void BM_DynamicResolution(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    const double scale = DynamicResolution::kScales[state.range(0)];
+    const ScaledSize size = scaledSize(1350, 990, scale);
+    RenderRequest q;
+    q.width = size.width;
+    q.height = size.height;
+    f.renderer->render(q);  // the targets of this size
+    double ms = 0;
+    FrameCost cost;
+    for (auto _ : state) {
+        ms += f.renderer->render(q).milliseconds;
+        cost.add(f.renderer->renderer());
+    }
+    // The rule as the viewport runs it: the full frame (the last refinement) and this scale.
+    static double full = 0.0;
+    const double budget = f.ctx->deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU ? 100.0 : 1000.0 / 60.0;
+    std::string label = std::to_string(size.width) + "x" + std::to_string(size.height);
+    if (cost.timed > 0) {
+        const double gpu = cost.gpu / cost.timed;
+        if (state.range(0) == 0) full = gpu;
+        DynamicResolution rule(budget);
+        rule.frameFinished(full, 1.0);
+        rule.frameFinished(gpu, scale);
+        state.counters["predicted_ms"] = rule.predictedMilliseconds(scale);
+        label += ", budget " + std::to_string(int(budget)) + " ms: the rule picks scale " +
+                 std::to_string(rule.interactiveScale()).substr(0, 5);
+    }
+    state.SetLabel(label + " on " + f.ctx->deviceName());
+    state.counters["scale"] = scale;
+    state.counters["frame_ms"] = ms / double(state.iterations());
+    cost.report(state);
+}
+BENCHMARK(BM_DynamicResolution)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
 // Beauty at 1280 x 720 with the terrain surface's parts each on or off: horizon AO, the
 // normal-variance specular and the micro-detail (shadows and fog off, so only these differ).

@@ -938,6 +938,38 @@ private slots:
         QCOMPARE(w_->document()->project().scene.sun.illuminance, sun);
     }
 
+    // Dynamic resolution: with a budget no frame meets, a camera move draws at a quarter of the
+    // side (the status bar says so), and the full resolution follows once the moves stop; with
+    // it off every frame is full. The budget comes from the device: 100 ms on lavapipe.
+    void dynamicResolutionHoldsTheBudgetAndRefines() {
+        ViewportWindow* v = w_->viewport();
+        QCOMPARE(v->resolution().budgetMilliseconds(), ViewportWindow::kCpuFrameBudgetMs);
+        auto* action = w_->findChild<QAction*>("action.dynamicResolution");
+        QVERIFY(action && action->isCheckable() && action->isChecked());
+        v->setFrameBudget(1e-3);
+        v->renderNow();  // a frame measured (its GPU time arrives with the next ones)
+        QVERIFY(settlesQuiet(v));
+        QSignalSpy frames(v, &ViewportWindow::frameRendered);
+        QTest::keyClick(v, Qt::Key_Left);
+        QTRY_VERIFY_WITH_TIMEOUT(frames.count() > 0, 5000);
+        QTRY_VERIFY_WITH_TIMEOUT(v->presentedScale() < 0.3, 5000);
+        QVERIFY(w_->findChild<QLabel*>("status.frame")->text().contains("6 % res"));
+        // No change for the refine delay: one frame at full resolution.
+        QTRY_VERIFY_WITH_TIMEOUT(v->presentedScale() == 1.0, 5000);
+        QVERIFY(!w_->findChild<QLabel*>("status.frame")->text().contains("% res"));
+        QVERIFY(settlesQuiet(v));
+        action->setChecked(false);
+        QVERIFY(!v->dynamicResolution());
+        QSignalSpy fullFrames(v, &ViewportWindow::frameRendered);
+        QTest::keyClick(v, Qt::Key_Right);
+        QTRY_VERIFY_WITH_TIMEOUT(fullFrames.count() > 0, 5000);
+        QCOMPARE(v->presentedScale(), 1.0);
+        QVERIFY(settlesQuiet(v));
+        QCOMPARE(v->presentedScale(), 1.0);
+        action->setChecked(true);
+        v->setFrameBudget(ViewportWindow::kCpuFrameBudgetMs);
+    }
+
     // A camera move from the viewport keeps the exposure (the viewport writes only its own keys).
     void cameraMovesKeepTheExposure() {
         auto* exposure = w_->findChild<QDoubleSpinBox*>("param.camera.exposure_ev");
