@@ -85,18 +85,44 @@ void ProjectRenderer::setProject(const Project& project) {
     litB.scene = scenarioScene(scene, b);
     const BakeLighting lighting = lightingOf(t < 0.5f ? litA : litB, hf);
     shown_ = lighting;
-    // The sky behind the terrain at full resolution (the shown scenario's, for a blend the nearer
-    // end's); uploaded when the image is another one, not for an edit of its intensity.
-    int skyWidth = 0, skyHeight = 0;
+    const bool blending = t > 0.0f && t < 1.0f;
+    std::optional<BakeLighting> la, lb;
+    if (blending) la = lightingOf(litA, hf), lb = lightingOf(litB, hf);
+    // The sky behind the terrain at full resolution: the shown scenario's image, uploaded when it
+    // is another one (not for an edit of its intensity); between two scenarios whose skies are
+    // not both uniform, the two skies mixed into one image, made again when either or the blend
+    // changes.
+    int skyWidth = 0, skyHeight = 0, otherWidth = 0, otherHeight = 0;
     const std::vector<glm::vec3>* skyImage = lighting.sky.image(&skyWidth, &skyHeight);
-    int heldWidth = 0, heldHeight = 0;
-    if (skyImage != (heldSky_ ? heldSky_->image(&heldWidth, &heldHeight) : nullptr)) {
-        renderer_->setSkyImage(skyImage ? skyWidth : 0, skyImage ? skyHeight : 0,
-                               skyImage ? *skyImage : std::vector<glm::vec3>{});
-        heldSky_ = lighting.sky;  // holds the texels, so no other image can take their address
+    if (blending && (la->sky.image(&skyWidth, &skyHeight) || lb->sky.image(&otherWidth, &otherHeight))) {
+        std::ostringstream key;
+        for (const BakeLighting* l : {&*la, &*lb}) {
+            int w = 0, h = 0;
+            const glm::vec3 s = l->sky.scale(), up = l->sky.radiance(glm::vec3(0.0f, 1.0f, 0.0f));
+            key << static_cast<const void*>(l->sky.image(&w, &h)) << ' ' << s.x << ' ' << s.y << ' ' << s.z << ' '
+                << l->sky.rotationTurns() << ' ' << up.x << ' ' << up.y << ' ' << up.z << ' ';
+        }
+        key << t;
+        if (key.str() != blendedSkyKey_) {
+            // The finer of the two images, at most a 2048 x 1024 equirectangular one.
+            const int w = std::min(std::max(skyWidth, otherWidth), 2048), h = std::min(std::max(skyHeight, otherHeight), 1024);
+            renderer_->setSkyImage(w, h, blendedEquirect(la->sky, lb->sky, t, w, h));
+            heldSky_.reset();
+            blendedSkyKey_ = key.str();
+        }
+        base_.skyImageScale = glm::vec3(1.0f);
+        base_.skyImageRotation = 0.0f;
+    } else {
+        int heldWidth = 0, heldHeight = 0;
+        if (!blendedSkyKey_.empty() || skyImage != (heldSky_ ? heldSky_->image(&heldWidth, &heldHeight) : nullptr)) {
+            renderer_->setSkyImage(skyImage ? skyWidth : 0, skyImage ? skyHeight : 0,
+                                   skyImage ? *skyImage : std::vector<glm::vec3>{});
+            heldSky_ = lighting.sky;  // holds the texels, so no other image can take their address
+            blendedSkyKey_.clear();
+        }
+        base_.skyImageScale = lighting.sky.scale();
+        base_.skyImageRotation = lighting.sky.rotationTurns();
     }
-    base_.skyImageScale = lighting.sky.scale();
-    base_.skyImageRotation = lighting.sky.rotationTurns();
     base_.albedo = lighting.albedo;
     base_.terrain = scene.terrain;
     base_.detail = scene.detail;
@@ -133,22 +159,21 @@ void ProjectRenderer::setProject(const Project& project) {
     base_.exposure = float(exposureScale(scene.camera.ev100, scene.camera.exposureEv));
     base_.antialiasing = scene.camera.antialiasing;
     base_.shadows = scene.shadows;
-    if (t == 0.0f || t == 1.0f) {
+    if (!blending) {
         base_.sun = lighting.sun;
         base_.skySh = lighting.sky.sh();
         base_.fog = resolvedFog(scene.fog, lighting.sky, hf);
     } else {
         // Between two scenarios: the sun turns along the arc between its two directions (nlerp),
         // its illuminance and size and the sky's SH mix linearly, as the probes do.
-        const BakeLighting la = lightingOf(litA, hf), lb = lightingOf(litB, hf);
-        const glm::vec3 d = glm::mix(la.sun.direction, lb.sun.direction, t);
-        base_.sun = la.sun;
-        base_.sun.direction = glm::length(d) > 1e-4f ? glm::normalize(d) : (t < 0.5f ? la.sun.direction : lb.sun.direction);
-        base_.sun.illuminance = glm::mix(la.sun.illuminance, lb.sun.illuminance, t);
-        base_.sun.angularRadius = glm::mix(la.sun.angularRadius, lb.sun.angularRadius, t);
-        const sh::ShRgb sa = la.sky.sh(), sb = lb.sky.sh();
+        const glm::vec3 d = glm::mix(la->sun.direction, lb->sun.direction, t);
+        base_.sun = la->sun;
+        base_.sun.direction = glm::length(d) > 1e-4f ? glm::normalize(d) : (t < 0.5f ? la->sun.direction : lb->sun.direction);
+        base_.sun.illuminance = glm::mix(la->sun.illuminance, lb->sun.illuminance, t);
+        base_.sun.angularRadius = glm::mix(la->sun.angularRadius, lb->sun.angularRadius, t);
+        const sh::ShRgb sa = la->sky.sh(), sb = lb->sky.sh();
         for (size_t k = 0; k < sa.c.size(); ++k) base_.skySh.c[k] = glm::mix(sa.c[k], sb.c[k], t);
-        const FogSettings fa = resolvedFog(scene.fog, la.sky, hf), fb = resolvedFog(scene.fog, lb.sky, hf);
+        const FogSettings fa = resolvedFog(scene.fog, la->sky, hf), fb = resolvedFog(scene.fog, lb->sky, hf);
         base_.fog = fa;
         if (fa.color && fb.color) base_.fog.color = glm::mix(*fa.color, *fb.color, t);
     }

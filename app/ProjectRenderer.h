@@ -224,6 +224,7 @@ private:
     ScenarioView view_;
     BakeLighting shown_;  // the lighting of the scenario shown (the blend's nearer end)
     std::optional<Sky> heldSky_;  // the sky whose image the renderer holds
+    std::string blendedSkyKey_;   // while it holds two scenarios' skies mixed: which, and how
     std::unique_ptr<TerrainRenderer> renderer_;
     std::shared_ptr<const HeightfieldTracer> tracer_;  // for the LPV, made on first use
     std::string lpvKey_;

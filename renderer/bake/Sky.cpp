@@ -81,18 +81,28 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
     return s;
 }
 
+namespace {
+
+// The unit direction through the centre of texel (x, y) of a width x height equirectangular image
+// at rotation 0 (the inverse of equirectU and equirectV): the texel centres computeSh() integrates
+// over.
+glm::vec3 texelDirection(int x, int y, int width, int height) {
+    const double theta = std::numbers::pi * (y + 0.5) / height;
+    const float st = float(std::sin(theta)), ct = float(std::cos(theta));
+    const float phi = ((x + 0.5f) / width - 0.5f) * 2.0f * kPi;
+    return glm::vec3(st * std::sin(phi), ct, -st * std::cos(phi));
+}
+
+}  // namespace
+
 Sky Sky::physical(const PhysicalSky& model, int width, int height) {
     if (width < 1 || height < 1)
         throw std::invalid_argument("physical sky: " + std::to_string(width) + "x" +
                                     std::to_string(height) + " is not an image size");
     std::vector<float> rgb(size_t(width) * size_t(height) * 3);
-    // The texel centres computeSh() integrates over, at rotation 0.
     tbb::parallel_for(0, height, [&](int y) {
-        const double theta = std::numbers::pi * (y + 0.5) / height;
-        const float st = float(std::sin(theta)), ct = float(std::cos(theta));
         for (int x = 0; x < width; ++x) {
-            const float phi = ((x + 0.5f) / width - 0.5f) * 2.0f * kPi;
-            const glm::vec3 r = model.radiance(glm::vec3(st * std::sin(phi), ct, -st * std::cos(phi)));
+            const glm::vec3 r = model.radiance(texelDirection(x, y, width, height));
             float* out = &rgb[3 * (size_t(y) * width + x)];
             out[0] = r.x;
             out[1] = r.y;
@@ -168,6 +178,20 @@ glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
     const glm::vec3 a = sample((*levels_)[size_t(l0)], u, v);
     if (t <= 0.0f || l1 == l0) return scale_ * a;
     return scale_ * glm::mix(a, sample((*levels_)[size_t(l1)], u, v), t);
+}
+
+std::vector<glm::vec3> blendedEquirect(const Sky& a, const Sky& b, float t, int width, int height) {
+    if (width < 1 || height < 1)
+        throw std::invalid_argument("blended sky: " + std::to_string(width) + "x" + std::to_string(height) +
+                                    " is not an image size");
+    std::vector<glm::vec3> out(size_t(width) * size_t(height));
+    tbb::parallel_for(0, height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            const glm::vec3 d = texelDirection(x, y, width, height);
+            out[size_t(y) * width + x] = glm::mix(a.radiance(d), b.radiance(d), t);
+        }
+    });
+    return out;
 }
 
 }  // namespace terralux

@@ -76,4 +76,9 @@ private:
     glm::vec3 openUp_{0.0f};
 };
 
+// The equirectangular image (rotation 0, row 0 at the zenith, scale 1) of two skies mixed,
+// (1 − t)·a + t·b toward each texel centre: what a blend between two lighting scenarios shows
+// behind the terrain, whatever the two skies' kinds, resolutions and rotations.
+std::vector<glm::vec3> blendedEquirect(const Sky& a, const Sky& b, float t, int width, int height);
+
 }  // namespace terralux

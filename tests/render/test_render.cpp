@@ -2449,6 +2449,52 @@ TEST_F(RenderTest, TheMeteredExposurePutsTheTerrainNearMiddleGrey) {
         }
 }
 
+TEST_F(RenderTest, BetweenTwoScenariosTheBackgroundIsBothSkiesMixed) {
+    // The physical sky and a dim uniform one, the same sun behind the camera: halfway between the
+    // scenarios each sky pixel is the mean of the two ends' (the nearer end's image alone would be
+    // off by some 70 %). Scene-linear, fog off.
+    Project p = loadEffectiveProject("", {"probe_volumes[0].enabled=false", "sky.mode=\"physical\"", "fog.enabled=false",
+                                          "sun.mode=\"manual\"", "sun.azimuth_deg=135", "sun.elevation_deg=30",
+                                          "camera.azimuth_deg=135", "camera.elevation_deg=4",
+                                          "camera.antialiasing=\"off\""},
+                                     "", nullptr);
+    p.scene.exportSettings.outDir = (kOut / "bake_scenario_background").string();
+    LightingScenario grey;
+    grey.name = "grey";
+    grey.sun = p.scene.sun;
+    grey.sky.mode = SkyMode::Uniform;
+    grey.sky.color = glm::vec3(0.02f, 0.02f, 0.025f);
+    p.scene.scenarios = {grey};
+    ProjectRenderer r(*ctx_, p);
+    const uint32_t w = 320, h = 180;
+    auto frame = [&](float t, int view) {
+        r.setScenarioView({"default", "grey", t});
+        return draw(r, view, false, true, w, h);
+    };
+    const RenderedImage mask = frame(0.0f, kViewShadow);  // green 1 on the terrain
+    const RenderedImage a = frame(0.0f, kViewBeauty), b = frame(1.0f, kViewBeauty), half = frame(0.5f, kViewBeauty);
+    double error = 0.0, apart = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+        if (mask.rgba[i * 4 + 1] > 0.5f) continue;
+        for (int c = 0; c < 3; ++c) {
+            const double mean = 0.5 * (a.rgba[i * 4 + c] + b.rgba[i * 4 + c]);
+            if (!(mean > 1e-4)) continue;
+            error += std::abs(half.rgba[i * 4 + c] - mean) / mean;
+            apart += std::abs(a.rgba[i * 4 + c] - b.rgba[i * 4 + c]) / mean;
+            ++n;
+        }
+    }
+    ASSERT_GT(n, size_t(w) * h / 4);
+    std::cout << n / 3 << " sky pixels: halfway off the mean by " << 100.0 * error / double(n) << " %, the ends "
+              << 100.0 * apart / double(n) << " % apart\n";
+    EXPECT_GT(apart / double(n), 0.5);
+    EXPECT_LT(error / double(n), 0.02);
+    // Back at an end the end's own image is drawn again.
+    EXPECT_EQ(test::compareImages(frame(0.0f, kViewBeauty).rgba, a.rgba, w, h).maxAbs, 0.0);
+    EXPECT_EQ(test::compareImages(frame(1.0f, kViewBeauty).rgba, b.rgba, w, h).maxAbs, 0.0);
+}
+
 TEST_F(RenderTest, AnHdrSkyIsDrawnBehindTheTerrainAtItsOwnResolution) {
     // A checkered HDR of 16 x 8 cells (radiance 0.1 and 1.0), rotated: the sky pass must draw its
     // texels through the bake's own mapping (Sky::radiance), not the SH's blur of them. Compared

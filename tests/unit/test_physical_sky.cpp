@@ -282,3 +282,34 @@ TEST(EnvironmentImage, ExrDataWindowThatIsNoSkyIsRefusedBeforeOpenExrSizesItsBuf
     const std::string sky = refusal(7, 3);  // 8 x 4: the header walk lets it through to OpenImageIO
     EXPECT_EQ(sky.find("data window"), std::string::npos) << sky;
 }
+
+// Two scenarios' skies mixed into one image for the background between them: each texel is the
+// mix of the two skies toward its centre, whatever their kinds and rotations.
+TEST(PhysicalSky, BlendedEquirectMixesTheTwoSkiesTowardEachTexel) {
+    const Sky physical = Sky::physical(PhysicalSky(sunDirection(80.0, 25.0), 4.0), 128, 64);
+    std::vector<float> rgb(64 * 32 * 3);
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = float((i * 7) % 13) / 13.0f;
+    const Sky turned = Sky::equirect(rgb, 64, 32, 2.0f, 40.0f);
+    const Sky uniform = Sky::uniform(glm::vec3(0.2f, 0.3f, 0.4f));
+    const int w = 96, h = 48;
+    const std::vector<glm::vec3> mixed = blendedEquirect(physical, turned, 0.25f, w, h);
+    ASSERT_EQ(mixed.size(), size_t(w * h));
+    for (int y = 0; y < h; y += 5)
+        for (int x = 0; x < w; x += 7) {
+            // The texel centre's direction as the sky pass maps it (equirectU/V at rotation 0).
+            const double theta = kPi * (y + 0.5) / h, phi = ((x + 0.5) / w - 0.5) * 2.0 * kPi;
+            const glm::vec3 d(float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)),
+                              float(-std::sin(theta) * std::cos(phi)));
+            const glm::vec3 expected = 0.75f * physical.radiance(d) + 0.25f * turned.radiance(d);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(mixed[size_t(y * w + x)][c], expected[c], 1e-4f * (1.0f + expected[c])) << x << "," << y;
+        }
+    // Uniform with uniform is the mixed colour; the ends are the skies themselves.
+    const std::vector<glm::vec3> flat = blendedEquirect(uniform, Sky::uniform(glm::vec3(1.0f)), 0.5f, 4, 2);
+    for (const glm::vec3& v : flat)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(v[c], glm::vec3(0.6f, 0.65f, 0.7f)[c], 1e-6f);
+    const std::vector<glm::vec3> end = blendedEquirect(uniform, physical, 1.0f, w, h);
+    const std::vector<glm::vec3> start = blendedEquirect(physical, uniform, 0.0f, w, h);
+    EXPECT_EQ(end, start);
+    EXPECT_THROW(blendedEquirect(uniform, physical, 0.5f, 0, 4), std::invalid_argument);
+}
