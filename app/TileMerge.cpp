@@ -88,12 +88,21 @@ void shiftTextures(nlohmann::json& j, size_t offset) {
     }
 }
 
+// One probe grid of a tile: its seed-001 record and, per lighting scenario (in the order of
+// TERRALUX_lighting.scenarios), its file of that scenario, each addressed through the tile's folder.
+struct MergedGrid {
+    nlohmann::json grid;
+    std::vector<std::string> scenarioPaths;
+};
+
 // The tiles' glTF documents as one: each tile's nodes, meshes, materials and buffers appended with
 // their indices moved, buffers and images addressed through the tile's folder, and the probe
-// grids of every tile listed in the scene's VULKAN_SCHNEE_engine_properties, sorted by file name.
+// grids of every tile listed in the scene's VULKAN_SCHNEE_engine_properties, sorted by file name;
+// each lighting scenario's files listed in that same order.
 nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::json& region) {
     nlohmann::json out = {{"asset", tiles.front().gltf["asset"]}, {"scene", 0}};
-    nlohmann::json used = nlohmann::json::array(), grids = nlohmann::json::array(), roots = nlohmann::json::array();
+    nlohmann::json used = nlohmann::json::array(), roots = nlohmann::json::array();
+    std::vector<MergedGrid> grids;
     nlohmann::json sceneExt = tiles.front().gltf["scenes"][0].value("extensions", nlohmann::json::object());
     static const char* kArrays[] = {"nodes", "meshes", "materials", "samplers", "images", "textures",
                                     "accessors", "bufferViews", "buffers"};
@@ -150,17 +159,42 @@ nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::j
             out["buffers"].push_back(x);
         }
         const nlohmann::json ext = scene.value("extensions", nlohmann::json::object());
-        if (ext.contains("VULKAN_SCHNEE_engine_properties"))
-            for (nlohmann::json grid : ext["VULKAN_SCHNEE_engine_properties"].value("shProbeGrids", nlohmann::json::array())) {
-                grid["shProbePath"] = prefix + grid["shProbePath"].get<std::string>();
-                grids.push_back(grid);
+        const nlohmann::json scenarios =
+            ext.value("TERRALUX_lighting", nlohmann::json::object()).value("scenarios", nlohmann::json::array());
+        if (ext.contains("VULKAN_SCHNEE_engine_properties")) {
+            const nlohmann::json tileGrids = ext["VULKAN_SCHNEE_engine_properties"].value("shProbeGrids", nlohmann::json::array());
+            for (size_t k = 0; k < tileGrids.size(); ++k) {
+                MergedGrid m{tileGrids[k], {}};
+                m.grid["shProbePath"] = prefix + m.grid["shProbePath"].get<std::string>();
+                for (const auto& s : scenarios) {
+                    const nlohmann::json paths = s.value("shProbePaths", nlohmann::json::array());
+                    if (k >= paths.size() || !paths[k].is_string())
+                        throw ProjectError((tiles[t].dir / "scene.gltf").string() + ": scenario " + s.value("name", std::string("?")) +
+                                           " lists " + std::to_string(paths.size()) + " files for " +
+                                           std::to_string(tileGrids.size()) + " grids; bake the tile again");
+                    m.scenarioPaths.push_back(prefix + paths[k].get<std::string>());
+                }
+                grids.push_back(std::move(m));
             }
+        }
     }
     // The seed's rule: grids sorted by file name; the first that holds a point wins.
-    std::stable_sort(grids.begin(), grids.end(), [](const nlohmann::json& a, const nlohmann::json& b) {
-        return a["shProbePath"].get<std::string>() < b["shProbePath"].get<std::string>();
+    std::stable_sort(grids.begin(), grids.end(), [](const MergedGrid& a, const MergedGrid& b) {
+        return a.grid["shProbePath"].get<std::string>() < b.grid["shProbePath"].get<std::string>();
     });
-    sceneExt["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"] = grids;
+    nlohmann::json gridList = nlohmann::json::array();
+    for (const MergedGrid& m : grids) gridList.push_back(m.grid);
+    sceneExt["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"] = gridList;
+    // Each scenario's files in the order of the grids (the tiles share one set of scenarios: they
+    // were baked from the same inputs).
+    if (sceneExt.contains("TERRALUX_lighting") && sceneExt["TERRALUX_lighting"].contains("scenarios")) {
+        nlohmann::json& scenarios = sceneExt["TERRALUX_lighting"]["scenarios"];
+        for (size_t s = 0; s < scenarios.size(); ++s) {
+            nlohmann::json paths = nlohmann::json::array();
+            for (const MergedGrid& m : grids) paths.push_back(m.scenarioPaths.at(s));
+            scenarios[s]["shProbePaths"] = paths;
+        }
+    }
     // The region's grid and stride, not the first tile's.
     if (sceneExt.contains("TERRALUX_geo")) {
         sceneExt["TERRALUX_geo"]["gridSize"] = region["region_grid"];
@@ -307,9 +341,9 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
         const std::optional<nlohmann::json> g = readJson(t.dir / "scene.gltf");
         if (!g) throw ProjectError((t.dir / "scene.gltf").string() + ": missing or unreadable; bake the tile with export.gltf on");
         const nlohmann::json lighting = (*g)["scenes"][0].value("extensions", nlohmann::json::object()).value("TERRALUX_lighting", nlohmann::json::object());
-        if (lighting.contains("scenarios") || lighting.contains("reflection_probes"))
-            throw ProjectError(t.dir.string() + ": a tile with lighting scenarios or reflection probes; --merge lists "
-                               "diffuse probe grids and meshes only, so bake the tiles without them");
+        if (lighting.contains("reflection_probes"))
+            throw ProjectError(t.dir.string() + ": a tile with reflection probes; --merge lists diffuse probe grids, "
+                               "their lighting scenarios and meshes only, so bake the tiles without them");
         t.gltf = *g;
         nlohmann::json files = nlohmann::json::array();
         for (const auto& f : t.report.value("files", nlohmann::json::array())) {

@@ -365,3 +365,62 @@ TEST(Tiles, TheDerivedHaloHoldsEveryProbeOfAMountainTileWithinItsShare) {
     EXPECT_LE(worst, kHaloShare);
     fs::remove_all(dir);
 }
+
+TEST(Tiles, TheMergeListsEachLightingScenarioInTheOrderOfTheGrids) {
+    // Two tiles of the crop with a dusk scenario beside the default: the merged scene's
+    // TERRALUX_lighting.scenarios lists, per scenario, every tile's file in the order of the
+    // sorted shProbeGrids (the default's are the grids themselves), and tiles.json hashes them.
+    const fs::path tiled = freshDir("scenarios");
+    for (int i = 0; i < 2; ++i) {
+        BakeRequest r{regionProject(tiled), 2, false};
+        LightingScenario dusk;
+        dusk.name = "dusk";
+        dusk.sun = r.project.scene.sun;
+        dusk.sky = r.project.scene.sky;
+        dusk.sun.elevationDeg = 8.0;
+        r.project.scene.scenarios = {dusk};
+        r.tile = parseTiles("2,1", std::to_string(i) + "/2", std::optional<double>(300.0));
+        r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
+        runBake(r, {}, nullptr);
+    }
+    const MergeOutcome m = mergeTiles(tiled);
+    EXPECT_EQ(m.grids, 2u);
+    std::ifstream in(tiled / "scene.gltf");
+    const nlohmann::json g = nlohmann::json::parse(in);
+    const auto& ext = g["scenes"][0]["extensions"];
+    const auto& grids = ext["VULKAN_SCHNEE_engine_properties"]["shProbeGrids"];
+    const auto& scenarios = ext["TERRALUX_lighting"]["scenarios"];
+    ASSERT_EQ(scenarios.size(), 2u);
+    EXPECT_EQ(scenarios[0]["name"], "default");
+    EXPECT_EQ(scenarios[1]["name"], "dusk");
+    ASSERT_EQ(scenarios[1]["shProbePaths"].size(), grids.size());
+    for (size_t k = 0; k < grids.size(); ++k) {
+        EXPECT_EQ(scenarios[0]["shProbePaths"][k], grids[k]["shProbePath"]);
+        const std::string dusk = scenarios[1]["shProbePaths"][k].get<std::string>();
+        const std::string tile = grids[k]["shProbePath"].get<std::string>().substr(0, std::string("tiles/tile_000_000/").size());
+        EXPECT_EQ(dusk, tile + "scenarios/probes.dusk.shprobe");
+        EXPECT_TRUE(fs::exists(tiled / dusk)) << dusk;
+    }
+    std::ifstream indexIn(tiled / "tiles.json");
+    const nlohmann::json index = nlohmann::json::parse(indexIn);
+    size_t hashed = 0;
+    for (const auto& t : index["tiles"])
+        for (const auto& f : t["files"]) hashed += f["path"].get<std::string>().find("scenarios/") != std::string::npos;
+    EXPECT_EQ(hashed, 2u);
+    // Reflection probes are still refused, by tile and reason.
+    {
+        const fs::path gltf = tiled / kTilesFolder / "tile_000_000" / "scene.gltf";
+        std::ifstream tileIn(gltf);
+        nlohmann::json tile = nlohmann::json::parse(tileIn);
+        tileIn.close();
+        tile["scenes"][0]["extensions"]["TERRALUX_lighting"]["reflection_probes"] = {{"uri", "reflection/probes.rprobe"}};
+        std::ofstream(gltf) << tile.dump();
+    }
+    try {
+        mergeTiles(tiled);
+        ADD_FAILURE() << "merged tiles with reflection probes";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("tile_000_000: a tile with reflection probes"), std::string::npos) << e.what();
+    }
+    fs::remove_all(tiled);
+}
