@@ -206,6 +206,13 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         // two tiles hold the same probe) they differ from it by their sampling noise, no more.
         double sum = 0.0, worst = 0.0;
         size_t matched = 0, border = 0;
+        // Per border segment: the x border's north and south halves, the z border's west and
+        // east halves (the crossing's probe counts in all four).
+        struct Segment {
+            double sum = 0.0, worst = 0.0;
+            size_t n = 0;
+        };
+        std::map<std::string, Segment> segments;
         for (const auto& e : fs::directory_iterator(tiled / kTilesFolder)) {
             if (!e.is_directory()) continue;  // the region's summary (region.json, region.f32)
             for (const Probe& p : probesIn(e.path())) {
@@ -222,6 +229,22 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
                     ++border;
                     sum += z;
                     worst = std::max(worst, z);
+                    const float bx = reference[4].position.x, bz = reference[27].position.z;
+                    std::vector<std::string> in;
+                    if (std::abs(p.position.x - bx) < 0.05f) {
+                        if (p.position.z <= bz + 0.05f) in.push_back("x border, north half");
+                        if (p.position.z >= bz - 0.05f) in.push_back("x border, south half");
+                    }
+                    if (std::abs(p.position.z - bz) < 0.05f) {
+                        if (p.position.x <= bx + 0.05f) in.push_back("z border, west half");
+                        if (p.position.x >= bx - 0.05f) in.push_back("z border, east half");
+                    }
+                    for (const std::string& k : in) {
+                        Segment& g = segments[k];
+                        g.sum += z;
+                        g.worst = std::max(g.worst, z);
+                        ++g.n;
+                    }
                 }
             }
         }
@@ -246,6 +269,11 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         std::cout << "halo " << (halo ? std::to_string(*halo) + " m" : std::string("derived")) << ": " << border
                   << " border probes, |difference| / its standard error mean " << sum / double(border) << ", max "
                   << worst << "\n";
+        EXPECT_EQ(segments.size(), 4u);
+        for (const auto& [name, g] : segments) {
+            std::cout << "  " << name << ": " << g.n << " probes, mean " << g.sum / double(g.n) << ", max " << g.worst << "\n";
+            EXPECT_LT(g.worst, 2.0) << name;
+        }
         // Within twice the standard error of their difference, every one (without a halo, the
         // skirt standing in for the terrain beyond: mean 0.74, max 2.9).
         EXPECT_LT(sum / double(border), 0.5) << "halo " << (halo ? *halo : -1.0);
