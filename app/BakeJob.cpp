@@ -1,7 +1,9 @@
 #include "BakeJob.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <optional>
@@ -195,12 +197,13 @@ struct GridSuggestion {
 // The grid a suggestion tries next from an ax x az grid of `side` probes a side (geometric mean)
 // whose map errs `error` on average: each side grown by (error / target)^(1 / exponent) (bilinear
 // error falls with the square of the spacing, exponent 2, until trials measure another), then
-// shrunk to the terrain-grid limit (`capped`).
-std::array<double, 2> grownGrid(int ax, int az, double side, double error, double exponent, bool& capped) {
+// shrunk to `maxProbes`, the terrain-grid limit or a tile's share of it (`capped`).
+std::array<double, 2> grownGrid(int ax, int az, double side, double error, double exponent, bool& capped,
+                                int maxProbes = kMaxTerrainGridProbes) {
     const double grow = std::pow(error / kSuggestTargetMeanError, 1.0 / exponent);
     double nx = std::ceil(ax * side / std::sqrt(double(ax) * az) * grow);
     double nz = std::ceil(az * side / std::sqrt(double(ax) * az) * grow);
-    const double fit = std::sqrt(double(kMaxTerrainGridProbes) / (nx * nz));
+    const double fit = std::sqrt(double(maxProbes) / (nx * nz));
     capped = fit < 1.0;
     if (capped) nx = std::floor(nx * fit), nz = std::floor(nz * fit);
     return {nx, nz};
@@ -208,7 +211,8 @@ std::array<double, 2> grownGrid(int ax, int az, double side, double error, doubl
 
 std::optional<GridSuggestion> denserGrid(
     const ProbeVolumeSettings& v, size_t index, const ProbeLayout& layout, const ErrorMapStats& now,
-    const std::function<std::optional<ErrorMapStats>(const ProbeVolumeSettings&, size_t&, uint64_t&)>& measure) {
+    const std::function<std::optional<ErrorMapStats>(const ProbeVolumeSettings&, size_t&, uint64_t&)>& measure,
+    int maxProbes) {
     const std::string at = "probe_volumes[" + std::to_string(index) + "].";
     const int ax = layout.probeDims[0], az = layout.probeDims[2];
     double side = std::sqrt(double(ax) * az), error = now.mean, exponent = 2.0;
@@ -218,7 +222,7 @@ std::optional<GridSuggestion> denserGrid(
     uint64_t rays = 0;
     for (; trials < kSuggestTrials; ++trials) {
         bool capped = false;
-        const auto [nx, nz] = grownGrid(ax, az, side, error, exponent, capped);
+        const auto [nx, nz] = grownGrid(ax, az, side, error, exponent, capped, maxProbes);
         if (nx * nz <= side * side + 0.5) break;  // no denser grid left to try
         ProbeVolumeSettings candidate = v;
         candidate.gridDims = {int(nx), 1, int(nz)};
@@ -297,6 +301,20 @@ nlohmann::json suggestions(const BakeRequest& request, size_t index, const std::
         // A suggestion the estimate refuses (a placement limit) is not made.
         setup.volumes = own;
     }
+    // A tile measured its own share of the grid: the project is the region's, so the suggestion
+    // names the region's grid_dims whose share this tile is (tile_set keeps the tile's).
+    const std::string dims = "probe_volumes[" + std::to_string(index) + "].grid_dims=";
+    if (setup.tileWindow)
+        for (auto& s : out) {
+            s["tile_set"] = s["set"];
+            for (auto& set : s["set"]) {
+                const std::string text = set.get<std::string>();
+                int nx = 0, nz = 0;
+                if (text.rfind(dims, 0) != 0 || std::sscanf(text.c_str() + dims.size(), "%d,%d", &nx, &nz) != 2) continue;
+                const std::array<int, 2> region = regionTerrainGridDims({nx, nz}, *setup.tileWindow);
+                set = dims + std::to_string(region[0]) + "," + std::to_string(region[1]);
+            }
+        }
     return out;
 }
 
@@ -1065,7 +1083,10 @@ VolumeErrorMap measureVolumeErrorMap(const SceneDescription& scene, const BakeSe
             out.rays = before;
             return errorMapStats(m);
         };
-        out.suggestion = denserGrid(v, volumeIndex, layout, out.stats, measure);
+        // A tile suggests within its share of the limit, so the region's grid it names fits it.
+        const int maxProbes = setup.tileWindow ? tileShareOfProbes(kMaxTerrainGridProbes, *setup.tileWindow)
+                                               : kMaxTerrainGridProbes;
+        out.suggestion = denserGrid(v, volumeIndex, layout, out.stats, measure, maxProbes);
     }
     out.seconds = secondsSince(start);
     return out;

@@ -326,7 +326,7 @@ int commandBake(const Args& a) {
             for (const auto& s : v["suggestions"]) {
                 std::cout << "     ";
                 for (const auto& set : s["set"]) std::cout << " --set " << set.get<std::string>();
-                std::cout << "  (" << s["probes"].get<size_t>() << " probes";
+                std::cout << "  (" << (s.contains("tile_set") ? "this tile: " : "") << s["probes"].get<size_t>() << " probes";
                 if (s["probes_max"].get<size_t>() > s["probes"].get<size_t>())
                     std::cout << ", up to " << s["probes_max"].get<size_t>();
                 std::cout << ", about " << duration(s["estimated_time_s"].get<double>());
@@ -338,6 +338,11 @@ int commandBake(const Args& a) {
                 if (!s["meets_target"].get<bool>())
                     std::cout << ", short of the " << fixed(100.0 * s["target_mean"].get<double>(), 0)
                               << " % mean aimed at";
+                // A tile measured its share: the project's setting is the region's.
+                if (s.contains("tile_set")) {
+                    std::cout << "; the region's grid, measured on this tile as";
+                    for (const auto& set : s["tile_set"]) std::cout << " " << set.get<std::string>();
+                }
                 std::cout << "\n";
             }
         }

@@ -126,11 +126,43 @@ nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const DemGrid&
 
 namespace terralux {
 
+namespace {
+
+// The tile's share of the region's cells along x and z.
+std::array<double, 2> tileShares(const TileWindow& w) {
+    return {double(w.cols - 1) / double(w.regionCols - 1), double(w.rows - 1) / double(w.regionRows - 1)};
+}
+
+// Probes along an axis of a tile, the region's n over its span: the first and last on the tile's
+// edges.
+int tileProbes(int n, double share) { return n <= 1 ? n : std::max(2, int(std::lround((n - 1) * share)) + 1); }
+
+}  // namespace
+
+std::array<int, 2> regionTerrainGridDims(const std::array<int, 2>& tileDims, const TileWindow& w) {
+    const std::array<double, 2> share = tileShares(w);
+    std::array<int, 2> out{};
+    for (int a = 0; a < 2; ++a) {
+        const int n = tileDims[size_t(a)];
+        // The inverse of tileProbes, then the nearest count whose share is n again.
+        int r = n <= 1 ? n : int(std::lround((n - 1) / share[size_t(a)])) + 1;
+        while (r > 2 && tileProbes(r, share[size_t(a)]) > n) --r;
+        while (tileProbes(r, share[size_t(a)]) < n) ++r;
+        out[size_t(a)] = r;
+    }
+    return out;
+}
+
+int tileShareOfProbes(int probes, const TileWindow& w) {
+    const std::array<double, 2> share = tileShares(w);
+    // Each axis of the region's grid may round up by one probe from the tile's.
+    const double side = std::sqrt(double(probes));
+    return std::max(4, int(std::floor((side - 1.0) * share[0] * (side - 1.0) * share[1])));
+}
+
 void scaleSceneToTile(SceneDescription& scene, const TileWindow& w) {
-    const double shareX = double(w.cols - 1) / double(w.regionCols - 1);
-    const double shareZ = double(w.rows - 1) / double(w.regionRows - 1);
-    // Probes along an axis, the region's n over its span: the first and last on the tile's edges.
-    auto probes = [](int n, double share) { return n <= 1 ? n : std::max(2, int(std::lround((n - 1) * share)) + 1); };
+    const auto [shareX, shareZ] = tileShares(w);
+    auto probes = tileProbes;
     auto cells = [](int n, double share) { return std::max(1, int(std::lround(n * share))); };
     auto list = [](std::initializer_list<float> v) {
         std::string out;

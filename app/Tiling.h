@@ -3,6 +3,7 @@
 // as a complete bake, seeing the terrain within a halo around it, in the region's engine space,
 // so a merge lists the tiles' grids side by side with no transform.
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -80,6 +81,12 @@ struct SceneDescription;
 // what the region would. Throws ProjectError for what cannot be cut: an explicit origin, or an
 // adaptive volume's explicit size (each tile places over its own footprint).
 void scaleSceneToTile(SceneDescription& scene, const TileWindow& w);
+// The terrain grid_dims of the region whose tile share (scaleSceneToTile's rule) is `tileDims`
+// [x, z]: what a suggestion measured on one tile asks of the project.
+std::array<int, 2> regionTerrainGridDims(const std::array<int, 2>& tileDims, const TileWindow& w);
+// The probes of a region's terrain grid of `probes` that fall to the tile, rounded down, with a
+// margin for the rounding of each axis: a tile's grid within it names a region grid within `probes`.
+int tileShareOfProbes(int probes, const TileWindow& w);
 }  // namespace terralux
 
 namespace terralux {

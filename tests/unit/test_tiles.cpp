@@ -17,6 +17,7 @@
 #include "Tiling.h"
 #include "bake/HeightfieldTracer.h"
 #include "bake/ProbeDiagnostics.h"
+#include "bake/ProbePlacement.h"
 #include "bake/SphericalHarmonics.h"
 
 using namespace terralux;
@@ -450,5 +451,36 @@ TEST(Tiles, TheMergeListsEachLightingScenarioInTheOrderOfTheGrids) {
     } catch (const ProjectError& e) {
         EXPECT_NE(std::string(e.what()).find("tile_000_000: a tile with reflection probes"), std::string::npos) << e.what();
     }
+    fs::remove_all(tiled);
+}
+
+TEST(Tiles, ASuggestionMeasuredOnATileNamesTheRegionsGrid) {
+    // The crop's 9 x 7 grid errs over 10 % on average, so a tile's bake measures a denser grid of
+    // its own share, within its share of the 4 096 probes a terrain grid holds; the suggestion it
+    // prints asks the project for the region's grid_dims whose share is exactly the grid the tile
+    // measured (it named the tile's own, 71 x 57, which the region would hold four times).
+    const fs::path tiled = freshDir("suggestion");
+    BakeRequest r{regionProject(tiled), 2, false};
+    r.tile = parseTiles("2,2", "0/4", std::optional<double>(300.0));
+    r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
+    const BakeOutcome o = runBake(r, {}, nullptr);
+    const nlohmann::json& s = o.report["volumes"][0]["suggestions"];
+    ASSERT_FALSE(s.empty()) << o.report["volumes"][0].dump();
+    const std::string set = s[0]["set"][0].get<std::string>(), tileSet = s[0]["tile_set"][0].get<std::string>();
+    std::cout << "suggestion: " << set << " (this tile: " << tileSet << ")\n";
+    int nx = 0, nz = 0, tx = 0, tz = 0;
+    ASSERT_EQ(std::sscanf(set.c_str(), "probe_volumes[0].grid_dims=%d,%d", &nx, &nz), 2) << set;
+    ASSERT_EQ(std::sscanf(tileSet.c_str(), "probe_volumes[0].grid_dims=%d,%d", &tx, &tz), 2) << tileSet;
+    EXPECT_GT(nx, tx);
+    EXPECT_GT(nz, tz);
+    // Within what a terrain grid may hold: the tile searched within its share of the limit.
+    EXPECT_LE(nx * nz, kMaxTerrainGridProbes);
+    // The region's grid applied to the project gives this tile the grid it measured.
+    Project region = regionProject(tiled);
+    region.scene.probeVolumes[0].gridDims = {nx, 1, nz};
+    const TileWindow w = tileWindow(loadProjectGrid(regionProject(tiled)), *r.tile);
+    scaleSceneToTile(region.scene, w);
+    EXPECT_EQ(region.scene.probeVolumes[0].gridDims[0], tx);
+    EXPECT_EQ(region.scene.probeVolumes[0].gridDims[2], tz);
     fs::remove_all(tiled);
 }
