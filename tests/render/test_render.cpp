@@ -92,6 +92,9 @@ RenderRequest unprobed(int view, bool linear) {
     return q;
 }
 
+// View 34's colour of cascades 0-3 (shaders/views.glsl, cascadeColour); grey beyond them.
+const glm::vec3 kCascadeColours[4] = {{0.90f, 0.25f, 0.20f}, {0.25f, 0.75f, 0.25f}, {0.25f, 0.45f, 0.95f}, {0.95f, 0.85f, 0.20f}};
+
 RenderedImage draw(ProjectRenderer& r, int view, bool probes = true, bool linear = false,
                    uint32_t width = kW, uint32_t height = kH) {
     RenderRequest q = unprobed(view, linear);
@@ -2577,13 +2580,12 @@ TEST_F(RenderTest, CascadeBlendingHandsOverWithinTheBandAndKeepsTheAgreement) {
     };
     const RenderedImage hard = frame(kViewShadow, 0.0), blended = frame(kViewShadow, 0.25);
     const RenderedImage bands = frame(kViewCascades, 0.25);
-    const glm::vec3 colours[4] = {{0.90f, 0.25f, 0.20f}, {0.25f, 0.75f, 0.25f}, {0.25f, 0.45f, 0.95f}, {0.95f, 0.85f, 0.20f}};
     size_t changed = 0, outside = 0, bandPixels = 0;
     for (size_t i = 0; i < size_t(w) * h; ++i) {
         if (hard.rgba[i * 4 + 1] < 0.5f) continue;  // off the terrain
         const glm::vec3 c(bands.rgba[i * 4], bands.rgba[i * 4 + 1], bands.rgba[i * 4 + 2]);
         float best = 0.0f;
-        for (const glm::vec3& k : colours) best = std::max(best, glm::dot(glm::normalize(c), glm::normalize(k)));
+        for (const glm::vec3& k : kCascadeColours) best = std::max(best, glm::dot(glm::normalize(c), glm::normalize(k)));
         const bool band = glm::length(c) < 0.05f || best < 0.9995f;
         bandPixels += band;
         // A band's first hundredths mix colours a dot product cannot tell from pure: the shadow
@@ -2635,8 +2637,7 @@ TEST_F(RenderTest, TheLastCascadeFadesIntoTheUnshadowedSunAtAShortShadowDistance
     const RenderedImage hard = frame(kViewShadow, 0.0), faded = frame(kViewShadow, 0.25);
     const RenderedImage bands = frame(kViewCascades, 0.25);
     const int last = p.scene.shadows.cascades - 1;
-    const glm::vec3 colours[4] = {{0.90f, 0.25f, 0.20f}, {0.25f, 0.75f, 0.25f}, {0.25f, 0.45f, 0.95f}, {0.95f, 0.85f, 0.20f}};
-    const glm::vec3 lastColour = colours[last], grey(0.45f);
+    const glm::vec3 lastColour = kCascadeColours[last], grey(0.45f);
     size_t fading = 0, beyond = 0, moved = 0, wrong = 0, changedElsewhere = 0;
     double lifted = 0.0;
     for (size_t i = 0; i < size_t(w) * h; ++i) {
