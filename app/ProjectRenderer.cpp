@@ -92,9 +92,13 @@ void ProjectRenderer::setProject(const Project& project) {
     // is another one (not for an edit of its intensity); between two scenarios whose skies are
     // not both uniform, the two skies mixed into one image, made again when either or the blend
     // changes.
-    int skyWidth = 0, skyHeight = 0, otherWidth = 0, otherHeight = 0;
+    int skyWidth = 0, skyHeight = 0;
     const std::vector<glm::vec3>* skyImage = lighting.sky.image(&skyWidth, &skyHeight);
-    if (blending && (la->sky.image(&skyWidth, &skyHeight) || lb->sky.image(&otherWidth, &otherHeight))) {
+    // Both ends' sizes: the blend is drawn at the finer of the two.
+    int widthA = 0, heightA = 0, widthB = 0, heightB = 0;
+    const bool imageA = blending && la->sky.image(&widthA, &heightA) != nullptr;
+    const bool imageB = blending && lb->sky.image(&widthB, &heightB) != nullptr;
+    if (imageA || imageB) {
         std::ostringstream key;
         for (const BakeLighting* l : {&*la, &*lb}) {
             int w = 0, h = 0;
@@ -105,7 +109,7 @@ void ProjectRenderer::setProject(const Project& project) {
         key << t;
         if (key.str() != blendedSkyKey_) {
             // The finer of the two images, at most a 2048 x 1024 equirectangular one.
-            const int w = std::min(std::max(skyWidth, otherWidth), 2048), h = std::min(std::max(skyHeight, otherHeight), 1024);
+            const int w = std::min(std::max(widthA, widthB), 2048), h = std::min(std::max(heightA, heightB), 1024);
             renderer_->setSkyImage(w, h, blendedEquirect(la->sky, lb->sky, t, w, h));
             heldSky_.reset();
             blendedSkyKey_ = key.str();
