@@ -3,10 +3,27 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+
+// The walk and its cell tests are inlined into one function per kernel, so that each is compiled
+// for that kernel's instruction set; only the (rare) skirt pieces and the final normal stay
+// shared, baseline code.
+#if defined(__GNUC__)
+#define TLX_WALK_INLINE [[gnu::always_inline]] inline
+#else
+#define TLX_WALK_INLINE inline
+#endif
+#if (defined(__x86_64__) || defined(_M_X64)) && defined(__GNUC__)
+#define TLX_HAVE_X86_64_V3 1
+#define TLX_TARGET_X86_64_V3 __attribute__((target("arch=x86-64-v3")))
+#else
+#define TLX_HAVE_X86_64_V3 0
+#endif
 
 namespace terralux {
 namespace {
@@ -32,7 +49,7 @@ struct Piece {
 // Plane h(u, v) = h0 + (u - uc) * gu + (v - vc) * gv against the ray: t in (tLo, tHi] and the
 // hit's position relative to (uc, vc). The height difference ray - plane is linear in t, so
 // this is exact up to rounding. A parallel ray gives t = inf or NaN, which the range rejects.
-inline bool planeHit(const GridRay& r, double uc, double vc, double h0, double gu, double gv,
+TLX_WALK_INLINE bool planeHit(const GridRay& r, double uc, double vc, double h0, double gu, double gv,
                      double tLo, double tHi, double& t, double& fu, double& fv) {
     const double a = r.u0 - uc, b = r.v0 - vc;
     const double f0 = r.y0 - h0 - a * gu - b * gv;
@@ -47,7 +64,7 @@ inline bool planeHit(const GridRay& r, double uc, double vc, double h0, double g
 
 // The two triangles of cell (c, r): updates tBest / piece with the nearest hit in
 // (tLo, tBest]. hRC = height of vertex (c or c + 1, r or r + 1).
-inline bool trianglesHit(const GridRay& ray, int c, int r, double h00, double h10, double h01,
+TLX_WALK_INLINE bool trianglesHit(const GridRay& ray, int c, int r, double h00, double h10, double h01,
                          double h11, double tLo, double& tBest, Piece& piece) {
     constexpr double e = kEdgeSlack;
     bool found = false;
@@ -116,7 +133,7 @@ bool skirtHit(const GridRay& ray, int cellsX, int cellsZ, int c, int r, int c1, 
 
 // Cell index along one axis for grid coordinate p, clamped to the grid (border cells extend to
 // infinity outward).
-inline int startIndex(double p, int cells) {
+TLX_WALK_INLINE int startIndex(double p, int cells) {
     return int(std::clamp(std::floor(p), 0.0, double(cells - 1)));
 }
 
@@ -130,7 +147,43 @@ glm::vec3 pieceNormal(const Piece& p, double cellX, double cellZ) {
 
 HeightfieldTracer::HeightfieldTracer(const Heightfield& hf) : HeightfieldTracer(hf, Options{}) {}
 
+bool HeightfieldTracer::cpuHasX86_64_v3() {
+#if TLX_HAVE_X86_64_V3
+    // The features the kernel's code uses beyond the baseline; every CPU that has these four
+    // (Haswell, Excavator and later) has the rest of x86-64-v3. GCC's check of AVX includes the
+    // OS saving the YMM registers.
+    static const bool has = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+               __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
+    }();
+    return has;
+#else
+    return false;
+#endif
+}
+
+namespace {
+HeightfieldTracer::Kernel autoKernel() {
+    static const HeightfieldTracer::Kernel k = [] {
+        const char* pin = std::getenv("TERRALUX_TRACER_KERNEL");
+        if (pin && std::strcmp(pin, "baseline") == 0)
+            return HeightfieldTracer::Kernel::kBaseline;
+        return HeightfieldTracer::cpuHasX86_64_v3() ? HeightfieldTracer::Kernel::kX86_64_v3
+                                                    : HeightfieldTracer::Kernel::kBaseline;
+    }();
+    return k;
+}
+}  // namespace
+
+const char* HeightfieldTracer::autoKernelName() {
+    return autoKernel() == Kernel::kX86_64_v3 ? "x86-64-v3" : "baseline";
+}
+
 HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&hf), opt_(opt) {
+    kernel_ = opt.kernel == Kernel::kAuto ? autoKernel()
+              : opt.kernel == Kernel::kX86_64_v3 && cpuHasX86_64_v3() ? Kernel::kX86_64_v3
+                                                                      : Kernel::kBaseline;
     const int w = hf.width(), d = hf.depth();
     invCellX_ = 1.0 / hf.cellSizeX();
     invCellZ_ = 1.0 / hf.cellSizeZ();
@@ -205,16 +258,19 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
 // to infinity outward, which is where the skirt lives; with the skirt off, t is clipped to the
 // footprint instead.
 template <bool AnyHit>
-bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
-                              RayHit* hit) const {
+TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
+                                              RayHit* hit) const {
     // NaN or infinite input would make the cell index below undefined.
     if (!std::isfinite(double(o.x) + o.y + o.z + dir.x + dir.y + dir.z))
         return false;
     const Heightfield& hf = *hf_;
     const int w = hf.width(), d = hf.depth();
     GridRay ray;
-    ray.u0 = double(o.x) * invCellX_ + hf.originCol();
-    ray.v0 = double(o.z) * invCellZ_ + hf.originRow();
+    // Heightfield's own mapping (a division, then an add): a multiply by the reciprocal followed
+    // by the add would be fused on x86-64-v3 and put a ray through a border vertex a rounding
+    // error outside the footprint.
+    ray.u0 = hf.colOf(o.x);
+    ray.v0 = hf.rowOf(o.z);
     ray.y0 = o.y;
     ray.du = double(dir.x) * invCellX_;
     ray.dv = double(dir.z) * invCellZ_;
@@ -353,13 +409,30 @@ bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tM
     }
 }
 
+template <bool AnyHit>
+bool HeightfieldTracer::traceBaseline(const glm::vec3& o, const glm::vec3& dir, float tMax,
+                                      RayHit* hit) const {
+    return trace<AnyHit>(o, dir, tMax, hit);
+}
+
+template <bool AnyHit>
+#if TLX_HAVE_X86_64_V3
+TLX_TARGET_X86_64_V3
+#endif
+bool HeightfieldTracer::traceX86_64_v3(const glm::vec3& o, const glm::vec3& dir, float tMax,
+                                       RayHit* hit) const {
+    return trace<AnyHit>(o, dir, tMax, hit);
+}
+
 bool HeightfieldTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax,
                                   RayHit& hit) const {
-    return trace<false>(origin, dir, tMax, &hit);
+    return kernel_ == Kernel::kX86_64_v3 ? traceX86_64_v3<false>(origin, dir, tMax, &hit)
+                                         : traceBaseline<false>(origin, dir, tMax, &hit);
 }
 
 bool HeightfieldTracer::occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const {
-    return trace<true>(origin, dir, tMax, nullptr);
+    return kernel_ == Kernel::kX86_64_v3 ? traceX86_64_v3<true>(origin, dir, tMax, nullptr)
+                                         : traceBaseline<true>(origin, dir, tMax, nullptr);
 }
 
 bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& origin,

@@ -202,14 +202,32 @@ const BenchDem& dem() {
     return d;
 }
 
-const HeightfieldTracer& tracer() {
-    static const HeightfieldTracer t(dem().hf, {true});
-    return t;
+using Kernel = HeightfieldTracer::Kernel;
+
+// kernel: 0 baseline, 1 x86-64-v3 (the benchmark is skipped where the CPU lacks it), 2 the
+// process default (what a bake uses).
+const HeightfieldTracer& tracer(int kernel = 2, bool skirt = true) {
+    static const HeightfieldTracer t[2][3] = {
+        {HeightfieldTracer(dem().hf, {false, Kernel::kBaseline}),
+         HeightfieldTracer(dem().hf, {false, Kernel::kX86_64_v3}),
+         HeightfieldTracer(dem().hf, {false, Kernel::kAuto})},
+        {HeightfieldTracer(dem().hf, {true, Kernel::kBaseline}),
+         HeightfieldTracer(dem().hf, {true, Kernel::kX86_64_v3}),
+         HeightfieldTracer(dem().hf, {true, Kernel::kAuto})}};
+    return t[skirt][kernel];
 }
 
-const HeightfieldTracer& tracerNoSkirt() {
-    static const HeightfieldTracer t(dem().hf, {false});
-    return t;
+const HeightfieldTracer& tracerNoSkirt(int kernel = 2) { return tracer(kernel, false); }
+
+const char* const kKernelNames[] = {"baseline kernel", "x86-64-v3 kernel", "default kernel"};
+
+// Skips (and says why) a kernel this CPU cannot run.
+bool kernelRuns(benchmark::State& state, int kernel) {
+    if (kernel == 1 && !HeightfieldTracer::cpuHasX86_64_v3()) {
+        state.SkipWithError("this CPU has no x86-64-v3");
+        return false;
+    }
+    return true;
 }
 
 struct Rays {
@@ -301,7 +319,7 @@ const struct RegisterContext {
 } registerContext;
 
 template <class Trace>
-void runRays(benchmark::State& state, int set, Trace&& trace) {
+void runRays(benchmark::State& state, int set, Trace&& trace, const char* kernel = kKernelNames[2]) {
     const Rays& r = rays(set);
     size_t next = 0;
     int64_t hits = 0;
@@ -316,25 +334,33 @@ void runRays(benchmark::State& state, int set, Trace&& trace) {
     const int64_t n = int64_t(state.iterations()) * kBatch;
     state.SetItemsProcessed(n);
     state.counters["hit_fraction"] = double(hits) / double(std::max<int64_t>(n, 1));
-    state.SetLabel(std::string(kRaySetNames[set]) + "; " + dem().source);
+    state.SetLabel(std::string(kRaySetNames[set]) + "; " + kernel + "; " + dem().source);
 }
 
+// Arguments: the ray set, and the kernel (0 baseline, 1 x86-64-v3).
 void BM_Tracer(benchmark::State& state) {
-    const HeightfieldTracer& t = tracer();
+    const int kernel = int(state.range(1));
+    if (!kernelRuns(state, kernel))
+        return;
+    const HeightfieldTracer& t = tracer(kernel);
     RayHit hit;
     runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) {
         const bool h = t.intersect(o, d, kInf, hit);
         benchmark::DoNotOptimize(hit);
         return h;
-    });
+    }, kKernelNames[kernel]);
 }
-BENCHMARK(BM_Tracer)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Tracer)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 void BM_TracerOccluded(benchmark::State& state) {
-    const HeightfieldTracer& t = tracer();
-    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); });
+    const int kernel = int(state.range(1));
+    if (!kernelRuns(state, kernel))
+        return;
+    const HeightfieldTracer& t = tracer(kernel);
+    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); },
+            kKernelNames[kernel]);
 }
-BENCHMARK(BM_TracerOccluded)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TracerOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 void BM_RayMarch(benchmark::State& state) {
     const Heightfield& hf = dem().hf;
@@ -524,21 +550,28 @@ BENCHMARK(BM_EmbreeOccluded1)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark
 
 // The tracer without its skirt on the same rays, the fair opponent of the two above.
 void BM_TracerNoSkirt(benchmark::State& state) {
-    const HeightfieldTracer& t = tracerNoSkirt();
+    const int kernel = int(state.range(1));
+    if (!kernelRuns(state, kernel))
+        return;
+    const HeightfieldTracer& t = tracerNoSkirt(kernel);
     RayHit hit;
     runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) {
         const bool h = t.intersect(o, d, kInf, hit);
         benchmark::DoNotOptimize(hit);
         return h;
-    });
+    }, kKernelNames[kernel]);
 }
-BENCHMARK(BM_TracerNoSkirt)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TracerNoSkirt)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 void BM_TracerNoSkirtOccluded(benchmark::State& state) {
-    const HeightfieldTracer& t = tracerNoSkirt();
-    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); });
+    const int kernel = int(state.range(1));
+    if (!kernelRuns(state, kernel))
+        return;
+    const HeightfieldTracer& t = tracerNoSkirt(kernel);
+    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); },
+            kKernelNames[kernel]);
 }
-BENCHMARK(BM_TracerNoSkirtOccluded)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TracerNoSkirtOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // Every ray of a set through both: hit/miss disagreements, and distances that differ by more
 // than 1 mm + 1e-4 t (Embree's vertices are floats; the tracer's grid is exact in double).

@@ -46,6 +46,29 @@ print(json.dumps(strip(json.load(open(sys.argv[1]))), sort_keys=True))' "$1"; }
       fail "bake_report.json differs beyond timings"
     grep -q "TimeSeconds\|time_s" "$work/a/scene.gltf" && fail "scene.gltf carries a timing"
     ;;
+  kernels)
+    # The x86-64-v3 build of the tracer and the baseline one give the same bake, byte for byte:
+    # a farm of mixed CPUs gets the same tiles from every node.
+    TERRALUX_TRACER_KERNEL=baseline "$terralux" --bake --out "$work/a" --quiet --quality draft >/dev/null ||
+      fail "baseline bake exited $?"
+    "$terralux" --bake --out "$work/b" --quiet --quality draft >/dev/null || fail "default bake exited $?"
+    kernel() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["tracer_kernel"])' "$1"; }
+    [ "$(kernel "$work/a/bake_report.json")" = baseline ] || fail "the pinned bake reports $(kernel "$work/a/bake_report.json")"
+    v3=no
+    if grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo && grep -qw bmi1 /proc/cpuinfo &&
+       grep -qw bmi2 /proc/cpuinfo; then v3=yes; fi
+    expected=baseline; [ $v3 = yes ] && expected=x86-64-v3
+    [ "$(kernel "$work/b/bake_report.json")" = $expected ] ||
+      fail "the default bake reports $(kernel "$work/b/bake_report.json"), expected $expected"
+    [ $v3 = yes ] || { echo "SKIP: this CPU has no x86-64-v3, both bakes ran the baseline"; exit 77; }
+    (cd "$work/a" && find . -type f | sort) >"$work/a.list"
+    (cd "$work/b" && find . -type f | sort) >"$work/b.list"
+    cmp -s "$work/a.list" "$work/b.list" || fail "the two bakes wrote different files"
+    while read -r f; do
+      [ "$f" = "./bake_report.json" ] && continue
+      cmp -s "$work/a/$f" "$work/b/$f" || fail "$f differs between the baseline and x86-64-v3 kernels"
+    done <"$work/a.list"
+    ;;
   albedo_map)
     # An albedo map drapes a PNG texture over the exported terrain; dem is the fixtures' folder.
     "$terralux" --bake --dem "$dem/bigtujunga_utm11_crop.tif" --out "$work/out" --quality draft --quiet \

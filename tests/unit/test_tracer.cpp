@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -266,12 +267,29 @@ Stats specialRays(const HeightfieldTracer& tracer, uint32_t seed) {
     return s;
 }
 
-void runComparison(bool skirt, uint32_t seedBase) {
+using Kernel = HeightfieldTracer::Kernel;
+
+// The two builds of the walk; x86-64-v3 only where this CPU runs it (elsewhere it would fall back
+// to the baseline, which is already on the list).
+std::vector<Kernel> kernelsHere() {
+    std::vector<Kernel> k{Kernel::kBaseline};
+    if (HeightfieldTracer::cpuHasX86_64_v3())
+        k.push_back(Kernel::kX86_64_v3);
+    return k;
+}
+
+const char* kernelName(Kernel k) {
+    return k == Kernel::kX86_64_v3 ? "x86-64-v3" : "baseline";
+}
+
+void runComparison(bool skirt, uint32_t seedBase, Kernel kernel) {
     Stats total, special;
     uint32_t seed = seedBase;
+    std::cout << "[ kernel " << kernelName(kernel) << " ]\n";
     for (const DemCase& dc : kDems) {
         const Heightfield hf = makeRoughDem(dc.w, dc.d, dc.cellX, dc.cellZ, dc.relief, ++seed);
-        const HeightfieldTracer tracer(hf, {skirt});
+        const HeightfieldTracer tracer(hf, {skirt, kernel});
+        EXPECT_EQ(tracer.kernel(), kernel);
         const Stats r = randomRays(tracer, dc, ++seed);
         const Stats g = specialRays(tracer, ++seed);
         std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] " << dc.name << ": random " << r
@@ -292,20 +310,80 @@ void runComparison(bool skirt, uint32_t seedBase) {
 }
 
 TEST(HeightfieldTracer, MatchesBruteForceWithSkirt) {
-    runComparison(true, 100);
+    for (Kernel k : kernelsHere())
+        runComparison(true, 100, k);
 }
 TEST(HeightfieldTracer, MatchesBruteForceWithoutSkirt) {
-    runComparison(false, 200);
+    for (Kernel k : kernelsHere())
+        runComparison(false, 200, k);
+}
+
+// The two kernels on the same 40 000 rays of a rough 601 x 401 grid give the same answers to the
+// bit: neither fuses multiply-adds, so a bake is the same bytes on any CPU.
+TEST(HeightfieldTracer, KernelsAgree) {
+    if (!HeightfieldTracer::cpuHasX86_64_v3())
+        GTEST_SKIP() << "this CPU has no x86-64-v3: only the baseline kernel runs here";
+    const Heightfield hf = makeRoughDem(601, 401, 30.0, 45.0, 2500.0f, 11);
+    for (bool skirt : {true, false}) {
+        const HeightfieldTracer base(hf, {skirt, Kernel::kBaseline});
+        const HeightfieldTracer v3(hf, {skirt, Kernel::kX86_64_v3});
+        ASSERT_EQ(base.kernel(), Kernel::kBaseline);
+        ASSERT_EQ(v3.kernel(), Kernel::kX86_64_v3);
+        std::mt19937 rng(skirt ? 5 : 6);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        int hits = 0, hitMiss = 0, occMiss = 0, tOff = 0, pieceOff = 0;
+        for (int i = 0; i < 20000; ++i) {
+            const float x = hf.minX() + u01(rng) * (hf.maxX() - hf.minX());
+            const float z = hf.minZ() + u01(rng) * (hf.maxZ() - hf.minZ());
+            const glm::vec3 o(x, hf.surfaceHeight(x, z) + 0.05f + 50.0f * u01(rng) * u01(rng), z);
+            const glm::vec3 d = randomDir(rng);
+            RayHit a, b;
+            const bool ha = base.intersect(o, d, kInf, a), hb = v3.intersect(o, d, kInf, b);
+            hits += ha;
+            hitMiss += ha != hb;
+            occMiss += base.occluded(o, d, kInf) != v3.occluded(o, d, kInf);
+            if (ha && hb) {
+                tOff += a.t != b.t || a.position != b.position;
+                pieceOff += a.normal != b.normal || a.onTerrain != b.onTerrain;
+            }
+        }
+        std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] 20000 rays, " << hits
+                  << " hits; kernels differ: hit/miss " << hitMiss << ", occluded " << occMiss
+                  << ", t or position " << tOff << ", normal or piece " << pieceOff << "\n";
+        EXPECT_GT(hits, 5000);
+        EXPECT_EQ(hitMiss, 0);
+        EXPECT_EQ(occMiss, 0);
+        EXPECT_EQ(tOff, 0);
+        EXPECT_EQ(pieceOff, 0);
+    }
+}
+
+// kAuto resolves to a real kernel: the CPU's best unless TERRALUX_TRACER_KERNEL pins the
+// baseline; asking for x86-64-v3 where the CPU lacks it gives the baseline.
+TEST(HeightfieldTracer, KernelChoice) {
+    const Heightfield hf = makeRoughDem(9, 9, 10.0, 10.0, 50.0f, 3);
+    const HeightfieldTracer automatic(hf);
+    const char* pin = std::getenv("TERRALUX_TRACER_KERNEL");
+    const bool pinned = pin && std::string(pin) == "baseline";
+    const Kernel expected = HeightfieldTracer::cpuHasX86_64_v3() && !pinned ? Kernel::kX86_64_v3
+                                                                            : Kernel::kBaseline;
+    EXPECT_EQ(automatic.kernel(), expected);
+    EXPECT_STREQ(HeightfieldTracer::autoKernelName(), kernelName(expected));
+    const HeightfieldTracer asked(hf, {true, Kernel::kX86_64_v3});
+    EXPECT_EQ(asked.kernel(), HeightfieldTracer::cpuHasX86_64_v3() ? Kernel::kX86_64_v3
+                                                                    : Kernel::kBaseline);
 }
 
 // Larger non-power-of-two grid: 1000 rays per skirt setting against the reference.
 TEST(HeightfieldTracer, MatchesBruteForceOnLargeOddGrid) {
     const Heightfield hf = makeRoughDem(203, 131, 30.0, 45.0, 1500.0f, 7);
+    for (Kernel k : kernelsHere())
     for (bool skirt : {true, false}) {
-        const HeightfieldTracer tracer(hf, {skirt});
+        const HeightfieldTracer tracer(hf, {skirt, k});
         const DemCase dc{"203x131", 203, 131, 30.0, 45.0, 1500.0f, 1000};
         const Stats s = randomRays(tracer, dc, 8);
-        std::cout << "[ skirt " << (skirt ? "on " : "off") << " ] 203x131: " << s << "\n";
+        std::cout << "[ " << kernelName(k) << ", skirt " << (skirt ? "on " : "off")
+                  << " ] 203x131: " << s << "\n";
         EXPECT_EQ(s.disagreements(), 0);
         EXPECT_GT(s.hits, 200);
     }
