@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
+#include <cstdint>
+#include <numbers>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -115,6 +118,60 @@ TEST(Srgb, DecodingIsTheExactEotf) {
         EXPECT_EQ(std::lround(linearToSrgb(srgbToLinear(v / 255.0f)) * 255.0f), v) << v;
         EXPECT_EQ(srgb8(linearOfSrgb8(uint8_t(v))), v) << v;
     }
+}
+
+// srgb8 searches a table of the formula's thresholds: the same byte as the formula for every
+// float, sampled densely over [0, 1] (every 61st bit pattern, 17 million values) and beyond.
+TEST(Srgb, EncodingByTableIsTheFormulasByte) {
+    auto formula = [](float v) { return uint8_t(std::lround(linearToSrgb(v) * 255.0f)); };
+    size_t differ = 0, checked = 0;
+    for (uint32_t b = 0; b <= std::bit_cast<uint32_t>(1.0f); b += 61, ++checked)
+        differ += srgb8(std::bit_cast<float>(b)) != formula(std::bit_cast<float>(b));
+    // Each code's first float and the one before it, where a rounding slip would show.
+    for (int v = 1; v < 256; ++v) {
+        float x = srgbToLinear((float(v) - 0.5f) / 255.0f);
+        for (int k = 0; k < 64; ++k, x = std::nextafter(x, 2.0f), ++checked)
+            differ += srgb8(x) != formula(x);
+    }
+    EXPECT_EQ(differ, 0u) << "of " << checked;
+    EXPECT_EQ(srgb8(-1.0f), 0);
+    EXPECT_EQ(srgb8(std::nanf("")), 0);
+    EXPECT_EQ(srgb8(2.0f), 255);
+    EXPECT_EQ(srgb8(INFINITY), 255);
+}
+
+// The ramp field skips acos where the slope is clearly outside the rock blend and fills rows in
+// parallel: texel for texel what the plain formula gives, on rough ground whose slopes span
+// 0 to 80 degrees (so every case of the blend is hit).
+TEST(Ramp, FieldIsThePlainFormulaTexelForTexel) {
+    const int n = 300;
+    std::vector<float> h(size_t(n) * n);
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c)
+            h[size_t(r) * n + c] = float(1500.0 + 900.0 * std::sin(c * 0.07) * std::cos(r * 0.05) +
+                                         40.0 * std::sin(c * 1.3 + r * 0.9));
+    const Heightfield hf(n, n, 30.0, 30.0, h);
+    const AlbedoRampSettings ramp;
+    const SurfaceAlbedo a = rampAlbedo(hf, ramp, 1.0, glm::vec3(0.3f));
+    ASSERT_EQ(a.width, n);
+    int rock = 0, blend = 0, ground = 0, differ = 0;
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+            const double slope =
+                std::acos(std::clamp(double(hf.vertexNormal(c, r).y), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+            rock += slope > ramp.rockSlopeDeg[1];
+            ground += slope < ramp.rockSlopeDeg[0];
+            blend += slope >= ramp.rockSlopeDeg[0] && slope <= ramp.rockSlopeDeg[1];
+            SurfaceAlbedo plain;
+            plain.resize(1, 1);
+            plain.setTexel(0, rampColor(ramp, double(hf.at(c, r)), slope));
+            const size_t i = size_t(r) * size_t(n) + size_t(c);
+            differ += std::memcmp(&a.srgb[3 * i], plain.srgb.data(), 3) != 0;
+        }
+    EXPECT_GT(rock, 1000);
+    EXPECT_GT(blend, 1000);
+    EXPECT_GT(ground, 1000);
+    EXPECT_EQ(differ, 0);
 }
 
 TEST(Ramp, SnowAboveTheLineRockOnSteepSlopesGroundBelow) {
