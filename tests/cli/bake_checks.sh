@@ -5,6 +5,16 @@ set -u
 case_=$1 terralux=$2 checker=$3 validator=$4 work=$5 build=$6 dem=${7:-}
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
+# same_outputs A B WHAT: the two bakes wrote the same files, each the same bytes but the report.
+same_outputs() {
+  (cd "$1" && find . -type f | sort) >"$work/a.list"
+  (cd "$2" && find . -type f | sort) >"$work/b.list"
+  cmp -s "$work/a.list" "$work/b.list" || fail "the two bakes wrote different files"
+  while read -r f; do
+    [ "$f" = "./bake_report.json" ] && continue
+    cmp -s "$1/$f" "$2/$f" || fail "$f differs between $3"
+  done <"$work/a.list"
+}
 case "$case_" in
   sample)
     "$terralux" --bake --out "$work/out" --quiet >"$work/stdout" || fail "bake exited $?"
@@ -26,13 +36,7 @@ case "$case_" in
     "$terralux" --bake --out "$work/a" --quiet --threads 1 --quality draft >/dev/null || fail "1 thread"
     "$terralux" --bake --out "$work/b" --quiet --threads 2 --quality draft >/dev/null || fail "2 threads"
     # Every file is the same byte for byte, except the report's timings and thread count.
-    (cd "$work/a" && find . -type f | sort) >"$work/a.list"
-    (cd "$work/b" && find . -type f | sort) >"$work/b.list"
-    cmp -s "$work/a.list" "$work/b.list" || fail "the two bakes wrote different files"
-    while read -r f; do
-      [ "$f" = "./bake_report.json" ] && continue
-      cmp -s "$work/a/$f" "$work/b/$f" || fail "$f differs between 1 and 2 threads"
-    done <"$work/a.list"
+    same_outputs "$work/a" "$work/b" "1 and 2 threads"
     untimed() { python3 -c '
 import json, sys
 def strip(v):
@@ -61,13 +65,7 @@ print(json.dumps(strip(json.load(open(sys.argv[1]))), sort_keys=True))' "$1"; }
     [ "$(kernel "$work/b/bake_report.json")" = $expected ] ||
       fail "the default bake reports $(kernel "$work/b/bake_report.json"), expected $expected"
     [ $v3 = yes ] || { echo "SKIP: this CPU has no x86-64-v3, both bakes ran the baseline"; exit 77; }
-    (cd "$work/a" && find . -type f | sort) >"$work/a.list"
-    (cd "$work/b" && find . -type f | sort) >"$work/b.list"
-    cmp -s "$work/a.list" "$work/b.list" || fail "the two bakes wrote different files"
-    while read -r f; do
-      [ "$f" = "./bake_report.json" ] && continue
-      cmp -s "$work/a/$f" "$work/b/$f" || fail "$f differs between the baseline and x86-64-v3 kernels"
-    done <"$work/a.list"
+    same_outputs "$work/a" "$work/b" "the baseline and x86-64-v3 kernels"
     ;;
   albedo_map)
     # An albedo map drapes a PNG texture over the exported terrain; dem is the fixtures' folder.
