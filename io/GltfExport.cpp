@@ -89,14 +89,24 @@ class BinStream {
 public:
     BinStream() = default;
     explicit BinStream(std::FILE* file) : file_(file) { chunk_.reserve(kChunk); }
-    void push_back(uint8_t b) {
-        ++size_;
-        if (!file_) return;
-        chunk_.push_back(b);
-        if (chunk_.size() == kChunk) flush();
+    // Counting only: the caller may skip producing bytes and say how many there would be.
+    bool counting() const { return !file_; }
+    void skip(size_t n) {
+        if (!counting()) throw std::logic_error("BinStream::skip while writing");
+        size_ += n;
     }
-    void append(std::span<const uint8_t> bytes) {
-        for (uint8_t b : bytes) push_back(b);
+    void push_back(uint8_t b) { write(&b, 1); }
+    void append(std::span<const uint8_t> bytes) { write(bytes.data(), bytes.size()); }
+    void write(const uint8_t* bytes, size_t n) {
+        size_ += n;
+        if (!file_) return;
+        while (n > 0) {
+            const size_t take = std::min(n, kChunk - chunk_.size());
+            chunk_.insert(chunk_.end(), bytes, bytes + take);
+            bytes += take;
+            n -= take;
+            if (chunk_.size() == kChunk) flush();
+        }
     }
     size_t size() const { return size_; }
     // False once a write has failed; errno then says why.
@@ -114,6 +124,17 @@ private:
     size_t size_ = 0;
     bool ok_ = true;
 };
+
+// Little-endian words into a BinStream, a word at a time (the mesh is most of a scene.bin).
+void putU16(BinStream& out, uint16_t v) {
+    const uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)};
+    out.write(b, 2);
+}
+void putU32(BinStream& out, uint32_t v) {
+    const uint8_t b[4] = {uint8_t(v), uint8_t(v >> 8), uint8_t(v >> 16), uint8_t(v >> 24)};
+    out.write(b, 4);
+}
+void putF32(BinStream& out, float v) { putU32(out, std::bit_cast<uint32_t>(v)); }
 
 template <class Out>
 void putU16(Out& out, uint16_t v) {
@@ -319,16 +340,22 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const size_t positionOffset = bin.size();
     glm::vec3 lo(std::numeric_limits<float>::infinity());
     glm::vec3 hi(-std::numeric_limits<float>::infinity());
+    // Counting (the pass that lays out the document) needs the bounds but none of the bytes.
+    const bool counting = bin.counting();
+    const std::vector<int> none;
+    const std::vector<int>& rowsWritten = counting ? none : rows;
     for (int r : rows) {
         for (int c : cols) {
             const glm::vec3 p = hf.vertex(c, r);
             lo = glm::min(lo, p);
             hi = glm::max(hi, p);
+            if (counting) continue;
             putF32(bin, p.x);
             putF32(bin, p.y);
             putF32(bin, p.z);
         }
     }
+    if (counting) bin.skip(vertexCount * 12);
     const size_t normalOffset = bin.size();
     // Vertex (c, r) of hf is (c + dc, r + dr) of its surroundings: window origins are exact.
     const Heightfield& around = input.surroundings ? *input.surroundings : hf;
@@ -336,7 +363,8 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const int dr = int(std::lround(around.originRow() - hf.originRow()));
     if (dc < 0 || dr < 0 || dc + hf.width() > around.width() || dr + hf.depth() > around.depth())
         throw std::invalid_argument("glTF export: the surroundings do not hold the heightfield's window");
-    for (int r : rows) {
+    if (counting) bin.skip(vertexCount * 12);
+    for (int r : rowsWritten) {
         for (int c : cols) {
             const glm::vec3 n = around.vertexNormal(c + dc, r + dr);
             putF32(bin, n.x);
@@ -347,7 +375,8 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const SurfaceAlbedo* texture =
         input.albedoTexture && !input.albedoTexture->empty() ? input.albedoTexture : nullptr;
     const size_t uvOffset = bin.size();
-    for (int r : rows) {
+    if (counting) bin.skip(vertexCount * 8);
+    for (int r : rowsWritten) {
         for (int c : cols) {
             const double u = double(c + dc) / double(std::max(around.width() - 1, 1));
             const double v = double(r + dr) / double(std::max(around.depth() - 1, 1));
@@ -372,7 +401,8 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     };
     // Per cell, the bake's two triangles along the (c, r)-(c+1, r+1) diagonal. With X east and
     // Z south, (c, r) -> (c, r+1) -> (c+1, r+1) turns counter-clockwise seen from +Y.
-    for (size_t ri = 0; ri + 1 < nr; ++ri) {
+    if (counting) bin.skip(indexCount * (wideIndices ? 4 : 2));
+    for (size_t ri = 0; !counting && ri + 1 < nr; ++ri) {
         for (size_t ci = 0; ci + 1 < nc; ++ci) {
             putIndex(ci, ri);
             putIndex(ci, ri + 1);
