@@ -266,9 +266,9 @@ TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec
     const Heightfield& hf = *hf_;
     const int w = hf.width(), d = hf.depth();
     GridRay ray;
-    // Heightfield's own mapping (a division, then an add): a multiply by the reciprocal followed
-    // by the add would be fused on x86-64-v3 and put a ray through a border vertex a rounding
-    // error outside the footprint.
+    // Heightfield's own mapping (a division, then an add), so that a ray through a vertex lands
+    // on its integer grid coordinate: a multiply by the rounded reciprocal can leave it a
+    // rounding error off, outside the footprint at a border vertex.
     ray.u0 = hf.colOf(o.x);
     ray.v0 = hf.rowOf(o.z);
     ray.y0 = o.y;
