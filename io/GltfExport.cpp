@@ -136,22 +136,7 @@ void putU32(BinStream& out, uint32_t v) {
 }
 void putF32(BinStream& out, float v) { putU32(out, std::bit_cast<uint32_t>(v)); }
 
-template <class Out>
-void putU16(Out& out, uint16_t v) {
-    out.push_back(static_cast<uint8_t>(v));
-    out.push_back(static_cast<uint8_t>(v >> 8));
-}
-template <class Out>
-void putU32(Out& out, uint32_t v) {
-    for (int shift = 0; shift < 32; shift += 8)
-        out.push_back(static_cast<uint8_t>(v >> shift));
-}
-template <class Out>
-void putF32(Out& out, float v) {
-    putU32(out, std::bit_cast<uint32_t>(v));
-}
-template <class Out>
-void padTo4(Out& out) {
+void padTo4(BinStream& out) {
     while (out.size() % 4 != 0)
         out.push_back(0);
 }

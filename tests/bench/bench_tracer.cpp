@@ -337,29 +337,26 @@ void runRays(benchmark::State& state, int set, Trace&& trace, const char* kernel
     state.SetLabel(std::string(kRaySetNames[set]) + "; " + kernel + "; " + dem().source);
 }
 
-// Arguments: the ray set, and the kernel (0 baseline, 1 x86-64-v3).
-void BM_Tracer(benchmark::State& state) {
+// One of the tracer's benchmarks: arguments the ray set and the kernel (0 baseline, 1 x86-64-v3).
+void traceRays(benchmark::State& state, bool skirt, bool anyHit) {
     const int kernel = int(state.range(1));
     if (!kernelRuns(state, kernel))
         return;
-    const HeightfieldTracer& t = tracer(kernel);
+    const HeightfieldTracer& t = tracer(kernel, skirt);
     RayHit hit;
     runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) {
+        if (anyHit)
+            return t.occluded(o, d, kInf);
         const bool h = t.intersect(o, d, kInf, hit);
         benchmark::DoNotOptimize(hit);
         return h;
     }, kKernelNames[kernel]);
 }
+
+void BM_Tracer(benchmark::State& state) { traceRays(state, true, false); }
 BENCHMARK(BM_Tracer)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
-void BM_TracerOccluded(benchmark::State& state) {
-    const int kernel = int(state.range(1));
-    if (!kernelRuns(state, kernel))
-        return;
-    const HeightfieldTracer& t = tracer(kernel);
-    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); },
-            kKernelNames[kernel]);
-}
+void BM_TracerOccluded(benchmark::State& state) { traceRays(state, true, true); }
 BENCHMARK(BM_TracerOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 void BM_RayMarch(benchmark::State& state) {
@@ -549,28 +546,10 @@ void BM_EmbreeOccluded1(benchmark::State& state) {
 BENCHMARK(BM_EmbreeOccluded1)->ArgName("rays")->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 // The tracer without its skirt on the same rays, the fair opponent of the two above.
-void BM_TracerNoSkirt(benchmark::State& state) {
-    const int kernel = int(state.range(1));
-    if (!kernelRuns(state, kernel))
-        return;
-    const HeightfieldTracer& t = tracerNoSkirt(kernel);
-    RayHit hit;
-    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) {
-        const bool h = t.intersect(o, d, kInf, hit);
-        benchmark::DoNotOptimize(hit);
-        return h;
-    }, kKernelNames[kernel]);
-}
+void BM_TracerNoSkirt(benchmark::State& state) { traceRays(state, false, false); }
 BENCHMARK(BM_TracerNoSkirt)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
-void BM_TracerNoSkirtOccluded(benchmark::State& state) {
-    const int kernel = int(state.range(1));
-    if (!kernelRuns(state, kernel))
-        return;
-    const HeightfieldTracer& t = tracerNoSkirt(kernel);
-    runRays(state, int(state.range(0)), [&](const glm::vec3& o, const glm::vec3& d) { return t.occluded(o, d, kInf); },
-            kKernelNames[kernel]);
-}
+void BM_TracerNoSkirtOccluded(benchmark::State& state) { traceRays(state, false, true); }
 BENCHMARK(BM_TracerNoSkirtOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 // Every ray of a set through both: hit/miss disagreements, and distances that differ by more
