@@ -1,11 +1,13 @@
 #include "AuthoringCommands.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <optional>
+#include <vector>
 
 #include "CommandLineSupport.h"
 #include "ImageFile.h"
@@ -19,6 +21,53 @@ namespace terralux {
 namespace {
 
 using namespace cli;
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Warm frames of one request, each figure the median over them (per pass by name, in the first
+// frame's order).
+struct ProfileSummary {
+    FrameTimings timings;
+    double wallMilliseconds = 0.0;
+    int frames = 0;
+};
+
+ProfileSummary profileWarmFrames(ProjectRenderer& renderer, const RenderRequest& request) {
+    constexpr double kMinSeconds = 1.0;
+    constexpr int kMinFrames = 3, kMaxFrames = 200;
+    std::vector<FrameTimings> frames;
+    std::vector<double> wall;
+    double spent = 0.0;
+    while (int(frames.size()) < kMinFrames || (spent < kMinSeconds * 1000.0 && int(frames.size()) < kMaxFrames)) {
+        const double ms = renderer.render(request).milliseconds;
+        wall.push_back(ms);
+        spent += ms;
+        frames.push_back(renderer.renderer().lastFrameTimings());
+    }
+    ProfileSummary s;
+    s.frames = int(frames.size());
+    s.wallMilliseconds = median(wall);
+    auto of = [&](auto get) {
+        std::vector<double> v;
+        for (const auto& f : frames) v.push_back(get(f));
+        return median(v);
+    };
+    s.timings = frames.front();
+    s.timings.recordMilliseconds = of([](const FrameTimings& f) { return f.recordMilliseconds; });
+    s.timings.readbackMilliseconds = of([](const FrameTimings& f) { return f.readbackMilliseconds; });
+    s.timings.gpuMilliseconds = of([](const FrameTimings& f) { return f.gpuMilliseconds; });
+    for (auto& pass : s.timings.passes)
+        pass.gpuMilliseconds = of([&](const FrameTimings& f) {
+            for (const auto& p : f.passes)
+                if (p.name == pass.name) return p.gpuMilliseconds;
+            return 0.0;
+        });
+    return s;
+}
 
 int commandRender(const Args& a) {
     const QStringList positional = a.parser.positionalArguments();
@@ -143,9 +192,11 @@ int commandRender(const Args& a) {
                   << kViewInterpolationError << " is grey\n";
     const RenderedImage img = renderer.render(request);
     writeImage(image, img.width, img.height, img.rgba);
-    // The first frame builds pipelines, maps and volumes; the profile is of the same frame warm.
-    std::optional<RenderedImage> warm;
-    if (a.parser.isSet(a.profile)) warm = renderer.render(request);
+    // The first frame builds pipelines, maps and volumes; the profile is of the same frame warm,
+    // drawn again for at least a second (a GPU's clocks ramp up under load) and at least three
+    // times, the median of each figure reported: one warm frame on an idle GPU read up to 5x high.
+    std::optional<ProfileSummary> warm;
+    if (a.parser.isSet(a.profile)) warm = profileWarmFrames(renderer, request);
     const auto view = findDebugView(std::to_string(request.debugView));
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
@@ -155,22 +206,24 @@ int commandRender(const Args& a) {
                   << exposureModeName(project.scene.camera.exposureMode) << "), compensation "
                   << fixed(project.scene.camera.exposureEv, 1) << " EV\n";
     if (warm) {
-        const FrameTimings& t = renderer.renderer().lastFrameTimings();
-        std::cout << "profile (the frame drawn again, warm):\n";
+        const FrameTimings& t = warm->timings;
+        std::cout << "profile (the frame drawn " << warm->frames << " times more, warm; medians):\n";
         if (t.gpuTimed()) {
-            size_t width = 8;
+            // Names padded to the longest, then the milliseconds right-aligned in their own column.
+            size_t width = std::string("GPU total").size();
             for (const auto& p : t.passes) width = std::max(width, p.name.size());
-            std::cout << "  " << std::left << std::setw(int(width)) << "pass" << std::right << "  GPU ms\n";
-            for (const auto& p : t.passes)
-                std::cout << "  " << std::left << std::setw(int(width)) << p.name << std::right << std::setw(8)
-                          << fixed(p.gpuMilliseconds, 3) << "\n";
-            std::cout << "  " << std::left << std::setw(int(width)) << "GPU total" << std::right << std::setw(8)
-                      << fixed(t.gpuMilliseconds, 3) << "\n";
+            auto row = [&](const std::string& name, const std::string& value) {
+                std::cout << "  " << std::left << std::setw(int(width)) << name << std::right << " " << std::setw(9)
+                          << value << "\n";
+            };
+            row("pass", "GPU ms");
+            for (const auto& p : t.passes) row(p.name, fixed(p.gpuMilliseconds, 3));
+            row("GPU total", fixed(t.gpuMilliseconds, 3));
         } else {
             std::cout << "  GPU: " << ctx->deviceName() << " writes no timestamps\n";
         }
         std::cout << "  host: recording " << fixed(t.recordMilliseconds, 2) << " ms, read-back conversion "
-                  << fixed(t.readbackMilliseconds, 2) << " ms; wall " << fixed(warm->milliseconds, 1)
+                  << fixed(t.readbackMilliseconds, 2) << " ms; wall " << fixed(warm->wallMilliseconds, 1)
                   << " ms warm, " << fixed(img.milliseconds, 1) << " ms cold\n";
     }
     // The LPV views' own exposure, printed with the view so the image can be read as numbers.

@@ -96,9 +96,9 @@ CommandLineHelp commandLineHelp(Binary binary) {
          "--render: light with the bake's lighting scenario NAME (default: \"default\", the project's own sun "
          "and sky), or blend from NAME toward TO by T in [0, 1] as an engine blends two scenarios."},
         {"--profile",
-         "--render: draw the frame a second time, warm, and print what it cost: each pass's GPU time from "
-         "timestamps (where the device writes them), the GPU total, and the host's recording and read-back "
-         "conversion, beside both frames' wall time."},
+         "--render: draw the frame again, warm, for at least a second and at least three times, and print "
+         "what it cost (medians): each pass's GPU time from timestamps (where the device writes them), the "
+         "GPU total, and the host's recording and read-back conversion, beside the cold and warm wall time."},
         {"--camera AZ,EL[,RADIUS]",
          "Orbit camera: azimuth (clockwise from north) and elevation in degrees, radius in metres (default: "
          "the project's camera)."},
