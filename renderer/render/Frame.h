@@ -177,6 +177,11 @@ struct RendererGpu {
     bool tracerSkirt = true;
     std::vector<FrameSlot> slots;
     std::unique_ptr<RenderTarget> target;
+    // The target drawn before, kept while frames alternate between two sizes (a metered frame's
+    // 128-pixel meter and the frame itself): switching back allocates nothing and waits for
+    // nothing.
+    std::unique_ptr<RenderTarget> spareTarget;
+    size_t targetAllocations = 0;
     vk::RenderPass clearPass, drawPass, shadowPass;
     vk::Sampler depthSampler;
     vk::UniqueSetLayout emptySet;

@@ -1,5 +1,6 @@
 #include "render/FrameGraph.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace terralux {
@@ -89,9 +90,23 @@ const char* accessName(Access a) {
     return "?";
 }
 
+// Takes `handle`'s state back from those parked under `name` where `resumable` (it is dropped
+// otherwise): whether it did.
+template <class Same>
+bool FrameGraph::resume(const std::string& name, Resource& r, Same same, bool resumable) {
+    const auto list = parked_.find(name);
+    if (list == parked_.end()) return false;
+    const auto found = std::find_if(list->second.begin(), list->second.end(), same);
+    if (found == list->second.end()) return false;
+    if (resumable) r = *found;
+    list->second.erase(found);
+    return resumable;
+}
+
 void FrameGraph::importBuffer(const std::string& name, VkBuffer buffer, bool uploaded) {
     Resource& r = resources_[name];
     if (r.buffer == buffer && !r.image) return;
+    if (resume(name, r, [&](const Resource& p) { return !p.image && p.buffer == buffer; }, !uploaded)) return;
     r = Resource{};
     r.buffer = buffer;
     if (uploaded) {
@@ -104,6 +119,7 @@ void FrameGraph::importImage(const std::string& name, VkImage image, VkImageAspe
                              uint32_t layers, VkPipelineStageFlags waitStage) {
     Resource& r = resources_[name];
     if (r.image && r.imageHandle == image && waitStage == 0) return;
+    if (resume(name, r, [&](const Resource& p) { return p.image && p.imageHandle == image; }, waitStage == 0)) return;
     r = Resource{};
     r.image = true;
     r.imageHandle = image;
@@ -112,7 +128,20 @@ void FrameGraph::importImage(const std::string& name, VkImage image, VkImageAspe
     r.stages = waitStage;
 }
 
-void FrameGraph::forget(const std::string& name) { resources_.erase(name); }
+void FrameGraph::park(const std::string& name) {
+    const auto r = resources_.find(name);
+    if (r == resources_.end()) return;
+    std::vector<Resource>& list = parked_[name];
+    std::erase_if(list, [&](const Resource& p) {
+        return p.image == r->second.image && p.buffer == r->second.buffer && p.imageHandle == r->second.imageHandle;
+    });
+    list.push_back(r->second);
+}
+
+void FrameGraph::forget(const std::string& name) {
+    resources_.erase(name);
+    parked_.erase(name);
+}
 
 void FrameGraph::addPass(PassInfo info, std::function<void(VkCommandBuffer)> record) {
     for (const auto& u : info.uses)

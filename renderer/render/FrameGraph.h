@@ -51,13 +51,18 @@ struct PassInfo {
 class FrameGraph {
 public:
     // Resources by name; their state persists across frames for as long as the handle stays the
-    // same (a new handle starts with undefined contents). `waitStage`: the stage a semaphore
-    // wait guards (a freshly acquired swapchain image), 0 for none.
+    // same (a new handle starts with undefined contents; a parked one resumes where it was).
+    // `waitStage`: the stage a semaphore wait guards (a freshly acquired swapchain image), 0 for
+    // none.
     // `uploaded`: filled by a transfer (a staging copy) that the first use must wait for.
     void importBuffer(const std::string& name, VkBuffer buffer, bool uploaded = false);
     void importImage(const std::string& name, VkImage image, VkImageAspectFlags aspect,
                      uint32_t layers = 1, VkPipelineStageFlags waitStage = 0);
-    // Forgets a resource (its handle is about to be destroyed).
+    // Keeps the state of the handle `name` holds now, to resume when that handle is imported
+    // under the name again: a renderer that alternates between two targets (a small frame and a
+    // large one) keeps the barriers of both right without waiting for either.
+    void park(const std::string& name);
+    // Forgets a resource and every handle parked under its name (they are about to be destroyed).
     void forget(const std::string& name);
 
     // Drops passes added but never executed (a frame whose recording failed).
@@ -102,8 +107,11 @@ private:
         std::function<void(VkCommandBuffer)> record;
     };
     void barrier(VkCommandBuffer cb, const ResourceUse& use);
+    template <class Same>
+    bool resume(const std::string& name, Resource& r, Same same, bool resumable);
 
     std::map<std::string, Resource> resources_;
+    std::map<std::string, std::vector<Resource>> parked_;  // by name: the handles it held before
     std::vector<Pass> passes_;
     std::vector<ResourceUse> finals_;
     std::vector<PassInfo> last_;

@@ -332,16 +332,34 @@ void TerrainRenderer::setWater(std::optional<float> level, float margin) {
 void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale) {
     RendererGpu& g = *gpu_;
     WaterResources& w = *g.water;
-    if (!features::waterTargetsNeeded(w, width, height, reflectionScale)) return;
-    ctx_.waitIdle();  // frames in flight may still read the old targets
-    for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene}) g.graph.forget(name);
-    features::buildWaterTargets(ctx_, g, w, width, height, reflectionScale);
-    g.graph.importImage(kWaterReflection, w.reflection.handle(), w.reflection.aspect());
-    g.graph.importImage(kWaterReflectionDepth, w.reflectionDepth.handle(), w.reflectionDepth.aspect());
-    g.graph.importImage(kWaterScene, w.scene.handle(), w.scene.aspect());
+    if (features::waterTargetsServe(w.targets.get(), width, height, reflectionScale)) return;
+    constexpr const char* kNames[] = {kWaterReflection, kWaterReflectionDepth, kWaterScene};
+    auto importTargets = [&g](const WaterTargets& t) {
+        g.graph.importImage(kWaterReflection, t.reflection.handle(), t.reflection.aspect());
+        g.graph.importImage(kWaterReflectionDepth, t.reflectionDepth.handle(), t.reflectionDepth.aspect());
+        g.graph.importImage(kWaterScene, t.scene.handle(), t.scene.aspect());
+    };
+    if (features::waterTargetsServe(w.spareTargets.get(), width, height, reflectionScale)) {
+        // As ensureTarget: back to the size drawn before, each image resumed where it was left.
+        for (const char* name : kNames) g.graph.park(name);
+        std::swap(w.targets, w.spareTargets);
+        importTargets(*w.targets);
+        return;
+    }
+    ctx_.waitIdle();  // frames in flight may still read the targets
+    for (const char* name : kNames) g.graph.forget(name);
+    w.spareTargets = std::move(w.targets);
+    w.targets = features::buildWaterTargets(ctx_, g, w, width, height, reflectionScale);
+    if (w.spareTargets) {
+        importTargets(*w.spareTargets);
+        for (const char* name : kNames) g.graph.park(name);
+    }
+    importTargets(*w.targets);
 }
 
 bool TerrainRenderer::hasShadowResources() const { return gpu_->shadows != nullptr; }
+
+size_t TerrainRenderer::targetAllocations() const { return gpu_->targetAllocations; }
 
 void TerrainRenderer::redrawShadowMaps() {
     if (gpu_->shadows) gpu_->shadows->drawn.clear();
@@ -706,16 +724,39 @@ void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
     gpu_->graph.importBuffer(kLeaves, gpu_->leaves.handle(), true);
 }
 
+namespace {
+
+// Whether `t` serves a frame of that size and plan. A view without the pass keeps the output image
+// it does not use: switching between a picture and a data view allocates nothing.
+bool serves(const RenderTarget* t, uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
+    return t && t->width == width && t->height == height && t->scale == plan.scale && (t->source || !plan.pass);
+}
+
+void importTarget(FrameGraph& graph, const RenderTarget& t) {
+    graph.importImage(kColor, t.color.handle(), t.color.aspect());
+    graph.importImage(kDepth, t.depth.handle(), t.depth.aspect());
+    graph.importBuffer(kReadback, t.readback.buffer());
+    if (t.output.handle()) graph.importImage(kOutput, t.output.handle(), t.output.aspect());
+}
+
+}  // namespace
+
 void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
     RendererGpu& g = *gpu_;
-    // A view without the pass keeps the output image it does not use: switching between a
-    // picture and a data view allocates nothing.
-    if (g.target && g.target->width == width && g.target->height == height && g.target->scale == plan.scale &&
-        (g.target->source || !plan.pass))
+    if (serves(g.target.get(), width, height, plan)) return;
+    constexpr const char* kTargetNames[] = {kColor, kDepth, kReadback, kOutput};
+    if (serves(g.spareTarget.get(), width, height, plan)) {
+        // Back to the target drawn before: the graph resumes each image where it was left, so the
+        // barriers still order this frame after the frames in flight that used it.
+        for (const char* name : kTargetNames) g.graph.park(name);
+        std::swap(g.target, g.spareTarget);
+        importTarget(g.graph, *g.target);
         return;
-    ctx_.waitIdle();  // frames in flight may still draw into the old target
-    for (const char* name : {kColor, kDepth, kReadback, kOutput}) g.graph.forget(name);
-    g.target.reset();
+    }
+    ctx_.waitIdle();  // frames in flight may still draw into the targets
+    for (const char* name : kTargetNames) g.graph.forget(name);
+    g.spareTarget = std::move(g.target);  // kept: the next frame may go back to it
+    ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
     auto t = std::make_unique<RenderTarget>(RenderTarget{
         vk::Image::colorTarget(ctx_, drawnWidth, drawnHeight), vk::Image::depthTarget(ctx_, drawnWidth, drawnHeight),
@@ -725,13 +766,13 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     t->scale = plan.scale;
     const VkImageView views[] = {t->color.view(), t->depth.view()};
     t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, drawnWidth, drawnHeight);
-    g.graph.importImage(kColor, t->color.handle(), t->color.aspect());
-    g.graph.importImage(kDepth, t->depth.handle(), t->depth.aspect());
-    g.graph.importBuffer(kReadback, t->readback.buffer());
-    if (plan.pass) {
-        features::buildAntialiasingTarget(ctx_, g, *t);
-        g.graph.importImage(kOutput, t->output.handle(), t->output.aspect());
+    if (plan.pass) features::buildAntialiasingTarget(ctx_, g, *t);
+    // The spare's handles start afresh too (the graph forgot them; nothing is in flight now).
+    if (g.spareTarget) {
+        importTarget(g.graph, *g.spareTarget);
+        for (const char* name : kTargetNames) g.graph.park(name);
     }
+    importTarget(g.graph, *t);
     g.target = std::move(t);
 }
 
@@ -883,8 +924,8 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     if (f.planarReflection) {
         // The camera mirrored in the plane, drawing scene-linear beauty into the reflection.
         const blocks::CameraBlock mirrored =
-            features::packMirroredCamera(s, camera, extent, f.water->level, float(f.water->reflectionWidth),
-                                         float(f.water->reflectionHeight));
+            features::packMirroredCamera(s, camera, extent, f.water->level, float(f.water->targets->reflectionWidth),
+                                         float(f.water->targets->reflectionHeight));
         slot.reflectionCamera.write(&mirrored, sizeof mirrored);
     }
     if (f.reflections) {

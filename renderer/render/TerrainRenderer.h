@@ -178,6 +178,9 @@ public:
     // How often the sun's visibility was traced at the vertices (cached per sun and surface).
     size_t sunVisibilityTraces() const { return sunTraces_; }
 
+    // How often a frame needed targets of a size neither the current nor the spare target had
+    // (RendererGpu::spareTarget): a metered frame's meter and the frame itself allocate once.
+    size_t targetAllocations() const;
     int meshStride() const { return stride_; }
     size_t vertexCount() const { return vertexCount_; }
     size_t triangleCount() const { return indexCount_ / 3; }

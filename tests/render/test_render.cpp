@@ -2369,6 +2369,35 @@ TEST_F(RenderTest, TheSkyMeetsTheFoggedGroundAtTheHorizonWithoutAStep) {
     EXPECT_GT(lumaOf(img, 10, size_t(horizon)), lumaOf(img, 10, size_t(horizon) - 40) + 0.02);
 }
 
+TEST_F(RenderTest, AMeteredFrameAndItsMeterKeepTheirTargets) {
+    // Histogram metering draws a 128-pixel meter before each frame whose camera changed: two
+    // sizes, frame after frame. Each size's targets (the frame's and the water's) are allocated
+    // once and kept; switching back waits for nothing and draws the same pixels as a renderer
+    // that never drew the other size.
+    Project p = sampleProject("meter_targets", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Histogram;
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
+    RenderRequest q = unprobed(kViewBeauty, false);
+    const RenderedImage first = r.render(q);
+    const size_t allocations = r.renderer().targetAllocations();
+    EXPECT_EQ(allocations, 2u) << "the meter's targets and the frame's";
+    RenderedImage again;
+    for (int i = 0; i < 3; ++i) {
+        p.scene.camera.azimuthDeg += 20.0;
+        r.setProject(p);
+        again = r.render(q);  // meters again: the camera moved
+    }
+    EXPECT_EQ(r.renderer().targetAllocations(), allocations) << "switching sizes allocated targets again";
+    ProjectRenderer fresh(*ctx_, p);
+    const RenderedImage reference = fresh.render(q);
+    ASSERT_EQ(again.rgba.size(), reference.rgba.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < again.rgba.size(); ++i) differing += again.rgba[i] != reference.rgba[i];
+    EXPECT_EQ(differing, 0u) << "of " << again.rgba.size() << " values";
+    EXPECT_NE(first.rgba, again.rgba) << "the camera moved";
+}
+
 TEST_F(RenderTest, TheMeteredExposurePutsTheTerrainNearMiddleGrey) {
     // Histogram metering on three terrains and three suns under the default sky: the terrain's
     // mean log luminance on the display (sRGB decoded) within a stop of middle grey (0.18), and

@@ -138,32 +138,33 @@ std::unique_ptr<WaterResources> buildWater(vk::VulkanContext& ctx, const Heightf
     return w;
 }
 
-bool waterTargetsNeeded(const WaterResources& w, uint32_t width, uint32_t height, float reflectionScale) {
+bool waterTargetsServe(const WaterTargets* t, uint32_t width, uint32_t height, float reflectionScale) {
     const glm::uvec2 r = reflectionSize(width, height, reflectionScale);
-    return !(w.width == width && w.height == height && w.reflectionWidth == r.x && w.reflectionHeight == r.y);
+    return t && t->width == width && t->height == height && t->reflectionWidth == r.x && t->reflectionHeight == r.y;
 }
 
-void buildWaterTargets(vk::VulkanContext& ctx, const RendererGpu& g, WaterResources& w, uint32_t width,
-                       uint32_t height, float reflectionScale) {
+std::unique_ptr<WaterTargets> buildWaterTargets(vk::VulkanContext& ctx, const RendererGpu& g, const WaterResources& w,
+                                                uint32_t width, uint32_t height, float reflectionScale) {
     const glm::uvec2 r = reflectionSize(width, height, reflectionScale);
-    w.sets.clear();
-    w.reflection = vk::Image::colorTarget(ctx, r.x, r.y);
-    w.reflectionDepth = vk::Image::depthTarget(ctx, r.x, r.y);
-    const VkImageView views[] = {w.reflection.view(), w.reflectionDepth.view()};
-    w.reflectionFramebuffer = vk::Framebuffer(ctx, g.clearPass, views, r.x, r.y);
+    auto t = std::make_unique<WaterTargets>();
+    t->reflection = vk::Image::colorTarget(ctx, r.x, r.y);
+    t->reflectionDepth = vk::Image::depthTarget(ctx, r.x, r.y);
+    const VkImageView views[] = {t->reflection.view(), t->reflectionDepth.view()};
+    t->reflectionFramebuffer = vk::Framebuffer(ctx, g.clearPass, views, r.x, r.y);
     vk::ImageDesc copy;
     copy.width = width;
     copy.height = height;
     copy.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    w.scene = vk::Image(ctx, copy);
+    t->scene = vk::Image(ctx, copy);
     for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
-        w.sets.push_back(waterSetBuilder(w.blocks[i], w.reflection.view(), w.scene.view(), w.field.view(),
-                                         g.linear.handle())
-                             .build(ctx));
-    w.width = width;
-    w.height = height;
-    w.reflectionWidth = r.x;
-    w.reflectionHeight = r.y;
+        t->sets.push_back(waterSetBuilder(w.blocks[i], t->reflection.view(), t->scene.view(), w.field.view(),
+                                          g.linear.handle())
+                              .build(ctx));
+    t->width = width;
+    t->height = height;
+    t->reflectionWidth = r.x;
+    t->reflectionHeight = r.y;
+    return t;
 }
 
 namespace {
@@ -196,8 +197,8 @@ void addReflectionPass(Frame& f) {
                                     f.slot.reflectionView);
     info.bindings.push_back("sky");
     const VkDescriptorSet viewSet = f.slot.reflectionView.handle(), skyLights = f.slot.lights.handle();
-    const VkFramebuffer fb = water->reflectionFramebuffer.handle();
-    const uint32_t rw = water->reflectionWidth, rh = water->reflectionHeight;
+    const VkFramebuffer fb = water->targets->reflectionFramebuffer.handle();
+    const uint32_t rw = water->targets->reflectionWidth, rh = water->targets->reflectionHeight;
     const VkPipeline sky = skyPipeline(f);
     f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f), viewSet, skyLights, fb, rw, rh,
                                         sky](VkCommandBuffer c) {
@@ -221,7 +222,7 @@ void addReflectionPass(Frame& f) {
 
 // What lies under the water as the frame drew it, for the refraction.
 void addSceneCopyPass(Frame& f) {
-    const VkImage source = f.g.target->color.handle(), dest = f.water->scene.handle();
+    const VkImage source = f.g.target->color.handle(), dest = f.water->targets->scene.handle();
     const uint32_t w = f.width, h = f.height;
     f.g.graph.addPass({"water-scene", {{kColor, Access::TransferRead}, {kWaterScene, Access::TransferWrite}}, {}},
                       [source, dest, w, h](VkCommandBuffer c) {
@@ -236,7 +237,7 @@ void addSceneCopyPass(Frame& f) {
 
 void addSurfacePass(Frame& f) {
     WaterResources* water = f.water;
-    const vk::DescriptorSet& waterSet = water->sets[f.slotIndex];
+    const vk::DescriptorSet& waterSet = water->targets->sets[f.slotIndex];
     const vk::DescriptorSet& lights = f.lights();
     PassInfo info{"water",
                   {{kColor, Access::ColorAttachmentDraw},

@@ -14,6 +14,15 @@ namespace terralux {
 
 // Present only while the scene has water. The field and mesh follow the level; the reflection
 // target and the copy of the frame follow the frame's size.
+// What a frame size needs of the water: the planar reflection at the reflection scale, the copy
+// of the frame under the water, and the per-slot sets that bind them with the block and the field.
+struct WaterTargets {
+    uint32_t width = 0, height = 0, reflectionWidth = 0, reflectionHeight = 0;
+    vk::Image reflection, reflectionDepth, scene;
+    vk::Framebuffer reflectionFramebuffer;
+    std::vector<vk::DescriptorSet> sets;  // per frame slot: block, reflection, scene, field
+};
+
 struct WaterResources {
     float level = 0.0f, margin = 0.0f;
     glm::ivec2 fieldSize{1, 1};
@@ -21,11 +30,10 @@ struct WaterResources {
     vk::Buffer vertices, indices;
     uint32_t indexCount = 0;
     float spacing = 1.0f;  // metres between mesh vertices
-    uint32_t width = 0, height = 0, reflectionWidth = 0, reflectionHeight = 0;
-    vk::Image reflection, reflectionDepth, scene;
-    vk::Framebuffer reflectionFramebuffer;
-    std::vector<vk::Buffer> blocks;        // per frame slot: the WaterBlock
-    std::vector<vk::DescriptorSet> sets;   // per frame slot: block, reflection, scene, field
+    std::vector<vk::Buffer> blocks;  // per frame slot: the WaterBlock
+    // The frame size's targets, and those of the size drawn before, kept as the frame's own
+    // spare target is (RendererGpu::spareTarget).
+    std::unique_ptr<WaterTargets> targets, spareTargets;
 };
 
 namespace features {
@@ -41,12 +49,11 @@ blocks::WaterBlock packWater(const RenderSettings& s, const WaterInputs& in);
 // The field over the footprint (depth below `level` and distance to shore) and the mesh over
 // every cell whose bed lies below level + `margin`, with a block per frame slot.
 std::unique_ptr<WaterResources> buildWater(vk::VulkanContext& ctx, const Heightfield& hf, float level, float margin);
-// Whether a frame of `width` × `height` needs new targets: the planar reflection at
-// `reflectionScale` and the copy of the frame under the water.
-bool waterTargetsNeeded(const WaterResources& w, uint32_t width, uint32_t height, float reflectionScale);
-// Builds those targets and the per-slot sets that bind them with the block and the field.
-void buildWaterTargets(vk::VulkanContext& ctx, const RendererGpu& g, WaterResources& w, uint32_t width,
-                       uint32_t height, float reflectionScale);
+// Whether `t` serves a frame of `width` × `height` with the reflection at `reflectionScale`.
+bool waterTargetsServe(const WaterTargets* t, uint32_t width, uint32_t height, float reflectionScale);
+// The targets of such a frame, with the per-slot sets that bind them with w's blocks and field.
+std::unique_ptr<WaterTargets> buildWaterTargets(vk::VulkanContext& ctx, const RendererGpu& g, const WaterResources& w,
+                                                uint32_t width, uint32_t height, float reflectionScale);
 // The water set: its block, the reflection, the frame under the water and the field (read by the
 // mesh too). Null views: the layout alone.
 vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView reflection, VkImageView scene,
