@@ -111,9 +111,10 @@ float cascadeShadow(int c, vec3 p, vec3 ng, vec3 l, float rotation, bool partner
     vec2 plane = receiverPlane(c, ng);
     float z = lc.z - kSlopeTexels * (abs(plane.x) + abs(plane.y)) * texelUv;
     float layer = float(c);
-    if (shadow.filterMode == kFilterHard) return litFraction(texelQuad(uv, layer, z, plane));
+    int filterMode = camera.shadowFilter >= 0 ? camera.shadowFilter : shadow.filterMode;
+    if (filterMode == kFilterHard) return litFraction(texelQuad(uv, layer, z, plane));
     float radiusTexels = 1.5;
-    if (shadow.filterMode == kFilterPcss) {
+    if (filterMode == kFilterPcss) {
         float tanR = shadow.tanSunRadius;
         // Blocker search: the widest penumbra comes from a blocker at the map's near plane.
         float searchTexels = clamp(z * shadow.depthRange[c] * tanR / texelWorld, 1.0, kMaxKernelTexels);

@@ -1532,6 +1532,62 @@ TEST_F(RenderTest, PlanarReflectionShowsTheDarkMountainAndChangesOnlyWater) {
     EXPECT_LE(brighter, water / 200) << brighter << " of " << water << " water pixels";
 }
 
+TEST_F(RenderTest, ThePlanarReflectionDrawsHardShadowsWhateverTheFilter) {
+    // The lake and the wall of PlanarReflectionShowsTheDarkMountainAndChangesOnlyWater, the wall
+    // ribbed so that a low sun from the east casts shadows with penumbrae across its face; black,
+    // absorbing water shows only its reflection. The terrain's filter changes the land; the
+    // water, reflecting the terrain drawn with the hard filter, stays (drawn with the scene's
+    // PCSS, 44 of its 10 056 pixels changed).
+    const fs::path dem = writeDem("lake_ribbed_wall", 129, 10.0, [](int c, int r) {
+        const float rib = 60.0f * std::max(0.0f, std::sin(float(c) * 0.45f));
+        return r < 40 ? (600.0f + rib) * std::min(1.0f, float(40 - r) / 12.0f) : 0.0f;
+    });
+    Project p = sampleProject("reflection_filter", 2, 2);
+    p.scene.terrain.dem = dem.string();
+    p.scene.camera.azimuthDeg = 180.0;
+    p.scene.camera.elevationDeg = 8.0;
+    p.scene.camera.antialiasing = Antialiasing::Off;
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    p.scene.sun.mode = SunMode::Manual;
+    p.scene.sun.azimuthDeg = 100.0;
+    p.scene.sun.elevationDeg = 12.0;
+    p.scene.fog.enabled = false;
+    ProjectRenderer r(*ctx_, p);
+    p = withWater(p, r, 5.0);
+    p.scene.water.color = glm::vec3(0.0f);
+    p.scene.water.absorption = glm::vec3(10.0f);
+    r.setProject(p);
+    const uint32_t w = 480, h = 270;
+    RenderRequest q = unprobed(kViewWaterMask, true);
+    q.width = w;
+    q.height = h;
+    const std::vector<uint8_t> mask = waterMask(r.render(q));
+    q.debugView = kViewLinear;
+    std::map<ShadowFilter, RenderedImage> images;
+    for (ShadowFilter filter : {ShadowFilter::Pcss, ShadowFilter::Hard}) {
+        p.scene.shadows.filter = filter;
+        r.setProject(p);
+        images[filter] = r.render(q);
+    }
+    size_t water = 0, waterChanged = 0, landChanged = 0;
+    for (size_t i = 0; i < mask.size(); ++i) {
+        double d = 0.0;
+        for (int c = 0; c < 3; ++c)
+            d = std::max(d, double(std::abs(images[ShadowFilter::Pcss].rgba[4 * i + size_t(c)] -
+                                            images[ShadowFilter::Hard].rgba[4 * i + size_t(c)])));
+        if (mask[i]) {
+            ++water;
+            waterChanged += d > 1e-4;
+        } else {
+            landChanged += d > 1e-4;
+        }
+    }
+    ASSERT_GT(water, 5000u);
+    EXPECT_GT(landChanged, 500u) << "the filter changes the land's shadows";
+    EXPECT_EQ(waterChanged, 0u) << "of " << water << " water pixels";
+    writeImage(kOut / "reflection_filter_pcss.png", w, h, images[ShadowFilter::Pcss].rgba);
+}
+
 // Without water the frame has no water pass and binds nothing of it.
 TEST_F(RenderTest, NoWaterNoWaterPass) {
     ProjectRenderer r(*ctx_, sampleProject("no_water", 2, 2));

@@ -26,6 +26,7 @@ blocks::CameraBlock packCamera(const RenderSettings& s, float extent, const Debu
     // What the per-vertex attribute holds: 2 the traced sun visibility, 1 the probe diagnostics,
     // 0 probe light.
     camera.vertexAttribute = view.needs.sunVisibility ? 2 : view.needs.probeDiagnostics ? 1 : 0;
+    camera.shadowFilter = -1;
     return camera;
 }
 
@@ -40,6 +41,9 @@ blocks::CameraBlock packMirroredCamera(const RenderSettings& s, const blocks::Ca
     mirrored.invViewportSize = 1.0f / mirrored.viewportSize;
     mirrored.debugView = kViewBeauty;
     mirrored.linearOutput = 1;
+    // The waves distort the reflection by more than a penumbra: the 40 taps of PCSS would cost the
+    // terrain drawn again at full price for nothing seen.
+    mirrored.shadowFilter = int(ShadowFilter::Hard);
     return mirrored;
 }
 
