@@ -30,6 +30,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <tbb/parallel_for.h>
 #include <tiny_gltf.h>
 
 namespace terralux {
@@ -135,6 +136,38 @@ void putU32(BinStream& out, uint32_t v) {
     out.write(b, 4);
 }
 void putF32(BinStream& out, float v) { putU32(out, std::bit_cast<uint32_t>(v)); }
+
+// The same words stored into a buffer, for the mesh's rows (writeRows).
+uint8_t* storeU16(uint8_t* p, uint16_t v) {
+    p[0] = uint8_t(v);
+    p[1] = uint8_t(v >> 8);
+    return p + 2;
+}
+uint8_t* storeU32(uint8_t* p, uint32_t v) {
+    p[0] = uint8_t(v);
+    p[1] = uint8_t(v >> 8);
+    p[2] = uint8_t(v >> 16);
+    p[3] = uint8_t(v >> 24);
+    return p + 4;
+}
+uint8_t* storeF32(uint8_t* p, float v) { return storeU32(p, std::bit_cast<uint32_t>(v)); }
+
+// `rows` rows of `rowBytes` bytes each into `bin`, in order: fill(row, out) stores row's bytes
+// at out. The rows of a window of some 16 MiB are filled in parallel, then written: the same bytes
+// as writing them one by one, at bounded memory (a 4800² mesh is 1.3 GB). Counting, only skipped.
+template <class Fill>
+void writeRows(BinStream& bin, size_t rows, size_t rowBytes, const Fill& fill) {
+    if (bin.counting()) return bin.skip(rows * rowBytes);
+    constexpr size_t kWindowBytes = size_t(16) << 20;
+    const size_t window = std::max<size_t>(1, kWindowBytes / std::max<size_t>(rowBytes, 1));
+    std::vector<uint8_t> buffer;
+    for (size_t first = 0; first < rows; first += window) {
+        const size_t n = std::min(window, rows - first);
+        buffer.resize(n * rowBytes);
+        tbb::parallel_for(size_t(0), n, [&](size_t i) { fill(first + i, buffer.data() + i * rowBytes); });
+        bin.write(buffer.data(), buffer.size());
+    }
+}
 
 void padTo4(BinStream& out) {
     while (out.size() % 4 != 0)
@@ -325,22 +358,19 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const size_t positionOffset = bin.size();
     glm::vec3 lo(std::numeric_limits<float>::infinity());
     glm::vec3 hi(-std::numeric_limits<float>::infinity());
-    // Counting (the pass that lays out the document) needs the bounds but none of the bytes.
-    const bool counting = bin.counting();
-    const std::vector<int> none;
-    const std::vector<int>& rowsWritten = counting ? none : rows;
-    for (int r : rows) {
+    for (int r : rows)
         for (int c : cols) {
             const glm::vec3 p = hf.vertex(c, r);
             lo = glm::min(lo, p);
             hi = glm::max(hi, p);
-            if (counting) continue;
-            putF32(bin, p.x);
-            putF32(bin, p.y);
-            putF32(bin, p.z);
         }
-    }
-    if (counting) bin.skip(vertexCount * 12);
+    // The layout pass (counting) needs the bounds but none of the bytes: writeRows skips them.
+    writeRows(bin, nr, nc * 12, [&](size_t ri, uint8_t* out) {
+        for (int c : cols) {
+            const glm::vec3 p = hf.vertex(c, rows[ri]);
+            out = storeF32(storeF32(storeF32(out, p.x), p.y), p.z);
+        }
+    });
     const size_t normalOffset = bin.size();
     // Vertex (c, r) of hf is (c + dc, r + dr) of its surroundings: window origins are exact.
     const Heightfield& around = input.surroundings ? *input.surroundings : hf;
@@ -348,55 +378,47 @@ void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::pat
     const int dr = int(std::lround(around.originRow() - hf.originRow()));
     if (dc < 0 || dr < 0 || dc + hf.width() > around.width() || dr + hf.depth() > around.depth())
         throw std::invalid_argument("glTF export: the surroundings do not hold the heightfield's window");
-    if (counting) bin.skip(vertexCount * 12);
-    for (int r : rowsWritten) {
+    writeRows(bin, nr, nc * 12, [&](size_t ri, uint8_t* out) {
         for (int c : cols) {
-            const glm::vec3 n = around.vertexNormal(c + dc, r + dr);
-            putF32(bin, n.x);
-            putF32(bin, n.y);
-            putF32(bin, n.z);
+            const glm::vec3 n = around.vertexNormal(c + dc, rows[ri] + dr);
+            out = storeF32(storeF32(storeF32(out, n.x), n.y), n.z);
         }
-    }
+    });
     const SurfaceAlbedo* texture =
         input.albedoTexture && !input.albedoTexture->empty() ? input.albedoTexture : nullptr;
     const size_t uvOffset = bin.size();
-    if (counting) bin.skip(vertexCount * 8);
-    for (int r : rowsWritten) {
+    writeRows(bin, nr, nc * 8, [&](size_t ri, uint8_t* out) {
+        const int r = rows[ri];
         for (int c : cols) {
             const double u = double(c + dc) / double(std::max(around.width() - 1, 1));
             const double v = double(r + dr) / double(std::max(around.depth() - 1, 1));
             if (texture) {
                 // Texel centres span the footprint corner to corner (SurfaceAlbedo.h), and glTF
                 // addresses texel i's centre at (i + 0.5) / size: corners land on corner texels.
-                putF32(bin, float((u * (texture->width - 1) + 0.5) / texture->width));
-                putF32(bin, float((v * (texture->height - 1) + 0.5) / texture->height));
+                out = storeF32(out, float((u * (texture->width - 1) + 0.5) / texture->width));
+                out = storeF32(out, float((v * (texture->height - 1) + 0.5) / texture->height));
             } else {
-                putF32(bin, float(u));
-                putF32(bin, float(v));
+                out = storeF32(storeF32(out, float(u)), float(v));
             }
         }
-    }
+    });
     const size_t indexOffset = bin.size();
-    auto putIndex = [&](size_t ci, size_t ri) {
-        const size_t v = ri * nc + ci;
-        if (wideIndices)
-            putU32(bin, uint32_t(v));
-        else
-            putU16(bin, uint16_t(v));
-    };
     // Per cell, the bake's two triangles along the (c, r)-(c+1, r+1) diagonal. With X east and
     // Z south, (c, r) -> (c, r+1) -> (c+1, r+1) turns counter-clockwise seen from +Y.
-    if (counting) bin.skip(indexCount * (wideIndices ? 4 : 2));
-    for (size_t ri = 0; !counting && ri + 1 < nr; ++ri) {
+    writeRows(bin, nr - 1, (nc - 1) * 6 * (wideIndices ? 4 : 2), [&](size_t ri, uint8_t* out) {
+        auto put = [&](size_t ci, size_t row) {
+            const size_t v = row * nc + ci;
+            out = wideIndices ? storeU32(out, uint32_t(v)) : storeU16(out, uint16_t(v));
+        };
         for (size_t ci = 0; ci + 1 < nc; ++ci) {
-            putIndex(ci, ri);
-            putIndex(ci, ri + 1);
-            putIndex(ci + 1, ri + 1);
-            putIndex(ci, ri);
-            putIndex(ci + 1, ri + 1);
-            putIndex(ci + 1, ri);
+            put(ci, ri);
+            put(ci, ri + 1);
+            put(ci + 1, ri + 1);
+            put(ci, ri);
+            put(ci + 1, ri + 1);
+            put(ci + 1, ri);
         }
-    }
+    });
     const size_t indexBytes = bin.size() - indexOffset;
     padTo4(bin);
     const size_t imageOffset = bin.size();
