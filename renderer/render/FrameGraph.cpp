@@ -90,8 +90,8 @@ const char* accessName(Access a) {
     return "?";
 }
 
-// Takes `handle`'s state back from those parked under `name` where `resumable` (it is dropped
-// otherwise): whether it did.
+// Takes back into `r` the state parked under `name` for the handle `same` picks, where
+// `resumable` (else that parked state is dropped): whether it did.
 template <class Same>
 bool FrameGraph::resume(const std::string& name, Resource& r, Same same, bool resumable) {
     const auto list = parked_.find(name);
