@@ -638,7 +638,7 @@ void BM_MeteredFrame(benchmark::State& state) {
 BENCHMARK(BM_MeteredFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
 // At least a second of frames: a GPU's clocks ramp up under load, and five frames of an idle
-// one read up to twice the time (README, "What a frame costs on a GPU").
+// one read up to twice the time (docs/gpu_frame_cost.md).
 BENCHMARK(BM_FramePasses)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
 }  // namespace
