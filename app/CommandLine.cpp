@@ -71,7 +71,7 @@ int commandInfo(const Args& a) {
       << fixed(hf.maxHeight() - hf.minHeight(), 2) << ")\n";
     o << "nodata:       " << hf.nodataCount() << " of " << cells << " cells ("
       << fixed(100.0 * double(hf.nodataCount()) / double(cells), 3) << " %)"
-      << (hf.nodataCount() ? ", filled by inverse-distance interpolation" : "") << "\n";
+      << (hf.nodataCount() ? ", filled by the membrane (Laplace) surface" : "") << "\n";
     o << "extent:       x " << fixed(hf.minX(), 2) << " .. " << fixed(hf.maxX(), 2) << " m, z "
       << fixed(hf.minZ(), 2) << " .. " << fixed(hf.maxZ(), 2) << " m ("
       << fixed((hf.maxX() - hf.minX()) / 1000.0, 3) << " x "

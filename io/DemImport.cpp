@@ -146,6 +146,14 @@ MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::v
     const size_t holes = size_t(std::count_if(nodata.begin(), nodata.end(), [](uint8_t v) { return v != 0; }));
     if (holes == 0) return {};
     if (holes == nodata.size()) throw DemError("filling nodata cells: every cell is nodata; nothing to fill from");
+    if (method == VoidFill::Membrane) {
+        try {
+            return membraneFill(heights, w, h, nodata, MembraneStart::RimMean);
+        } catch (const std::bad_alloc&) {
+            throw DemError("filling nodata cells: not enough memory for the membrane over " + std::to_string(holes) +
+                           " cells; set terrain.max_resolution");
+        }
+    }
     registerDriversOnce();
     QuietGdalErrors quiet;
     // GDALFillNodata interpolates by inverse distance weighting over a search in four directions,
@@ -162,15 +170,7 @@ MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::v
     if (GDALFillNodata(fb, mb, double(std::max(w, h)) * 1.5, 0, 2, nullptr, nullptr, nullptr) != CE_None)
         throw DemError(withGdalReason("filling nodata cells failed"));
     static_cast<GDALDataset*>(fillDs.get())->FlushCache();
-    fillDs.reset();
-    maskDs.reset();
-    if (method != VoidFill::GdalMembrane) return {};
-    try {
-        return membraneFill(heights, w, h, nodata);
-    } catch (const std::bad_alloc&) {
-        throw DemError("filling nodata cells: not enough memory for the membrane over " + std::to_string(holes) +
-                       " cells; set terrain.max_resolution");
-    }
+    return {};
 }
 
 namespace {

@@ -262,7 +262,8 @@ HoleResult solve(Multigrid& mg, const std::vector<double>& b, std::vector<double
 
 }  // namespace
 
-MembraneReport membraneFill(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata) {
+MembraneReport membraneFill(std::vector<float>& heights, int w, int h, const std::vector<uint8_t>& nodata,
+                            MembraneStart start) {
     if (w < 1 || h < 1 || heights.size() != size_t(w) * size_t(h) || nodata.size() != heights.size())
         throw std::invalid_argument("membrane fill: grid " + std::to_string(w) + " x " + std::to_string(h) + " has " +
                                     std::to_string(heights.size()) + " heights and " +
@@ -304,7 +305,8 @@ MembraneReport membraneFill(std::vector<float>& heights, int w, int h, const std
         Level level;
         level.resize(n);
         std::vector<double> b(n, 0.0), u(n);
-        double rim = 0.0;
+        double rim = 0.0, rimSum = 0.0;
+        size_t rimLinks = 0;
         bool anchored = false;
         for (size_t k = 0; k < n; ++k) {
             const int x = int(cells[k] % uint32_t(w)), y = int(cells[k] / uint32_t(w));
@@ -322,18 +324,25 @@ MembraneReport membraneFill(std::vector<float>& heights, int w, int h, const std
                 } else {
                     b[k] += heights[c];
                     rim = std::max(rim, std::fabs(double(heights[c])));
+                    rimSum += heights[c];
+                    ++rimLinks;
                     anchored = true;
                 }
             }
         }
         if (!anchored) return;
+        if (start == MembraneStart::RimMean) {
+            const double mean = rimSum / double(rimLinks);
+            std::fill(u.begin(), u.end(), mean);
+            for (size_t k = 0; k < n; ++k) heights[cells[k]] = float(mean);
+        }
         // 0.1 mm, or the spacing of floats at the rim's heights (4 mm at 32 km) where coarser:
         // the result is stored as float.
         const double tolerance = std::max(1e-4, rim * double(FLT_EPSILON));
         Multigrid mg(std::move(level));
         results[id] = solve(mg, b, u, tolerance);
         if (!std::all_of(u.begin(), u.end(), [](double v) { return std::isfinite(v); })) {
-            results[id].converged = false;  // keep GDAL's fill
+            results[id].converged = false;  // keep the start
             return;
         }
         for (size_t k = 0; k < n; ++k) heights[cells[k]] = float(u[k]);
