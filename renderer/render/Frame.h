@@ -177,10 +177,10 @@ struct RendererGpu {
     bool tracerSkirt = true;
     std::vector<FrameSlot> slots;
     std::unique_ptr<RenderTarget> target;
-    // The target drawn before, kept while frames alternate between two sizes (a metered frame's
-    // 128-pixel meter and the frame itself): switching back allocates nothing and waits for
-    // nothing.
-    std::unique_ptr<RenderTarget> spareTarget;
+    // The targets of the sizes drawn lately (TargetSet.h): a metered frame's 128-pixel meter,
+    // the dynamic-resolution steps and the full frame. Going back to one allocates nothing and
+    // waits for nothing.
+    std::vector<std::unique_ptr<RenderTarget>> spareTargets;
     size_t targetAllocations = 0;
     vk::RenderPass clearPass, drawPass, shadowPass;
     vk::Sampler depthSampler;

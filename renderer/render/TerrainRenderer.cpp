@@ -19,6 +19,7 @@
 #include "bake/SphereSampling.h"
 #include "lpv/Lpv.h"
 #include "render/Frame.h"
+#include "render/TargetSet.h"
 #include "render/features/Antialiasing.h"
 #include "render/features/Atmosphere.h"
 #include "render/features/Lpv.h"
@@ -339,19 +340,18 @@ void TerrainRenderer::ensureWaterTargets(uint32_t width, uint32_t height, float 
         g.graph.importImage(kWaterReflectionDepth, t.reflectionDepth.handle(), t.reflectionDepth.aspect());
         g.graph.importImage(kWaterScene, t.scene.handle(), t.scene.aspect());
     };
-    if (features::waterTargetsServe(w.spareTargets.get(), width, height, reflectionScale)) {
-        // As ensureTarget: back to the size drawn before, each image resumed where it was left.
-        for (const char* name : kNames) g.graph.park(name);
-        std::swap(w.targets, w.spareTargets);
+    const auto serves = [&](const WaterTargets* t) { return features::waterTargetsServe(t, width, height, reflectionScale); };
+    for (const char* name : kNames) g.graph.park(name);
+    if (takeSpare(w.targets, w.spareTargets, serves)) {
+        // As ensureTarget: back to a size drawn lately, each image resumed where it was left.
         importTargets(*w.targets);
         return;
     }
     ctx_.waitIdle();  // frames in flight may still read the targets
     for (const char* name : kNames) g.graph.forget(name);
-    w.spareTargets = std::move(w.targets);
-    w.targets = features::buildWaterTargets(ctx_, g, w, width, height, reflectionScale);
-    if (w.spareTargets) {
-        importTargets(*w.spareTargets);
+    replaceTarget(w.targets, w.spareTargets, features::buildWaterTargets(ctx_, g, w, width, height, reflectionScale));
+    for (const auto& spare : w.spareTargets) {
+        importTargets(*spare);
         for (const char* name : kNames) g.graph.park(name);
     }
     importTargets(*w.targets);
@@ -745,17 +745,15 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     RendererGpu& g = *gpu_;
     if (serves(g.target.get(), width, height, plan)) return;
     constexpr const char* kTargetNames[] = {kColor, kDepth, kReadback, kOutput};
-    if (serves(g.spareTarget.get(), width, height, plan)) {
-        // Back to the target drawn before: the graph resumes each image where it was left, so the
+    for (const char* name : kTargetNames) g.graph.park(name);
+    if (takeSpare(g.target, g.spareTargets, [&](const RenderTarget* t) { return serves(t, width, height, plan); })) {
+        // Back to a target drawn lately: the graph resumes each image where it was left, so the
         // barriers still order this frame after the frames in flight that used it.
-        for (const char* name : kTargetNames) g.graph.park(name);
-        std::swap(g.target, g.spareTarget);
         importTarget(g.graph, *g.target);
         return;
     }
     ctx_.waitIdle();  // frames in flight may still draw into the targets
     for (const char* name : kTargetNames) g.graph.forget(name);
-    g.spareTarget = std::move(g.target);  // kept: the next frame may go back to it
     ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
     auto t = std::make_unique<RenderTarget>(RenderTarget{
@@ -767,13 +765,13 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     const VkImageView views[] = {t->color.view(), t->depth.view()};
     t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, drawnWidth, drawnHeight);
     if (plan.pass) features::buildAntialiasingTarget(ctx_, g, *t);
-    // The spare's handles start afresh too (the graph forgot them; nothing is in flight now).
-    if (g.spareTarget) {
-        importTarget(g.graph, *g.spareTarget);
+    replaceTarget(g.target, g.spareTargets, std::move(t));
+    // The spares' handles start afresh too (the graph forgot them; nothing is in flight now).
+    for (const auto& spare : g.spareTargets) {
+        importTarget(g.graph, *spare);
         for (const char* name : kTargetNames) g.graph.park(name);
     }
-    importTarget(g.graph, *t);
-    g.target = std::move(t);
+    importTarget(g.graph, *g.target);
 }
 
 features::AntialiasingPlan TerrainRenderer::antialiasingOf(const RenderSettings& s) const {

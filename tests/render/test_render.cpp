@@ -2454,6 +2454,42 @@ TEST_F(RenderTest, AMeteredFrameAndItsMeterKeepTheirTargets) {
     EXPECT_NE(first.rgba, again.rgba) << "the camera moved";
 }
 
+TEST_F(RenderTest, TheViewportsThreeSizesKeepTheirTargets) {
+    // The viewport draws one view at three sizes: the meter's 128 pixels, a dynamic-resolution
+    // step while the camera moves and the full frame when it stops. Each keeps its targets (the
+    // frame's and the water's) once drawn; cycling through them allocates nothing, and the full
+    // frame drawn last matches a renderer that drew it alone.
+    Project p = sampleProject("three_sizes", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Histogram;
+    ProjectRenderer r(*ctx_, p);
+    addLake(p, r);
+    RenderRequest full = unprobed(kViewBeauty, false);
+    full.width = 2 * kW;  // the step, half of it, still wider than the meter
+    full.height = 2 * kH;
+    RenderRequest step = full;
+    step.width = kW;
+    step.height = kH;
+    r.render(full);
+    r.render(step);
+    const size_t allocations = r.renderer().targetAllocations();
+    EXPECT_EQ(allocations, 3u) << "the meter's targets, the step's and the full frame's";
+    RenderedImage last;
+    for (int i = 0; i < 3; ++i) {
+        p.scene.camera.azimuthDeg += 20.0;
+        r.setProject(p);
+        r.render(step);         // meters, then draws the step
+        last = r.render(full);  // the same camera: the step's exposure, no meter
+    }
+    EXPECT_EQ(r.renderer().targetAllocations(), allocations) << "stepping between sizes allocated targets again";
+    ProjectRenderer fresh(*ctx_, p);
+    fresh.render(step);
+    const RenderedImage reference = fresh.render(full);
+    ASSERT_EQ(last.rgba.size(), reference.rgba.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < last.rgba.size(); ++i) differing += last.rgba[i] != reference.rgba[i];
+    EXPECT_EQ(differing, 0u) << "of " << last.rgba.size() << " values";
+}
+
 TEST_F(RenderTest, TheMeteredExposurePutsTheTerrainNearMiddleGrey) {
     // Histogram metering on three terrains and three suns under the default sky: the terrain's
     // mean log luminance on the display (sRGB decoded) within a stop of middle grey (0.18), and

@@ -31,9 +31,10 @@ struct WaterResources {
     uint32_t indexCount = 0;
     float spacing = 1.0f;  // metres between mesh vertices
     std::vector<vk::Buffer> blocks;  // per frame slot: the WaterBlock
-    // The frame size's targets, and those of the size drawn before, kept as the frame's own
-    // spare target is (RendererGpu::spareTarget).
-    std::unique_ptr<WaterTargets> targets, spareTargets;
+    // The frame size's targets, and those of the sizes drawn lately, kept as the frame's own
+    // are (RendererGpu::spareTargets).
+    std::unique_ptr<WaterTargets> targets;
+    std::vector<std::unique_ptr<WaterTargets>> spareTargets;
 };
 
 namespace features {
