@@ -976,8 +976,8 @@ std::vector<ParameterSpec> buildTable() {
                 });
     add(Row("lights[].color", T::Color)).range(0.0, 1.0).label("Light colour")
         .about("Linear RGB tint of the intensity").redoes(kUpload).light(&LocalLight::color);
-    add(Row("lights[].intensity", T::Number)).range(0.0, 1.0e12).label("Intensity")
-        .about("Irradiance on a surface facing the light 1 m away, in the sun's scene-linear units (E = intensity / d^2 inside the range); exported as candela: intensity / 3e-5, the scene units per lux")
+    add(Row("lights[].intensity", T::Number)).range(0.0, 1.0e17).unit("cd").label("Intensity")
+        .about("Luminous intensity: the illuminance in lux on a surface facing the light 1 m away (E = intensity / d^2 inside the range), as the sun's illuminance is in lux; exported as it is (KHR_lights_punctual's candela)")
         .redoes(kUpload).light(&LocalLight::intensity);
     add(Row("lights[].range", T::Number)).above(0.0, 1.0e6).unit("m").label("Range")
         .about("Distance where the light ends: its falloff is windowed by clamp(1 - (d/range)^4, 0, 1) (KHR_lights_punctual)")

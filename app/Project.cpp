@@ -329,6 +329,22 @@ const std::vector<ProjectMigration>& projectMigrations() {
                  for (size_t i = 0; i < doc["scenarios"].size(); ++i)
                      toLux(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
          }},
+        {4,
+         "lights[].intensity became candela: a version-4 value in scene units at 1 m is divided by "
+         "kSceneUnitsPerLux (1000 became 33 333 333 cd), the same light",
+         [](json& doc, std::vector<std::string>& notes) {
+             if (!doc.contains("lights") || !doc["lights"].is_array()) return;
+             for (size_t i = 0; i < doc["lights"].size(); ++i) {
+                 json& light = doc["lights"][i];
+                 // Anything but a number is left for the check to name.
+                 if (!light.is_object() || !light.contains("intensity") || !light["intensity"].is_number()) continue;
+                 const double before = light["intensity"].get<double>();
+                 const double cd = std::round(before / kSceneUnitsPerLux * 1000.0) / 1000.0;
+                 light["intensity"] = cd;
+                 notes.push_back("lights[" + std::to_string(i) + "].intensity " + json(before).dump() + " is " +
+                                 json(cd).dump() + " cd");
+             }
+         }},
     };
     return steps;
 }

@@ -295,8 +295,7 @@ void addLights(ojson& doc, const std::vector<LocalLight>& lights) {
         ojson light = {{"name", "light " + std::to_string(i)},
                        {"type", spot ? "spot" : "point"},
                        {"color", floats({l.color.r, l.color.g, l.color.b})},
-                       // Candela: the scene units' irradiance at 1 m, in lux, as the sun's.
-                       {"intensity", l.intensity / kSceneUnitsPerLux},
+                       {"intensity", l.intensity},  // candela, as authored
                        {"range", l.range}};
         if (spot)
             light["spot"] = {{"innerConeAngle", l.innerConeDeg * kDeg}, {"outerConeAngle", l.outerConeDeg * kDeg}};

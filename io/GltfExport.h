@@ -93,8 +93,8 @@ struct GltfSceneInput {
     nlohmann::json lighting = nullptr;
     // Unset: no water node (a one-sample-wide heightfield, with no footprint, has none either).
     std::optional<GltfWater> water;
-    // KHR_lights_punctual, in this order. Intensity in candela = LocalLight::intensity (one
-    // scene-linear unit of illuminance is one lux); cone angles in radians.
+    // KHR_lights_punctual, in this order. Intensity in candela = LocalLight::intensity; cone
+    // angles in radians.
     std::vector<LocalLight> lights;
     std::string generatorVersion;                    // asset.generator = "Terralux <version>"
     // Vertex budget: a larger heightfield is exported with every k-th row and column (the smallest

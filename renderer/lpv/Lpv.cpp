@@ -567,7 +567,7 @@ void Volumes::injectLights() {
         const int r1 = std::clamp(int(std::ceil((pos.z + light.range - o.z) / step)), 0, side);
         const int w = c1 - c0, d = r1 - r0;
         std::vector<Emitter> emitters(size_t(std::max(w, 0)) * size_t(std::max(d, 0)));
-        const glm::vec3 emitted = light.color * float(light.intensity);
+        const glm::vec3 emitted = light.emitted();
         tbb::parallel_for(tbb::blocked_range<int>(0, std::max(d, 0), 4), [&](const tbb::blocked_range<int>& r) {
             for (int row = r.begin(); row != r.end(); ++row)
                 for (int col = 0; col < w; ++col) {

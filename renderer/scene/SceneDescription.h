@@ -10,6 +10,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "bake/PhysicalSky.h"
 #include "blocks/limits.h"
 
 namespace terralux {
@@ -366,12 +367,18 @@ struct LocalLight {
     glm::vec3 position{0.0f};                 // engine space, metres
     glm::vec3 direction{0.0f, -1.0f, 0.0f};   // spot: where the cone points, engine space (normalised on use)
     glm::vec3 color{1.0f};                    // linear RGB, each in [0, 1]
-    // Intensity I: the irradiance, in the sun's scene-linear units, on a surface facing the
-    // light 1 m away (so E = I / d^2 before the range window); exported as candela 1:1.
-    double intensity = 1000.0;
+    // Luminous intensity I in candela (KHR_lights_punctual's unit, exported as it is): the
+    // illuminance in lux on a surface facing the light 1 m away (E = I / d^2 before the range
+    // window), drawn at the sun's scale (emitted()). 30 Mcd gives 3 000 lx 100 m away, the
+    // default range's end, where the default sun gives 100 000.
+    double intensity = 3.0e7;
     double range = 100.0;                     // metres, > 0: the light reaches nothing beyond
     double innerConeDeg = 20.0;               // spot: full intensity inside, [0, 90)
     double outerConeDeg = 30.0;               // spot: nothing outside, (inner, 90]
+
+    // colour × intensity in scene-linear units at 1 m: candela × kSceneUnitsPerLux, the scale
+    // of the sun's lux (docs/lighting.md, "Units").
+    glm::vec3 emitted() const { return color * float(intensity * kSceneUnitsPerLux); }
 };
 
 // How the picture views (beauty, filled, linear) smooth their edges (docs/lighting.md,

@@ -465,7 +465,7 @@ void BM_Lpv(benchmark::State& state) {
             const float x = camera.target.x + 500.0f * float(i - 2), z = camera.target.z;
             light.position = glm::vec3(x, hf.surfaceHeight(x, z) + 100.0f, z);
             light.range = 600.0;
-            light.intensity = 3.0e4;
+            light.intensity = 3.0e4 / kSceneUnitsPerLux;
             p.scene.lights.push_back(light);
         }
     }

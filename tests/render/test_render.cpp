@@ -2089,7 +2089,7 @@ TEST_F(RenderTest, APointLightBrightensTheGroundUnderIt) {
     LocalLight light;
     light.position = ground + glm::vec3(0.0f, 150.0f, 0.0f);
     light.range = 800.0;
-    light.intensity = 6.0e4;  // 2.7 under it, about the sun's 3
+    light.intensity = 6.0e4 / kSceneUnitsPerLux;  // 2 Gcd: 2.7 scene units under it, about the sun's 3
     p.scene.lights = {light};
     r.setProject(p);
     const RenderedImage lit = draw(r, kViewLinear, false, true);
@@ -2127,7 +2127,7 @@ Project lpvLit(Project p) {
     LocalLight light;
     light.position = glm::vec3(300.0f, 1700.0f, -200.0f);
     light.range = 900.0;
-    light.intensity = 5.0e5;
+    light.intensity = 5.0e5 / kSceneUnitsPerLux;
     p.scene.lights = {light};
     return p;
 }

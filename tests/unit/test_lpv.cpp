@@ -463,7 +463,7 @@ TEST(Lpv, EverySettingChangesTheResult) {
     std::vector<LocalLight> lights(1);
     lights[0].position = glm::vec3(-60.0f, 200.0f, 0.0f);
     lights[0].range = 300.0;
-    lights[0].intensity = 2.0e5;
+    lights[0].intensity = 2.0e5 / kSceneUnitsPerLux;
     LpvSettings base = smallLpv();
     base.cascades = 2;
     base.autoCascadeMinSize = 0.0;
@@ -543,7 +543,7 @@ TEST(Lpv, SpotConesLightOnlyWhatTheyPointAt) {
     lights[0].type = LocalLightType::Spot;
     lights[0].position = glm::vec3(0.0f, 200.0f, 0.0f);
     lights[0].range = 300.0;
-    lights[0].intensity = 1.0e5;
+    lights[0].intensity = 1.0e5 / kSceneUnitsPerLux;
     lights[0].direction = glm::vec3(0, -1, 0);
     const Volumes down(s, {&lighting, &lights}, glm::dvec3(0.0, 200.0, 0.0), glm::dvec3(0.0, -1.0, 0.0));
     lights[0].direction = glm::vec3(0, 1, 0);

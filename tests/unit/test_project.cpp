@@ -134,7 +134,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=5", "p.json: version = 5: is newer than this Terralux reads (4); open it with a newer Terralux"},
+        Rule{"version=6", "p.json: version = 6: is newer than this Terralux reads (5); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -596,4 +596,24 @@ TEST(ProjectVersions, VersionThreeSunIlluminanceBecomesLux) {
     json current = v3;
     current["version"] = kProjectVersion;
     EXPECT_EQ(sceneFromJson(current, "new.json", nullptr).sun.illuminance, 3.0);
+}
+
+// Version 4 wrote a light's intensity in scene units at 1 m (its default 1000); version 5 writes
+// candela, as KHR_lights_punctual exports it, and an older file keeps its light.
+TEST(ProjectVersions, VersionFourLightIntensityBecomesCandela) {
+    const json v4 = {{"version", 4},
+                     {"lights", {{{"intensity", 1000.0}, {"range", 150.0}}, {{"type", "spot"}}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v4, "old.json", &notes);
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_NEAR(s.lights[0].intensity, 1000.0 / kSceneUnitsPerLux, 1e-3);
+    EXPECT_EQ(s.lights[1].intensity, LocalLight{}.intensity);  // unset: the default, in candela
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], "old.json: version 4 migrated to 5: lights[0].intensity 1000.0 is 33333333.333 cd");
+    // The same light: what the renderer and the LPV emit is what version 4 wrote.
+    EXPECT_NEAR(s.lights[0].emitted().x, 1000.0f, 1e-3f);
+    // A current file means candela.
+    json current = v4;
+    current["version"] = kProjectVersion;
+    EXPECT_EQ(sceneFromJson(current, "new.json", nullptr).lights[0].intensity, 1000.0);
 }

@@ -22,7 +22,7 @@ std::vector<blocks::LocalLightRecord> packLocalLights(const std::vector<LocalLig
         const bool spot = l.type == LocalLightType::Spot;
         r.position = l.position;
         r.range = float(l.range);
-        r.emitted = l.color * float(l.intensity);
+        r.emitted = l.emitted();
         r.spot = spot ? 1.0f : 0.0f;
         const float len = glm::length(l.direction);
         r.direction = len > 0.0f ? l.direction / len : glm::vec3(0.0f, -1.0f, 0.0f);
