@@ -209,8 +209,8 @@ int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
 
 namespace {
 
-// importDem, and demGrid (`gridOnly` set): that returns as soon as the grid is known without a
-// whole read, or fills it from the whole import otherwise.
+// importDem, and demGrid (`gridOnly` set): that returns as soon as the grid is known, before any
+// height is read but the streamed minimum and maximum.
 DemImportResult importDemImpl(const std::string& path, const DemImportOptions& options, DemGrid* gridOnly) {
     registerDriversOnce();
     QuietGdalErrors quiet;
@@ -321,6 +321,7 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
 
     // Pick the output grid: metric CRS, north up, optionally reduced.
     DatasetPtr work;        // the grid we finally read (may be src itself)
+    bool lazyWarp = false;  // work is a virtual warp or resampling of the source, read on demand
     DatasetPtr coverage;    // 1 where the warped output lies inside the source footprint
     GDALDatasetH readFrom = heightSource;
     const double maxCells = options.maxCells;
@@ -382,14 +383,20 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
-        if (double(outW) * outH > maxCells)
+        // A window's heights are checked once its size is known; the coverage holds a byte a cell.
+        if (double(outW) * outH > maxCells * (options.window || gridOnly ? 4.0 : 1.0))
             fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
 
         // -wm: GDAL's warp buffers (64 MB by default) at 8 MB, so a bake's peak memory stays a
         // few rasters (bench_bake_memory); chunking costs no accuracy.
-        std::vector<std::string> args = {"-of", "MEM", "-t_srs", dstWkt, "-ot", "Float32",
+        // Only the grid, or a window of it: a virtual warp, which warps the blocks read and no
+        // others (so a tile of a geographic DEM never warps the whole raster). Its blocks are the
+        // whole grid's, so every window sees the same value in a cell.
+        lazyWarp = gridOnly || options.window.has_value();
+        if (options.window && !gridOnly) info.windowRead = true;
+        std::vector<std::string> args = {"-of", lazyWarp ? "VRT" : "MEM", "-t_srs", dstWkt, "-ot", "Float32",
                                          "-dstnodata", fmt(kWarpNodata), "-wm", "8"};
         if (outW != fullW || outH != fullH) {
             args.insert(args.end(), {"-ts", std::to_string(outW), std::to_string(outH), "-r",
@@ -442,22 +449,16 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
             return result;
         }
         const bool direct = outW == info.sourceWidth && outH == info.sourceHeight;
-        if (options.window && direct) {
-            const GridWindow& win = *options.window;
-            if (win.cols < 2 || win.rows < 2 || win.col0 < 0 || win.row0 < 0 || win.col0 + win.cols > outW ||
-                win.row0 + win.rows > outH)
-                fail(path, "window " + std::to_string(win.cols) + "x" + std::to_string(win.rows) + " at (" +
-                               std::to_string(win.col0) + ", " + std::to_string(win.row0) + ") must lie inside the " +
-                               std::to_string(outW) + "x" + std::to_string(outH) + " grid, 2 x 2 at least");
-            info.windowRead = true;
-        }
-        if (double(outW) * outH > maxCells && !info.windowRead)
+        // Reduced, for the grid or a window of it: a virtual resampling, as the warp above.
+        lazyWarp = !direct && (gridOnly || options.window.has_value());
+        if (options.window && !gridOnly) info.windowRead = true;  // checked against the grid below
+        if (double(outW) * outH > maxCells && !info.windowRead && !gridOnly)
             fail(path, "raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
         if (outW != info.sourceWidth || outH != info.sourceHeight) {
             work = translateTo(path, heightSource,
-                               {"-of", "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),
+                               {"-of", lazyWarp ? "VRT" : "MEM", "-ot", "Float32", "-outsize", std::to_string(outW),
                                 std::to_string(outH), "-r", "average"});
             readFrom = work.get();
             info.resampled = true;
@@ -466,7 +467,7 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
     // Each GDAL dataset goes as soon as it has been read, so the import holds at most one grid
     // of GDAL's beside its own: the source (and its cached blocks) once a working copy exists,
     // the coverage once read.
-    if (work) {
+    if (work && !lazyWarp) {
         firstBand.reset();  // the view reads the source: it goes first
         src.reset();
     }
@@ -482,23 +483,65 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
     }
 
     auto* rd = static_cast<GDALDataset*>(readFrom);
-    int w = rd->GetRasterXSize();
-    int h = rd->GetRasterYSize();
-    // A window read alone: its first cell and the whole grid's size place it.
-    const int wholeW = w, wholeH = h;
-    int readX = 0, readY = 0;
+    // The grid: a reprojected raster trimmed to the window that lies wholly inside the source
+    // footprint, whose first cell is (x0, y0) of the warp.
+    int x0 = 0, y0 = 0;
+    int gridW = rd->GetRasterXSize(), gridH = rd->GetRasterYSize();
+    if (!cov.empty()) {
+        if (cov.size() != size_t(gridW) * size_t(gridH))
+            fail(path, "reprojected coverage of " + std::to_string(cov.size()) + " cells does not match the " +
+                           std::to_string(gridW) + "x" + std::to_string(gridH) + " grid");
+        const Window win = coveredWindow(cov, gridW, gridH);
+        cov = {};
+        if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");
+        x0 = win.x0;
+        y0 = win.y0;
+        gridW = win.x1 - win.x0 + 1;
+        gridH = win.y1 - win.y0 + 1;
+    }
+    // A sliver footprint can reproject to a single row or column.
+    if (gridW < 2 || gridH < 2)
+        fail(path, "imports as " + std::to_string(gridW) + " x " + std::to_string(gridH) +
+                       " cells; a DEM needs at least 2 x 2");
+    int w = gridW, h = gridH;
+    int readX = x0, readY = y0;
     if (info.windowRead) {
-        readX = options.window->col0;
-        readY = options.window->row0;
-        w = options.window->cols;
-        h = options.window->rows;
+        const GridWindow& win = *options.window;
+        if (win.cols < 2 || win.rows < 2 || win.col0 < 0 || win.row0 < 0 || win.col0 + win.cols > gridW ||
+            win.row0 + win.rows > gridH)
+            fail(path, "window " + std::to_string(win.cols) + "x" + std::to_string(win.rows) + " at (" +
+                           std::to_string(win.col0) + ", " + std::to_string(win.row0) + ") must lie inside the " +
+                           std::to_string(gridW) + "x" + std::to_string(gridH) + " grid, 2 x 2 at least");
+        if (double(win.cols) * win.rows > maxCells)
+            fail(path, "window " + std::to_string(win.cols) + "x" + std::to_string(win.rows) +
+                           " is too large to hold in memory; set terrain.max_resolution");
+        readX += win.col0;
+        readY += win.row0;
+        w = win.cols;
+        h = win.rows;
+    }
+    if (gridOnly && lazyWarp) {
+        // The trimmed warp's grid, and the height range of the source's valid cells (one streamed
+        // pass), which bounds the warp's: bilinear and averaged values, and the membrane over
+        // the holes, lie within the values around them.
+        double minMax[2] = {0.0, 0.0};
+        if (GDALComputeRasterMinMax(GDALGetRasterBand(heightSource, 1), FALSE, minMax) != CE_None)
+            fail(path, withGdalReason("cannot read band 1"));
+        double wgt[6];
+        rd->GetGeoTransform(wgt);
+        double u = 1.0;
+        if (const OGRSpatialReference* outSrs = rd->GetSpatialRef(); outSrs && outSrs->GetLinearUnits() > 0.0)
+            u = outSrs->GetLinearUnits();
+        *gridOnly = {gridW, gridH, std::abs(wgt[1]) * u, std::abs(wgt[5]) * u,
+                     minMax[0] * options.verticalScale, minMax[1] * options.verticalScale, true};
+        return result;
     }
     double rgt[6] = {0, 1, 0, 0, 0, -1};
     if (hasGeoTransform) {
         rd->GetGeoTransform(rgt);
     } else {  // 1 m source cells, widened by any reduction (GDAL keeps no geotransform for it)
-        rgt[1] = double(info.sourceWidth) / w;
-        rgt[5] = -double(info.sourceHeight) / h;
+        rgt[1] = double(info.sourceWidth) / rd->GetRasterXSize();
+        rgt[5] = -double(info.sourceHeight) / rd->GetRasterYSize();
     }
     GDALRasterBand* rband = rd->GetRasterBand(1);
     int rHasNodata = 0;
@@ -551,40 +594,6 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
         }
     }
 
-    // Trim a reprojected grid to the window that lies wholly inside the source footprint.
-    int x0 = 0, y0 = 0;
-    if (!cov.empty()) {
-        if (cov.size() != heights.size())
-            fail(path, "reprojected coverage of " + std::to_string(cov.size()) + " cells does not match the " +
-                           std::to_string(w) + "x" + std::to_string(h) + " grid");
-        const Window win = coveredWindow(cov, w, h);
-        cov = {};
-        if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");
-        const int cw = win.x1 - win.x0 + 1, ch = win.y1 - win.y0 + 1;
-        // In place: a cell's index in the window is never past its index in the grid, and both
-        // rise together, so no cell is overwritten before it is moved.
-        nodataCount = 0;
-        for (int y = 0; y < ch; ++y)
-            for (int x = 0; x < cw; ++x) {
-                const size_t s = size_t(y + win.y0) * w + (x + win.x0), d = size_t(y) * cw + x;
-                heights[d] = heights[s];
-                nodata[d] = nodata[s];
-                nodataCount += nodata[d];
-            }
-        heights.resize(size_t(cw) * ch);
-        nodata.resize(size_t(cw) * ch);
-        heights.shrink_to_fit();
-        nodata.shrink_to_fit();
-        x0 = win.x0;
-        y0 = win.y0;
-        w = cw;
-        h = ch;
-    }
-
-    // A sliver footprint can reproject to a single row or column.
-    if (w < 2 || h < 2)
-        fail(path, "imports as " + std::to_string(w) + " x " + std::to_string(h) +
-                       " cells; a DEM needs at least 2 x 2");
     if (nodataCount == heights.size()) fail(path, "every cell is nodata; nothing to import");
 
     if (nodataCount > 0) {
@@ -616,27 +625,16 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
     } catch (const std::invalid_argument& e) {
         fail(path, e.what());
     }
-    if (info.windowRead) result.heightfield.placeInGrid(wholeW, wholeH, readX, readY);
+    if (info.windowRead) result.heightfield.placeInGrid(gridW, gridH, readX - x0, readY - y0);
     GeoOrigin& geo = result.heightfield.geo;
     // The footprint centre: the whole grid's, for a window read alone.
-    geo.easting = (rgt[0] + rgt[1] * (info.windowRead ? wholeW * 0.5 : x0 + w * 0.5)) * unit;
-    geo.northing = (rgt[3] + rgt[5] * (info.windowRead ? wholeH * 0.5 : y0 + h * 0.5)) * unit;
+    geo.easting = (rgt[0] + rgt[1] * (x0 + gridW * 0.5)) * unit;
+    geo.northing = (rgt[3] + rgt[5] * (y0 + gridH * 0.5)) * unit;
     geo.height = 0.0;
     geo.crsWkt = crsWkt;
     geo.crsName = crsName;
     geo.epsg = epsg;
     if (!crsWkt.empty()) locateOnEarth(geo, unit);
-    if (gridOnly) {
-        const Heightfield& hf = result.heightfield;
-        *gridOnly = {hf.width(), hf.depth(), hf.cellSizeX(), hf.cellSizeZ(), hf.minHeight(), hf.maxHeight(), false};
-    } else if (options.window && !info.windowRead) {
-        const GridWindow& win = *options.window;
-        try {
-            result.heightfield = result.heightfield.window(win.col0, win.row0, win.cols, win.rows);
-        } catch (const std::invalid_argument& e) {
-            fail(path, e.what());
-        }
-    }
     return result;
 }
 

@@ -34,10 +34,12 @@ struct DemImportOptions {
     double maxCells = 256.0 * 1024 * 1024;
     double verticalScale = 1.0;
     // Set: the import returns only this window of the grid it would make, in that grid's engine
-    // space (as Heightfield::window cuts it), with the whole grid's geo origin. A source whose
-    // cells are the grid's (projected, north up, not reduced) is read only there: memory follows
-    // the window, not the raster. Any other is imported whole, then cut (DemSourceInfo::windowRead
-    // says which). Nodata holes are filled from the window's own cells.
+    // space (as Heightfield::window cuts it), with the whole grid's geo origin, read alone
+    // (DemSourceInfo::windowRead): a source whose cells are the grid's (projected, north up, not
+    // reduced) only there; one that is reprojected or reduced through a virtual warp or
+    // resampling of the whole grid, which computes the window's cells and no others (its
+    // coverage, a byte a cell of the whole grid, places the trim). Heights memory follows the
+    // window, not the raster. Nodata holes are filled from the window's own cells.
     std::optional<GridWindow> window;
 };
 
@@ -89,10 +91,12 @@ MembraneReport fillVoids(std::vector<float>& heights, int w, int h, const std::v
 // Reads `path` (a file, or any GDAL virtual path such as /vsizip/...). Throws DemError.
 DemImportResult importDem(const std::string& path, const DemImportOptions& options = {});
 
-// The grid importDem makes of `path`: its size, cell sizes and height range (valid cells, after the
-// vertical scale). Where the source's cells are the grid's, from its header and one streamed pass
-// over its blocks (GDAL's exact minimum and maximum), never holding the raster; otherwise from a
-// whole import (`streamed` false). Throws DemError as importDem does.
+// The grid importDem makes of `path`: its size, cell sizes and height range (after the vertical
+// scale), from the header (and, reprojected, the coverage of the warp) and one streamed pass over
+// the source's blocks (GDAL's exact minimum and maximum of its valid cells), never holding the
+// raster. Reprojected or reduced, that range is the source's, which bounds the grid's (bilinear
+// and averaged values, and filled holes, lie within the values around them). `streamed` is always
+// true; kept for the region summary's file. Throws DemError as importDem does.
 struct DemGrid {
     int width = 0, depth = 0;
     double cellX = 0.0, cellZ = 0.0;

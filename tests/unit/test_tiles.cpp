@@ -122,31 +122,67 @@ TEST(Tiles, AWindowKeepsItsVerticesAndItsSurfaceToTheBit) {
 }
 
 TEST(Tiles, AWindowReadAloneFromTheDemEqualsTheWholeImportCut) {
-    // Projected, north up: read alone (windowRead); geographic: imported whole, then cut. Either
-    // way the window is the whole import's, vertex for vertex, in its engine space.
-    for (const char* name : {"bigtujunga_utm11_crop.tif", "n42e001_voids_crop.tif"}) {
+    // Never the whole raster: a projected, north-up source is read only in the window; a
+    // geographic one is warped only there (a virtual warp over the whole grid, warping the
+    // blocks read). The window lies in the whole import's grid and engine space.
+    const auto filled = [](const Heightfield& hf, int c, int r) {
+        return !hf.nodataMask().empty() && hf.nodataMask()[size_t(r) * size_t(hf.width()) + size_t(c)] != 0;
+    };
+    for (const char* name : {"bigtujunga_utm11_crop.tif", "n42e001_voids_crop.tif", "rainier_crop.tif"}) {
         const std::string path = (fs::path(TERRALUX_TEST_DATA) / "dem" / name).string();
+        const bool projected = std::string(name).find("utm") != std::string::npos;
         const DemImportResult whole = importDem(path);
         const DemGrid grid = demGrid(path);
-        EXPECT_EQ(grid.streamed, std::string(name).find("utm") != std::string::npos) << name;
+        EXPECT_TRUE(grid.streamed) << name;
         EXPECT_EQ(grid.width, whole.heightfield.width());
         EXPECT_EQ(grid.depth, whole.heightfield.depth());
         EXPECT_DOUBLE_EQ(grid.cellX, whole.heightfield.cellSizeX());
-        EXPECT_FLOAT_EQ(float(grid.minHeight), whole.heightfield.minHeight());
-        EXPECT_FLOAT_EQ(float(grid.maxHeight), whole.heightfield.maxHeight());
+        EXPECT_DOUBLE_EQ(grid.cellZ, whole.heightfield.cellSizeZ());
+        // A projected grid's range is its cells'; a warped one's the source's, which bounds it.
+        if (projected) {
+            EXPECT_FLOAT_EQ(float(grid.minHeight), whole.heightfield.minHeight());
+            EXPECT_FLOAT_EQ(float(grid.maxHeight), whole.heightfield.maxHeight());
+        } else {
+            EXPECT_LE(float(grid.minHeight), whole.heightfield.minHeight()) << name;
+            EXPECT_GE(float(grid.maxHeight), whole.heightfield.maxHeight()) << name;
+            EXPECT_LT(whole.heightfield.minHeight() - grid.minHeight, 0.02 * (grid.maxHeight - grid.minHeight)) << name;
+        }
         DemImportOptions o;
         o.window = GridWindow{9, 5, 30, 21};
         const DemImportResult part = importDem(path, o);
-        EXPECT_EQ(part.source.windowRead, grid.streamed) << name;
+        EXPECT_TRUE(part.source.windowRead) << name;
         const Heightfield cut = whole.heightfield.window(9, 5, 30, 21);
         ASSERT_EQ(part.heightfield.width(), 30);
         ASSERT_EQ(part.heightfield.depth(), 21);
         EXPECT_EQ(part.heightfield.geo.easting, whole.heightfield.geo.easting);
         EXPECT_EQ(part.heightfield.geo.northing, whole.heightfield.geo.northing);
+        // A second window overlapping the first by half: every measured cell the two share is
+        // the same to the bit, so tiles meet without a seam.
+        o.window = GridWindow{18, 12, 30, 21};
+        const DemImportResult other = importDem(path, o);
+        const double relief = grid.maxHeight - grid.minHeight;
+        double worst = 0.0;
+        size_t measured = 0, shared = 0;
         for (int r = 0; r < 21; ++r)
             for (int c = 0; c < 30; ++c) {
-                ASSERT_EQ(part.heightfield.vertex(c, r), cut.vertex(c, r)) << name << " " << c << ", " << r;
+                const glm::vec3 a = part.heightfield.vertex(c, r), b = cut.vertex(c, r);
+                ASSERT_EQ(a.x, b.x);
+                ASSERT_EQ(a.z, b.z);
+                if (filled(part.heightfield, c, r)) continue;
+                ++measured;
+                // The whole import warps in its own chunks: the same cell to the warper's
+                // approximation (projected: the same sample).
+                if (projected) ASSERT_EQ(a.y, b.y) << name << " " << c << ", " << r;
+                worst = std::max(worst, double(std::fabs(a.y - b.y)));
+                const int oc = c + 9 - 18, orow = r + 5 - 12;
+                if (oc < 0 || orow < 0 || filled(other.heightfield, oc, orow)) continue;
+                ++shared;
+                ASSERT_EQ(a.y, other.heightfield.vertex(oc, orow).y) << name << " " << c << ", " << r;
             }
+        EXPECT_GT(measured, 300u) << name;
+        EXPECT_GT(shared, 100u) << name;
+        EXPECT_LT(worst, 0.005 * relief) << name;
+        std::printf("%s: window against the whole import, worst |dh| %.3f m of %.0f m relief\n", name, worst, relief);
         o.window = GridWindow{grid.width - 3, 0, 4, 4};
         EXPECT_THROW(importDem(path, o), DemError) << name;
     }
@@ -482,5 +518,23 @@ TEST(Tiles, ASuggestionMeasuredOnATileNamesTheRegionsGrid) {
     scaleSceneToTile(region.scene, w);
     EXPECT_EQ(region.scene.probeVolumes[0].gridDims[0], tx);
     EXPECT_EQ(region.scene.probeVolumes[0].gridDims[2], tz);
+    // And it delivers: the tile baked again with the region's grid in the project measures, on
+    // its own error map, the error the suggestion predicted, within 1.5x (as an untiled
+    // suggestion must, BakeSuggestions.TheSuggestedGridDeliversThePredictedError).
+    const double predictedMean = s[0]["predicted_error"]["mean"].get<double>();
+    const double predictedP95 = s[0]["predicted_error"]["p95"].get<double>();
+    BakeRequest again = r;
+    again.project.scene.probeVolumes[0].gridDims = {nx, 1, nz};
+    again.project.scene.exportSettings.outDir = (tiled / "suggested" / kTilesFolder / tileName(*r.tile)).string();
+    const BakeOutcome b = runBake(again, {}, nullptr);
+    const nlohmann::json& v = b.report["volumes"][0];
+    EXPECT_EQ(v["probes"].get<int>(), tx * tz) << "the tile's share of the region's grid, as measured";
+    const double mean = v["error_map"]["mean"].get<double>(), p95 = v["error_map"]["p95"].get<double>();
+    std::printf("tile's suggestion predicted %.2f / %.2f %%, the region's grid baked on the tile %.2f / %.2f %%\n",
+                100 * predictedMean, 100 * predictedP95, 100 * mean, 100 * p95);
+    EXPECT_LT(mean, 1.5 * predictedMean);
+    EXPECT_GT(mean, predictedMean / 1.5);
+    EXPECT_LT(p95, 1.5 * predictedP95);
+    EXPECT_GT(p95, predictedP95 / 1.5);
     fs::remove_all(tiled);
 }
