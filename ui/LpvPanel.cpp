@@ -67,7 +67,7 @@ LpvPanel::LpvPanel(ProjectDocument* doc, QWidget* parent) : QWidget(parent), doc
     v->addWidget(new QLabel("Lights (point and spot; the LPV injects them with Local lights on)"));
     table_ = new QTableWidget(0, kColumns, this);
     table_->setObjectName("lights.table");
-    table_->setHorizontalHeaderLabels({"Type", "Position (m)", "Colour", "Intensity", "Range (m)"});
+    table_->setHorizontalHeaderLabels({"Type", "Position (m)", "Colour", "Intensity (cd)", "Range (m)"});
     table_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
     table_->verticalHeader()->setVisible(false);
     table_->setSelectionBehavior(QAbstractItemView::SelectRows);
