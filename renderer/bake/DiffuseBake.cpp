@@ -481,13 +481,17 @@ glm::vec3 IrradianceCache::indirectAt(const RayHit& hit) const {
                     glm::vec3(0.0f));
 }
 
-namespace {
-std::vector<uint64_t> indexSeeds(size_t n, uint64_t seed) {
-    std::vector<uint64_t> seeds(n);
-    for (size_t i = 0; i < n; ++i) seeds[i] = seed ^ (uint64_t(i) * 0x9E3779B97F4A7C15ull);
+std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uint64_t seed) {
+    std::vector<uint64_t> seeds(positions.size());
+    for (size_t i = 0; i < positions.size(); ++i) {
+        // To the centimetre: the same place computed in another engine space (a tile's, placed in
+        // its region's) differs by float rounding, far below that.
+        uint64_t h = 0;
+        for (int c = 0; c < 3; ++c) h = splitmix64(h ^ uint64_t(std::llround(double(positions[i][c]) * 100.0)));
+        seeds[i] = seed ^ h;
+    }
     return seeds;
 }
-}  // namespace
 
 // Traces one probe's rays (ProbeRays) into slot i of `out`: `ray(d, weight)` is the radiance
 // along direction d, weight the solid angle one ray of the round stands for. Returns the rays.
@@ -534,8 +538,7 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
 ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      const ProbeRays& rays, uint64_t seed, const BakeControl& control) {
-    return bakeProbesSeeded(L, cache, bounces, positions, valid, rays,
-                            indexSeeds(positions.size(), seed), control);
+    return bakeProbesSeeded(L, cache, bounces, positions, valid, rays, positionSeeds(positions, seed), control);
 }
 
 ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, int bounces,
@@ -595,8 +598,7 @@ int referencePathLength(const glm::vec3& albedo) {
 ProbeBake referenceProbes(const BakeLighting& L, int bounces, const std::vector<glm::vec3>& positions,
                           const std::vector<uint8_t>& valid, const ProbeRays& rays, uint64_t seed,
                           const BakeControl& control) {
-    return referenceProbesSeeded(L, bounces, positions, valid, rays,
-                                 indexSeeds(positions.size(), seed), control);
+    return referenceProbesSeeded(L, bounces, positions, valid, rays, positionSeeds(positions, seed), control);
 }
 
 ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,

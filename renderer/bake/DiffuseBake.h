@@ -176,8 +176,13 @@ struct RaySpread {
 };
 RaySpread raySpreadOf(const ProbeBake& bake, const std::vector<uint8_t>& valid);
 
+// The seed of each probe of bakeProbes and referenceProbes: `seed` mixed with its position
+// rounded to the centimetre.
+std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uint64_t seed);
+
 // Bakes the probes at `positions` (skipping those with valid[i] == 0). Deterministic: each probe's
-// directions and rounds depend only on its index and `seed`.
+// directions and rounds depend only on its position and `seed` (positionSeeds), so a probe at the
+// same place in two bakes (a tile's border probe and the untiled bake's) traces the same rays.
 ProbeBake bakeProbes(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      const ProbeRays& rays, uint64_t seed, const BakeControl& control);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -125,7 +126,7 @@ TEST(Bake, SameBytesWithOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(a.standardError.data(), b.standardError.data(), a.standardError.size() * sizeof(float)), 0);
 }
 
-TEST(Bake, PerProbeSeedsGiveTheIndexSeededBytesAndFollowTheProbe) {
+TEST(Bake, PerProbeSeedsGiveThePositionSeededBytesAndFollowTheProbe) {
     std::vector<float> h(20 * 20);
     Rng rng(9);
     for (float& v : h) v = 80.0f * rng.next();
@@ -134,8 +135,12 @@ TEST(Bake, PerProbeSeedsGiveTheIndexSeededBytesAndFollowTheProbe) {
     const BakeLighting L = lightingFor(tracer, glm::vec3(1.0f), glm::vec3(0.3f));
     const std::vector<glm::vec3> probes = {{0, 120, 0}, {30, 130, -20}, {-50, 150, 40}};
     const std::vector<uint8_t> valid = {1, 1, 1};
-    std::vector<uint64_t> seeds;
-    for (uint64_t i = 0; i < probes.size(); ++i) seeds.push_back(42 ^ (i * 0x9E3779B97F4A7C15ull));
+    const std::vector<uint64_t> seeds = positionSeeds(probes, 42);
+    // Each probe its own seed, a probe's position to the centimetre: a millimetre off is the same
+    // probe, a centimetre off another.
+    EXPECT_EQ(std::set<uint64_t>(seeds.begin(), seeds.end()).size(), probes.size());
+    EXPECT_EQ(positionSeeds({probes[1] + glm::vec3(0.001f, 0.0f, -0.001f)}, 42)[0], seeds[1]);
+    EXPECT_NE(positionSeeds({probes[1] + glm::vec3(0.0f, 0.0f, 0.02f)}, 42)[0], seeds[1]);
     const ProbeBake a = bakeProbes(L, nullptr, 0, probes, valid, 64, 42, {});
     const ProbeBake b = bakeProbesSeeded(L, nullptr, 0, probes, valid, 64, seeds, {});
     EXPECT_EQ(std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * sizeof(sh::ShRgb)), 0);
