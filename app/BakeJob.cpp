@@ -18,8 +18,6 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include <sys/stat.h>
-
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
 #include "GltfExport.h"
@@ -1531,10 +1529,7 @@ nlohmann::json fileIdentity(const std::filesystem::path& path) {
     nlohmann::json id = {{"path", path.lexically_normal().generic_string()}};
     const auto size = std::filesystem::file_size(path, ec);
     if (!ec) id["bytes"] = size;
-    // Unix time in nanoseconds, as stat(2) gives it (std::filesystem's file clock has its own epoch).
-    struct stat st {};
-    if (::stat(path.c_str(), &st) == 0)
-        id["modified_ns"] = int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
+    if (const std::optional<int64_t> ns = modifiedUnixNanoseconds(path)) id["modified_ns"] = *ns;
     return id;
 }
 

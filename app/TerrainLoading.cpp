@@ -5,6 +5,8 @@
 #include <mutex>
 #include <optional>
 
+#include <sys/stat.h>
+
 #include "AlbedoImport.h"
 #include "EnvironmentImage.h"
 #include "SampleTerrain.h"
@@ -60,6 +62,12 @@ DemImportResult loadProjectTerrain(const Project& project, const std::optional<G
         return importDemFromMemory(kSampleTerrainName, sampleTerrainBytes(), sampleTerrainSize(),
                                    options);
     return importDem(dem.string(), options);
+}
+
+std::optional<int64_t> modifiedUnixNanoseconds(const std::filesystem::path& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return std::nullopt;
+    return int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
 }
 
 DemGrid loadProjectGrid(const Project& project) {

@@ -1,7 +1,10 @@
 #pragma once
 // Shared by every command and, later, the UI: the effective project and its terrain.
 
+#include <cstdint>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,10 @@ Project loadEffectiveProject(const std::string& projectFile, const std::vector<s
 DemImportResult loadProjectTerrain(const Project& project, const std::optional<GridWindow>& window = std::nullopt);
 // The grid loadProjectTerrain makes, without holding the DEM where it can (demGrid).
 DemGrid loadProjectGrid(const Project& project);
+
+// A file's modification time in nanoseconds since the Unix epoch, as stat(2) gives it
+// (std::filesystem's file clock has its own epoch); none when the file cannot be read.
+std::optional<int64_t> modifiedUnixNanoseconds(const std::filesystem::path& path);
 
 // The project's terrain albedo over `terrain` (its DEM's import), as the bake, the preview, the
 // renderer and the glTF export all use it: null in mode constant (terrain.albedo everywhere), the

@@ -231,7 +231,7 @@ nlohmann::json regionKey(const Project& project) {
     std::error_code ec;
     if (!dem.empty()) {
         key["size"] = std::filesystem::file_size(dem, ec);
-        key["mtime_ns"] = std::filesystem::last_write_time(dem, ec).time_since_epoch().count();
+        key["mtime_ns"] = modifiedUnixNanoseconds(dem).value_or(0);  // Unix time, as the report's inputs
     }
     return key;
 }

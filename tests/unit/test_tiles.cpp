@@ -339,6 +339,10 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         EXPECT_EQ(o.report["tile"]["region_summary"], "computed");
         EXPECT_EQ(bytesOf(folder / "sh_coeffs" / "probes.shprobe"), read);
         EXPECT_TRUE(fs::exists(tiled / kTilesFolder / "region.json"));
+        // Keyed by the DEM's modification time in Unix nanoseconds, as the report's inputs say it.
+        const nlohmann::json summary = nlohmann::json::parse(bytesOf(tiled / kTilesFolder / "region.json"));
+        EXPECT_EQ(summary["key"]["mtime_ns"], o.report["inputs"]["files"]["terrain.dem"]["modified_ns"]);
+        EXPECT_GT(summary["key"]["mtime_ns"].get<int64_t>(), 0);
     }
 
     // The merge lists the four tiles' grids, sorted by file name, and their meshes.
