@@ -374,13 +374,16 @@ std::vector<ParameterSpec> buildTable() {
     add(Row("sky.mode", T::Choice)).choices({"uniform", "hdr", "physical"}).label("Sky")
         .about("uniform: one radiance from every direction; hdr: an equirectangular image; physical: a clear sky from the sun's position and the turbidity (Preetham 1999)")
         .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::mode);
-    add(Row("sky.color", T::Color)).range(0.0, kUnbounded).label("Sky colour")
-        .about("Radiance of the uniform sky, linear RGB; the default with the default sun is a clear day's direct-to-diffuse ratio")
-        .redoes(kUpload | kRebake)
-        .onlyWhen([](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Uniform; })
-        .field(&SceneDescription::sky, &SkySettings::color);
+    const auto uniformSky = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Uniform; };
+    add(Row("sky.color", T::Color)).range(0.0, 1.0).label("Sky colour")
+        .about("Linear RGB tint of the uniform sky's luminance")
+        .redoes(kUpload | kRebake).onlyWhen(uniformSky).field(&SceneDescription::sky, &SkySettings::color);
+    add(Row("sky.luminance", T::Number)).range(0.0, 1.0e7).unit("cd/m²").decimals(0).label("Sky luminance")
+        .about("Luminance of the uniform sky, the same from every direction, per channel times its colour: a clear day's "
+               "sky is a few thousand cd/m²; with the default sun and colour, a clear day's direct-to-diffuse ratio")
+        .redoes(kUpload | kRebake).onlyWhen(uniformSky).field(&SceneDescription::sky, &SkySettings::luminance);
     add(Row("sky.intensity", T::Number)).range(0.0, 1.0e5).label("Sky intensity")
-        .about("Multiplies the sky's radiance (the uniform colour or the HDR image); in mode physical, the exposure of the whole daylight, sun included")
+        .about("Multiplies the sky's light (the uniform sky's luminance or the HDR image); in mode physical, the exposure of the whole daylight, sun included")
         .redoes(kUpload | kRebake).field(&SceneDescription::sky, &SkySettings::intensity);
     add(Row("sky.turbidity", T::Number)).range(kMinTurbidity, kMaxTurbidity).label("Turbidity")
         .about("Haze of the physical sky: 2 very clear, 3 clear, 6 and above hazy; a hazier sky is brighter and whiter, its sun dimmer and redder")

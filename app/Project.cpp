@@ -345,6 +345,36 @@ const std::vector<ProjectMigration>& projectMigrations() {
                                  json(cd).dump() + " cd");
              }
          }},
+        {5,
+         "the uniform sky's sky.color (radiance in scene units) became a colour in [0, 1] and sky.luminance in cd/m²: "
+         "the colour is divided by its largest component and the luminance is that component divided by "
+         "kSceneUnitsPerLux ((0.09, 0.11, 0.15) became (0.6, 0.733, 1) at 5 000 cd/m²), the same sky; so are the scenarios' skies",
+         [](json& doc, std::vector<std::string>& notes) {
+             auto toLuminance = [&](json& section, const std::string& where) {
+                 if (!section.is_object() || !section.contains("sky") || !section["sky"].is_object()) return;
+                 json& sky = section["sky"];
+                 // An absent colour was version 5's default, which is version 6's default sky; anything
+                 // but three non-negative numbers is left for the check to name.
+                 if (!sky.contains("color") || !sky["color"].is_array() || sky["color"].size() != 3) return;
+                 double peak = 0.0;
+                 for (const json& c : sky["color"]) {
+                     if (!c.is_number() || c.get<double>() < 0.0) return;
+                     peak = std::max(peak, c.get<double>());
+                 }
+                 const json before = sky["color"];
+                 // Whole millicandelas a square metre, as the sun's and the lights' steps round.
+                 const double cd = std::round(peak / kSceneUnitsPerLux * 1000.0) / 1000.0;
+                 if (peak > 0.0)
+                     for (json& c : sky["color"]) c = shortestDecimal(float(c.get<double>() / peak));
+                 sky["luminance"] = cd;
+                 notes.push_back(where + "sky.color " + before.dump() + " is " + sky["color"].dump() + " at " +
+                                 json(cd).dump() + " cd/m²");
+             };
+             toLuminance(doc, "");
+             if (doc.contains("scenarios") && doc["scenarios"].is_array())
+                 for (size_t i = 0; i < doc["scenarios"].size(); ++i)
+                     toLuminance(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
+         }},
     };
     return steps;
 }

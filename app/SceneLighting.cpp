@@ -121,12 +121,12 @@ SunAngles sunAnglesOf(const SceneDescription& scene, const Heightfield& hf) {
 
 Sky skyOf(const Project& p, const Heightfield& hf) {
     const SkySettings& s = p.scene.sky;
-    if (s.mode == SkyMode::Uniform) return Sky::uniform(s.color * float(s.intensity));
-    // sky.color is not read: the model gives the colour; intensity exposes sky and sun alike.
+    if (s.mode == SkyMode::Uniform) return Sky::uniform(s.uniformRadiance());
+    // sky.color and sky.luminance are not read: the model gives them; intensity exposes sky and sun alike.
     if (s.mode == SkyMode::Physical) return physicalSkyOf(p.scene, hf).scaled(glm::vec3(float(s.intensity)));
     const std::string path = p.hdrPath().string();
     SkyKey key{path, {}, 0, float(s.rotationDeg)};
-    // The image's colour is the sky (sky.color is the uniform sky's); intensity scales it.
+    // The image's colour and scale are the sky (sky.color and sky.luminance are the uniform sky's); intensity scales it.
     const glm::vec3 scale(float(s.intensity));
     std::error_code ec;
     key.time = std::filesystem::last_write_time(path, ec);

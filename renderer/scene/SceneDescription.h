@@ -92,10 +92,16 @@ enum class SkyMode { Uniform, Hdr, Physical };
 
 struct SkySettings {
     SkyMode mode = SkyMode::Uniform;
-    // Uniform sky radiance, each >= 0: with the sun's 3, a clear day's direct-to-diffuse ratio
-    // (docs/lighting.md, "Sun and sky").
-    glm::vec3 color{0.09f, 0.11f, 0.15f};
-    double intensity = 1.0;              // >= 0
+    // The uniform sky: colour (linear RGB, each in [0, 1]) × luminance (cd/m²) per channel, drawn
+    // at the sun's scale (uniformRadiance()). With the default sun's 100 klx, a clear day's
+    // direct-to-diffuse ratio (docs/lighting.md, "Sun and sky").
+    glm::vec3 color{0.6f, 0.73333333f, 1.0f};
+    double luminance = 5000.0;           // cd/m², >= 0
+    double intensity = 1.0;              // >= 0, every mode
+
+    // The uniform sky's radiance in scene-linear units: colour × luminance × kSceneUnitsPerLux ×
+    // intensity (docs/lighting.md, "Units").
+    glm::vec3 uniformRadiance() const { return color * float(luminance * kSceneUnitsPerLux * intensity); }
     std::string hdr;                     // equirectangular image, for mode hdr
     double rotationDeg = 0.0;            // turns the HDR about +Y
     double turbidity = 3.0;              // mode physical: haze, [1.7, 10]

@@ -41,7 +41,7 @@ void benchDem(const char* label, const std::filesystem::path& file) {
     const HeightfieldTracer tracer(hf);
     BakeLighting L;
     L.tracer = &tracer;
-    L.sky = Sky::uniform(scene.sky.color * float(scene.sky.intensity));
+    L.sky = Sky::uniform(scene.sky.uniformRadiance());
     L.sun.direction = sunDirection(scene.sun.azimuthDeg, scene.sun.elevationDeg);
     L.sun.illuminance = scene.sun.color * sceneUnitsOfLux(scene.sun.illuminance);
     L.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);

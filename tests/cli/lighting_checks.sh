@@ -161,7 +161,7 @@ sets=(--set shadows.cascades=3 --set fog.enabled=true --set fog.density=0.0001 -
       --set bake.error_map_resolution=0)
 "$terralux" --print-project "${sets[@]}" >"$work/sample.json" || fail "--print-project exited $?"
 "$terralux" --bake --quiet --quality draft "${sets[@]}" --out "$work/sample" >/dev/null || fail "bake exited $?"
-# The default uniform sky (0.09, 0.11, 0.15) × 1 is its own mean.
+# The default uniform sky, (0.6, 0.733, 1) × 5000 cd/m² = (0.09, 0.11, 0.15) scene units, is its own mean.
 check "$work/sample.json" "$work/sample/scene.gltf" 3 0.09,0.11,0.15 || fail "sample: TERRALUX_lighting disagrees with --print-project"
 validate "$work/sample/scene.gltf"
 
@@ -199,7 +199,7 @@ cat >"$work/scenarios.terralux.json" <<'EOF'
 {
   "probe_volumes": [{"name": "valley", "grid_dims": [5, 4]}, {"name": "peaks", "grid_dims": [3, 3], "height_offset": 50}],
   "scenarios": [{"name": "dusk", "sun": {"azimuth_deg": 250, "elevation_deg": 6, "illuminance": 40000}, "sky": {"intensity": 0.4}},
-                {"name": "overcast", "sun": {"illuminance": 0}, "sky": {"intensity": 2.5, "color": [0.2, 0.2, 0.21]}}],
+                {"name": "overcast", "sun": {"illuminance": 0}, "sky": {"intensity": 2.5, "color": [0.95, 0.95, 1], "luminance": 8000}}],
   "bake": {"error_map_resolution": 0}
 }
 EOF

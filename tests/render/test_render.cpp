@@ -428,6 +428,7 @@ TEST_F(RenderTest, SkyColourAndGridChangeProbeIrradiance) {
     ASSERT_EQ(ra.loadProbes(true), 1u);
     Project b = sampleProject("skyB", 8, 8);
     b.scene.sky.color = glm::vec3(1.0f, 0.5f, 0.2f);
+    b.scene.sky.luminance = 1.0 / kSceneUnitsPerLux;
     ProjectRenderer rb(*ctx_, b);
     ASSERT_EQ(rb.loadProbes(true), 1u);
     ProjectRenderer rc(*ctx_, sampleProject("gridC", 2, 2));
@@ -1054,7 +1055,7 @@ TEST_F(RenderTest, BelowTheHorizonTheSkyPassDrawsTheSkirtsGround) {
     p.scene.terrain.skirt = false;
     r.setProject(p);
     const RenderedImage off = draw(r, kViewBeauty, false, true);
-    const glm::vec3 sky = p.scene.sky.color * float(p.scene.sky.intensity);
+    const glm::vec3 sky = p.scene.sky.uniformRadiance();
     const glm::vec3 sun = p.scene.sun.color * sceneUnitsOfLux(p.scene.sun.illuminance);
     const glm::vec3 ground = p.scene.terrain.albedo / std::numbers::pi_v<float> *
                              (std::numbers::pi_v<float> * sky + sun * float(std::sin(30.0 * std::numbers::pi / 180.0)));
@@ -2587,7 +2588,8 @@ TEST_F(RenderTest, BetweenTwoScenariosTheBackgroundIsBothSkiesMixed) {
     grey.name = "grey";
     grey.sun = p.scene.sun;
     grey.sky.mode = SkyMode::Uniform;
-    grey.sky.color = glm::vec3(0.02f, 0.02f, 0.025f);
+    grey.sky.color = glm::vec3(0.8f, 0.8f, 1.0f);
+    grey.sky.luminance = 0.025 / kSceneUnitsPerLux;
     p.scene.scenarios = {grey};
     ProjectRenderer r(*ctx_, p);
     const uint32_t w = 320, h = 180;
@@ -2673,7 +2675,7 @@ TEST_F(RenderTest, AnHdrSkyIsDrawnBehindTheTerrainAtItsOwnResolution) {
     p.scene.sky.mode = SkyMode::Uniform;
     r.setProject(p);
     const RenderedImage uniform = draw(r, kViewBeauty, false, true, w, h);
-    const glm::vec3 sky = glm::vec3(p.scene.sky.color) * float(p.scene.sky.intensity);
+    const glm::vec3 sky = p.scene.sky.uniformRadiance();
     EXPECT_NEAR(uniform.rgba[(size_t(2) * w + w / 2) * 4], sky.x, 1e-3 * sky.x + 1e-5);
 }
 

@@ -231,7 +231,7 @@ private slots:
         auto* button = dock->findChild<QPushButton*>("param.fog.color");
         QVERIFY(button);
         QCOMPARE(button->text(), QString("auto: the sky's mean radiance"));
-        const glm::vec3 sky = doc->project().scene.sky.color * float(doc->project().scene.sky.intensity);
+        const glm::vec3 sky = doc->project().scene.sky.uniformRadiance();
         QColor started;
         QTimer::singleShot(200, [&] {
             auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
@@ -1298,6 +1298,7 @@ private slots:
             rowsMatchTheTable();
             QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sun.illuminance"))->isVisibleTo(dock));
             QVERIFY(rowOf(w_->findChild<QWidget*>("param.sky.turbidity"))->isVisibleTo(dock));
+            QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.luminance"))->isVisibleTo(dock));
             follow->setChecked(false);
             QVERIFY(!w_->document()->project().scene.sun.followSky);
             rowsMatchTheTable();
@@ -1307,6 +1308,14 @@ private slots:
             QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.turbidity"))->isVisibleTo(dock));
             QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.hdr"))->isVisibleTo(dock));
             QVERIFY(rowOf(w_->findChild<QWidget*>("param.sky.color"))->isVisibleTo(dock));
+            // The uniform sky's luminance is entered in cd/m² and lights the preview as such.
+            auto* luminance = w_->findChild<QDoubleSpinBox*>("param.sky.luminance");
+            QVERIFY(luminance && rowOf(luminance)->isVisibleTo(dock));
+            QVERIFY(luminance->suffix().contains("cd/m"));
+            luminance->setValue(8000.0);
+            QCOMPARE(w_->document()->project().scene.sky.luminance, 8000.0);
+            w_->document()->undoStack()->undo();
+            QCOMPARE(w_->document()->project().scene.sky.luminance, 5000.0);
         }
         // Max_resolution 'source' sends 0, never null (maxResolutionSourceSendsZero)
         {

@@ -133,6 +133,7 @@ Row flat(const std::string& name, float height) {
             [=] {
                 Project p = quick(utmDem(name, 17, 17, 30.0, [=](int, int) { return height; }));
                 p.scene.sky.color = glm::vec3(1.0f);
+                p.scene.sky.luminance = 1.0 / kSceneUnitsPerLux;
                 p.scene.sun.illuminance = 0.0;
                 p.scene.sun.followSky = false;
                 p.scene.terrain.albedoMode = AlbedoMode::Constant;

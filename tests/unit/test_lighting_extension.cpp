@@ -184,7 +184,8 @@ TEST(LightingExtension, FogResolvesItsAutoValues) {
     EXPECT_TRUE(fog["base_height"].is_null());
     EXPECT_TRUE(fog["color"].is_null());
     EXPECT_EQ(float(fog["resolved_base_height"].get<double>()), hf.minHeight());
-    // The mean radiance of the default uniform sky (0.09, 0.11, 0.15) × 2.
+    // The mean radiance of the default uniform sky, (0.6, 0.733, 1) × 5000 cd/m² = (0.09, 0.11, 0.15)
+    // scene units, × 2.
     const glm::vec3 mean = vec3Of(fog["resolved_color"]);
     EXPECT_NEAR(mean.r, 0.18f, 1e-5f);
     EXPECT_NEAR(mean.g, 0.22f, 1e-5f);

@@ -44,12 +44,18 @@ TEST(Project, DefaultsAreLightingMdDefaults) {
     EXPECT_EQ(s.probeVolumes[0].gridDims[2], 8);
     EXPECT_DOUBLE_EQ(s.probeVolumes[0].heightOffset, 5.0);
     EXPECT_FALSE(s.probeVolumes[0].spacing.has_value());  // auto-span
-    EXPECT_EQ(s.sky.color, glm::vec3(0.09f, 0.11f, 0.15f));
+    EXPECT_EQ(s.sky.color, glm::vec3(0.6f, 0.73333333f, 1.0f));
+    EXPECT_DOUBLE_EQ(s.sky.luminance, 5000.0);
     EXPECT_DOUBLE_EQ(s.sky.intensity, 1.0);
+    // The sky the defaults were tuned with, before the sky had a unit.
+    const glm::vec3 radiance = s.sky.uniformRadiance();
+    EXPECT_NEAR(radiance.x, 0.09f, 1e-6f);
+    EXPECT_NEAR(radiance.y, 0.11f, 1e-6f);
+    EXPECT_NEAR(radiance.z, 0.15f, 1e-6f);
     // A clear day: direct sun on level ground at the default elevation against the uniform sky's
     // irradiance π·L on it lands within the 4-10 : 1 of docs/lighting.md.
     const double direct = s.sun.illuminance * kSceneUnitsPerLux * std::sin(s.sun.elevationDeg * M_PI / 180.0);
-    const double diffuse = M_PI * s.sky.intensity * (0.2126 * s.sky.color.x + 0.7152 * s.sky.color.y + 0.0722 * s.sky.color.z);
+    const double diffuse = M_PI * (0.2126 * radiance.x + 0.7152 * radiance.y + 0.0722 * radiance.z);
     EXPECT_GE(direct / diffuse, 4.0);
     EXPECT_LE(direct / diffuse, 10.0);
     EXPECT_TRUE(s.shadows.enabled);
@@ -104,8 +110,10 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"probe_volumes[0].adaptive.max_bytes=0", "p.json: probe_volumes[0].adaptive.max_bytes = 0: must be in [1, 9007199254740992] or null"},
         Rule{"probe_volumes[0].adaptive.max_move_share=0.6", "p.json: probe_volumes[0].adaptive.max_move_share = 0.6: must be in [0, 0.5]"},
         Rule{"probe_volumes[0].adaptive=3", "p.json: probe_volumes[0].adaptive = 3: must be an object"},
-        Rule{"sky.color=[0.5,-1,1]", "p.json: sky.color[1] = -1: three components, each in [0, inf]"},
+        Rule{"sky.color=[0.5,-1,1]", "p.json: sky.color[1] = -1: three components, each in [0, 1]"},
         Rule{"sky.color=[1,1]", "p.json: sky.color = [1,1]: must be an array of 3 numbers"},
+        Rule{"sky.color=[0.5,1.5,1]", "p.json: sky.color[1] = 1.5: three components, each in [0, 1]"},
+        Rule{"sky.luminance=-1", "p.json: sky.luminance = -1: must be in [0, 10000000]"},
         Rule{"sky.intensity=-0.5", "p.json: sky.intensity = -0.5: must be in [0, 100000]"},
         Rule{"sky.mode=hdr", "p.json: sky.hdr = \"\": must name an image when sky.mode is \"hdr\""},
         Rule{"sky.mode=sunny", "p.json: sky.mode = \"sunny\": must be one of uniform | hdr | physical"},
@@ -134,7 +142,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=6", "p.json: version = 6: is newer than this Terralux reads (5); open it with a newer Terralux"},
+        Rule{"version=7", "p.json: version = 7: is newer than this Terralux reads (6); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -358,7 +366,8 @@ TEST(SceneLighting, PhysicalSkyDrivesSkyAndSun) {
     Project p;
     p.scene.sky.mode = SkyMode::Physical;
     p.scene.sky.turbidity = 3.0;
-    p.scene.sky.color = glm::vec3(5.0f, 0.0f, 0.0f);  // not read in mode physical
+    p.scene.sky.color = glm::vec3(1.0f, 0.0f, 0.0f);  // not read in mode physical
+    p.scene.sky.luminance = 1.0e5;
     const size_t before = physicalSkyBuilds();
     const BakeLighting a = lightingOf(p, flatGround());
     EXPECT_EQ(physicalSkyBuilds(), before + 1);
@@ -410,8 +419,9 @@ TEST(SceneLighting, HdrSkyIsReadOnceUntilWhatShapesItChanges) {
     EXPECT_EQ(hdrSkyReads(), before + 1) << "a sun or camera edit read the HDR again";
     EXPECT_EQ(first.sh().c[0], again.sh().c[0]);
     // Intensity scales the cached environment exactly as filtering the scaled image would; the
-    // uniform sky's colour does not touch an HDR sky.
+    // uniform sky's colour and luminance do not touch an HDR sky.
     p.scene.sky.color = glm::vec3(1.0f, 0.5f, 0.25f);
+    p.scene.sky.luminance = 123.0;
     p.scene.sky.intensity = 4.0;
     const Sky tinted = skyOf(p, flatGround());
     EXPECT_EQ(hdrSkyReads(), before + 1) << "an intensity edit read the HDR again";
@@ -616,4 +626,43 @@ TEST(ProjectVersions, VersionFourLightIntensityBecomesCandela) {
     json current = v4;
     current["version"] = kProjectVersion;
     EXPECT_EQ(sceneFromJson(current, "new.json", nullptr).lights[0].intensity, 1000.0);
+}
+
+// Version 5 wrote the uniform sky as a radiance in scene units (its default (0.09, 0.11, 0.15));
+// version 6 writes a colour in [0, 1] and a luminance in cd/m², and an older file, its scenarios'
+// skies included, keeps its sky.
+TEST(ProjectVersions, VersionFiveSkyColourBecomesColourAndLuminance) {
+    const json v5 = {{"version", 5},
+                     {"sky", {{"color", {0.3, 0.6, 1.5}}, {"intensity", 2.0}}},
+                     {"scenarios", {{{"name", "night"}, {"sky", {{"color", {0.0, 0.0, 0.0}}}}},
+                                    {{"name", "grey"}, {"sky", {{"intensity", 0.5}}}}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v5, "old.json", &notes);
+    EXPECT_EQ(s.sky.color, glm::vec3(0.2f, 0.4f, 1.0f));
+    EXPECT_DOUBLE_EQ(s.sky.luminance, 50000.0);
+    ASSERT_EQ(s.scenarios.size(), 2u);
+    EXPECT_EQ(s.scenarios[0].sky.luminance, 0.0);
+    EXPECT_EQ(s.scenarios[0].sky.uniformRadiance(), glm::vec3(0.0f));
+    // An unset colour was version 5's default, which is the current default sky.
+    EXPECT_EQ(s.scenarios[1].sky.color, SkySettings{}.color);
+    EXPECT_EQ(s.scenarios[1].sky.luminance, SkySettings{}.luminance);
+    ASSERT_EQ(notes.size(), 2u);
+    EXPECT_EQ(notes[0], "old.json: version 5 migrated to 6: sky.color [0.3,0.6,1.5] is [0.2,0.4,1.0] at 50000.0 cd/m²");
+    EXPECT_EQ(notes[1], "old.json: version 5 migrated to 6: scenarios[0].sky.color [0.0,0.0,0.0] is [0.0,0.0,0.0] at 0.0 cd/m²");
+    // The same sky: the radiance the bake lights with is what version 5 wrote, times its intensity.
+    const glm::vec3 radiance = s.sky.uniformRadiance();
+    EXPECT_NEAR(radiance.x, 0.6f, 1e-6f);
+    EXPECT_NEAR(radiance.y, 1.2f, 1e-6f);
+    EXPECT_NEAR(radiance.z, 3.0f, 1e-6f);
+    const SceneDescription defaults = sceneFromJson(json{{"version", 5}}, "old.json", nullptr);
+    EXPECT_EQ(defaults.sky.uniformRadiance(), SkySettings{}.uniformRadiance());
+    // A current file means a colour: a component above 1 is refused, naming the rule.
+    json current = v5;
+    current["version"] = kProjectVersion;
+    try {
+        sceneFromJson(current, "new.json", nullptr);
+        ADD_FAILURE() << "a colour above 1 was accepted";
+    } catch (const ProjectError& e) {
+        EXPECT_EQ(std::string(e.what()), "new.json: sky.color[2] = 1.5: three components, each in [0, 1]");
+    }
 }
