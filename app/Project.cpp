@@ -269,6 +269,20 @@ json sceneToJson(const SceneDescription& s) {
 
 json defaultProjectJson() { return sceneToJson(SceneDescription{}); }
 
+namespace {
+
+// A migration step's edit of a sun or sky applied to the project's own lighting and to each
+// scenario's: fn(section, where), where "" or "scenarios[i]." prefixes the step's notes.
+template <typename Fn>
+void forEachLighting(json& doc, Fn&& fn) {
+    fn(doc, std::string());
+    if (doc.contains("scenarios") && doc["scenarios"].is_array())
+        for (size_t i = 0; i < doc["scenarios"].size(); ++i)
+            fn(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
+}
+
+}  // namespace
+
 const std::vector<ProjectMigration>& projectMigrations() {
     static const std::vector<ProjectMigration> steps = {
         {1,
@@ -324,10 +338,7 @@ const std::vector<ProjectMigration>& projectMigrations() {
                  sun["illuminance"] = lux;
                  notes.push_back(where + "sun.illuminance " + json(before).dump() + " is " + json(lux).dump() + " lx");
              };
-             toLux(doc, "");
-             if (doc.contains("scenarios") && doc["scenarios"].is_array())
-                 for (size_t i = 0; i < doc["scenarios"].size(); ++i)
-                     toLux(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
+             forEachLighting(doc, toLux);
          }},
         {4,
          "lights[].intensity became candela: a version-4 value in scene units at 1 m is divided by "
@@ -370,10 +381,7 @@ const std::vector<ProjectMigration>& projectMigrations() {
                  notes.push_back(where + "sky.color " + before.dump() + " is " + sky["color"].dump() + " at " +
                                  json(cd).dump() + " cd/m²");
              };
-             toLuminance(doc, "");
-             if (doc.contains("scenarios") && doc["scenarios"].is_array())
-                 for (size_t i = 0; i < doc["scenarios"].size(); ++i)
-                     toLuminance(doc["scenarios"][i], "scenarios[" + std::to_string(i) + "].");
+             forEachLighting(doc, toLuminance);
          }},
     };
     return steps;
