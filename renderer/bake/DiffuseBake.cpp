@@ -184,14 +184,42 @@ bool hitsWater(const BakeLighting& L, const glm::vec3& o, const glm::vec3& d, fl
     return L.tracer->options().skirt || L.tracer->heightfield().contains(at.x, at.z);
 }
 
-// What a terrain hit reflects toward the ray: albedo/π × (the cache's indirect light + the sun at
-// the hit, one shadow ray across the disc); the skirt is unshadowed by definition.
+// A direction about `n` with density cos θ / π, from two fresh random numbers.
+glm::vec3 randomCosineDirection(const glm::vec3& n, Rng& rng) {
+    const float u1 = rng.next(), u2 = rng.next();
+    const float rr = std::sqrt(u1), phi = 2.0f * kPi * u2;
+    glm::vec3 t, bt;
+    basisAround(n, t, bt);
+    return glm::normalize(rr * std::cos(phi) * t + rr * std::sin(phi) * bt + std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+}
+
+// The sun at a hit: one shadow ray across the disc; the skirt is unshadowed by definition.
+glm::vec3 sunAtHit(const BakeLighting& L, const RayHit& hit, Rng& rng) {
+    return hit.onTerrain ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
+                         : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
+}
+
+// What a terrain hit reflects toward the ray: albedo/π × (its indirect light + the sun at the
+// hit). With one bounce the indirect light is the cache's, read at the hit. With more (a cache
+// with a gather), it is gathered by one cosine-weighted ray from the hit itself, with the hit's
+// own normal (a final gather, docs/lighting.md "Irradiance cache"): the sky where it escapes,
+// and where it meets the terrain again what that point reflects of the sun and of the cache's
+// light one gather earlier. The cache's points stand on a surface smoothed over their spacing, so
+// its irradiance read at the hit would light every slope as that smoothed surface; one bounce
+// later its error is damped by the albedo. The skirt's light is exact.
 glm::vec3 terrainRadiance(const BakeLighting& L, const IrradianceCache* cache, int bounces, const RayHit& hit,
                           Rng& rng) {
     if (!(bounces > 0 && cache)) return glm::vec3(0.0f);
-    const glm::vec3 sun = hit.onTerrain ? sunIrradiance(L, hit.position, hit.normal, 1, rng)
-                                        : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
-    return L.albedoAt(hit) / kPi * (cache->indirectAt(hit) + sun);
+    const glm::vec3 albedo = L.albedoAt(hit) / kPi;
+    if (!hit.onTerrain || !cache->gathersAtHits()) return albedo * (cache->indirectAt(hit) + sunAtHit(L, hit, rng));
+    const glm::vec3 d = randomCosineDirection(hit.normal, rng);
+    RayHit next;
+    glm::vec3 gathered;  // radiance along d: the irradiance is π × it under cosine sampling
+    if (!L.tracer->intersect(liftOff(hit.position, hit.normal), d, INFINITY, next))
+        gathered = L.sky.radiance(d, 0.0f);
+    else
+        gathered = L.albedoAt(next) / kPi * (cache->earlierIndirectAt(next) + sunAtHit(L, next, rng));
+    return albedo * (kPi * gathered + sunAtHit(L, hit, rng));
 }
 
 // The irradiance on the level water surface at `at`: the open sky's (as on the skirt: what the
@@ -352,9 +380,10 @@ std::vector<IrradianceCache> IrradianceCache::byGathers(const BakeLighting& L, i
     std::vector<std::vector<glm::vec3>> levels;
     IrradianceCache last(L, resolution, rays, sunSamples, gathers, control, &levels);
     std::vector<IrradianceCache> out;
-    for (auto& level : levels) {
+    for (size_t g = 0; g < levels.size(); ++g) {
         out.push_back(last);
-        out.back().irradiance_ = std::move(level);
+        out.back().irradiance_ = levels[g];
+        out.back().earlier_ = g > 0 ? levels[g - 1] : std::vector<glm::vec3>();
     }
     return out;
 }
@@ -428,6 +457,7 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
     std::vector<glm::vec3> next(points);
     for (int b = 0; b < bounces; ++b) {
         if (levels) levels->push_back(irradiance_);
+        if (b + 1 == bounces) earlier_ = irradiance_;
         BakeControl gather = control;
         gather.progress = control.progress
                               ? [&](double f) { control.progress(0.8 + 0.2 * (b + f) / bounces); }
@@ -477,6 +507,13 @@ glm::vec3 IrradianceCache::at(const RayHit& hit) const {
 glm::vec3 IrradianceCache::indirectAt(const RayHit& hit) const {
     if (!hit.onTerrain) return skirt_ - skirtSun_;
     return glm::max(interpolate(irradiance_, hit.position.x, hit.position.z) -
+                        interpolate(sunDirect_, hit.position.x, hit.position.z),
+                    glm::vec3(0.0f));
+}
+
+glm::vec3 IrradianceCache::earlierIndirectAt(const RayHit& hit) const {
+    if (!hit.onTerrain) return skirt_ - skirtSun_;
+    return glm::max(interpolate(earlier_, hit.position.x, hit.position.z) -
                         interpolate(sunDirect_, hit.position.x, hit.position.z),
                     glm::vec3(0.0f));
 }
@@ -626,13 +663,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                 }
                 const glm::vec3 n = hit.normal;
                 radiance += throughput * sunIrradiance(L, hit.position, n, 1, rng);
-                // Cosine-weighted direction from two fresh random numbers.
-                const float u1 = rng.next(), u2 = rng.next();
-                const float rr = std::sqrt(u1), phi = 2.0f * kPi * u2;
-                glm::vec3 t, bt;
-                basisAround(n, t, bt);
-                const glm::vec3 dir = glm::normalize(rr * std::cos(phi) * t + rr * std::sin(phi) * bt +
-                                                     std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+                const glm::vec3 dir = randomCosineDirection(n, rng);
                 const glm::vec3 o = liftOff(hit.position, n);
                 ++count;
                 RayHit next;

@@ -133,6 +133,12 @@ public:
     // The same without the direct sun at the hit: callers that trace the sun themselves add it
     // exactly (sun shadows are the sharpest part of terrain irradiance, too sharp for the cache).
     glm::vec3 indirectAt(const RayHit& hit) const;
+    // Whether a probe ray's terrain hit gathers its indirect light with a ray of its own (a cache
+    // with at least one gather, i.e. two bounces or more) rather than read it here.
+    bool gathersAtHits() const { return !earlier_.empty(); }
+    // indirectAt one gather earlier, with gathersAtHits: what that ray reads where it meets the
+    // terrain again.
+    glm::vec3 earlierIndirectAt(const RayHit& hit) const;
     int pointsX() const { return nx_; }
     int pointsZ() const { return nz_; }
     // Hemisphere rays traced (shadow rays toward the sun not counted, as for probes).
@@ -150,6 +156,7 @@ private:
     float x0_ = 0, z0_ = 0, dx_ = 1, dz_ = 1;
     glm::vec3 skirt_{0.0f};
     std::vector<glm::vec3> irradiance_;
+    std::vector<glm::vec3> earlier_;  // the irradiance before the last gather; empty with none
     std::vector<glm::vec3> sunDirect_;
     glm::vec3 skirtSun_{0.0f};
 };

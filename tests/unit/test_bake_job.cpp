@@ -146,7 +146,9 @@ TEST(StandardError, MatchesTheMeasuredSamplingErrorOfEachPreset) {
 // times ... as many, within the cap. On a mountain crop the open probes stop at the lower count
 // and the others trace on; a fixed count traces every probe alike.
 TEST(PresetRounds, EachProbeTracesWhatItsFirstRaysAskWithinTheCap) {
-    const fs::path crop = fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif";
+    // Big Tujunga: open ridges and deep canyons. (On the Rainier crop every probe sees bright snow,
+    // whose gathered bounce light asks every one for more than the lower count.)
+    const fs::path crop = fs::path(TERRALUX_TEST_DATA) / "dem" / "bigtujunga_utm11_crop.tif";
     const Project project = loadEffectiveProject("", {}, crop.string(), nullptr);
     const DemImportResult dem = importDem(crop.string());
     const HeightfieldTracer tracer(dem.heightfield);
@@ -202,23 +204,38 @@ TEST(PresetRounds, EachProbeTracesWhatItsFirstRaysAskWithinTheCap) {
 }
 
 // The preset's error against the reference path tracer, as the bake reports it with
-// --compare-reference, on two committed crops (mountains, steppe) under the project's default lighting:
-// draft within 2 %, standard within 0.5 %, high within 0.25 % (mean over the probes).
+// --compare-reference, on two committed crops (mountains, steppe) under the project's default
+// lighting: draft within 2 %, standard within 0.5 %, high within 0.25 % (mean over the probes).
+// Under the physical sky, whose skylight is a larger share than the default's, the irradiance
+// cache read at a hit put standard at 0.72 % and high at 0.35 % on the Big Tujunga crop; the hit's
+// own gather (two bounces and more) brings them to 0.52 % and 0.22 %. Draft (one bounce) is held
+// only under the default lighting: under the physical sky its missing bounces leave 2.2-2.5 %.
 TEST(PresetRounds, EachPresetReachesItsErrorAgainstTheReference) {
-    const std::pair<QualityPreset, double> presets[] = {
-        {QualityPreset::Draft, 0.02}, {QualityPreset::Standard, 0.005}, {QualityPreset::High, 0.0025}};
+    struct Case {
+        QualityPreset preset;
+        SkyMode sky;
+        double target;
+    };
+    const Case cases[] = {{QualityPreset::Draft, SkyMode::Uniform, 0.02},
+                          {QualityPreset::Standard, SkyMode::Uniform, 0.005},
+                          {QualityPreset::High, SkyMode::Uniform, 0.0025},
+                          {QualityPreset::Standard, SkyMode::Physical, 0.006},
+                          {QualityPreset::High, SkyMode::Physical, 0.0025}};
     for (const char* name : {"bigtujunga_utm11_crop.tif", "orkhon_crop.asc"}) {
-        for (const auto& [preset, target] : presets) {
-            const fs::path dir = tempDir(std::string("preset_") + qualityName(preset));
+        for (const Case& c : cases) {
+            const fs::path dir = tempDir(std::string("preset_") + qualityName(c.preset));
             Project p = cropProject(dir, 8);
             p.scene.terrain.dem = (fs::path(TERRALUX_TEST_DATA) / "dem" / name).string();
-            p.scene.bake.quality = preset;
+            p.scene.bake.quality = c.preset;
+            p.scene.sky.mode = c.sky;
+            const std::string what = std::string(name) + " " + qualityName(c.preset) +
+                                     (c.sky == SkyMode::Physical ? ", physical sky" : "");
             const nlohmann::json r = runBake(BakeRequest{p, 0, true}, {}, nullptr).report;
             const nlohmann::json& v = r["volumes"][0];
             const double mean = v["reference_error"]["mean"].get<double>();
-            std::printf("%s %s: error vs reference %.3f %%, rays per probe %s\n", name, qualityName(preset),
-                        100 * mean, v["rays_per_probe"].dump().c_str());
-            EXPECT_LE(mean, target) << name << " " << qualityName(preset);
+            std::printf("%s: error vs reference %.3f %%, rays per probe %s\n", what.c_str(), 100 * mean,
+                        v["rays_per_probe"].dump().c_str());
+            EXPECT_LE(mean, c.target) << what;
             // The reference's own noise is a small part of what is measured.
             EXPECT_LT(v["reference_error"]["reference_standard_error"]["mean"].get<double>(), 0.5 * mean);
             fs::remove_all(dir);
