@@ -166,6 +166,7 @@ glm::vec3 Sky::sample(const Level& level, float u, float v) const {
 
 glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
     if (!levels_) return uniform_;
+    solidAngle = std::min(solidAngle, kMaxFilterSolidAngle);
     const float u = glsl::equirectU(dir.x, dir.z, rotation_), v = glsl::equirectV(dir.y);
     const Level& base = levels_->front();
     // Level whose texel (at the equator) covers about `solidAngle`; blend the two nearest.

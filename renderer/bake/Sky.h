@@ -51,9 +51,15 @@ public:
     glm::vec3 scale() const { return scale_; }
     float rotationTurns() const { return rotation_; }
     // Radiance toward `dir`, averaged over about `solidAngle` steradians around it (the share of
-    // the sphere one sample stands for). Prefiltering a peaky HDR this way removes most of the
-    // variance of a few hundred samples at the cost of blur below the SH's own resolution.
+    // the sphere one sample stands for), at most kMaxFilterSolidAngle. Prefiltering a peaky HDR
+    // this way removes most of the variance of a few hundred samples at the cost of blur below
+    // the SH's own resolution.
     glm::vec3 radiance(const glm::vec3& dir, float solidAngle = 0.0f) const;
+    // The widest prefilter a lookup gets, 4π/1024 sr (docs/lighting.md, "HDR sky"): a filter of
+    // Ω steradians takes about Ω/2 off the SH's band 2 (a kernel of variance Ω/6 per axis, whose
+    // band-l factor is exp(−l(l+1)·Ω/12)), 0.6 % here. Draft's 96 rays (0.13 sr each) took 6 %
+    // off, a bias under the physical sky larger than draft's noise.
+    static constexpr float kMaxFilterSolidAngle = 4.0f * 3.14159265f / 1024.0f;
     // Exact projection of the whole sky onto SH L2 (texel solid angles, no sampling).
     const sh::ShRgb& sh() const { return sh_; }
     // Irradiance on an unoccluded level surface (normal +Y), integrated exactly over the texels.
