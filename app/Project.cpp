@@ -271,6 +271,16 @@ json defaultProjectJson() { return sceneToJson(SceneDescription{}); }
 
 namespace {
 
+// A version's value in scene units as the photometric unit it stands for (lux, candela, cd/m²),
+// to the thousandth: the scene units' decimals give no more, and the sun's 3 gives 100 000 lx.
+double fromSceneUnits(double v) { return std::round(v / kSceneUnitsPerLux * 1000.0) / 1000.0; }
+
+// section[key] when it is an object, else null: a step leaves anything else for the check to name.
+json* objectIn(json& section, const char* key) {
+    if (!section.is_object() || !section.contains(key) || !section[key].is_object()) return nullptr;
+    return &section[key];
+}
+
 // A migration step's edit of a sun or sky applied to the project's own lighting and to each
 // scenario's: fn(section, where), where "" or "scenarios[i]." prefixes the step's notes.
 template <typename Fn>
@@ -328,14 +338,11 @@ const std::vector<ProjectMigration>& projectMigrations() {
          "(3 became 100 000 lx), the same light; so are the scenarios' suns",
          [](json& doc, std::vector<std::string>& notes) {
              auto toLux = [&](json& section, const std::string& where) {
-                 if (!section.is_object() || !section.contains("sun") || !section["sun"].is_object()) return;
-                 json& sun = section["sun"];
-                 // Anything but a number is left for the check to name.
-                 if (!sun.contains("illuminance") || !sun["illuminance"].is_number()) return;
-                 const double before = sun["illuminance"].get<double>();
-                 // Whole millilux: the scene units' decimals give no more, and 3 gives 100000.
-                 const double lux = std::round(before / kSceneUnitsPerLux * 1000.0) / 1000.0;
-                 sun["illuminance"] = lux;
+                 json* sun = objectIn(section, "sun");
+                 if (!sun || !sun->contains("illuminance") || !(*sun)["illuminance"].is_number()) return;
+                 const double before = (*sun)["illuminance"].get<double>();
+                 const double lux = fromSceneUnits(before);
+                 (*sun)["illuminance"] = lux;
                  notes.push_back(where + "sun.illuminance " + json(before).dump() + " is " + json(lux).dump() + " lx");
              };
              forEachLighting(doc, toLux);
@@ -350,7 +357,7 @@ const std::vector<ProjectMigration>& projectMigrations() {
                  // Anything but a number is left for the check to name.
                  if (!light.is_object() || !light.contains("intensity") || !light["intensity"].is_number()) continue;
                  const double before = light["intensity"].get<double>();
-                 const double cd = std::round(before / kSceneUnitsPerLux * 1000.0) / 1000.0;
+                 const double cd = fromSceneUnits(before);
                  light["intensity"] = cd;
                  notes.push_back("lights[" + std::to_string(i) + "].intensity " + json(before).dump() + " is " +
                                  json(cd).dump() + " cd");
@@ -362,8 +369,9 @@ const std::vector<ProjectMigration>& projectMigrations() {
          "kSceneUnitsPerLux ((0.09, 0.11, 0.15) became (0.6, 0.733, 1) at 5 000 cd/m²), the same sky; so are the scenarios' skies",
          [](json& doc, std::vector<std::string>& notes) {
              auto toLuminance = [&](json& section, const std::string& where) {
-                 if (!section.is_object() || !section.contains("sky") || !section["sky"].is_object()) return;
-                 json& sky = section["sky"];
+                 json* found = objectIn(section, "sky");
+                 if (!found) return;
+                 json& sky = *found;
                  // An absent colour was version 5's default, which is version 6's default sky; anything
                  // but three non-negative numbers is left for the check to name.
                  if (!sky.contains("color") || !sky["color"].is_array() || sky["color"].size() != 3) return;
@@ -373,8 +381,7 @@ const std::vector<ProjectMigration>& projectMigrations() {
                      peak = std::max(peak, c.get<double>());
                  }
                  const json before = sky["color"];
-                 // Whole millicandelas a square metre, as the sun's and the lights' steps round.
-                 const double cd = std::round(peak / kSceneUnitsPerLux * 1000.0) / 1000.0;
+                 const double cd = fromSceneUnits(peak);
                  if (peak > 0.0)
                      for (json& c : sky["color"]) c = shortestDecimal(float(c.get<double>() / peak));
                  sky["luminance"] = cd;
