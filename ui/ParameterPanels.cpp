@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include <QApplication>
 #include <QCheckBox>
 #include <QColorDialog>
 #include <QComboBox>
@@ -23,6 +24,7 @@
 #include <QSpinBox>
 #include <QStyle>
 #include <QVBoxLayout>
+#include <QWheelEvent>
 
 #include "ParameterTable.h"
 #include "ProjectDocument.h"
@@ -30,6 +32,30 @@
 namespace terralux {
 
 using nlohmann::json;
+
+namespace {
+
+// The wheel scrolls the dock, not the value under the pointer: a field takes wheel steps only once
+// it has focus (a click or Tab), so scrolling through a panel never edits what it passes over.
+class WheelGuard : public QObject {
+public:
+    using QObject::QObject;
+    bool eventFilter(QObject* watched, QEvent* e) override {
+        if (e->type() != QEvent::Wheel) return false;
+        auto* w = qobject_cast<QWidget*>(watched);
+        if (!w || w->hasFocus()) return false;
+        e->ignore();  // on to the parent: the dock's scroll area
+        return true;
+    }
+};
+
+void scrollsPastUnlessFocused(QWidget* w) {
+    static WheelGuard* guard = new WheelGuard(qApp);
+    w->setFocusPolicy(Qt::StrongFocus);
+    w->installEventFilter(guard);
+}
+
+}  // namespace
 
 ParameterForm::ParameterForm(ProjectDocument* doc, QWidget* parent)
     : QWidget(parent), doc_(doc), form_(new QFormLayout(this)) {
@@ -147,6 +173,7 @@ void ParameterForm::addNumber(const ParameterSpec& spec) {
     auto* h = new QHBoxLayout(row);
     h->setContentsMargins(0, 0, 0, 0);
     auto* spin = new QDoubleSpinBox(row);
+    scrollsPastUnlessFocused(spin);
     const QString name = QString::fromStdString(uiObjectName(spec));
     spin->setObjectName(name);
     const double step = std::pow(10.0, -spec.decimals);
@@ -162,6 +189,7 @@ void ParameterForm::addNumber(const ParameterSpec& spec) {
     QSlider* s = nullptr;
     if (spec.slider) {
         s = new QSlider(Qt::Horizontal, row);
+        scrollsPastUnlessFocused(s);
         s->setObjectName(name + ".slider");
         s->setRange(0, 1000);
         h->addWidget(s, 1);
@@ -199,6 +227,7 @@ void ParameterForm::addNumber(const ParameterSpec& spec) {
 
 void ParameterForm::addInteger(const ParameterSpec& spec) {
     auto* spin = new QSpinBox(this);
+    scrollsPastUnlessFocused(spin);
     spin->setObjectName(QString::fromStdString(uiObjectName(spec)));
     const int lo = int(spec.min), hi = int(std::min<double>(spec.max, std::numeric_limits<int>::max()));
     const bool nullable = spec.nullable();
@@ -245,6 +274,7 @@ void ParameterForm::addList(const ParameterSpec& spec) {
             spin = sb;
         }
         spin->setObjectName(name + "." + QString::number(i));
+        scrollsPastUnlessFocused(spin);
         spin->setKeyboardTracking(false);
         // Share the row's width: three wide spin boxes side by side would widen the dock.
         spin->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
@@ -323,6 +353,7 @@ void ParameterForm::addBool(const ParameterSpec& spec) {
 
 void ParameterForm::addChoice(const ParameterSpec& spec) {
     auto* combo = new QComboBox(this);
+    scrollsPastUnlessFocused(combo);
     combo->setObjectName(QString::fromStdString(uiObjectName(spec)));
     for (const auto& c : spec.choices) combo->addItem(QString::fromStdString(c));
     connect(combo, &QComboBox::currentTextChanged, this,

@@ -36,6 +36,7 @@
 #include <QSpinBox>
 #include <QTimer>
 #include <QUndoStack>
+#include <QWheelEvent>
 #include <QtTest>
 #include <QtCharts/QXYSeries>
 
@@ -1316,6 +1317,15 @@ private slots:
             QCOMPARE(w_->document()->project().scene.sky.luminance, 8000.0);
             w_->document()->undoStack()->undo();
             QCOMPARE(w_->document()->project().scene.sky.luminance, 5000.0);
+            // The wheel over a field without focus scrolls the dock and leaves the value alone.
+            luminance->clearFocus();
+            QVERIFY(!luminance->hasFocus());
+            QWheelEvent wheel(QPointF(5, 5), luminance->mapToGlobal(QPointF(5, 5)), QPoint(), QPoint(0, -120),
+                              Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
+            QApplication::sendEvent(luminance, &wheel);
+            QCOMPARE(luminance->value(), 5000.0);
+            QCOMPARE(w_->document()->project().scene.sky.luminance, 5000.0);
+            QCOMPARE(luminance->focusPolicy(), Qt::StrongFocus);
         }
         // Max_resolution 'source' sends 0, never null (maxResolutionSourceSendsZero)
         {
