@@ -8,6 +8,7 @@
 // image centre column faces north.
 
 #include <memory>
+#include <numbers>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -59,7 +60,7 @@ public:
     // Ω steradians takes about Ω/2 off the SH's band 2 (a kernel of variance Ω/6 per axis, whose
     // band-l factor is exp(−l(l+1)·Ω/12)), 0.6 % here. Draft's 96 rays (0.13 sr each) took 6 %
     // off, a bias under the physical sky larger than draft's noise.
-    static constexpr float kMaxFilterSolidAngle = 4.0f * 3.14159265f / 1024.0f;
+    static constexpr float kMaxFilterSolidAngle = 4.0f * std::numbers::pi_v<float> / 1024.0f;
     // Exact projection of the whole sky onto SH L2 (texel solid angles, no sampling).
     const sh::ShRgb& sh() const { return sh_; }
     // Irradiance on an unoccluded level surface (normal +Y), integrated exactly over the texels.
