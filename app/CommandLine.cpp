@@ -393,7 +393,10 @@ int commandMerge(const Args& a) {
     const std::string dir = str(a.parser.value(a.merge));
     if (dir.empty()) throw UsageError("--merge: must name the folder the tiles were baked into (--out)");
     const MergeOutcome m = mergeTiles(dir);
-    std::cout << "merged " << m.tiles << " tiles (" << m.grids << " probe grids) in " << m.dir.string() << ":\n";
+    std::cout << "merged " << m.tiles << " tiles (" << m.grids << " probe grids";
+    if (m.report.contains("reflection_probes"))
+        std::cout << ", " << m.report["reflection_probes"].value("probes", uint64_t(0)) << " reflection probes";
+    std::cout << ") in " << m.dir.string() << ":\n";
     for (const auto& f : m.files) std::cout << "  " << f.filename().string() << "\n";
     return kExitOk;
 }

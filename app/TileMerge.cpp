@@ -95,10 +95,58 @@ struct MergedGrid {
     std::vector<std::string> scenarioPaths;
 };
 
+// The keys of TERRALUX_lighting.reflection_probes that describe one bake's own set of probes
+// (its files, its share of the grid and resolved blend distance), not what every tile shares.
+constexpr const char* kReflectionSetKeys[] = {"uri",  "simvx_desktop_uri", "simvx_wire_uri", "probes",
+                                              "grid", "grid_dims", "fallback_blend_distance",
+                                              "simvx_probes", "simvx_ids"};
+
+// The tiles' reflection probes as one section (docs/farm.md, "The merge"): the authored section
+// and what every tile resolves alike (encoding, face size, mips), the probes summed, and under
+// `sets` each tile's own set, its files addressed through the tile's folder, in tile order.
+// Nothing when no tile has reflection probes; a ProjectError when only some have, or their
+// shared keys differ (tiles of other inputs are refused before).
+std::optional<nlohmann::json> mergedReflections(const std::vector<BakedTile>& tiles) {
+    std::optional<nlohmann::json> merged;
+    nlohmann::json sets = nlohmann::json::array();
+    size_t probes = 0, with = 0;
+    for (const BakedTile& t : tiles) {
+        const nlohmann::json& g = t.gltf;
+        const nlohmann::json lighting =
+            g["scenes"][0].value("extensions", nlohmann::json::object()).value("TERRALUX_lighting", nlohmann::json::object());
+        if (!lighting.contains("reflection_probes")) continue;
+        ++with;
+        nlohmann::json shared = lighting["reflection_probes"];
+        nlohmann::json set = {{"tile", t.name}};
+        for (const char* k : kReflectionSetKeys) {
+            if (!shared.contains(k)) continue;
+            set[k] = shared[k];
+            shared.erase(k);
+        }
+        const std::string prefix = std::string(kTilesFolder) + "/" + t.name + "/";
+        for (const char* k : {"uri", "simvx_desktop_uri", "simvx_wire_uri"})
+            if (set.contains(k) && set[k].is_string()) set[k] = prefix + set[k].get<std::string>();
+        probes += set.value("probes", size_t(0));
+        sets.push_back(set);
+        if (!merged) merged = shared;
+        else if (*merged != shared)
+            throw ProjectError((t.dir / "scene.gltf").string() + ": reflection probes resolved otherwise than in " +
+                               tiles.front().name + "; bake the tiles again");
+    }
+    if (with == 0) return std::nullopt;
+    if (with != tiles.size())
+        throw ProjectError(std::to_string(tiles.size() - with) + " of " + std::to_string(tiles.size()) +
+                           " tiles without reflection probes; bake them again");
+    (*merged)["probes"] = probes;
+    (*merged)["sets"] = sets;
+    return merged;
+}
+
 // The tiles' glTF documents as one: each tile's nodes, meshes, materials and buffers appended with
 // their indices moved, buffers and images addressed through the tile's folder, and the probe
 // grids of every tile listed in the scene's VULKAN_SCHNEE_engine_properties, sorted by file name;
-// each lighting scenario's files listed in that same order.
+// each lighting scenario's files listed in that same order; the reflection probes of every tile
+// (mergedReflections).
 nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::json& region) {
     nlohmann::json out = {{"asset", tiles.front().gltf["asset"]}, {"scene", 0}};
     nlohmann::json used = nlohmann::json::array(), roots = nlohmann::json::array();
@@ -195,6 +243,8 @@ nlohmann::json mergedGltf(const std::vector<BakedTile>& tiles, const nlohmann::j
             scenarios[s]["shProbePaths"] = paths;
         }
     }
+    if (const std::optional<nlohmann::json> reflections = mergedReflections(tiles))
+        sceneExt["TERRALUX_lighting"]["reflection_probes"] = *reflections;
     // The region's grid and stride, not the first tile's.
     if (sceneExt.contains("TERRALUX_geo")) {
         sceneExt["TERRALUX_geo"]["gridSize"] = region["region_grid"];
@@ -220,6 +270,8 @@ nlohmann::json mergedReport(const std::vector<BakedTile>& tiles, const nlohmann:
         double seSum = 0.0, seMax = 0.0, mapSum = 0.0, mapMax = 0.0;
     };
     std::map<std::string, Volume> volumes;
+    // Reflection probes: the tiles' probes, bytes and time summed.
+    nlohmann::json reflections = nlohmann::json::object();
     nlohmann::json perTile = nlohmann::json::array();
     for (const BakedTile& t : tiles) {
         const nlohmann::json& r = t.report;
@@ -243,6 +295,12 @@ nlohmann::json mergedReport(const std::vector<BakedTile>& tiles, const nlohmann:
                 m.mapMax = std::max(m.mapMax, v["error_map"].value("max", 0.0));
             }
         }
+        if (r.contains("reflection_probes")) {
+            const nlohmann::json& rr = r["reflection_probes"];
+            reflections["probes"] = reflections.value("probes", uint64_t(0)) + rr.value("probes", uint64_t(0));
+            reflections["bytes"] = reflections.value("bytes", uint64_t(0)) + rr.value("bytes", uint64_t(0));
+            reflections["time_s"] = reflections.value("time_s", 0.0) + rr.value("time_s", 0.0);
+        }
         perTile.push_back({{"name", t.name}, {"time_s", s}, {"rays", r.value("rays", uint64_t(0))}});
     }
     nlohmann::json vs = nlohmann::json::array();
@@ -254,7 +312,7 @@ nlohmann::json mergedReport(const std::vector<BakedTile>& tiles, const nlohmann:
             v["error_map"] = {{"points", m.mapPoints}, {"mean", m.mapSum / double(m.mapPoints)}, {"max", m.mapMax}};
         vs.push_back(v);
     }
-    return {{"generator", tiles.front().report.value("generator", std::string())},
+    nlohmann::json out = {{"generator", tiles.front().report.value("generator", std::string())},
             {"region", region},
             {"inputs", tiles.front().report["inputs"]},
             {"tiles", perTile},
@@ -264,6 +322,8 @@ nlohmann::json mergedReport(const std::vector<BakedTile>& tiles, const nlohmann:
             {"probe_rays", probeRays},
             {"volumes", vs},
             {"failures", nlohmann::json::array()}};
+    if (!reflections.empty()) out["reflection_probes"] = reflections;
+    return out;
 }
 
 }  // namespace
@@ -340,10 +400,6 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
     for (BakedTile& t : tiles) {
         const std::optional<nlohmann::json> g = readJson(t.dir / "scene.gltf");
         if (!g) throw ProjectError((t.dir / "scene.gltf").string() + ": missing or unreadable; bake the tile with export.gltf on");
-        const nlohmann::json lighting = (*g)["scenes"][0].value("extensions", nlohmann::json::object()).value("TERRALUX_lighting", nlohmann::json::object());
-        if (lighting.contains("reflection_probes"))
-            throw ProjectError(t.dir.string() + ": a tile with reflection probes; --merge lists diffuse probe grids, "
-                               "their lighting scenarios and meshes only, so bake the tiles without them");
         t.gltf = *g;
         nlohmann::json files = nlohmann::json::array();
         for (const auto& f : t.report.value("files", nlohmann::json::array())) {

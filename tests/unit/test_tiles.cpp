@@ -11,6 +11,7 @@
 
 #include "BakeJob.h"
 #include "ProbeDiagnosticsFile.h"
+#include "ReflectionProbeFile.h"
 #include "ShProbeFile.h"
 #include "TerrainLoading.h"
 #include "TileMerge.h"
@@ -480,20 +481,75 @@ TEST(Tiles, TheMergeListsEachLightingScenarioInTheOrderOfTheGrids) {
     for (const auto& t : index["tiles"])
         for (const auto& f : t["files"]) hashed += f["path"].get<std::string>().find("scenarios/") != std::string::npos;
     EXPECT_EQ(hashed, 2u);
-    // Reflection probes are still refused, by tile and reason.
+    fs::remove_all(tiled);
+}
+
+TEST(Tiles, TheMergeListsEveryTilesReflectionProbes) {
+    // Two tiles with a 6 x 3 reflection grid for the region: each tile bakes its share over its own
+    // footprint, and the merged scene's TERRALUX_lighting.reflection_probes lists both sets (their
+    // files through the tile's folder, each set's probes inside its tile), sums the probes and
+    // keeps what the tiles share; tiles.json hashes the files; the report sums the probes.
+    const fs::path tiled = freshDir("reflections");
+    size_t baked = 0;
+    for (int i = 0; i < 2; ++i) {
+        BakeRequest r{regionProject(tiled), 2, false};
+        ReflectionProbeSettings& rp = r.project.scene.reflectionProbes;
+        rp.enabled = true;
+        rp.gridDims = {6, 3};
+        rp.resolution = 8;
+        rp.rayCount = 2;
+        r.tile = parseTiles("2,1", std::to_string(i) + "/2", std::optional<double>(300.0));
+        r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
+        const BakeOutcome o = runBake(r, {}, nullptr);
+        baked += o.report["reflection_probes"]["probes"].get<size_t>();
+    }
+    const MergeOutcome m = mergeTiles(tiled);
+    std::ifstream in(tiled / "scene.gltf");
+    const nlohmann::json g = nlohmann::json::parse(in);
+    const nlohmann::json& rp = g["scenes"][0]["extensions"]["TERRALUX_lighting"]["reflection_probes"];
+    ASSERT_TRUE(rp.contains("sets")) << rp.dump();
+    EXPECT_FALSE(rp.contains("uri"));
+    EXPECT_EQ(rp["probes"].get<size_t>(), baked);
+    EXPECT_EQ(rp["encoding"], "cubemap");
+    EXPECT_EQ(rp["face_size"], 8);
+    ASSERT_EQ(rp["sets"].size(), 2u);
+    std::ifstream indexIn(tiled / "tiles.json");
+    const nlohmann::json index = nlohmann::json::parse(indexIn);
+    for (size_t k = 0; k < 2; ++k) {
+        const nlohmann::json& set = rp["sets"][k];
+        const std::string name = k == 0 ? "tile_000_000" : "tile_000_001";
+        EXPECT_EQ(set["tile"], name);
+        EXPECT_EQ(set["uri"], "tiles/" + name + "/reflection/probes.rprobe");
+        for (const char* key : {"uri", "simvx_desktop_uri", "simvx_wire_uri"})
+            EXPECT_TRUE(fs::exists(tiled / set[key].get<std::string>())) << set[key];
+        const ReflectionProbeSet probes = readReflectionProbeFile(tiled / set["uri"].get<std::string>());
+        EXPECT_EQ(probes.probes.size(), set["probes"].get<size_t>());
+        const nlohmann::json& t = index["tiles"][k];
+        ASSERT_EQ(t["name"], name);
+        const float x0 = t["bounds_m"]["min"][0], x1 = t["bounds_m"]["max"][0];
+        for (const ReflectionProbe& p : probes.probes) {
+            EXPECT_GE(p.position.x, x0 - 1e-3f) << name;
+            EXPECT_LE(p.position.x, x1 + 1e-3f) << name;
+        }
+        bool hashed = false;
+        for (const auto& f : t["files"]) hashed |= f["path"] == set["uri"];
+        EXPECT_TRUE(hashed) << t.dump();
+    }
+    EXPECT_EQ(m.report["reflection_probes"]["probes"].get<size_t>(), baked);
+    // A tile baked without them cannot join: the merge names how many lack them.
     {
-        const fs::path gltf = tiled / kTilesFolder / "tile_000_000" / "scene.gltf";
+        const fs::path gltf = tiled / kTilesFolder / "tile_000_001" / "scene.gltf";
         std::ifstream tileIn(gltf);
         nlohmann::json tile = nlohmann::json::parse(tileIn);
         tileIn.close();
-        tile["scenes"][0]["extensions"]["TERRALUX_lighting"]["reflection_probes"] = {{"uri", "reflection/probes.rprobe"}};
+        tile["scenes"][0]["extensions"]["TERRALUX_lighting"].erase("reflection_probes");
         std::ofstream(gltf) << tile.dump();
     }
     try {
         mergeTiles(tiled);
-        ADD_FAILURE() << "merged tiles with reflection probes";
+        ADD_FAILURE() << "merged tiles of which one has no reflection probes";
     } catch (const ProjectError& e) {
-        EXPECT_NE(std::string(e.what()).find("tile_000_000: a tile with reflection probes"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("1 of 2 tiles without reflection probes"), std::string::npos) << e.what();
     }
     fs::remove_all(tiled);
 }
