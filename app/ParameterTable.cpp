@@ -495,17 +495,30 @@ std::vector<ParameterSpec> buildTable() {
         .autoMeans("the lowest terrain").label("Base height")
         .about("Height where the density is fog.density, engine space")
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::baseHeight);
-    add(Row("fog.color", T::Color)).range(0.0, kUnbounded).autoMeans("the sky's mean radiance").label("Fog colour")
-        .about("Radiance the fog scatters toward the camera from the sky, linear RGB")
-        .resolvedBy([](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
-            // The skies the scene alone describes; an HDR sky's mean needs its file, read by the bake.
-            if (s.sky.mode == SkyMode::Hdr) return nullptr;
-            Project p;
-            p.scene = s;
-            const glm::vec3 c = *resolvedFog(s.fog, skyOf(p, hf), hf).color;
-            return json{c.x, c.y, c.z};
+    // The skies the scene alone describes; an HDR sky's mean needs its file, read by the bake.
+    const auto resolvedFogOf = [](const SceneDescription& s, const Heightfield& hf) -> std::optional<FogSettings> {
+        if (s.sky.mode == SkyMode::Hdr) return std::nullopt;
+        Project p;
+        p.scene = s;
+        return resolvedFog(s.fog, skyOf(p, hf), hf);
+    };
+    add(Row("fog.color", T::Color)).range(0.0, 1.0).autoMeans("the sky's mean colour").label("Fog colour")
+        .about("Linear RGB tint of the light the fog scatters toward the camera from the sky")
+        .resolvedBy([resolvedFogOf](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
+            const std::optional<FogSettings> f = resolvedFogOf(s, hf);
+            if (!f) return nullptr;
+            return json{f->color->x, f->color->y, f->color->z};
         })
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::color);
+    add(Row("fog.luminance", T::Number)).range(0.0, 1.0e7).unit("cd/m²").decimals(0)
+        .autoMeans("the sky's mean luminance").label("Fog luminance")
+        .about("Luminance of the light the fog scatters toward the camera from the sky, per channel times its colour")
+        .resolvedBy([resolvedFogOf](const SceneDescription& s, const Heightfield& hf, size_t) -> json {
+            const std::optional<FogSettings> f = resolvedFogOf(s, hf);
+            if (!f) return nullptr;
+            return json(*f->luminance);
+        })
+        .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::luminance);
     add(Row("fog.inscatter", T::Number)).range(0.0, 100.0).label("Sun inscatter")
         .about("Scales the sunlight the fog scatters toward the camera")
         .redoes(kUpload).onlyWhen(fogOn).field(&SceneDescription::fog, &FogSettings::inscatter);

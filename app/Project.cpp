@@ -281,6 +281,27 @@ json* objectIn(json& section, const char* key) {
     return &section[key];
 }
 
+// A radiance in scene units, `section`.color, as a colour in [0, 1] (divided by its largest
+// component; black stays black) and `section`.luminance in cd/m² (that component,
+// fromSceneUnits): the same light. The note names `where` + `name`; anything but three
+// non-negative numbers is left for the check to name.
+void radianceToLuminance(json& section, const std::string& name, const std::string& where,
+                         std::vector<std::string>& notes) {
+    if (!section.contains("color") || !section["color"].is_array() || section["color"].size() != 3) return;
+    double peak = 0.0;
+    for (const json& c : section["color"]) {
+        if (!c.is_number() || c.get<double>() < 0.0) return;
+        peak = std::max(peak, c.get<double>());
+    }
+    const json before = section["color"];
+    const double cd = fromSceneUnits(peak);
+    if (peak > 0.0)
+        for (json& c : section["color"]) c = shortestDecimal(float(c.get<double>() / peak));
+    section["luminance"] = cd;
+    notes.push_back(where + name + ".color " + before.dump() + " is " + section["color"].dump() + " at " +
+                    json(cd).dump() + " cd/m²");
+}
+
 // A migration step's edit of a sun or sky applied to the project's own lighting and to each
 // scenario's: fn(section, where), where "" or "scenarios[i]." prefixes the step's notes.
 template <typename Fn>
@@ -368,27 +389,16 @@ const std::vector<ProjectMigration>& projectMigrations() {
          "the colour is divided by its largest component and the luminance is that component divided by "
          "kSceneUnitsPerLux ((0.09, 0.11, 0.15) became (0.6, 0.733, 1) at 5 000 cd/m²), the same sky; so are the scenarios' skies",
          [](json& doc, std::vector<std::string>& notes) {
-             auto toLuminance = [&](json& section, const std::string& where) {
-                 json* found = objectIn(section, "sky");
-                 if (!found) return;
-                 json& sky = *found;
-                 // An absent colour was version 5's default, which is version 6's default sky; anything
-                 // but three non-negative numbers is left for the check to name.
-                 if (!sky.contains("color") || !sky["color"].is_array() || sky["color"].size() != 3) return;
-                 double peak = 0.0;
-                 for (const json& c : sky["color"]) {
-                     if (!c.is_number() || c.get<double>() < 0.0) return;
-                     peak = std::max(peak, c.get<double>());
-                 }
-                 const json before = sky["color"];
-                 const double cd = fromSceneUnits(peak);
-                 if (peak > 0.0)
-                     for (json& c : sky["color"]) c = shortestDecimal(float(c.get<double>() / peak));
-                 sky["luminance"] = cd;
-                 notes.push_back(where + "sky.color " + before.dump() + " is " + sky["color"].dump() + " at " +
-                                 json(cd).dump() + " cd/m²");
-             };
-             forEachLighting(doc, toLuminance);
+             // An absent colour was version 5's default, which is version 6's default sky.
+             forEachLighting(doc, [&](json& section, const std::string& where) {
+                 if (json* sky = objectIn(section, "sky")) radianceToLuminance(*sky, "sky", where, notes);
+             });
+         }},
+        {6,
+         "fog.color (the fog's ambient radiance in scene units) became a colour in [0, 1] and fog.luminance in "
+         "cd/m², as the uniform sky's did in version 6: the same fog; an unset colour stays unset (the sky's mean)",
+         [](json& doc, std::vector<std::string>& notes) {
+             if (json* fog = objectIn(doc, "fog")) radianceToLuminance(*fog, "fog", "", notes);
          }},
     };
     return steps;

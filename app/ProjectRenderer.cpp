@@ -179,7 +179,7 @@ void ProjectRenderer::setProject(const Project& project) {
         for (size_t k = 0; k < sa.c.size(); ++k) base_.skySh.c[k] = glm::mix(sa.c[k], sb.c[k], t);
         const FogSettings fa = resolvedFog(scene.fog, la->sky, hf), fb = resolvedFog(scene.fog, lb->sky, hf);
         base_.fog = fa;
-        if (fa.color && fb.color) base_.fog.color = glm::mix(*fa.color, *fb.color, t);
+        base_.fog.setAmbientRadiance(glm::mix(fa.ambientRadiance(), fb.ambientRadiance(), t));
     }
     base_.skirt = scene.terrain.skirt;
     base_.reflectionStrength = float(scene.reflectionProbes.strength);

@@ -153,8 +153,12 @@ Sky skyOf(const Project& p, const Heightfield& hf) {
 FogSettings resolvedFog(const FogSettings& fog, const Sky& sky, const Heightfield& terrain) {
     FogSettings f = fog;
     if (!f.baseHeight) f.baseHeight = double(terrain.minHeight());
-    // The mean radiance over the sphere is the SH DC term times Y_00 = 1 / (2√π).
-    if (!f.color) f.color = glm::max(sky.sh().c[0] * 0.28209479f, glm::vec3(0.0f));
+    // The mean radiance over the sphere is the SH DC term times Y_00 = 1 / (2√π); what the fog
+    // leaves unset of colour and luminance comes from it.
+    FogSettings mean;
+    mean.setAmbientRadiance(glm::max(sky.sh().c[0] * 0.28209479f, glm::vec3(0.0f)));
+    if (!f.color) f.color = mean.color;
+    if (!f.luminance) f.luminance = mean.luminance;
     return f;
 }
 
@@ -274,12 +278,15 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     shadows["computed_fades_out"] = range.fadesOut;
 
     // What fog's unset ("auto") values stand for: the lowest terrain, and the sky's mean radiance,
-    // L_0 · Y_0 (the DC term spread over 4π steradians; Y_0 = 1/(2√π), docs/lighting.md).
+    // L_0 · Y_0 (the DC term spread over 4π steradians; Y_0 = 1/(2√π), docs/lighting.md), as a
+    // colour and a luminance.
     const nlohmann::json& fogAuthored = authored.at("fog");
     nlohmann::json& fog = ext["fog"];
     fog["resolved_base_height"] = scene.fog.baseHeight ? fogAuthored.at("base_height")
                                                        : nlohmann::json(shortestDecimal(hf.minHeight()));
-    fog["resolved_color"] = scene.fog.color ? fogAuthored.at("color") : shortest(*resolvedFog(scene.fog, l.sky, hf).color);
+    const FogSettings resolved = resolvedFog(scene.fog, l.sky, hf);
+    fog["resolved_color"] = scene.fog.color ? fogAuthored.at("color") : shortest(*resolved.color);
+    fog["resolved_luminance"] = scene.fog.luminance ? fogAuthored.at("luminance") : nlohmann::json(shortestDecimal(float(*resolved.luminance)));
 
     // The terrain's specular and occlusion as the renderer shades it (docs/lighting.md, "Terrain
     // surface"): GGX roughness before the normals' variance widens it, whether it does, the floor

@@ -2,12 +2,14 @@
 // Every lighting parameter of a Terralux scene, in one place (docs/lighting.md). The project JSON,
 // `--set`, the UI and the bake all read these fields; defaults here are the documented ones.
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 
 #include "bake/PhysicalSky.h"
@@ -287,9 +289,26 @@ struct FogSettings {
     double density = 2.0e-5;                   // 1/m at the base height
     double scaleHeight = 1200.0;               // m over which the density falls by e; 0 = uniform
     std::optional<double> baseHeight;          // metres; unset = the lowest terrain
-    std::optional<glm::vec3> color;            // ambient inscatter radiance; unset = the sky's mean
+    // The ambient light the fog scatters toward the camera: colour (linear RGB, each in [0, 1]) ×
+    // luminance (cd/m²) per channel, drawn at the sun's scale (ambientRadiance()). Unset = the
+    // sky's mean radiance's colour (divided by its largest channel) and luminance (that channel).
+    std::optional<glm::vec3> color;
+    std::optional<double> luminance;           // cd/m², >= 0
     double inscatter = 1.0;                    // scales the sun's inscatter
     double anisotropy = 0.6;                   // Henyey–Greenstein g, (−1, 1)
+
+    // The ambient inscatter radiance in scene-linear units, colour × luminance × kSceneUnitsPerLux
+    // (docs/lighting.md, "Units"); an unset part reads 0 (resolvedFog sets both).
+    glm::vec3 ambientRadiance() const {
+        return color.value_or(glm::vec3(0.0f)) * float(luminance.value_or(0.0) * kSceneUnitsPerLux);
+    }
+    // Sets colour and luminance to stand for `radiance` (scene units): the colour divided by its
+    // largest channel, the luminance that channel; black stays black at 0 cd/m².
+    void setAmbientRadiance(const glm::vec3& radiance) {
+        const float peak = std::max({radiance.x, radiance.y, radiance.z, 0.0f});
+        color = peak > 0.0f ? glm::max(radiance / peak, glm::vec3(0.0f)) : glm::vec3(0.0f);
+        luminance = double(peak) / kSceneUnitsPerLux;
+    }
 };
 
 // Horizon ambient occlusion of the terrain (docs/lighting.md, "Horizon ambient occlusion"),

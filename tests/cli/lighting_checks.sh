@@ -79,9 +79,13 @@ else:
 if project["fog"]["color"] is not None:
     expect(fog["resolved_color"] == project["fog"]["color"], "fog.resolved_color differs")
 elif mean_sky is not None:
-    # 1 %: HDR decoders differ by half a mantissa step.
-    expect(all(close(x, y, 1e-2) for x, y in zip(fog["resolved_color"], mean_sky)),
-           f"fog.resolved_color {fog['resolved_color']} is not the sky's mean {mean_sky}")
+    # The fog's ambient radiance, colour x luminance in scene units, is the sky's mean; 1 %: HDR
+    # decoders differ by half a mantissa step.
+    units = ext["scene_units_per_lux"] * fog["resolved_luminance"]
+    ambient = [c * units for c in fog["resolved_color"]]
+    expect(max(fog["resolved_color"]) == 1.0, f"fog.resolved_color {fog['resolved_color']} does not peak at 1")
+    expect(all(close(x, y, 1e-2) for x, y in zip(ambient, mean_sky)),
+           f"fog ambient {ambient} is not the sky's mean {mean_sky}")
 
 # Water: every setting as the project prints it, the level and the waves resolved, and a water
 # node with a transmissive material; none of it without water, nor where "auto" found no water in

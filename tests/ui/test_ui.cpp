@@ -221,7 +221,8 @@ private slots:
     }
 
     // The fog colour left to the sky says so on its button, and the picker starts from the colour
-    // it resolves to (the uniform sky's mean radiance), not from nothing.
+    // it resolves to (the uniform sky's mean colour), not from nothing; the luminance, still left
+    // to the sky, keeps the fog's light as it was.
     void fogColourLeftToTheSkySaysSo() {
         auto* dock = w_->findChild<QDockWidget*>("dock.atmosphere");
         dock->raise();
@@ -231,8 +232,9 @@ private slots:
         QVERIFY(doc->value("fog.color").is_null());
         auto* button = dock->findChild<QPushButton*>("param.fog.color");
         QVERIFY(button);
-        QCOMPARE(button->text(), QString("auto: the sky's mean radiance"));
-        const glm::vec3 sky = doc->project().scene.sky.uniformRadiance();
+        QCOMPARE(button->text(), QString("auto: the sky's mean colour"));
+        QVERIFY(doc->value("fog.luminance").is_null());
+        const glm::vec3 sky = doc->project().scene.sky.color;
         QColor started;
         QTimer::singleShot(200, [&] {
             auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
@@ -242,12 +244,12 @@ private slots:
         });
         button->click();
         QVERIFY(started.isValid());
-        // The sky's colour (below 1, so no intensity on top), as the dialog's 8-bit channels hold it.
+        // The sky's colour, as the dialog's 8-bit channels hold it.
         QVERIFY(std::abs(started.redF() - sky.x) < 0.01 && std::abs(started.blueF() - sky.z) < 0.01);
         const auto& set = doc->project().scene.fog.color;
         QVERIFY(set.has_value());
         QVERIFY(std::abs(set->x - sky.x) < 0.01f && std::abs(set->z - sky.z) < 0.01f);
-        QVERIFY(button->text().startsWith("0.09"));
+        QVERIFY(button->text().startsWith("0.6"));
     }
 
     void startsWithTheSampleAndEditsAreUndoable() {

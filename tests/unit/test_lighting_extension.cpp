@@ -185,17 +185,21 @@ TEST(LightingExtension, FogResolvesItsAutoValues) {
     EXPECT_TRUE(fog["color"].is_null());
     EXPECT_EQ(float(fog["resolved_base_height"].get<double>()), hf.minHeight());
     // The mean radiance of the default uniform sky, (0.6, 0.733, 1) × 5000 cd/m² = (0.09, 0.11, 0.15)
-    // scene units, × 2.
+    // scene units, × 2: its colour and, in the largest channel, 10 000 cd/m².
+    EXPECT_TRUE(fog["luminance"].is_null());
     const glm::vec3 mean = vec3Of(fog["resolved_color"]);
-    EXPECT_NEAR(mean.r, 0.18f, 1e-5f);
-    EXPECT_NEAR(mean.g, 0.22f, 1e-5f);
-    EXPECT_NEAR(mean.b, 0.30f, 1e-5f);
+    EXPECT_NEAR(mean.r, 0.6f, 1e-5f);
+    EXPECT_NEAR(mean.g, 0.733333f, 1e-5f);
+    EXPECT_NEAR(mean.b, 1.0f, 1e-5f);
+    EXPECT_NEAR(fog["resolved_luminance"].get<double>(), 10000.0, 0.05);
 
-    fog = lightingExtension(projectWith({"fog.base_height=-12.5", "fog.color=0.1,0.2,0.3"}), hf)["fog"];
+    fog = lightingExtension(projectWith({"fog.base_height=-12.5", "fog.color=0.1,0.2,0.3", "fog.luminance=250"}), hf)["fog"];
     EXPECT_EQ(fog["resolved_base_height"], fog["base_height"]);
     EXPECT_EQ(fog["resolved_base_height"].get<double>(), -12.5);
     EXPECT_EQ(fog["resolved_color"], fog["color"]);
     EXPECT_EQ(fog["resolved_color"], json({0.1, 0.2, 0.3}));
+    EXPECT_EQ(fog["resolved_luminance"], fog["luminance"]);
+    EXPECT_EQ(fog["resolved_luminance"].get<double>(), 250.0);
 }
 
 TEST(LightingExtension, IsAUsedNeverRequiredSceneExtension) {

@@ -142,7 +142,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=7", "p.json: version = 7: is newer than this Terralux reads (6); open it with a newer Terralux"},
+        Rule{"version=8", "p.json: version = 8: is newer than this Terralux reads (7); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -664,5 +664,33 @@ TEST(ProjectVersions, VersionFiveSkyColourBecomesColourAndLuminance) {
         ADD_FAILURE() << "a colour above 1 was accepted";
     } catch (const ProjectError& e) {
         EXPECT_EQ(std::string(e.what()), "new.json: sky.color[2] = 1.5: three components, each in [0, 1]");
+    }
+}
+
+TEST(ProjectVersions, VersionSixFogColourBecomesColourAndLuminance) {
+    const json v6 = {{"version", 6}, {"fog", {{"color", {0.03, 0.06, 0.15}}, {"density", 1e-4}}}};
+    std::vector<std::string> notes;
+    const SceneDescription s = sceneFromJson(v6, "old.json", &notes);
+    ASSERT_TRUE(s.fog.color && s.fog.luminance);
+    EXPECT_EQ(*s.fog.color, glm::vec3(0.2f, 0.4f, 1.0f));
+    EXPECT_DOUBLE_EQ(*s.fog.luminance, 5000.0);
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_EQ(notes[0], "old.json: version 6 migrated to 7: fog.color [0.03,0.06,0.15] is [0.2,0.4,1.0] at 5000.0 cd/m²");
+    // The same fog: the radiance it scatters is what version 6 wrote.
+    const glm::vec3 radiance = s.fog.ambientRadiance();
+    EXPECT_NEAR(radiance.x, 0.03f, 1e-7f);
+    EXPECT_NEAR(radiance.y, 0.06f, 1e-7f);
+    EXPECT_NEAR(radiance.z, 0.15f, 1e-7f);
+    // An unset colour stays unset: the sky's mean, colour and luminance both.
+    const SceneDescription unset = sceneFromJson(json{{"version", 6}, {"fog", {{"density", 1e-4}}}}, "old.json", nullptr);
+    EXPECT_FALSE(unset.fog.color);
+    EXPECT_FALSE(unset.fog.luminance);
+    // A current file means a colour: a component above 1 is refused, naming the rule.
+    json current = {{"version", kProjectVersion}, {"fog", {{"color", {0.5, 1.5, 0.2}}}}};
+    try {
+        sceneFromJson(current, "new.json", nullptr);
+        ADD_FAILURE() << "a colour above 1 was accepted";
+    } catch (const ProjectError& e) {
+        EXPECT_EQ(std::string(e.what()), "new.json: fog.color[1] = 1.5: three components, each in [0, 1]");
     }
 }

@@ -21,7 +21,7 @@ blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog) {
     atmosphere.fogFalloff = float(fog.scaleHeight > 0.0 ? 1.0 / fog.scaleHeight : 0.0);
     atmosphere.fogBase = float(fog.baseHeight.value_or(0.0));
     atmosphere.fogAnisotropy = float(fog.anisotropy);
-    atmosphere.fogColor = fog.color.value_or(glm::vec3(0.0f));
+    atmosphere.fogColor = fog.ambientRadiance();
     atmosphere.sunInscatter = float(fog.inscatter);
     return atmosphere;
 }
