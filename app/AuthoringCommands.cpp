@@ -201,6 +201,11 @@ int commandRender(const Args& a) {
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    // An msaa count the device lacks is drawn with the largest it has below (or fxaa): say so.
+    const Antialiasing asked = project.scene.camera.antialiasing, drawn = renderer.renderer().drawnAntialiasing();
+    if (msaaSamples(asked) > 1 && drawn != Antialiasing::Off && drawn != asked)
+        std::cout << "anti-aliasing: " << antialiasingName(drawn) << " (" << ctx->deviceName() << " has no "
+                  << antialiasingName(asked) << ")\n";
     if (project.scene.camera.exposureMode != ExposureMode::Manual && std::isfinite(renderer.meteredEv100()))
         std::cout << "exposure: EV100 " << fixed(renderer.meteredEv100(), 2) << " metered ("
                   << exposureModeName(project.scene.camera.exposureMode) << "), compensation "

@@ -1077,10 +1077,14 @@ std::vector<ParameterSpec> buildTable() {
                "renders and exports use the metered exposure itself")
         .redoes(kUpload).onlyWhen(metered).field(&SceneDescription::camera, &CameraSettings::adaptationSeconds);
     add(Row("camera.antialiasing", T::Choice))
-        .choices({antialiasingName(Antialiasing::Off), antialiasingName(Antialiasing::Fxaa), antialiasingName(Antialiasing::Ssaa)})
+        .choices({antialiasingName(Antialiasing::Off), antialiasingName(Antialiasing::Fxaa), antialiasingName(Antialiasing::Ssaa),
+                  antialiasingName(Antialiasing::Msaa2), antialiasingName(Antialiasing::Msaa4),
+                  antialiasingName(Antialiasing::Msaa8)})
         .label("Anti-aliasing")
         .about("Edges of the picture views: fxaa filters the finished frame along luminance edges (one full-screen pass); "
-               "ssaa draws at 2x2 the pixels and averages them (4x the cost); off: one sample a pixel. Data views stay exact")
+               "ssaa draws at 2x2 the pixels and averages them (4x the cost); msaa2/4/8 take 2, 4 or 8 coverage samples a "
+               "pixel and shade once (the most the device offers up to that; fxaa where it offers none); off: one sample "
+               "a pixel. Data views stay exact")
         .redoes(kUpload).field(&SceneDescription::camera, &CameraSettings::antialiasing);
 
     // Export.

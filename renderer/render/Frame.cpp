@@ -44,21 +44,30 @@ const vk::DescriptorSet& Frame::lights() const {
     return shadows ? slot.shadowedLights : slot.lights;
 }
 
+const vk::RenderPass& RendererGpu::clearPassFor(uint32_t samples) const {
+    return samples > 1 ? multisampledPasses.at(samples).first : clearPass;
+}
+
+const vk::RenderPass& RendererGpu::drawPassFor(uint32_t samples) const {
+    return samples > 1 ? multisampledPasses.at(samples).second : drawPass;
+}
+
 void Frame::beginDrawing(VkCommandBuffer cb) const {
     VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-    rbi.renderPass = g.drawPass.handle();
+    rbi.renderPass = g.drawPassFor(samples).handle();
     rbi.framebuffer = framebuffer;
     rbi.renderArea = {{0, 0}, {width, height}};
     vkCmdBeginRenderPass(cb, &rbi, VK_SUBPASS_CONTENTS_INLINE);
     frame::setViewport(cb, width, height);
 }
 
-void Frame::beginClearing(VkCommandBuffer cb, VkFramebuffer fb, uint32_t fw, uint32_t fh, glm::vec3 clearColor) const {
+void Frame::beginClearing(VkCommandBuffer cb, VkFramebuffer fb, uint32_t fw, uint32_t fh, glm::vec3 clearColor,
+                          uint32_t fbSamples) const {
     VkClearValue clear[2];
     clear[0].color = {{clearColor.x, clearColor.y, clearColor.z, 1.0f}};
     clear[1].depthStencil = {0.0f, 0};  // reversed Z: the far plane
     VkRenderPassBeginInfo rbi{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-    rbi.renderPass = g.clearPass.handle();
+    rbi.renderPass = g.clearPassFor(fbSamples).handle();
     rbi.framebuffer = fb;
     rbi.renderArea = {{0, 0}, {fw, fh}};
     rbi.clearValueCount = 2;

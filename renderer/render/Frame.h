@@ -77,6 +77,9 @@ inline constexpr const char* kSkyImage = "sky-image";
 // Pipeline variants of the terrain (all bits) and water (shadow, fog, reflection) passes.
 inline constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4, kReflectionVariant = 8,
                      kLpvVariant = 16, kLocalLightsVariant = 32;
+// A pipeline's key for a pass of `samples` a pixel: render passes of other sample counts are not
+// compatible, so a multisampled frame and the single-sampled water reflection each have their own.
+inline int kSamplesKey(uint32_t samples) { return int(samples) << 8; }
 // The lights set's variants, an index into the layouts: the shadow cascades, the reflection probes.
 inline constexpr int kShadowedLights = 1, kReflectedLights = 2;
 
@@ -132,14 +135,15 @@ struct FrameSlot {
     size_t gizmoCapacity = 0;
 };
 
-// The frame's colour and depth, drawn at `scale` x the output's width and height, and, when a
-// pass anti-aliases the picture, the output image it writes and the set that reads the colour.
+// The frame's colour and depth, drawn at `scale` x the output's width and height (or with
+// `samples` a pixel), and, when a pass anti-aliases the picture, the output image it writes and
+// the set that reads the colour (or the output a resolve writes).
 // The read-back holds the output's pixels.
 struct RenderTarget {
-    vk::Image color, depth;
+    vk::Image color, depth;  // multisampled with samples > 1 (msaa), resolved into output
     vk::Framebuffer framebuffer;
     vk::Readback readback;
-    uint32_t width = 0, height = 0, scale = 1;
+    uint32_t width = 0, height = 0, scale = 1, samples = 1;
     vk::Image output;
     vk::Framebuffer outputFramebuffer;
     vk::DescriptorSet source;
@@ -183,6 +187,11 @@ struct RendererGpu {
     std::vector<std::unique_ptr<RenderTarget>> spareTargets;
     size_t targetAllocations = 0;
     vk::RenderPass clearPass, drawPass, shadowPass;
+    // The camera's clearing and drawing passes for a multisampled target, by its samples a pixel
+    // (> 1); built with the first target of that count.
+    std::map<uint32_t, std::pair<vk::RenderPass, vk::RenderPass>> multisampledPasses;
+    const vk::RenderPass& clearPassFor(uint32_t samples) const;
+    const vk::RenderPass& drawPassFor(uint32_t samples) const;
     vk::Sampler depthSampler;
     vk::UniqueSetLayout emptySet;
     std::array<vk::UniqueSetLayout, 4> lightsLayouts;     // by lights variant
@@ -202,8 +211,10 @@ struct RendererGpu {
     // Terrain pipelines by variant: kProbeLightVariant | kShadowVariant | kFogVariant |
     // kReflectionVariant | kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV
     // shaders and layout).
+    // Keyed also by the samples a pixel of the pass they draw in (kSamplesKey).
     std::map<int, vk::UniquePipeline> terrain;
-    vk::UniquePipeline skyPlain, skyFog, shadowDepth, markerPipeline, leafPipeline, gizmoPipeline, probePass;
+    std::map<int, vk::UniquePipeline> sky, markerPipelines, leafPipelines, gizmoPipelines;
+    vk::UniquePipeline shadowDepth, probePass;
     // The anti-aliasing pass: its colour-only render pass, layout and pipelines by
     // (ssaa ? 2 : 0) + (scene-linear output ? 1 : 0).
     vk::RenderPass outputPass;
@@ -247,6 +258,7 @@ struct Frame {
 
     // The target.
     uint32_t width = 0, height = 0;
+    uint32_t samples = 1;  // a pixel, of the colour and depth targets (msaa)
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
     glm::vec3 background{0.0f};  // the clear colour where no pass draws the sky
 
@@ -255,8 +267,9 @@ struct Frame {
     const vk::DescriptorSet& lights() const;
     // Begins the pass that draws on top of what the frame holds (sky, water, overlays).
     void beginDrawing(VkCommandBuffer cb) const;
-    // Begins the clearing render pass on a framebuffer, with the viewport over it.
-    void beginClearing(VkCommandBuffer cb, VkFramebuffer fb, uint32_t fw, uint32_t fh, glm::vec3 clearColor) const;
+    // Begins the clearing render pass on a framebuffer of `fbSamples` a pixel, with the viewport over it.
+    void beginClearing(VkCommandBuffer cb, VkFramebuffer fb, uint32_t fw, uint32_t fh, glm::vec3 clearColor,
+                       uint32_t fbSamples = 1) const;
 };
 
 }  // namespace terralux

@@ -729,7 +729,8 @@ namespace {
 // Whether `t` serves a frame of that size and plan. A view without the pass keeps the output image
 // it does not use: switching between a picture and a data view allocates nothing.
 bool serves(const RenderTarget* t, uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
-    return t && t->width == width && t->height == height && t->scale == plan.scale && (t->source || !plan.pass);
+    return t && t->width == width && t->height == height && t->scale == plan.scale && t->samples == plan.samples &&
+           (t->source || !plan.pass) && (t->output.handle() || !plan.resolve);
 }
 
 void importTarget(FrameGraph& graph, const RenderTarget& t) {
@@ -756,15 +757,29 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     for (const char* name : kTargetNames) g.graph.forget(name);
     ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
+    const uint32_t samples = plan.samples;
+    if (samples > 1 && !g.multisampledPasses.count(samples)) {
+        const VkFormat colorFormats[] = {vk::kColorFormat};
+        vk::RenderPassDesc clear{colorFormats, vk::kDepthFormat, true, true};
+        clear.samples = samples;
+        vk::RenderPassDesc draw = clear;
+        draw.clear = false;
+        g.multisampledPasses.emplace(samples, std::make_pair(vk::RenderPass(ctx_, clear), vk::RenderPass(ctx_, draw)));
+    }
     auto t = std::make_unique<RenderTarget>(RenderTarget{
-        vk::Image::colorTarget(ctx_, drawnWidth, drawnHeight), vk::Image::depthTarget(ctx_, drawnWidth, drawnHeight),
+        samples > 1 ? vk::Image::multisampledTarget(ctx_, drawnWidth, drawnHeight, samples, vk::kColorFormat)
+                    : vk::Image::colorTarget(ctx_, drawnWidth, drawnHeight),
+        samples > 1 ? vk::Image::multisampledTarget(ctx_, drawnWidth, drawnHeight, samples, vk::kDepthFormat)
+                    : vk::Image::depthTarget(ctx_, drawnWidth, drawnHeight),
         {}, vk::Readback(ctx_, width, height)});
     t->width = width;
     t->height = height;
     t->scale = plan.scale;
+    t->samples = samples;
     const VkImageView views[] = {t->color.view(), t->depth.view()};
-    t->framebuffer = vk::Framebuffer(ctx_, g.clearPass, views, drawnWidth, drawnHeight);
+    t->framebuffer = vk::Framebuffer(ctx_, g.clearPassFor(samples), views, drawnWidth, drawnHeight);
     if (plan.pass) features::buildAntialiasingTarget(ctx_, g, *t);
+    if (plan.resolve) features::buildResolveTarget(ctx_, *t);
     replaceTarget(g.target, g.spareTargets, std::move(t));
     // The spares' handles start afresh too (the graph forgot them; nothing is in flight now).
     for (const auto& spare : g.spareTargets) {
@@ -776,7 +791,8 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
 
 features::AntialiasingPlan TerrainRenderer::antialiasingOf(const RenderSettings& s) const {
     return features::antialiasingPlan(s.antialiasing,
-                                      findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)));
+                                      findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)),
+                                      ctx_.framebufferSampleCounts());
 }
 
 // The settings the passes draw with: the output's size times the anti-aliasing's samples a side.
@@ -793,6 +809,7 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const auto start = std::chrono::steady_clock::now();
     Output out;
     out.antialiasing = antialiasingOf(s);
+    drawnAntialiasing_ = out.antialiasing.mode;
     ensureTarget(s.width, s.height, out.antialiasing);
     RenderSettings scaled;
     const RenderSettings& drawn = drawnSettings(s, out.antialiasing, scaled);
@@ -841,6 +858,7 @@ void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
 bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain) {
     Output out;
     out.antialiasing = antialiasingOf(s);
+    drawnAntialiasing_ = out.antialiasing.mode;
     ensureTarget(s.width, s.height, out.antialiasing);
     const std::optional<vk::SwapchainFrame> frame = swapchain.begin();
     if (!frame) return false;
@@ -1026,6 +1044,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.width = s.width;
     f.height = s.height;
     f.framebuffer = g.target->framebuffer.handle();
+    f.samples = g.target->samples;
     writeBlocks(f);
 
     // The passes, in order; a feature that does not take part adds none.
@@ -1038,10 +1057,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     features::addWaterPasses(f);
     features::addOverlayPass(f);
     features::addAntialiasPass(f, out.antialiasing);
-    // What leaves the frame: the anti-aliased output where a pass wrote it, else the colour.
+    features::addResolvePass(f, out.antialiasing);
+    // What leaves the frame: the anti-aliased output where a pass or a resolve wrote it, else the colour.
     RenderTarget& t = *g.target;
-    const char* final = out.antialiasing.pass ? kOutput : kColor;
-    const VkImage source = out.antialiasing.pass ? t.output.handle() : t.color.handle();
+    const bool toOutput = out.antialiasing.pass || out.antialiasing.resolve;
+    const char* final = toOutput ? kOutput : kColor;
+    const VkImage source = toOutput ? t.output.handle() : t.color.handle();
     if (out.readback) {
         g.graph.addPass({"readback", {{final, Access::TransferRead}, {kReadback, Access::TransferWrite}}, {}},
                         [&t, source](VkCommandBuffer c) { t.readback.recordCopy(c, source); });

@@ -165,6 +165,9 @@ public:
     // frame; after present(), the frame last drawn in the slot it reused (whose fence it waited
     // for), so reading them never stalls a later frame.
     const FrameTimings& lastFrameTimings() const { return timings_; }
+    // The anti-aliasing the last frame was drawn with: its settings', or for an msaa count the
+    // device lacks the largest it has below (fxaa with none); off for a data view.
+    Antialiasing drawnAntialiasing() const { return drawnAntialiasing_; }
     // Whether the probe subsystem holds GPU resources (volumes are bound).
     bool hasProbeResources() const;
     // Whether the shadow subsystem holds GPU resources (a frame drew shadows and the scene's
@@ -221,6 +224,7 @@ private:
     glm::ivec2 surfaceMapSize_{1, 1}, albedoMapSize_{1, 1};
     float finestProbeSpacing_ = 0.0f;  // of the bound volumes; 0 without
     FrameTimings timings_;
+    Antialiasing drawnAntialiasing_ = Antialiasing::Off;
 };
 
 }  // namespace terralux

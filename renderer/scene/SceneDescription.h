@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -409,11 +410,26 @@ struct LocalLight {
 // How the picture views (beauty, filled, linear) smooth their edges (docs/lighting.md,
 // "Anti-aliasing"): fxaa filters the finished frame along its luminance edges (one full-screen
 // pass); ssaa draws every pass at twice the width and height and averages each 2 x 2 block (four
-// samples a pixel, four times the shading). The data views always keep one exact sample a pixel.
-enum class Antialiasing { Off, Fxaa, Ssaa };
+// samples a pixel, four times the shading); msaa2/4/8 rasterise 2, 4 or 8 coverage and depth
+// samples a pixel, shading once per pixel and triangle, and resolve them (the largest count the
+// device offers up to the one asked for; fxaa where it offers none). The data views always keep
+// one exact sample a pixel.
+enum class Antialiasing { Off, Fxaa, Ssaa, Msaa2, Msaa4, Msaa8 };
 // A mode's project-file name.
 inline const char* antialiasingName(Antialiasing a) {
-    return a == Antialiasing::Off ? "off" : a == Antialiasing::Fxaa ? "fxaa" : "ssaa";
+    switch (a) {
+        case Antialiasing::Off: return "off";
+        case Antialiasing::Fxaa: return "fxaa";
+        case Antialiasing::Ssaa: return "ssaa";
+        case Antialiasing::Msaa2: return "msaa2";
+        case Antialiasing::Msaa4: return "msaa4";
+        case Antialiasing::Msaa8: return "msaa8";
+    }
+    return "off";
+}
+// The samples a pixel an msaa mode asks for; 1 for the others.
+inline uint32_t msaaSamples(Antialiasing a) {
+    return a == Antialiasing::Msaa2 ? 2u : a == Antialiasing::Msaa4 ? 4u : a == Antialiasing::Msaa8 ? 8u : 1u;
 }
 
 // How the camera finds its exposure (docs/lighting.md, "Exposure"): manual at camera.ev100, or

@@ -40,7 +40,7 @@ Image::Image(const VulkanContext& ctx, const ImageDesc& desc) : desc_(desc) {
     ici.extent = {desc_.width, desc_.height, 1};
     ici.mipLevels = std::max(desc_.mipLevels, 1u);
     ici.arrayLayers = desc_.layers;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.samples = VkSampleCountFlagBits(std::max(desc_.samples, 1u));
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
     ici.usage = desc_.usage;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
@@ -72,6 +72,19 @@ constexpr VkImageUsageFlags kColorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
 
 Image Image::colorTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, VkFormat format) {
     return Image(ctx, {ImageShape::Plane, format, width, height, 1, kColorUsage});
+}
+
+Image Image::multisampledTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t samples,
+                                VkFormat format) {
+    const VkImageUsageFlags usage = isDepthFormat(format) ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT
+                                                          : VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    ImageDesc d{ImageShape::Plane, format, width, height, 1, usage};
+    d.samples = samples;
+    return Image(ctx, d);
+}
+
+Image Image::resolveTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, VkFormat format) {
+    return Image(ctx, {ImageShape::Plane, format, width, height, 1, kColorUsage | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
 }
 
 Image Image::layeredTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t layers,

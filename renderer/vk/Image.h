@@ -23,6 +23,7 @@ struct ImageDesc {
     uint32_t layers = 1;  // Layers: the array size; Cube: 6; CubeArray: 6 × cubes
     VkImageUsageFlags usage = 0;
     uint32_t mipLevels = 1;
+    uint32_t samples = 1;  // > 1: a multisampled Plane, drawn into and resolved, never sampled
 };
 
 // One mip level's texels, tightly packed rows (level 0 first).
@@ -39,6 +40,13 @@ public:
     // A colour target shaders can sample, read back or blit from.
     static Image colorTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
                              VkFormat format = kColorFormat);
+    // A multisampled colour or depth target of `samples` (a count the device supports for both,
+    // VulkanContext::framebufferSampleCounts): drawn into, then resolved (a colour target's
+    // transfer source), never sampled.
+    static Image multisampledTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, uint32_t samples,
+                                    VkFormat format);
+    // A colour target a multisampled one can also be resolved into (a transfer destination).
+    static Image resolveTarget(const VulkanContext& ctx, uint32_t width, uint32_t height, VkFormat format = kColorFormat);
     // A 2D array colour target, one layer per slice (cascades, volume slices).
     static Image layeredTarget(const VulkanContext& ctx, uint32_t width, uint32_t height,
                                uint32_t layers, VkFormat format = kColorFormat);

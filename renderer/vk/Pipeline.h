@@ -24,6 +24,7 @@ struct GraphicsPipelineDesc {
     // the far plane, so water meets the shore without fighting); shadow maps keep 0 near.
     VkCompareOp depthCompare = VK_COMPARE_OP_GREATER_OR_EQUAL;
     bool depthClamp = false;  // needs VulkanContext::depthClamp()
+    uint32_t samples = 1;     // the render pass's
 };
 
 UniquePipeline createGraphicsPipeline(const VulkanContext& ctx, VkRenderPass pass,

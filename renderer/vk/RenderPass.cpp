@@ -1,5 +1,6 @@
 #include "vk/RenderPass.h"
 
+#include <algorithm>
 #include <vector>
 
 namespace terralux::vk {
@@ -10,7 +11,7 @@ RenderPass::RenderPass(const VulkanContext& ctx, const RenderPassDesc& desc) {
     for (VkFormat f : desc.colors) {
         VkAttachmentDescription a{};
         a.format = f;
-        a.samples = VK_SAMPLE_COUNT_1_BIT;
+        a.samples = VkSampleCountFlagBits(std::max(desc.samples, 1u));
         a.loadOp = desc.clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
         a.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
         a.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
@@ -23,7 +24,7 @@ RenderPass::RenderPass(const VulkanContext& ctx, const RenderPassDesc& desc) {
     if (desc.depth != VK_FORMAT_UNDEFINED) {
         VkAttachmentDescription a{};
         a.format = desc.depth;
-        a.samples = VK_SAMPLE_COUNT_1_BIT;
+        a.samples = VkSampleCountFlagBits(std::max(desc.samples, 1u));
         a.loadOp = desc.clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
         a.storeOp = desc.storeDepth ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
         a.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;

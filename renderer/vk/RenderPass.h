@@ -17,6 +17,7 @@ struct RenderPassDesc {
     VkFormat depth = VK_FORMAT_UNDEFINED;  // none
     bool clear = true;                     // false: load what is there
     bool storeDepth = false;               // true when a later pass reads or draws on the depth
+    uint32_t samples = 1;                  // of every attachment
 };
 
 class RenderPass {

@@ -136,6 +136,7 @@ void VulkanContext::create(const ContextOptions& options) {
             deviceType_ = p.deviceType;
             timestampBits_ = qf[size_t(family)].timestampValidBits;
             timestampPeriod_ = timestampBits_ > 0 ? double(p.limits.timestampPeriod) : 0.0;
+            sampleCounts_ = uint32_t(p.limits.framebufferColorSampleCounts & p.limits.framebufferDepthSampleCounts);
         }
     }
     if (physical_ == VK_NULL_HANDLE) {

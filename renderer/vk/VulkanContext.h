@@ -67,6 +67,9 @@ public:
     // holds (the rest are undefined).
     double timestampPeriod() const { return timestampPeriod_; }
     uint32_t timestampBits() const { return timestampBits_; }
+    // The sample counts (VkSampleCountFlags) a framebuffer may have with both a colour and a depth
+    // attachment: the multisampled anti-aliasing the device offers.
+    uint32_t framebufferSampleCounts() const { return sampleCounts_; }
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
 
     // Validation messages seen so far (warnings and errors), for tests that must see none.
@@ -103,6 +106,7 @@ private:
     bool depthClamp_ = false;
     double timestampPeriod_ = 0.0;
     uint32_t timestampBits_ = 0;
+    uint32_t sampleCounts_ = VK_SAMPLE_COUNT_1_BIT;
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;

@@ -246,7 +246,7 @@ void BM_BeautyShadowsFog(benchmark::State& state) {
 BENCHMARK(BM_BeautyShadowsFog)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1})
     ->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
-// Beauty at 1920 x 1080 with each camera.antialiasing mode: the frame and the antialias pass's
+// Beauty at 1920 x 1080 with each camera.antialiasing mode (off, fxaa, ssaa, msaa2, msaa4, msaa8): the frame and the antialias or resolve pass's
 // own GPU time (aa_gpu_ms, where the device writes timestamps).
 void BM_Antialiasing(benchmark::State& state) {
     Fixture& f = fixture();
@@ -268,15 +268,16 @@ void BM_Antialiasing(benchmark::State& state) {
         ms += f.renderer->render(q).milliseconds;
         cost.add(f.renderer->renderer());
         for (const auto& t : f.renderer->renderer().lastFrameTimings().passes)
-            if (t.name == "antialias") pass += t.gpuMilliseconds, ++timed;
+            if (t.name == "antialias" || t.name == "resolve") pass += t.gpuMilliseconds, ++timed;
     }
-    state.SetLabel(std::string(antialiasingName(p.scene.camera.antialiasing)) + " on " + f.ctx->deviceName());
+    // The mode drawn: an msaa count the device lacks falls to the largest it has below.
+    state.SetLabel(std::string(antialiasingName(f.renderer->renderer().drawnAntialiasing())) + " on " + f.ctx->deviceName());
     state.counters["frame_ms"] = ms / double(state.iterations());
     if (timed > 0) state.counters["aa_gpu_ms"] = pass / timed;
     cost.report(state);
     f.renderer->setProject(fixtureProject());
 }
-BENCHMARK(BM_Antialiasing)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
+BENCHMARK(BM_Antialiasing)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->MinTime(1.0)->UseRealTime();
 
 // The viewport's dynamic resolution: beauty over N42E001 at a 1350 x 990 window (the size the
 // viewport had when it was measured on lavapipe) drawn at each of the scales it steps through,

@@ -6,9 +6,20 @@ namespace terralux::features {
 
 using namespace frame;
 
-AntialiasingPlan antialiasingPlan(Antialiasing mode, const DebugView& view) {
+AntialiasingPlan antialiasingPlan(Antialiasing mode, const DebugView& view, uint32_t sampleCounts) {
     // The data views are measured per pixel (shadow agreement, masks, indices): one exact sample.
     if (mode == Antialiasing::Off || view.background == ViewBackground::Black) return {};
+    if (const uint32_t asked = msaaSamples(mode); asked > 1) {
+        for (uint32_t n = asked; n >= 2; n /= 2)
+            if (sampleCounts & n) {
+                AntialiasingPlan p;
+                p.mode = n == 8 ? Antialiasing::Msaa8 : n == 4 ? Antialiasing::Msaa4 : Antialiasing::Msaa2;
+                p.samples = n;
+                p.resolve = true;
+                return p;
+            }
+        mode = Antialiasing::Fxaa;
+    }
     return {mode == Antialiasing::Ssaa ? 2u : 1u, true, mode};
 }
 
@@ -49,6 +60,26 @@ void buildAntialiasingTarget(vk::VulkanContext& ctx, RendererGpu& g, RenderTarge
     const VkImageView views[] = {t.output.view()};
     t.outputFramebuffer = vk::Framebuffer(ctx, g.outputPass, views, t.width, t.height);
     t.source = sourceSet(t.color.view(), g.linear.handle()).build(ctx);
+}
+
+void buildResolveTarget(vk::VulkanContext& ctx, RenderTarget& t) {
+    t.output = vk::Image::resolveTarget(ctx, t.width, t.height);
+}
+
+void addResolvePass(Frame& f, const AntialiasingPlan& plan) {
+    if (!plan.resolve) return;
+    RenderTarget& t = *f.g.target;
+    const VkImage source = t.color.handle(), dest = t.output.handle();
+    const uint32_t w = t.width, h = t.height;
+    f.g.graph.addPass({"resolve", {{kColor, Access::TransferRead}, {kOutput, Access::TransferWrite}}, {}},
+                      [source, dest, w, h](VkCommandBuffer c) {
+                          VkImageResolve region{};
+                          region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                          region.extent = {w, h, 1};
+                          vkCmdResolveImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
+                                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+                      });
 }
 
 void addAntialiasPass(Frame& f, const AntialiasingPlan& plan) {

@@ -26,15 +26,16 @@ blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog) {
     return atmosphere;
 }
 
-VkPipeline skyPipeline(Frame& f) {
-    vk::UniquePipeline& pipeline = f.fog ? f.g.skyFog : f.g.skyPlain;
+VkPipeline skyPipeline(Frame& f, uint32_t samples) {
+    vk::UniquePipeline& pipeline = f.g.sky[(f.fog ? 1 : 0) | kSamplesKey(samples)];
     if (!pipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::fullscreenVert();
         d.frag = shaders::skyBackgroundFrag();
         d.fragConstants = {f.fog ? 1u : 0u};
         d.depthWrite = false;
-        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.terrainLayouts[0].handle(), d);
+        d.samples = samples;
+        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(samples).handle(), f.g.terrainLayouts[0].handle(), d);
     }
     return pipeline.get();
 }
@@ -45,7 +46,7 @@ void addSkyPass(Frame& f) {
                   {{kColor, Access::ColorAttachmentDraw}, {kDepth, Access::DepthAttachmentDraw}},
                   concat(f.slot.view.bindingNames(), f.slot.lights.bindingNames())};
     if (f.fog) info.bindings.push_back("fog");
-    const VkPipeline pipeline = skyPipeline(f);
+    const VkPipeline pipeline = skyPipeline(f, f.samples);
     const VkDescriptorSet sets[] = {f.slot.view.handle(), f.slot.lights.handle()};
     f.g.graph.addPass(std::move(info), [&f, pipeline, sets](VkCommandBuffer c) {
         f.beginDrawing(c);

@@ -10,7 +10,7 @@ blocks::SunSkyBlock packSunSky(const RenderSettings& s);
 // Height fog with its base height and colour resolved.
 blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog);
 // The sky pipeline for the frame's fog, built on first use (the water's reflection draws it too).
-VkPipeline skyPipeline(Frame& f);
+VkPipeline skyPipeline(Frame& f, uint32_t samples);
 // Draws the sky where the terrain left the far plane.
 void addSkyPass(Frame& f);
 

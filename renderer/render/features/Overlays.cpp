@@ -39,19 +39,24 @@ vk::UniquePipeline overlayPipeline(Frame& f, std::span<const uint32_t> vert, VkP
     d.attributes = {{0, 0, VK_FORMAT_R32G32B32A32_SFLOAT, 0}};
     d.topology = topology;
     d.depthWrite = false;
-    return vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.overlayLayout.handle(), d);
+    d.samples = f.samples;
+    return vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(f.samples).handle(), f.g.overlayLayout.handle(), d);
 }
 
 void ensurePipelines(Frame& f) {
     RendererGpu& g = f.g;
-    if ((f.drawMarkers || f.drawReflectionMarkers) && !g.markerPipeline)
-        g.markerPipeline = overlayPipeline(f, shaders::markersVert(), VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST);
+    const int key = kSamplesKey(f.samples);
+    vk::UniquePipeline& markers = g.markerPipelines[key];
+    if ((f.drawMarkers || f.drawReflectionMarkers) && !markers)
+        markers = overlayPipeline(f, shaders::markersVert(), VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST);
     // The 12 edges of each leaf box as a line list.
-    if (f.drawLeaves && !g.leafPipeline)
-        g.leafPipeline = overlayPipeline(f, shaders::leavesVert(), VK_PRIMITIVE_TOPOLOGY_LINE_LIST);
+    vk::UniquePipeline& leaves = g.leafPipelines[key];
+    if (f.drawLeaves && !leaves)
+        leaves = overlayPipeline(f, shaders::leavesVert(), VK_PRIMITIVE_TOPOLOGY_LINE_LIST);
     // Gizmos: two vertices per line instance, drawn whatever the depth says, so a volume's bounds
     // and handles stay in sight behind a ridge.
-    if (f.drawGizmos && !g.gizmoPipeline) {
+    vk::UniquePipeline& gizmos = g.gizmoPipelines[key];
+    if (f.drawGizmos && !gizmos) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::gizmosVert();
         d.frag = shaders::markersFrag();
@@ -62,7 +67,8 @@ void ensurePipelines(Frame& f) {
         d.topology = VK_PRIMITIVE_TOPOLOGY_LINE_LIST;
         d.depthWrite = false;
         d.depthCompare = VK_COMPARE_OP_ALWAYS;
-        g.gizmoPipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(), f.g.overlayLayout.handle(), d);
+        d.samples = f.samples;
+        gizmos = vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(f.samples).handle(), f.g.overlayLayout.handle(), d);
     }
 }
 
@@ -92,8 +98,11 @@ void addOverlayPass(Frame& f) {
     const uint32_t gizmoCount = f.drawGizmos ? f.gizmoCount : 0;
     const vk::Buffer* reflectionMarkers = f.drawReflectionMarkers ? &g.reflections->markers : nullptr;
     const uint32_t reflectionMarkerCount = f.drawReflectionMarkers ? g.reflections->markerCount : 0;
+    const int key = kSamplesKey(f.samples);
+    const VkPipeline leafPipeline = g.leafPipelines[key].get(), markerPipeline = g.markerPipelines[key].get(),
+                     gizmoPipeline = g.gizmoPipelines[key].get();
     g.graph.addPass(std::move(info), [&f, leafCount, markerCount, reflectionMarkers, reflectionMarkerCount,
-                                      gizmoCount](VkCommandBuffer c) {
+                                      gizmoCount, leafPipeline, markerPipeline, gizmoPipeline](VkCommandBuffer c) {
         RendererGpu& g = f.g;
         f.beginDrawing(c);
         const VkDescriptorSet view = f.slot.view.handle(), overlay = f.slot.overlays.handle();
@@ -108,10 +117,10 @@ void addOverlayPass(Frame& f) {
             vkCmdBindVertexBuffers(c, 0, 1, &b, &offset);
             vkCmdDraw(c, vertices, count, 0, 0);
         };
-        if (leafCount > 0) draw(g.leafPipeline.get(), g.leaves, 24, leafCount);
-        if (markerCount > 0) draw(g.markerPipeline.get(), g.markers, 6, markerCount);
-        if (reflectionMarkerCount > 0) draw(g.markerPipeline.get(), *reflectionMarkers, 6, reflectionMarkerCount);
-        if (gizmoCount > 0) draw(g.gizmoPipeline.get(), f.slot.gizmos, 2, gizmoCount);
+        if (leafCount > 0) draw(leafPipeline, g.leaves, 24, leafCount);
+        if (markerCount > 0) draw(markerPipeline, g.markers, 6, markerCount);
+        if (reflectionMarkerCount > 0) draw(markerPipeline, *reflectionMarkers, 6, reflectionMarkerCount);
+        if (gizmoCount > 0) draw(gizmoPipeline, f.slot.gizmos, 2, gizmoCount);
         vkCmdEndRenderPass(c);
     });
 }

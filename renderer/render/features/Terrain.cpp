@@ -78,7 +78,7 @@ blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& i
     return surface;
 }
 
-TerrainDraw terrainDraw(Frame& f) {
+TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
     RendererGpu& g = f.g;
     // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
     // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
@@ -90,7 +90,7 @@ TerrainDraw terrainDraw(Frame& f) {
     const size_t lightsVariant = size_t(f.lightsVariant());
     const VkPipelineLayout layout =
         f.lpvSet ? g.terrainLpvLayouts[lightsVariant].handle() : g.terrainLayouts[lightsVariant].handle();
-    vk::UniquePipeline& pipeline = g.terrain[variant];
+    vk::UniquePipeline& pipeline = g.terrain[variant | kSamplesKey(samples)];
     if (!pipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
@@ -108,7 +108,8 @@ TerrainDraw terrainDraw(Frame& f) {
             d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
             d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
         }
-        pipeline = vk::createGraphicsPipeline(f.ctx, g.clearPass.handle(), layout, d);
+        d.samples = samples;
+        pipeline = vk::createGraphicsPipeline(f.ctx, g.clearPassFor(samples).handle(), layout, d);
     }
     VkBuffer attribute = VK_NULL_HANDLE;
     if (f.probes)
@@ -165,8 +166,8 @@ void addTerrainPass(Frame& f) {
     PassInfo info = terrainPassInfo(f, "terrain", {{kColor, Access::ColorAttachmentClear}, {kDepth, Access::DepthAttachmentClear}},
                                     f.slot.view);
     const VkDescriptorSet viewSet = f.slot.view.handle();
-    f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f), viewSet](VkCommandBuffer c) {
-        f.beginClearing(c, f.framebuffer, f.width, f.height, f.background);
+    f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f, f.samples), viewSet](VkCommandBuffer c) {
+        f.beginClearing(c, f.framebuffer, f.width, f.height, f.background, f.samples);
         draw(c, viewSet);
         vkCmdEndRenderPass(c);
     });

@@ -40,9 +40,9 @@ blocks::CameraBlock packMirroredCamera(const RenderSettings& s, const blocks::Ca
 blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& in);
 
 // Records the terrain mesh with the frame's pipeline variant, with `viewSet` (the frame's view or
-// the mirrored camera's).
+// the mirrored camera's), in a pass of `samples` a pixel (the frame's, or the reflection's 1).
 using TerrainDraw = std::function<void(VkCommandBuffer, VkDescriptorSet viewSet)>;
-TerrainDraw terrainDraw(Frame& f);
+TerrainDraw terrainDraw(Frame& f, uint32_t samples);
 // The terrain pass's uses and bindings beyond `targets`, for a pass named `name` with `viewSet`.
 PassInfo terrainPassInfo(const Frame& f, const char* name, std::vector<ResourceUse> targets,
                          const vk::DescriptorSet& viewSet);

@@ -172,7 +172,7 @@ namespace {
 VkPipeline waterPipeline(Frame& f) {
     const int variant = (f.shadows ? kShadowVariant : 0) | (f.fog ? kFogVariant : 0) |
                         (f.reflections ? kReflectionVariant : 0);
-    vk::UniquePipeline& pipeline = f.g.waterPipelines[variant];
+    vk::UniquePipeline& pipeline = f.g.waterPipelines[variant | kSamplesKey(f.samples)];
     if (!pipeline) {
         vk::GraphicsPipelineDesc d;
         d.vert = shaders::waterVert();
@@ -181,7 +181,8 @@ VkPipeline waterPipeline(Frame& f) {
         d.fragConstants = {f.fog ? 1u : 0u};
         d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
         d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
-        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPass.handle(),
+        d.samples = f.samples;
+        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(f.samples).handle(),
                                               f.g.waterLayouts[size_t(f.lightsVariant())].handle(), d);
     }
     return pipeline.get();
@@ -199,8 +200,9 @@ void addReflectionPass(Frame& f) {
     const VkDescriptorSet viewSet = f.slot.reflectionView.handle(), skyLights = f.slot.lights.handle();
     const VkFramebuffer fb = water->targets->reflectionFramebuffer.handle();
     const uint32_t rw = water->targets->reflectionWidth, rh = water->targets->reflectionHeight;
-    const VkPipeline sky = skyPipeline(f);
-    f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f), viewSet, skyLights, fb, rw, rh,
+    // The reflection target has one sample a pixel, whatever the frame's.
+    const VkPipeline sky = skyPipeline(f, 1);
+    f.g.graph.addPass(std::move(info), [&f, draw = terrainDraw(f, 1), viewSet, skyLights, fb, rw, rh,
                                         sky](VkCommandBuffer c) {
         f.beginClearing(c, fb, rw, rh, glm::vec3(0.0f));
         draw(c, viewSet);
@@ -220,12 +222,23 @@ void addReflectionPass(Frame& f) {
     });
 }
 
-// What lies under the water as the frame drew it, for the refraction.
+// What lies under the water as the frame drew it, for the refraction: copied, or with msaa
+// resolved (the refraction reads one value a pixel).
 void addSceneCopyPass(Frame& f) {
     const VkImage source = f.g.target->color.handle(), dest = f.water->targets->scene.handle();
     const uint32_t w = f.width, h = f.height;
+    const bool resolve = f.samples > 1;
     f.g.graph.addPass({"water-scene", {{kColor, Access::TransferRead}, {kWaterScene, Access::TransferWrite}}, {}},
-                      [source, dest, w, h](VkCommandBuffer c) {
+                      [source, dest, w, h, resolve](VkCommandBuffer c) {
+                          if (resolve) {
+                              VkImageResolve r{};
+                              r.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                              r.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                              r.extent = {w, h, 1};
+                              vkCmdResolveImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
+                                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
+                              return;
+                          }
                           VkImageCopy region{};
                           region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
                           region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
