@@ -421,7 +421,7 @@ TEST(BakeReport, RaysCountTheCacheAndTheProbes) {
     EXPECT_EQ(r["probe_rays"].get<uint64_t>(),
               uint64_t(std::llround(v["probes"].get<double>() * v["rays_per_probe"]["mean"].get<double>())));
     EXPECT_EQ(v["rays_per_probe"]["min"].get<int>(), 96);
-    EXPECT_LE(v["rays_per_probe"]["max"].get<int>(), 768);
+    EXPECT_LE(v["rays_per_probe"]["max"].get<int>(), qualityPreset(QualityPreset::Draft).maxRays);
     EXPECT_EQ(r["probe_rays"], v["rays"]);
     const uint64_t cache = r["quality"]["cache_points"].get<uint64_t>() * r["quality"]["cache_rays"].get<uint64_t>();
     EXPECT_GT(cache, 0u);

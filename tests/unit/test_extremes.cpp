@@ -395,6 +395,7 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
 
     // Every probe of every volume: finite, and no negative irradiance toward 256 normals.
     size_t probes = 0;
+    std::vector<float> analyticSums;
     float worstStandardError = 0.0f;
     for (const auto& v : outcome.report["volumes"])
         if (v.contains("standard_error") && v["standard_error"]["max"].is_number())
@@ -412,19 +413,32 @@ TEST_P(Extremes, BakesSoundlyOrRefusesWithTheRule) {
                 const float scale = 1e-5f * std::max(1.0f, glm::length(sh::evalIrradiance(s, glm::vec3(0, 1, 0))));
                 ASSERT_GE(std::min({e.x, e.y, e.z}), -scale) << "probe " << probes << ", normal " << k;
             }
-            for (const Expected& x : row.analytic) {
-                // Within the row's tolerance or three of the bake's own standard errors (the
-                // largest over its probes): an analytic value is met up to the sampling noise the
-                // bake reports.
-                const float tolerance = std::max(x.tolerance, 3.0f * worstStandardError);
+            for (size_t k = 0; k < row.analytic.size(); ++k) {
+                // Each probe within the row's tolerance or three of the bake's own standard errors
+                // at that normal. The reported error (the largest over the probes) is the RMS over
+                // normals; at one normal a band-l coefficient's error weighs up to sqrt(2l + 1) times
+                // its RMS (the addition theorem, Σ_m Y_lm(n)² = (2l + 1) / 4π), so sqrt(5) for the
+                // quadratic band: on flat ground the error lies in the m != 0 terms, which peak at the
+                // horizon (measured 1.4 % RMS toward the horizon against 1.0 % reported at draft).
+                const Expected& x = row.analytic[k];
+                const float tolerance = std::max(x.tolerance, 3.0f * std::sqrt(5.0f) * worstStandardError);
                 const float got = luminance(sh::evalIrradiance(s, x.normal));
                 EXPECT_NEAR(got, x.irradiance, tolerance * x.irradiance) << "toward (" << x.normal.x << ", "
                                                                             << x.normal.y << ", " << x.normal.z << ")";
+                analyticSums.resize(row.analytic.size());
+                analyticSums[k] += got;
             }
             ++probes;
         }
     }
     EXPECT_GT(probes, 0u);
+    // Over the row's probes (each the same analytic answer, each its own noise) the mean holds
+    // the row's own tolerance: a bias, not noise, would leave it.
+    for (size_t k = 0; k < analyticSums.size(); ++k) {
+        const Expected& x = row.analytic[k];
+        EXPECT_NEAR(analyticSums[k] / float(probes), x.irradiance, x.tolerance * x.irradiance)
+            << "mean toward (" << x.normal.x << ", " << x.normal.y << ", " << x.normal.z << ")";
+    }
     // The reflection probes: the reader refuses any non-finite or negative radiance.
     if (p.scene.reflectionProbes.enabled) {
         const ReflectionProbeSet set = readReflectionProbeFile(out / "reflection" / kReflectionProbeFile);
