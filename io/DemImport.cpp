@@ -109,16 +109,18 @@ bool suggestedWarpSize(GDALDatasetH src, const std::string& dstWkt, int& w, int&
 struct Window {
     int x0, y0, x1, y1;  // inclusive
 };
-Window coveredWindow(const std::vector<uint8_t>& cov, int w, int h) {
+Window coveredWindow(const CoverageRuns& cov) {
+    const int w = cov.width, h = int(cov.rows.size());
     Window win{0, 0, w - 1, h - 1};
     auto rowGaps = [&](int y) {
-        int n = 0;
-        for (int x = win.x0; x <= win.x1; ++x) n += cov[size_t(y) * w + x] == 0;
-        return n;
+        int covered = 0;
+        for (const auto& [a, b] : cov.rows[size_t(y)])
+            covered += std::max(0, std::min(b, win.x1) - std::max(a, win.x0) + 1);
+        return (win.x1 - win.x0 + 1) - covered;
     };
     auto colGaps = [&](int x) {
         int n = 0;
-        for (int y = win.y0; y <= win.y1; ++y) n += cov[size_t(y) * w + x] == 0;
+        for (int y = win.y0; y <= win.y1; ++y) n += !cov.covers(x, y);
         return n;
     };
     while (win.x0 <= win.x1 && win.y0 <= win.y1) {
@@ -199,6 +201,26 @@ void locateOnEarth(GeoOrigin& geo, double unit) {
 }
 
 }  // namespace
+
+void CoverageRuns::addRow(int y, const uint8_t* cells) {
+    std::vector<std::pair<int, int>>& runs = rows.at(size_t(y));
+    runs.clear();
+    for (int x = 0; x < width;) {
+        if (!cells[x]) {
+            ++x;
+            continue;
+        }
+        const int first = x;
+        while (x < width && cells[x]) ++x;
+        runs.emplace_back(first, x - 1);
+    }
+}
+
+bool CoverageRuns::covers(int x, int y) const {
+    for (const auto& [a, b] : rows[size_t(y)])
+        if (x >= a && x <= b) return true;
+    return false;
+}
 
 int utmEpsgFor(double longitudeDeg, double latitudeDeg) {
     double lon = std::fmod(longitudeDeg + 180.0, 360.0);
@@ -322,7 +344,7 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
     // Pick the output grid: metric CRS, north up, optionally reduced.
     DatasetPtr work;        // the grid we finally read (may be src itself)
     bool lazyWarp = false;  // work is a virtual warp or resampling of the source, read on demand
-    DatasetPtr coverage;    // 1 where the warped output lies inside the source footprint
+    CoverageRuns coverage;  // where the warped output lies inside the source footprint
     GDALDatasetH readFrom = heightSource;
     const double maxCells = options.maxCells;
 
@@ -383,8 +405,9 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
-        // A window's heights are checked once its size is known; the coverage holds a byte a cell.
-        if (double(outW) * outH > maxCells * (options.window || gridOnly ? 4.0 : 1.0))
+        // A window's heights are checked once its size is known (the coverage holds its runs, a
+        // few integers a row).
+        if (!(options.window || gridOnly) && double(outW) * outH > maxCells)
             fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
@@ -429,10 +452,28 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
         static_cast<GDALDataset*>(work.get())->GetGeoTransform(wgt);
         const int ww = static_cast<GDALDataset*>(work.get())->GetRasterXSize();
         const int wh = static_cast<GDALDataset*>(work.get())->GetRasterYSize();
-        coverage = warpTo(path, ones.get(),
-                          {"-of", "MEM", "-t_srs", dstWkt, "-te", fmt(wgt[0]), fmt(wgt[3] + wgt[5] * wh),
-                           fmt(wgt[0] + wgt[1] * ww), fmt(wgt[3]), "-ts", std::to_string(ww),
-                           std::to_string(wh), "-r", "near", "-dstnodata", "0", "-wm", "8"});
+        // A virtual warp, read a strip of rows at a time into runs: never a byte a cell of the grid.
+        DatasetPtr warped = warpTo(path, ones.get(),
+                                   {"-of", "VRT", "-t_srs", dstWkt, "-te", fmt(wgt[0]), fmt(wgt[3] + wgt[5] * wh),
+                                    fmt(wgt[0] + wgt[1] * ww), fmt(wgt[3]), "-ts", std::to_string(ww),
+                                    std::to_string(wh), "-r", "near", "-dstnodata", "0", "-wm", "8"});
+        auto* c = static_cast<GDALDataset*>(warped.get());
+        if (c->GetRasterXSize() != ww || c->GetRasterYSize() != wh)
+            fail(path, "reprojected coverage of " + std::to_string(c->GetRasterXSize()) + "x" +
+                           std::to_string(c->GetRasterYSize()) + " cells does not match the " + std::to_string(ww) +
+                           "x" + std::to_string(wh) + " grid");
+        coverage.width = ww;
+        coverage.rows.resize(size_t(wh));
+        constexpr int kStrip = 256;
+        std::vector<uint8_t> strip;
+        for (int y0 = 0; y0 < wh; y0 += kStrip) {
+            const int rows = std::min(kStrip, wh - y0);
+            strip.resize(size_t(ww) * size_t(rows));
+            if (c->GetRasterBand(1)->RasterIO(GF_Read, 0, y0, ww, rows, strip.data(), ww, rows, GDT_Byte, 0, 0,
+                                              nullptr) != CE_None)
+                fail(path, withGdalReason("cannot read the reprojected coverage"));
+            for (int r = 0; r < rows; ++r) coverage.addRow(y0 + r, strip.data() + size_t(r) * size_t(ww));
+        }
         readFrom = work.get();
     } else {
         int outW, outH;
@@ -471,28 +512,19 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
         firstBand.reset();  // the view reads the source: it goes first
         src.reset();
     }
-    std::vector<uint8_t> cov;
-    if (coverage) {
-        auto* c = static_cast<GDALDataset*>(coverage.get());
-        const int cw = c->GetRasterXSize(), chh = c->GetRasterYSize();
-        cov.resize(size_t(cw) * size_t(chh));
-        if (c->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, cw, chh, cov.data(), cw, chh, GDT_Byte, 0, 0,
-                                          nullptr) != CE_None)
-            fail(path, withGdalReason("cannot read the reprojected coverage"));
-        coverage.reset();
-    }
 
     auto* rd = static_cast<GDALDataset*>(readFrom);
     // The grid: a reprojected raster trimmed to the window that lies wholly inside the source
     // footprint, whose first cell is (x0, y0) of the warp.
     int x0 = 0, y0 = 0;
     int gridW = rd->GetRasterXSize(), gridH = rd->GetRasterYSize();
-    if (!cov.empty()) {
-        if (cov.size() != size_t(gridW) * size_t(gridH))
-            fail(path, "reprojected coverage of " + std::to_string(cov.size()) + " cells does not match the " +
-                           std::to_string(gridW) + "x" + std::to_string(gridH) + " grid");
-        const Window win = coveredWindow(cov, gridW, gridH);
-        cov = {};
+    if (!coverage.rows.empty()) {
+        if (coverage.width != gridW || coverage.rows.size() != size_t(gridH))
+            fail(path, "reprojected coverage of " + std::to_string(coverage.width) + "x" +
+                           std::to_string(coverage.rows.size()) + " cells does not match the " + std::to_string(gridW) +
+                           "x" + std::to_string(gridH) + " grid");
+        const Window win = coveredWindow(coverage);
+        coverage = {};
         if (win.x0 > win.x1 || win.y0 > win.y1) fail(path, "reprojected raster has no coverage");
         x0 = win.x0;
         y0 = win.y0;

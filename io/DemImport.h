@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "Membrane.h"
@@ -106,6 +107,17 @@ struct DemGrid {
 DemGrid demGrid(const std::string& path, const DemImportOptions& options = {});
 DemGrid demGridFromMemory(const std::string& name, const unsigned char* bytes, size_t size,
                           const DemImportOptions& options = {});
+
+// Where a reprojected grid has source cells, row by row: each row's covered runs [first, last]
+// of columns (inclusive, ascending). The import trims the grid to the largest window whose border
+// is covered, and holds this, a few integers a row, rather than a byte a cell of the whole grid.
+struct CoverageRuns {
+    int width = 0;
+    std::vector<std::vector<std::pair<int, int>>> rows;
+    // Row y from its `width` cells (non-zero: covered).
+    void addRow(int y, const uint8_t* cells);
+    bool covers(int x, int y) const;
+};
 
 // The UTM zone EPSG code (WGS 84) for a geographic position: 326zz north, 327zz south.
 int utmEpsgFor(double longitudeDeg, double latitudeDeg);

@@ -543,3 +543,23 @@ TEST(DemImportShared, RealDems) {
         EXPECT_THROW(importDem(zip + "/nothing.zip/x.tif"), DemError);
     }
 }
+
+// The coverage of a reprojected grid is held as runs a row: a row of a rotated footprint is one
+// run, a concave footprint's two, an uncovered row none; covers() answers as the cells did.
+TEST(CoverageRuns, HoldARowsCoveredColumnsAsRuns) {
+    CoverageRuns c;
+    c.width = 8;
+    c.rows.resize(3);
+    const uint8_t one[8] = {0, 0, 1, 1, 1, 1, 1, 0};
+    const uint8_t two[8] = {1, 1, 0, 0, 1, 0, 1, 1};
+    const uint8_t none[8] = {};
+    c.addRow(0, one);
+    c.addRow(1, two);
+    c.addRow(2, none);
+    EXPECT_EQ(c.rows[0], (std::vector<std::pair<int, int>>{{2, 6}}));
+    EXPECT_EQ(c.rows[1], (std::vector<std::pair<int, int>>{{0, 1}, {4, 4}, {6, 7}}));
+    EXPECT_TRUE(c.rows[2].empty());
+    const uint8_t* rows[3] = {one, two, none};
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 8; ++x) EXPECT_EQ(c.covers(x, y), rows[y][x] != 0) << x << ", " << y;
+}
