@@ -23,6 +23,19 @@ void setViewport(VkCommandBuffer cb, uint32_t width, uint32_t height) {
     vkCmdSetScissor(cb, 0, 1, &sc);
 }
 
+void copyColor(VkCommandBuffer cb, VkImage source, VkImage dest, uint32_t width, uint32_t height, bool resolve) {
+    const VkImageSubresourceLayers layers{VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    if (resolve) {
+        const VkImageResolve r{layers, {}, layers, {}, {width, height, 1}};
+        vkCmdResolveImage(cb, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                          1, &r);
+    } else {
+        const VkImageCopy r{layers, {}, layers, {}, {width, height, 1}};
+        vkCmdCopyImage(cb, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                       &r);
+    }
+}
+
 void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,
                    VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
     VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};

@@ -95,6 +95,9 @@ inline constexpr uint32_t kFrameTimestamps = 64;
 
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b);
 void setViewport(VkCommandBuffer cb, uint32_t width, uint32_t height);
+// Records the copy of a `width` x `height` colour image `source` (transfer-source layout) into
+// `dest` (transfer-destination layout), resolving its samples when `resolve` (a multisampled source).
+void copyColor(VkCommandBuffer cb, VkImage source, VkImage dest, uint32_t width, uint32_t height, bool resolve);
 // One global memory dependency: what `srcStages` wrote through `srcAccess` is visible to
 // `dstAccess` in `dstStages`.
 void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessFlags srcAccess,

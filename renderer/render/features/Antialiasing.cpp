@@ -72,14 +72,7 @@ void addResolvePass(Frame& f, const AntialiasingPlan& plan) {
     const VkImage source = t.color.handle(), dest = t.output.handle();
     const uint32_t w = t.width, h = t.height;
     f.g.graph.addPass({"resolve", {{kColor, Access::TransferRead}, {kOutput, Access::TransferWrite}}, {}},
-                      [source, dest, w, h](VkCommandBuffer c) {
-                          VkImageResolve region{};
-                          region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.extent = {w, h, 1};
-                          vkCmdResolveImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
-                                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-                      });
+                      [source, dest, w, h](VkCommandBuffer c) { copyColor(c, source, dest, w, h, true); });
 }
 
 void addAntialiasPass(Frame& f, const AntialiasingPlan& plan) {

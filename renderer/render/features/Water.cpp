@@ -229,23 +229,7 @@ void addSceneCopyPass(Frame& f) {
     const uint32_t w = f.width, h = f.height;
     const bool resolve = f.samples > 1;
     f.g.graph.addPass({"water-scene", {{kColor, Access::TransferRead}, {kWaterScene, Access::TransferWrite}}, {}},
-                      [source, dest, w, h, resolve](VkCommandBuffer c) {
-                          if (resolve) {
-                              VkImageResolve r{};
-                              r.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                              r.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                              r.extent = {w, h, 1};
-                              vkCmdResolveImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
-                                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &r);
-                              return;
-                          }
-                          VkImageCopy region{};
-                          region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                          region.extent = {w, h, 1};
-                          vkCmdCopyImage(c, source, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dest,
-                                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-                      });
+                      [source, dest, w, h, resolve](VkCommandBuffer c) { copyColor(c, source, dest, w, h, resolve); });
 }
 
 void addSurfacePass(Frame& f) {
