@@ -108,12 +108,14 @@ constexpr const char* kReflectionSetKeys[] = {"uri",  "simvx_desktop_uri", "simv
 // shared keys differ (tiles of other inputs are refused before).
 std::optional<nlohmann::json> mergedReflections(const std::vector<BakedTile>& tiles) {
     std::optional<nlohmann::json> merged;
+    std::string firstWith;
     nlohmann::json sets = nlohmann::json::array();
     size_t probes = 0, with = 0;
     for (const BakedTile& t : tiles) {
         const nlohmann::json& g = t.gltf;
-        const nlohmann::json lighting =
-            g["scenes"][0].value("extensions", nlohmann::json::object()).value("TERRALUX_lighting", nlohmann::json::object());
+        const nlohmann::json lighting = g["scenes"][g.value("scene", 0)]
+                                            .value("extensions", nlohmann::json::object())
+                                            .value("TERRALUX_lighting", nlohmann::json::object());
         if (!lighting.contains("reflection_probes")) continue;
         ++with;
         nlohmann::json shared = lighting["reflection_probes"];
@@ -128,10 +130,13 @@ std::optional<nlohmann::json> mergedReflections(const std::vector<BakedTile>& ti
             if (set.contains(k) && set[k].is_string()) set[k] = prefix + set[k].get<std::string>();
         probes += set.value("probes", size_t(0));
         sets.push_back(set);
-        if (!merged) merged = shared;
-        else if (*merged != shared)
+        if (!merged) {
+            merged = shared;
+            firstWith = t.name;
+        } else if (*merged != shared) {
             throw ProjectError((t.dir / "scene.gltf").string() + ": reflection probes resolved otherwise than in " +
-                               tiles.front().name + "; bake the tiles again");
+                               firstWith + "; bake the tiles again");
+        }
     }
     if (with == 0) return std::nullopt;
     if (with != tiles.size())
@@ -400,6 +405,12 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
     for (BakedTile& t : tiles) {
         const std::optional<nlohmann::json> g = readJson(t.dir / "scene.gltf");
         if (!g) throw ProjectError((t.dir / "scene.gltf").string() + ": missing or unreadable; bake the tile with export.gltf on");
+        // Every later read indexes its scene: one that is not there is a file to bake again.
+        const nlohmann::json* scenes = g->contains("scenes") ? &(*g)["scenes"] : nullptr;
+        const nlohmann::json scene = g->value("scene", nlohmann::json(0));
+        if (!scenes || !scenes->is_array() || !scene.is_number_unsigned() || scene.get<size_t>() >= scenes->size() ||
+            !(*scenes)[scene.get<size_t>()].is_object())
+            throw ProjectError((t.dir / "scene.gltf").string() + ": has no scene " + scene.dump() + "; bake the tile again");
         t.gltf = *g;
         nlohmann::json files = nlohmann::json::array();
         for (const auto& f : t.report.value("files", nlohmann::json::array())) {

@@ -405,9 +405,9 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
-        // A window's heights are checked once its size is known (the coverage holds its runs, a
-        // few integers a row).
-        if (!(options.window || gridOnly) && double(outW) * outH > maxCells)
+        // A window's heights are checked once its size is known; the all-ones raster the coverage
+        // is warped from holds a byte a cell at up to twice the grid's resolution (below).
+        if (double(outW) * outH > maxCells * (options.window || gridOnly ? 4.0 : 1.0))
             fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);

@@ -727,7 +727,9 @@ void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
 namespace {
 
 // Whether `t` serves a frame of that size and plan. A view without the pass keeps the output image
-// it does not use: switching between a picture and a data view allocates nothing.
+// it does not use: switching between a picture and a data view allocates nothing, except with
+// msaa, whose multisampled target a data view (one sample) cannot draw in; it takes a
+// single-sampled one, kept as a spare beside it.
 bool serves(const RenderTarget* t, uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
     return t && t->width == width && t->height == height && t->scale == plan.scale && t->samples == plan.samples &&
            (t->source || !plan.pass) && (t->output.handle() || !plan.resolve);

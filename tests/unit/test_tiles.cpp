@@ -551,6 +551,14 @@ TEST(Tiles, TheMergeListsEveryTilesReflectionProbes) {
     } catch (const ProjectError& e) {
         EXPECT_NE(std::string(e.what()).find("1 of 2 tiles without reflection probes"), std::string::npos) << e.what();
     }
+    // A scene.gltf without its scene is refused, naming the file.
+    std::ofstream(tiled / kTilesFolder / "tile_000_001" / "scene.gltf") << R"({"asset": {"version": "2.0"}, "scenes": []})";
+    try {
+        mergeTiles(tiled);
+        ADD_FAILURE() << "merged a tile whose glTF has no scene";
+    } catch (const ProjectError& e) {
+        EXPECT_NE(std::string(e.what()).find("tile_000_001/scene.gltf: has no scene 0"), std::string::npos) << e.what();
+    }
     fs::remove_all(tiled);
 }
 
