@@ -405,9 +405,9 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
             fail(path, withGdalReason("cannot compute the reprojected grid"));
         int outW, outH;
         reducedSize(fullW, fullH, outW, outH);
-        // A window's heights are checked once its size is known; the all-ones raster the coverage
-        // is warped from holds a byte a cell at up to twice the grid's resolution (below).
-        if (double(outW) * outH > maxCells * (options.window || gridOnly ? 4.0 : 1.0))
+        // A window's heights are checked once its size is known (the coverage holds its runs, a
+        // few integers a row).
+        if (!(options.window || gridOnly) && double(outW) * outH > maxCells)
             fail(path, "reprojected raster " + std::to_string(outW) + "x" + std::to_string(outH) +
                            " is too large to hold in memory; set terrain.max_resolution");
         checkReduction(outW, outH);
@@ -434,18 +434,20 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
 
         // Same warp of an all-ones raster: where the output has no source at all. Coverage
         // depends only on the footprint, so the ones raster spans it at no more than twice the
-        // output's resolution instead of the source's (a large source would cost a byte a cell).
+        // output's resolution instead of the source's (fewer source cells for the warp to visit).
+        // It holds no cells: a virtual band with no sources reads as its nodata value, 1, which
+        // the warp is told not to treat as nodata.
         const int onesW = std::min(info.sourceWidth, 2 * outW + 2);
         const int onesH = std::min(info.sourceHeight, 2 * outH + 2);
         const double sx = double(info.sourceWidth) / onesW, sy = double(info.sourceHeight) / onesH;
         double onesGt[6] = {gt[0], gt[1] * sx, gt[2] * sy, gt[3], gt[4] * sx, gt[5] * sy};
-        GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-        DatasetPtr ones(mem->Create("", onesW, onesH, 1, GDT_Byte, nullptr));
-        if (!ones) fail(path, withGdalReason("cannot allocate the coverage raster"));
+        GDALDriver* vrt = GetGDALDriverManager()->GetDriverByName("VRT");
+        DatasetPtr ones(vrt ? vrt->Create("", onesW, onesH, 1, GDT_Byte, nullptr) : nullptr);
+        if (!ones) fail(path, withGdalReason("cannot create the coverage raster"));
         auto* onesDs = static_cast<GDALDataset*>(ones.get());
         onesDs->SetGeoTransform(onesGt);
         onesDs->SetSpatialRef(srcSrs);
-        onesDs->GetRasterBand(1)->Fill(1.0);
+        onesDs->GetRasterBand(1)->SetNoDataValue(1.0);
         // On the heights' own grid: the same extent and size, so coverage cell (i, j) is
         // heights cell (i, j) by construction, not because both warps chose alike.
         double wgt[6];
@@ -456,7 +458,8 @@ DemImportResult importDemImpl(const std::string& path, const DemImportOptions& o
         DatasetPtr warped = warpTo(path, ones.get(),
                                    {"-of", "VRT", "-t_srs", dstWkt, "-te", fmt(wgt[0]), fmt(wgt[3] + wgt[5] * wh),
                                     fmt(wgt[0] + wgt[1] * ww), fmt(wgt[3]), "-ts", std::to_string(ww),
-                                    std::to_string(wh), "-r", "near", "-dstnodata", "0", "-wm", "8"});
+                                    std::to_string(wh), "-r", "near", "-srcnodata", "None", "-dstnodata", "0",
+                                    "-wm", "8"});
         auto* c = static_cast<GDALDataset*>(warped.get());
         if (c->GetRasterXSize() != ww || c->GetRasterYSize() != wh)
             fail(path, "reprojected coverage of " + std::to_string(c->GetRasterXSize()) + "x" +
