@@ -6,7 +6,8 @@
 // frame). `total_ms` is their sum: what the user waits for, besides the window's 150 ms debounce
 // before a preview starts. A volume drag is one step of a drag of the probe volume's move handle
 // in the viewport: the handle's edit computed and validated through the project file's rules and
-// the bounds drawn again (`ui_ms`), then as any edit of the probes.
+// the bounds drawn again (`ui_ms`), then as any edit of the probes. The frame's GPU time (`gpu_ms`,
+// and per pass, where the device writes timestamps) and host recording time (`host_ms`) beside.
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -15,6 +16,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "FrameCost.h"
 #include "PreviewBake.h"
 #include "ProjectRenderer.h"
 #include "TerrainLoading.h"
@@ -95,6 +97,7 @@ void BM_Edit(benchmark::State& state) {
     q.height = 720;
     double ui = 0, preview = 0, frame = 0;
     int n = 0;
+    FrameCost cost;
     for (auto _ : state) {
         ++n;
         Project& p = s.project;
@@ -125,6 +128,7 @@ void BM_Edit(benchmark::State& state) {
         const RenderedImage img = s.renderer->render(q);
         benchmark::DoNotOptimize(img.rgba.data());
         frame += msSince(t);
+        cost.add(s.renderer->renderer());
     }
     static const char* kEdits[] = {"sun elevation", "sky intensity", "debug view", "volume drag"};
     state.SetLabel(std::string(kEdits[edit]) + (dem ? ", N42E001" : ", sample") + (hdr ? ", HDR sky" : ", uniform sky"));
@@ -132,6 +136,7 @@ void BM_Edit(benchmark::State& state) {
     state.counters["preview_ms"] = preview / n;
     state.counters["frame_ms"] = frame / n;
     state.counters["total_ms"] = (ui + preview + frame) / n;
+    cost.report(state);
 }
 
 void cases(benchmark::internal::Benchmark* b) {

@@ -13,6 +13,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "FrameCost.h"
 #include "PreviewBake.h"
 #include "ProjectRenderer.h"
 #include "TerrainLoading.h"
@@ -40,31 +41,6 @@ Project fixtureProject() {
     p.scene.exportSettings.outDir = (std::filesystem::temp_directory_path() / "terralux_bench_render").string();
     return p;
 }
-
-// GPU time (timestamps) and host recording time summed over a benchmark's frames, reported beside
-// the wall time as gpu_ms and host_ms, and each pass's GPU time as gpu_<pass>_ms, its mean over
-// the frames that ran it (gpu_ms and the passes absent where the device writes no timestamps).
-struct FrameCost {
-    double gpu = 0.0, host = 0.0;
-    int frames = 0, timed = 0;
-    std::map<std::string, std::pair<double, int>> passes;
-    void add(const TerrainRenderer& r) {
-        const FrameTimings& t = r.lastFrameTimings();
-        host += t.recordMilliseconds;
-        ++frames;
-        if (t.gpuTimed()) gpu += t.gpuMilliseconds, ++timed;
-        for (const auto& p : t.passes) {
-            auto& [ms, n] = passes[p.name];
-            ms += p.gpuMilliseconds;
-            ++n;
-        }
-    }
-    void report(benchmark::State& state) const {
-        if (frames > 0) state.counters["host_ms"] = host / frames;
-        if (timed > 0) state.counters["gpu_ms"] = gpu / timed;
-        for (const auto& [name, sum] : passes) state.counters["gpu_" + name + "_ms"] = sum.first / sum.second;
-    }
-};
 
 Fixture& fixture() {
     static Fixture f = [] {
