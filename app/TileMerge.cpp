@@ -110,14 +110,17 @@ std::optional<nlohmann::json> mergedReflections(const std::vector<BakedTile>& ti
     std::optional<nlohmann::json> merged;
     std::string firstWith;
     nlohmann::json sets = nlohmann::json::array();
-    size_t probes = 0, with = 0;
+    size_t probes = 0;
+    std::vector<std::string> without;
     for (const BakedTile& t : tiles) {
         const nlohmann::json& g = t.gltf;
         const nlohmann::json lighting = g["scenes"][g.value("scene", 0)]
                                             .value("extensions", nlohmann::json::object())
                                             .value("TERRALUX_lighting", nlohmann::json::object());
-        if (!lighting.contains("reflection_probes")) continue;
-        ++with;
+        if (!lighting.contains("reflection_probes")) {
+            without.push_back(t.name);
+            continue;
+        }
         nlohmann::json shared = lighting["reflection_probes"];
         nlohmann::json set = {{"tile", t.name}};
         for (const char* k : kReflectionSetKeys) {
@@ -138,10 +141,14 @@ std::optional<nlohmann::json> mergedReflections(const std::vector<BakedTile>& ti
                                firstWith + "; bake the tiles again");
         }
     }
-    if (with == 0) return std::nullopt;
-    if (with != tiles.size())
-        throw ProjectError(std::to_string(tiles.size() - with) + " of " + std::to_string(tiles.size()) +
-                           " tiles without reflection probes; bake them again");
+    if (!merged) return std::nullopt;
+    if (!without.empty()) {
+        std::string list;
+        for (const std::string& n : without) list += (list.empty() ? "" : ", ") + n;
+        throw ProjectError(std::to_string(without.size()) + " of " + std::to_string(tiles.size()) +
+                           " tiles without reflection probes, which " + firstWith + " has: " + list +
+                           "; bake them again");
+    }
     (*merged)["probes"] = probes;
     (*merged)["sets"] = sets;
     return merged;
