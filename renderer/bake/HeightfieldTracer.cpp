@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -205,6 +207,7 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
     // Culling compares double ray heights with these bounds; the margin dwarfs the rounding of
     // either side, and only costs a little culling.
     cullMargin_ = 1e-6 * (1.0 + std::max(std::fabs(hf.minHeight()), std::fabs(hf.maxHeight())));
+    rootMax_ = double(hf.maxHeight()) + cullMargin_;
     qBase_ = hf.minHeight();
     qStep_ = std::max(double(hf.maxHeight()) - double(hf.minHeight()), 1.0) / 60000.0;
     auto quantize = [&](double m) {
@@ -257,15 +260,35 @@ HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&
 // which node holds the ray, and every step moves forward: the walk ends. Border nodes extend
 // to infinity outward, which is where the skirt lives; with the skirt off, t is clipped to the
 // footprint instead.
-template <bool AnyHit>
-TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
-                                              RayHit* hit) const {
+// One ray's walk between two node visits: what the traversal below keeps from one visit to the
+// next, so that a batch can interleave several walks (and prefetch each one's next node while
+// the others run) and a single ray can run the same visits back to back.
+struct HeightfieldTracer::Walk {
+    GridRay ray;
+    glm::vec3 origin, dir;
+    double tLo, t, tEnd, invDu, invDv;
+    int lvl, ix, iz;
+    // Per axis: negU when u decreases along the ray; exit boundary = (index + exit) << lvl.
+    bool negU, negV, rising;
+};
+
+// Stackless max-mipmap traversal (Tevs et al. 2008, sec. 4): keep the current node (level, ix,
+// iz) and the ray parameter t at which the ray is inside it. If the ray's lowest height over
+// the node's t interval is above the node max, step to the next node at the same level and go
+// up a level (see the end of step()); else descend into the child holding the ray at t, or
+// at a cell test its triangles. Node boundaries are integer cell indices and every boundary's
+// t is computed by one expression, so stepping, ascending and descending agree exactly on
+// which node holds the ray, and every step moves forward: the walk ends. Border nodes extend
+// to infinity outward, which is where the skirt lives; with the skirt off, t is clipped to the
+// footprint instead.
+TLX_WALK_INLINE bool HeightfieldTracer::start(Walk& w, const glm::vec3& o, const glm::vec3& dir, float tMax) const {
     // NaN or infinite input would make the cell index below undefined.
     if (!std::isfinite(double(o.x) + o.y + o.z + dir.x + dir.y + dir.z))
         return false;
     const Heightfield& hf = *hf_;
-    const int w = hf.width(), d = hf.depth();
-    GridRay ray;
+    GridRay& ray = w.ray;
+    w.origin = o;
+    w.dir = dir;
     // Heightfield's own mapping (a division, then an add), so that a ray through a vertex lands
     // on its integer grid coordinate: a multiply by the rounded reciprocal can leave it a
     // rounding error off, outside the footprint at a border vertex.
@@ -276,8 +299,8 @@ TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec
     ray.dv = double(dir.z) * invCellZ_;
     ray.dy = dir.y;
 
-    const double tLo = minDistance(o);
-    double t = tLo;
+    w.tLo = minDistance(o);
+    double t = w.tLo;
     // At most FLT_MAX: hit.t must fit a float, and t = inf (a ray parallel to a level skirt
     // piece) is no hit.
     double tEnd = std::min(double(tMax), double(FLT_MAX));
@@ -299,39 +322,29 @@ TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec
             t = std::max(t, ta);
             tEnd = std::min(tEnd, tb);
         };
-        clip(ray.u0, ray.du, w - 1);
-        clip(ray.v0, ray.dv, d - 1);
+        clip(ray.u0, ray.du, hf.width() - 1);
+        clip(ray.v0, ray.dv, hf.depth() - 1);
         if (!(t <= tEnd))
             return false;
     }
+    w.t = t;
+    w.tEnd = tEnd;
 
-    // Per axis: negU when u decreases along the ray. A ray with du = 0 is walked as increasing
-    // u with 1 / du = DBL_MAX: its crossings then lie at t = 0 (u0 on the line) or at |t| far
-    // beyond FLT_MAX >= tEnd, so "which side of u = k" comes out as u0 >= k with no separate
-    // case in the loop.
-    const bool negU = ray.du < 0, negV = ray.dv < 0;
-    const double invDu = ray.du != 0 ? 1.0 / ray.du : DBL_MAX;
-    const double invDv = ray.dv != 0 ? 1.0 / ray.dv : DBL_MAX;
-    const int stepU = negU ? -1 : 1, stepV = negV ? -1 : 1;
-    const int exitU = negU ? 0 : 1, exitV = negV ? 0 : 1;  // exit boundary = (index + exit) << lvl
-    const bool rising = ray.dy >= 0;
-    const int top = int(levels_.size()) - 1;
-    const Level* levels = levels_.data();
-    const uint16_t* maxQ = maxQ_.data();
-    const double rootMax = double(hf.maxHeight()) + cullMargin_;
-    const float* heights = hf.heights().data();
-
-    // t at which the ray crosses grid line u = k (v = k): the single expression used everywhere.
-    auto crossU = [&](int k) { return (double(k) - ray.u0) * invDu; };
-    auto crossV = [&](int k) { return (double(k) - ray.v0) * invDv; };
-    // Whether the ray at t is on the high side of u = k (v = k), consistent with crossU.
-    auto highU = [&](int k) { return (t >= crossU(k)) != negU; };
-    auto highV = [&](int k) { return (t >= crossV(k)) != negV; };
+    // A ray with du = 0 is walked as increasing u with 1 / du = DBL_MAX: its crossings then lie
+    // at t = 0 (u0 on the line) or at |t| far beyond FLT_MAX >= tEnd, so "which side of u = k"
+    // comes out as u0 >= k with no separate case in the walk.
+    w.negU = ray.du < 0;
+    w.negV = ray.dv < 0;
+    w.invDu = ray.du != 0 ? 1.0 / ray.du : DBL_MAX;
+    w.invDv = ray.dv != 0 ? 1.0 / ray.dv : DBL_MAX;
+    w.rising = ray.dy >= 0;
+    // Whether the ray at t is on the high side of u = k (v = k), consistent with step()'s crossings.
+    auto highU = [&](int k) { return (t >= (double(k) - ray.u0) * w.invDu) != w.negU; };
+    auto highV = [&](int k) { return (t >= (double(k) - ray.v0) * w.invDv) != w.negV; };
 
     // Start at the cell holding the ray at t (most rays cast from the surface end within a few
     // cells, and a walk down from the root would cost a dependent cache miss per level). The
     // floor() guess is settled against the crossings so that it agrees with stepping.
-    int lvl = 0;
     int ix = startIndex(ray.u0 + t * ray.du, cellsX_);
     int iz = startIndex(ray.v0 + t * ray.dv, cellsZ_);
     while (ix > 0 && !highU(ix))
@@ -342,70 +355,148 @@ TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec
         --iz;
     while (iz + 1 < cellsZ_ && highV(iz + 1))
         ++iz;
+    w.lvl = 0;
+    w.ix = ix;
+    w.iz = iz;
+    return true;
+}
 
-    for (;;) {
-        // Where the ray leaves the node; the outermost nodes reach to infinity (the skirt).
-        const int ku = (ix + exitU) << lvl, kv = (iz + exitV) << lvl;
-        const double tx = ku > 0 && ku < cellsX_ ? crossU(ku) : kInf;
-        const double tz = kv > 0 && kv < cellsZ_ ? crossV(kv) : kInf;
-        const double tExit = std::min(std::min(tx, tz), tEnd);
-        const double yLow = ray.y0 + ray.dy * (rising ? t : tExit);
-        if (lvl == 0) {
-            // A cell: its own four heights bound it (and its skirt pieces), no stored level.
-            const int c1 = std::min(ix + 1, w - 1), r1 = std::min(iz + 1, d - 1);
-            const float* row0 = heights + size_t(iz) * size_t(w);
-            const float* row1 = heights + size_t(r1) * size_t(w);
-            const float f00 = row0[ix], f10 = row0[c1], f01 = row1[ix], f11 = row1[c1];
-            const double cellMax = std::max(std::max(f00, f10), std::max(f01, f11));
-            // The cell's pieces cannot be hit outside its box (up to kEdgeSlack), so the first
-            // cell with a hit holds the nearest one.
-            if (yLow <= cellMax + cullMargin_) {
-                double tHit = tEnd;
-                Piece piece;
-                bool found = hasTriangles_ &&
-                             trianglesHit(ray, ix, iz, f00, f10, f01, f11, tLo, tHit, piece);
-                if (opt_.skirt && (ix == 0 || iz == 0 || ix == cellsX_ - 1 || iz == cellsZ_ - 1))
-                    found |= skirtHit(ray, cellsX_, cellsZ_, ix, iz, c1, r1, f00, f10, f01, f11,
-                                      tLo, tHit, piece);
-                if (found) {
-                    if constexpr (!AnyHit) {
-                        hit->t = float(tHit);
-                        hit->position = o + hit->t * dir;
-                        hit->normal = pieceNormal(piece, hf.cellSizeX(), hf.cellSizeZ());
-                        hit->onTerrain = piece.onTerrain;
-                    }
-                    return true;
+// Asks for the memory the walk's next visit reads: a cell's two height rows, or a node's bound.
+TLX_WALK_INLINE void HeightfieldTracer::prefetch(const Walk& w) const {
+#if defined(__GNUC__)
+    if (w.lvl == 0) {
+        const size_t width = size_t(hf_->width());
+        const float* row0 = hf_->heights().data() + size_t(w.iz) * width + size_t(w.ix);
+        __builtin_prefetch(row0);
+        __builtin_prefetch(row0 + (w.iz + 1 < hf_->depth() ? width : 0));
+    } else {
+        const Level& L = levels_[size_t(w.lvl)];
+        __builtin_prefetch(maxQ_.data() + L.offset + size_t(w.iz) * size_t(L.nx) + size_t(w.ix));
+    }
+#else
+    (void)w;
+#endif
+}
+
+// One node visit: a hit, the walk ended without one, or the walk moved to its next node.
+template <bool AnyHit>
+TLX_WALK_INLINE HeightfieldTracer::Step HeightfieldTracer::step(Walk& w, RayHit* hit) const {
+    const Heightfield& hf = *hf_;
+    const GridRay& ray = w.ray;
+    const int lvl = w.lvl, ix = w.ix, iz = w.iz;
+    const double t = w.t, tEnd = w.tEnd;
+    // t at which the ray crosses grid line u = k (v = k): the single expression used everywhere.
+    auto crossU = [&](int k) { return (double(k) - ray.u0) * w.invDu; };
+    auto crossV = [&](int k) { return (double(k) - ray.v0) * w.invDv; };
+    auto highU = [&](int k) { return (t >= crossU(k)) != w.negU; };
+    auto highV = [&](int k) { return (t >= crossV(k)) != w.negV; };
+
+    // Where the ray leaves the node; the outermost nodes reach to infinity (the skirt).
+    const int ku = (ix + (w.negU ? 0 : 1)) << lvl, kv = (iz + (w.negV ? 0 : 1)) << lvl;
+    const double tx = ku > 0 && ku < cellsX_ ? crossU(ku) : kInf;
+    const double tz = kv > 0 && kv < cellsZ_ ? crossV(kv) : kInf;
+    const double tExit = std::min(std::min(tx, tz), tEnd);
+    const double yLow = ray.y0 + ray.dy * (w.rising ? t : tExit);
+    if (lvl == 0) {
+        // A cell: its own four heights bound it (and its skirt pieces), no stored level.
+        const int wd = hf.width(), d = hf.depth();
+        const int c1 = std::min(ix + 1, wd - 1), r1 = std::min(iz + 1, d - 1);
+        const float* heights = hf.heights().data();
+        const float* row0 = heights + size_t(iz) * size_t(wd);
+        const float* row1 = heights + size_t(r1) * size_t(wd);
+        const float f00 = row0[ix], f10 = row0[c1], f01 = row1[ix], f11 = row1[c1];
+        const double cellMax = std::max(std::max(f00, f10), std::max(f01, f11));
+        // The cell's pieces cannot be hit outside its box (up to kEdgeSlack), so the first
+        // cell with a hit holds the nearest one.
+        if (yLow <= cellMax + cullMargin_) {
+            double tHit = tEnd;
+            Piece piece;
+            bool found = hasTriangles_ && trianglesHit(ray, ix, iz, f00, f10, f01, f11, w.tLo, tHit, piece);
+            if (opt_.skirt && (ix == 0 || iz == 0 || ix == cellsX_ - 1 || iz == cellsZ_ - 1))
+                found |= skirtHit(ray, cellsX_, cellsZ_, ix, iz, c1, r1, f00, f10, f01, f11, w.tLo, tHit, piece);
+            if (found) {
+                if constexpr (!AnyHit) {
+                    hit->t = float(tHit);
+                    hit->position = w.origin + hit->t * w.dir;
+                    hit->normal = pieceNormal(piece, hf.cellSizeX(), hf.cellSizeZ());
+                    hit->onTerrain = piece.onTerrain;
                 }
-            }
-        } else {
-            const Level& L = levels[lvl];
-            const double nodeMax =
-                qBase_ + qStep_ * maxQ[L.offset + size_t(iz) * size_t(L.nx) + size_t(ix)];
-            if (yLow <= nodeMax) {
-                // Descend into the child holding the ray at t.
-                --lvl;
-                ix <<= 1;
-                iz <<= 1;
-                const Level& C = levels[lvl];
-                if (ix + 1 < C.nx)
-                    ix += highU((ix + 1) << lvl);
-                if (iz + 1 < C.nz)
-                    iz += highV((iz + 1) << lvl);
-                continue;
+                return Step::kHit;
             }
         }
-        if (tExit >= tEnd || (rising && ray.y0 + ray.dy * tExit > rootMax))
-            return false;
-        // Step to the next node; go one level up when it lies in another parent or, for a
-        // rising ray (which only gets higher), always, as the parent may now be cleared too.
-        t = tExit;
-        const int px = ix, pz = iz;
-        ix += tx <= tExit ? stepU : 0;
-        iz += tz <= tExit ? stepV : 0;
-        const int up = lvl < top && (rising || ((px ^ ix) | (pz ^ iz)) > 1);
-        lvl += up;
-        ix >>= up;
-        iz >>= up;
+    } else {
+        const Level& L = levels_[size_t(lvl)];
+        const double nodeMax = qBase_ + qStep_ * maxQ_[L.offset + size_t(iz) * size_t(L.nx) + size_t(ix)];
+        if (yLow <= nodeMax) {
+            // Descend into the child holding the ray at t.
+            const int cl = lvl - 1;
+            int cx = ix << 1, cz = iz << 1;
+            const Level& C = levels_[size_t(cl)];
+            if (cx + 1 < C.nx)
+                cx += highU((cx + 1) << cl);
+            if (cz + 1 < C.nz)
+                cz += highV((cz + 1) << cl);
+            w.lvl = cl;
+            w.ix = cx;
+            w.iz = cz;
+            return Step::kRunning;
+        }
+    }
+    if (tExit >= tEnd || (w.rising && ray.y0 + ray.dy * tExit > rootMax_))
+        return Step::kMiss;
+    // Step to the next node; go one level up when it lies in another parent or, for a rising
+    // ray (which only gets higher), always, as the parent may now be cleared too.
+    w.t = tExit;
+    const int nx = ix + (tx <= tExit ? (w.negU ? -1 : 1) : 0);
+    const int nz = iz + (tz <= tExit ? (w.negV ? -1 : 1) : 0);
+    const int up = lvl < int(levels_.size()) - 1 && (w.rising || ((ix ^ nx) | (iz ^ nz)) > 1);
+    w.lvl = lvl + up;
+    w.ix = nx >> up;
+    w.iz = nz >> up;
+    return Step::kRunning;
+}
+
+template <bool AnyHit>
+TLX_WALK_INLINE bool HeightfieldTracer::trace(const glm::vec3& o, const glm::vec3& dir, float tMax,
+                                              RayHit* hit) const {
+    Walk w;
+    if (!start(w, o, dir, tMax))
+        return false;
+    for (;;) {
+        const Step s = step<AnyHit>(w, hit);
+        if (s != Step::kRunning)
+            return s == Step::kHit;
+    }
+}
+
+// The batch, ahead-started: ray i + kAhead is set up (no memory read) and its start cell
+// prefetched while ray i walks in registers, so the cold start cell, the costliest read of a
+// short walk, arrives before it is needed. Every ray's visits are the single-ray walk's.
+template <bool AnyHit>
+TLX_WALK_INLINE void HeightfieldTracer::traceBatch(const TraceRay* rays, size_t n, RayHit* hits,
+                                                   uint8_t* found) const {
+    constexpr size_t kAhead = 4;
+    Walk ring[kAhead];
+    bool live[kAhead] = {};
+    auto begin = [&](size_t k) {
+        const size_t slot = k % kAhead;
+        live[slot] = start(ring[slot], rays[k].origin, rays[k].dir, rays[k].tMax);
+        if (live[slot])
+            prefetch(ring[slot]);
+    };
+    for (size_t k = 0; k < std::min(n, kAhead); ++k)
+        begin(k);
+    for (size_t i = 0; i < n; ++i) {
+        const size_t slot = i % kAhead;
+        Step s = Step::kMiss;
+        if (live[slot]) {
+            Walk& w = ring[slot];
+            while ((s = step<AnyHit>(w, AnyHit ? nullptr : hits + i)) == Step::kRunning) {
+            }
+        }
+        found[i] = s == Step::kHit;
+        if (i + kAhead < n)
+            begin(i + kAhead);
     }
 }
 
@@ -422,6 +513,40 @@ TLX_TARGET_X86_64_V3
 bool HeightfieldTracer::traceX86_64_v3(const glm::vec3& o, const glm::vec3& dir, float tMax,
                                        RayHit* hit) const {
     return trace<AnyHit>(o, dir, tMax, hit);
+}
+
+template <bool AnyHit>
+void HeightfieldTracer::batchBaseline(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const {
+    traceBatch<AnyHit>(rays, n, hits, found);
+}
+
+template <bool AnyHit>
+#if TLX_HAVE_X86_64_V3
+TLX_TARGET_X86_64_V3
+#endif
+void HeightfieldTracer::batchX86_64_v3(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const {
+    traceBatch<AnyHit>(rays, n, hits, found);
+}
+
+void HeightfieldTracer::intersect(std::span<const TraceRay> rays, std::span<RayHit> hits,
+                                  std::span<uint8_t> found) const {
+    if (hits.size() < rays.size() || found.size() < rays.size())
+        throw std::invalid_argument("HeightfieldTracer::intersect: " + std::to_string(rays.size()) +
+                                    " rays need as many hits and flags");
+    if (kernel_ == Kernel::kX86_64_v3)
+        batchX86_64_v3<false>(rays.data(), rays.size(), hits.data(), found.data());
+    else
+        batchBaseline<false>(rays.data(), rays.size(), hits.data(), found.data());
+}
+
+void HeightfieldTracer::occluded(std::span<const TraceRay> rays, std::span<uint8_t> blocked) const {
+    if (blocked.size() < rays.size())
+        throw std::invalid_argument("HeightfieldTracer::occluded: " + std::to_string(rays.size()) +
+                                    " rays need as many flags");
+    if (kernel_ == Kernel::kX86_64_v3)
+        batchX86_64_v3<true>(rays.data(), rays.size(), nullptr, blocked.data());
+    else
+        batchBaseline<true>(rays.data(), rays.size(), nullptr, blocked.data());
 }
 
 bool HeightfieldTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax,

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -30,6 +31,13 @@ struct RayHit {
     glm::vec3 position{};    // origin + t * dir
     glm::vec3 normal{};      // unit geometric normal of the surface hit, facing up (y > 0)
     bool onTerrain = false;  // true: a mesh triangle inside the footprint; false: the skirt
+};
+
+// One ray of a batch: as intersect()'s arguments.
+struct TraceRay {
+    glm::vec3 origin{};
+    glm::vec3 dir{};  // unit length
+    float tMax = INFINITY;
 };
 
 class HeightfieldTracer {
@@ -61,6 +69,12 @@ public:
     // Whether any hit exists in the same range; cheaper than intersect when only visibility
     // matters.
     bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const;
+    // A batch: found[i] (blocked[i]) and hits[i] are what intersect (occluded) gives for rays[i],
+    // bit for bit. Several walks run interleaved, each one's next node prefetched while the
+    // others run, so a batch hides the memory latency that dominates a single incoherent ray.
+    // The spans of results hold at least rays.size() entries.
+    void intersect(std::span<const TraceRay> rays, std::span<RayHit> hits, std::span<uint8_t> found) const;
+    void occluded(std::span<const TraceRay> rays, std::span<uint8_t> blocked) const;
 
     const Heightfield& heightfield() const { return *hf_; }
     const Options& options() const { return opt_; }
@@ -83,8 +97,20 @@ private:
         int nx = 0, nz = 0;  // nodes along X and Z
         size_t offset = 0;   // first node in maxQ_ (unused for level 0)
     };
+    struct Walk;
+    enum class Step : uint8_t { kRunning, kHit, kMiss };
+    bool start(Walk& w, const glm::vec3& origin, const glm::vec3& dir, float tMax) const;
+    template <bool AnyHit>
+    Step step(Walk& w, RayHit* hit) const;
+    void prefetch(const Walk& w) const;
     template <bool AnyHit>
     bool trace(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit* hit) const;
+    template <bool AnyHit>
+    void traceBatch(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const;
+    template <bool AnyHit>
+    void batchBaseline(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const;
+    template <bool AnyHit>
+    void batchX86_64_v3(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const;
     // trace<> compiled for each kernel (HeightfieldTracer.cpp inlines it into both).
     template <bool AnyHit>
     bool traceBaseline(const glm::vec3& origin, const glm::vec3& dir, float tMax,
@@ -107,6 +133,7 @@ private:
     std::vector<uint16_t> maxQ_;
     double qBase_ = 0, qStep_ = 1;
     double cullMargin_ = 0;  // absorbs rounding in the culling comparisons
+    double rootMax_ = 0;     // the highest vertex plus the margin: a rising ray above it escapes
 };
 
 // Reference: every triangle (and, when skirt is true, every skirt piece) tested one by one with

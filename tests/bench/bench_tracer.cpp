@@ -12,6 +12,7 @@
 //     directions each (a Fibonacci sphere turned by a random rotation per probe), probe by probe;
 //   2 cache-ordered, as the irradiance cache traces: 1 024 surface points lifted 5 cm along the
 //     normal, 64 cosine-weighted directions about the normal each, point by point.
+// BM_TracerBatch* trace the same sets through the batch API, kBatch rays per call.
 // The tracer runs with the skirt on, except in the Embree comparison (built when libembree-dev is
 // installed), where both sides trace the same triangles (same heights, same diagonal) without a
 // skirt. All numbers are single-threaded.
@@ -27,6 +28,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <span>
 #include <random>
 #include <string>
 #include <vector>
@@ -358,6 +360,51 @@ BENCHMARK(BM_Tracer)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 
 
 void BM_TracerOccluded(benchmark::State& state) { traceRays(state, true, true); }
 BENCHMARK(BM_TracerOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// The batch API on the same rays, kBatch at a time (as a bake hands it a probe's or a cache
+// point's rays): the interleaved, prefetching walk against the one-ray loop above.
+void traceBatches(benchmark::State& state, bool skirt, bool anyHit) {
+    const int kernel = int(state.range(1)), set = int(state.range(0));
+    if (!kernelRuns(state, kernel))
+        return;
+    const HeightfieldTracer& t = tracer(kernel, skirt);
+    const Rays& r = rays(set);
+    std::vector<TraceRay> batch(kRayCount);
+    for (int k = 0; k < kRayCount; ++k)
+        batch[size_t(k)] = {r.origin[size_t(k)], r.dir[size_t(k)], kInf};
+    std::vector<RayHit> hits(kBatch);
+    std::vector<uint8_t> found(kBatch);
+    size_t next = 0;
+    int64_t hitCount = 0;
+    for (auto _ : state) {
+        const std::span<const TraceRay> chunk(batch.data() + (next & (kRayCount - 1)), kBatch);
+        next += kBatch;
+        if (anyHit)
+            t.occluded(chunk, found);
+        else
+            t.intersect(chunk, hits, found);
+        benchmark::DoNotOptimize(found.data());
+        benchmark::DoNotOptimize(hits.data());
+        for (uint8_t f : found) hitCount += f;
+    }
+    const int64_t n = int64_t(state.iterations()) * kBatch;
+    state.SetItemsProcessed(n);
+    state.counters["hit_fraction"] = double(hitCount) / double(std::max<int64_t>(n, 1));
+    state.SetLabel(std::string(kRaySetNames[set]) + "; batch; " + kKernelNames[kernel] + "; " + dem().source);
+}
+
+void BM_TracerBatch(benchmark::State& state) { traceBatches(state, true, false); }
+BENCHMARK(BM_TracerBatch)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+void BM_TracerBatchOccluded(benchmark::State& state) { traceBatches(state, true, true); }
+BENCHMARK(BM_TracerBatchOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+// Without the skirt: the batch's column beside Embree's (BM_Embree*1 trace the same triangles).
+void BM_TracerBatchNoSkirt(benchmark::State& state) { traceBatches(state, false, false); }
+BENCHMARK(BM_TracerBatchNoSkirt)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
+
+void BM_TracerBatchNoSkirtOccluded(benchmark::State& state) { traceBatches(state, false, true); }
+BENCHMARK(BM_TracerBatchNoSkirtOccluded)->ArgNames({"rays", "kernel"})->ArgsProduct({{0, 1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 void BM_RayMarch(benchmark::State& state) {
     const Heightfield& hf = dem().hf;

@@ -9,6 +9,8 @@
 #include <iostream>
 #include <limits>
 #include <random>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -363,6 +365,61 @@ TEST(HeightfieldTracer, KernelsAgree) {
         EXPECT_EQ(tOff, 0);
         EXPECT_EQ(pieceOff, 0);
     }
+}
+
+// The batch API gives each ray exactly what the single-ray calls give (so it is as exact as
+// they are against the brute force): for both kernels, with and without the skirt, batches
+// shorter than its look-ahead and long ones, finite and infinite tMax, and rays that end before
+// they start (NaN, tMax 0, behind the origin).
+TEST(HeightfieldTracer, BatchesAgreeWithSingleRays) {
+    const Heightfield hf = makeRoughDem(301, 257, 30.0, 45.0, 2500.0f, 21);
+    for (Kernel kernel : kernelsHere())
+        for (bool skirt : {true, false}) {
+            const HeightfieldTracer tracer(hf, {skirt, kernel});
+            std::mt19937 rng(skirt ? 31 : 32);
+            std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+            std::vector<TraceRay> rays;
+            for (int i = 0; i < 6000; ++i) {
+                const float x = hf.minX() + (1.4f * u01(rng) - 0.2f) * (hf.maxX() - hf.minX());
+                const float z = hf.minZ() + (1.4f * u01(rng) - 0.2f) * (hf.maxZ() - hf.minZ());
+                const glm::vec3 o(x, hf.surfaceHeight(x, z) + std::pow(10.0f, -2.0f + 5.0f * u01(rng)), z);
+                // Runs of rays from one origin (as a probe traces) between incoherent ones.
+                const int run = i % 7 == 0 ? 16 : 1;
+                for (int k = 0; k < run; ++k)
+                    rays.push_back({o, randomDir(rng), i % 3 == 0 ? 3000.0f * u01(rng) : kInf});
+            }
+            const glm::vec3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f), o(0.0f, hf.maxHeight() + 10.0f, 0.0f);
+            rays.push_back({glm::vec3(std::nanf(""), 0.0f, 0.0f), down, kInf});
+            rays.push_back({o, down, 0.0f});
+            rays.push_back({o, down, -5.0f});
+            rays.push_back({o, up, kInf});
+            std::shuffle(rays.end() - 4, rays.end(), rng);
+            for (size_t n : {size_t(1), size_t(3), rays.size()}) {
+                const std::span<const TraceRay> batch(rays.data() + rays.size() - n, n);
+                std::vector<RayHit> hits(n);
+                std::vector<uint8_t> found(n, 7), blocked(n, 7);
+                tracer.intersect(batch, hits, found);
+                tracer.occluded(batch, blocked);
+                int differ = 0, hitCount = 0;
+                for (size_t i = 0; i < n; ++i) {
+                    RayHit single;
+                    const bool h = tracer.intersect(batch[i].origin, batch[i].dir, batch[i].tMax, single);
+                    hitCount += h;
+                    differ += found[i] != uint8_t(h) ||
+                              blocked[i] != uint8_t(tracer.occluded(batch[i].origin, batch[i].dir, batch[i].tMax));
+                    if (h && found[i])
+                        differ += hits[i].t != single.t || hits[i].position != single.position ||
+                                  hits[i].normal != single.normal || hits[i].onTerrain != single.onTerrain;
+                }
+                EXPECT_EQ(differ, 0) << kernelName(kernel) << (skirt ? " skirt" : " no skirt") << ", batch of " << n;
+                if (n > 1000) {
+                    EXPECT_GT(hitCount, int(n) / 5);
+                }
+            }
+            std::vector<RayHit> tooFew(2);
+            std::vector<uint8_t> flags(rays.size());
+            EXPECT_THROW(tracer.intersect(rays, tooFew, flags), std::invalid_argument);
+        }
 }
 
 // kAuto resolves to a real kernel: the CPU's best unless TERRALUX_TRACER_KERNEL pins the
