@@ -537,7 +537,8 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
     else {
         // Metered again only when what the frame shows changed; the shown exposure follows the
         // meter with the authored time constant, frame after frame.
-        if (const std::string key = meterKey(r, camera); key != meterKey_) {
+        if (const std::string key = meterKey(r, camera);
+            key != meterKey_ && (!r.interactive || std::isnan(meteredEv100_))) {
             meteredEv100_ = meter(r, camera);
             meterKey_ = key;
         }

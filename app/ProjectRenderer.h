@@ -32,6 +32,11 @@ struct RenderRequest {
     bool leaves = false;          // overlay of the adaptive volumes' octree leaves
     double time = 0.0;            // seconds: the phase of the water's waves
     std::vector<GizmoLine> gizmos;  // the viewport's volume bounds and handles
+    // A viewport frame drawn below full resolution while the view changes (dynamic resolution),
+    // which a full-resolution frame follows: it keeps the exposure last metered rather than
+    // meter again (a meter is a frame of its own, drawn and read back while the caller waits),
+    // and the full-resolution frame meters. Only present() reads it.
+    bool interactive = false;
 };
 
 class ProjectRenderer;

@@ -160,6 +160,8 @@ void ViewportWindow::renderNow() {
     const ScaledSize size = scaledSize(request_.width, request_.height, scale);
     drawn.width = size.width;
     drawn.height = size.height;
+    // Below full resolution the refine timer below brings the full-resolution frame, which meters.
+    drawn.interactive = size.width < request_.width || size.height < request_.height;
     if (!renderer_->present(drawn, camera_, *swapchain_)) return;
     presentedScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
     if (presentedScale_ < 1.0) refineTimer_.start();

@@ -346,6 +346,65 @@ private slots:
         QCOMPARE(points->value(), 64);
     }
 
+    // A metered exposure is a frame of its own, drawn and read back while the UI thread waits
+    // (170-260 ms on lavapipe at 128 pixels: its shadow maps are drawn again for each new camera).
+    // Frames of a change, drawn below full resolution, keep the exposure last metered; the
+    // full-resolution frame that follows meters once. The UI thread's longest stall during the
+    // drag is printed (a measurement, not a bound: it is the device's frame time).
+    void framesOfAChangeKeepTheExposureAndTheFullFrameMeters() {
+        QString error;
+        QVERIFY(w_->document()->setParameter("camera.exposure_mode", "average", &error));
+        ViewportWindow* v = w_->viewport();
+        ProjectRenderer* r = v->renderer();
+        QVERIFY(r);
+        v->setFrameBudget(1.0);  // no frame meets it: every frame of a change is drawn small
+        v->renderNow();
+        QVERIFY(settlesQuiet(v));
+        QCOMPARE(v->presentedScale(), 1.0);
+        const size_t before = r->meterings();
+        const double metered = r->meteredEv100();
+        QVERIFY(std::isfinite(metered));
+
+        QElapsedTimer clock;
+        clock.start();
+        qint64 last = clock.elapsed(), worst = 0;
+        QTimer watchdog;
+        watchdog.setInterval(5);
+        QObject::connect(&watchdog, &QTimer::timeout, [&] {
+            worst = std::max(worst, clock.elapsed() - last);
+            last = clock.elapsed();
+        });
+        QSignalSpy frames(v, &ViewportWindow::frameRendered);
+        watchdog.start();
+        // An orbit drag toward the ground: a darker, different frame the exposure would follow.
+        const QPoint c(v->width() / 2, v->height() / 2);
+        QTest::mousePress(v, Qt::LeftButton, {}, c);
+        double smallest = 1.0;
+        for (int i = 1; i <= 12; ++i) {
+            const QPointF at(c + QPoint(6 * i, -8 * i));
+            QMouseEvent move(QEvent::MouseMove, at, v->mapToGlobal(at), Qt::NoButton, Qt::LeftButton, {});
+            QCoreApplication::sendEvent(v, &move);
+            QTest::qWait(40);
+            smallest = std::min(smallest, v->presentedScale());
+        }
+        const qint64 dragStall = worst;
+        const int dragFrames = int(frames.count());
+        const size_t duringDrag = r->meterings() - before;
+        QTest::mouseRelease(v, Qt::LeftButton, {}, c + QPoint(72, -96));
+        qInfo() << "drag:" << dragFrames << "frames, longest UI stall" << dragStall << "ms, meterings" << duringDrag;
+        QVERIFY2(dragFrames >= 3, qPrintable(QString::number(dragFrames)));
+        QVERIFY(smallest < 1.0);
+        QCOMPARE(duringDrag, size_t(0));
+        QCOMPARE(r->meteredEv100(), metered);
+        // The full-resolution frame meters the camera the drag left.
+        QTRY_VERIFY_WITH_TIMEOUT(v->presentedScale() == 1.0 && r->meterings() == before + 1, 10000);
+        QVERIFY(settlesQuiet(v));
+        QCOMPARE(r->meterings(), before + 1);
+        QVERIFY2(std::abs(r->meteredEv100() - metered) > 1e-3,
+                 qPrintable(QString("metered %1 before and after the drag").arg(metered)));
+        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
+    }
+
     void rejectedValuesLeaveTheProject() {
         auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
         QVERIFY(elevation);
