@@ -29,6 +29,8 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
         refining_ = true;
         requestUpdate();
     });
+    presentPoll_.setInterval(2);
+    connect(&presentPoll_, &QTimer::timeout, this, &ViewportWindow::pollPresent);
 }
 
 void ViewportWindow::setDynamicResolution(bool on) {
@@ -84,7 +86,7 @@ void ViewportWindow::exposeEvent(QExposeEvent*) {
 
 bool ViewportWindow::event(QEvent* e) {
     if (e->type() == QEvent::UpdateRequest) {
-        renderNow();
+        draw(false);
         return true;
     }
     return QWindow::event(e);
@@ -141,8 +143,22 @@ void ViewportWindow::scheduleLpv() {
     });
 }
 
-void ViewportWindow::renderNow() {
+void ViewportWindow::renderNow() { draw(true); }
+
+void ViewportWindow::draw(bool now) {
     if (!renderer_ || !isExposed()) return;
+    if (swapchain_ && swapchain_->pending()) {
+        if (now) swapchain_->waitForHeld();
+        pollPresent();
+        if (swapchain_->pending()) {
+            // The last frame is not on screen yet: this one is drawn when it is (pollPresent). A
+            // change asked for meanwhile puts the full-resolution frame off, as a drawn one does.
+            frameWanted_ = true;
+            if (!refining_ && refineTimer_.isActive()) refineTimer_.start();
+            presentPoll_.start();
+            return;
+        }
+    }
     scheduleLpv();
     const auto start = std::chrono::steady_clock::now();
     updateSize();
@@ -163,19 +179,33 @@ void ViewportWindow::renderNow() {
     // Below full resolution the refine timer below brings the full-resolution frame, which meters.
     drawn.interactive = size.width < request_.width || size.height < request_.height;
     if (!renderer_->present(drawn, camera_, *swapchain_)) return;
-    presentedScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
-    if (presentedScale_ < 1.0) refineTimer_.start();
+    drawnScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
+    if (drawnScale_ < 1.0) refineTimer_.start();
     else refineTimer_.stop();
+    frameStart_ = start;
+    presentPoll_.start();
+    pollPresent();
+}
+
+void ViewportWindow::pollPresent() {
+    if (!swapchain_ || !swapchain_->presentIfDone()) return;
+    presentPoll_.stop();
+    if (!frameStart_) return;
+    // The frame's wall time from its recording to its presentation.
+    const auto ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - *frameStart_).count();
+    frameStart_.reset();
+    presentedScale_ = drawnScale_;
+    if (!renderer_) return;
     // The frame last known finished (this slot's previous one): its GPU time where timed, at the
     // scale it was drawn at.
-    const auto ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const FrameTimings& t = renderer_->renderer().lastFrameTimings();
     if (t.gpuTimed() && t.width > 0 && t.height > 0)
         resolution_.frameFinished(t.gpuMilliseconds,
                                   std::min(1.0, std::sqrt(double(t.width) * t.height / (double(request_.width) * request_.height))));
     else if (!t.gpuTimed())
         resolution_.frameFinished(ms, presentedScale_);
-    if (renderer_->exposureAdapting()) requestUpdate();  // the eye has not yet adapted
+    if (renderer_->exposureAdapting() || frameWanted_) requestUpdate();  // the eye has not yet adapted, or a change waits
+    frameWanted_ = false;
     emit frameRendered(ms);
 }
 

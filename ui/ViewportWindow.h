@@ -5,6 +5,7 @@
 //   left drag: orbit   middle drag or shift + left drag: pan   wheel: zoom   left click: pick
 //   arrows: orbit   +/-: zoom   W/A/S/D: pan   F or Home: frame the terrain
 
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -61,7 +62,8 @@ public:
     // for tests and screenshots, never per frame. Without `gizmos`, the frame alone, as
     // `terralux --render` draws it; with them, the bounds and handles over it as on screen.
     RenderedImage grabImage(bool gizmos = false);
-    // Records and submits a frame now instead of at the next update.
+    // Records and submits a frame now instead of at the next update, waiting for the frame
+    // before it to finish if it has not (the updates the viewport asks for itself never wait).
     void renderNow();
     // The light propagation volumes: each frame that draws them asks the schedule
     // (lpv.update_interval in frames) whether to start an update for its camera and settings; the
@@ -88,6 +90,9 @@ public:
     const DynamicResolution& resolution() const { return resolution_; }
     // The scale of the last frame presented: its pixels over the window's, square-rooted.
     double presentedScale() const { return presentedScale_; }
+    // Whether a frame is submitted and not yet presented, asked for, or due (the full-resolution
+    // frame after a change): the viewport has more to show.
+    bool drawing() const { return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive(); }
 
 signals:
     // Wall time the frame took on this thread: recording, submitting and any wait for a free
@@ -110,6 +115,11 @@ protected:
 
 private:
     void updateSize();
+    // Draws a frame; when the one before is not presented yet, waits for it (`now`) or draws
+    // once it is.
+    void draw(bool now);
+    // Presents the submitted frame once the device has finished it, then finishes its accounting.
+    void pollPresent();
     void scheduleLpv();
     void orbit(float dAzimuth, float dElevation);
     void pan(float dx, float dy);
@@ -130,7 +140,13 @@ private:
     bool dynamicResolution_ = true;
     bool refining_ = false;       // the next frame is the full-resolution one after the changes
     double presentedScale_ = 1.0;
+    double drawnScale_ = 1.0;  // of the frame submitted last, presented or not
     QTimer refineTimer_;
+    // The UI thread never waits for the device: a submitted frame is presented once it has
+    // finished (polled every few milliseconds), and a frame asked for meanwhile is drawn then.
+    QTimer presentPoll_;
+    std::optional<std::chrono::steady_clock::time_point> frameStart_;
+    bool frameWanted_ = false;
 };
 
 }  // namespace terralux

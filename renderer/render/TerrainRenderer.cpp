@@ -873,7 +873,7 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
     recordFrame(frame->cb, frame->slot, drawnSettings(s, out.antialiasing, scaled), out);
     gpu_->slots[frame->slot].width = s.width;
     gpu_->slots[frame->slot].height = s.height;
-    swapchain.submitAndPresent(*frame);
+    swapchain.submit(*frame);
     return true;
 }
 

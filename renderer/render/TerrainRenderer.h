@@ -157,7 +157,8 @@ public:
     // Draws a frame and reads it back, waiting for the GPU.
     RenderedImage render(const RenderSettings& settings);
     // Draws a frame into the swapchain's next image (a blit of the offscreen colour target, no
-    // readback) without waiting for the GPU. False when nothing could be shown.
+    // readback) and submits it without waiting for the GPU; the swapchain presents it once it
+    // has finished (vk::Swapchain::presentIfDone). False when nothing could be shown.
     bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
     // The passes of the last frame, in order, with what each used and bound.
     const std::vector<PassInfo>& lastFramePasses() const;

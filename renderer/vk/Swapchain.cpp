@@ -96,7 +96,15 @@ bool Swapchain::recreate() {
     return true;
 }
 
+void Swapchain::waitForHeld() {
+    if (!pending_) return;
+    VkFence held = slots_[pending_->slot].done.get();
+    check(vkWaitForFences(ctx_.device(), 1, &held, VK_TRUE, UINT64_MAX), "vkWaitForFences (held frame)");
+}
+
 std::optional<SwapchainFrame> Swapchain::begin() {
+    waitForHeld();
+    presentIfDone();
     Slot& slot = slots_[next_];
     VkFence fence = slot.done.get();
     check(vkWaitForFences(ctx_.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences (frame slot)");
@@ -129,7 +137,7 @@ std::optional<SwapchainFrame> Swapchain::begin() {
     return f;
 }
 
-void Swapchain::submitAndPresent(const SwapchainFrame& f) {
+void Swapchain::submit(const SwapchainFrame& f) {
     Slot& slot = slots_[f.slot];
     next_ = (f.slot + 1) % kFramesInFlight;
     check(vkEndCommandBuffer(f.cb), "vkEndCommandBuffer");
@@ -146,13 +154,29 @@ void Swapchain::submitAndPresent(const SwapchainFrame& f) {
     VkFence fence = slot.done.get();
     check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences");
     check(vkQueueSubmit(ctx_.queue(), 1, &si, fence), "vkQueueSubmit (frame)");
+    pending_ = Held{f.slot, f.imageIndex};
+}
+
+bool Swapchain::presentIfDone() {
+    if (!pending_) return true;
+    const VkResult status = vkGetFenceStatus(ctx_.device(), slots_[pending_->slot].done.get());
+    if (status == VK_NOT_READY) return false;
+    check(status, "vkGetFenceStatus (held frame)");
+    const uint32_t imageIndex = pending_->imageIndex;
+    pending_.reset();
+    present(imageIndex);
+    return true;
+}
+
+void Swapchain::present(uint32_t imageIndex) {
+    VkSemaphore presentable = presentable_[imageIndex].get();
     VkSwapchainKHR sc = swapchain_.get();
     VkPresentInfoKHR pi{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
     pi.waitSemaphoreCount = 1;
     pi.pWaitSemaphores = &presentable;
     pi.swapchainCount = 1;
     pi.pSwapchains = &sc;
-    pi.pImageIndices = &f.imageIndex;
+    pi.pImageIndices = &imageIndex;
     const VkResult r = vkQueuePresentKHR(ctx_.queue(), &pi);
     // The next begin() recreates it for the new size.
     if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) extent_ = {0, 0};

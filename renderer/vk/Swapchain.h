@@ -31,20 +31,35 @@ public:
     Swapchain(const Swapchain&) = delete;
     Swapchain& operator=(const Swapchain&) = delete;
 
-    // Waits until the next slot is free (its frame of kFramesInFlight ago has finished),
-    // acquires an image (recreating the swapchain when the window size changed) and begins the
-    // slot's command buffer. nullopt when nothing can be shown (a zero-sized window). The image
-    // is in an undefined layout; the frame leaves it in PRESENT_SRC_KHR, having waited for
-    // the acquire at the transfer stage.
+    // Presents the frame submitted last if it is still held (waiting for it), waits until the
+    // next slot is free (its frame of kFramesInFlight ago has finished), acquires an image
+    // (recreating the swapchain when the window size changed) and begins the slot's command
+    // buffer. nullopt when nothing can be shown (a zero-sized window). The image is in an
+    // undefined layout; the frame leaves it in PRESENT_SRC_KHR, having waited for the acquire at
+    // the transfer stage.
     std::optional<SwapchainFrame> begin();
-    // Ends the command buffer, submits it and queues the image for presentation. No wait.
-    void submitAndPresent(const SwapchainFrame& frame);
+    // Ends the command buffer and submits it; the image is held until presentIfDone() finds the
+    // frame finished. Some presentation engines (Mesa's software WSI under X11) wait inside
+    // vkQueuePresentKHR for the frame's commands: presenting only finished frames keeps that
+    // wait off the caller's thread. No wait.
+    void submit(const SwapchainFrame& frame);
+    // Whether a submitted frame is held for presentation.
+    bool pending() const { return pending_.has_value(); }
+    // Presents the held frame if its commands have finished. True when nothing is held any more.
+    bool presentIfDone();
+    // Waits until the held frame's commands have finished (none held: returns at once).
+    void waitForHeld();
     // Waits for every slot (before resources the frames use are destroyed).
     void waitIdle();
 
 private:
     bool recreate();
     void destroySwapchain();
+    void present(uint32_t imageIndex);
+    struct Held {
+        uint32_t slot = 0, imageIndex = 0;
+    };
+    std::optional<Held> pending_;
     struct Slot {
         UniqueCommandBuffer cb;
         UniqueFence done;

@@ -73,13 +73,14 @@ std::string fileBytes(const fs::path& p) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// Whether the viewport, within ten tries, goes 300 ms without drawing a frame: a frame asked for
-// before may still land (slow under load), but a viewport that keeps drawing never goes quiet.
+// Whether the viewport, within ten tries, goes 300 ms without presenting a frame and with none
+// submitted, asked for or due: a frame asked for before may still land (slow under load), but a
+// viewport that keeps drawing never goes quiet.
 bool settlesQuiet(ViewportWindow* viewport) {
     for (int attempt = 0; attempt < 10; ++attempt) {
         QSignalSpy frames(viewport, &ViewportWindow::frameRendered);
         QTest::qWait(300);
-        if (frames.count() == 0) return true;
+        if (frames.count() == 0 && !viewport->drawing()) return true;
     }
     return false;
 }
@@ -346,11 +347,13 @@ private slots:
         QCOMPARE(points->value(), 64);
     }
 
-    // A metered exposure is a frame of its own, drawn and read back while the UI thread waits
-    // (170-260 ms on lavapipe at 128 pixels: its shadow maps are drawn again for each new camera).
-    // Frames of a change, drawn below full resolution, keep the exposure last metered; the
-    // full-resolution frame that follows meters once. The UI thread's longest stall during the
-    // drag is printed (a measurement, not a bound: it is the device's frame time).
+    // An orbit drag never makes the UI thread wait: frames are presented once the device has
+    // drawn them (Mesa's software presentation waited inside vkQueuePresentKHR, 55-360 ms a
+    // frame), and a metered exposure, a frame of its own drawn and read back while the UI thread
+    // waits (170-260 ms at 128 pixels on lavapipe), is not taken by the frames of a change, drawn
+    // below full resolution: they keep the exposure last metered, and the full-resolution frame
+    // that follows meters once. A watchdog ticking every 5 ms measures the UI thread's longest
+    // stall over the drag.
     void framesOfAChangeKeepTheExposureAndTheFullFrameMeters() {
         QString error;
         QVERIFY(w_->document()->setParameter("camera.exposure_mode", "average", &error));
@@ -380,11 +383,11 @@ private slots:
         const QPoint c(v->width() / 2, v->height() / 2);
         QTest::mousePress(v, Qt::LeftButton, {}, c);
         double smallest = 1.0;
-        for (int i = 1; i <= 12; ++i) {
-            const QPointF at(c + QPoint(6 * i, -8 * i));
+        for (int i = 1; i <= 24; ++i) {
+            const QPointF at(c + QPoint(3 * i, -4 * i));
             QMouseEvent move(QEvent::MouseMove, at, v->mapToGlobal(at), Qt::NoButton, Qt::LeftButton, {});
             QCoreApplication::sendEvent(v, &move);
-            QTest::qWait(40);
+            QTest::qWait(50);
             smallest = std::min(smallest, v->presentedScale());
         }
         const qint64 dragStall = worst;
@@ -392,7 +395,9 @@ private slots:
         const size_t duringDrag = r->meterings() - before;
         QTest::mouseRelease(v, Qt::LeftButton, {}, c + QPoint(72, -96));
         qInfo() << "drag:" << dragFrames << "frames, longest UI stall" << dragStall << "ms, meterings" << duringDrag;
-        QVERIFY2(dragFrames >= 3, qPrintable(QString::number(dragFrames)));
+        QVERIFY2(dragFrames >= 2, qPrintable(QString::number(dragFrames)));
+        // The watchdog: the UI thread answered within 50 ms throughout the drag.
+        QVERIFY2(dragStall <= 50, qPrintable(QString("the UI thread stalled %1 ms").arg(dragStall)));
         QVERIFY(smallest < 1.0);
         QCOMPARE(duringDrag, size_t(0));
         QCOMPARE(r->meteredEv100(), metered);
@@ -989,7 +994,9 @@ private slots:
         QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
         QTRY_VERIFY_WITH_TIMEOUT(std::abs(r->meteredEv100() - (before - 2.0)) < 0.1, 15000);
         QVERIFY(std::abs(r->shownEv100() - r->meteredEv100()) <= 0.02);
-        QVERIFY(w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)));
+        // The label follows the frame's presentation, which comes once the device has drawn it.
+        QTRY_VERIFY_WITH_TIMEOUT(
+            w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)), 5000);
         // Adapted: no frame without a change, and a redraw of the same view does not meter again.
         QVERIFY(settlesQuiet(w_->viewport()));
         const size_t settled = r->meterings();
