@@ -324,7 +324,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
                                              ? QString("last bake")
                                              : "export in " + QString::fromStdString(bakeOutDir_.string()));
             showBoundProbes();
-            viewport_->renderNow();
+            viewport_->requestUpdate();
             updateStatus();
         }
     });
@@ -1334,7 +1334,7 @@ void MainWindow::startPreview() {
             renderer_->loadProbes(false, nullptr, nullptr, *folder);
             probeSource_ = withStaleness("last bake");
             showBoundProbes();
-            viewport_->renderNow();
+            viewport_->requestUpdate();
             updateStatus();
         }
         return;
@@ -1360,7 +1360,7 @@ void MainWindow::startPreview() {
                 renderer_->setReflectionProbes(preview->reflections);
                 probeSource_ = "draft preview";
                 showBoundProbes();
-                viewport_->renderNow();
+                viewport_->requestUpdate();
                 updateStatus();
             });
         } catch (const PlacementError&) {
@@ -1372,7 +1372,7 @@ void MainWindow::startPreview() {
                 renderer_->setReflectionProbes(nullptr);
                 probeSource_ = "no preview: placement failed";
                 showBoundProbes();
-                viewport_->renderNow();
+                viewport_->requestUpdate();
                 updateStatus();
             });
         } catch (const std::exception&) {
