@@ -537,8 +537,13 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
     else {
         // Metered again only when what the frame shows changed; the shown exposure follows the
         // meter with the authored time constant, frame after frame.
-        if (const std::string key = meterKey(r, camera);
-            key != meterKey_ && (!r.interactive || std::isnan(meteredEv100_))) {
+        // A frame below full resolution meters only once the view holds still (the key of the
+        // frame before it): while it changes, the full-resolution frame that follows meters, and
+        // frames that keep coming for other reasons (the water's waves playing) meter the still view.
+        const std::string key = meterKey(r, camera);
+        const bool still = key == lastFrameKey_;
+        lastFrameKey_ = key;
+        if (key != meterKey_ && (!r.interactive || still || std::isnan(meteredEv100_))) {
             meteredEv100_ = meter(r, camera);
             meterKey_ = key;
         }

@@ -35,7 +35,8 @@ struct RenderRequest {
     // A viewport frame drawn below full resolution while the view changes (dynamic resolution),
     // which a full-resolution frame follows: it keeps the exposure last metered rather than
     // meter again (a meter is a frame of its own, drawn and read back while the caller waits),
-    // and the full-resolution frame meters. Only present() reads it.
+    // unless the view is the one the frame before it showed; the full-resolution frame meters.
+    // Only present() reads it.
     bool interactive = false;
 };
 
@@ -236,6 +237,7 @@ private:
     size_t lpvUpdates_ = 0;
     size_t revision_ = 0;  // bumped by every change of what a frame shows but the camera
     std::string meterKey_;
+    std::string lastFrameKey_;  // the meter key of the frame present() drew last
     double meteredEv100_ = std::numeric_limits<double>::quiet_NaN();
     double shownEv100_ = std::numeric_limits<double>::quiet_NaN();
     std::chrono::steady_clock::time_point shownAt_;

@@ -166,6 +166,8 @@ void ViewportWindow::draw(bool now) {
         VkSurfaceKHR surface = QVulkanInstance::surfaceForWindow(this);
         if (!surface) return;
         swapchain_ = std::make_unique<vk::Swapchain>(ctx_, surface);
+        // A CPU device presents in software, waiting for the frame: present finished frames only.
+        swapchain_->setHoldsFrames(ctx_.deviceType() == VK_PHYSICAL_DEVICE_TYPE_CPU);
     }
     request_.gizmos = interaction_ ? interaction_->gizmos(camera_, QSizeF(width(), height())) : std::vector<GizmoLine>{};
     // A frame of a change draws at the scale that holds the budget; the full-resolution frame
@@ -195,6 +197,8 @@ void ViewportWindow::pollPresent() {
     const auto ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - *frameStart_).count();
     frameStart_.reset();
     presentedScale_ = drawnScale_;
+    const bool wanted = frameWanted_;
+    frameWanted_ = false;
     if (!renderer_) return;
     // The frame last known finished (this slot's previous one): its GPU time where timed, at the
     // scale it was drawn at.
@@ -204,8 +208,7 @@ void ViewportWindow::pollPresent() {
                                   std::min(1.0, std::sqrt(double(t.width) * t.height / (double(request_.width) * request_.height))));
     else if (!t.gpuTimed())
         resolution_.frameFinished(ms, presentedScale_);
-    if (renderer_->exposureAdapting() || frameWanted_) requestUpdate();  // the eye has not yet adapted, or a change waits
-    frameWanted_ = false;
+    if (renderer_->exposureAdapting() || wanted) requestUpdate();  // the eye has not yet adapted, or a change waits
     emit frameRendered(ms);
 }
 

@@ -95,8 +95,9 @@ public:
     bool drawing() const { return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive(); }
 
 signals:
-    // Wall time the frame took on this thread: recording, submitting and any wait for a free
-    // frame slot (which, with every slot busy, is the GPU's frame time).
+    // A frame reached the window: the wall time from its recording to its presentation (on a
+    // CPU device, which holds a frame until it is drawn, the device's time and the wait for the
+    // next poll included).
     void frameRendered(double milliseconds);
     void cameraChanged();
     // A left click that did not drag: `position` in the window's logical pixels.

@@ -70,8 +70,9 @@ public:
     // matters.
     bool occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const;
     // A batch: found[i] (blocked[i]) and hits[i] are what intersect (occluded) gives for rays[i],
-    // bit for bit. Several walks run interleaved, each one's next node prefetched while the
-    // others run, so a batch hides the memory latency that dominates a single incoherent ray.
+    // bit for bit. The rays walk one after another, but ray i + 4 is set up and its start cell
+    // prefetched while ray i walks, hiding the cold start cell that dominates a short
+    // incoherent ray.
     // The spans of results hold at least rays.size() entries.
     void intersect(std::span<const TraceRay> rays, std::span<RayHit> hits, std::span<uint8_t> found) const;
     void occluded(std::span<const TraceRay> rays, std::span<uint8_t> blocked) const;

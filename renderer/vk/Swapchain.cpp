@@ -154,7 +154,8 @@ void Swapchain::submit(const SwapchainFrame& f) {
     VkFence fence = slot.done.get();
     check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences");
     check(vkQueueSubmit(ctx_.queue(), 1, &si, fence), "vkQueueSubmit (frame)");
-    pending_ = Held{f.slot, f.imageIndex};
+    if (holdsFrames_) pending_ = Held{f.slot, f.imageIndex};
+    else present(f.imageIndex);
 }
 
 bool Swapchain::presentIfDone() {

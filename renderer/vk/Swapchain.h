@@ -38,11 +38,14 @@ public:
     // undefined layout; the frame leaves it in PRESENT_SRC_KHR, having waited for the acquire at
     // the transfer stage.
     std::optional<SwapchainFrame> begin();
-    // Ends the command buffer and submits it; the image is held until presentIfDone() finds the
-    // frame finished. Some presentation engines (Mesa's software WSI under X11) wait inside
-    // vkQueuePresentKHR for the frame's commands: presenting only finished frames keeps that
-    // wait off the caller's thread. No wait.
+    // Ends the command buffer and submits it, then queues the image for presentation, or, when
+    // the swapchain holds frames, keeps it until presentIfDone() finds the frame finished. Some
+    // presentation engines (Mesa's software WSI under X11, what a CPU device such as lavapipe
+    // presents through) wait inside vkQueuePresentKHR for the frame's commands: presenting only
+    // finished frames keeps that wait off the caller's thread. A GPU's engine queues the image
+    // and returns, and presenting at once keeps its next frame recorded while it draws. No wait.
     void submit(const SwapchainFrame& frame);
+    void setHoldsFrames(bool holds) { holdsFrames_ = holds; }
     // Whether a submitted frame is held for presentation.
     bool pending() const { return pending_.has_value(); }
     // Presents the held frame if its commands have finished. True when nothing is held any more.
@@ -60,6 +63,7 @@ private:
         uint32_t slot = 0, imageIndex = 0;
     };
     std::optional<Held> pending_;
+    bool holdsFrames_ = true;
     struct Slot {
         UniqueCommandBuffer cb;
         UniqueFence done;

@@ -402,12 +402,13 @@ private slots:
         QCOMPARE(duringDrag, size_t(0));
         QCOMPARE(r->meteredEv100(), metered);
         // The full-resolution frame meters the camera the drag left.
-        QTRY_VERIFY_WITH_TIMEOUT(v->presentedScale() == 1.0 && r->meterings() == before + 1, 10000);
+        QTRY_VERIFY_WITH_TIMEOUT(r->meterings() == before + 1, 10000);
+        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
         QVERIFY(settlesQuiet(v));
+        QCOMPARE(v->presentedScale(), 1.0);
         QCOMPARE(r->meterings(), before + 1);
         QVERIFY2(std::abs(r->meteredEv100() - metered) > 1e-3,
                  qPrintable(QString("metered %1 before and after the drag").arg(metered)));
-        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
     }
 
     void rejectedValuesLeaveTheProject() {
@@ -991,8 +992,8 @@ private slots:
         // On the way: the shown exposure has not jumped to the new reading.
         QVERIFY2(r->shownEv100() > r->meteredEv100() + 0.1,
                  qPrintable(QString("shown %1, metered %2").arg(r->shownEv100()).arg(r->meteredEv100())));
-        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting(), 15000);
-        QTRY_VERIFY_WITH_TIMEOUT(std::abs(r->meteredEv100() - (before - 2.0)) < 0.1, 15000);
+        // Both at once: a later meter (the preview bake landing) may start the eye adapting again.
+        QTRY_VERIFY_WITH_TIMEOUT(!r->exposureAdapting() && std::abs(r->meteredEv100() - (before - 2.0)) < 0.1, 15000);
         QVERIFY(std::abs(r->shownEv100() - r->meteredEv100()) <= 0.02);
         // The label follows the frame's presentation, which comes once the device has drawn it.
         QTRY_VERIFY_WITH_TIMEOUT(
