@@ -1644,10 +1644,14 @@ private slots:
             auto bottom = [&] { return image->mapTo(area->widget(), QPoint(0, image->height())).y(); };
             QTRY_VERIFY(image->height() >= 3 * 48 &&
                         area->verticalScrollBar()->maximum() >= bottom() - area->viewport()->height());
-            area->verticalScrollBar()->setValue(bottom() - area->viewport()->height());
-            QTest::qWait(50);
-            const QRect shown(image->mapTo(area->viewport(), QPoint(0, 0)), image->size());
-            const QRect pixmap(shown.topLeft() + image->contentsRect().topLeft(), image->pixmap().size());
+            // Scrolled again until the layout holds still: the page may still grow after a scroll.
+            auto shownRect = [&] { return QRect(image->mapTo(area->viewport(), QPoint(0, 0)), image->size()); };
+            auto pixmapRect = [&] { return QRect(shownRect().topLeft() + image->contentsRect().topLeft(), image->pixmap().size()); };
+            QTRY_VERIFY_WITH_TIMEOUT(
+                (area->verticalScrollBar()->setValue(bottom() - area->viewport()->height()),
+                 area->viewport()->rect().contains(pixmapRect())),
+                5000);
+            const QRect shown = shownRect(), pixmap = pixmapRect();
             QVERIFY(w_->grab().save(QString::fromStdString((kOut / "reflection_inspector.png").string())));
             QVERIFY2(image->height() >= 3 * 48 && area->viewport()->rect().contains(pixmap),
                      qPrintable(QString("label %1x%2 at %3,%4 in a %5x%6 view").arg(image->width()).arg(image->height())
