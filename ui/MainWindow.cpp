@@ -333,11 +333,13 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         progress_->setValue(0);
         bakeButton_->setEnabled(true);
         cancelButton_->setEnabled(false);
+        schedulePreview();  // what the bake would have shown, as a draft again
     });
     connect(bake_, &BakeController::failed, this, [this](const QString& m) {
         eta_->setText("failed");
         bakeButton_->setEnabled(true);
         cancelButton_->setEnabled(false);
+        schedulePreview();
         showError("Bake", m);
     });
 
@@ -1581,6 +1583,11 @@ void MainWindow::startBake(const QString& outDir) {
     eta_->setText("starting");
     bakeButton_->setEnabled(false);
     cancelButton_->setEnabled(true);
+    // The bake shows its own probes when it lands: a preview of this same project, running or
+    // due, would land after it and put a draft in its place (a cancelled or failed bake asks for
+    // the preview again). One asked for by a later edit lands.
+    previewTimer_.stop();
+    previewJob_.stop();
     bake_->start(p);
 }
 
