@@ -50,6 +50,21 @@ Buffer Buffer::hostReadable(const VulkanContext& ctx, VkDeviceSize size, VkBuffe
 
 Buffer Buffer::deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                            VkBufferUsageFlags usage, VkDeviceSize capacity) {
+    // Where the device shares the host's memory (a CPU device, an integrated GPU), its local
+    // memory is host-visible too: written in place, the buffer needs no copy on the queue, which
+    // would wait behind every frame already queued there.
+    const VkPhysicalDeviceType type = ctx.deviceType();
+    if (type == VK_PHYSICAL_DEVICE_TYPE_CPU || type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
+        try {
+            Buffer b(ctx, std::max(size, capacity), usage,
+                     VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                         VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+            if (size > 0) b.write(bytes, size);
+            return b;
+        } catch (const VulkanError&) {
+            // No such memory type: through a staging copy, as on a discrete GPU.
+        }
+    }
     Buffer staging = hostVisible(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     if (size > 0) staging.write(bytes, size);
     Buffer b(ctx, std::max(size, capacity), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);

@@ -28,8 +28,9 @@ public:
         return *this;
     }
 
-    // A device-local buffer holding `bytes`, uploaded through a host-visible staging buffer;
-    // `capacity` bytes long where that is more (the rest undefined until written).
+    // A device-local buffer holding `bytes`, uploaded through a host-visible staging buffer (on
+    // a device that shares the host's memory, written in place); `capacity` bytes long where that
+    // is more (the rest undefined until written).
     static Buffer deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                               VkBufferUsageFlags usage, VkDeviceSize capacity = 0);
     // A host-visible, coherent buffer (uniforms, staging).
