@@ -201,6 +201,11 @@ int commandRender(const Args& a) {
     std::cout << "rendered " << image.string() << " (" << img.width << "x" << img.height << ", view "
               << view->number << " " << view->name << ", " << volumes << " probe volume(s), "
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
+    // The level of detail the image drew (docs/ARCHITECTURE.md, "Level of detail").
+    const TerrainRenderer& terrain = renderer.renderer();
+    std::cout << "terrain: " << terrain.lastLod().triangles << " of " << terrain.triangleCount()
+              << " triangles at the level of detail, within " << fixed(terrain.lastLod().screenErrorPixels, 2)
+              << " px of the DEM\n";
     // An msaa count the device lacks is drawn with the largest it has below (or fxaa): say so.
     const Antialiasing asked = project.scene.camera.antialiasing, drawn = renderer.renderer().drawnAntialiasing();
     if (msaaSamples(asked) > 1 && drawn != Antialiasing::Off && drawn != asked)

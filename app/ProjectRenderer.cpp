@@ -270,8 +270,9 @@ void ProjectRenderer::updateOverlays() {
         markers.insert(markers.end(), o->markers.begin(), o->markers.end());
         leaves.insert(leaves.end(), o->leaves.begin(), o->leaves.end());
     }
-    renderer_->setProbePositions(markers);
-    renderer_->setProbeLeaves(leaves);
+    if (markers != shownOverlay_.markers) renderer_->setProbePositions(markers);
+    if (leaves != shownOverlay_.leaves) renderer_->setProbeLeaves(leaves);
+    shownOverlay_ = {std::move(markers), std::move(leaves)};
 }
 
 ProjectRenderer::~ProjectRenderer() = default;
@@ -474,6 +475,7 @@ double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera)
     q.gizmos.clear();
     RenderSettings s = settingsOf(q, camera);
     s.antialiasing = Antialiasing::Off;
+    s.levelOfDetailRows = r.height;
     const RenderedImage img = renderer_->render(s);
     ++meterings_;
     return meterEv100(img.rgba, img.width, img.height, project_.scene.camera.exposureMode);

@@ -211,6 +211,7 @@ private:
 
     Project project_;
     std::map<std::string, Overlay> placed_, bound_;  // by volume name
+    Overlay shownOverlay_;  // what the renderer draws: an edit that leaves it uploads nothing
     std::shared_ptr<const std::vector<GpuProbeVolume>> boundVolumeData_ = std::make_shared<const std::vector<GpuProbeVolume>>();
     std::string boundVolumes_;  // probe_volumes JSON of the bound probes
     std::string placedVolumes_;  // probe_volumes JSON of placed_

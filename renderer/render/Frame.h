@@ -119,6 +119,10 @@ struct LpvResources;
 // water (the planar reflection pass).
 struct FrameSlot {
     vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay, reflectionCamera;
+    // The terrain's triangles at the level of detail this slot drew last (host-visible, written
+    // when the levels change), and which levels those are.
+    vk::Buffer terrainIndices;
+    uint64_t terrainIndicesSerial = 0;
     vk::DescriptorSet view, lights, shadowedLights, overlays, reflectionView;
     // The terrain pass's LPV and local-lights set: its block, the lights (grown as needed), and
     // the set, written again when the bound volumes or the lights buffer change (`lpvSetKey`).
@@ -163,7 +167,7 @@ struct SurfaceTextures {
 // targets, the render passes and layouts every feature shares, and each feature's resources.
 // Pipelines are built on first use (lavapipe compiles a pipeline when it is created).
 struct RendererGpu {
-    vk::Buffer vertices, indices, markers, leaves;
+    vk::Buffer vertices, markers, leaves;
     SurfaceTextures surface;
     vk::Sampler trilinear;
     vk::UniqueSetLayout viewLayout;
@@ -256,6 +260,8 @@ struct Frame {
     // The terrain mesh and the overlays' instances.
     uint32_t vertexCount = 0, indexCount = 0, markerCount = 0, leafCount = 0, gizmoCount = 0;
     uint32_t skirtIndexCount = 0;  // drawn after indexCount by the shadow pass alone (terrain.skirt)
+    VkBuffer indexBuffer = VK_NULL_HANDLE;  // the level of detail's triangles, then its skirt's
+    uint64_t lodSerial = 0;                 // which levels those are (TerrainRenderer::updateLod)
     // The cascades' light projections this frame (empty without shadows).
     std::vector<glm::mat4> lightMatrices;
 

@@ -64,6 +64,10 @@ struct RenderSettings {
     bool lpvLight = false;
     // Point and spot lights: their direct light, unshadowed (none: no lights code runs).
     std::vector<LocalLight> lights;
+    // The rows the terrain's level of detail is chosen for (0: height). The exposure meter, a small
+    // copy of a frame, draws that frame's levels: it neither rebuilds them nor draws the shadow
+    // maps again for its own size.
+    uint32_t levelOfDetailRows = 0;
 };
 
 }  // namespace terralux

@@ -31,6 +31,7 @@
 #include "render/features/Water.h"
 #include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
+#include "terrain/MeshLod.h"
 #include "terrain/SurfaceAlbedo.h"
 #include "terrain/SurfaceMaps.h"
 #include "vk/Buffer.h"
@@ -158,11 +159,11 @@ std::vector<vk::MipLevel> boxMipChain(std::vector<Texel> level, int w, int h, En
 // shadow maps draw it, so the preview's sun is shadowed by the world the bake traces: each border
 // edge of the drawn mesh extruded outward, and a level square at the corner height in each corner
 // quadrant. It reaches 100 footprints out: a border ridge's shadow from further falls on the
-// footprint only below a sun of about atan(relief / 100 footprints), well under a degree. Appended
-// after the terrain's own vertices and indices; only the shadow pass draws its indices.
-void appendSkirt(std::vector<float>& vertices, std::vector<uint32_t>& indices, const std::vector<int>& cols,
-                 const std::vector<int>& rows) {
-    const uint32_t nc = uint32_t(cols.size()), nr = uint32_t(rows.size());
+// footprint only below a sun of about atan(relief / 100 footprints), well under a degree. Every
+// border vertex of the drawn grid has its pushed-out twin, appended after the terrain's vertices
+// (which only the shadow pass draws), so the skirt follows whichever border vertices the frame's
+// level of detail keeps.
+lod::SkirtVertices appendSkirtVertices(std::vector<float>& vertices, uint32_t nc, uint32_t nr) {
     auto at = [&](uint32_t c, uint32_t r) {
         const size_t i = (size_t(r) * nc + c) * 6;
         return glm::vec3(vertices[i], vertices[i + 1], vertices[i + 2]);
@@ -173,29 +174,28 @@ void appendSkirt(std::vector<float>& vertices, std::vector<uint32_t>& indices, c
         vertices.insert(vertices.end(), {p.x, p.y, p.z, 0.0f, 1.0f, 0.0f});
         return uint32_t(vertices.size() / 6 - 1);
     };
-    auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-        const uint32_t ia = add(a), ib = add(b), ic = add(c), id = add(d);
-        indices.insert(indices.end(), {ia, ib, ic, ia, ic, id});
-    };
-    // One border edge: n + 1 vertices from `edge(i)`, pushed out along `out`.
-    auto extrude = [&](uint32_t n, auto edge, glm::vec3 out) {
-        for (uint32_t i = 0; i + 1 < n; ++i) {
-            const glm::vec3 a = edge(i), b = edge(i + 1);
-            quad(a, b, b + out * reach, a + out * reach);
-        }
-    };
+    lod::SkirtVertices k;
+    k.nc = nc;
+    k.nr = nr;
     const glm::vec3 west(-1, 0, 0), east(1, 0, 0), north(0, 0, -1), south(0, 0, 1);
-    extrude(nr, [&](uint32_t r) { return at(0, r); }, west);
-    extrude(nr, [&](uint32_t r) { return at(nc - 1, r); }, east);
-    extrude(nc, [&](uint32_t c) { return at(c, 0); }, north);
-    extrude(nc, [&](uint32_t c) { return at(c, nr - 1); }, south);
-    auto corner = [&](glm::vec3 p, glm::vec3 a, glm::vec3 b) {
-        quad(p, p + a * reach, p + (a + b) * reach, p + b * reach);
+    for (uint32_t c = 0; c < nc; ++c) {
+        k.north.push_back(add(at(c, 0) + north * reach));
+        k.south.push_back(add(at(c, nr - 1) + south * reach));
+    }
+    for (uint32_t r = 0; r < nr; ++r) {
+        k.west.push_back(add(at(0, r) + west * reach));
+        k.east.push_back(add(at(nc - 1, r) + east * reach));
+    }
+    auto corner = [&](uint32_t c, uint32_t r, glm::vec3 a, glm::vec3 b) {
+        const glm::vec3 p = at(c, r);
+        const uint32_t ip = r * nc + c, ia = add(p + a * reach), iab = add(p + (a + b) * reach), ib = add(p + b * reach);
+        k.corners.insert(k.corners.end(), {ip, ia, iab, ip, iab, ib});
     };
-    corner(at(0, 0), west, north);
-    corner(at(nc - 1, 0), east, north);
-    corner(at(0, nr - 1), west, south);
-    corner(at(nc - 1, nr - 1), east, south);
+    corner(0, 0, west, north);
+    corner(nc - 1, 0, east, north);
+    corner(0, nr - 1, west, south);
+    corner(nc - 1, nr - 1, east, south);
+    return k;
 }
 
 }  // namespace
@@ -206,32 +206,28 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     while (((w - 1) / size_t(stride_) + 2) * ((d - 1) / size_t(stride_) + 2) > vertexBudget &&
            stride_ < int(std::max(w, d)))
         ++stride_;
-    std::vector<int> cols, rows;
-    for (size_t c = 0; c < w; c += size_t(stride_)) cols.push_back(int(c));
-    if (cols.back() != int(w) - 1) cols.push_back(int(w) - 1);
-    for (size_t r = 0; r < d; r += size_t(stride_)) rows.push_back(int(r));
-    if (rows.back() != int(d) - 1) rows.push_back(int(d) - 1);
+    const std::vector<uint32_t> cols = lod::kept(uint32_t(w), uint32_t(stride_)), rows = lod::kept(uint32_t(d), uint32_t(stride_));
 
     std::vector<float> vertices;
     vertices.reserve(cols.size() * rows.size() * 6);
-    for (int r : rows)
-        for (int c : cols) {
-            const glm::vec3 p = hf.vertex(c, r), n = hf.vertexNormal(c, r);
+    for (uint32_t r : rows)
+        for (uint32_t c : cols) {
+            const glm::vec3 p = hf.vertex(int(c), int(r)), n = hf.vertexNormal(int(c), int(r));
             vertices.insert(vertices.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
         }
-    std::vector<uint32_t> indices;
-    const uint32_t nc = uint32_t(cols.size());
-    for (uint32_t r = 0; r + 1 < rows.size(); ++r)
-        for (uint32_t c = 0; c + 1 < nc; ++c) {
-            const uint32_t v00 = r * nc + c, v10 = v00 + 1, v01 = v00 + nc, v11 = v01 + 1;
-            // The bake's fixed diagonal (c, r)-(c+1, r+1), counter-clockwise from above.
-            indices.insert(indices.end(), {v00, v01, v11, v00, v11, v10});
-        }
     vertexCount_ = vertices.size() / 6;
-    indexCount_ = indices.size();
     meshVertices_ = vertices;
-    appendSkirt(vertices, indices, cols, rows);
-    skirtIndexCount_ = indices.size() - indexCount_;
+    // The level of detail's patches (MeshLod.h). The drawn grid's own error is what the
+    // decimation above leaves out of the source DEM; every level's error adds its own to that.
+    const uint32_t nc = uint32_t(cols.size()), nr = uint32_t(rows.size());
+    std::vector<float> drawnHeights(vertexCount_), colX(nc), rowZ(nr);
+    for (size_t i = 0; i < vertexCount_; ++i) drawnHeights[i] = vertices[6 * i + 1];
+    for (uint32_t c = 0; c < nc; ++c) colX[c] = vertices[6 * c];
+    for (uint32_t r = 0; r < nr; ++r) rowZ[r] = vertices[6 * size_t(r) * nc + 2];
+    baseError_ = stride_ > 1 ? lod::gridError(hf.heights(), uint32_t(w), cols, rows) : 0.0;
+    patches_ = lod::buildPatches(drawnHeights, nc, nr, colX, rowZ, kLodPatchCells, baseError_);
+    skirt_ = appendSkirtVertices(vertices, nc, nr);
+    indexCount_ = size_t(nc - 1) * (nr - 1) * 6;
     {
         double sum = 0.0;
         size_t n = 0;
@@ -244,10 +240,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     RendererGpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    g.indices = vk::Buffer::deviceLocal(ctx_, indices.data(), std::max<size_t>(indices.size(), 1) * 4,
-                                        VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     g.graph.importBuffer(kVertices, g.vertices.handle(), true);
-    g.graph.importBuffer(kIndices, g.indices.handle(), true);
 
     for (uint32_t i = 0; i < vk::kFramesInFlight; ++i) {
         FrameSlot f;
@@ -319,11 +312,10 @@ glm::ivec2 TerrainRenderer::waterFieldSize() const { return gpu_->water ? gpu_->
 
 void TerrainRenderer::setWater(std::optional<float> level, float margin) {
     RendererGpu& g = *gpu_;
-    if (level && g.water && g.water->level == *level && g.water->margin == margin) return;
-    ctx_.waitIdle();  // frames in flight may still read the old resources
+    if (level ? g.water && g.water->level == *level && g.water->margin == margin : !g.water) return;
     for (const char* name : {kWaterReflection, kWaterReflectionDepth, kWaterScene, kWaterVertices, kWaterIndices})
         g.graph.forget(name);
-    g.water.reset();
+    if (g.water) retire(std::move(g.water));
     if (!level) return;
     g.water = features::buildWater(ctx_, hf_, *level, margin);
     g.graph.importBuffer(kWaterVertices, g.water->vertices.handle(), true);
@@ -628,9 +620,8 @@ std::vector<TerrainRenderer::LpvSample> TerrainRenderer::sampleLpv(
 
 void TerrainRenderer::setReflectionProbes(std::shared_ptr<const ReflectionProbeSet> set) {
     RendererGpu& g = *gpu_;
-    ctx_.waitIdle();  // no frame may still read the old probes
     for (const char* name : {kReflectionRecords, kReflectionMarkers}) g.graph.forget(name);
-    g.reflections.reset();
+    if (g.reflections) retire(std::move(g.reflections));
     reflectionBytes_ = 0;
     if (!set || set->probes.empty()) return;
     g.reflections = features::buildReflections(ctx_, g, *set);
@@ -660,14 +651,52 @@ void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
                                         glm::vec3(v[3], v[4], v[5]), kSunVisibilitySamples, rng);
         values[2 * i] = glm::vec4(vis, 0.0f, 0.0f, 0.0f);
     });
-    ctx_.waitIdle();  // no frame may still read the old buffer
     g.graph.forget(kSunVisibility);
+    if (g.sunVisibility) retire(std::move(g.sunVisibility));
     g.sunVisibility = vk::Buffer::deviceLocal(ctx_, values.data(), values.size() * sizeof(glm::vec4),
                                               VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     g.graph.importBuffer(kSunVisibility, g.sunVisibility.handle(), true);
     g.sunVisibilityKey = key;
     g.sunVisibilitySkirt = int(skirt);
     ++sunTraces_;
+}
+
+void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water) {
+    double worst = 0.0;
+    // A caster's height error moves the edge of its shadow 1 / tan(sun elevation) times as far
+    // across the ground: with shadows, the levels keep that within the pixel (5x finer at a 11°
+    // sun, 1.4x at 35°).
+    // The data views are measured against the bake vertex by vertex: they draw every vertex.
+    double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
+    if (shadowed) {
+        const double up = std::clamp(double(s.sun.direction.y), 1e-3, 1.0);
+        maxPixels *= std::min(1.0, up / std::sqrt(std::max(1.0 - up * up, 0.0)));
+    }
+    // At 0 pixels a patch still draws a coarser level whose error is 0: it loses nothing.
+    const double rows = double(s.levelOfDetailRows > 0 ? s.levelOfDetailRows : s.height);
+    std::vector<uint8_t> levels = lod::chooseLevels(patches_, s.camera.position(), glm::radians(double(s.camera.fovDeg)),
+                                                    rows, maxPixels, &worst);
+    // Where the water meets the land, a height error moves the shore by the error over the
+    // ground's slope, many pixels on a flat shore: patches the water's surface can cross (its
+    // level, give or take the crests) draw every vertex.
+    if (water)
+        for (uint32_t k = 0; k < patches_.count(); ++k)
+            if (patches_.lo[k].y <= water->level + water->margin && patches_.hi[k].y >= water->level - water->margin)
+                levels[k] = 0;
+    lastLod_.screenErrorPixels = worst;
+    if (levels == lastLod_.levels && lodSerial_ > 0) return;
+    lastLod_.levels = std::move(levels);
+    lodIndices_.clear();
+    std::vector<uint32_t> border;
+    lod::appendPatchTriangles(lodIndices_, patches_, lastLod_.levels, &border);
+    lodMeshIndices_ = lodIndices_.size();
+    lod::appendSkirt(lodIndices_, skirt_, border);
+    lastLod_.triangles = lodMeshIndices_ / 3;
+    ++lodSerial_;
+}
+
+void TerrainRenderer::releaseRetired(bool idle) {
+    std::erase_if(retired_, [&](const Retired& r) { return idle || r.releaseAt <= framesBegun_; });
 }
 
 TerrainRenderer::~TerrainRenderer() {
@@ -681,10 +710,9 @@ const std::vector<PassInfo>& TerrainRenderer::lastFramePasses() const { return g
 
 void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes) {
     RendererGpu& g = *gpu_;
-    ctx_.waitIdle();  // no frame may still read the old buffers
     for (const char* name : {kProbeCoefficients, kProbeCells, kProbeVolumes, kProbeErrorMaps, kProbeLight})
         g.graph.forget(name);
-    g.probes.reset();
+    if (g.probes) retire(std::move(g.probes));
     volumeCount_ = 0;
     anyErrorMap_ = false;
     probeBytes_ = 0;
@@ -700,10 +728,9 @@ void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes
 }
 
 void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions) {
-    ctx_.waitIdle();  // no frame may still read the old buffer
     gpu_->graph.forget(kMarkers);
     markerCount_ = uint32_t(positions.size());
-    gpu_->markers = vk::Buffer();
+    if (gpu_->markers) retire(std::move(gpu_->markers));
     if (positions.empty()) return;
     gpu_->markers = vk::Buffer::deviceLocal(ctx_, positions.data(), positions.size() * sizeof(glm::vec4),
                                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -711,11 +738,10 @@ void TerrainRenderer::setProbePositions(const std::vector<glm::vec4>& positions)
 }
 
 void TerrainRenderer::setProbeLeaves(const std::vector<glm::vec4>& leaves) {
-    ctx_.waitIdle();  // no frame may still read the old buffer
     gpu_->graph.forget(kLeaves);
     leafCount_ = uint32_t(leaves.size());
     smallestLeaf_ = 1.0f;
-    gpu_->leaves = vk::Buffer();
+    if (gpu_->leaves) retire(std::move(gpu_->leaves));
     if (leaves.empty()) return;
     smallestLeaf_ = leaves.front().w;
     for (const auto& l : leaves) smallestLeaf_ = std::min(smallestLeaf_, l.w);
@@ -802,6 +828,8 @@ const RenderSettings& TerrainRenderer::drawnSettings(const RenderSettings& s, co
                                                      RenderSettings& scaled) {
     if (plan.scale == 1) return s;
     scaled = s;
+    // The level of detail keeps to the output's pixels.
+    if (scaled.levelOfDetailRows == 0) scaled.levelOfDetailRows = s.height;
     scaled.width *= plan.scale;
     scaled.height *= plan.scale;
     return scaled;
@@ -817,6 +845,7 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     const RenderSettings& drawn = drawnSettings(s, out.antialiasing, scaled);
     // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
     ctx_.waitIdle();
+    releaseRetired(true);
     ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, drawn, out); });
     gpu_->slots[0].width = s.width;
     gpu_->slots[0].height = s.height;
@@ -864,6 +893,8 @@ bool TerrainRenderer::present(const RenderSettings& s, vk::Swapchain& swapchain)
     ensureTarget(s.width, s.height, out.antialiasing);
     const std::optional<vk::SwapchainFrame> frame = swapchain.begin();
     if (!frame) return false;
+    ++framesBegun_;
+    releaseRetired(false);
     out.readback = false;
     out.swapchainImage = frame->image;
     out.extent = frame->extent;
@@ -1039,8 +1070,25 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.planarReflection = f.waterShading && s.water.reflection == WaterReflection::Planar;
     if (f.water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
     f.vertexCount = uint32_t(vertexCount_);
-    f.indexCount = uint32_t(indexCount_);
-    f.skirtIndexCount = s.skirt ? uint32_t(skirtIndexCount_) : 0;
+    // The level of detail's triangles, in this slot's index buffer (its last frame is done).
+    updateLod(s, view.needs.sky, shadowed, f.water);
+    if (f.slot.terrainIndicesSerial != lodSerial_) {
+        const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
+        if (f.slot.terrainIndices.size() < bytes) {
+            g.graph.forget(kIndices);
+            if (f.slot.terrainIndices) retire(std::move(f.slot.terrainIndices));
+            // A quarter more, so that a camera move does not grow it frame after frame.
+            f.slot.terrainIndices = vk::Buffer::hostVisible(ctx_, bytes + bytes / 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+        }
+        if (!lodIndices_.empty()) f.slot.terrainIndices.write(lodIndices_.data(), lodIndices_.size() * sizeof(uint32_t));
+        f.slot.terrainIndicesSerial = lodSerial_;
+    }
+    g.graph.park(kIndices);
+    g.graph.importBuffer(kIndices, f.slot.terrainIndices.handle());
+    f.indexBuffer = f.slot.terrainIndices.handle();
+    f.lodSerial = lodSerial_;
+    f.indexCount = uint32_t(lodMeshIndices_);
+    f.skirtIndexCount = s.skirt ? uint32_t(lodIndices_.size() - lodMeshIndices_) : 0;
     f.markerCount = markerCount_;
     f.leafCount = leafCount_;
     f.width = s.width;

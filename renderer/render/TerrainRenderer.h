@@ -25,6 +25,7 @@
 #include "scene/ShadowCascades.h"
 #include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
+#include "terrain/MeshLod.h"
 #include "vk/Swapchain.h"
 #include "water/Water.h"
 #include "vk/VulkanContext.h"
@@ -33,6 +34,7 @@ namespace terralux {
 
 struct RendererGpu;  // render/Frame.h
 struct Frame;
+struct WaterResources;  // render/features/Water.h
 struct ReflectionProbeSet;  // bake/ReflectionBake.h
 namespace features {
 struct AntialiasingPlan;  // render/features/Antialiasing.h
@@ -186,6 +188,24 @@ public:
     // (RendererGpu::spareTarget): a metered frame's meter and the frame itself allocate once.
     size_t targetAllocations() const;
     int meshStride() const { return stride_; }
+    // The mesh's level of detail (terrain/MeshLod.h): square patches of the drawn grid, each
+    // drawing every 2^l-th of its vertices, l chosen per frame so that the terrain strays at most
+    // setLodPixelError pixels (1 by default; at 0 only what is exact is left out) from the source DEM as the
+    // frame's camera sees it, in the picture views (the data views draw every vertex: they are
+    // read against the bake vertex by vertex). The shadow maps and the water's reflection draw
+    // the frame's levels.
+    static constexpr uint32_t kLodPatchCells = 32;
+    const lod::Patches& lodPatches() const { return patches_; }
+    // What the drawn grid itself leaves out of the source DEM (metres; 0 when drawn whole).
+    double decimationError() const { return baseError_; }
+    void setLodPixelError(double pixels) { lodPixelError_ = pixels; }
+    struct LodChoice {
+        std::vector<uint8_t> levels;     // per patch
+        size_t triangles = 0;            // the terrain's, skirt aside
+        double screenErrorPixels = 0.0;  // the largest error of a patch's level as the camera sees it
+    };
+    // The levels the last frame drew.
+    const LodChoice& lastLod() const { return lastLod_; }
     size_t vertexCount() const { return vertexCount_; }
     size_t triangleCount() const { return indexCount_ / 3; }
     size_t probeBytes() const { return probeBytes_; }
@@ -206,11 +226,35 @@ private:
     void buildReflectionSets();
     void propagateLpvNow();  // runs the owed propagation in a submission of its own
     void readFrameTimings(uint32_t slot);  // the slot's last frame into timings_; its fence has passed
+    // Resources replaced while a frame in flight may still read them: kept until every frame slot
+    // has been waited for since (kFramesInFlight frames begun), or the queue has been waited
+    // for, then released. Replacing them never waits for the device.
+    template <class T>
+    void retire(T&& resource) {
+        retired_.push_back({framesBegun_ + vk::kFramesInFlight, std::make_shared<std::decay_t<T>>(std::move(resource))});
+    }
+    void releaseRetired(bool idle);
+    struct Retired {
+        uint64_t releaseAt;  // framesBegun_ at which no frame can still read it
+        std::shared_ptr<void> resource;
+    };
+    std::vector<Retired> retired_;
+    uint64_t framesBegun_ = 0;  // swapchain frames begun: each waited for its slot's frame before
+    // Chooses the frame's levels; builds their triangles when they changed (++lodSerial_).
+    void updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water);
+    lod::Patches patches_;
+    lod::SkirtVertices skirt_;
+    double baseError_ = 0.0;
+    double lodPixelError_ = 1.0;
+    LodChoice lastLod_;
+    std::vector<uint32_t> lodIndices_;  // the levels' triangles, then their skirt's
+    size_t lodMeshIndices_ = 0;
+    uint64_t lodSerial_ = 0;            // counts the index lists built
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<RendererGpu> gpu_;
     int stride_ = 1;
-    size_t vertexCount_ = 0, indexCount_ = 0, skirtIndexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
+    size_t vertexCount_ = 0, indexCount_ = 0, probeBytes_ = 0, reflectionBytes_ = 0;
     int volumeCount_ = 0;
     bool anyErrorMap_ = false;
     uint32_t markerCount_ = 0, leafCount_ = 0;

@@ -744,6 +744,9 @@ TEST_F(RenderTest, ASceneWithoutProbeVolumesBindsNoProbeResources) {
         const std::string mention = probeMention(without.renderer().lastFramePasses());
         EXPECT_TRUE(mention.empty()) << v.name << ": " << mention;
     }
+    // The data views drew every vertex, the picture draws its level of detail: once for its
+    // shadow maps, then the frame alone.
+    draw(without, kViewBeauty);
     const RenderedImage none = draw(without, kViewBeauty);
     EXPECT_EQ(passNames(without.renderer().lastFramePasses()), (Names{"terrain", "sky", "antialias", "readback"}));
 
@@ -2847,4 +2850,48 @@ TEST_F(RenderTest, TheLastCascadeFadesIntoTheUnshadowedSunAtAShortShadowDistance
         greyish += std::abs(u.x - u.y) < 0.02f && std::abs(u.y - u.z) < 0.02f;
     }
     EXPECT_EQ(greyish, 0u);
+}
+
+// The mesh's level of detail (terrain/MeshLod.h): each patch draws the coarsest level whose error
+// against the DEM covers at most a pixel from the camera, and the frame is the frame of the whole
+// mesh up to that pixel; close to the ground the patches there draw every vertex.
+TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
+    Project p = sampleProject("lod", 4, 4);
+    ProjectRenderer r(*ctx_, p);
+    TerrainRenderer& t = r.renderer();
+    const lod::Patches& patches = t.lodPatches();
+    ASSERT_GE(patches.count(), 16u);
+    EXPECT_EQ(t.decimationError(), 0.0);  // the sample is drawn whole
+    const size_t whole = t.triangleCount();
+    for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{kW, kH}, {480, 320}}) {
+        t.setLodPixelError(1.0);
+        const RenderedImage lod = draw(r, kViewBeauty, false, false, w, h);
+        const TerrainRenderer::LodChoice chosen = t.lastLod();
+        t.setLodPixelError(0.0);
+        const RenderedImage all = draw(r, kViewBeauty, false, false, w, h);
+        std::printf("%ux%u: %zu of %zu triangles, %.3f px\n", w, h, chosen.triangles, t.lastLod().triangles,
+                    chosen.screenErrorPixels);
+        EXPECT_LE(chosen.screenErrorPixels, 1.0);
+        EXPECT_EQ(t.lastLod().screenErrorPixels, 0.0);
+        EXPECT_LT(chosen.triangles, whole / 2) << w << "x" << h;
+        const test::ImageDiff d = test::compareImages(lod.rgba, all.rgba, w, h);
+        std::printf("  mean %.5f max %.4f ssim %.5f\n", d.meanAbs, d.maxAbs, d.ssim);
+        EXPECT_LT(d.meanAbs, 0.004) << w << "x" << h;
+        EXPECT_GT(d.ssim, 0.98) << w << "x" << h;
+    }
+    // Standing near the ground: the patches around the camera draw every vertex.
+    t.setLodPixelError(1.0);
+    OrbitCamera close = OrbitCamera::fromSettings(p.scene.camera, r.heightfield());
+    close.radius = 150.0f;
+    close.elevationDeg = 10.0f;
+    RenderRequest q = unprobed(kViewBeauty, false);
+    r.render(q, close);
+    const std::vector<uint8_t>& levels = t.lastLod().levels;
+    ASSERT_EQ(levels.size(), patches.count());
+    size_t wholePatches = 0;
+    for (size_t k = 0; k < levels.size(); ++k)
+        if (levels[k] == 0 && lod::distanceToBox(close.position(), patches.lo[k], patches.hi[k]) < 100.0) ++wholePatches;
+    EXPECT_GE(wholePatches, 1u);
+    EXPECT_GT(*std::max_element(levels.begin(), levels.end()), 0);
+    EXPECT_LE(t.lastLod().screenErrorPixels, 1.0);
 }

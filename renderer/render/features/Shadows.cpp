@@ -50,7 +50,9 @@ std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const R
 void addShadowPass(Frame& f) {
     ShadowResources* shadows = f.shadows;
     const bool skirt = f.skirtIndexCount > 0;
-    if (!shadows || (shadows->drawn == f.lightMatrices && shadows->drawnSkirt == skirt)) return;
+    if (!shadows || (shadows->drawn == f.lightMatrices && shadows->drawnSkirt == skirt &&
+                     shadows->drawnLod == f.lodSerial))
+        return;
     RendererGpu& g = f.g;
     if (!g.shadowDepth) {
         vk::GraphicsPipelineDesc d;
@@ -70,7 +72,9 @@ void addShadowPass(Frame& f) {
                    {kIndices, Access::IndexRead}},
                   {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
     const uint32_t indexCount = f.indexCount + f.skirtIndexCount, res = uint32_t(shadows->resolution);
-    g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, res](VkCommandBuffer c) {
+    const VkBuffer indices = f.indexBuffer;
+    g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, indices,
+                                      res](VkCommandBuffer c) {
         for (size_t i = 0; i < lightMatrices.size(); ++i) {
             VkClearValue clear{};
             clear.depthStencil = {1.0f, 0};
@@ -89,7 +93,7 @@ void addShadowPass(Frame& f) {
                 const VkBuffer vb = g.vertices.handle();
                 const VkDeviceSize offset = 0;
                 vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
-                vkCmdBindIndexBuffer(c, g.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+                vkCmdBindIndexBuffer(c, indices, 0, VK_INDEX_TYPE_UINT32);
                 vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
             }
             vkCmdEndRenderPass(c);
@@ -97,6 +101,7 @@ void addShadowPass(Frame& f) {
     });
     shadows->drawn = f.lightMatrices;
     shadows->drawnSkirt = skirt;
+    shadows->drawnLod = f.lodSerial;
 }
 
 }  // namespace terralux::features

@@ -16,6 +16,7 @@ struct ShadowResources {
     int resolution = 0, cascades = 0;
     std::vector<glm::mat4> drawn;  // the light projections the maps hold now (empty: none yet)
     bool drawnSkirt = false;       // whether they hold the skirt (terrain.skirt when drawn)
+    uint64_t drawnLod = 0;         // the terrain's levels of detail they hold (Frame::lodSerial)
 };
 
 namespace features {

@@ -122,7 +122,7 @@ TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
     const VkPipeline handle = pipeline.get();
     const VkDescriptorSet lights = f.lights().handle();
     const VkDescriptorSet lpvSet = f.lpvSet ? f.slot.lpvSet.handle() : VK_NULL_HANDLE;
-    const VkBuffer vertices = g.vertices.handle(), indices = g.indices.handle();
+    const VkBuffer vertices = g.vertices.handle(), indices = f.indexBuffer;
     const uint32_t indexCount = f.indexCount;
     return [handle, layout, lights, lpvSet, vertices, indices, attribute, attributeOffset,
             indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {

@@ -1,0 +1,295 @@
+#include "terrain/MeshLod.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+namespace terralux::lod {
+
+std::vector<uint32_t> kept(uint32_t n, uint32_t step) {
+    std::vector<uint32_t> k;
+    if (n == 0) return k;
+    step = std::max(step, 1u);
+    for (uint32_t i = 0; i < n; i += step) k.push_back(i);
+    if (k.back() != n - 1) k.push_back(n - 1);
+    return k;
+}
+
+void appendTriangles(std::vector<uint32_t>& indices, uint32_t nc, const std::vector<uint32_t>& kc,
+                     const std::vector<uint32_t>& kr) {
+    for (size_t r = 0; r + 1 < kr.size(); ++r)
+        for (size_t c = 0; c + 1 < kc.size(); ++c) {
+            const uint32_t v00 = kr[r] * nc + kc[c], v10 = kr[r] * nc + kc[c + 1];
+            const uint32_t v01 = kr[r + 1] * nc + kc[c], v11 = kr[r + 1] * nc + kc[c + 1];
+            indices.insert(indices.end(), {v00, v01, v11, v00, v11, v10});
+        }
+}
+
+namespace {
+
+// Per grid line from k.front() to k.back(): the kept cell holding it and where in that cell (0..1).
+struct Span {
+    std::vector<uint32_t> cell;
+    std::vector<double> f;
+};
+
+Span spans(const std::vector<uint32_t>& k) {
+    const uint32_t n = k.back() - k.front() + 1;
+    Span s{std::vector<uint32_t>(n), std::vector<double>(n)};
+    size_t cell = 0;
+    for (uint32_t i = k.front(); i <= k.back(); ++i) {
+        while (cell + 2 < k.size() && i > k[cell + 1]) ++cell;
+        s.cell[i - k.front()] = uint32_t(cell);
+        s.f[i - k.front()] = double(i - k[cell]) / double(k[cell + 1] - k[cell]);
+    }
+    return s;
+}
+
+}  // namespace
+
+double gridError(std::span<const float> heights, uint32_t nc, const std::vector<uint32_t>& kc,
+                 const std::vector<uint32_t>& kr) {
+    if (kc.size() < 2 || kr.size() < 2) return 0.0;
+    const uint32_t c0 = kc.front(), r0 = kr.front();
+    const Span u = spans(kc), v = spans(kr);
+    auto h = [&](uint32_t c, uint32_t r) { return double(heights[size_t(r) * nc + c]); };
+    return tbb::parallel_reduce(
+        tbb::blocked_range<uint32_t>(r0, kr.back() + 1), 0.0,
+        [&](const tbb::blocked_range<uint32_t>& rows, double worst) {
+            for (uint32_t r = rows.begin(); r != rows.end(); ++r) {
+                const uint32_t cell = v.cell[r - r0];
+                const uint32_t ra = kr[cell], rb = kr[cell + 1];
+                const double fv = v.f[r - r0];
+                for (uint32_t c = c0; c <= kc.back(); ++c) {
+                    const uint32_t cc = u.cell[c - c0];
+                    const uint32_t ca = kc[cc], cb = kc[cc + 1];
+                    const double fu = u.f[c - c0];
+                    const double h00 = h(ca, ra), h10 = h(cb, ra), h01 = h(ca, rb), h11 = h(cb, rb);
+                    // The triangle (ca, ra), (ca, rb), (cb, rb) where fu <= fv, else
+                    // (ca, ra), (cb, rb), (cb, ra): the tracer's and the mesh's split.
+                    const double s = fu <= fv ? h00 + fu * (h11 - h01) + fv * (h01 - h00)
+                                              : h00 + fu * (h10 - h00) + fv * (h11 - h10);
+                    worst = std::max(worst, std::abs(h(c, r) - s));
+                }
+            }
+            return worst;
+        },
+        [](double a, double b) { return std::max(a, b); });
+}
+
+double distanceToBox(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& hi) {
+    const glm::dvec3 d = glm::max(glm::max(glm::dvec3(lo) - glm::dvec3(p), glm::dvec3(p) - glm::dvec3(hi)), glm::dvec3(0.0));
+    return glm::length(d);
+}
+
+double screenPixels(double metres, double distance, double fovY, double heightPixels) {
+    if (metres <= 0.0) return 0.0;
+    if (!(distance > 0.0)) return std::numeric_limits<double>::infinity();
+    return metres / distance * heightPixels / (2.0 * std::tan(0.5 * fovY));
+}
+
+namespace {
+
+// Boundaries of patches of about `cells` cells over n vertices: every `cells`, the last patch
+// taking the remainder (so none is smaller than `cells` where the grid is not).
+std::vector<uint32_t> boundaries(uint32_t n, uint32_t cells) {
+    std::vector<uint32_t> b{0};
+    const uint32_t last = n - 1, count = std::max(last / cells, 1u);
+    for (uint32_t i = 1; i < count; ++i) b.push_back(i * cells);
+    b.push_back(last);
+    return b;
+}
+
+// `from`..`to` at `step` (relative to `from`), `to` always.
+std::vector<uint32_t> keptRange(uint32_t from, uint32_t to, uint32_t step) {
+    std::vector<uint32_t> k = kept(to - from + 1, step);
+    for (uint32_t& v : k) v += from;
+    return k;
+}
+
+// Levels a span of `cells` cells has: steps up to half of it (two cells a side at least).
+uint8_t coarsestLevel(uint32_t cells) {
+    uint8_t l = 0;
+    while (2u * stepOf(uint8_t(l + 1)) <= cells) ++l;
+    return l;
+}
+
+}  // namespace
+
+Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, std::span<const float> colX,
+                     std::span<const float> rowZ, uint32_t patchCells, double baseError) {
+    Patches p;
+    p.nc = nc;
+    p.nr = nr;
+    if (nc < 2 || nr < 2) return p;
+    p.cols = boundaries(nc, std::max(patchCells, 2u));
+    p.rows = boundaries(nr, std::max(patchCells, 2u));
+    const uint32_t n = p.count();
+    p.coarsest.resize(n);
+    p.lo.resize(n);
+    p.hi.resize(n);
+    for (uint32_t j = 0; j < p.patchesZ(); ++j)
+        for (uint32_t i = 0; i < p.patchesX(); ++i) {
+            const uint32_t k = j * p.patchesX() + i;
+            p.coarsest[k] = std::min(coarsestLevel(p.cols[i + 1] - p.cols[i]), coarsestLevel(p.rows[j + 1] - p.rows[j]));
+            p.levels = std::max(p.levels, uint32_t(p.coarsest[k]) + 1);
+        }
+    p.error.assign(size_t(n) * p.levels, 0.0);
+    tbb::parallel_for(uint32_t(0), n, [&](uint32_t k) {
+        const uint32_t i = k % p.patchesX(), j = k / p.patchesX();
+        const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
+        float yLo = heights[size_t(r0) * nc + c0], yHi = yLo;
+        for (uint32_t r = r0; r <= r1; ++r)
+            for (uint32_t c = c0; c <= c1; ++c) {
+                yLo = std::min(yLo, heights[size_t(r) * nc + c]);
+                yHi = std::max(yHi, heights[size_t(r) * nc + c]);
+            }
+        p.lo[k] = glm::vec3(std::min(colX[c0], colX[c1]), yLo, std::min(rowZ[r0], rowZ[r1]));
+        p.hi[k] = glm::vec3(std::max(colX[c0], colX[c1]), yHi, std::max(rowZ[r0], rowZ[r1]));
+        for (uint32_t l = 0; l < p.levels; ++l) {
+            // Levels past the patch's coarsest stand at its coarsest, never chosen.
+            const uint32_t step = stepOf(uint8_t(std::min<uint32_t>(l, p.coarsest[k])));
+            p.error[size_t(k) * p.levels + l] =
+                baseError + (step > 1 ? gridError(heights, nc, keptRange(c0, c1, step), keptRange(r0, r1, step)) : 0.0);
+        }
+    });
+    return p;
+}
+
+std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double fovY, double heightPixels,
+                                  double maxPixels, double* worstPixels) {
+    std::vector<uint8_t> levels(p.count(), 0);
+    double worst = 0.0;
+    for (uint32_t k = 0; k < p.count(); ++k) {
+        const double distance = distanceToBox(eye, p.lo[k], p.hi[k]);
+        uint8_t chosen = 0;
+        for (uint8_t l = 1; l <= p.coarsest[k]; ++l)
+            if (screenPixels(p.error[size_t(k) * p.levels + l], distance, fovY, heightPixels) <= maxPixels) chosen = l;
+        levels[k] = chosen;
+        worst = std::max(worst, screenPixels(p.error[size_t(k) * p.levels + chosen], distance, fovY, heightPixels));
+    }
+    if (worstPixels) *worstPixels = worst;
+    return levels;
+}
+
+namespace {
+
+struct GridPoint {
+    uint32_t c, r;
+};
+
+// The strip between two runs of vertices along one axis, `outer` on the patch's edge and `inner`
+// one ring of cells in, from one shared rung (outer.front()-inner.front()) to the other, each
+// triangle counter-clockwise from above. At a tie the diagonal the plain grid would draw is
+// taken: innerFirst says it runs from the outer vertex to the next inner one.
+void zip(std::vector<uint32_t>& out, uint32_t nc, const std::vector<GridPoint>& outer,
+         const std::vector<GridPoint>& inner, bool alongColumns, bool innerFirst) {
+    auto t = [&](const GridPoint& g) { return alongColumns ? g.c : g.r; };
+    auto index = [&](const GridPoint& g) { return g.r * nc + g.c; };
+    auto emit = [&](const GridPoint& a, const GridPoint& b, const GridPoint& c) {
+        // Counter-clockwise from above is negative area in (c, r) (rows run along +z).
+        const int64_t area = (int64_t(b.c) - a.c) * (int64_t(c.r) - a.r) - (int64_t(c.c) - a.c) * (int64_t(b.r) - a.r);
+        if (area == 0) return;
+        if (area < 0)
+            out.insert(out.end(), {index(a), index(b), index(c)});
+        else
+            out.insert(out.end(), {index(a), index(c), index(b)});
+    };
+    size_t i = 0, j = 0;
+    while (i + 1 < outer.size() || j + 1 < inner.size()) {
+        const bool outerNext = j + 1 >= inner.size() ||
+                               (i + 1 < outer.size() && (t(outer[i + 1]) < t(inner[j + 1]) ||
+                                                         (t(outer[i + 1]) == t(inner[j + 1]) && !innerFirst)));
+        if (outerNext) {
+            emit(outer[i], outer[i + 1], inner[j]);
+            ++i;
+        } else {
+            emit(outer[i], inner[j + 1], inner[j]);
+            ++j;
+        }
+    }
+}
+
+}  // namespace
+
+void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
+                          std::vector<uint32_t>* borderSegments) {
+    const uint32_t px = p.patchesX(), pz = p.patchesZ(), nc = p.nc;
+    if (p.cols.size() < 2 || p.rows.size() < 2) return;
+    auto level = [&](int64_t i, int64_t j) -> int {
+        if (i < 0 || j < 0 || i >= int64_t(px) || j >= int64_t(pz)) return -1;  // outside: the border
+        return levels[size_t(j) * px + size_t(i)];
+    };
+    for (uint32_t j = 0; j < pz; ++j)
+        for (uint32_t i = 0; i < px; ++i) {
+            const int own = level(i, j);
+            const uint32_t step = stepOf(uint8_t(own));
+            const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
+            const std::vector<uint32_t> kc = keptRange(c0, c1, step), kr = keptRange(r0, r1, step);
+            // Each edge at the coarser of the two patches' steps (a border edge at its own).
+            auto edgeStep = [&](int neighbour) { return stepOf(uint8_t(std::max(own, neighbour))); };
+            const uint32_t sN = edgeStep(level(i, int64_t(j) - 1)), sS = edgeStep(level(i, j + 1));
+            const uint32_t sW = edgeStep(level(int64_t(i) - 1, j)), sE = edgeStep(level(i + 1, j));
+            if (borderSegments) {
+                auto segments = [&](const std::vector<uint32_t>& run, bool alongColumns, uint32_t fixed) {
+                    for (size_t k = 0; k + 1 < run.size(); ++k) {
+                        const uint32_t a = alongColumns ? fixed * nc + run[k] : run[k] * nc + fixed;
+                        const uint32_t b = alongColumns ? fixed * nc + run[k + 1] : run[k + 1] * nc + fixed;
+                        borderSegments->insert(borderSegments->end(), {a, b});
+                    }
+                };
+                if (j == 0) segments(keptRange(c0, c1, sN), true, r0);
+                if (j + 1 == pz) segments(keptRange(c0, c1, sS), true, r1);
+                if (i == 0) segments(keptRange(r0, r1, sW), false, c0);
+                if (i + 1 == px) segments(keptRange(r0, r1, sE), false, c1);
+            }
+            // (A patch one cell across has no ring; its neighbours along its row or column are one
+            // cell across too, so they all stand at level 0 and nothing is zipped.)
+            if ((sN == step && sS == step && sW == step && sE == step) || kc.size() < 3 || kr.size() < 3) {
+                appendTriangles(indices, nc, kc, kr);
+                continue;
+            }
+            // The ring of cells along the edges zipped to the edges' vertices, the inside as a
+            // plain grid. Its inner runs are the second and second-last kept lines.
+            const std::vector<uint32_t> ic(kc.begin() + 1, kc.end() - 1), ir(kr.begin() + 1, kr.end() - 1);
+            appendTriangles(indices, nc, ic, ir);
+            auto row = [](const std::vector<uint32_t>& cs, uint32_t r) {
+                std::vector<GridPoint> g;
+                for (uint32_t c : cs) g.push_back({c, r});
+                return g;
+            };
+            auto column = [](const std::vector<uint32_t>& rs, uint32_t c) {
+                std::vector<GridPoint> g;
+                for (uint32_t r : rs) g.push_back({c, r});
+                return g;
+            };
+            // The plain grid's diagonal (c, r)-(c+1, r+1) runs from the outer vertex to the next
+            // inner one on the north and west edges, and from the inner vertex to the next outer
+            // one on the south and east edges.
+            zip(indices, nc, row(keptRange(c0, c1, sN), r0), row(ic, ir.front()), true, true);
+            zip(indices, nc, row(keptRange(c0, c1, sS), r1), row(ic, ir.back()), true, false);
+            zip(indices, nc, column(keptRange(r0, r1, sW), c0), column(ir, ic.front()), false, true);
+            zip(indices, nc, column(keptRange(r0, r1, sE), c1), column(ir, ic.back()), false, false);
+        }
+}
+
+void appendSkirt(std::vector<uint32_t>& indices, const SkirtVertices& k, const std::vector<uint32_t>& segments) {
+    for (size_t i = 0; i + 1 < segments.size(); i += 2) {
+        const uint32_t a = segments[i], b = segments[i + 1];
+        const uint32_t ca = a % k.nc, ra = a / k.nc, cb = b % k.nc, rb = b / k.nc;
+        uint32_t ta, tb;
+        if (ra == rb && ra == 0) ta = k.north[ca], tb = k.north[cb];
+        else if (ra == rb) ta = k.south[ca], tb = k.south[cb];
+        else if (ca == 0) ta = k.west[ra], tb = k.west[rb];
+        else ta = k.east[ra], tb = k.east[rb];
+        indices.insert(indices.end(), {a, b, tb, a, tb, ta});
+    }
+    indices.insert(indices.end(), k.corners.begin(), k.corners.end());
+}
+
+}  // namespace terralux::lod

@@ -1,0 +1,96 @@
+#pragma once
+// The terrain mesh's level of detail. The drawn grid (the DEM's vertices, or every k-th under the
+// renderer's vertex budget) is cut into square patches; each frame every patch draws every
+// 2^l-th of its vertices along each axis (its last row and column always), choosing the coarsest
+// level whose geometric error, seen from the camera at the patch's nearest point, covers at most
+// a pixel. A shared edge is drawn with the vertices of the coarser of its two patches, and the
+// finer patch zips its ring of cells to them, so the mesh has no cracks whatever the levels.
+// Every vertex is a vertex of the drawn grid, so per-vertex data (probe light, sun visibility)
+// serves every level.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+namespace terralux::lod {
+
+// The vertices a level keeps along an axis of n: 0, step, 2 step, ... and n - 1.
+std::vector<uint32_t> kept(uint32_t n, uint32_t step);
+
+// Appends the triangles of the grid through columns kc and rows kr of an nc-wide vertex grid
+// (vertex (c, r) is index r * nc + c): two per cell, split along (c, r)-(c+1, r+1), counter-
+// clockwise seen from above (y up, rows along +z).
+void appendTriangles(std::vector<uint32_t>& indices, uint32_t nc, const std::vector<uint32_t>& kc,
+                     const std::vector<uint32_t>& kr);
+
+// The largest |h - s| over the vertices of the nc-wide height grid `heights` (row-major) from
+// column kc.front() to kc.back() and row kr.front() to kr.back(), where s is the surface of the
+// grid through columns kc and rows kr at that vertex: two triangles per cell, split as
+// appendTriangles splits them, linear across each.
+double gridError(std::span<const float> heights, uint32_t nc, const std::vector<uint32_t>& kc,
+                 const std::vector<uint32_t>& kr);
+
+// The distance from p to the box [lo, hi] (0 inside it).
+double distanceToBox(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& hi);
+
+// Pixels a geometric error of `metres` covers at most, seen `distance` metres away through a
+// perspective camera with a vertical field of view fovY (radians) over heightPixels rows: the
+// angle an offset subtends is at most metres / distance, and a pixel subtends
+// 2 tan(fovY / 2) / heightPixels at the centre of the image (less at its edges). At distance 0,
+// infinity unless the error is 0.
+double screenPixels(double metres, double distance, double fovY, double heightPixels);
+
+// The drawn grid cut into patches of about `patchCells` cells a side (the last ones take the
+// remainder), with each patch's bounds and the error of each of its levels.
+struct Patches {
+    uint32_t nc = 0, nr = 0;               // the drawn grid's vertices along each axis
+    std::vector<uint32_t> cols, rows;      // patch boundaries: patch (i, j) spans columns
+                                           // cols[i]..cols[i+1] and rows rows[j]..rows[j+1]
+    uint32_t levels = 1;                   // levels a patch may have (the largest count)
+    std::vector<uint8_t> coarsest;         // per patch: its last level (2 cells a side at least)
+    std::vector<double> error;             // per patch, per level (patch * levels + l): metres
+    std::vector<glm::vec3> lo, hi;         // per patch: its bounds in the world
+    uint32_t patchesX() const { return uint32_t(cols.size()) - 1; }
+    uint32_t patchesZ() const { return uint32_t(rows.size()) - 1; }
+    uint32_t count() const { return patchesX() * patchesZ(); }
+};
+
+// `heights` is the drawn grid (nc x nr, row-major), colX and rowZ its columns' and rows' world
+// coordinates; `baseError` (metres) is added to every level's error: what the drawn grid itself
+// leaves out of the source DEM.
+Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, std::span<const float> colX,
+                     std::span<const float> rowZ, uint32_t patchCells, double baseError);
+
+// Each patch's level: the coarsest whose error covers at most maxPixels seen from `eye` at the
+// patch's nearest point. worstPixels (if given) receives the largest such cover of the levels
+// chosen.
+std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double fovY, double heightPixels,
+                                  double maxPixels, double* worstPixels = nullptr);
+
+// The step of patch `patch`'s level: 2^level.
+inline uint32_t stepOf(uint8_t level) { return 1u << level; }
+
+// Appends the triangles of every patch at its level, zipped along edges shared with a coarser
+// patch (as appendTriangles winds and, where no edge is zipped, splits them), and returns the
+// mesh's border segments at the border patches' steps: pairs of vertex indices, in order along
+// the border, for the skirt.
+void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
+                          std::vector<uint32_t>* borderSegments = nullptr);
+
+// The skirt's vertices (the renderer's terrain.skirt): for each border vertex of the drawn grid
+// its twin pushed out across that border (a corner vertex has one per border), and the four
+// corner squares' triangles.
+struct SkirtVertices {
+    uint32_t nc = 0, nr = 0;
+    std::vector<uint32_t> north, south;  // per column: twins of row 0 and row nr - 1
+    std::vector<uint32_t> west, east;    // per row: twins of column 0 and column nc - 1
+    std::vector<uint32_t> corners;       // triangles
+};
+
+// Appends the skirt for `segments` (pairs of border vertices from appendPatchTriangles): each
+// segment and its twins as two triangles, then the corner squares.
+void appendSkirt(std::vector<uint32_t>& indices, const SkirtVertices& k, const std::vector<uint32_t>& segments);
+
+}  // namespace terralux::lod

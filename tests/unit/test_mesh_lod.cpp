@@ -1,0 +1,226 @@
+// The terrain mesh's levels of detail (renderer/terrain/MeshLod.h): the vertices each level
+// keeps, its triangles, the error bound it carries and the level a camera picks.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "terrain/MeshLod.h"
+
+using namespace terralux;
+
+TEST(MeshLod, ALevelKeepsEveryStepthVertexAndTheLast) {
+    EXPECT_EQ(lod::kept(10, 4), (std::vector<uint32_t>{0, 4, 8, 9}));
+    EXPECT_EQ(lod::kept(9, 4), (std::vector<uint32_t>{0, 4, 8}));
+    EXPECT_EQ(lod::kept(5, 1), (std::vector<uint32_t>{0, 1, 2, 3, 4}));
+    EXPECT_EQ(lod::kept(1, 2), (std::vector<uint32_t>{0}));
+    EXPECT_TRUE(lod::kept(0, 2).empty());
+}
+
+// Every level is a watertight grid: each inner edge is shared by two triangles wound opposite
+// ways, each border edge belongs to one, and the triangles cover the grid's rectangle once.
+TEST(MeshLod, EveryLevelIsAWatertightGridOverTheSameVertices) {
+    const uint32_t nc = 11, nr = 7;
+    for (uint32_t step : {1u, 2u, 4u}) {
+        const std::vector<uint32_t> kc = lod::kept(nc, step), kr = lod::kept(nr, step);
+        std::vector<uint32_t> idx;
+        lod::appendTriangles(idx, nc, kc, kr);
+        ASSERT_EQ(idx.size(), (kc.size() - 1) * (kr.size() - 1) * 6);
+        std::map<std::pair<uint32_t, uint32_t>, int> directed;
+        double area = 0.0;
+        for (size_t t = 0; t < idx.size(); t += 3) {
+            for (int e = 0; e < 3; ++e) ++directed[{idx[t + e], idx[t + (e + 1) % 3]}];
+            // Signed area in (column, row) space: counter-clockwise from above (y up, rows
+            // along +z) is clockwise in (c, r), so negative.
+            auto cr = [&](uint32_t v) { return std::array<double, 2>{double(v % nc), double(v / nc)}; };
+            const auto a = cr(idx[t]), b = cr(idx[t + 1]), c = cr(idx[t + 2]);
+            const double signedArea = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+            EXPECT_LT(signedArea, 0.0);
+            area -= signedArea;
+        }
+        EXPECT_DOUBLE_EQ(area, double((nc - 1) * (nr - 1))) << "step " << step;
+        size_t border = 0;
+        for (const auto& [edge, n] : directed) {
+            EXPECT_EQ(n, 1);
+            if (!directed.count({edge.second, edge.first})) ++border;
+        }
+        EXPECT_EQ(border, 2 * (kc.size() - 1) + 2 * (kr.size() - 1)) << "step " << step;
+    }
+}
+
+TEST(MeshLod, APlaneLosesNothingAtAnyLevel) {
+    const uint32_t nc = 9, nr = 6;
+    std::vector<float> h(nc * nr);
+    for (uint32_t r = 0; r < nr; ++r)
+        for (uint32_t c = 0; c < nc; ++c) h[r * nc + c] = 3.0f * float(c) - 2.0f * float(r) + 100.0f;
+    for (uint32_t step : {1u, 2u, 4u, 8u})
+        EXPECT_NEAR(lod::gridError(h, nc, lod::kept(nc, step), lod::kept(nr, step)), 0.0, 1e-9) << step;
+}
+
+// The coarse cell splits along (c, r)-(c+1, r+1) like the mesh and the tracer: a ridge along
+// that diagonal is kept whole, and one along the other diagonal is lost.
+TEST(MeshLod, TheErrorFollowsTheMeshsDiagonal) {
+    // 3 x 3 heights over one coarse cell, a ridge of 6 m along one diagonal, falling linearly to
+    // 0 at the other two corners (3 m at the edges' midpoints). Row-major, (c, r) at r * 3 + c.
+    const std::vector<float> ridge{6, 3, 0,  //
+                                   3, 6, 3,  //
+                                   0, 3, 6};
+    const std::vector<float> crossRidge{0, 3, 6,  //
+                                        3, 6, 3,  //
+                                        6, 3, 0};
+    const std::vector<uint32_t> k = lod::kept(3, 2);
+    EXPECT_DOUBLE_EQ(lod::gridError(ridge, 3, k, k), 0.0);
+    // Across the split, the centre falls to the mean of (0, 0) and (2, 2): 0, not 6.
+    EXPECT_DOUBLE_EQ(lod::gridError(crossRidge, 3, k, k), 6.0);
+    // A peak at one inner vertex is lost whole.
+    std::vector<float> peak(25, 0.0f);
+    peak[2 * 5 + 1] = 4.5f;
+    EXPECT_DOUBLE_EQ(lod::gridError(peak, 5, lod::kept(5, 2), lod::kept(5, 2)), 4.5);
+    EXPECT_DOUBLE_EQ(lod::gridError(peak, 5, lod::kept(5, 1), lod::kept(5, 1)), 0.0);
+}
+
+TEST(MeshLod, ScreenErrorAndDistance) {
+    const double fov = std::numbers::pi / 2.0;  // 2 tan(fov / 2) = 2
+    EXPECT_NEAR(lod::screenPixels(1.0, 1000.0, fov, 1000.0), 0.5, 1e-12);
+    EXPECT_EQ(lod::screenPixels(0.0, 0.0, fov, 1000.0), 0.0);
+    EXPECT_TRUE(std::isinf(lod::screenPixels(0.5, 0.0, fov, 1000.0)));
+    EXPECT_DOUBLE_EQ(lod::distanceToBox({0, 0, 0}, {-1, -1, -1}, {1, 1, 1}), 0.0);
+    EXPECT_DOUBLE_EQ(lod::distanceToBox({4, 5, 0}, {-1, -1, -1}, {1, 1, 1}), 5.0);
+}
+
+namespace {
+
+// A rough grid (a slope and up to 1 m of noise from a hash) of nc x nr vertices, 10 m apart, in patches of `cells`.
+struct Terrain {
+    uint32_t nc, nr;
+    std::vector<float> h, x, z;
+    lod::Patches patches;
+    Terrain(uint32_t nc_, uint32_t nr_, uint32_t cells) : nc(nc_), nr(nr_), h(size_t(nc_) * nr_), x(nc_), z(nr_) {
+        for (uint32_t r = 0; r < nr; ++r)
+            for (uint32_t c = 0; c < nc; ++c) {
+                uint32_t k = (r * 73856093u) ^ (c * 19349663u);
+                k = (k ^ (k >> 13)) * 0x5bd1e995u;
+                h[size_t(r) * nc + c] = float(k % 1000u) * 0.001f + 0.5f * float(c);
+            }
+        for (uint32_t c = 0; c < nc; ++c) x[c] = 10.0f * float(c);
+        for (uint32_t r = 0; r < nr; ++r) z[r] = 10.0f * float(r);
+        patches = lod::buildPatches(h, nc, nr, x, z, cells, 0.25);
+    }
+};
+
+// The directed edges of a triangle list: each inner edge must appear once each way, each border
+// edge once; returns false (with a message) otherwise. Also checks every triangle is wound
+// counter-clockwise from above and that the triangles cover the grid's area exactly.
+::testing::AssertionResult watertight(const std::vector<uint32_t>& idx, uint32_t nc, uint32_t nr) {
+    std::map<std::pair<uint32_t, uint32_t>, int> directed;
+    double area = 0.0;
+    for (size_t t = 0; t < idx.size(); t += 3) {
+        auto cr = [&](uint32_t v) { return std::array<double, 2>{double(v % nc), double(v / nc)}; };
+        const auto a = cr(idx[t]), b = cr(idx[t + 1]), c = cr(idx[t + 2]);
+        const double signedArea = 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+        if (!(signedArea < 0.0)) return ::testing::AssertionFailure() << "triangle " << t / 3 << " wound " << signedArea;
+        area -= signedArea;
+        for (int e = 0; e < 3; ++e)
+            if (++directed[{idx[t + e], idx[t + (e + 1) % 3]}] > 1)
+                return ::testing::AssertionFailure() << "edge " << idx[t + e] << "-" << idx[t + (e + 1) % 3] << " twice";
+    }
+    for (const auto& [edge, n] : directed) {
+        if (directed.count({edge.second, edge.first})) continue;
+        // A border edge: both ends on the same border line.
+        const uint32_t ca = edge.first % nc, ra = edge.first / nc, cb = edge.second % nc, rb = edge.second / nc;
+        const bool border = (ra == rb && (ra == 0 || ra == nr - 1)) || (ca == cb && (ca == 0 || ca == nc - 1));
+        if (!border) return ::testing::AssertionFailure() << "crack at edge (" << ca << "," << ra << ")-(" << cb << "," << rb << ")";
+    }
+    if (std::abs(area - double(nc - 1) * double(nr - 1)) > 1e-6)
+        return ::testing::AssertionFailure() << "area " << area << " of " << double(nc - 1) * double(nr - 1);
+    return ::testing::AssertionSuccess();
+}
+
+}  // namespace
+
+// No cracks whatever the levels: every patch at a random level of its own, neighbours far apart,
+// over grids whose patches do not divide them evenly.
+TEST(MeshLod, PatchesAtAnyLevelsMeetWithoutCracks) {
+    for (const auto& [nc, nr] : {std::pair<uint32_t, uint32_t>{65, 65}, {97, 40}, {130, 75}}) {
+        const Terrain t(nc, nr, 16);
+        ASSERT_GE(t.patches.count(), 4u);
+        EXPECT_GT(t.patches.levels, 3u);
+        uint32_t seed = 12345;
+        for (int trial = 0; trial < 30; ++trial) {
+            std::vector<uint8_t> levels(t.patches.count());
+            for (size_t k = 0; k < levels.size(); ++k) {
+                seed = seed * 1664525u + 1013904223u;
+                levels[k] = uint8_t((seed >> 16) % (t.patches.coarsest[k] + 1u));
+            }
+            std::vector<uint32_t> idx, border;
+            lod::appendPatchTriangles(idx, t.patches, levels, &border);
+            ASSERT_TRUE(watertight(idx, nc, nr)) << nc << "x" << nr << " trial " << trial;
+            // The border segments run the whole border once.
+            double length = 0.0;
+            for (size_t i = 0; i + 1 < border.size(); i += 2) {
+                const double dc = double(border[i] % nc) - double(border[i + 1] % nc);
+                const double dr = double(border[i] / nc) - double(border[i + 1] / nc);
+                length += std::abs(dc) + std::abs(dr);
+            }
+            EXPECT_DOUBLE_EQ(length, 2.0 * (nc - 1) + 2.0 * (nr - 1));
+        }
+    }
+}
+
+// At level 0 everywhere the patches draw exactly the whole grid's triangles (the bake's surface).
+TEST(MeshLod, LevelZeroEverywhereIsTheWholeGrid) {
+    const Terrain t(70, 45, 16);
+    std::vector<uint32_t> idx, whole;
+    lod::appendPatchTriangles(idx, t.patches, std::vector<uint8_t>(t.patches.count(), 0));
+    lod::appendTriangles(whole, t.nc, lod::kept(t.nc, 1), lod::kept(t.nr, 1));
+    auto triangles = [](const std::vector<uint32_t>& v) {
+        std::vector<std::array<uint32_t, 3>> out;
+        for (size_t i = 0; i < v.size(); i += 3) {
+            std::array<uint32_t, 3> tri{v[i], v[i + 1], v[i + 2]};
+            std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+            out.push_back(tri);
+        }
+        std::sort(out.begin(), out.end());
+        return out;
+    };
+    EXPECT_EQ(triangles(idx), triangles(whole));
+}
+
+// A patch's error at each level is its own grid's against the heights, plus the base error; the
+// camera picks, per patch, the coarsest level within the pixel, coarser far away than near.
+TEST(MeshLod, EachPatchTakesTheCoarsestLevelWithinAPixel) {
+    const Terrain t(129, 129, 16);
+    const lod::Patches& p = t.patches;
+    ASSERT_EQ(p.count(), 64u);
+    for (uint32_t k = 0; k < p.count(); ++k) {
+        EXPECT_DOUBLE_EQ(p.error[size_t(k) * p.levels], 0.25);
+        for (uint32_t l = 1; l <= p.coarsest[k]; ++l) EXPECT_GT(p.error[size_t(k) * p.levels + l], 0.25);
+    }
+    const double fov = std::numbers::pi / 3.0;
+    // Standing over one corner, 100 m up: that patch is under 100 m away, the far corner's 1.7 km.
+    const glm::vec3 eye(0.0f, 100.0f, 0.0f);
+    double worst = 0.0;
+    const std::vector<uint8_t> levels = lod::chooseLevels(p, eye, fov, 1080.0, 1.0, &worst);
+    EXPECT_EQ(levels.front(), 0);
+    EXPECT_GT(levels.back(), levels.front());
+    for (uint32_t k = 0; k < p.count(); ++k) {
+        const double d = lod::distanceToBox(eye, p.lo[k], p.hi[k]);
+        const double chosen = lod::screenPixels(p.error[size_t(k) * p.levels + levels[k]], d, fov, 1080.0);
+        if (levels[k] > 0) {
+            EXPECT_LE(chosen, 1.0);
+        }
+        if (levels[k] < p.coarsest[k]) {
+            EXPECT_GT(lod::screenPixels(p.error[size_t(k) * p.levels + levels[k] + 1u], d, fov, 1080.0), 1.0);
+        }
+        EXPECT_LE(chosen, worst);
+    }
+    // Far away, every patch draws its coarsest.
+    const std::vector<uint8_t> far = lod::chooseLevels(p, glm::vec3(0.0f, 1e7f, 0.0f), fov, 1080.0, 1.0);
+    for (uint32_t k = 0; k < p.count(); ++k) EXPECT_EQ(far[k], p.coarsest[k]);
+}
