@@ -85,6 +85,27 @@ bool settlesQuiet(ViewportWindow* viewport) {
     return false;
 }
 
+// The UI thread's longest stall while it lives: a timer ticking every 5 ms, and the longest gap
+// between its ticks.
+class Watchdog {
+public:
+    Watchdog() {
+        clock_.start();
+        timer_.setInterval(5);
+        QObject::connect(&timer_, &QTimer::timeout, [this] {
+            worst_ = std::max(worst_, clock_.elapsed() - last_);
+            last_ = clock_.elapsed();
+        });
+        timer_.start();
+    }
+    qint64 worst() const { return worst_; }
+
+private:
+    QElapsedTimer clock_;
+    QTimer timer_;
+    qint64 last_ = 0, worst_ = 0;
+};
+
 // Waits for the next draft preview or bake to reach the viewport.
 bool waitForProbes(MainWindow& w, const QString& source, int ms = 20000) {
     return QTest::qWaitFor([&] { return w.probeSource() == source; }, ms);
@@ -368,17 +389,8 @@ private slots:
         const double metered = r->meteredEv100();
         QVERIFY(std::isfinite(metered));
 
-        QElapsedTimer clock;
-        clock.start();
-        qint64 last = clock.elapsed(), worst = 0;
-        QTimer watchdog;
-        watchdog.setInterval(5);
-        QObject::connect(&watchdog, &QTimer::timeout, [&] {
-            worst = std::max(worst, clock.elapsed() - last);
-            last = clock.elapsed();
-        });
         QSignalSpy frames(v, &ViewportWindow::frameRendered);
-        watchdog.start();
+        Watchdog watchdog;
         // An orbit drag toward the ground: a darker, different frame the exposure would follow.
         const QPoint c(v->width() / 2, v->height() / 2);
         QTest::mousePress(v, Qt::LeftButton, {}, c);
@@ -390,7 +402,7 @@ private slots:
             QTest::qWait(50);
             smallest = std::min(smallest, v->presentedScale());
         }
-        const qint64 dragStall = worst;
+        const qint64 dragStall = watchdog.worst();
         const int dragFrames = int(frames.count());
         const size_t duringDrag = r->meterings() - before;
         QTest::mouseRelease(v, Qt::LeftButton, {}, c + QPoint(72, -96));
@@ -423,16 +435,7 @@ private slots:
         QVERIFY(settlesQuiet(v));
         auto* elevation = w_->findChild<QDoubleSpinBox*>("param.sun.elevation_deg");
         QVERIFY(elevation);
-        QElapsedTimer clock;
-        clock.start();
-        qint64 last = clock.elapsed(), worst = 0;
-        QTimer watchdog;
-        watchdog.setInterval(5);
-        QObject::connect(&watchdog, &QTimer::timeout, [&] {
-            worst = std::max(worst, clock.elapsed() - last);
-            last = clock.elapsed();
-        });
-        watchdog.start();
+        Watchdog watchdog;
         const QString before = w_->probeSource();
         for (int i = 0; i < 5; ++i) {
             QSignalSpy frames(v, &ViewportWindow::frameRendered);
@@ -441,7 +444,7 @@ private slots:
             QTest::qWait(400);  // the preview bakes and lands, and the full frame may begin
         }
         QVERIFY(settlesQuiet(v));
-        watchdog.stop();
+        const qint64 worst = watchdog.worst();
         qInfo() << "sun edits: longest UI stall" << worst << "ms";
         QVERIFY2(worst <= 50, qPrintable(QString("the UI thread stalled %1 ms").arg(worst)));
         QCOMPARE(before, QString("draft preview"));
