@@ -224,8 +224,17 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
     for (size_t i = 0; i < vertexCount_; ++i) drawnHeights[i] = vertices[6 * i + 1];
     for (uint32_t c = 0; c < nc; ++c) colX[c] = vertices[6 * c];
     for (uint32_t r = 0; r < nr; ++r) rowZ[r] = vertices[6 * size_t(r) * nc + 2];
-    baseError_ = stride_ > 1 ? lod::gridError(hf.heights(), uint32_t(w), cols, rows) : 0.0;
-    patches_ = lod::buildPatches(drawnHeights, nc, nr, colX, rowZ, kLodPatchCells, baseError_);
+    patches_ = lod::buildPatches(drawnHeights, nc, nr, colX, rowZ, kLodPatchCells, 0.0);
+    // What the drawn grid leaves out of the source DEM, per patch: the levels keep what they
+    // leave out of the drawn grid within the pixel, and the error reported adds this.
+    decimation_.assign(patches_.count(), 0.0);
+    if (stride_ > 1)
+        for (uint32_t k = 0; k < patches_.count(); ++k) {
+            const uint32_t i = k % patches_.patchesX(), j = k / patches_.patchesX();
+            const std::vector<uint32_t> pc(cols.begin() + patches_.cols[i], cols.begin() + patches_.cols[i + 1] + 1);
+            const std::vector<uint32_t> pr(rows.begin() + patches_.rows[j], rows.begin() + patches_.rows[j + 1] + 1);
+            decimation_[k] = lod::gridError(hf.heights(), uint32_t(w), pc, pr);
+        }
     skirt_ = appendSkirtVertices(vertices, nc, nr);
     indexCount_ = size_t(nc - 1) * (nr - 1) * 6;
     {
@@ -663,19 +672,20 @@ void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
 
 void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water) {
     double worst = 0.0;
+    // The data views are measured against the bake vertex by vertex: they draw every vertex.
+    double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
     // A caster's height error moves the edge of its shadow 1 / tan(sun elevation) times as far
     // across the ground: with shadows, the levels keep that within the pixel (5x finer at a 11°
     // sun, 1.4x at 35°).
-    // The data views are measured against the bake vertex by vertex: they draw every vertex.
-    double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
     if (shadowed) {
         const double up = std::clamp(double(s.sun.direction.y), 1e-3, 1.0);
         maxPixels *= std::min(1.0, up / std::sqrt(std::max(1.0 - up * up, 0.0)));
     }
     // At 0 pixels a patch still draws a coarser level whose error is 0: it loses nothing.
     const double rows = double(s.levelOfDetailRows > 0 ? s.levelOfDetailRows : s.height);
-    std::vector<uint8_t> levels = lod::chooseLevels(patches_, s.camera.position(), glm::radians(double(s.camera.fovDeg)),
-                                                    rows, maxPixels, &worst);
+    const glm::vec3 eye = s.camera.position();
+    const double fovY = glm::radians(double(s.camera.fovDeg));
+    std::vector<uint8_t> levels = lod::chooseLevels(patches_, eye, fovY, rows, maxPixels);
     // Where the water meets the land, a height error moves the shore by the error over the
     // ground's slope, many pixels on a flat shore: patches the water's surface can cross (its
     // level, give or take the crests) draw every vertex.
@@ -683,6 +693,9 @@ void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shad
         for (uint32_t k = 0; k < patches_.count(); ++k)
             if (patches_.lo[k].y <= water->level + water->margin && patches_.hi[k].y >= water->level - water->margin)
                 levels[k] = 0;
+    for (uint32_t k = 0; k < patches_.count(); ++k)
+        worst = std::max(worst, lod::screenPixels(patches_.error[size_t(k) * patches_.levels + levels[k]] + decimation_[k],
+                                                  lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
     lastLod_.screenErrorPixels = worst;
     if (levels == lastLod_.levels && lodSerial_ > 0) return;
     lastLod_.levels = std::move(levels);

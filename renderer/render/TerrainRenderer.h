@@ -6,6 +6,7 @@
 // (`terralux --render`, the tests, a viewport grab) or the blit to a window's swapchain. A
 // subsystem the frame does not use adds no pass and no binding.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -196,8 +197,12 @@ public:
     // the frame's levels.
     static constexpr uint32_t kLodPatchCells = 32;
     const lod::Patches& lodPatches() const { return patches_; }
-    // What the drawn grid itself leaves out of the source DEM (metres; 0 when drawn whole).
-    double decimationError() const { return baseError_; }
+    // What the drawn grid itself leaves out of the source DEM (metres, the largest of the
+    // patches'; 0 when drawn whole). The levels keep what they leave out of the drawn grid
+    // within the pixel; the screen error reported adds this.
+    double decimationError() const {
+        return decimation_.empty() ? 0.0 : *std::max_element(decimation_.begin(), decimation_.end());
+    }
     void setLodPixelError(double pixels) { lodPixelError_ = pixels; }
     struct LodChoice {
         std::vector<uint8_t> levels;     // per patch
@@ -244,7 +249,7 @@ private:
     void updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water);
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
-    double baseError_ = 0.0;
+    std::vector<double> decimation_;  // per patch
     double lodPixelError_ = 1.0;
     LodChoice lastLod_;
     std::vector<uint32_t> lodIndices_;  // the levels' triangles, then their skirt's
