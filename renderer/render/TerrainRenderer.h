@@ -87,7 +87,7 @@ public:
     // Large DEMs are drawn from every k-th row and column (always including the last), the
     // smallest k that keeps the mesh within `vertexBudget`: a uniform grid, so no cracks.
     TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf,
-                    size_t vertexBudget = size_t(1) << 20);
+                    size_t vertexBudget = size_t(1) << 22);
     ~TerrainRenderer();
 
     // Binds the volumes (none: the probe subsystem and its buffers go away); the next frame that
