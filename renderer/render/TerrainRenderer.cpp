@@ -217,14 +217,13 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         }
     vertexCount_ = vertices.size() / 6;
     meshVertices_ = vertices;
-    // The level of detail's patches (MeshLod.h). The drawn grid's own error is what the
-    // decimation above leaves out of the source DEM; every level's error adds its own to that.
+    // The level of detail's patches (MeshLod.h); their levels' errors are against the drawn grid.
     const uint32_t nc = uint32_t(cols.size()), nr = uint32_t(rows.size());
     std::vector<float> drawnHeights(vertexCount_), colX(nc), rowZ(nr);
     for (size_t i = 0; i < vertexCount_; ++i) drawnHeights[i] = vertices[6 * i + 1];
     for (uint32_t c = 0; c < nc; ++c) colX[c] = vertices[6 * c];
     for (uint32_t r = 0; r < nr; ++r) rowZ[r] = vertices[6 * size_t(r) * nc + 2];
-    patches_ = lod::buildPatches(drawnHeights, nc, nr, colX, rowZ, kLodPatchCells, 0.0);
+    patches_ = lod::buildPatches(drawnHeights, nc, nr, colX, rowZ, kLodPatchCells);
     // What the drawn grid leaves out of the source DEM, per patch: the levels keep what they
     // leave out of the drawn grid within the pixel, and the error reported adds this.
     decimation_.assign(patches_.count(), 0.0);

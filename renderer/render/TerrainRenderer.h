@@ -190,8 +190,8 @@ public:
     size_t targetAllocations() const;
     int meshStride() const { return stride_; }
     // The mesh's level of detail (terrain/MeshLod.h): square patches of the drawn grid, each
-    // drawing every 2^l-th of its vertices, l chosen per frame so that the terrain strays at most
-    // setLodPixelError pixels (1 by default; at 0 only what is exact is left out) from the source DEM as the
+    // drawing every 2^l-th of its vertices, l chosen per frame so that the levels leave out at most
+    // setLodPixelError pixels (1 by default; at 0 only what is exact) of the drawn grid as the
     // frame's camera sees it, in the picture views (the data views draw every vertex: they are
     // read against the bake vertex by vertex). The shadow maps and the water's reflection draw
     // the frame's levels.

@@ -122,7 +122,7 @@ uint8_t coarsestLevel(uint32_t cells) {
 }  // namespace
 
 Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, std::span<const float> colX,
-                     std::span<const float> rowZ, uint32_t patchCells, double baseError) {
+                     std::span<const float> rowZ, uint32_t patchCells) {
     Patches p;
     p.nc = nc;
     p.nr = nr;
@@ -155,25 +155,22 @@ Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, s
             // Levels past the patch's coarsest stand at its coarsest, never chosen.
             const uint32_t step = stepOf(uint8_t(std::min<uint32_t>(l, p.coarsest[k])));
             p.error[size_t(k) * p.levels + l] =
-                baseError + (step > 1 ? gridError(heights, nc, keptRange(c0, c1, step), keptRange(r0, r1, step)) : 0.0);
+                step > 1 ? gridError(heights, nc, keptRange(c0, c1, step), keptRange(r0, r1, step)) : 0.0;
         }
     });
     return p;
 }
 
 std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double fovY, double heightPixels,
-                                  double maxPixels, double* worstPixels) {
+                                  double maxPixels) {
     std::vector<uint8_t> levels(p.count(), 0);
-    double worst = 0.0;
     for (uint32_t k = 0; k < p.count(); ++k) {
         const double distance = distanceToBox(eye, p.lo[k], p.hi[k]);
         uint8_t chosen = 0;
         for (uint8_t l = 1; l <= p.coarsest[k]; ++l)
             if (screenPixels(p.error[size_t(k) * p.levels + l], distance, fovY, heightPixels) <= maxPixels) chosen = l;
         levels[k] = chosen;
-        worst = std::max(worst, screenPixels(p.error[size_t(k) * p.levels + chosen], distance, fovY, heightPixels));
     }
-    if (worstPixels) *worstPixels = worst;
     return levels;
 }
 

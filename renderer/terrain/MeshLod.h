@@ -58,16 +58,14 @@ struct Patches {
 };
 
 // `heights` is the drawn grid (nc x nr, row-major), colX and rowZ its columns' and rows' world
-// coordinates; `baseError` (metres) is added to every level's error: what the drawn grid itself
-// leaves out of the source DEM.
+// coordinates. A level's error is what it leaves out of the drawn grid (0 at level 0).
 Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, std::span<const float> colX,
-                     std::span<const float> rowZ, uint32_t patchCells, double baseError);
+                     std::span<const float> rowZ, uint32_t patchCells);
 
 // Each patch's level: the coarsest whose error covers at most maxPixels seen from `eye` at the
-// patch's nearest point. worstPixels (if given) receives the largest such cover of the levels
-// chosen.
+// patch's nearest point.
 std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double fovY, double heightPixels,
-                                  double maxPixels, double* worstPixels = nullptr);
+                                  double maxPixels);
 
 // The step of patch `patch`'s level: 2^level.
 inline uint32_t stepOf(uint8_t level) { return 1u << level; }

@@ -110,7 +110,7 @@ struct Terrain {
             }
         for (uint32_t c = 0; c < nc; ++c) x[c] = 10.0f * float(c);
         for (uint32_t r = 0; r < nr; ++r) z[r] = 10.0f * float(r);
-        patches = lod::buildPatches(h, nc, nr, x, z, cells, 0.25);
+        patches = lod::buildPatches(h, nc, nr, x, z, cells);
     }
 };
 
@@ -192,21 +192,20 @@ TEST(MeshLod, LevelZeroEverywhereIsTheWholeGrid) {
     EXPECT_EQ(triangles(idx), triangles(whole));
 }
 
-// A patch's error at each level is its own grid's against the heights, plus the base error; the
+// A patch's error at each level is its own grid's against the heights (0 at level 0); the
 // camera picks, per patch, the coarsest level within the pixel, coarser far away than near.
 TEST(MeshLod, EachPatchTakesTheCoarsestLevelWithinAPixel) {
     const Terrain t(129, 129, 16);
     const lod::Patches& p = t.patches;
     ASSERT_EQ(p.count(), 64u);
     for (uint32_t k = 0; k < p.count(); ++k) {
-        EXPECT_DOUBLE_EQ(p.error[size_t(k) * p.levels], 0.25);
-        for (uint32_t l = 1; l <= p.coarsest[k]; ++l) EXPECT_GT(p.error[size_t(k) * p.levels + l], 0.25);
+        EXPECT_EQ(p.error[size_t(k) * p.levels], 0.0);
+        for (uint32_t l = 1; l <= p.coarsest[k]; ++l) EXPECT_GT(p.error[size_t(k) * p.levels + l], 0.0);
     }
     const double fov = std::numbers::pi / 3.0;
     // Standing over one corner, 100 m up: that patch is under 100 m away, the far corner's 1.7 km.
     const glm::vec3 eye(0.0f, 100.0f, 0.0f);
-    double worst = 0.0;
-    const std::vector<uint8_t> levels = lod::chooseLevels(p, eye, fov, 1080.0, 1.0, &worst);
+    const std::vector<uint8_t> levels = lod::chooseLevels(p, eye, fov, 1080.0, 1.0);
     EXPECT_EQ(levels.front(), 0);
     EXPECT_GT(levels.back(), levels.front());
     for (uint32_t k = 0; k < p.count(); ++k) {
@@ -218,7 +217,6 @@ TEST(MeshLod, EachPatchTakesTheCoarsestLevelWithinAPixel) {
         if (levels[k] < p.coarsest[k]) {
             EXPECT_GT(lod::screenPixels(p.error[size_t(k) * p.levels + levels[k] + 1u], d, fov, 1080.0), 1.0);
         }
-        EXPECT_LE(chosen, worst);
     }
     // Far away, every patch draws its coarsest.
     const std::vector<uint8_t> far = lod::chooseLevels(p, glm::vec3(0.0f, 1e7f, 0.0f), fov, 1080.0, 1.0);
