@@ -692,8 +692,15 @@ void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shad
         for (uint32_t k = 0; k < patches_.count(); ++k)
             if (patches_.lo[k].y <= water->level + water->margin && patches_.hi[k].y >= water->level - water->margin)
                 levels[k] = 0;
+    // A ring zipped to a coarser neighbour can stray further than either level: such neighbours
+    // come finer until every patch's drawn surface is within the pixel, and the figure reported
+    // is what each patch's surface leaves out of the drawn grid (plus what the grid leaves out of
+    // the DEM), seen from its nearest point.
+    const std::vector<double> surface =
+        lod::settleRings(patches_, levels, std::span<const float>(meshVertices_).subspan(1), 6, eye, fovY, rows,
+                         maxPixels, &lodSurfaceCache_);
     for (uint32_t k = 0; k < patches_.count(); ++k)
-        worst = std::max(worst, lod::screenPixels(patches_.error[size_t(k) * patches_.levels + levels[k]] + decimation_[k],
+        worst = std::max(worst, lod::screenPixels(surface[k] + decimation_[k],
                                                   lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
     lastLod_.screenErrorPixels = worst;
     if (levels == lastLod_.levels && lodSerial_ > 0) return;

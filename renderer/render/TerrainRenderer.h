@@ -207,7 +207,8 @@ public:
     struct LodChoice {
         std::vector<uint8_t> levels;     // per patch
         size_t triangles = 0;            // the terrain's, skirt aside
-        double screenErrorPixels = 0.0;  // the largest error of a patch's level as the camera sees it
+        double screenErrorPixels = 0.0;  // the largest of a patch's drawn surface against the DEM, as the
+                                         // camera sees it at the patch's nearest point
     };
     // The levels the last frame drew.
     const LodChoice& lastLod() const { return lastLod_; }
@@ -250,6 +251,7 @@ private:
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
     std::vector<double> decimation_;  // per patch
+    lod::SurfaceErrorCache lodSurfaceCache_;  // what each patch's drawn surface leaves out, by its levels
     double lodPixelError_ = 1.0;
     LodChoice lastLod_;
     std::vector<uint32_t> lodIndices_;  // the levels' triangles, then their skirt's

@@ -126,6 +126,8 @@ Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, s
     Patches p;
     p.nc = nc;
     p.nr = nr;
+    p.x.assign(colX.begin(), colX.end());
+    p.z.assign(rowZ.begin(), rowZ.end());
     if (nc < 2 || nr < 2) return p;
     p.cols = boundaries(nc, std::max(patchCells, 2u));
     p.rows = boundaries(nr, std::max(patchCells, 2u));
@@ -166,9 +168,15 @@ std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double
     std::vector<uint8_t> levels(p.count(), 0);
     for (uint32_t k = 0; k < p.count(); ++k) {
         const double distance = distanceToBox(eye, p.lo[k], p.hi[k]);
+        // A finer level can leave out more than a coarser one (its vertices are not the coarser's
+        // plus some: every 8th keeps a spike that every 16th skips). The level taken is the
+        // coarsest with every finer one within the pixel too, so a patch drawn finer than it
+        // chose (settleRings) stays within it.
         uint8_t chosen = 0;
-        for (uint8_t l = 1; l <= p.coarsest[k]; ++l)
-            if (screenPixels(p.error[size_t(k) * p.levels + l], distance, fovY, heightPixels) <= maxPixels) chosen = l;
+        for (uint8_t l = 1; l <= p.coarsest[k]; ++l) {
+            if (screenPixels(p.error[size_t(k) * p.levels + l], distance, fovY, heightPixels) > maxPixels) break;
+            chosen = l;
+        }
         levels[k] = chosen;
     }
     return levels;
@@ -212,18 +220,17 @@ void zip(std::vector<uint32_t>& out, uint32_t nc, const std::vector<GridPoint>& 
     }
 }
 
-}  // namespace
-
-void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
-                          std::vector<uint32_t>* borderSegments) {
+// Appends patch (i, j)'s triangles at its level, zipped to coarser neighbours; returns whether
+// any edge is zipped.
+bool appendPatch(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels, uint32_t i,
+                 uint32_t j, std::vector<uint32_t>* borderSegments) {
     const uint32_t px = p.patchesX(), pz = p.patchesZ(), nc = p.nc;
-    if (p.cols.size() < 2 || p.rows.size() < 2) return;
-    auto level = [&](int64_t i, int64_t j) -> int {
-        if (i < 0 || j < 0 || i >= int64_t(px) || j >= int64_t(pz)) return -1;  // outside: the border
-        return levels[size_t(j) * px + size_t(i)];
+    auto level = [&](int64_t a, int64_t b) -> int {
+        if (a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz)) return -1;  // outside: the border
+        return levels[size_t(b) * px + size_t(a)];
     };
-    for (uint32_t j = 0; j < pz; ++j)
-        for (uint32_t i = 0; i < px; ++i) {
+    {
+        {
             const int own = level(i, j);
             const uint32_t step = stepOf(uint8_t(own));
             const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
@@ -249,7 +256,7 @@ void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std:
             // cell across too, so they all stand at level 0 and nothing is zipped.)
             if ((sN == step && sS == step && sW == step && sE == step) || kc.size() < 3 || kr.size() < 3) {
                 appendTriangles(indices, nc, kc, kr);
-                continue;
+                return false;
             }
             // The ring of cells along the edges zipped to the edges' vertices, the inside as a
             // plain grid. Its inner runs are the second and second-last kept lines.
@@ -272,7 +279,76 @@ void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std:
             zip(indices, nc, row(keptRange(c0, c1, sS), r1), row(ic, ir.back()), true, false);
             zip(indices, nc, column(keptRange(r0, r1, sW), c0), column(ir, ic.front()), false, true);
             zip(indices, nc, column(keptRange(r0, r1, sE), c1), column(ir, ic.back()), false, false);
+            return true;
         }
+    }
+}
+
+}  // namespace
+
+void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
+                          std::vector<uint32_t>* borderSegments) {
+    if (p.cols.size() < 2 || p.rows.size() < 2) return;
+    for (uint32_t j = 0; j < p.patchesZ(); ++j)
+        for (uint32_t i = 0; i < p.patchesX(); ++i) appendPatch(indices, p, levels, i, j, borderSegments);
+}
+
+std::vector<double> surfaceErrors(const Patches& p, std::span<const uint8_t> levels, std::span<const float> heights,
+                                  size_t stride, SurfaceErrorCache* cache) {
+    std::vector<double> out(p.count(), 0.0);
+    if (p.cols.size() < 2 || p.rows.size() < 2) return out;
+    auto h = [&](uint32_t c, uint32_t r) { return double(heights[stride * (size_t(r) * p.nc + c)]); };
+    const uint32_t px = p.patchesX(), pz = p.patchesZ();
+    // A patch's surface follows from its level and its four neighbours'.
+    auto keyOf = [&](uint32_t i, uint32_t j) {
+        auto at = [&](int64_t a, int64_t b) -> uint64_t {
+            if (a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz)) return 0xFF;
+            return levels[size_t(b) * px + size_t(a)];
+        };
+        return at(i, j) | at(int64_t(i) - 1, j) << 8 | at(int64_t(i) + 1, j) << 16 | at(i, int64_t(j) - 1) << 24 |
+               at(i, int64_t(j) + 1) << 32;
+    };
+    if (cache && cache->key.size() != p.count()) {
+        cache->key.assign(p.count(), ~uint64_t(0));
+        cache->error.assign(p.count(), 0.0);
+    }
+    // What patch (i, j) draws leaves out of the grid.
+    auto measure = [&](uint32_t i, uint32_t j, uint32_t k) {
+        std::vector<uint32_t> tris;
+        if (!appendPatch(tris, p, levels, i, j, nullptr)) return p.error[size_t(k) * p.levels + levels[k]];
+        // Zipped: each grid vertex under each triangle against the triangle's plane, in world
+        // (x, z).
+        double worst = 0.0;
+        for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+            uint32_t c[3], r[3];
+            for (int v = 0; v < 3; ++v) c[v] = tris[t + v] % p.nc, r[v] = tris[t + v] / p.nc;
+            const double x0 = p.x[c[0]], z0 = p.z[r[0]];
+            const double ax = p.x[c[1]] - x0, az = p.z[r[1]] - z0, bx = p.x[c[2]] - x0, bz = p.z[r[2]] - z0;
+            const double det = ax * bz - az * bx;
+            if (det == 0.0) continue;
+            const double h0 = h(c[0], r[0]), h1 = h(c[1], r[1]), h2 = h(c[2], r[2]);
+            const double eps = 1e-9;
+            for (uint32_t rr = std::min({r[0], r[1], r[2]}); rr <= std::max({r[0], r[1], r[2]}); ++rr)
+                for (uint32_t cc = std::min({c[0], c[1], c[2]}); cc <= std::max({c[0], c[1], c[2]}); ++cc) {
+                    const double dx = p.x[cc] - x0, dz = p.z[rr] - z0;
+                    const double u = (dx * bz - dz * bx) / det, v = (ax * dz - az * dx) / det;
+                    if (u < -eps || v < -eps || u + v > 1.0 + eps) continue;
+                    worst = std::max(worst, std::abs(h(cc, rr) - (h0 + u * (h1 - h0) + v * (h2 - h0))));
+                }
+        }
+        return worst;
+    };
+    tbb::parallel_for(uint32_t(0), p.count(), [&](uint32_t k) {
+        const uint32_t i = k % px, j = k / px;
+        const uint64_t key = keyOf(i, j);
+        if (cache && cache->key[k] == key) {
+            out[k] = cache->error[k];
+            return;
+        }
+        out[k] = measure(i, j, k);
+        if (cache) cache->key[k] = key, cache->error[k] = out[k];
+    });
+    return out;
 }
 
 void appendSkirt(std::vector<uint32_t>& indices, const SkirtVertices& k, const std::vector<uint32_t>& segments) {
@@ -287,6 +363,30 @@ void appendSkirt(std::vector<uint32_t>& indices, const SkirtVertices& k, const s
         indices.insert(indices.end(), {a, b, tb, a, tb, ta});
     }
     indices.insert(indices.end(), k.corners.begin(), k.corners.end());
+}
+
+std::vector<double> settleRings(const Patches& p, std::vector<uint8_t>& levels, std::span<const float> heights,
+                                size_t stride, const glm::vec3& eye, double fovY, double heightPixels, double maxPixels,
+                                SurfaceErrorCache* cache) {
+    const uint32_t px = p.patchesX(), pz = p.patchesZ();
+    for (;;) {
+        std::vector<double> error = surfaceErrors(p, levels, heights, stride, cache);
+        std::vector<uint8_t> next = levels;
+        for (uint32_t k = 0; k < p.count(); ++k) {
+            if (error[k] <= p.error[size_t(k) * p.levels + levels[k]]) continue;  // not past its own level
+            if (screenPixels(error[k], distanceToBox(eye, p.lo[k], p.hi[k]), fovY, heightPixels) <= maxPixels) continue;
+            // The ring strays for a coarser neighbour's edge: that neighbour comes a level finer.
+            const uint32_t i = k % px, j = k / px;
+            auto finer = [&](int64_t a, int64_t b) {
+                if (a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz)) return;
+                uint8_t& l = next[size_t(b) * px + size_t(a)];
+                if (levels[size_t(b) * px + size_t(a)] > levels[k] && l == levels[size_t(b) * px + size_t(a)]) --l;
+            };
+            finer(int64_t(i) - 1, j), finer(int64_t(i) + 1, j), finer(i, int64_t(j) - 1), finer(i, int64_t(j) + 1);
+        }
+        if (next == levels) return error;
+        levels = std::move(next);
+    }
 }
 
 }  // namespace terralux::lod

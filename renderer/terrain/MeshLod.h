@@ -52,6 +52,7 @@ struct Patches {
     std::vector<uint8_t> coarsest;         // per patch: its last level (2 cells a side at least)
     std::vector<double> error;             // per patch, per level (patch * levels + l): metres
     std::vector<glm::vec3> lo, hi;         // per patch: its bounds in the world
+    std::vector<float> x, z;               // the drawn grid's columns' and rows' world coordinates
     uint32_t patchesX() const { return uint32_t(cols.size()) - 1; }
     uint32_t patchesZ() const { return uint32_t(rows.size()) - 1; }
     uint32_t count() const { return patchesX() * patchesZ(); }
@@ -62,8 +63,8 @@ struct Patches {
 Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, std::span<const float> colX,
                      std::span<const float> rowZ, uint32_t patchCells);
 
-// Each patch's level: the coarsest whose error covers at most maxPixels seen from `eye` at the
-// patch's nearest point.
+// Each patch's level: the coarsest whose error, and every finer level's, covers at most
+// maxPixels seen from `eye` at the patch's nearest point.
 std::vector<uint8_t> chooseLevels(const Patches& p, const glm::vec3& eye, double fovY, double heightPixels,
                                   double maxPixels);
 
@@ -76,6 +77,29 @@ inline uint32_t stepOf(uint8_t level) { return 1u << level; }
 // the border, for the skirt.
 void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
                           std::vector<uint32_t>* borderSegments = nullptr);
+
+// Per patch, the largest |h - s| over its vertices of the drawn grid, s the surface its triangles
+// at `levels` draw there (appendPatchTriangles's): its level's error where no edge is zipped, and
+// where one is, measured under every triangle of the patch, so a ring zipped to a coarser
+// neighbour's edge counts what it leaves out. Vertex (c, r)'s height is
+// heights[stride * (r * nc + c)].
+// `cache`, kept between calls over the same patches, keeps each patch's error until its level or
+// a neighbour's changes.
+struct SurfaceErrorCache {
+    std::vector<uint64_t> key;  // per patch: its level and its four neighbours'
+    std::vector<double> error;
+};
+std::vector<double> surfaceErrors(const Patches& p, std::span<const uint8_t> levels, std::span<const float> heights,
+                                  size_t stride = 1, SurfaceErrorCache* cache = nullptr);
+
+// A ring zipped to a coarser neighbour's edge is a surface neither patch's level has, and can
+// stray further than either: each patch whose ring strays past its own level's error and past
+// maxPixels seen from `eye` has its coarser neighbours drawn a level finer, until none does.
+// Returns the final levels' surfaceErrors, so every patch's surface is within maxPixels (or
+// within what its own level leaves out, where chooseLevels kept that finer than asked).
+std::vector<double> settleRings(const Patches& p, std::vector<uint8_t>& levels, std::span<const float> heights,
+                                size_t stride, const glm::vec3& eye, double fovY, double heightPixels, double maxPixels,
+                                SurfaceErrorCache* cache = nullptr);
 
 // The skirt's vertices (the renderer's terrain.skirt): for each border vertex of the drawn grid
 // its twin pushed out across that border (a corner vertex has one per border), and the four

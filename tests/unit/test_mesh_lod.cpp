@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <map>
 #include <numbers>
 #include <utility>
@@ -11,6 +13,10 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+#include <glm/vec2.hpp>
+
+#include "DemImport.h"
 #include "terrain/MeshLod.h"
 
 using namespace terralux;
@@ -221,4 +227,115 @@ TEST(MeshLod, EachPatchTakesTheCoarsestLevelWithinAPixel) {
     // Far away, every patch draws its coarsest.
     const std::vector<uint8_t> far = lod::chooseLevels(p, glm::vec3(0.0f, 1e7f, 0.0f), fov, 1080.0, 1.0);
     for (uint32_t k = 0; k < p.count(); ++k) EXPECT_EQ(far[k], p.coarsest[k]);
+}
+
+// What the printed figure claims on real mountains: from cameras near the ground and far above,
+// every vertex of a committed mountain crop lies within the reported pixels of the surface the
+// levels draw, seen from that vertex's own distance, zipped rings included (there a finer
+// patch's ring takes its coarser neighbour's edge, a surface neither level has). The vertices
+// are found under the whole mesh's triangles, not patch by patch as surfaceErrors finds them.
+TEST(MeshLod, EveryVertexOfAMountainIsWithinTheReportedPixels) {
+    const double fov = 45.0 * std::numbers::pi / 180.0, rows = 1080.0;
+    namespace fs = std::filesystem;
+    size_t ringsPast = 0, madeFiner = 0;
+    // The committed crops in 16-cell patches, and the whole N42E001 tile in the renderer's 32 when
+    // the shared data is there.
+    for (const char* name : {"rainier_crop.tif", "n42e001_voids_crop.tif", "bigtujunga_utm11_crop.tif", "N42E001.hgt"}) {
+        const bool shared = std::string(name) == "N42E001.hgt";
+        const fs::path file = (shared ? fs::path(TERRALUX_SHARED_DATA) : fs::path(TERRALUX_TEST_DATA)) / "dem" / name;
+        if (!fs::exists(file)) {
+            std::printf("%s is absent (shared data not installed)\n", file.string().c_str());
+            continue;
+        }
+        const DemImportResult dem = importDem(file.string());
+        const Heightfield& hf = dem.heightfield;
+        const uint32_t nc = uint32_t(hf.width()), nr = uint32_t(hf.depth());
+        std::vector<float> heights(size_t(nc) * nr), x(nc), z(nr);
+        for (uint32_t r = 0; r < nr; ++r)
+            for (uint32_t c = 0; c < nc; ++c) heights[size_t(r) * nc + c] = hf.vertex(int(c), int(r)).y;
+        for (uint32_t c = 0; c < nc; ++c) x[c] = hf.vertex(int(c), 0).x;
+        for (uint32_t r = 0; r < nr; ++r) z[r] = hf.vertex(0, int(r)).z;
+        const lod::Patches p = lod::buildPatches(heights, nc, nr, x, z, shared ? 32 : 16);
+        const float top = *std::max_element(heights.begin(), heights.end());
+        const glm::vec3 lo(x.front(), 0.0f, z.front()), hi(x.back(), top, z.back());
+        const glm::vec3 centre = 0.5f * (lo + hi);
+        const float side = std::max(hi.x - lo.x, hi.z - lo.z);
+        // Near the ground at a corner and at the centre, over a ridge, and far above.
+        const glm::vec3 eyes[] = {glm::vec3(lo.x, heights.front() + 20.0f, lo.z),
+                                  glm::vec3(centre.x, heights[size_t(nr / 2) * nc + nc / 2] + 30.0f, centre.z),
+                                  glm::vec3(hi.x, top + 200.0f, centre.z),
+                                  glm::vec3(centre.x, top + 1.5f * side, centre.z + side)};
+        lod::SurfaceErrorCache cache;  // across cameras and pixels, as the renderer keeps it
+        for (const glm::vec3& eye : eyes)
+          for (const double allowed : {1.0, 4.0, 16.0}) {
+            std::vector<uint8_t> levels = lod::chooseLevels(p, eye, fov, rows, allowed);
+            const std::vector<uint8_t> chosen = levels;
+            const std::vector<double> settled = lod::settleRings(p, levels, heights, 1, eye, fov, rows, allowed, &cache);
+            std::vector<uint32_t> tris;
+            lod::appendPatchTriangles(tris, p, levels);
+            // Every vertex under every triangle: its distance from the triangle's plane in y.
+            std::vector<double> deviation(heights.size(), 0.0);
+            for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+                glm::dvec3 v[3];
+                uint32_t c[3], r[3];
+                for (int k = 0; k < 3; ++k) {
+                    c[k] = tris[t + k] % nc, r[k] = tris[t + k] / nc;
+                    v[k] = glm::dvec3(x[c[k]], heights[tris[t + k]], z[r[k]]);
+                }
+                const glm::dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+                ASSERT_NE(n.y, 0.0);
+                for (uint32_t rr = std::min({r[0], r[1], r[2]}); rr <= std::max({r[0], r[1], r[2]}); ++rr)
+                    for (uint32_t cc = std::min({c[0], c[1], c[2]}); cc <= std::max({c[0], c[1], c[2]}); ++cc) {
+                        const glm::dvec2 q(x[cc], z[rr]);
+                        auto side2 = [&](int a, int b) {
+                            return (v[b].x - v[a].x) * (q.y - v[a].z) - (v[b].z - v[a].z) * (q.x - v[a].x);
+                        };
+                        const double s0 = side2(0, 1), s1 = side2(1, 2), s2 = side2(2, 0);
+                        const double eps = 1e-9 * std::abs(n.y);  // twice the triangle's area in (x, z)
+                        if (!((s0 >= -eps && s1 >= -eps && s2 >= -eps) || (s0 <= eps && s1 <= eps && s2 <= eps)))
+                            continue;
+                        // The plane through the triangle at (x, z).
+                        const double y = v[0].y - (n.x * (q.x - v[0].x) + n.z * (q.y - v[0].z)) / n.y;
+                        const size_t i = size_t(rr) * nc + cc;
+                        deviation[i] = std::max(deviation[i], std::abs(double(heights[i]) - y));
+                    }
+            }
+            const std::vector<double> reported = lod::surfaceErrors(p, levels, heights);
+            EXPECT_EQ(settled, reported);
+            size_t finer = 0;
+            for (size_t k = 0; k < levels.size(); ++k) {
+                EXPECT_LE(levels[k], chosen[k]);
+                finer += levels[k] < chosen[k];
+            }
+            double worstReported = 0.0, worstMeasured = 0.0;
+            size_t zipped = 0;
+            for (uint32_t k = 0; k < p.count(); ++k) {
+                const uint32_t i = k % p.patchesX(), j = k / p.patchesX();
+                double measured = 0.0;
+                for (uint32_t r = p.rows[j]; r <= p.rows[j + 1]; ++r)
+                    for (uint32_t c = p.cols[i]; c <= p.cols[i + 1]; ++c) {
+                        const size_t v = size_t(r) * nc + c;
+                        measured = std::max(measured, deviation[v]);
+                        const double d = glm::length(glm::dvec3(eye) - glm::dvec3(x[c], heights[v], z[r]));
+                        worstMeasured = std::max(worstMeasured, lod::screenPixels(deviation[v], d, fov, rows));
+                    }
+                // surfaceErrors is exact, up to the float coordinates (the level's error is taken
+                // in grid steps, the brute force in metres): the patch's own vertices under its own
+                // triangles (a vertex on a shared edge lies on the edge, which both draw alike).
+                EXPECT_NEAR(reported[k], measured, 1e-3 + 1e-4 * measured) << name << " patch " << k;
+                if (reported[k] > p.error[size_t(k) * p.levels + levels[k]] + 1e-9) ++zipped;
+                worstReported = std::max(worstReported,
+                                         lod::screenPixels(reported[k], lod::distanceToBox(eye, p.lo[k], p.hi[k]), fov, rows));
+            }
+            std::printf("%s eye (%.0f, %.0f, %.0f) at %.0f px: measured %.3f px, reported %.3f px, %zu rings above their level, %zu patches finer\n",
+                        name, eye.x, eye.y, eye.z, allowed, worstMeasured, worstReported, zipped, finer);
+            EXPECT_LE(worstMeasured, worstReported + 1e-9) << name;
+            EXPECT_LE(worstReported, allowed) << name;
+            ringsPast += zipped;
+            madeFiner += finer;
+        }
+    }
+    // The crops alone have rings past their level that had to be made finer.
+    EXPECT_GT(ringsPast, 0u);
+    EXPECT_GT(madeFiner, 0u);
 }
