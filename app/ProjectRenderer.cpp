@@ -465,7 +465,7 @@ std::string ProjectRenderer::meterKey(const RenderRequest& r, const OrbitCamera&
     return key.str();
 }
 
-double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera) {
+RenderSettings ProjectRenderer::meterSettings(const RenderRequest& r, const OrbitCamera& camera) const {
     // The meter reads the frame's own scene-linear light at a small size: a mean over ten
     // thousand pixels moves by far less than the 0.1 EV a viewer notices.
     RenderRequest q = r;
@@ -476,7 +476,11 @@ double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera)
     RenderSettings s = settingsOf(q, camera);
     s.antialiasing = Antialiasing::Off;
     s.levelOfDetailRows = r.height;
-    const RenderedImage img = renderer_->render(s);
+    return s;
+}
+
+double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera) {
+    const RenderedImage img = renderer_->render(meterSettings(r, camera));
     ++meterings_;
     return meterEv100(img.rgba, img.width, img.height, project_.scene.camera.exposureMode);
 }
@@ -545,9 +549,23 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
         const std::string key = meterKey(r, camera);
         const bool still = key == lastFrameKey_;
         lastFrameKey_ = key;
+        // The meter is a frame the device draws behind the viewport's without anyone waiting
+        // (a wait held the window 70-110 ms a metering on a CPU device): a frame after it lands
+        // its reading is taken, and the shown exposure adapts toward it from there.
+        if (std::optional<RenderedImage> img = renderer_->takeOffscreen()) {
+            meteredEv100_ = meterEv100(img->rgba, img->width, img->height, project_.scene.camera.exposureMode);
+            meterKey_ = pendingMeterKey_;
+            ++meterings_;
+        }
         if (key != meterKey_ && (!r.interactive || still || std::isnan(meteredEv100_))) {
-            meteredEv100_ = meter(r, camera);
-            meterKey_ = key;
+            if (std::isnan(meteredEv100_)) {
+                // The first frame has no reading to show: it waits for its own.
+                meteredEv100_ = meter(r, camera);
+                meterKey_ = key;
+            } else if (!renderer_->offscreenPending()) {
+                renderer_->beginOffscreen(meterSettings(r, camera));
+                pendingMeterKey_ = key;
+            }
         }
         // An adapted eye starts adapting at the first frame of a change, however long the
         // viewport was idle before it.
@@ -555,7 +573,8 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
         const double seconds = adapting_ ? std::chrono::duration<double>(now - shownAt_).count() : 0.0;
         shownEv100_ = adaptEv100(shownEv100_, meteredEv100_, seconds, project_.scene.camera.adaptationSeconds);
         shownAt_ = now;
-        adapting_ = std::abs(shownEv100_ - meteredEv100_) > kAdaptedEv;
+        // A reading still to come keeps the frames coming, as adapting does.
+        adapting_ = std::abs(shownEv100_ - meteredEv100_) > kAdaptedEv || renderer_->offscreenPending();
         s.exposure = float(exposureScale(shownEv100_, project_.scene.camera.exposureEv));
     }
     return renderer_->present(s, swapchain);

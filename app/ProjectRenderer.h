@@ -34,7 +34,7 @@ struct RenderRequest {
     std::vector<GizmoLine> gizmos;  // the viewport's volume bounds and handles
     // A viewport frame drawn below full resolution while the view changes (dynamic resolution),
     // which a full-resolution frame follows: it keeps the exposure last metered rather than
-    // meter again (a meter is a frame of its own, drawn and read back while the caller waits),
+    // meter again (a meter is a frame of its own, which the device draws and reads back),
     // unless the view is the one the frame before it showed; the full-resolution frame meters.
     // Only present() reads it.
     bool interactive = false;
@@ -158,6 +158,9 @@ public:
     bool exposureAdapting() const { return adapting_; }
     // How often a frame was metered (edits and camera moves meter again; adaptation does not).
     size_t meterings() const { return meterings_; }
+    // What a frame of `request` from `camera` is drawn with (the exposure aside, which render()
+    // and present() set).
+    RenderSettings settingsOf(const RenderRequest& request, const OrbitCamera& camera) const;
 
     // Whether a frame of `request` draws the LPV; a frame that does not frees bound volumes.
     bool drawsLpv(const RenderRequest& request) const;
@@ -199,11 +202,12 @@ private:
     // Per volume, the overlays follow the bound probes where they carry diagnostics and were
     // baked from the current probe-volume settings; otherwise the placement of those settings.
     void updateOverlays();
-    RenderSettings settingsOf(const RenderRequest& request, const OrbitCamera& camera) const;
     // Whether a frame of `request` is metered (a metered mode, a picture view, display output).
     bool meters(const RenderRequest& request) const;
     // The EV100 the meter reads from `request`'s frame, drawn scene-linear kMeterWidth wide.
     double meter(const RenderRequest& request, const OrbitCamera& camera);
+    // The frame the meter reads.
+    RenderSettings meterSettings(const RenderRequest& request, const OrbitCamera& camera) const;
     // What a metering depends on: the bound inputs' revision, the view and the camera.
     std::string meterKey(const RenderRequest& request, const OrbitCamera& camera) const;
     static constexpr uint32_t kMeterWidth = 128;
@@ -238,6 +242,7 @@ private:
     size_t lpvUpdates_ = 0;
     size_t revision_ = 0;  // bumped by every change of what a frame shows but the camera
     std::string meterKey_;
+    std::string pendingMeterKey_;  // what the meter frame the device is drawing (present()) reads
     std::string lastFrameKey_;  // the meter key of the frame present() drew last
     double meteredEv100_ = std::numeric_limits<double>::quiet_NaN();
     double shownEv100_ = std::numeric_limits<double>::quiet_NaN();

@@ -30,6 +30,7 @@
 #include "vk/Readback.h"
 #include "vk/RenderPass.h"
 #include "vk/Sampler.h"
+#include "vk/Swapchain.h"
 #include "vk/VulkanContext.h"
 
 namespace terralux {
@@ -112,6 +113,11 @@ struct WaterResources;
 struct ReflectionResources;
 struct LpvResources;
 
+// The frame slots: one per swapchain frame in flight, and one for a frame drawn offscreen without
+// waiting (TerrainRenderer::beginOffscreen) while those are in flight.
+inline constexpr uint32_t kOffscreenSlot = vk::kFramesInFlight;
+inline constexpr uint32_t kRenderSlots = vk::kFramesInFlight + 1;
+
 // What one frame in flight writes from the host: its uniform blocks and the sets that bind them.
 // `shadowedLights` adds the cascades to `lights`; it exists while the shadow maps do (the lights
 // sets with reflection probes belong to ReflectionResources).
@@ -133,6 +139,7 @@ struct FrameSlot {
     // Timestamps around the frame graph's passes (devices that write them): the queries the last
     // frame drawn in this slot wrote, and its passes' names, read once its fence has passed.
     vk::UniqueQueryPool timestamps;
+    vk::Buffer timestampResults;  // the frame's own copy of them, host-visible
     uint32_t timestampsWritten = 0;
     std::vector<std::string> timedPasses;
     double recordMilliseconds = 0.0;

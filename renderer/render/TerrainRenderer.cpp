@@ -250,7 +250,7 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     g.graph.importBuffer(kVertices, g.vertices.handle(), true);
 
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i) {
+    for (uint32_t i = 0; i < kRenderSlots; ++i) {
         FrameSlot f;
         auto ubo = [&](size_t bytes) {
             return vk::Buffer::hostVisible(ctx_, bytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -274,6 +274,8 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
             VkQueryPool pool = VK_NULL_HANDLE;
             vk::check(vkCreateQueryPool(ctx_.device(), &qci, nullptr, &pool), "vkCreateQueryPool");
             f.timestamps = vk::UniqueQueryPool(ctx_.device(), pool);
+            f.timestampResults = vk::Buffer::hostVisible(ctx_, kFrameTimestamps * sizeof(uint64_t),
+                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT);
         }
         g.slots.push_back(std::move(f));
     }
@@ -715,6 +717,8 @@ void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shad
 }
 
 void TerrainRenderer::releaseRetired(bool idle) {
+    // An offscreen frame still drawing may read what was retired after it was recorded.
+    if (!idle && offscreen_ && !offscreen_->read && !offscreen_->submission.done()) return;
     std::erase_if(retired_, [&](const Retired& r) { return idle || r.releaseAt <= framesBegun_; });
 }
 
@@ -801,6 +805,7 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
         return;
     }
     ctx_.waitIdle();  // frames in flight may still draw into the targets
+    readOffscreen();  // before its target may go
     for (const char* name : kTargetNames) g.graph.forget(name);
     ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
@@ -862,8 +867,10 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     ensureTarget(s.width, s.height, out.antialiasing);
     RenderSettings scaled;
     const RenderSettings& drawn = drawnSettings(s, out.antialiasing, scaled);
-    // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free.
+    // The synchronous path: whatever the viewport queued finishes first, then slot 0 is free
+    // (and an offscreen frame's read-back is read before this frame may overwrite it).
     ctx_.waitIdle();
+    readOffscreen();
     releaseRetired(true);
     ctx_.submitAndWait([&](VkCommandBuffer cb) { recordFrame(cb, 0, drawn, out); });
     gpu_->slots[0].width = s.width;
@@ -880,6 +887,43 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     return img;
 }
 
+bool TerrainRenderer::beginOffscreen(const RenderSettings& s) {
+    if (offscreen_) return false;
+    Offscreen o;
+    o.start = std::chrono::steady_clock::now();
+    Output out;
+    out.antialiasing = antialiasingOf(s);
+    ensureTarget(s.width, s.height, out.antialiasing);
+    RenderSettings scaled;
+    const RenderSettings& drawn = drawnSettings(s, out.antialiasing, scaled);
+    o.target = gpu_->target.get();
+    o.image.width = s.width;
+    o.image.height = s.height;
+    // Its slot's last frame was read (takeOffscreen) before this one could begin: it is free.
+    o.submission = ctx_.submit([&](VkCommandBuffer cb) { recordFrame(cb, kOffscreenSlot, drawn, out); });
+    gpu_->slots[kOffscreenSlot].width = s.width;
+    gpu_->slots[kOffscreenSlot].height = s.height;
+    offscreen_ = std::move(o);
+    return true;
+}
+
+void TerrainRenderer::readOffscreen() {
+    if (!offscreen_ || offscreen_->read || !offscreen_->submission.done()) return;
+    offscreen_->image.rgba = offscreen_->target->readback.pixels();
+    offscreen_->image.milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - offscreen_->start).count();
+    offscreen_->read = true;
+    offscreen_->submission = vk::Submission();
+}
+
+std::optional<RenderedImage> TerrainRenderer::takeOffscreen() {
+    readOffscreen();
+    if (!offscreen_ || !offscreen_->read) return std::nullopt;
+    RenderedImage image = std::move(offscreen_->image);
+    offscreen_.reset();
+    return image;
+}
+
 void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
     FrameSlot& slot = gpu_->slots[slotIndex];
     timings_ = FrameTimings{};
@@ -889,11 +933,9 @@ void TerrainRenderer::readFrameTimings(uint32_t slotIndex) {
     const uint32_t n = slot.timestampsWritten;
     slot.timestampsWritten = 0;
     if (n < 2) return;
+    // The slot's fence has passed: the frame's copy of its timestamps is there.
     std::vector<uint64_t> ticks(n);
-    // The slot's fence has passed: no wait, and results not yet available are left out.
-    if (vkGetQueryPoolResults(ctx_.device(), slot.timestamps.get(), 0, n, n * sizeof(uint64_t), ticks.data(),
-                              sizeof(uint64_t), VK_QUERY_RESULT_64_BIT) != VK_SUCCESS)
-        return;
+    std::memcpy(ticks.data(), slot.timestampResults.map(), n * sizeof(uint64_t));
     const uint32_t bits = ctx_.timestampBits();
     const uint64_t mask = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
     const double msPerTick = ctx_.timestampPeriod() * 1e-6;
@@ -1156,6 +1198,21 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     }
     FrameSlot& slot = f.slot;
     slot.timestampsWritten = g.graph.execute(cb, slot.timestamps.get(), slot.timestamps ? kFrameTimestamps : 0);
+    if (slot.timestampsWritten > 0) {
+        // The frame copies its own timestamps into memory the host reads once the slot's fence
+        // has passed: asking the query pool instead waits, on some drivers (lavapipe), for every
+        // frame submitted since, the meter's included.
+        vkCmdCopyQueryPoolResults(cb, slot.timestamps.get(), 0, slot.timestampsWritten, slot.timestampResults.handle(), 0,
+                                  sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT);
+        VkBufferMemoryBarrier toHost{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+        toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+        toHost.srcQueueFamilyIndex = toHost.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        toHost.buffer = slot.timestampResults.handle();
+        toHost.size = VK_WHOLE_SIZE;
+        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1, &toHost, 0,
+                             nullptr);
+    }
     slot.timedPasses.clear();
     for (const PassInfo& p : g.graph.lastFrame()) slot.timedPasses.push_back(p.name);
     if (f.probes) f.probes->lightStale = false;

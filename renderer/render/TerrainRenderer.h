@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -34,6 +35,7 @@
 namespace terralux {
 
 struct RendererGpu;  // render/Frame.h
+struct RenderTarget;  // render/Frame.h
 struct Frame;
 struct WaterResources;  // render/features/Water.h
 struct ReflectionProbeSet;  // bake/ReflectionBake.h
@@ -159,6 +161,14 @@ public:
     glm::ivec2 surfaceMapSize() const { return surfaceMapSize_; }
     // Draws a frame and reads it back, waiting for the GPU.
     RenderedImage render(const RenderSettings& settings);
+    // Draws a frame and its read-back like render(), but submits it without waiting for the GPU
+    // (in a slot of its own, so the swapchain's frames in flight go on): takeOffscreen() gives
+    // the image once the GPU has drawn it. False, drawing nothing, while one is still untaken.
+    bool beginOffscreen(const RenderSettings& settings);
+    bool offscreenPending() const { return offscreen_.has_value(); }
+    // The image beginOffscreen() drew, once the GPU has finished it (never waits); nullopt before
+    // then and when none was begun.
+    std::optional<RenderedImage> takeOffscreen();
     // Draws a frame into the swapchain's next image (a blit of the offscreen colour target, no
     // readback) and submits it without waiting for the GPU; the swapchain presents it once it
     // has finished (vk::Swapchain::presentIfDone). False when nothing could be shown.
@@ -240,6 +250,19 @@ private:
         retired_.push_back({framesBegun_ + vk::kFramesInFlight, std::make_shared<std::decay_t<T>>(std::move(resource))});
     }
     void releaseRetired(bool idle);
+    // The frame beginOffscreen() submitted, and its pixels once read: they are read as soon as
+    // the GPU has finished and before anything may draw into or free its target again.
+    struct Offscreen {
+        vk::Submission submission;
+        RenderTarget* target = nullptr;
+        RenderedImage image;
+        bool read = false;
+        std::chrono::steady_clock::time_point start;
+    };
+    std::optional<Offscreen> offscreen_;
+    // Reads the offscreen frame's pixels if the GPU has finished it (always after a wait for the
+    // queue).
+    void readOffscreen();
     struct Retired {
         uint64_t releaseAt;  // framesBegun_ at which no frame can still read it
         std::shared_ptr<void> resource;

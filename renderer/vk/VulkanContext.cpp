@@ -244,4 +244,40 @@ void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& re
     check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
 
+Submission VulkanContext::submit(const std::function<void(VkCommandBuffer)>& record) const {
+    Submission sub;
+    sub.device_ = device_;
+    sub.cb_ = allocateCommandBuffer();
+    VkFenceCreateInfo fi{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence fence = VK_NULL_HANDLE;
+    check(vkCreateFence(device_, &fi, nullptr, &fence), "vkCreateFence");
+    UniqueFence ownedFence(device_, fence);
+    VkCommandBuffer cb = sub.cb_.get();
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
+    record(cb);
+    check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cb;
+    check(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+    sub.fence_ = std::move(ownedFence);  // only submitted work has a fence to wait for
+    return sub;
+}
+
+bool Submission::done() const {
+    if (!fence_) return true;
+    const VkResult r = vkGetFenceStatus(device_, fence_.get());
+    if (r == VK_NOT_READY) return false;
+    check(r, "vkGetFenceStatus");
+    return true;
+}
+
+void Submission::wait() const {
+    if (!fence_) return;
+    const VkFence f = fence_.get();
+    check(vkWaitForFences(device_, 1, &f, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+}
+
 }  // namespace terralux::vk

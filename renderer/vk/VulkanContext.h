@@ -42,6 +42,23 @@ struct ContextOptions {
     bool swapchain = false;
 };
 
+// Work submitted without waiting (VulkanContext::submit): its command buffer and fence.
+class Submission {
+public:
+    Submission() = default;
+    // Whether there is work (a default submission has none).
+    explicit operator bool() const { return fence_.get() != VK_NULL_HANDLE; }
+    // Whether the device has finished it: true when there is none.
+    bool done() const;
+    void wait() const;
+
+private:
+    friend class VulkanContext;
+    VkDevice device_ = VK_NULL_HANDLE;
+    UniqueCommandBuffer cb_;
+    UniqueFence fence_;
+};
+
 class VulkanContext {
 public:
     explicit VulkanContext(const ContextOptions& options = {});
@@ -86,6 +103,9 @@ public:
     // Records commands into a one-time command buffer, submits it and waits. The command buffer
     // is freed on every path, a throw from `record` included.
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
+    // Records and submits as submitAndWait does, without waiting: the submission says when the
+    // device has finished it, and must outlive the work (wait for it, or for the queue, first).
+    Submission submit(const std::function<void(VkCommandBuffer)>& record) const;
     // Waits until the queue has finished everything submitted so far.
     void waitIdle() const;
 

@@ -9,6 +9,8 @@
 #include <iostream>
 #include <memory>
 #include <numbers>
+#include <optional>
+#include <thread>
 
 #include <gdal_priv.h>
 #include <glm/matrix.hpp>
@@ -2855,6 +2857,50 @@ TEST_F(RenderTest, TheLastCascadeFadesIntoTheUnshadowedSunAtAShortShadowDistance
 // The mesh's level of detail (terrain/MeshLod.h): each patch draws the coarsest level whose error
 // against the DEM covers at most a pixel from the camera, and the frame is the frame of the whole
 // mesh up to that pixel; close to the ground the patches there draw every vertex.
+// A frame drawn offscreen without waiting (the viewport's exposure meter) is the frame render()
+// draws, pixel for pixel, taken once the device has drawn it; one is in flight at a time, and a
+// synchronous render meanwhile neither waits for it in vain nor overwrites its read-back.
+TEST_F(RenderTest, AnOffscreenFrameIsTheRenderedFrameTakenWithoutWaiting) {
+    Project p = sampleProject("offscreen", 4, 4);
+    ProjectRenderer r(*ctx_, p);
+    TerrainRenderer& t = r.renderer();
+    const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, r.heightfield());
+    RenderRequest q = unprobed(kViewBeauty, true);
+    q.width = 128;
+    q.height = 96;
+    const RenderSettings s = r.settingsOf(q, camera);
+    const RenderedImage waited = t.render(s);
+    auto take = [&] {
+        std::optional<RenderedImage> img;
+        for (int i = 0; i < 6000 && !img; ++i) {
+            img = t.takeOffscreen();
+            if (!img) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+        return img;
+    };
+    ASSERT_TRUE(t.beginOffscreen(s));
+    EXPECT_TRUE(t.offscreenPending());
+    EXPECT_FALSE(t.beginOffscreen(s));  // one at a time
+    std::optional<RenderedImage> taken = take();
+    ASSERT_TRUE(taken);
+    EXPECT_FALSE(t.offscreenPending());
+    EXPECT_FALSE(t.takeOffscreen());  // taken once
+    ASSERT_EQ(taken->width, waited.width);
+    ASSERT_EQ(taken->height, waited.height);
+    EXPECT_EQ(taken->rgba, waited.rgba);
+
+    // Another frame of the same size drawn synchronously while it is in flight draws into the
+    // same target: the offscreen frame's pixels are read first.
+    ASSERT_TRUE(t.beginOffscreen(s));
+    RenderSettings other = s;
+    other.debugView = kViewNormal;
+    const RenderedImage normals = t.render(other);
+    EXPECT_NE(normals.rgba, waited.rgba);
+    taken = take();
+    ASSERT_TRUE(taken);
+    EXPECT_EQ(taken->rgba, waited.rgba);
+}
+
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
     Project p = sampleProject("lod", 4, 4);
     ProjectRenderer r(*ctx_, p);

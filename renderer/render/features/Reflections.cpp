@@ -91,7 +91,7 @@ std::unique_ptr<ReflectionResources> buildReflections(vk::VulkanContext& ctx, Re
     r->grid.spacing = s.spacing;
     r->grid.cellSize = s.cellSize;
     r->grid.blendDistance = s.blendDistance;
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+    for (uint32_t i = 0; i < kRenderSlots; ++i)
         r->blocks.push_back(vk::Buffer::hostVisible(ctx, sizeof(blocks::ReflectionBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
     g.graph.importBuffer(kReflectionRecords, r->records.handle(), true);
     g.graph.importBuffer(kReflectionMarkers, r->markers.handle(), true);

@@ -133,7 +133,7 @@ std::unique_ptr<WaterResources> buildWater(vk::VulkanContext& ctx, const Heightf
     if (indices.empty()) indices.push_back(0);
     w->vertices = vk::Buffer::deviceLocal(ctx, rest.data(), rest.size() * sizeof(glm::vec2), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     w->indices = vk::Buffer::deviceLocal(ctx, indices.data(), indices.size() * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+    for (uint32_t i = 0; i < kRenderSlots; ++i)
         w->blocks.push_back(vk::Buffer::hostVisible(ctx, sizeof(blocks::WaterBlock), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT));
     return w;
 }
@@ -156,7 +156,7 @@ std::unique_ptr<WaterTargets> buildWaterTargets(vk::VulkanContext& ctx, const Re
     copy.height = height;
     copy.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     t->scene = vk::Image(ctx, copy);
-    for (uint32_t i = 0; i < vk::kFramesInFlight; ++i)
+    for (uint32_t i = 0; i < kRenderSlots; ++i)
         t->sets.push_back(waterSetBuilder(w.blocks[i], t->reflection.view(), t->scene.view(), w.field.view(),
                                           g.linear.handle())
                               .build(ctx));
