@@ -532,8 +532,14 @@ std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uin
 
 // Traces one probe's rays (ProbeRays) into slot i of `out`: `ray(d, weight)` is the radiance
 // along direction d, weight the solid angle one ray of the round stands for. Returns the rays.
+// With `base`, the rays estimate what the probe differs from it: the probe is `base` plus their
+// projection, and ray(d, weight) is the radiance less base's own along d.
 template <typename Ray>
-int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t i, Ray&& ray) {
+int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t i, const sh::ShRgb* base,
+                     Ray&& ray) {
+    std::array<double, sh::kCoeffCount> baseLuminance{};
+    if (base)
+        for (int j = 0; j < sh::kCoeffCount; ++j) baseLuminance[size_t(j)] = double(luminance(base->c[size_t(j)]));
     Rounds rounds;
     sh::ShRgb total;
     auto round = [&](int n) {
@@ -552,7 +558,9 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
         total *= 1.0f - share;
         acc *= share;
         total += acc;
-        rounds.add(n, replicates.moments());
+        CoefficientMoments m = replicates.moments();
+        for (size_t j = 0; j < m.mean.size(); ++j) m.mean[j] += baseLuminance[j];
+        rounds.add(n, m);
     };
     if (!schedule.adaptive()) {
         round(std::max(schedule.rays, 1));
@@ -567,6 +575,7 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
         while (rounds.rays < planned) round(rounds.rays);
     }
     out.standardError[i] = rounds.relativeError();
+    if (base) total += *base;  // the rounds' shares add up to one
     out.sh[i] = total;
     out.raysPerProbe[i] = uint32_t(rounds.rays);
     return rounds.rays;
@@ -588,11 +597,18 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
         if (!valid[i]) return;
         Rng rng(splitmix64(seeds[i]));
         int fromBelow = 0;
-        const int rays = traceProbeRounds(schedule, rng, out, i, [&](const glm::vec3& d, float weight) {
+        // The sky as a control variate (Glasserman 2003, "Monte Carlo Methods in Financial
+        // Engineering", 4.1): its projection is exact (Sky::sh), so the rays only estimate how
+        // the probe's light differs from the open sky's. A ray that escapes adds nothing, and the
+        // sky's bright spots (an HDR's sun glow, the physical sky's circumsolar light) add noise
+        // only where the terrain hides them.
+        const int rays = traceProbeRounds(schedule, rng, out, i, &L.sky.sh(), [&](const glm::vec3& d, float weight) {
             RayHit hit;
             const bool terrain = L.tracer->intersect(positions[i], d, INFINITY, hit);
             if (terrain) fromBelow += glm::dot(d, hit.normal) > 0.0f;
-            return rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng);
+            if (!terrain && !L.water) return glm::vec3(0.0f);
+            return rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng) -
+                   L.sky.radiance(d, weight);
         });
         out.fromBelowShare[i] = float(fromBelow) / float(rays);
         traced.fetch_add(uint64_t(rays), std::memory_order_relaxed);
@@ -678,7 +694,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
             }
             return radiance;
         };
-        const int rays = traceProbeRounds(schedule, rng, out, i, [&](const glm::vec3& d0, float weight) {
+        const int rays = traceProbeRounds(schedule, rng, out, i, nullptr, [&](const glm::vec3& d0, float weight) {
             RayHit hit;
             ++count;
             glm::vec3 radiance(0.0f);
