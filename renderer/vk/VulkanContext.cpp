@@ -228,9 +228,12 @@ UniqueCommandBuffer VulkanContext::allocateCommandBuffer() const {
 
 void VulkanContext::waitIdle() const { check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle"); }
 
-void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
-    const UniqueCommandBuffer owned = allocateCommandBuffer();
-    VkCommandBuffer cb = owned.get();
+namespace {
+
+// Records `record` into `cb` as a one-time command buffer and submits it to `queue`, signalling
+// `fence` (unsignalled) when the device has finished it.
+void recordAndSubmit(VkQueue queue, VkCommandBuffer cb, VkFence fence,
+                     const std::function<void(VkCommandBuffer)>& record) {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
@@ -239,8 +242,15 @@ void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& re
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cb;
+    check(vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
+}
+
+}  // namespace
+
+void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
+    const UniqueCommandBuffer owned = allocateCommandBuffer();
     check(vkResetFences(device_, 1, &fence_), "vkResetFences");
-    check(vkQueueSubmit(queue_, 1, &si, fence_), "vkQueueSubmit");
+    recordAndSubmit(queue_, owned.get(), fence_, record);
     check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
 
@@ -252,16 +262,7 @@ Submission VulkanContext::submit(const std::function<void(VkCommandBuffer)>& rec
     VkFence fence = VK_NULL_HANDLE;
     check(vkCreateFence(device_, &fi, nullptr, &fence), "vkCreateFence");
     UniqueFence ownedFence(device_, fence);
-    VkCommandBuffer cb = sub.cb_.get();
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cb, &bi), "vkBeginCommandBuffer");
-    record(cb);
-    check(vkEndCommandBuffer(cb), "vkEndCommandBuffer");
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &cb;
-    check(vkQueueSubmit(queue_, 1, &si, fence), "vkQueueSubmit");
+    recordAndSubmit(queue_, sub.cb_.get(), fence, record);
     sub.fence_ = std::move(ownedFence);  // only submitted work has a fence to wait for
     return sub;
 }
