@@ -481,6 +481,8 @@ RenderSettings ProjectRenderer::meterSettings(const RenderRequest& r, const Orbi
 
 double ProjectRenderer::meter(const RenderRequest& r, const OrbitCamera& camera) {
     const RenderedImage img = renderer_->render(meterSettings(r, camera));
+    // A meter the viewport began before reads an older frame: this reading replaces it.
+    (void)renderer_->takeOffscreen();
     ++meterings_;
     return meterEv100(img.rgba, img.width, img.height, project_.scene.camera.exposureMode);
 }

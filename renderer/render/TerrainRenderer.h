@@ -260,8 +260,8 @@ private:
         std::chrono::steady_clock::time_point start;
     };
     std::optional<Offscreen> offscreen_;
-    // Reads the offscreen frame's pixels if the GPU has finished it (always after a wait for the
-    // queue).
+    // Reads the offscreen frame's pixels if the GPU has finished it (always so after a wait for
+    // the queue, which is when anything may next write its read-back or free its target).
     void readOffscreen();
     struct Retired {
         uint64_t releaseAt;  // framesBegun_ at which no frame can still read it

@@ -38,14 +38,17 @@ struct Span {
     std::vector<double> f;
 };
 
-Span spans(const std::vector<uint32_t>& k) {
+// With `at` (the lines' world coordinates), where in the cell is measured in the world, as the
+// drawn triangles interpolate; without, in lines (the same on an evenly spaced grid).
+Span spans(const std::vector<uint32_t>& k, std::span<const float> at) {
     const uint32_t n = k.back() - k.front() + 1;
     Span s{std::vector<uint32_t>(n), std::vector<double>(n)};
     size_t cell = 0;
     for (uint32_t i = k.front(); i <= k.back(); ++i) {
         while (cell + 2 < k.size() && i > k[cell + 1]) ++cell;
         s.cell[i - k.front()] = uint32_t(cell);
-        s.f[i - k.front()] = double(i - k[cell]) / double(k[cell + 1] - k[cell]);
+        s.f[i - k.front()] = at.empty() ? double(i - k[cell]) / double(k[cell + 1] - k[cell])
+                                        : (double(at[i]) - at[k[cell]]) / (double(at[k[cell + 1]]) - at[k[cell]]);
     }
     return s;
 }
@@ -53,10 +56,10 @@ Span spans(const std::vector<uint32_t>& k) {
 }  // namespace
 
 double gridError(std::span<const float> heights, uint32_t nc, const std::vector<uint32_t>& kc,
-                 const std::vector<uint32_t>& kr) {
+                 const std::vector<uint32_t>& kr, std::span<const float> colX, std::span<const float> rowZ) {
     if (kc.size() < 2 || kr.size() < 2) return 0.0;
     const uint32_t c0 = kc.front(), r0 = kr.front();
-    const Span u = spans(kc), v = spans(kr);
+    const Span u = spans(kc, colX), v = spans(kr, rowZ);
     auto h = [&](uint32_t c, uint32_t r) { return double(heights[size_t(r) * nc + c]); };
     return tbb::parallel_reduce(
         tbb::blocked_range<uint32_t>(r0, kr.back() + 1), 0.0,
@@ -157,7 +160,7 @@ Patches buildPatches(std::span<const float> heights, uint32_t nc, uint32_t nr, s
             // Levels past the patch's coarsest stand at its coarsest, never chosen.
             const uint32_t step = stepOf(uint8_t(std::min<uint32_t>(l, p.coarsest[k])));
             p.error[size_t(k) * p.levels + l] =
-                step > 1 ? gridError(heights, nc, keptRange(c0, c1, step), keptRange(r0, r1, step)) : 0.0;
+                step > 1 ? gridError(heights, nc, keptRange(c0, c1, step), keptRange(r0, r1, step), colX, rowZ) : 0.0;
         }
     });
     return p;

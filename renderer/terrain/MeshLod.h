@@ -28,9 +28,11 @@ void appendTriangles(std::vector<uint32_t>& indices, uint32_t nc, const std::vec
 // The largest |h - s| over the vertices of the nc-wide height grid `heights` (row-major) from
 // column kc.front() to kc.back() and row kr.front() to kr.back(), where s is the surface of the
 // grid through columns kc and rows kr at that vertex: two triangles per cell, split as
-// appendTriangles splits them, linear across each.
+// appendTriangles splits them, linear across each, in the world coordinates colX and rowZ of
+// the grid's columns and rows where given (a decimated grid's last step is shorter), else in grid
+// steps.
 double gridError(std::span<const float> heights, uint32_t nc, const std::vector<uint32_t>& kc,
-                 const std::vector<uint32_t>& kr);
+                 const std::vector<uint32_t>& kr, std::span<const float> colX = {}, std::span<const float> rowZ = {});
 
 // The distance from p to the box [lo, hi] (0 inside it).
 double distanceToBox(const glm::vec3& p, const glm::vec3& lo, const glm::vec3& hi);

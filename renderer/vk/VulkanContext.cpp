@@ -226,7 +226,10 @@ UniqueCommandBuffer VulkanContext::allocateCommandBuffer() const {
     return UniqueCommandBuffer(device_, pool_, cb);
 }
 
-void VulkanContext::waitIdle() const { check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle"); }
+void VulkanContext::waitIdle() const {
+    hostWaits_.fetch_add(1, std::memory_order_relaxed);
+    check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle");
+}
 
 namespace {
 
@@ -251,6 +254,7 @@ void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& re
     const UniqueCommandBuffer owned = allocateCommandBuffer();
     check(vkResetFences(device_, 1, &fence_), "vkResetFences");
     recordAndSubmit(queue_, owned.get(), fence_, record);
+    hostWaits_.fetch_add(1, std::memory_order_relaxed);
     check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
 

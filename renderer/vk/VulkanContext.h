@@ -108,6 +108,9 @@ public:
     Submission submit(const std::function<void(VkCommandBuffer)>& record) const;
     // Waits until the queue has finished everything submitted so far.
     void waitIdle() const;
+    // How often the host has waited for the device here (waitIdle, submitAndWait): what a path
+    // that must not wait is checked against.
+    size_t hostWaits() const { return hostWaits_.load(std::memory_order_relaxed); }
 
 private:
     // Destroys whatever exists, in reverse order of creation; safe on a half-built context.
@@ -121,6 +124,7 @@ private:
     uint32_t queueFamily_ = 0;
     VkCommandPool pool_ = VK_NULL_HANDLE;
     VkFence fence_ = VK_NULL_HANDLE;
+    mutable std::atomic<size_t> hostWaits_{0};
     std::string deviceName_;
     bool cubeArrays_ = false;
     bool depthClamp_ = false;

@@ -2854,9 +2854,6 @@ TEST_F(RenderTest, TheLastCascadeFadesIntoTheUnshadowedSunAtAShortShadowDistance
     EXPECT_EQ(greyish, 0u);
 }
 
-// The mesh's level of detail (terrain/MeshLod.h): each patch draws the coarsest level whose error
-// against the DEM covers at most a pixel from the camera, and the frame is the frame of the whole
-// mesh up to that pixel; close to the ground the patches there draw every vertex.
 // A frame drawn offscreen without waiting (the viewport's exposure meter) is the frame render()
 // draws, pixel for pixel, taken once the device has drawn it; one is in flight at a time, and a
 // synchronous render meanwhile neither waits for it in vain nor overwrites its read-back.
@@ -2878,10 +2875,13 @@ TEST_F(RenderTest, AnOffscreenFrameIsTheRenderedFrameTakenWithoutWaiting) {
         }
         return img;
     };
+    // Nothing on the way waits for the device: beginning submits, taking polls the fence.
+    const size_t waits = ctx_->hostWaits();
     ASSERT_TRUE(t.beginOffscreen(s));
     EXPECT_TRUE(t.offscreenPending());
     EXPECT_FALSE(t.beginOffscreen(s));  // one at a time
     std::optional<RenderedImage> taken = take();
+    EXPECT_EQ(ctx_->hostWaits(), waits);
     ASSERT_TRUE(taken);
     EXPECT_FALSE(t.offscreenPending());
     EXPECT_FALSE(t.takeOffscreen());  // taken once
@@ -2901,6 +2901,9 @@ TEST_F(RenderTest, AnOffscreenFrameIsTheRenderedFrameTakenWithoutWaiting) {
     EXPECT_EQ(taken->rgba, waited.rgba);
 }
 
+// The mesh's level of detail (terrain/MeshLod.h): each patch draws the coarsest level whose error
+// against the DEM covers at most a pixel from the camera, and the frame is the frame of the whole
+// mesh up to that pixel; close to the ground the patches there draw every vertex.
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
     Project p = sampleProject("lod", 4, 4);
     ProjectRenderer r(*ctx_, p);
