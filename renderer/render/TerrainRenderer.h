@@ -251,7 +251,7 @@ private:
     }
     void releaseRetired(bool idle);
     // The frame beginOffscreen() submitted, and its pixels once read: they are read as soon as
-    // the GPU has finished and before anything may draw into or free its target again.
+    // the GPU has finished, and before anything may write its read-back again or free its target.
     struct Offscreen {
         vk::Submission submission;
         RenderTarget* target = nullptr;

@@ -232,59 +232,55 @@ bool appendPatch(std::vector<uint32_t>& indices, const Patches& p, std::span<con
         if (a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz)) return -1;  // outside: the border
         return levels[size_t(b) * px + size_t(a)];
     };
-    {
-        {
-            const int own = level(i, j);
-            const uint32_t step = stepOf(uint8_t(own));
-            const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
-            const std::vector<uint32_t> kc = keptRange(c0, c1, step), kr = keptRange(r0, r1, step);
-            // Each edge at the coarser of the two patches' steps (a border edge at its own).
-            auto edgeStep = [&](int neighbour) { return stepOf(uint8_t(std::max(own, neighbour))); };
-            const uint32_t sN = edgeStep(level(i, int64_t(j) - 1)), sS = edgeStep(level(i, j + 1));
-            const uint32_t sW = edgeStep(level(int64_t(i) - 1, j)), sE = edgeStep(level(i + 1, j));
-            if (borderSegments) {
-                auto segments = [&](const std::vector<uint32_t>& run, bool alongColumns, uint32_t fixed) {
-                    for (size_t k = 0; k + 1 < run.size(); ++k) {
-                        const uint32_t a = alongColumns ? fixed * nc + run[k] : run[k] * nc + fixed;
-                        const uint32_t b = alongColumns ? fixed * nc + run[k + 1] : run[k + 1] * nc + fixed;
-                        borderSegments->insert(borderSegments->end(), {a, b});
-                    }
-                };
-                if (j == 0) segments(keptRange(c0, c1, sN), true, r0);
-                if (j + 1 == pz) segments(keptRange(c0, c1, sS), true, r1);
-                if (i == 0) segments(keptRange(r0, r1, sW), false, c0);
-                if (i + 1 == px) segments(keptRange(r0, r1, sE), false, c1);
+    const int own = level(i, j);
+    const uint32_t step = stepOf(uint8_t(own));
+    const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
+    const std::vector<uint32_t> kc = keptRange(c0, c1, step), kr = keptRange(r0, r1, step);
+    // Each edge at the coarser of the two patches' steps (a border edge at its own).
+    auto edgeStep = [&](int neighbour) { return stepOf(uint8_t(std::max(own, neighbour))); };
+    const uint32_t sN = edgeStep(level(i, int64_t(j) - 1)), sS = edgeStep(level(i, j + 1));
+    const uint32_t sW = edgeStep(level(int64_t(i) - 1, j)), sE = edgeStep(level(i + 1, j));
+    if (borderSegments) {
+        auto segments = [&](const std::vector<uint32_t>& run, bool alongColumns, uint32_t fixed) {
+            for (size_t k = 0; k + 1 < run.size(); ++k) {
+                const uint32_t a = alongColumns ? fixed * nc + run[k] : run[k] * nc + fixed;
+                const uint32_t b = alongColumns ? fixed * nc + run[k + 1] : run[k + 1] * nc + fixed;
+                borderSegments->insert(borderSegments->end(), {a, b});
             }
-            // (A patch one cell across has no ring; its neighbours along its row or column are one
-            // cell across too, so they all stand at level 0 and nothing is zipped.)
-            if ((sN == step && sS == step && sW == step && sE == step) || kc.size() < 3 || kr.size() < 3) {
-                appendTriangles(indices, nc, kc, kr);
-                return false;
-            }
-            // The ring of cells along the edges zipped to the edges' vertices, the inside as a
-            // plain grid. Its inner runs are the second and second-last kept lines.
-            const std::vector<uint32_t> ic(kc.begin() + 1, kc.end() - 1), ir(kr.begin() + 1, kr.end() - 1);
-            appendTriangles(indices, nc, ic, ir);
-            auto row = [](const std::vector<uint32_t>& cs, uint32_t r) {
-                std::vector<GridPoint> g;
-                for (uint32_t c : cs) g.push_back({c, r});
-                return g;
-            };
-            auto column = [](const std::vector<uint32_t>& rs, uint32_t c) {
-                std::vector<GridPoint> g;
-                for (uint32_t r : rs) g.push_back({c, r});
-                return g;
-            };
-            // The plain grid's diagonal (c, r)-(c+1, r+1) runs from the outer vertex to the next
-            // inner one on the north and west edges, and from the inner vertex to the next outer
-            // one on the south and east edges.
-            zip(indices, nc, row(keptRange(c0, c1, sN), r0), row(ic, ir.front()), true, true);
-            zip(indices, nc, row(keptRange(c0, c1, sS), r1), row(ic, ir.back()), true, false);
-            zip(indices, nc, column(keptRange(r0, r1, sW), c0), column(ir, ic.front()), false, true);
-            zip(indices, nc, column(keptRange(r0, r1, sE), c1), column(ir, ic.back()), false, false);
-            return true;
-        }
+        };
+        if (j == 0) segments(keptRange(c0, c1, sN), true, r0);
+        if (j + 1 == pz) segments(keptRange(c0, c1, sS), true, r1);
+        if (i == 0) segments(keptRange(r0, r1, sW), false, c0);
+        if (i + 1 == px) segments(keptRange(r0, r1, sE), false, c1);
     }
+    // (A patch one cell across has no ring; its neighbours along its row or column are one
+    // cell across too, so they all stand at level 0 and nothing is zipped.)
+    if ((sN == step && sS == step && sW == step && sE == step) || kc.size() < 3 || kr.size() < 3) {
+        appendTriangles(indices, nc, kc, kr);
+        return false;
+    }
+    // The ring of cells along the edges zipped to the edges' vertices, the inside as a
+    // plain grid. Its inner runs are the second and second-last kept lines.
+    const std::vector<uint32_t> ic(kc.begin() + 1, kc.end() - 1), ir(kr.begin() + 1, kr.end() - 1);
+    appendTriangles(indices, nc, ic, ir);
+    auto row = [](const std::vector<uint32_t>& cs, uint32_t r) {
+        std::vector<GridPoint> g;
+        for (uint32_t c : cs) g.push_back({c, r});
+        return g;
+    };
+    auto column = [](const std::vector<uint32_t>& rs, uint32_t c) {
+        std::vector<GridPoint> g;
+        for (uint32_t r : rs) g.push_back({c, r});
+        return g;
+    };
+    // The plain grid's diagonal (c, r)-(c+1, r+1) runs from the outer vertex to the next
+    // inner one on the north and west edges, and from the inner vertex to the next outer
+    // one on the south and east edges.
+    zip(indices, nc, row(keptRange(c0, c1, sN), r0), row(ic, ir.front()), true, true);
+    zip(indices, nc, row(keptRange(c0, c1, sS), r1), row(ic, ir.back()), true, false);
+    zip(indices, nc, column(keptRange(r0, r1, sW), c0), column(ir, ic.front()), false, true);
+    zip(indices, nc, column(keptRange(r0, r1, sE), c1), column(ir, ic.back()), false, false);
+    return true;
 }
 
 }  // namespace
