@@ -58,7 +58,7 @@ CommandLineHelp commandLineHelp(Binary binary) {
         {"--study [PROJECT]",
          "Sweep the settings that trade bake time for accuracy (quality, rays, bounces, probe spacing or "
          "adaptive tolerance, error-map resolution, AO directions, LPV quality and cascades, reflection cube "
-         "size, rays and encoding; shadow cascades, map size and filter on the Vulkan device), measure each "
+         "size, rays and encoding; shadow cascades, map size, filter and the terrain horizon on the Vulkan device), measure each "
          "against the exact answer on the same points, and write study.json, study.csv, study.png and "
          "study.html into --out DIR (default: \"study\" beside the project or in the current folder)."},
         {"--info [FILE]",

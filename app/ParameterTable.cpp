@@ -478,6 +478,11 @@ std::vector<ParameterSpec> buildTable() {
                "so the change of texel size leaves no seam, and the last one's into the unshadowed sun where the "
                "shadow distance ends before the terrain; 0 switches at once")
         .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::cascadeBlend);
+    add(Row("shadows.heightfield", T::Boolean)).label("Terrain horizon")
+        .about("Where a cascade's texels lose shadows longer than a DEM cell (0.75 texel of depth slope: "
+               "0.75·texel/tan(sun elevation) on level ground), the terrain's own shadow comes from its horizon "
+               "toward the sun at every DEM vertex, swept when the sun moves; off: the maps everywhere")
+        .redoes(kUpload).onlyWhen(shadowsOn).field(&SceneDescription::shadows, &ShadowSettings::heightfield);
 
     // Height fog.
     const auto fogOn = [](const SceneDescription& s, size_t) { return s.fog.enabled; };

@@ -18,6 +18,7 @@
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "scene/ShadowCascades.h"
+#include "terrain/SurfaceMaps.h"
 #include "scene/SolarPosition.h"
 #include "water/Water.h"
 
@@ -276,6 +277,17 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     shadows["computed_range"] = {range.nearDistance, range.farDistance};
     shadows["computed_for_aspect"] = kLightingExportAspect;
     shadows["computed_fades_out"] = range.fadesOut;
+    // The first cascade whose texels lose the shadows of the relief a DEM cell resolves at this
+    // sun, from which the terrain's horizon map stands in (shadows.heightfield); the cascade count
+    // when none does.
+    if (scene.shadows.heightfield && scene.shadows.enabled) {
+        const std::vector<Cascade> cascades = fitCascades(range, camera, float(kLightingExportAspect), l.sun.direction,
+                                                          scene.shadows.mapResolution, lo, hi);
+        const HorizonMapInfo map = horizonMapOf(hf.width(), hf.depth(), hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(),
+                                                kMaxSurfaceTexels);
+        shadows["computed_heightfield_from_cascade"] = horizonFirstCascade(cascades, l.sun.direction.y, map);
+        shadows["computed_heightfield_cell"] = shortestDecimal(map.cell);
+    }
 
     // What fog's unset ("auto") values stand for: the lowest terrain, and the sky's mean radiance,
     // L_0 · Y_0 (the DC term spread over 4π steradians; Y_0 = 1/(2√π), docs/lighting.md), as a

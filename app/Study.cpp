@@ -522,6 +522,9 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
             if (f != sh.filter)
                 add("shadow_filter", shadowLabel(sh.cascades, res, shadowFilterName(f)),
                     {std::string("shadows.filter=") + shadowFilterName(f)}, StudyMetric::Shadow);
+        // The terrain's horizon map against the maps alone (or the other way round).
+        add("shadow_heightfield", shadowLabel(sh.cascades, res, filter) + (sh.heightfield ? ", maps only" : ", terrain horizon"),
+            {std::string("shadows.heightfield=") + (sh.heightfield ? "false" : "true")}, StudyMetric::Shadow);
     }
 
     // Work, in each kind's unit, for the estimates.
@@ -829,13 +832,15 @@ StudyPoint Study::measureShadow(const Candidate& c) {
     p.seconds = a.shadowMilliseconds / 1000.0;
     // Depth maps of 32-bit texels, one layer a cascade.
     p.peakMemoryBytes = uint64_t(s.shadows.cascades) * uint64_t(s.shadows.mapResolution) * uint64_t(s.shadows.mapResolution) * 4u;
+    // The horizon map: a byte a vertex in each frame slot.
+    if (s.shadows.heightfield) p.peakMemoryBytes += shadowRenderer->renderer().horizonMapBytes();
     setErrors(p, a.tileDisagreeing);
     // The budget pays for the whole measurement (the traced view and a warm-up frame besides the
     // timed one), not the frame alone.
     learn("shadow", c.work, secondsSince(t0));
     const ShadowSettings& own = project.scene.shadows;
     p.current = s.shadows.cascades == own.cascades && s.shadows.mapResolution == own.mapResolution &&
-                s.shadows.filter == own.filter;
+                s.shadows.filter == own.filter && s.shadows.heightfield == own.heightfield;
     return p;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // The rules C++ and GLSL share, each written once in the common subset of the two languages:
 // height-fog optics (fog_math.glsl), the display encoding (display_math.glsl), the SH basis
-// (sh_basis.glsl), the equirectangular sky (sky_math.glsl), and the Gerstner waves
+// (sh_basis.glsl), the equirectangular sky (sky_math.glsl), the shadow hand-over
+// (shadow_math.glsl), and the Gerstner waves
 // (water_math.glsl). C++ sees them here as inline float
 // functions in terralux::glsl (the waves in double, in terralux::glsl::dbl), with the GLSL
 // built-ins they call; tests/render/test_shader_math.cpp holds each against the shaders' own
@@ -33,6 +34,7 @@ inline float atan(float y, float x) { return std::atan2(y, x); }  // GLSL's two-
 #include "display_math.glsl"
 #include "sh_basis.glsl"
 #include "sky_math.glsl"
+#include "shadow_math.glsl"
 #undef TLX_SHARED
 
 }  // namespace terralux::glsl

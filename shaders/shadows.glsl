@@ -16,7 +16,39 @@ vec3 faceNormal(vec3 p, vec3 n) {
 
 #ifdef TLX_SHADOWS
 #include "blocks/shadows.h"
+#include "shadow_math.glsl"
 layout(set = TLX_SET_LIGHTS, binding = TLX_SHADOW_MAP_DEPTH_BINDING) uniform sampler2DArray shadowDepth;
+
+// The terrain's own shadow where a cascade cannot draw the relief (shadowTakesHorizon): the
+// sun's visible share at every vertex of the DEM, from its horizon in the sun's azimuth
+// (renderer/terrain/HorizonAO.h, sunHorizonVisibility), interpolated between the vertices. Only the
+// terrain reads it (surface.glsl's footprint): water and anything above the surface see more of
+// the sun than the ground under them, and keep the maps (TLX_SHADOW_MAPS_ONLY).
+#ifndef TLX_SHADOW_MAPS_ONLY
+layout(std430, set = TLX_SET_LIGHTS, binding = TLX_SUN_HORIZON_BINDING) readonly buffer SunHorizon {
+    uint sunHorizonBytes[];
+};
+float sunHorizonAt(ivec2 v) {
+    int k = v.y * shadow.horizonWidth + v.x;
+    return float((sunHorizonBytes[k >> 2] >> uint(8 * (k & 3))) & 0xffu) * (1.0 / 255.0);
+}
+float horizonShadow(vec3 p) {
+    ivec2 size = ivec2(shadow.horizonWidth, shadow.horizonHeight);
+    vec2 q = clamp(footprintT(p), 0.0, 1.0) * vec2(size - 1);
+    ivec2 i = min(ivec2(q), max(size - 2, ivec2(0)));
+    vec2 f = q - vec2(i);
+    ivec2 j = min(i + 1, size - 1);
+    // Across the cell's two triangles, split along the bake's diagonal (Heightfield::surfaceHeight),
+    // as the mesh interpolates what it carries per vertex.
+    float v00 = sunHorizonAt(i), v11 = sunHorizonAt(j);
+    return f.x <= f.y ? v00 + f.y * (sunHorizonAt(ivec2(i.x, j.y)) - v00) + f.x * (v11 - sunHorizonAt(ivec2(i.x, j.y)))
+                      : v00 + f.x * (sunHorizonAt(ivec2(j.x, i.y)) - v00) + f.y * (v11 - sunHorizonAt(ivec2(j.x, i.y)));
+}
+#define TLX_HORIZON_FROM shadow.horizonFrom
+#else
+float horizonShadow(vec3 p) { return 1.0; }
+#define TLX_HORIZON_FROM shadow.cascadeCount
+#endif
 
 const int kFilterPcss = 0, kFilterPcf = 1, kFilterHard = 2;
 const int kBlockerTaps = 16, kFilterTaps = 24;
@@ -54,10 +86,7 @@ float spiralRadius(int i, int n) { return sqrt((float(i) + 0.5) / float(n)); }
 // kMaxReceiverSlope (the plane's rise per metre across the light, about 87°): a plane nearly
 // parallel to the sun gives no bound, and faces that steep are turned away or at the terminator.
 const float kMaxReceiverSlope = 20.0;
-// Depth allowed below the plane, in texels of its slope: a neighbouring triangle in a valley
-// rises above the plane through the point. ½ texel left 0.66 % acne on the committed crops at a
-// 5° sun, one texel lost more of the traced shadows (docs/lighting.md, "Shadows").
-const float kSlopeTexels = 0.75;
+// The depth allowed below the plane is shadowSlopeTexels() texels of its slope (shadow_math.glsl).
 vec2 receiverPlane(int c, vec3 ng) {
     vec3 m = inverse(transpose(mat3(shadow.lightViewProj[c]))) * ng;
     vec2 g = -2.0 * m.xy / (abs(m.z) > 1e-12 ? m.z : 1e-12);
@@ -109,7 +138,7 @@ float cascadeShadow(int c, vec3 p, vec3 ng, vec3 l, float rotation, bool partner
     if (partner && (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))))) return -1.0;
     float texelUv = 1.0 / shadow.mapResolution;
     vec2 plane = receiverPlane(c, ng);
-    float z = lc.z - kSlopeTexels * (abs(plane.x) + abs(plane.y)) * texelUv;
+    float z = lc.z - shadowSlopeTexels() * (abs(plane.x) + abs(plane.y)) * texelUv;
     float layer = float(c);
     int filterMode = camera.shadowFilter >= 0 ? camera.shadowFilter : shadow.filterMode;
     if (filterMode == kFilterHard) return litFraction(texelQuad(uv, layer, z, plane));
@@ -172,9 +201,15 @@ float sunShadow(vec3 p, vec3 n, vec3 ng) {
     // A surface facing away from the sun does not see it (as the traced visibility has it).
     if (dot(n, l) <= 0.0) return 0.0;
     float rotation = shadowNoise();
-    float lit = cascadeShadow(c, p, ng, l, rotation, false);
+    // From cascade TLX_HORIZON_FROM on the horizon map stands in for the maps; a cascade before
+    // it blends into the map over its band as into the next cascade.
+    int from = TLX_HORIZON_FROM;
+    float lit = c >= from ? horizonShadow(p) : cascadeShadow(c, p, ng, l, rotation, false);
     float t = cascadeBlendWeight(p, c);
-    float next = t <= 0.0 ? -1.0 : nextCascade(c) < 0 ? 1.0 : cascadeShadow(c + 1, p, ng, l, rotation, true);
+    float next = t <= 0.0 ? -1.0
+               : nextCascade(c) < 0 ? 1.0
+               : c + 1 >= from ? horizonShadow(p)
+               : cascadeShadow(c + 1, p, ng, l, rotation, true);
     return next >= 0.0 ? mix(lit, next, t) : lit;
 }
 

@@ -50,6 +50,7 @@ void main() {
     s.filled = inside && camera.debugView == kViewFilled ? texture(surfaceFilled, uv).r : 0.0;
     float pixelMetres = length(fwidth(worldPos));
     s.faceNormal = faceNormal(worldPos, worldNormal);
+    s.vertexNormal = normalize(worldNormal);
     float distance = length(worldPos - camera.position);
 
     float meanLength = length(normalAo.xyz);

@@ -12,6 +12,8 @@
 struct ShadingPoint {
     vec3 position, normal, albedo;
     vec3 faceNormal;   // the drawn triangle's normal: the surface the shadow maps hold
+    vec3 vertexNormal; // the mesh's normal interpolated from its vertices: which side of the
+                       // terminator the point is on, as the traced sun visibility decides it
     // rgb probe irradiance, a blend weight; in the diagnostics views instead: x share of moved
     // probes in the blend (-1 where no probe lights the point), y interpolation error × known,
     // z known (1 = measured), w 1 = inside a volume with no probe to light it; in the
@@ -168,7 +170,10 @@ vec3 viewLpvAo(ShadingPoint s) {
 vec3 shadeView(int view, ShadingPoint s) {
     // Once for every view: a CPU driver runs every branch of a switch under a mask, so the two
     // views that need the full shading share one evaluation.
-    s.shadow = sunShadow(s.position, s.normal, s.faceNormal);
+    // The terminator by the mesh's own normal, not the filtered normal map's: the shading's n·l
+    // darkens whatever faces away by the shading normal anyway, and the traced visibility this
+    // factor is measured against decides it per vertex.
+    s.shadow = sunShadow(s.position, s.vertexNormal, s.faceNormal);
     vec3 toPoint = s.position - camera.position;
     float distance = length(toPoint);
     vec3 dir = toPoint / max(distance, 1e-6);

@@ -16,6 +16,8 @@
 #include "sky.glsl"
 #include "brdf.glsl"
 #include "tonemap.glsl"
+// The water lies above the ground the horizon map describes: it keeps the maps.
+#define TLX_SHADOW_MAPS_ONLY
 #include "shadows.glsl"
 #include "fog.glsl"
 #include "reflections.glsl"

@@ -22,6 +22,7 @@
 #include "render/RenderSettings.h"
 #include "render/UniformBlocks.h"
 #include "scene/DebugViews.h"
+#include "scene/ShadowCascades.h"
 #include "vk/Buffer.h"
 #include "vk/Descriptors.h"
 #include "vk/Image.h"
@@ -129,6 +130,9 @@ struct FrameSlot {
     // when the levels change), and which levels those are.
     vk::Buffer terrainIndices;
     uint64_t terrainIndicesSerial = 0;
+    // The terrain's horizon map (TLX_SUN_HORIZON_BINDING), host-visible, and the sweep it holds.
+    vk::Buffer sunHorizon;
+    uint64_t sunHorizonSerial = 0;
     vk::DescriptorSet view, lights, shadowedLights, overlays, reflectionView;
     // The terrain pass's LPV and local-lights set: its block, the lights (grown as needed), and
     // the set, written again when the bound volumes or the lights buffer change (`lpvSetKey`).
@@ -269,7 +273,10 @@ struct Frame {
     uint32_t skirtIndexCount = 0;  // drawn after indexCount by the shadow pass alone (terrain.skirt)
     VkBuffer indexBuffer = VK_NULL_HANDLE;  // the level of detail's triangles, then its skirt's
     uint64_t lodSerial = 0;                 // which levels those are (TerrainRenderer::updateLod)
-    // The cascades' light projections this frame (empty without shadows).
+    // The cascades' depth range this frame (with shadows), and the light projections of the
+    // cascades whose maps it reads (empty without shadows): those before the horizon map's
+    // first, or all where the water reads them.
+    CascadeRange cascadeRange;
     std::vector<glm::mat4> lightMatrices;
 
     // The target.

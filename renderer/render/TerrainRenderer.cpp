@@ -11,6 +11,7 @@
 #include <glm/packing.hpp>
 #include <glm/mat4x4.hpp>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "ShaderBinaries.h"
 #include "ShaderMath.h"
@@ -33,6 +34,7 @@
 #include "render/UniformBlocks.h"
 #include "terrain/MeshLod.h"
 #include "terrain/SurfaceAlbedo.h"
+#include "terrain/HorizonAO.h"
 #include "terrain/SurfaceMaps.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
@@ -83,7 +85,8 @@ vk::DescriptorSetBuilder lightsBuilder(int variant, const FrameSlot& f, const Gp
     if (variant & kShadowedLights)
         b.uniform(blocks::ShadowBlock::kBinding, "shadow", f.shadow, frag)
             .image(TLX_SHADOW_MAP_DEPTH_BINDING, std::string(kShadowMaps) + "(depth)", maps,
-                   g.depthSampler.handle(), frag);
+                   g.depthSampler.handle(), frag)
+            .storage(TLX_SUN_HORIZON_BINDING, "sun-horizon", f.sunHorizon, frag);
     if (variant & kReflectedLights) {
         static const vk::Buffer none;
         b.uniform(blocks::ReflectionBlock::kBinding, kReflectionGrid, r ? r->blocks[slot] : none, frag)
@@ -245,6 +248,8 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         borderHeight_ = float(sum / double(std::max<size_t>(n, 1)));
     }
 
+    horizonMap_ = horizonMapOf(hf.width(), hf.depth(), hf.maxX() - hf.minX(), hf.maxZ() - hf.minZ(), kMaxSurfaceTexels);
+
     RendererGpu& g = *gpu_;
     g.vertices = vk::Buffer::deviceLocal(ctx_, vertices.data(), vertices.size() * 4,
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -263,6 +268,11 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
         f.shadow = ubo(sizeof(blocks::ShadowBlock));
         f.overlay = ubo(sizeof(blocks::OverlayBlock));
         f.lpvBlock = ubo(sizeof(blocks::LpvBlock));
+        // One byte a vertex of the horizon map, written by the host when the slot's frame begins
+        // (its previous frame done), as the uniform blocks are.
+        f.sunHorizon = vk::Buffer::hostVisible(
+            ctx_, std::max<VkDeviceSize>(4, (VkDeviceSize(horizonMap_.width) * VkDeviceSize(horizonMap_.height) + 3) / 4 * 4),
+            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
         f.lights = lightsBuilder(0, f, g, VK_NULL_HANDLE, nullptr, 0).build(ctx_);
         f.overlays = vk::DescriptorSetBuilder()
                          .uniform(blocks::OverlayBlock::kBinding, "overlay", f.overlay, VK_SHADER_STAGE_VERTEX_BIT)
@@ -671,6 +681,41 @@ void TerrainRenderer::updateSunVisibility(const SunLight& sun, bool skirt) {
     ++sunTraces_;
 }
 
+uint64_t TerrainRenderer::horizonMapBytes() const {
+    return uint64_t(horizonMap_.width) * uint64_t(horizonMap_.height) * uint64_t(kRenderSlots);
+}
+
+void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt) {
+    const glm::vec4 key(sun.direction, sun.angularRadius);
+    if (sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt)) return;
+    // Isolated: a thread waiting for its sweep's tasks may otherwise take up any task of the
+    // shared pool meanwhile, such as a chunk of the preview bake's, on the UI thread.
+    std::vector<float> perVertex;
+    tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, sun.direction, sun.angularRadius, skirt); });
+    const int w = horizonMap_.width, h = horizonMap_.height;
+    const bool whole = w == hf_.width() && h == hf_.depth();
+    if (whole) {
+        sunHorizonMap_ = perVertex;
+    } else {
+        // The nearest DEM vertex to each map vertex, both spanning the footprint corner to corner.
+        sunHorizonMap_.assign(size_t(w) * size_t(h), 1.0f);
+        for (int r = 0; r < h; ++r) {
+            const size_t row = size_t(std::lround(double(r) * (hf_.depth() - 1) / std::max(h - 1, 1)));
+            for (int c = 0; c < w; ++c) {
+                const size_t col = size_t(std::lround(double(c) * (hf_.width() - 1) / std::max(w - 1, 1)));
+                sunHorizonMap_[size_t(r) * size_t(w) + size_t(c)] = perVertex[row * size_t(hf_.width()) + col];
+            }
+        }
+    }
+    sunHorizonBytes_.assign((sunHorizonMap_.size() + 3) / 4, 0u);
+    for (size_t i = 0; i < sunHorizonMap_.size(); ++i)
+        sunHorizonBytes_[i / 4] |= uint32_t(std::lround(std::clamp(sunHorizonMap_[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
+    sunHorizonKey_ = key;
+    sunHorizonSkirt_ = int(skirt);
+    ++sunHorizonSerial_;
+    ++sunHorizonSweeps_;
+}
+
 void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water) {
     double worst = 0.0;
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
@@ -977,7 +1022,6 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     FrameSlot& slot = f.slot;
     const float extent = std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(),
                                    hf_.maxHeight() - hf_.minHeight(), 1.0f});
-    const float aspect = float(s.width) / float(s.height);
     const blocks::CameraBlock camera = features::packCamera(s, extent, f.view);
     slot.camera.write(&camera, sizeof camera);
     const float spanX = hf_.maxX() - hf_.minX(), spanZ = hf_.maxZ() - hf_.minZ();
@@ -1012,13 +1056,15 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     slot.sunSky.write(&sunSky, sizeof sunSky);
     const blocks::AtmosphereBlock atmosphere = features::packAtmosphere(s.fog);
     slot.atmosphere.write(&atmosphere, sizeof atmosphere);
-    const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
-        if (f.shadows) {
-        const CascadeRange range = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
-        cascades_ = fitCascades(range, s.camera, aspect, s.sun.direction, f.shadows->resolution, boundsMin, boundsMax);
-        for (const Cascade& c : cascades_) f.lightMatrices.push_back(c.lightViewProj);
-        const blocks::ShadowBlock block = features::packShadows(s, cascades_, range, f.shadows->resolution);
+    if (f.shadows) {
+        const bool horizon = s.shadows.heightfield && sunHorizonSerial_ > 0;
+        const blocks::ShadowBlock block = features::packShadows(s, cascades_, f.cascadeRange, f.shadows->resolution,
+                                                                horizon ? horizonMap_ : HorizonMapInfo{});
         slot.shadow.write(&block, sizeof block);
+        if (horizon && block.horizonFrom < block.cascadeCount && slot.sunHorizonSerial != sunHorizonSerial_) {
+            slot.sunHorizon.write(sunHorizonBytes_.data(), sunHorizonBytes_.size() * sizeof(uint32_t));
+            slot.sunHorizonSerial = sunHorizonSerial_;
+        }
     } else if (!s.shadows.enabled) {
         cascades_.clear();
     }
@@ -1124,6 +1170,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     if (!s.shadows.enabled) ensureShadowMaps(0, 0);
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     f.shadows = shadowed ? g.shadows.get() : nullptr;
+    if (shadowed && s.shadows.heightfield) updateSunHorizon(s.sun, s.skirt);
     // Water: the scene has it and the view draws it; the reflection and the copy of the frame
     // under it only where the view shades it, the reflection only when planar.
     f.water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
@@ -1131,8 +1178,21 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.planarReflection = f.waterShading && s.water.reflection == WaterReflection::Planar;
     if (f.water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
     f.vertexCount = uint32_t(vertexCount_);
+    // The cascades, fitted to this frame's view. The ones the horizon map stands in for are read
+    // by the water alone: without it the shadow pass leaves them undrawn, and where it draws none
+    // no caster's height error moves a shadow.
+    if (f.shadows) {
+        const float aspect = float(s.width) / float(s.height);
+        const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
+        f.cascadeRange = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
+        cascades_ = fitCascades(f.cascadeRange, s.camera, aspect, s.sun.direction, f.shadows->resolution, boundsMin, boundsMax);
+        const int drawn = f.waterShading || !(s.shadows.heightfield && sunHorizonSerial_ > 0)
+                              ? int(cascades_.size())
+                              : horizonFirstCascade(cascades_, s.sun.direction.y, horizonMap_);
+        for (int i = 0; i < drawn; ++i) f.lightMatrices.push_back(cascades_[size_t(i)].lightViewProj);
+    }
     // The level of detail's triangles, in this slot's index buffer (its last frame is done).
-    updateLod(s, view.needs.sky, shadowed, f.water);
+    updateLod(s, view.needs.sky, !f.lightMatrices.empty(), f.water);
     if (f.slot.terrainIndicesSerial != lodSerial_) {
         const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
         if (f.slot.terrainIndices.size() < bytes) {

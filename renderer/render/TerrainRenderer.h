@@ -194,6 +194,14 @@ public:
     const std::vector<Cascade>& lastCascades() const { return cascades_; }
     // How often the sun's visibility was traced at the vertices (cached per sun and surface).
     size_t sunVisibilityTraces() const { return sunTraces_; }
+    // How often the terrain's horizon toward the sun was swept for the shadows (shadows.heightfield;
+    // once per sun and surface), and the map of the last sweep: the sun's visible share at each of
+    // its vertices, row-major (horizonMapInfo's width × height).
+    size_t sunHorizonSweeps() const { return sunHorizonSweeps_; }
+    const std::vector<float>& sunHorizonMap() const { return sunHorizonMap_; }
+    HorizonMapInfo horizonMapInfo() const { return horizonMap_; }
+    // The device memory the map takes: a byte a vertex in each frame slot.
+    uint64_t horizonMapBytes() const;
 
     // How often a frame needed targets of a size neither the current nor the spare target had
     // (RendererGpu::spareTarget): a metered frame's meter and the frame itself allocate once.
@@ -236,6 +244,7 @@ private:
                                                RenderSettings& scaled);
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
+    void updateSunHorizon(const SunLight& sun, bool skirt);
     void uploadSurfaceMaps(const std::vector<float>& ao);
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
@@ -292,6 +301,15 @@ private:
     std::vector<float> meshVertices_;  // position and normal per vertex, as uploaded
     std::vector<Cascade> cascades_;
     size_t sunTraces_ = 0;
+    // The horizon map's dimensions, its last sweep (and its packed bytes, which each frame slot
+    // copies when its serial is behind), the sun and surface it was swept for.
+    HorizonMapInfo horizonMap_;
+    std::vector<float> sunHorizonMap_;
+    std::vector<uint32_t> sunHorizonBytes_;
+    glm::vec4 sunHorizonKey_{0.0f};
+    int sunHorizonSkirt_ = -1;
+    uint64_t sunHorizonSerial_ = 0;
+    size_t sunHorizonSweeps_ = 0;
     bool hasAo_ = false, hasAlbedoMap_ = false;
     int skyImageHeight_ = 0;  // texels of the bound sky image, 0 without one
     float borderHeight_ = 0.0f;        // the DEM border's mean height: the skirt's, as the sky draws it

@@ -281,6 +281,10 @@ struct ShadowSettings {
     // Share of each cascade's depth slice, at its far end, over which its shadow blends into the
     // next cascade's (0: a hard switch).
     double cascadeBlend = 0.1;
+    // Where a cascade cannot draw the shadows the DEM's relief casts at this sun
+    // (shadow_math.glsl, shadowTakesHorizon), the terrain's own shadow comes from its horizon in
+    // the sun's azimuth at every DEM vertex instead (docs/lighting.md, "Shadows").
+    bool heightfield = true;
 };
 
 // Exponential height fog (docs/lighting.md, "Height fog"): extinction

@@ -1,5 +1,7 @@
 #include "scene/ShadowCascades.h"
 
+#include "ShaderMath.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -153,6 +155,23 @@ std::vector<Cascade> fitCascades(const CascadeRange& range, const OrbitCamera& c
         a = b;
     }
     return out;
+}
+
+HorizonMapInfo horizonMapOf(int demWidth, int demDepth, float spanX, float spanZ, int maxSide) {
+    HorizonMapInfo m;
+    m.width = std::min(demWidth, maxSide);
+    m.height = std::min(demDepth, maxSide);
+    m.cell = std::max(spanX / float(std::max(m.width - 1, 1)), spanZ / float(std::max(m.height - 1, 1)));
+    return m;
+}
+
+int horizonFirstCascade(const std::vector<Cascade>& cascades, float sunElevationSin, const HorizonMapInfo& map) {
+    if (map.width <= 0) return int(cascades.size());
+    const float sinE = std::clamp(sunElevationSin, -1.0f, 1.0f);
+    const float tanE = sinE / std::max(std::sqrt(1.0f - sinE * sinE), 1e-6f);
+    for (size_t i = 0; i < cascades.size(); ++i)
+        if (glsl::shadowTakesHorizon(cascades[i].texelSize, tanE, map.cell)) return int(i);
+    return int(cascades.size());
 }
 
 }  // namespace terralux

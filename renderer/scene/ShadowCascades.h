@@ -59,4 +59,19 @@ std::vector<Cascade> fitCascades(const CascadeRange& range, const OrbitCamera& c
                                  const glm::vec3& sunDirection, int resolution,
                                  const glm::vec3& boundsMin, const glm::vec3& boundsMax);
 
+// The terrain's horizon map a frame reads (shadows.heightfield): its vertices a row and rows,
+// and the metres between them; width 0 for none.
+struct HorizonMapInfo {
+    int width = 0, height = 0;
+    float cell = 0.0f;
+};
+// The map of a terrain: every DEM vertex up to `maxSide` a side (the surface maps' 4 096), the
+// nearest of every k-th beyond, both spanning the footprint corner to corner.
+HorizonMapInfo horizonMapOf(int demWidth, int demDepth, float spanX, float spanZ, int maxSide);
+// The first of `cascades` (near to far, texels growing) whose map loses shadows longer than the
+// horizon map's cell at a sun `sunElevationSin` high (shadow_math.glsl, shadowTakesHorizon):
+// from it on the horizon map stands in for the maps. cascades.size() when none does or there is
+// no map.
+int horizonFirstCascade(const std::vector<Cascade>& cascades, float sunElevationSin, const HorizonMapInfo& map);
+
 }  // namespace terralux

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <glm/vec3.hpp>
 #include <tbb/blocked_range.h>
@@ -77,9 +79,9 @@ struct SweepDir {
     float tx = 1, tz = 0;  // the same direction in engine space
 };
 
-// Azimuth k of n, clockwise from north (−Z) toward east (+X) as everywhere in docs/lighting.md.
-SweepDir sweepDir(int k, int n, double cellX, double cellZ) {
-    const double phi = 2.0 * std::numbers::pi * k / n;
+// Azimuth phi (radians), clockwise from north (−Z) toward east (+X) as everywhere in
+// docs/lighting.md.
+SweepDir sweepDirAt(double phi, double cellX, double cellZ) {
     // Exact zeros on the axes: a rounding residue would tilt the lines off the grid rows.
     const auto snap = [](double v) { return std::fabs(v) < 1e-12 ? 0.0 : v; };
     const double tx = snap(std::sin(phi)), tz = snap(-std::cos(phi));
@@ -99,21 +101,29 @@ SweepDir sweepDir(int k, int n, double cellX, double cellZ) {
     return s;
 }
 
+// Azimuth k of n.
+SweepDir sweepDir(int k, int n, double cellX, double cellZ) {
+    return sweepDirAt(2.0 * std::numbers::pi * k / n, cellX, cellZ);
+}
+
 // Line k of a sweep crosses column u at v = k + slope·u = k + base[u] + frac[u]: splitting
 // slope·u once per column gives every line at that column the same fraction, so the vertex pass
 // interpolates between two lines with one weight per column.
+// `offset` shifts every line by that share of a cell along v: v = k + offset + slope·u.
 struct Columns {
     std::vector<int> base;
     std::vector<float> frac;
     int minBase = 0, maxBase = 0;
+    double offset = 0.0;
 };
 
-Columns columnsFor(const Frame& f, const SweepDir& s) {
+Columns columnsFor(const Frame& f, const SweepDir& s, double offset = 0.0) {
     Columns c;
+    c.offset = offset;
     c.base.resize(size_t(f.w));
     c.frac.resize(size_t(f.w));
     for (int u = 0; u < f.w; ++u) {
-        const double x = s.slope * u;
+        const double x = s.slope * u + offset;
         const double b = std::floor(x);
         c.base[size_t(u)] = int(b);
         c.frac[size_t(u)] = float(x - b);
@@ -129,22 +139,47 @@ Columns columnsFor(const Frame& f, const SweepDir& s) {
 // linear interpolation of the two vertices on that grid line (every cell edge along v is a
 // triangle edge), so the samples lie on the mesh the bake traces. The profile between two
 // crossings (its kinks at the v grid lines and the diagonals) is not sampled.
+// Upper convex hull of a profile walked in t order (Timonen and Westerholm 2010): before (t, h)
+// joins the n points kept, drop those nearer than its tangent point; they lie under the segment
+// from the tangent point to it. Returns the points left.
+int dropUnderHull(const std::vector<double>& ts, const std::vector<double>& hs, int n, double t, double h) {
+    while (n >= 2 && (hs[size_t(n - 2)] - h) * (t - ts[size_t(n - 1)]) >= (hs[size_t(n - 1)] - h) * (t - ts[size_t(n - 2)]))
+        --n;
+    return n;
+}
+
+// Appends (t, h) at index n, growing the arrays when a skirt made the profile longer than a row.
+void appendSample(std::vector<double>& ts, std::vector<double>& hs, int& n, double t, double h) {
+    if (size_t(n) >= ts.size()) {
+        ts.resize(size_t(n) + 1);
+        hs.resize(size_t(n) + 1);
+    }
+    ts[size_t(n)] = t;
+    hs[size_t(n)] = h;
+    ++n;
+}
+
+// `behind`, when set, is called at each line's first sample (frame column u, row v, distance tq
+// along the walk) to add the profile that lies beyond the grid toward the horizon (the skirt):
+// samples (t, h) in walk order, t < tq, appended to ts and hs from index n, returning the new n.
+using Behind = std::function<int(int u, double v, double tq, std::vector<double>& ts, std::vector<double>& hs, int n)>;
 void sweepHorizons(const Frame& f, const SweepDir& s, const Columns& cols, double maxDistance,
-                   float* out) {
+                   float* out, const Behind& behind = {}) {
     const int kLo = -cols.maxBase - 1, kHi = f.d - 1 - cols.minBase;
     tbb::parallel_for(tbb::blocked_range<int>(kLo, kHi + 1, 8), [&](const tbb::blocked_range<int>& r) {
         std::vector<double> ts(size_t(f.w)), hs(size_t(f.w));
         for (int k = r.begin(); k != r.end(); ++k) {
+            bool first = true;
             int n = 0;
             double lineMax = -std::numeric_limits<double>::infinity();
             // Columns where the line is inside 0 <= v <= d - 1, one wider each way for rounding
             // (the test below is exact).
             int uLo = 0, uHi = f.w - 1;
             if (s.slope != 0.0) {
-                const double ua = -k / s.slope, ub = (f.d - 1 - k) / s.slope;
+                const double ua = (-k - cols.offset) / s.slope, ub = (f.d - 1 - k - cols.offset) / s.slope;
                 uLo = std::max(uLo, int(std::floor(std::min(ua, ub))) - 1);
                 uHi = std::min(uHi, int(std::ceil(std::max(ua, ub))) + 1);
-            } else if (k < 0 || k > f.d - 1) {
+            } else if (k + cols.offset < 0.0 || k + cols.offset > f.d - 1) {
                 continue;
             }
             const int jLo = s.sigma > 0 ? f.w - 1 - uHi : uLo, jHi = s.sigma > 0 ? f.w - 1 - uLo : uHi;
@@ -157,14 +192,17 @@ void sweepHorizons(const Frame& f, const SweepDir& s, const Columns& cols, doubl
                 const double hq = g > 0.0f ? double(f.at(u, i)) + double(g) * (f.at(u, i + 1) - f.at(u, i))
                                            : double(f.at(u, i));
                 const double tq = j * s.step;
+                if (first) {
+                    first = false;
+                    if (behind) {
+                        n = behind(u, i + double(g), tq, ts, hs, 0);
+                        for (int p = 0; p < n; ++p) lineMax = std::max(lineMax, hs[size_t(p)]);
+                    }
+                }
                 float sinH = -1.0f;
                 if (maxDistance <= 0.0) {
-                    // Upper convex hull of the profile behind (Timonen and Westerholm 2010): drop
-                    // hull points nearer than the tangent point; they lie under the segment from
-                    // the tangent point to this sample, which joins the hull.
-                    while (n >= 2 && (hs[size_t(n - 2)] - hq) * (tq - ts[size_t(n - 1)]) >=
-                                         (hs[size_t(n - 1)] - hq) * (tq - ts[size_t(n - 2)]))
-                        --n;
+                    // The hull's last point after the drop is this sample's tangent point.
+                    n = dropUnderHull(ts, hs, n, tq, hq);
                     if (n >= 1) {
                         const double dh = hs[size_t(n - 1)] - hq, dt = tq - ts[size_t(n - 1)];
                         sinH = float(dh / std::sqrt(dh * dh + dt * dt));
@@ -183,9 +221,7 @@ void sweepHorizons(const Frame& f, const SweepDir& s, const Columns& cols, doubl
                     }
                     if (best > -std::numeric_limits<double>::infinity()) sinH = sinOfSlope(best);
                 }
-                ts[size_t(n)] = tq;
-                hs[size_t(n)] = hq;
-                ++n;
+                appendSample(ts, hs, n, tq, hq);
                 lineMax = std::max(lineMax, hq);
                 out[size_t(i) * size_t(f.w) + size_t(u)] = sinH;
             }
@@ -302,6 +338,113 @@ std::vector<float> horizonSkyVisibility(const Heightfield& terrain, const Horizo
                 if (anyTransposed) sum += acc[1][size_t(c) * size_t(D) + size_t(row)];
                 out[i] = std::clamp(sum * scale, 0.0f, 1.0f);
             }
+    });
+    return out;
+}
+
+float sunDiscAboveHorizon(float horizon, float elevation, float angularRadius) {
+    if (!(angularRadius > 0.0f)) return horizon < elevation ? 1.0f : 0.0f;
+    // The disc's part above a horizontal chord y radii above its centre: the circular segment's
+    // area (acos y − y·sqrt(1 − y²)) over the disc's π.
+    const double y = std::clamp((double(horizon) - elevation) / angularRadius, -1.0, 1.0);
+    return float((std::acos(y) - y * std::sqrt(1.0 - y * y)) / std::numbers::pi);
+}
+
+std::vector<float> sunHorizonVisibility(const Heightfield& terrain, const glm::vec3& toSun, float angularRadius,
+                                        bool skirt) {
+    const int W = terrain.width(), D = terrain.depth();
+    const size_t N = size_t(W) * size_t(D);
+    const double len = std::hypot(double(toSun.x), double(toSun.z));
+    const float elevation = float(std::atan2(double(toSun.y), len));
+    // The sun at the zenith: no terrain of finite slope rises to it.
+    if (len < 1e-9) return std::vector<float>(N, 1.0f);
+    const SweepDir s = sweepDirAt(std::atan2(double(toSun.x), -double(toSun.z)), terrain.cellSizeX(), terrain.cellSizeZ());
+    const std::vector<float> heightsT = s.transposed ? transposed(terrain.heights(), W, D) : std::vector<float>{};
+    const Frame f = s.transposed ? Frame{heightsT.data(), D, W, terrain.cellSizeZ(), terrain.cellSizeX()}
+                                 : Frame{terrain.heights().data(), W, D, terrain.cellSizeX(), terrain.cellSizeZ()};
+    const Columns cols = columnsFor(f, s);
+
+    Behind behind;
+    if (skirt) {
+        // Beyond the border the surface continues at the nearest border point (Heightfield.h),
+        // without end. Past `reach` no skirt point rises to the disc's lower edge from the
+        // lowest terrain; once both coordinates are clamped the skirt is level, and its nearest
+        // point bounds every farther one for a receiver below it.
+        const double lowest = double(elevation) - double(angularRadius);
+        const double relief = double(terrain.maxHeight()) - double(terrain.minHeight());
+        const double reach = lowest > 1e-4 ? relief / std::tan(lowest) + s.step : 1e7;
+        const auto heightAt = [&](double u, double v) {
+            const double cu = std::clamp(u, 0.0, double(f.w - 1)), cv = std::clamp(v, 0.0, double(f.d - 1));
+            const int iu = std::min(int(cu), f.w - 1), iv = std::min(int(cv), f.d - 1);
+            const int ju = std::min(iu + 1, f.w - 1), jv = std::min(iv + 1, f.d - 1);
+            const double gu = cu - iu, gv = cv - iv;
+            const double a = f.at(iu, iv) + gu * (f.at(ju, iv) - f.at(iu, iv));
+            const double b = f.at(iu, jv) + gu * (f.at(ju, jv) - f.at(iu, jv));
+            return a + gv * (b - a);
+        };
+        behind = [=, &f](int u, double v, double tq, std::vector<double>& ts, std::vector<double>& hs, int n) {
+            std::vector<std::pair<double, double>> profile;  // (distance beyond, height), nearest first
+            double m = 1.0;
+            while (true) {
+                const double uu = u + s.sigma * m, vv = v + s.slope * s.sigma * m;
+                const bool level = (uu < 0.0 || uu > f.w - 1) && (s.slope == 0.0 || vv < 0.0 || vv > f.d - 1);
+                const double dist = m * s.step;
+                if (dist > reach) break;
+                profile.emplace_back(dist, heightAt(uu, vv));
+                if (level) {
+                    profile.emplace_back(reach, profile.back().second);
+                    break;
+                }
+                // Every cell near the border; farther out, steps growing by 2 %: a far sample
+                // subtends little.
+                m = m < 256.0 ? m + 1.0 : m * 1.02;
+            }
+            for (auto it = profile.rbegin(); it != profile.rend(); ++it) {
+                const double t = tq - it->first, h = it->second;
+                n = dropUnderHull(ts, hs, n, t, h);
+                appendSample(ts, hs, n, t, h);
+            }
+            return n;
+        };
+    }
+    // Two sweeps, the second's lines half a cell from the first's: a vertex is at most a quarter
+    // of a cell from a line, where one sweep leaves it up to half a cell from one (a crest
+    // between two lines is what a vertex's interpolated horizon misses).
+    const Columns half = columnsFor(f, s, 0.5);
+    std::vector<float> horizon(N, -1.0f), horizonHalf(N, -1.0f);
+    sweepHorizons(f, s, cols, 0.0, horizon.data(), behind);
+    sweepHorizons(f, s, half, 0.0, horizonHalf.data(), behind);
+
+    // A vertex's horizon: the nearest line's on each side of it, of either sweep, interpolated.
+    std::vector<float> out(N);
+    tbb::parallel_for(tbb::blocked_range<int>(0, f.d, 16), [&](const tbb::blocked_range<int>& r) {
+        for (int v = r.begin(); v != r.end(); ++v) {
+            for (int u = 0; u < f.w; ++u) {
+                // Each sweep's line stored in row v lies frac above the vertex (toward v + 1),
+                // the one stored in row v − 1 lies 1 − frac below; a line past the last row is
+                // not stored, and neither is a row before the first.
+                float upD = 2.0f, upH = -1.0f, downD = 2.0f, downH = -1.0f;
+                for (int k = 0; k < 2; ++k) {
+                    const float* h = (k == 0 ? horizon : horizonHalf).data();
+                    const float g = (k == 0 ? cols : half).frac[size_t(u)];
+                    if ((v < f.d - 1 || g == 0.0f) && g < upD) {
+                        upD = g;
+                        upH = h[size_t(v) * size_t(f.w) + size_t(u)];
+                    }
+                    if (v > 0 && 1.0f - g < downD) {
+                        downD = 1.0f - g;
+                        downH = h[size_t(v - 1) * size_t(f.w) + size_t(u)];
+                    }
+                }
+                float sinH = -1.0f;
+                if (upD == 0.0f || downD > 1.5f) sinH = upD < 1.5f ? upH : -1.0f;
+                else if (upD > 1.5f) sinH = downH;
+                else sinH = (downD * upH + upD * downH) / (upD + downD);
+                const float vis = sunDiscAboveHorizon(std::asin(std::clamp(sinH, -1.0f, 1.0f)), elevation, angularRadius);
+                const size_t i = s.transposed ? size_t(u) * size_t(W) + size_t(v) : size_t(v) * size_t(W) + size_t(u);
+                out[i] = vis;
+            }
+        }
     });
     return out;
 }

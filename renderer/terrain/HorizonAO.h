@@ -14,6 +14,8 @@
 #include <functional>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "terrain/Heightfield.h"
 
 namespace terralux {
@@ -36,5 +38,17 @@ std::vector<float> horizonSkyVisibility(const Heightfield& terrain, const Horizo
 // itself; the field above uses the vertex normal and the sweep's lines. Throws
 // std::invalid_argument for a point outside the footprint or settings out of range.
 float horizonSkyVisibilityAt(const Heightfield& terrain, const HorizonAoSettings& settings, float x, float z);
+
+// The share of the sun's disc (centre `elevation`, radius `angularRadius`, radians) above a
+// horizon at elevation `horizon`: the circular segment's area over the disc's.
+float sunDiscAboveHorizon(float horizon, float elevation, float angularRadius);
+
+// The share of the sun's disc the terrain leaves visible at every vertex (row-major, width ×
+// depth): the horizon in the sun's azimuth from one line sweep (the sweep above, Timonen and
+// Westerholm 2010), the disc's part above it (sunDiscAboveHorizon). Only the terrain's occlusion:
+// a surface turned from the sun is not darkened here. `skirt`: the surface continues past the
+// border at the nearest border point, as the tracer's skirt does. toSun: unit, toward the sun.
+std::vector<float> sunHorizonVisibility(const Heightfield& terrain, const glm::vec3& toSun, float angularRadius,
+                                        bool skirt);
 
 }  // namespace terralux

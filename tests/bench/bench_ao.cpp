@@ -9,13 +9,15 @@
 //   points:   horizonSkyVisibilityAt at random points, triangle normal (Heightfield::surfaceNormal);
 //   vertices: the field of horizonSkyVisibility at random vertices, vertex normal.
 // Cost of the field is measured on the tile and on the tile upsampled 3x each way (bilinear),
-// about 12 M vertices, the size of a 1" tile.
+// about 12 M vertices, the size of a 1" tile; so is the sun's horizon map of the shadows.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <numbers>
+#include <utility>
 #include <random>
 #include <vector>
 
@@ -24,6 +26,7 @@
 #include "DemImport.h"
 #include "bake/DiffuseBake.h"
 #include "bake/HeightfieldTracer.h"
+#include "bake/Sky.h"
 #include "bake/SphereSampling.h"
 #include "terrain/HorizonAO.h"
 
@@ -144,6 +147,26 @@ int main() {
         std::printf("| %d | %.4f | %.4f | %.3f | %.4f | %.4f | %.2f | %.2f |\n", k, meanP / kPoints, maxP, perPointMs,
                     meanV / kPoints, maxV, fieldSeconds, bigSeconds);
         std::fflush(stdout);
+    }
+
+    // The sun's horizon map (shadows.heightfield): one sweep in the sun's azimuth, skirt on, as
+    // the viewport runs it when the sun moves.
+    std::printf("\n| sun elevation, azimuth | sun horizon map %.2f M vertices (ms) | %.1f M vertices (ms) |\n",
+                hf.heights().size() / 1e6, big.heights().size() / 1e6);
+    std::printf("|---|---:|---:|\n");
+    for (const auto [elevation, azimuth] : {std::pair{5.0, 135.0}, std::pair{12.0, 17.0}, std::pair{35.0, 270.0}}) {
+        const glm::vec3 sun = sunDirection(azimuth, elevation);
+        const float radius = float(0.27 * std::numbers::pi / 180.0);
+        double best = 1e9, bestBig = 1e9;
+        for (int rep = 0; rep < 3; ++rep) {
+            t0 = std::chrono::steady_clock::now();
+            (void)sunHorizonVisibility(hf, sun, radius, true);
+            best = std::min(best, seconds(t0));
+            t0 = std::chrono::steady_clock::now();
+            (void)sunHorizonVisibility(big, sun, radius, true);
+            bestBig = std::min(bestBig, seconds(t0));
+        }
+        std::printf("| %.0f°, %.0f° | %.0f | %.0f |\n", elevation, azimuth, 1e3 * best, 1e3 * bestBig);
     }
     return 0;
 }

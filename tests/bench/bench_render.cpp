@@ -104,12 +104,13 @@ BENCHMARK(BM_Frame)->Apply(views)->Unit(benchmark::kMillisecond)->Iterations(5)-
 const char* const kFilters[] = {"pcss", "pcf", "hard"};
 
 // A renderer of the same DEM at a low sun, with the given shadow settings.
-Project lowSunProject(int cascades, int resolution, int filter) {
+Project lowSunProject(int cascades, int resolution, int filter, bool heightfield) {
     Project p = fixtureProject();
     p.scene.sun.elevationDeg = 10.0;
     p.scene.shadows.cascades = cascades;
     p.scene.shadows.mapResolution = resolution;
     p.scene.shadows.filter = ShadowFilter(filter);
+    p.scene.shadows.heightfield = heightfield;
     return p;
 }
 
@@ -120,7 +121,8 @@ void BM_ShadowAgreement(benchmark::State& state) {
         return;
     }
     const int cascades = int(state.range(0)), resolution = int(state.range(1)), filter = int(state.range(2));
-    f.renderer->setProject(lowSunProject(cascades, resolution, filter));
+    const bool heightfield = state.range(3) != 0;
+    f.renderer->setProject(lowSunProject(cascades, resolution, filter, heightfield));
     ShadowAgreement a;
     RenderRequest q;
     q.width = 1280;
@@ -130,10 +132,11 @@ void BM_ShadowAgreement(benchmark::State& state) {
         a = measureShadowAgreement(*f.renderer, 1280, 720);
         // Beauty with these shadows; the camera does not move, so the maps are drawn once
         // (the first frame), as in a viewport between edits: time both.
-        f.renderer->setProject(lowSunProject(cascades, resolution, filter));
+        f.renderer->setProject(lowSunProject(cascades, resolution, filter, heightfield));
         ms += f.renderer->render(q).milliseconds;
     }
-    state.SetLabel(std::to_string(cascades) + " cascades, " + std::to_string(resolution) + "², " + kFilters[filter]);
+    state.SetLabel(std::to_string(cascades) + " cascades, " + std::to_string(resolution) + "², " + kFilters[filter] +
+                   (heightfield ? ", terrain horizon" : ", maps only"));
     state.counters["disagree_pct"] = 100.0 * a.disagreeing;
     state.counters["acne_pct"] = 100.0 * a.acne;
     state.counters["mean_abs_diff"] = a.meanAbsDifference;
@@ -141,20 +144,23 @@ void BM_ShadowAgreement(benchmark::State& state) {
     state.counters["beauty_ms"] = ms / double(state.iterations());
 }
 
+// The maps alone over cascades, sizes and filters; then the default with the terrain's horizon.
 void shadowSettings(benchmark::internal::Benchmark* b) {
     for (int cascades : {1, 2, 4})
         for (int resolution : {1024, 2048, 4096})
             for (int filter : {0, 1, 2})
                 if (filter == 0 || (cascades == 4 && resolution == 2048) || (cascades == 1 && resolution == 4096))
-                    b->Args({cascades, resolution, filter});
-    b->Args({3, 2048, 0});
+                    b->Args({cascades, resolution, filter, 0});
+    b->Args({3, 2048, 0, 0});
+    b->Args({4, 2048, 0, 1});
 }
 BENCHMARK(BM_ShadowAgreement)->Apply(shadowSettings)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 
 // Acne and agreement at low, middle and high suns (azimuth 135°) on the embedded sample and the
 // shared mountain tiles, from the default framing (far) and from a camera a third as far at 15°
 // elevation (near): the cases RenderTest.ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns holds on the
-// committed crops, at 1280 x 720 and the default shadow settings.
+// committed crops, at 1280 x 720 and the default shadow settings, and with the maps alone
+// (shadows.heightfield off).
 void BM_ShadowCases(benchmark::State& state) {
     Fixture& f = fixture();
     if (!f.ctx) {
@@ -163,11 +169,12 @@ void BM_ShadowCases(benchmark::State& state) {
     }
     const char* dems[] = {"", "N42E001.hgt", "mt_rainier_90m.tif"};
     const int dem = int(state.range(0)), sun = int(state.range(1));
-    const bool near = state.range(2) != 0;
+    const bool near = state.range(2) != 0, heightfield = state.range(3) != 0;
     const std::string path = dem == 0 ? std::string() : (std::filesystem::path(TERRALUX_SHARED_DATA) / "dem" / dems[dem]).string();
     std::vector<std::string> sets = {"bake.quality=draft", "sun.mode=\"manual\"", "sun.azimuth_deg=135",
                                      "sun.elevation_deg=" + std::to_string(sun), "camera.azimuth_deg=210"};
     if (near) sets.push_back("camera.elevation_deg=15");
+    if (!heightfield) sets.push_back("shadows.heightfield=false");
     Project p = loadEffectiveProject("", sets, path, nullptr);
     p.scene.exportSettings.outDir = (std::filesystem::temp_directory_path() / "terralux_bench_shadow_cases").string();
     ProjectRenderer r(*f.ctx, p);
@@ -177,13 +184,14 @@ void BM_ShadowCases(benchmark::State& state) {
     }
     ShadowAgreement a;
     for (auto _ : state) a = measureShadowAgreement(r, 1280, 720);
-    state.SetLabel(std::string(dem == 0 ? "sample" : dems[dem]) + ", sun " + std::to_string(sun) + "°, " + (near ? "near" : "far"));
+    state.SetLabel(std::string(dem == 0 ? "sample" : dems[dem]) + ", sun " + std::to_string(sun) + "°, " + (near ? "near" : "far") +
+                   (heightfield ? "" : ", maps only"));
     state.counters["acne_pct"] = 100.0 * a.acne;
     state.counters["disagree_pct"] = 100.0 * a.disagreeing;
     state.counters["mean_abs_diff"] = a.meanAbsDifference;
 }
 BENCHMARK(BM_ShadowCases)
-    ->ArgsProduct({{0, 1, 2}, {5, 12, 35}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2}, {5, 12, 35}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -8,6 +8,7 @@ layout(local_size_x = 64) in;
 #include "fog_math.glsl"
 #include "sh_basis.glsl"
 #include "sky_math.glsl"
+#include "shadow_math.glsl"
 
 // Per sample two vec4: a = (scene-linear light, a value in [0, 1], height above the fog's base
 // (m), Henyey–Greenstein g); b = (unit direction xyz, distance (m)).
@@ -15,7 +16,7 @@ layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Outputs { float outputs[]; };
 layout(push_constant) uniform Push { ivec4 count; } push;
 
-const int kOutputs = 19;
+const int kOutputs = 21;
 
 void main() {
     int i = int(gl_GlobalInvocationID.x);
@@ -33,4 +34,6 @@ void main() {
     outputs[o + 16] = fogSkyOpticalDepth(0.002, 0.001, a.z, b.y, b.w);
     outputs[o + 17] = equirectU(b.x, b.z, a.y);
     outputs[o + 18] = equirectV(b.y);
+    outputs[o + 19] = shadowShortestDrawn(0.01 * b.w, 2.0 * a.y);
+    outputs[o + 20] = shadowTakesHorizon(0.01 * b.w, 2.0 * a.y, 60.0) ? 1.0 : 0.0;
 }

@@ -29,6 +29,7 @@
 #include "lpv/Lpv.h"
 #include "scene/Exposure.h"
 #include "scene/DebugViews.h"
+#include "terrain/HorizonAO.h"
 #include "render/FrameGraph.h"
 #include "render/features/Antialiasing.h"
 #include "vk/Descriptors.h"
@@ -969,6 +970,47 @@ TEST_F(RenderTest, ShadowMapsAgreeWithTheTracedSunVisibilityAtTheDefaults) {
     EXPECT_EQ(r.renderer().sunVisibilityTraces(), traces + 1);
 }
 
+TEST_F(RenderTest, TheHorizonMapIsSweptOncePerSunAndIsTheSweep) {
+    // A 5° sun: every cascade of the default framing hands the terrain to the horizon map. It is
+    // swept when the sun moves, not when the camera does, and not with the setting off; the
+    // shadow view reads it at the vertices as the CPU swept it.
+    Project p = sampleProject("horizon_map", 4, 4);
+    p.scene.sun.elevationDeg = 5.0;
+    p.scene.sun.azimuthDeg = 135.0;
+    ProjectRenderer r(*ctx_, p);
+    const RenderedImage first = draw(r, kViewShadow, false, true);
+    const TerrainRenderer& t = r.renderer();
+    ASSERT_EQ(t.sunHorizonSweeps(), 1u);
+    const HorizonMapInfo info = t.horizonMapInfo();
+    ASSERT_EQ(size_t(info.width) * size_t(info.height), t.sunHorizonMap().size());
+    const Heightfield& hf = r.heightfield();
+    const std::vector<float> cpu = sunHorizonVisibility(hf, sunDirection(135.0, 5.0), float(0.27 * std::numbers::pi / 180.0), true);
+    ASSERT_EQ(cpu.size(), t.sunHorizonMap().size());
+    for (size_t i = 0; i < cpu.size(); i += 97) ASSERT_EQ(cpu[i], t.sunHorizonMap()[i]) << i;
+    size_t shaded = 0;
+    for (float v : cpu) shaded += v < 0.5f;
+    EXPECT_GT(shaded, cpu.size() / 20) << "a 5° sun shades the sample's valleys";
+    p.scene.camera.azimuthDeg += 15.0;
+    r.setProject(p);
+    draw(r, kViewShadow, false, true);
+    EXPECT_EQ(t.sunHorizonSweeps(), 1u);
+    p.scene.sun.azimuthDeg = 150.0;
+    r.setProject(p);
+    const RenderedImage moved = draw(r, kViewShadow, false, true);
+    EXPECT_EQ(t.sunHorizonSweeps(), 2u);
+    EXPECT_GT(test::compareImages(moved.rgba, first.rgba, kW, kH).meanAbs, 1e-3);
+    p.scene.shadows.heightfield = false;
+    p.scene.sun.azimuthDeg = 160.0;
+    r.setProject(p);
+    const RenderedImage mapsOnly = draw(r, kViewShadow, false, true);
+    EXPECT_EQ(t.sunHorizonSweeps(), 2u);
+    p.scene.shadows.heightfield = true;
+    r.setProject(p);
+    const RenderedImage withMap = draw(r, kViewShadow, false, true);
+    EXPECT_EQ(t.sunHorizonSweeps(), 3u);
+    EXPECT_GT(test::compareImages(mapsOnly.rgba, withMap.rgba, kW, kH).meanAbs, 1e-3) << "the setting changes the frame";
+}
+
 // Shadow maps against the traced sun at low, middle and high suns, from the default framing
 // (far) and from a camera a third as far and low over the terrain (near), where a cascade texel
 // is smallest and the low sun's slope across it steepest: acne (exactly lit pixels the maps
@@ -977,6 +1019,7 @@ struct ShadowCase {
     std::string dem;  // empty: the embedded sample
     double sunDeg;
     bool near;
+    bool heightfield = true;  // shadows.heightfield
 };
 
 ShadowAgreement shadowCase(vk::VulkanContext& ctx, const ShadowCase& c, uint32_t w, uint32_t h) {
@@ -984,6 +1027,7 @@ ShadowAgreement shadowCase(vk::VulkanContext& ctx, const ShadowCase& c, uint32_t
                                      "sun.azimuth_deg=135", "sun.elevation_deg=" + std::to_string(c.sunDeg),
                                      "camera.azimuth_deg=210"};
     if (c.near) sets.push_back("camera.elevation_deg=15");
+    if (!c.heightfield) sets.push_back("shadows.heightfield=false");
     Project p = loadEffectiveProject("", sets, c.dem, nullptr);
     p.scene.exportSettings.outDir = (kOut / "bake_shadow_cases").string();
     ProjectRenderer r(ctx, p);
@@ -997,28 +1041,65 @@ ShadowAgreement shadowCase(vk::VulkanContext& ctx, const ShadowCase& c, uint32_t
 
 std::string describe(const ShadowCase& c) {
     return (c.dem.empty() ? std::string("sample") : fs::path(c.dem).filename().string()) + " sun " +
-           std::to_string(int(c.sunDeg)) + "° " + (c.near ? "near" : "far");
+           std::to_string(int(c.sunDeg)) + "° " + (c.near ? "near" : "far") + (c.heightfield ? "" : ", maps only");
+}
+
+std::string describe(const ShadowCase& c, const ShadowAgreement& a) {
+    return describe(c) + ": acne " + std::to_string(100.0 * a.acne) + " % of " + std::to_string(a.tracedLitPixels) +
+           " lit pixels, disagreeing " + std::to_string(100.0 * a.disagreeing) + " %, mean |difference| " +
+           std::to_string(a.meanAbsDifference);
 }
 
 TEST_F(RenderTest, ShadowMapsHaveNoAcneAtLowMiddleAndHighSuns) {
     // Before the receiver plane, 5 to 17 % of the exactly lit pixels were acne in every case, and
-    // without the skirt in the maps up to 13 % of the pixels disagreed at a 5° sun, far.
+    // without the skirt in the maps up to 13 % of the pixels disagreed at a 5° sun, far. The
+    // terminator is the mesh's (the normal map's filtered normal left 2 % acne at 480 × 270).
     const fs::path dems = fs::path(TERRALUX_SOURCE_DIR) / "tests" / "data" / "dem";
     for (const std::string& dem : {std::string(), (dems / "n42e001_voids_crop.tif").string(), (dems / "rainier_crop.tif").string()})
         for (double sun : {5.0, 12.0, 35.0})
             for (bool near : {false, true}) {
                 const ShadowCase c{dem, sun, near};
                 const ShadowAgreement a = shadowCase(*ctx_, c, 480, 270);
-                const std::string what = describe(c) + ": acne " + std::to_string(100.0 * a.acne) + " % of " +
-                                         std::to_string(a.tracedLitPixels) + " lit pixels, disagreeing " +
-                                         std::to_string(100.0 * a.disagreeing) + " %, mean |difference| " +
-                                         std::to_string(a.meanAbsDifference);
+                const std::string what = describe(c, a);
                 std::cout << what << "\n";
                 EXPECT_GT(a.tracedLitPixels, 480u * 270u / 50) << what;
                 EXPECT_LE(a.acne, 0.005) << what;
-                EXPECT_LE(a.disagreeing, 0.035) << what;
-                EXPECT_LE(a.meanAbsDifference, 0.06) << what;
+                // The crops, 80 cells filling the view, draw a DEM cell over several pixels: the
+                // near cascades' maps draw edges within a cell that the traced visibility,
+                // interpolated between vertices, cannot (up to 2.9 % apart, measured).
+                EXPECT_LE(a.disagreeing, dem.empty() ? 0.02 : 0.03) << what;
+                EXPECT_LE(a.meanAbsDifference, 0.055) << what;
             }
+}
+
+TEST_F(RenderTest, WholeMountainTilesAgreeWithTheTracedSunAtLowSuns) {
+    // A whole 80 km tile from the default framing: a cascade texel (about 40 m) loses the shadows
+    // shorter than 0.75 texel / tan(sun) on the ground, several DEM cells at a low sun, and with
+    // the maps alone 10 % of the pixels disagreed with the traced sun at 5° and 12°. The terrain's
+    // horizon map stands in for those cascades. Needs the shared DEMs; skips without them.
+    const fs::path dems = fs::path(TERRALUX_SHARED_DATA) / "dem";
+    size_t cases = 0;
+    for (const char* name : {"N42E001.hgt", "mt_rainier_90m.tif"}) {
+        const fs::path dem = dems / name;
+        if (!fs::exists(dem)) continue;
+        for (double sun : {5.0, 12.0, 35.0})
+            for (bool near : {false, true}) {
+                const ShadowCase c{dem.string(), sun, near};
+                const ShadowAgreement a = shadowCase(*ctx_, c, 480, 270);
+                const std::string what = describe(c, a);
+                std::cout << what << "\n";
+                EXPECT_LE(a.acne, 0.005) << what;
+                EXPECT_LE(a.disagreeing, 0.02) << what;
+                EXPECT_LE(a.meanAbsDifference, 0.03) << what;
+                ++cases;
+            }
+        // The setting does what it says: the maps alone miss the low relief's shadows.
+        const ShadowCase mapsOnly{dem.string(), 5.0, false, false};
+        const ShadowAgreement a = shadowCase(*ctx_, mapsOnly, 480, 270);
+        std::cout << describe(mapsOnly, a) << "\n";
+        EXPECT_GT(a.disagreeing, 0.05) << describe(mapsOnly, a);
+    }
+    if (cases == 0) GTEST_SKIP() << "the shared DEMs are not installed beside the repository";
 }
 
 TEST_F(RenderTest, TheSkirtShadowsTheBorderAtALowSunAndGoesWithIt) {

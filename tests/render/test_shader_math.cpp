@@ -32,7 +32,7 @@ using namespace terralux;
 
 namespace {
 
-constexpr int kOutputs = 19;
+constexpr int kOutputs = 21;
 
 struct Sample {
     glm::vec4 a, b;
@@ -70,12 +70,16 @@ std::array<float, kOutputs> onCpu(const Sample& s) {
     o[16] = glsl::fogSkyOpticalDepth(0.002f, 0.001f, s.a.z, s.b.y, s.b.w);
     o[17] = glsl::equirectU(s.b.x, s.b.z, s.a.y);
     o[18] = glsl::equirectV(s.b.y);
+    // A cascade texel of 0..200 m, a sun 0..63° high (tan 0..2), DEM cells of 60 m.
+    o[19] = glsl::shadowShortestDrawn(0.01f * s.b.w, 2.0f * s.a.y);
+    o[20] = glsl::shadowTakesHorizon(0.01f * s.b.w, 2.0f * s.a.y, 60.0f) ? 1.0f : 0.0f;
     return o;
 }
 
 const char* kNames[kOutputs] = {"acesFit", "srgbEncode", "srgbDecode", "acesFitInverse", "Y0", "Y1", "Y2",
                                 "Y3", "Y4", "Y5", "Y6", "Y7", "Y8", "fogOpticalDepth", "henyeyGreenstein",
-                                "display", "fogSkyOpticalDepth", "equirectU", "equirectV"};
+                                "display", "fogSkyOpticalDepth", "equirectU", "equirectV",
+                                "shadowShortestDrawn", "shadowTakesHorizon"};
 
 // A device with validation, or none (the test skips).
 std::unique_ptr<vk::VulkanContext> device(std::string& why) {
@@ -137,9 +141,10 @@ TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
     // (the SH basis's old 0.282095 was 7.4e-7 off). Vulkan lets pow be a few ulps off IEEE
     // (2e-6) and exp's error grows with its argument, up to 80 in the fog's optical depth (5e-5).
     // atan and acos may be 4096 ulps off (2.4e-4 relative); lavapipe's acos is 1.2e-4 off near
-    // the zenith, a fortieth of a texel of a 2k sky (5e-4).
+    // the zenith, a fortieth of a texel of a 2k sky (5e-4). A division may be 2.5 ulps off (1e-6).
     const double bound[kOutputs] = {2.5e-7, 2e-6, 2e-6, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7,
-                                    2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6, 5e-5, 5e-4, 5e-4};
+                                    2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6, 5e-5, 5e-4, 5e-4,
+                                    1e-6, 1e-6};
     for (int f = 0; f < kOutputs; ++f) {
         double worst = 0.0;
         for (size_t i = 0; i < in.size(); ++i) {

@@ -178,6 +178,42 @@ TEST(LightingExtension, ComputedSplitsAreTheProjectCamerasCascades) {
     }
 }
 
+TEST(LightingExtension, TheHorizonMapsCascadeFollowsTheSunAndTheRule) {
+    // The first cascade handing the terrain's shadow to the horizon map: the exported index is
+    // the rule applied to the project camera's cascades, earlier as the sun sinks, and absent
+    // with the setting off.
+    const Heightfield hf = makeTerrain();
+    const glm::vec3 lo(hf.minX(), hf.minHeight(), hf.minZ()), hi(hf.maxX(), hf.maxHeight(), hf.maxZ());
+    int previous = -1;
+    for (const double elevation : {80.0, 35.0, 12.0, 5.0, 1.0}) {
+        const Project p = projectWith({"sun.elevation_deg=" + json(elevation).dump()});
+        const json shadows = lightingExtension(p, hf)["shadows"];
+        ASSERT_TRUE(shadows.contains("computed_heightfield_from_cascade")) << elevation;
+        const int from = shadows["computed_heightfield_from_cascade"].get<int>();
+        const glm::vec3 sun = sunDirection(p.scene.sun.azimuthDeg, elevation);
+        const CascadeRange range =
+            cascadeRange(p.scene.shadows, OrbitCamera::fromSettings(p.scene.camera, hf), 16.0f / 9.0f, lo, hi);
+        const std::vector<Cascade> cascades = fitCascades(range, OrbitCamera::fromSettings(p.scene.camera, hf),
+                                                          16.0f / 9.0f, sun, p.scene.shadows.mapResolution, lo, hi);
+        const float cell = std::max((hf.maxX() - hf.minX()) / float(hf.width() - 1), (hf.maxZ() - hf.minZ()) / float(hf.depth() - 1));
+        EXPECT_EQ(shadows["computed_heightfield_cell"].get<double>(), double(cell)) << elevation;
+        int expected = int(cascades.size());
+        const double tanE = std::tan(elevation * std::numbers::pi / 180.0);
+        for (size_t i = 0; i < cascades.size(); ++i)
+            if (0.75 * cascades[i].texelSize / tanE > cell) {
+                expected = int(i);
+                break;
+            }
+        EXPECT_EQ(from, expected) << elevation;
+        if (previous >= 0) EXPECT_LE(from, previous) << elevation;
+        previous = from;
+    }
+    EXPECT_LT(previous, 4) << "at a 1° sun some cascade hands over";
+    const json off = lightingExtension(projectWith({"shadows.heightfield=false"}), hf)["shadows"];
+    EXPECT_FALSE(off.contains("computed_heightfield_from_cascade"));
+    EXPECT_EQ(off["heightfield"], false);
+}
+
 TEST(LightingExtension, FogResolvesItsAutoValues) {
     const Heightfield hf = makeTerrain();
     json fog = lightingExtension(projectWith(kEdits), hf)["fog"];

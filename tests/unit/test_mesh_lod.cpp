@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <numbers>
 #include <utility>
@@ -17,6 +16,7 @@
 #include <glm/vec2.hpp>
 
 #include "DemImport.h"
+#include "MountainDems.h"
 #include "terrain/MeshLod.h"
 
 using namespace terralux;
@@ -236,18 +236,13 @@ TEST(MeshLod, EachPatchTakesTheCoarsestLevelWithinAPixel) {
 // are found under the whole mesh's triangles, not patch by patch as surfaceErrors finds them.
 TEST(MeshLod, EveryVertexOfAMountainIsWithinTheReportedPixels) {
     const double fov = 45.0 * std::numbers::pi / 180.0, rows = 1080.0;
-    namespace fs = std::filesystem;
     size_t ringsPast = 0, madeFiner = 0;
     // The committed crops in 16-cell patches, and the whole N42E001 tile in the renderer's 32 when
     // the shared data is there.
-    for (const char* name : {"rainier_crop.tif", "n42e001_voids_crop.tif", "bigtujunga_utm11_crop.tif", "N42E001.hgt"}) {
-        const bool shared = std::string(name) == "N42E001.hgt";
-        const fs::path file = (shared ? fs::path(TERRALUX_SHARED_DATA) : fs::path(TERRALUX_TEST_DATA)) / "dem" / name;
-        if (!fs::exists(file)) {
-            std::printf("%s is absent (shared data not installed)\n", file.string().c_str());
-            continue;
-        }
-        const DemImportResult dem = importDem(file.string());
+    for (const test::MountainDem& mountain : test::mountainDems()) {
+        const bool shared = mountain.shared;
+        const std::string name = mountain.file.filename().string();
+        const DemImportResult dem = importDem(mountain.file.string());
         const Heightfield& hf = dem.heightfield;
         // The whole grid, and every third row and column as the renderer draws a DEM past its
         // vertex budget (the last step shorter where the side is not 3k + 1).
@@ -333,7 +328,7 @@ TEST(MeshLod, EveryVertexOfAMountainIsWithinTheReportedPixels) {
                                          lod::screenPixels(reported[k], lod::distanceToBox(eye, p.lo[k], p.hi[k]), fov, rows));
             }
             std::printf("%s stride %u eye (%.0f, %.0f, %.0f) at %.0f px: measured %.3f px, reported %.3f px, %zu rings above their level, %zu patches finer\n",
-                        name, stride, eye.x, eye.y, eye.z, allowed, worstMeasured, worstReported, zipped, finer);
+                        name.c_str(), stride, eye.x, eye.y, eye.z, allowed, worstMeasured, worstReported, zipped, finer);
             EXPECT_LE(worstMeasured, worstReported + 1e-9) << name;
             EXPECT_LE(worstReported, allowed) << name;
             ringsPast += zipped;

@@ -22,9 +22,10 @@ struct ShadowResources {
 namespace features {
 
 // The sun's cascades as fitted for this frame, with `range`'s near distance and the map
-// resolution.
+// resolution; from the first cascade that loses shadows longer than the horizon map's cell
+// (shadowTakesHorizon), the horizon map, where there is one.
 blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Cascade>& cascades,
-                                const CascadeRange& range, int resolution);
+                                const CascadeRange& range, int resolution, const HorizonMapInfo& horizon);
 // `cascades` depth maps of `resolution`² texels, one layer each, with a framebuffer per layer.
 std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const RendererGpu& g, int resolution,
                                                  int cascades);
