@@ -9,12 +9,16 @@
 #include <memory>
 #include <vector>
 
+#include "scene/DynamicResolution.h"
+
 namespace terralux {
 
-// Besides the size drawn now: the meter, one dynamic-resolution step and the full frame, with a
-// step to spare. The spares are at most the size drawn when the window is largest, and most are
-// a quarter of it or less.
-inline constexpr size_t kSpareTargets = 3;
+// Besides the size drawn now, one for every other size the viewport draws one view at: each rung
+// of the dynamic-resolution ladder (DynamicResolution::kScales) and the meter. With three, a
+// metered sun edit that stepped over two rungs pushed a target out and waited for the device to
+// replace it (80-120 ms on the UI thread on lavapipe). The rungs halve the pixels, so all of them
+// together are less than twice the full frame.
+inline constexpr size_t kSpareTargets = DynamicResolution::kScales.size();
 
 template <class Target>
 using SpareTargets = std::vector<std::unique_ptr<Target>>;  // the least recently drawn first
@@ -33,7 +37,7 @@ bool takeSpare(std::unique_ptr<Target>& current, SpareTargets<Target>& spares, S
 }
 
 // Puts `fresh` in place of the current target, which becomes a spare; the least recently drawn
-// spares past kSpareTargets are released. The caller waits for the device first.
+// spares past kSpareTargets are released: where one is, the caller waits for the device first.
 template <class Target>
 void replaceTarget(std::unique_ptr<Target>& current, SpareTargets<Target>& spares, std::unique_ptr<Target> fresh) {
     if (current) spares.push_back(std::move(current));

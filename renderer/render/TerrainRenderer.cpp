@@ -849,9 +849,15 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
         importTarget(g.graph, *g.target);
         return;
     }
-    ctx_.waitIdle();  // frames in flight may still draw into the targets
-    readOffscreen();  // before its target may go
-    for (const char* name : kTargetNames) g.graph.forget(name);
+    // A size not drawn lately. Only when the spares are full does a target go, and frames in
+    // flight may still draw into it: then wait. A new one beside them waits for nothing: the
+    // graph has parked the current target's state and starts the new images afresh.
+    const bool evicts = g.spareTargets.size() + (g.target ? 1 : 0) > kSpareTargets;
+    if (evicts) {
+        ctx_.waitIdle();
+        readOffscreen();  // before its target may go
+        for (const char* name : kTargetNames) g.graph.forget(name);
+    }
     ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
     const uint32_t samples = plan.samples;
@@ -878,11 +884,13 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     if (plan.pass) features::buildAntialiasingTarget(ctx_, g, *t);
     if (plan.resolve) features::buildResolveTarget(ctx_, *t);
     replaceTarget(g.target, g.spareTargets, std::move(t));
-    // The spares' handles start afresh too (the graph forgot them; nothing is in flight now).
-    for (const auto& spare : g.spareTargets) {
-        importTarget(g.graph, *spare);
-        for (const char* name : kTargetNames) g.graph.park(name);
-    }
+    // After a wait the spares' handles start afresh too (the graph forgot them; nothing is in
+    // flight now).
+    if (evicts)
+        for (const auto& spare : g.spareTargets) {
+            importTarget(g.graph, *spare);
+            for (const char* name : kTargetNames) g.graph.park(name);
+        }
     importTarget(g.graph, *g.target);
 }
 
