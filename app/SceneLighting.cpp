@@ -18,8 +18,8 @@
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
 #include "scene/ShadowCascades.h"
-#include "terrain/SurfaceMaps.h"
 #include "scene/SolarPosition.h"
+#include "terrain/SurfaceMaps.h"
 #include "water/Water.h"
 
 namespace terralux {

@@ -277,6 +277,7 @@ struct Frame {
     // cascades whose maps it reads (empty without shadows): those before the horizon map's
     // first, or all where the water reads them.
     CascadeRange cascadeRange;
+    int horizonFrom = 0;  // the first cascade the horizon map stands in for (the count: none)
     std::vector<glm::mat4> lightMatrices;
 
     // The target.

@@ -32,9 +32,9 @@
 #include "render/features/Water.h"
 #include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
+#include "terrain/HorizonAO.h"
 #include "terrain/MeshLod.h"
 #include "terrain/SurfaceAlbedo.h"
-#include "terrain/HorizonAO.h"
 #include "terrain/SurfaceMaps.h"
 #include "vk/Buffer.h"
 #include "vk/ComputePipeline.h"
@@ -695,7 +695,7 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt) {
     const int w = horizonMap_.width, h = horizonMap_.height;
     const bool whole = w == hf_.width() && h == hf_.depth();
     if (whole) {
-        sunHorizonMap_ = perVertex;
+        sunHorizonMap_ = std::move(perVertex);
     } else {
         // The nearest DEM vertex to each map vertex, both spanning the footprint corner to corner.
         sunHorizonMap_.assign(size_t(w) * size_t(h), 1.0f);
@@ -1065,11 +1065,11 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     const blocks::AtmosphereBlock atmosphere = features::packAtmosphere(s.fog);
     slot.atmosphere.write(&atmosphere, sizeof atmosphere);
     if (f.shadows) {
-        const bool horizon = s.shadows.heightfield && sunHorizonSerial_ > 0;
+        const bool horizon = f.horizonFrom < int(cascades_.size());
         const blocks::ShadowBlock block = features::packShadows(s, cascades_, f.cascadeRange, f.shadows->resolution,
-                                                                horizon ? horizonMap_ : HorizonMapInfo{});
+                                                                f.horizonFrom, horizon ? horizonMap_ : HorizonMapInfo{});
         slot.shadow.write(&block, sizeof block);
-        if (horizon && block.horizonFrom < block.cascadeCount && slot.sunHorizonSerial != sunHorizonSerial_) {
+        if (horizon && slot.sunHorizonSerial != sunHorizonSerial_) {
             slot.sunHorizon.write(sunHorizonBytes_.data(), sunHorizonBytes_.size() * sizeof(uint32_t));
             slot.sunHorizonSerial = sunHorizonSerial_;
         }
@@ -1194,9 +1194,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         const glm::vec3 boundsMin(hf_.minX(), hf_.minHeight(), hf_.minZ()), boundsMax(hf_.maxX(), hf_.maxHeight(), hf_.maxZ());
         f.cascadeRange = cascadeRange(s.shadows, s.camera, aspect, boundsMin, boundsMax);
         cascades_ = fitCascades(f.cascadeRange, s.camera, aspect, s.sun.direction, f.shadows->resolution, boundsMin, boundsMax);
-        const int drawn = f.waterShading || !(s.shadows.heightfield && sunHorizonSerial_ > 0)
-                              ? int(cascades_.size())
-                              : horizonFirstCascade(cascades_, s.sun.direction.y, horizonMap_);
+        f.horizonFrom = s.shadows.heightfield ? horizonFirstCascade(cascades_, s.sun.direction.y, horizonMap_)
+                                              : int(cascades_.size());
+        const int drawn = f.waterShading ? int(cascades_.size()) : f.horizonFrom;
         for (int i = 0; i < drawn; ++i) f.lightMatrices.push_back(cascades_[size_t(i)].lightViewProj);
     }
     // The level of detail's triangles, in this slot's index buffer (its last frame is done).

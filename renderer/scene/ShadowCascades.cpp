@@ -1,7 +1,5 @@
 #include "scene/ShadowCascades.h"
 
-#include "ShaderMath.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -9,6 +7,8 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
+
+#include "ShaderMath.h"
 
 namespace terralux {
 

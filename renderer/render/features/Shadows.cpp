@@ -12,7 +12,8 @@ namespace terralux::features {
 using namespace frame;
 
 blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Cascade>& cascades,
-                                const CascadeRange& range, int resolution, const HorizonMapInfo& horizon) {
+                                const CascadeRange& range, int resolution, int horizonFrom,
+                                const HorizonMapInfo& horizon) {
     blocks::ShadowBlock block;
     for (size_t i = 0; i < cascades.size(); ++i) {
         block.lightViewProj[i] = cascades[i].lightViewProj;
@@ -30,12 +31,9 @@ blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Casca
     block.filterMode = int(s.shadows.filter);
     block.cascadeBlend = float(s.shadows.cascadeBlend);
     block.fadeOut = range.fadesOut ? 1.0f : 0.0f;
-    block.horizonFrom = block.cascadeCount;
-    if (s.shadows.heightfield && horizon.width > 0) {
-        block.horizonFrom = horizonFirstCascade(cascades, s.sun.direction.y, horizon);
-        block.horizonWidth = horizon.width;
-        block.horizonHeight = horizon.height;
-    }
+    block.horizonFrom = horizonFrom;
+    block.horizonWidth = horizon.width;
+    block.horizonHeight = horizon.height;
     return block;
 }
 

@@ -22,10 +22,11 @@ struct ShadowResources {
 namespace features {
 
 // The sun's cascades as fitted for this frame, with `range`'s near distance and the map
-// resolution; from the first cascade that loses shadows longer than the horizon map's cell
-// (shadowTakesHorizon), the horizon map, where there is one.
+// resolution; from cascade `horizonFrom` on (horizonFirstCascade; cascades.size() for none), the
+// horizon map `horizon`.
 blocks::ShadowBlock packShadows(const RenderSettings& s, const std::vector<Cascade>& cascades,
-                                const CascadeRange& range, int resolution, const HorizonMapInfo& horizon);
+                                const CascadeRange& range, int resolution, int horizonFrom,
+                                const HorizonMapInfo& horizon);
 // `cascades` depth maps of `resolution`² texels, one layer each, with a framebuffer per layer.
 std::unique_ptr<ShadowResources> buildShadowMaps(vk::VulkanContext& ctx, const RendererGpu& g, int resolution,
                                                  int cascades);
