@@ -1,6 +1,7 @@
 #include "terrain/Heightfield.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 
@@ -8,9 +9,14 @@
 
 namespace terralux {
 
+uint64_t Heightfield::nextSerial() {
+    static std::atomic<uint64_t> last{0};
+    return ++last;
+}
+
 Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSizeZ,
                          std::vector<float> heights)
-    : width_(width), depth_(depth), cellSizeX_(cellSizeX), cellSizeZ_(cellSizeZ),
+    : serial_(nextSerial()), width_(width), depth_(depth), cellSizeX_(cellSizeX), cellSizeZ_(cellSizeZ),
       originCol_(0.5 * (width - 1)), originRow_(0.5 * (depth - 1)), heights_(std::move(heights)) {
     if (width < 1 || depth < 1)
         throw std::invalid_argument("heightfield: size " + std::to_string(width) + "x" +
@@ -97,6 +103,7 @@ Heightfield Heightfield::window(int col0, int row0, int width, int depth) const 
     w.originCol_ = originCol_ - col0;
     w.originRow_ = originRow_ - row0;
     if (std::find(mask.begin(), mask.end(), uint8_t(1)) != mask.end()) w.nodataMask_ = std::move(mask);
+    w.serial_ = nextSerial();
     w.geo = geo;
     return w;
 }
@@ -105,6 +112,7 @@ void Heightfield::setNodataMask(std::vector<uint8_t> mask) {
     if (!mask.empty() && mask.size() != heights_.size())
         throw std::invalid_argument("heightfield: nodata mask size does not match the grid");
     nodataMask_ = std::move(mask);
+    serial_ = nextSerial();
 }
 
 size_t Heightfield::nodataCount() const {

@@ -71,6 +71,7 @@ public:
     void placeInGrid(int wholeWidth, int wholeDepth, int col0, int row0) {
         originCol_ = 0.5 * (wholeWidth - 1) - col0;
         originRow_ = 0.5 * (wholeDepth - 1) - row0;
+        serial_ = nextSerial();
     }
     glm::vec3 vertex(int col, int row) const { return {xOf(col), at(col, row), zOf(row)}; }
 
@@ -98,9 +99,17 @@ public:
     void setNodataMask(std::vector<uint8_t> mask);
     size_t nodataCount() const;
 
+    // Names what this grid holds: its samples, cell sizes, placement in engine space and nodata
+    // marks. A copy keeps it; building a grid, or changing its placement or marks, takes a new
+    // one. What is derived from the grid alone (the water's auto level, a placement shown in a
+    // dock) may be kept under it instead of computed again on every edit of the project.
+    uint64_t serial() const { return serial_; }
+
     GeoOrigin geo;
 
 private:
+    static uint64_t nextSerial();
+    uint64_t serial_ = 0;  // 0: the empty grid
     int width_ = 0;
     int depth_ = 0;
     double cellSizeX_ = 1.0;

@@ -53,3 +53,25 @@ TEST(Heightfield, RejectsBadInput) {
     EXPECT_THROW(Heightfield(2, 1, 1.0, 1.0, {1.f}), std::invalid_argument);
     EXPECT_THROW(Heightfield(1, 1, 1.0, 1.0, {NAN}), std::invalid_argument);
 }
+
+// What is derived from a grid alone is kept under its serial (DerivedCache): a copy holds the same
+// samples and keeps it; a new grid, a window, a new placement or new nodata marks take a new one,
+// so nothing kept for one grid is ever read for another, even one built where it lay in memory.
+TEST(Heightfield, ASerialNamesWhatTheGridHolds) {
+    Heightfield a(3, 2, 10.0, 10.0, {1.f, 2.f, 3.f, 4.f, 5.f, 6.f});
+    EXPECT_EQ(Heightfield().serial(), 0u);
+    EXPECT_NE(a.serial(), 0u);
+    const Heightfield copy = a;
+    EXPECT_EQ(copy.serial(), a.serial());
+    const Heightfield same(3, 2, 10.0, 10.0, {1.f, 2.f, 3.f, 4.f, 5.f, 6.f});
+    EXPECT_NE(same.serial(), a.serial());  // built again: not known to hold the same
+    const Heightfield w = a.window(1, 0, 2, 2);
+    EXPECT_NE(w.serial(), a.serial());
+    uint64_t before = a.serial();
+    a.placeInGrid(5, 4, 1, 1);
+    EXPECT_NE(a.serial(), before);
+    before = a.serial();
+    a.setNodataMask({0, 1, 0, 0, 0, 0});
+    EXPECT_NE(a.serial(), before);
+    EXPECT_EQ(copy.serial(), Heightfield(copy).serial());
+}

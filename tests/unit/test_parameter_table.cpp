@@ -1,5 +1,6 @@
 // The parameter table drives the project reader and writer, --set, the schema and the docs:
 // these tests hold every row to its own declaration.
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -9,6 +10,7 @@
 #include "ParameterTable.h"
 #include "Project.h"
 #include "ProjectErrors.h"
+#include "bake/ProbePlacement.h"
 
 using namespace terralux;
 using nlohmann::json;
@@ -370,4 +372,45 @@ TEST(ParameterTable, LightsAreAListOfObjectsWithTheSpotRules) {
     EXPECT_EQ(test::projectErrorFor("lights[0].outer_cone_deg", 5, written), "");
     EXPECT_EQ(test::projectErrorFor("lights", json::parse(R"([{"typ": "spot"}])"), defaultProjectJson()),
               "p.json: unknown key 'lights[0].typ' (did you mean 'lights[].type'?)");
+}
+
+// The values a dock shows for an "auto" origin and spacing are the grid as placed now: the
+// placement kept between edits follows an edit of the volume, and each terrain keeps its own.
+TEST(ParameterTable, AutoValuesFollowTheVolumeAndTheTerrain) {
+    const ParameterSpec* origin = findParameter("probe_volumes[].origin");
+    const ParameterSpec* spacing = findParameter("probe_volumes[].spacing");
+    ASSERT_TRUE(origin && origin->resolved && spacing && spacing->resolved);
+    auto ramp = [](int n, double cell, float slope) {
+        std::vector<float> h(size_t(n) * n);
+        for (size_t i = 0; i < h.size(); ++i) h[i] = slope * float(i % size_t(n));
+        return Heightfield(n, n, cell, cell, std::move(h));
+    };
+    SceneDescription s;
+    auto placed = [&](const Heightfield& hf) {
+        const ProbeLayout l = placeProbes(s.probeVolumes.at(0), hf);
+        return std::array<float, 4>{l.positions.at(0).x, l.positions.at(0).z, l.spacing.x, l.spacing.z};
+    };
+    const Heightfield a = ramp(65, 10.0, 0.5f), b = ramp(65, 30.0, 2.0f);
+    for (int pass = 0; pass < 2; ++pass) {
+        for (int n : {8, 16, 8}) {
+            s.probeVolumes.at(0).gridDims = {n, 1, n};
+            for (const Heightfield* hf : {&a, &b}) {
+                const json o = origin->resolved(s, *hf, 0), d = spacing->resolved(s, *hf, 0);
+                const std::array<float, 4> p = placed(*hf);
+                ASSERT_EQ(o.size(), 2u);
+                ASSERT_EQ(d.size(), 2u);
+                EXPECT_FLOAT_EQ(o[0].get<float>(), p[0]) << n;
+                EXPECT_FLOAT_EQ(o[1].get<float>(), p[1]) << n;
+                EXPECT_FLOAT_EQ(d[0].get<float>(), p[2]) << n;
+                EXPECT_FLOAT_EQ(d[1].get<float>(), p[3]) << n;
+            }
+        }
+    }
+    // The two terrains and the two grids place differently, so a value kept for the wrong one
+    // would show.
+    s.probeVolumes.at(0).gridDims = {8, 1, 8};
+    EXPECT_NE(origin->resolved(s, a, 0), origin->resolved(s, b, 0));
+    const json coarse = spacing->resolved(s, a, 0);
+    s.probeVolumes.at(0).gridDims = {16, 1, 16};
+    EXPECT_NE(spacing->resolved(s, a, 0), coarse);
 }

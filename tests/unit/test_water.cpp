@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <random>
 
@@ -308,6 +309,25 @@ TEST(WaterShore, OneIslandAndTheEdgeCases) {
     EXPECT_EQ(shoreDistance(row, 0.0), (std::vector<float>{0.0f, 2.0f, 4.0f, 6.0f, 8.0f}));
     const Heightfield column(1, 4, 2.0, 5.0, {-1.0f, -1.0f, -1.0f, 1.0f});
     EXPECT_EQ(shoreDistance(column, 0.0), (std::vector<float>{15.0f, 10.0f, 5.0f, 0.0f}));
+}
+
+// The auto level is kept under the grid's serial: asked again it is the same, and a grid of the
+// same size built where the last one lay in memory gets its own level, not the one kept.
+TEST(WaterLevel, TheAutoLevelKeptIsTheGridsOwn) {
+    const int w = 40, d = 30;
+    auto floodedTo = [&](float level) {
+        std::vector<float> h(size_t(w) * d);
+        for (int z = 0; z < d; ++z)
+            for (int x = 0; x < w; ++x)
+                h[size_t(z) * w + size_t(x)] = std::max(float(0.03 * (x - 20) * (x - 20) + 0.5 * z + 400.0), level);
+        return h;
+    };
+    for (float level : {408.0f, 411.0f, 408.0f}) {
+        const auto hf = std::make_unique<Heightfield>(w, d, 30.0, 30.0, floodedTo(level));
+        ASSERT_EQ(autoLevel(*hf).level, double(level));
+        EXPECT_EQ(autoLevel(*hf).level, double(level));
+        EXPECT_EQ(autoLevel(Heightfield(*hf)).level, double(level));  // a copy: the same grid
+    }
 }
 
 // "auto" is the water the DEM shows: a sea or lake is stored as one height over the water body,
