@@ -475,7 +475,8 @@ RenderSettings ProjectRenderer::meterSettings(const RenderRequest& r, const Orbi
     q.gizmos.clear();
     RenderSettings s = settingsOf(q, camera);
     s.antialiasing = Antialiasing::Off;
-    s.levelOfDetailRows = r.height;
+    s.levelOfDetailRows = r.levelOfDetailRows > 0 ? r.levelOfDetailRows : r.height;
+    s.levelOfDetailYields = false;
     return s;
 }
 
@@ -597,6 +598,9 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.showLeaves = r.leaves;
     s.gizmos = r.gizmos;
     s.time = r.time;
+    s.levelOfDetailRows = r.levelOfDetailRows;
+    s.levelOfDetailYields = r.levelOfDetailRows > 0;
+    s.waitForHorizon = r.waitForHorizon;
     return s;
 }
 

@@ -38,6 +38,13 @@ struct RenderRequest {
     // unless the view is the one the frame before it showed; the full-resolution frame meters.
     // Only present() reads it.
     bool interactive = false;
+    // The rows the terrain's level of detail is chosen for (0: height): a viewport frame drawn
+    // below full resolution keeps the full frame's levels and the shadow maps drawn for them,
+    // unless its cascades moved (RenderSettings::levelOfDetailYields).
+    uint32_t levelOfDetailRows = 0;
+    // Off for the viewport: a sun edit's horizon map is swept on a worker while the frames draw
+    // the one held (RenderSettings::waitForHorizon).
+    bool waitForHorizon = true;
 };
 
 class ProjectRenderer;

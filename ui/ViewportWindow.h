@@ -91,8 +91,11 @@ public:
     // The scale of the last frame presented: its pixels over the window's, square-rooted.
     double presentedScale() const { return presentedScale_; }
     // Whether a frame is submitted and not yet presented, asked for, or due (the full-resolution
-    // frame after a change): the viewport has more to show.
-    bool drawing() const { return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive(); }
+    // frame after a change, the frame that takes a horizon map swept on a worker): the viewport
+    // has more to show.
+    bool drawing() const {
+        return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive() || sweepPoll_.isActive();
+    }
 
 signals:
     // A frame reached the window: the wall time from its recording to its presentation (on a
@@ -146,6 +149,7 @@ private:
     // The UI thread never waits for the device: a submitted frame is presented once it has
     // finished (polled every few milliseconds), and a frame asked for meanwhile is drawn then.
     QTimer presentPoll_;
+    QTimer sweepPoll_;  // while the renderer sweeps a horizon map on a worker
     std::optional<std::chrono::steady_clock::time_point> frameStart_;
     bool frameWanted_ = false;
 };

@@ -65,9 +65,18 @@ struct RenderSettings {
     // Point and spot lights: their direct light, unshadowed (none: no lights code runs).
     std::vector<LocalLight> lights;
     // The rows the terrain's level of detail is chosen for (0: height). The exposure meter, a small
-    // copy of a frame, draws that frame's levels: it neither rebuilds them nor draws the shadow
-    // maps again for its own size.
+    // copy of a frame, and the viewport's frames drawn below full resolution draw the full
+    // frame's levels: they neither rebuild them nor draw the shadow maps again for their own size.
     uint32_t levelOfDetailRows = 0;
+    // With levelOfDetailRows (the viewport's frames below full resolution): a picture whose
+    // cascades stand draws the levels its shadow maps hold (the full frame's, or a small frame's
+    // after the sun moved); where the cascades moved, so that the maps are drawn again anyway, it
+    // takes the levels of its own height, coarser and cheaper to cast and to draw.
+    bool levelOfDetailYields = false;
+    // Off (the viewport's frames): a horizon map for a new sun (shadows.heightfield) is swept on a
+    // worker and the frames draw the map held until it lands (TerrainRenderer::sunHorizonSweeping);
+    // on, the frame waits for it.
+    bool waitForHorizon = true;
 };
 
 }  // namespace terralux

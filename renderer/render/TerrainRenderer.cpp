@@ -685,13 +685,40 @@ uint64_t TerrainRenderer::horizonMapBytes() const {
     return uint64_t(horizonMap_.width) * uint64_t(horizonMap_.height) * uint64_t(kRenderSlots);
 }
 
-void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt) {
+bool TerrainRenderer::sunHorizonSwept() const {
+    return pendingHorizon_ && pendingHorizon_->perVertex.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+}
+
+void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wait) {
     const glm::vec4 key(sun.direction, sun.angularRadius);
-    if (sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt)) return;
     // Isolated: a thread waiting for its sweep's tasks may otherwise take up any task of the
     // shared pool meanwhile, such as a chunk of the preview bake's, on the UI thread.
-    std::vector<float> perVertex;
-    tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, sun.direction, sun.angularRadius, skirt); });
+    auto sweep = [this, direction = sun.direction, radius = sun.angularRadius, skirt] {
+        std::vector<float> perVertex;
+        tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, direction, radius, skirt); });
+        return perVertex;
+    };
+    // A sweep under way lands first (the sun it was started for is nearer the one asked for than
+    // the map held), then the one asked for starts if it is another.
+    if (pendingHorizon_ && (wait || sunHorizonSwept())) {
+        std::unique_ptr<PendingHorizon> done = std::move(pendingHorizon_);
+        installSunHorizon(done->perVertex.get(), done->key, done->skirt);
+    }
+    if (sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt)) return;
+    if (pendingHorizon_) return;  // one at a time: the frames draw the map held until it lands
+    // The first map, and every map of a frame that waits, is swept here; the viewport's frames
+    // sweep on a worker (a 12 M-vertex map takes 275 ms) and draw the map held meanwhile.
+    if (wait || sunHorizonSerial_ == 0) {
+        installSunHorizon(sweep(), key, skirt);
+        return;
+    }
+    pendingHorizon_ = std::make_unique<PendingHorizon>();
+    pendingHorizon_->key = key;
+    pendingHorizon_->skirt = skirt;
+    pendingHorizon_->perVertex = std::async(std::launch::async, sweep);
+}
+
+void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt) {
     const int w = horizonMap_.width, h = horizonMap_.height;
     const bool whole = w == hf_.width() && h == hf_.depth();
     if (whole) {
@@ -716,7 +743,8 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt) {
     ++sunHorizonSweeps_;
 }
 
-void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water) {
+void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, bool ownRows,
+                                const WaterResources* water) {
     double worst = 0.0;
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
     double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
@@ -728,7 +756,7 @@ void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shad
         maxPixels *= std::min(1.0, up / std::sqrt(std::max(1.0 - up * up, 0.0)));
     }
     // At 0 pixels a patch still draws a coarser level whose error is 0: it loses nothing.
-    const double rows = double(s.levelOfDetailRows > 0 ? s.levelOfDetailRows : s.height);
+    const double rows = double(s.levelOfDetailRows == 0 || ownRows ? s.height : s.levelOfDetailRows);
     const glm::vec3 eye = s.camera.position();
     const double fovY = glm::radians(double(s.camera.fovDeg));
     std::vector<uint8_t> levels = lod::chooseLevels(patches_, eye, fovY, rows, maxPixels);
@@ -768,6 +796,8 @@ void TerrainRenderer::releaseRetired(bool idle) {
 }
 
 TerrainRenderer::~TerrainRenderer() {
+    // A sweep under way reads the heightfield.
+    if (pendingHorizon_) pendingHorizon_->perVertex.wait();
     // Frames in flight may still read what is about to be destroyed.
     if (gpu_) ctx_.waitIdle();
 }
@@ -1178,7 +1208,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     if (!s.shadows.enabled) ensureShadowMaps(0, 0);
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     f.shadows = shadowed ? g.shadows.get() : nullptr;
-    if (shadowed && s.shadows.heightfield) updateSunHorizon(s.sun, s.skirt);
+    if (shadowed && s.shadows.heightfield) updateSunHorizon(s.sun, s.skirt, s.waitForHorizon);
     // Water: the scene has it and the view draws it; the reflection and the copy of the frame
     // under it only where the view shades it, the reflection only when planar.
     f.water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
@@ -1200,7 +1230,14 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         for (int i = 0; i < drawn; ++i) f.lightMatrices.push_back(cascades_[size_t(i)].lightViewProj);
     }
     // The level of detail's triangles, in this slot's index buffer (its last frame is done).
-    updateLod(s, view.needs.sky, !f.lightMatrices.empty(), f.water);
+    // A viewport frame below full resolution (RenderSettings::levelOfDetailYields) draws the levels
+    // the shadow maps hold while its cascades stand, and its own where they moved.
+    const bool redrawsShadows =
+        !f.lightMatrices.empty() && (f.shadows->drawn != f.lightMatrices || f.shadows->drawnSkirt != s.skirt);
+    const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0 && s.levelOfDetailRows != s.height;
+    const bool keepLevels = yields && view.needs.sky && !f.lightMatrices.empty() && !redrawsShadows &&
+                            lodSerial_ > 0 && f.shadows->drawnLod == lodSerial_;
+    if (!keepLevels) updateLod(s, view.needs.sky, !f.lightMatrices.empty(), yields && redrawsShadows, f.water);
     if (f.slot.terrainIndicesSerial != lodSerial_) {
         const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
         if (f.slot.terrainIndices.size() < bytes) {

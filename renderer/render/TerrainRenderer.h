@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -198,6 +199,11 @@ public:
     // once per sun and surface), and the map of the last sweep: the sun's visible share at each of
     // its vertices, row-major (horizonMapInfo's width × height).
     size_t sunHorizonSweeps() const { return sunHorizonSweeps_; }
+    // A frame that does not wait for the sweep (RenderSettings::waitForHorizon off) starts it on a
+    // worker and draws the map held: whether one is under way, and whether it has finished (the
+    // next frame takes its map).
+    bool sunHorizonSweeping() const { return pendingHorizon_ != nullptr; }
+    bool sunHorizonSwept() const;
     const std::vector<float>& sunHorizonMap() const { return sunHorizonMap_; }
     HorizonMapInfo horizonMapInfo() const { return horizonMap_; }
     // The device memory the map takes: a byte a vertex in each frame slot.
@@ -244,7 +250,8 @@ private:
                                                RenderSettings& scaled);
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
-    void updateSunHorizon(const SunLight& sun, bool skirt);
+    void updateSunHorizon(const SunLight& sun, bool skirt, bool wait);
+    void installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt);
     void uploadSurfaceMaps(const std::vector<float>& ao);
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
@@ -279,7 +286,8 @@ private:
     std::vector<Retired> retired_;
     uint64_t framesBegun_ = 0;  // swapchain frames begun: each waited for its slot's frame before
     // Chooses the frame's levels; builds their triangles when they changed (++lodSerial_).
-    void updateLod(const RenderSettings& s, bool picture, bool shadowed, const WaterResources* water);
+    // `ownRows`: for the frame's height even where RenderSettings::levelOfDetailRows names others.
+    void updateLod(const RenderSettings& s, bool picture, bool shadowed, bool ownRows, const WaterResources* water);
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
     std::vector<double> decimation_;  // per patch
@@ -310,6 +318,13 @@ private:
     int sunHorizonSkirt_ = -1;
     uint64_t sunHorizonSerial_ = 0;
     size_t sunHorizonSweeps_ = 0;
+    // The sweep under way on a worker, for a sun and surface not yet held.
+    struct PendingHorizon {
+        glm::vec4 key{0.0f};
+        bool skirt = false;
+        std::future<std::vector<float>> perVertex;
+    };
+    std::unique_ptr<PendingHorizon> pendingHorizon_;
     bool hasAo_ = false, hasAlbedoMap_ = false;
     int skyImageHeight_ = 0;  // texels of the bound sky image, 0 without one
     float borderHeight_ = 0.0f;        // the DEM border's mean height: the skirt's, as the sky draws it

@@ -2,6 +2,7 @@
 // and behaviour checks. They skip, saying why, when no Vulkan device exists, and fail on any
 // validation-layer message.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -968,6 +969,70 @@ TEST_F(RenderTest, ShadowMapsAgreeWithTheTracedSunVisibilityAtTheDefaults) {
     r.setProject(p);
     draw(r, kViewSunVisibility, false, true);
     EXPECT_EQ(r.renderer().sunVisibilityTraces(), traces + 1);
+}
+
+// The viewport's frames do not wait for a sun edit's horizon map (RenderSettings::waitForHorizon
+// off; a 12 M-vertex map takes 275 ms): the sweep runs on a worker while the frames draw the map
+// held, the first frame after it has finished takes it, and the map is the one a frame that waits
+// sweeps. A frame that waits takes any sweep under way and sweeps its own sun at once.
+TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
+    Project p = sampleProject("horizon_async", 4, 4);
+    p.scene.sun.elevationDeg = 5.0;
+    p.scene.sun.azimuthDeg = 135.0;
+    ProjectRenderer r(*ctx_, p);
+    const TerrainRenderer& t = r.renderer();
+    RenderRequest viewport = unprobed(kViewShadow, true);
+    viewport.waitForHorizon = false;
+    auto sweepOf = [&](double azimuth) {
+        return sunHorizonVisibility(r.heightfield(), sunDirection(azimuth, 5.0), float(0.27 * std::numbers::pi / 180.0), true);
+    };
+    auto waitForSweep = [&] {
+        for (int i = 0; i < 20000 && !t.sunHorizonSwept(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        return t.sunHorizonSwept();
+    };
+    r.render(viewport);  // the first map is swept at once: there is none to draw meanwhile
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    ASSERT_EQ(t.sunHorizonSweeps(), 1u);
+    const std::vector<float> first = t.sunHorizonMap();
+    ASSERT_EQ(first, sweepOf(135.0));
+
+    p.scene.sun.azimuthDeg = 150.0;
+    r.setProject(p);
+    const RenderedImage held = r.render(viewport);
+    EXPECT_TRUE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonSweeps(), 1u);
+    EXPECT_EQ(t.sunHorizonMap(), first);
+    ASSERT_TRUE(waitForSweep());
+    const RenderedImage swept = r.render(viewport);
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonSweeps(), 2u);
+    EXPECT_EQ(t.sunHorizonMap(), sweepOf(150.0));
+    EXPECT_GT(test::compareImages(held.rgba, swept.rgba, kW, kH).meanAbs, 1e-4) << "the frame took the new map";
+    // The same frame as one that waited.
+    RenderRequest waits = viewport;
+    waits.waitForHorizon = true;
+    EXPECT_EQ(test::compareImages(r.render(waits).rgba, swept.rgba, kW, kH).maxAbs, 0.0);
+
+    // Two edits while a sweep runs: the frames converge on the last sun.
+    p.scene.sun.azimuthDeg = 165.0;
+    r.setProject(p);
+    r.render(viewport);
+    p.scene.sun.azimuthDeg = 180.0;
+    r.setProject(p);
+    for (int frame = 0; frame < 4 && t.sunHorizonSweeping(); ++frame) {
+        ASSERT_TRUE(waitForSweep());
+        r.render(viewport);
+    }
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonMap(), sweepOf(180.0));
+    // A frame that waits, with a sweep under way: its own sun's map at once.
+    p.scene.sun.azimuthDeg = 200.0;
+    r.setProject(p);
+    r.render(viewport);
+    EXPECT_TRUE(t.sunHorizonSweeping());
+    r.render(waits);
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonMap(), sweepOf(200.0));
 }
 
 TEST_F(RenderTest, TheHorizonMapIsSweptOncePerSunAndIsTheSweep) {
@@ -2985,6 +3050,64 @@ TEST_F(RenderTest, AnOffscreenFrameIsTheRenderedFrameTakenWithoutWaiting) {
 // The mesh's level of detail (terrain/MeshLod.h): each patch draws the coarsest level whose error
 // against the DEM covers at most a pixel from the camera, and the frame is the frame of the whole
 // mesh up to that pixel; close to the ground the patches there draw every vertex.
+// The viewport's frames below full resolution (dynamic resolution) keep the full frame's levels
+// while its cascades stand, so an edit of the exposure, fog or water draws no shadow maps (on
+// lavapipe they were 60 ms of a 100 ms frame at a quarter of the side); once the cascades move
+// (a sun edit) the maps are drawn again anyway, and the small frame takes its own coarser levels.
+TEST_F(RenderTest, AFrameBelowFullResolutionKeepsTheShadowMapsUntilTheCascadesMove) {
+    Project p = sampleProject("lod_rows", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Manual;  // each render one frame: no meter's frame before it
+    ProjectRenderer r(*ctx_, p);
+    TerrainRenderer& t = r.renderer();
+    auto hasShadowPass = [&] {
+        const std::vector<std::string> names = passNames(t.lastFramePasses());
+        return std::find(names.begin(), names.end(), "shadow") != names.end();
+    };
+    const uint32_t w = 480, h = 320;
+    RenderRequest full = unprobed(kViewBeauty, false);
+    full.width = w;
+    full.height = h;
+    r.render(full);
+    ASSERT_TRUE(hasShadowPass());
+    const TerrainRenderer::LodChoice fullLevels = t.lastLod();
+    RenderRequest small = full;
+    small.width = w / 4;
+    small.height = h / 4;
+    small.levelOfDetailRows = h;
+    // The exposure changed: same cascades, the full frame's levels, no shadow pass.
+    p.scene.camera.exposureEv += 1.0;
+    r.setProject(p);
+    r.render(small);
+    EXPECT_FALSE(hasShadowPass());
+    EXPECT_EQ(t.lastLod().levels, fullLevels.levels);
+    // A frame of its own rows would have chosen coarser levels and drawn the maps for them.
+    RenderRequest own = small;
+    own.levelOfDetailRows = 0;
+    r.render(own);
+    EXPECT_TRUE(hasShadowPass());
+    EXPECT_LT(t.lastLod().triangles, fullLevels.triangles);
+    r.render(full);  // back to the full frame's levels and maps
+    ASSERT_TRUE(hasShadowPass());
+    // The sun moved: the maps are drawn again, at the small frame's own levels, which the frames
+    // after it keep while the sun stands; the full frame then takes its own again.
+    p.scene.sun.elevationDeg += 5.0;
+    r.setProject(p);
+    const RenderedImage moved = r.render(small);
+    EXPECT_TRUE(hasShadowPass());
+    const TerrainRenderer::LodChoice smallLevels = t.lastLod();
+    EXPECT_LT(smallLevels.triangles, fullLevels.triangles);
+    const RenderedImage kept = r.render(small);
+    EXPECT_FALSE(hasShadowPass());
+    EXPECT_EQ(t.lastLod().levels, smallLevels.levels);
+    EXPECT_EQ(test::compareImages(kept.rgba, moved.rgba, w / 4, h / 4).maxAbs, 0.0);
+    // The same picture as a frame of its own rows.
+    EXPECT_EQ(test::compareImages(kept.rgba, r.render(own).rgba, w / 4, h / 4).maxAbs, 0.0);
+    EXPECT_EQ(t.lastLod().levels, smallLevels.levels);
+    r.render(full);
+    EXPECT_TRUE(hasShadowPass());
+    EXPECT_GT(t.lastLod().triangles, smallLevels.triangles);
+}
+
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
     Project p = sampleProject("lod", 4, 4);
     ProjectRenderer r(*ctx_, p);
