@@ -1214,6 +1214,10 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
 
     BakeSetup setup;
     prepare(project, setup, report, cancelled, request.tile);
+    // A terrain the scene cannot carry is refused now, not after the probes (a 13 459 × 18 391
+    // mesh failed at the export, three and a half minutes into the bake).
+    if (scene.exportSettings.gltf && setup.terrain.heightfield.width() > 1 && setup.terrain.heightfield.depth() > 1)
+        checkTerrainMesh(setup.terrain.heightfield, GltfSceneInput{}.meshMaxVertices, project.outDir() / "scene.gltf");
     if (setup.tileWindow) {
         // Placed from here on: each volume over the tile's share (setup.volumes point into it).
         scaleSceneToTile(request.project.scene, *setup.tileWindow);

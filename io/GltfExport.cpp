@@ -334,25 +334,14 @@ struct MeshBuild {
 // to lay out the document, and again when the file is written, with the same bytes.
 void buildMesh(const Heightfield& hf, const GltfSceneInput& input, const fs::path& gltfPath,
                ojson& doc, BinStream& bin, MeshBuild& mesh) {
-    mesh.stride = chooseStride(hf, input.meshMaxVertices, gltfPath);
+    mesh.stride = checkTerrainMesh(hf, input.meshMaxVertices, gltfPath);
     const std::vector<int> cols = sampledLines(hf.width(), mesh.stride);
     const std::vector<int> rows = sampledLines(hf.depth(), mesh.stride);
     const size_t nc = cols.size(), nr = rows.size();
     const size_t vertexCount = nc * nr;
-    if (vertexCount > size_t(std::numeric_limits<uint32_t>::max())) {
-        throw std::runtime_error(gltfPath.string() + ": " + std::to_string(vertexCount) +
-                                 " mesh vertices do not fit 32-bit indices");
-    }
     const size_t indexCount = 6 * (nc - 1) * (nr - 1);
     // 65535 is the primitive-restart value of 16-bit indices, so it may not be used as an index.
     const bool wideIndices = vertexCount > 65535;
-    // Buffer views address bytes with 32-bit offsets in most loaders.
-    const double binBytes = double(vertexCount) * 32.0 + double(indexCount) * (wideIndices ? 4 : 2);
-    if (binBytes > double(std::numeric_limits<uint32_t>::max())) {
-        throw std::runtime_error(gltfPath.string() + ": the terrain mesh of " + std::to_string(nc) + " x " +
-                                 std::to_string(nr) + " vertices needs " + std::to_string(int(binBytes / (1 << 30))) +
-                                 " GiB, over the 4 GiB a glTF buffer can address; lower terrain.max_resolution");
-    }
 
     const size_t positionOffset = bin.size();
     glm::vec3 lo(std::numeric_limits<float>::infinity());
@@ -970,6 +959,28 @@ void createOutputDirectory(const fs::path& outDir) {
     }
 }
 }  // namespace
+
+size_t checkTerrainMesh(const Heightfield& hf, size_t meshMaxVertices, const std::filesystem::path& gltfPath) {
+    const size_t stride = chooseStride(hf, meshMaxVertices, gltfPath);
+    const size_t nc = sampledLines(hf.width(), stride).size(), nr = sampledLines(hf.depth(), stride).size();
+    const size_t vertexCount = nc * nr;
+    if (vertexCount > size_t(std::numeric_limits<uint32_t>::max())) {
+        throw std::runtime_error(gltfPath.string() + ": " + std::to_string(vertexCount) +
+                                 " mesh vertices do not fit 32-bit indices");
+    }
+    const size_t indexCount = 6 * (nc - 1) * (nr - 1);
+    const bool wideIndices = vertexCount > 65535;
+    // Buffer views address bytes with 32-bit offsets in most loaders.
+    const double binBytes = double(vertexCount) * 32.0 + double(indexCount) * (wideIndices ? 4 : 2);
+    if (binBytes > double(std::numeric_limits<uint32_t>::max())) {
+        char gib[32];
+        std::snprintf(gib, sizeof gib, "%.1f", binBytes / double(1 << 30));
+        throw std::runtime_error(gltfPath.string() + ": the terrain mesh of " + std::to_string(nc) + " x " +
+                                 std::to_string(nr) + " vertices needs " + gib +
+                                 " GiB, over the 4 GiB a glTF buffer can address; lower terrain.max_resolution");
+    }
+    return stride;
+}
 
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input) {
     // Everything is encoded before the filesystem is touched.

@@ -132,6 +132,12 @@ struct GltfExportResult {
 // Throws FileWriteError for filesystem failures, ShProbeError for a grid that cannot be encoded and
 // std::runtime_error for other invalid input, each with a one-line message naming the file.
 GltfExportResult exportGltfScene(const std::filesystem::path& outDir, const GltfSceneInput& input);
+
+// The terrain mesh the scene would carry for `hf` (every k-th row and column within
+// meshMaxVertices): its stride, or std::runtime_error naming `gltfPath` when a glTF cannot hold
+// it (32-bit indices, a buffer of at most 4 GiB). The bake asks before it traces anything, so a
+// terrain too large is refused at once rather than after the probes.
+size_t checkTerrainMesh(const Heightfield& hf, size_t meshMaxVertices, const std::filesystem::path& gltfPath);
 // Top-level files of `outDir` (name, contents), written as exportGltfScene writes its own: staged,
 // then committed together, or not at all (earlier files put back). Throws FileWriteError.
 void writeFilesTogether(const std::filesystem::path& outDir,

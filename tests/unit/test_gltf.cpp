@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -376,6 +377,23 @@ TEST_F(GltfExport, VertexBudgetTakesEveryKthLineAndKeepsTheLast) {
     exportGltfScene(dir, in);
     EXPECT_EQ(readJson(dir / "scene.gltf")["scenes"][0]["extensions"]["TERRALUX_geo"]["meshStride"], 1);
     EXPECT_EQ(readJson(dir / "scene.gltf")["accessors"][0]["count"], 60000);
+}
+
+// A terrain whose mesh a glTF buffer cannot hold (4 GiB) is refused by the rule the export and
+// the bake share, which the bake asks before it traces anything: 9 000² vertices need 4.2 GiB,
+// and the same grid at every second line fits.
+TEST_F(GltfExport, ATerrainMeshOverFourGibIsRefusedBeforeTheExport) {
+    EXPECT_EQ(checkTerrainMesh(makeHeightfield(300, 200), 10000, dir / "scene.gltf"), 3u);  // as above
+    const Heightfield big(9000, 9000, 1.0, 1.0, std::vector<float>(size_t(9000) * 9000, 0.0f));
+    try {
+        checkTerrainMesh(big, std::numeric_limits<size_t>::max(), dir / "scene.gltf");
+        ADD_FAILURE() << "a 4.2 GiB mesh was accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), (dir / "scene.gltf").string() +
+                                             ": the terrain mesh of 9000 x 9000 vertices needs 4.2 GiB, over the 4 GiB a "
+                                             "glTF buffer can address; lower terrain.max_resolution");
+    }
+    EXPECT_EQ(checkTerrainMesh(big, size_t(4501) * 4501, dir / "scene.gltf"), 2u);  // lines 0, 2, ..., 8998, 8999
 }
 
 TEST_F(GltfExport, IndexWidthFollowsTheVertexCount) {
