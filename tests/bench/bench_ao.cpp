@@ -154,7 +154,7 @@ int main() {
     std::printf("\n| sun elevation, azimuth | sun horizon map %.2f M vertices (ms) | %.1f M vertices (ms) |\n",
                 hf.heights().size() / 1e6, big.heights().size() / 1e6);
     std::printf("|---|---:|---:|\n");
-    for (const auto [elevation, azimuth] : {std::pair{5.0, 135.0}, std::pair{12.0, 17.0}, std::pair{35.0, 270.0}}) {
+    for (const auto& [elevation, azimuth] : {std::pair{5.0, 135.0}, std::pair{12.0, 17.0}, std::pair{35.0, 270.0}}) {
         const glm::vec3 sun = sunDirection(azimuth, elevation);
         const float radius = float(0.27 * std::numbers::pi / 180.0);
         double best = 1e9, bestBig = 1e9;

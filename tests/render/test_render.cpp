@@ -2578,8 +2578,9 @@ TEST_F(RenderTest, AntialiasingLowersTheEdgeErrorAgainstASupersampledFrame) {
             EXPECT_EQ(drawn, (counts & 8u) ? Antialiasing::Msaa8 : (counts & 4u) ? Antialiasing::Msaa4
                              : (counts & 2u) ? Antialiasing::Msaa2 : Antialiasing::Fxaa);
             const std::vector<std::string> msaaNames = passNames(r.renderer().lastFramePasses());
-            if (msaaSamples(drawn) > 1)
+            if (msaaSamples(drawn) > 1) {
                 EXPECT_NE(std::find(msaaNames.begin(), msaaNames.end(), "resolve"), msaaNames.end());
+            }
             const double eOff = meanEdgeError(off, reference, edges), eFxaa = meanEdgeError(fxaa, reference, edges),
                          eSsaa = meanEdgeError(ssaa, reference, edges), eMsaa = meanEdgeError(msaa, reference, edges);
             const std::string what = (dem.empty() ? std::string("sample") : fs::path(dem).filename().string()) +
@@ -2591,7 +2592,9 @@ TEST_F(RenderTest, AntialiasingLowersTheEdgeErrorAgainstASupersampledFrame) {
             EXPECT_GT(edges.size(), size_t(480 * 270 / 200)) << what;
             EXPECT_LT(eFxaa, (dem.empty() ? 1.02 : 0.75) * eOff) << what;
             EXPECT_LT(eSsaa, 0.5 * eOff) << what;
-            if (msaaSamples(drawn) > 1) EXPECT_LT(eMsaa, (dem.empty() ? kMsaaEdgeBound : kMsaaEdgeBoundCrop) * eOff) << what;
+            if (msaaSamples(drawn) > 1) {
+                EXPECT_LT(eMsaa, (dem.empty() ? kMsaaEdgeBound : kMsaaEdgeBoundCrop) * eOff) << what;
+            }
             if (near) continue;
 
             // The data views keep one exact sample a pixel whatever the mode: the same image, no pass.

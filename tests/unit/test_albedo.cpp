@@ -235,7 +235,9 @@ TEST(Ramp, FilledVoidsTakeTheColourOfTheGroundAroundThem) {
         }
     // Outside the void nothing changes.
     for (size_t t = 0; t < a.texels(); ++t)
-        if (!mask[t]) EXPECT_EQ(a.texel(t), unmarked.texel(t)) << t;
+        if (!mask[t]) {
+            EXPECT_EQ(a.texel(t), unmarked.texel(t)) << t;
+        }
 }
 
 TEST(Ramp, LargeTerrainsGetAtMostTheLargestFieldSide) {

@@ -205,7 +205,9 @@ TEST(LightingExtension, TheHorizonMapsCascadeFollowsTheSunAndTheRule) {
                 break;
             }
         EXPECT_EQ(from, expected) << elevation;
-        if (previous >= 0) EXPECT_LE(from, previous) << elevation;
+        if (previous >= 0) {
+            EXPECT_LE(from, previous) << elevation;
+        }
         previous = from;
     }
     EXPECT_LT(previous, 4) << "at a 1° sun some cascade hands over";

@@ -102,8 +102,9 @@ TEST(Tiles, AWindowKeepsItsVerticesAndItsSurfaceToTheBit) {
         for (int c = 0; c < w.width(); ++c) {
             ASSERT_EQ(w.vertex(c, r), region.vertex(c + 7, r + 5));
             // Inside the window, where central differences see the same neighbours.
-            if (c > 0 && r > 0 && c + 1 < w.width() && r + 1 < w.depth())
+            if (c > 0 && r > 0 && c + 1 < w.width() && r + 1 < w.depth()) {
                 ASSERT_EQ(w.vertexNormal(c, r), region.vertexNormal(c + 7, r + 5));
+            }
         }
     for (float fx : {0.1f, 0.5f, 0.93f})
         for (float fz : {0.2f, 0.77f}) {
@@ -173,7 +174,9 @@ TEST(Tiles, AWindowReadAloneFromTheDemEqualsTheWholeImportCut) {
                 ++measured;
                 // The whole import warps in its own chunks: the same cell to the warper's
                 // approximation (projected: the same sample).
-                if (projected) ASSERT_EQ(a.y, b.y) << name << " " << c << ", " << r;
+                if (projected) {
+                    ASSERT_EQ(a.y, b.y) << name << " " << c << ", " << r;
+                }
                 worst = std::max(worst, double(std::fabs(a.y - b.y)));
                 const int oc = c + 9 - 18, orow = r + 5 - 12;
                 if (oc < 0 || orow < 0 || filled(other.heightfield, oc, orow)) continue;
@@ -319,7 +322,9 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         // is all that differs.
         EXPECT_LT(sum / double(border), 0.5) << "halo " << (halo ? *halo : -1.0);
         EXPECT_LT(worst, 2.0) << "halo " << (halo ? *halo : -1.0);
-        if (!halo) EXPECT_EQ(worst, 0.0) << "the same rays over the same terrain and cache";
+        if (!halo) {
+            EXPECT_EQ(worst, 0.0) << "the same rays over the same terrain and cache";
+        }
     }
 
     // The first tile computed the region's summary, the others read it: a tile baked either way
