@@ -141,6 +141,11 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
     } else {
         b.terrain = loadProjectTerrain(project);
     }
+    // A terrain the scene cannot carry is refused now, in the dry run too, not after the probes
+    // (a 13 459 × 18 391 mesh failed at the export, three and a half minutes into the bake).
+    const Heightfield& meshed = b.terrain.heightfield;
+    if (scene.exportSettings.gltf && meshed.width() > 1 && meshed.depth() > 1)
+        checkTerrainMesh(meshed, GltfSceneInput{}.meshMaxVertices, project.outDir() / "scene.gltf");
     if (cancelled()) throw BakeCancelled();
     report("loading sky and albedo", 0.01);
     BakeScene traced = bakeSceneOf(project, b.tracedTerrain ? *b.tracedTerrain : b.terrain.heightfield);
@@ -1214,10 +1219,6 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
 
     BakeSetup setup;
     prepare(project, setup, report, cancelled, request.tile);
-    // A terrain the scene cannot carry is refused now, not after the probes (a 13 459 × 18 391
-    // mesh failed at the export, three and a half minutes into the bake).
-    if (scene.exportSettings.gltf && setup.terrain.heightfield.width() > 1 && setup.terrain.heightfield.depth() > 1)
-        checkTerrainMesh(setup.terrain.heightfield, GltfSceneInput{}.meshMaxVertices, project.outDir() / "scene.gltf");
     if (setup.tileWindow) {
         // Placed from here on: each volume over the tile's share (setup.volumes point into it).
         scaleSceneToTile(request.project.scene, *setup.tileWindow);

@@ -599,7 +599,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.gizmos = r.gizmos;
     s.time = r.time;
     s.levelOfDetailRows = r.levelOfDetailRows;
-    s.levelOfDetailYields = r.levelOfDetailRows > 0;
+    s.levelOfDetailYields = r.levelOfDetailRows > r.height;  // a frame below full resolution
     s.waitForHorizon = r.waitForHorizon;
     return s;
 }

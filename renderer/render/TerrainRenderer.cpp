@@ -698,13 +698,15 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wai
         tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, direction, radius, skirt); });
         return perVertex;
     };
-    // A sweep under way lands first (the sun it was started for is nearer the one asked for than
-    // the map held), then the one asked for starts if it is another.
+    auto held = [&] { return sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt); };
+    // A finished sweep lands first, unless the map held is the one asked for (the sun went back):
+    // its sun is newer than the held one's. Then the one asked for starts if it is another.
     if (pendingHorizon_ && (wait || sunHorizonSwept())) {
         std::unique_ptr<PendingHorizon> done = std::move(pendingHorizon_);
-        installSunHorizon(done->perVertex.get(), done->key, done->skirt);
+        std::vector<float> perVertex = done->perVertex.get();
+        if (!held()) installSunHorizon(std::move(perVertex), done->key, done->skirt);
     }
-    if (sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt)) return;
+    if (held()) return;
     if (pendingHorizon_) return;  // one at a time: the frames draw the map held until it lands
     // The first map, and every map of a frame that waits, is swept here; the viewport's frames
     // sweep on a worker (a 12 M-vertex map takes 275 ms) and draw the map held meanwhile.
@@ -712,10 +714,17 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wai
         installSunHorizon(sweep(), key, skirt);
         return;
     }
-    pendingHorizon_ = std::make_unique<PendingHorizon>();
-    pendingHorizon_->key = key;
-    pendingHorizon_->skirt = skirt;
-    pendingHorizon_->perVertex = std::async(std::launch::async, sweep);
+    auto pending = std::make_unique<PendingHorizon>();
+    pending->key = key;
+    pending->skirt = skirt;
+    pending->perVertex = std::async(std::launch::async, sweep);
+    pendingHorizon_ = std::move(pending);
+}
+
+void TerrainRenderer::dropSweptHorizon() {
+    // A frame that reads no horizon map lets a finished sweep go: the next one that reads it
+    // sweeps its own sun, and the viewport stops waiting for the sweep.
+    if (sunHorizonSwept()) pendingHorizon_.reset();
 }
 
 void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt) {
@@ -743,7 +752,7 @@ void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm:
     ++sunHorizonSweeps_;
 }
 
-void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shadowed, bool ownRows,
+void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool picture, bool shadowed,
                                 const WaterResources* water) {
     double worst = 0.0;
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
@@ -756,7 +765,6 @@ void TerrainRenderer::updateLod(const RenderSettings& s, bool picture, bool shad
         maxPixels *= std::min(1.0, up / std::sqrt(std::max(1.0 - up * up, 0.0)));
     }
     // At 0 pixels a patch still draws a coarser level whose error is 0: it loses nothing.
-    const double rows = double(s.levelOfDetailRows == 0 || ownRows ? s.height : s.levelOfDetailRows);
     const glm::vec3 eye = s.camera.position();
     const double fovY = glm::radians(double(s.camera.fovDeg));
     std::vector<uint8_t> levels = lod::chooseLevels(patches_, eye, fovY, rows, maxPixels);
@@ -1209,6 +1217,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     f.shadows = shadowed ? g.shadows.get() : nullptr;
     if (shadowed && s.shadows.heightfield) updateSunHorizon(s.sun, s.skirt, s.waitForHorizon);
+    else dropSweptHorizon();
     // Water: the scene has it and the view draws it; the reflection and the copy of the frame
     // under it only where the view shades it, the reflection only when planar.
     f.water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
@@ -1231,13 +1240,18 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     }
     // The level of detail's triangles, in this slot's index buffer (its last frame is done).
     // A viewport frame below full resolution (RenderSettings::levelOfDetailYields) draws the levels
-    // the shadow maps hold while its cascades stand, and its own where they moved.
+    // the shadow maps hold while its cascades stand, and its own where they moved or where it
+    // draws no maps (nothing to keep).
     const bool redrawsShadows =
         !f.lightMatrices.empty() && (f.shadows->drawn != f.lightMatrices || f.shadows->drawnSkirt != s.skirt);
-    const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0 && s.levelOfDetailRows != s.height;
+    const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0;
     const bool keepLevels = yields && view.needs.sky && !f.lightMatrices.empty() && !redrawsShadows &&
                             lodSerial_ > 0 && f.shadows->drawnLod == lodSerial_;
-    if (!keepLevels) updateLod(s, view.needs.sky, !f.lightMatrices.empty(), yields && redrawsShadows, f.water);
+    // The output's rows, not the supersampled target's.
+    const uint32_t outputRows = s.height / std::max<uint32_t>(uint32_t(out.antialiasing.scale), 1u);
+    const bool ownRows = s.levelOfDetailRows == 0 || (yields && (redrawsShadows || f.lightMatrices.empty()));
+    const double rows = double(ownRows ? outputRows : s.levelOfDetailRows);
+    if (!keepLevels) updateLod(s, rows, view.needs.sky, !f.lightMatrices.empty(), f.water);
     if (f.slot.terrainIndicesSerial != lodSerial_) {
         const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
         if (f.slot.terrainIndices.size() < bytes) {

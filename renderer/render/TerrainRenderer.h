@@ -252,6 +252,7 @@ private:
     void updateSunVisibility(const SunLight& sun, bool skirt);
     void updateSunHorizon(const SunLight& sun, bool skirt, bool wait);
     void installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt);
+    void dropSweptHorizon();
     void uploadSurfaceMaps(const std::vector<float>& ao);
     void buildViewSets();
     void ensureWaterTargets(uint32_t width, uint32_t height, float reflectionScale);
@@ -285,9 +286,9 @@ private:
     };
     std::vector<Retired> retired_;
     uint64_t framesBegun_ = 0;  // swapchain frames begun: each waited for its slot's frame before
-    // Chooses the frame's levels; builds their triangles when they changed (++lodSerial_).
-    // `ownRows`: for the frame's height even where RenderSettings::levelOfDetailRows names others.
-    void updateLod(const RenderSettings& s, bool picture, bool shadowed, bool ownRows, const WaterResources* water);
+    // Chooses the frame's levels for `rows` of output; builds their triangles when they changed
+    // (++lodSerial_).
+    void updateLod(const RenderSettings& s, double rows, bool picture, bool shadowed, const WaterResources* water);
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
     std::vector<double> decimation_;  // per patch

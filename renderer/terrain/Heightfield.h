@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -103,13 +104,26 @@ public:
     // marks. A copy keeps it; building a grid, or changing its placement or marks, takes a new
     // one. What is derived from the grid alone (the water's auto level, a placement shown in a
     // dock) may be kept under it instead of computed again on every edit of the project.
-    uint64_t serial() const { return serial_; }
+    uint64_t serial() const { return serial_.value; }
 
     GeoOrigin geo;
 
 private:
     static uint64_t nextSerial();
-    uint64_t serial_ = 0;  // 0: the empty grid
+    // 0: the empty grid. A grid moved from keeps no samples, so it keeps no serial either.
+    struct Serial {
+        uint64_t value = 0;
+        Serial() = default;
+        Serial(uint64_t v) : value(v) {}
+        Serial(const Serial&) = default;
+        Serial& operator=(const Serial&) = default;
+        Serial(Serial&& o) noexcept : value(std::exchange(o.value, 0)) {}
+        Serial& operator=(Serial&& o) noexcept {
+            value = std::exchange(o.value, 0);
+            return *this;
+        }
+    };
+    Serial serial_;
     int width_ = 0;
     int depth_ = 0;
     double cellSizeX_ = 1.0;

@@ -1033,6 +1033,25 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     r.render(waits);
     EXPECT_FALSE(t.sunHorizonSweeping());
     EXPECT_EQ(t.sunHorizonMap(), sweepOf(200.0));
+    // The sun back where the map held was swept while another sweep ran: the map held stays.
+    p.scene.sun.azimuthDeg = 215.0;
+    r.setProject(p);
+    r.render(viewport);
+    p.scene.sun.azimuthDeg = 200.0;
+    r.setProject(p);
+    ASSERT_TRUE(waitForSweep());
+    r.render(viewport);
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonMap(), sweepOf(200.0));
+    // A view that reads no horizon map lets a finished sweep go, so the viewport stops waiting.
+    p.scene.sun.azimuthDeg = 230.0;
+    r.setProject(p);
+    r.render(viewport);
+    ASSERT_TRUE(waitForSweep());
+    RenderRequest albedo = viewport;
+    albedo.debugView = kViewAlbedo;
+    r.render(albedo);
+    EXPECT_FALSE(t.sunHorizonSweeping());
 }
 
 TEST_F(RenderTest, TheHorizonMapIsSweptOncePerSunAndIsTheSweep) {
@@ -3109,6 +3128,24 @@ TEST_F(RenderTest, AFrameBelowFullResolutionKeepsTheShadowMapsUntilTheCascadesMo
     r.render(full);
     EXPECT_TRUE(hasShadowPass());
     EXPECT_GT(t.lastLod().triangles, smallLevels.triangles);
+
+    // The viewport names its own height for a full-resolution frame too: with supersampling (the
+    // target twice the rows) that frame still takes the levels of its output, not a small frame's.
+    p.scene.camera.antialiasing = Antialiasing::Ssaa;
+    p.scene.sun.elevationDeg += 5.0;
+    r.setProject(p);
+    RenderRequest viewportFull = full;
+    viewportFull.levelOfDetailRows = h;
+    r.render(full);
+    const TerrainRenderer::LodChoice supersampled = t.lastLod();
+    p.scene.sun.elevationDeg += 5.0;
+    r.setProject(p);
+    r.render(small);
+    EXPECT_LT(t.lastLod().triangles, supersampled.triangles);
+    p.scene.sun.elevationDeg -= 5.0;
+    r.setProject(p);
+    r.render(viewportFull);
+    EXPECT_EQ(t.lastLod().levels, supersampled.levels);
 }
 
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {

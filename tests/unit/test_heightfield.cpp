@@ -1,5 +1,6 @@
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -74,4 +75,8 @@ TEST(Heightfield, ASerialNamesWhatTheGridHolds) {
     a.setNodataMask({0, 1, 0, 0, 0, 0});
     EXPECT_NE(a.serial(), before);
     EXPECT_EQ(copy.serial(), Heightfield(copy).serial());
+    Heightfield from = copy;
+    const Heightfield to = std::move(from);
+    EXPECT_EQ(to.serial(), copy.serial());
+    EXPECT_EQ(from.serial(), 0u);  // NOLINT(bugprone-use-after-move): what a move leaves
 }
