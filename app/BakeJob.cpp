@@ -91,8 +91,12 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
 // What a bake needs before it places a probe: terrain, lighting, tracer, quality, volumes.
 struct BakeSetup {
     DemImportResult terrain;  // a tile's core when tiled
-    // A tiled bake: the terrain within the halo, which the tracer holds (by address: heap).
+    // A tiled bake: the terrain within the near halo, which the tracer holds (by address: heap)...
     std::unique_ptr<Heightfield> tracedTerrain;
+    // ... and, where the halo reaches further, the region's overview over the whole halo, which
+    // the tracer traces beyond the near halo.
+    std::unique_ptr<Heightfield> farTerrain;
+    std::unique_ptr<HeightfieldTracer> farTracer;
     // ... and the whole region, which the exported lighting (fog base, shadow range, LPV, water
     // level) describes, the same for every tile.
     std::unique_ptr<Heightfield> region;
@@ -123,8 +127,9 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         // nothing.
         RegionSummary region = regionSummary(project, project.outDir().parent_path(), writesSummary);
         const DemGrid& grid = region.grid;
+        const Heightfield& overview = region.overview;
         try {
-            b.tileWindow = tileWindow(grid, *tile);
+            b.tileWindow = tileWindow(grid, *tile, std::max(overview.cellSizeX(), overview.cellSizeZ()));
         } catch (const std::invalid_argument& e) {
             throw ProjectError(e.what());
         }
@@ -135,6 +140,21 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         b.tracedTerrain = std::make_unique<Heightfield>(std::move(b.terrain.heightfield));
         b.terrain.heightfield =
             b.tracedTerrain->window(w.col0 - w.tracedCol0, w.row0 - w.tracedRow0, w.cols, w.rows);
+        if (w.far) {
+            // The overview's cells over the halo window, rounded outward: both are in the region's
+            // engine space, so they need no transform.
+            auto xOf = [&](int c) { return (c - 0.5 * (grid.width - 1)) * grid.cellX; };
+            auto zOf = [&](int r) { return (r - 0.5 * (grid.depth - 1)) * grid.cellZ; };
+            const int oc0 = std::clamp(int(std::floor(overview.colOf(xOf(w.haloCol0)))), 0, overview.width() - 2);
+            const int or0 = std::clamp(int(std::floor(overview.rowOf(zOf(w.haloRow0)))), 0, overview.depth() - 2);
+            const int oc1 = std::clamp(int(std::ceil(overview.colOf(xOf(w.haloCol0 + w.haloCols - 1)))), oc0 + 1, overview.width() - 1);
+            const int or1 = std::clamp(int(std::ceil(overview.rowOf(zOf(w.haloRow0 + w.haloRows - 1)))), or0 + 1, overview.depth() - 1);
+            b.farTerrain = std::make_unique<Heightfield>(overview.window(oc0, or0, oc1 - oc0 + 1, or1 - or0 + 1));
+            b.farTracer = std::make_unique<HeightfieldTracer>(*b.farTerrain,
+                                                              HeightfieldTracer::Options{project.scene.terrain.skirt});
+            b.tileReport["far_window"] = {{"col0", oc0}, {"row0", or0}, {"cols", oc1 - oc0 + 1}, {"rows", or1 - or0 + 1},
+                                          {"cell_m", {overview.cellSizeX(), overview.cellSizeZ()}}};
+        }
         b.tileReport["region_summary"] = region.cached ? "read" : "computed";
         // The region as the exported lighting sees it, the same in every tile.
         b.region = std::make_unique<Heightfield>(std::move(region.overview));
@@ -148,7 +168,8 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         checkTerrainMesh(meshed, GltfSceneInput{}.meshMaxVertices, project.outDir() / "scene.gltf");
     if (cancelled()) throw BakeCancelled();
     report("loading sky and albedo", 0.01);
-    BakeScene traced = bakeSceneOf(project, b.tracedTerrain ? *b.tracedTerrain : b.terrain.heightfield);
+    BakeScene traced = bakeSceneOf(project, b.tracedTerrain ? *b.tracedTerrain : b.terrain.heightfield, false,
+                                   b.farTracer.get());
     b.lighting = traced.lighting;
     b.tracer = std::move(traced.tracer);
     // Water that "auto" finds sits at the region's level, not a tile's own.

@@ -205,6 +205,13 @@ int commandBake(const Args& a) {
         } catch (const std::invalid_argument& e) {
             throw UsageError(e.what());
         }
+        if (a.parser.isSet(a.nearHalo)) {
+            bool ok = false;
+            const double near = a.parser.value(a.nearHalo).toDouble(&ok);
+            if (!ok || !(std::isfinite(near) && near >= 0.0))
+                throw UsageError("--near-halo " + str(a.parser.value(a.nearHalo)) + ": must be a distance in metres >= 0");
+            request.tile->nearHaloMetres = near;
+        }
         // Each tile in a folder of its own under the region's: what --merge reads.
         request.project.scene.exportSettings.outDir =
             (request.project.outDir() / kTilesFolder / tileName(*request.tile)).string();
@@ -462,10 +469,11 @@ int runCommandLine(int argc, char** argv, Binary binary, const AuthoringCommands
         }
         if (a.parser.isSet(a.dryRun) && !a.parser.isSet(a.bake))
             throw UsageError("--dry-run: only with --bake");
-        for (const QCommandLineOption* o : {&a.tiles, &a.tile, &a.halo})
+        for (const QCommandLineOption* o : {&a.tiles, &a.tile, &a.halo, &a.nearHalo})
             if (a.parser.isSet(*o) && !a.parser.isSet(a.bake))
                 throw UsageError("--" + str(o->names().first()) + ": only with --bake");
         if (a.parser.isSet(a.halo) && !a.parser.isSet(a.tile)) throw UsageError("--halo: only with --tile");
+        if (a.parser.isSet(a.nearHalo) && !a.parser.isSet(a.tile)) throw UsageError("--near-halo: only with --tile");
         if (a.parser.isSet(a.progress)) {
             const QString mode = a.parser.value(a.progress);
             if (mode != "text" && mode != "json")

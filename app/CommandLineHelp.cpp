@@ -123,6 +123,10 @@ CommandLineHelp commandLineHelp(Binary binary) {
         {"--halo METRES",
          "With --tile: the terrain traced around the tile (default: derived from the relief, so terrain "
          "beyond it changes a probe's light by under 1 %)."},
+        {"--near-halo METRES",
+         "With --tile: how much of the halo is read at the DEM's resolution; beyond it the halo is traced on the "
+         "region's overview (default: a hundred overview cells, so its coarser heights change a probe's light by "
+         "under 1 %)."},
         {"--set KEY.PATH=VALUE",
          "Override a project parameter by its JSON path; repeatable.\n"
          "Examples: --set sun.elevation_deg=12\n"

@@ -46,6 +46,7 @@ struct Args {
     QCommandLineOption tiles{"tiles", "Tile cut.", "NX,NZ"};
     QCommandLineOption tile{"tile", "One tile.", "I/N|IX,IZ"};
     QCommandLineOption halo{"halo", "Halo metres.", "METRES"};
+    QCommandLineOption nearHalo{"near-halo", "Near halo metres.", "METRES"};
     QCommandLineOption merge{"merge", "Merge tiles.", "DIR"};
     QCommandLineOption progress{"progress", "Progress format.", "text|json"};
 
@@ -53,7 +54,7 @@ struct Args {
         parser.setSingleDashWordOptionMode(QCommandLineParser::ParseAsLongOptions);
         parser.addOptions({info, printProject, printSchema, printReference, help, version, dem, set, threads, quiet, bake, out,
                            quality, compareReference, noRebake, render, size, debugView, camera, noProbes,
-                           device, dryRun, overlay, time, study, budget, profile, scenario, tiles, tile, halo, merge, progress});
+                           device, dryRun, overlay, time, study, budget, profile, scenario, tiles, tile, halo, nearHalo, merge, progress});
     }
 };
 

@@ -206,10 +206,12 @@ std::optional<BakeWater> bakeWaterOf(const Project& p, const Heightfield& hf) {
     return BakeWater{float(*level), w.color};
 }
 
-BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable) {
+BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable,
+                      const HeightfieldTracer* beyond) {
     BakeScene b;
     b.lighting = lightingOf(project, hf);
-    b.tracer = std::make_unique<HeightfieldTracer>(hf, HeightfieldTracer::Options{project.scene.terrain.skirt});
+    b.tracer = std::make_unique<HeightfieldTracer>(
+        hf, HeightfieldTracer::Options{beyond ? false : project.scene.terrain.skirt, HeightfieldTracer::Kernel::kAuto, beyond});
     b.lighting.tracer = b.tracer.get();
     b.lighting.water = bakeWaterOf(project, hf);
     try {

@@ -63,12 +63,14 @@ std::optional<BakeWater> bakeWaterOf(const Project& project, const Heightfield& 
 // sun, sky and albedo (lightingOf), a tracer over `hf` as terrain.skirt says, the water its rays
 // see (bakeWaterOf) and the albedo field (surfaceAlbedoOf). The tracer lives here; `lighting`
 // points at it. An albedo map that cannot be read throws ImageError, or with
-// `constantAlbedoIfUnreadable` leaves terrain.albedo (as the viewport draws it).
+// `constantAlbedoIfUnreadable` leaves terrain.albedo (as the viewport draws it). `beyond`: the
+// terrain around `hf` at a coarser resolution (a tile's far halo), which then holds the skirt.
 struct BakeScene {
     std::unique_ptr<HeightfieldTracer> tracer;
     BakeLighting lighting;
 };
-BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable = false);
+BakeScene bakeSceneOf(const Project& project, const Heightfield& hf, bool constantAlbedoIfUnreadable = false,
+                      const HeightfieldTracer* beyond = nullptr);
 
 // The aspect ratio TERRALUX_lighting's cascade splits are computed for (shadows.computed_for_aspect).
 inline constexpr double kLightingExportAspect = 16.0 / 9.0;

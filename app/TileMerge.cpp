@@ -16,10 +16,10 @@ std::optional<nlohmann::json> readJson(const std::filesystem::path& file) {
     }
 }
 
-// What makes two bakes of a tile the same tile: the cut, its place and the halo asked for.
+// What makes two bakes of a tile the same tile: the cut, its place and the halos asked for.
 nlohmann::json tileKey(const nlohmann::json& tile) {
     return {tile.value("tiles", nlohmann::json()), tile.value("ix", -1), tile.value("iz", -1),
-            tile.value("halo_setting_m", nlohmann::json())};
+            tile.value("halo_setting_m", nlohmann::json()), tile.value("near_halo_setting_m", nlohmann::json())};
 }
 
 }  // namespace
@@ -32,7 +32,8 @@ std::optional<std::string> unchangedTile(const BakeRequest& request) {
         return std::nullopt;
     const TileSpec& t = *request.tile;
     const nlohmann::json now = {{"tiles", {t.nx, t.nz}}, {"ix", t.ix}, {"iz", t.iz},
-                                {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()}};
+                                {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()},
+                                {"near_halo_setting_m", t.nearHaloMetres ? nlohmann::json(*t.nearHaloMetres) : nlohmann::json()}};
     if (tileKey((*report)["tile"]) != tileKey(now)) return std::nullopt;
     if (!bakeInputDifferences((*report)["inputs"], bakeInputs(request.project)).empty()) return std::nullopt;
     std::error_code ec;
@@ -377,6 +378,8 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
         if (tile["tiles"] != first["tile"]["tiles"]) why = "cut " + tile["tiles"].dump() + ", not " + first["tile"]["tiles"].dump();
         else if (tile.value("halo_setting_m", nlohmann::json()) != first["tile"].value("halo_setting_m", nlohmann::json()))
             why = "halo " + tile.value("halo_setting_m", nlohmann::json()).dump();
+        else if (tile.value("near_halo_setting_m", nlohmann::json()) != first["tile"].value("near_halo_setting_m", nlohmann::json()))
+            why = "near halo " + tile.value("near_halo_setting_m", nlohmann::json()).dump();
         else if (tile["region_grid"] != first["tile"]["region_grid"]) why = "region grid " + tile["region_grid"].dump();
         else why = sameInputs(t.report["inputs"]);
         if (!why.empty()) mismatched.push_back(t.name + " (" + why + ")");
@@ -433,7 +436,8 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
                          {"files", files}});
     }
     const nlohmann::json& ft = first["tile"];
-    const nlohmann::json region = {{"tiles", ft["tiles"]}, {"region_grid", ft["region_grid"]}, {"halo", ft["halo"]}};
+    const nlohmann::json region = {{"tiles", ft["tiles"]}, {"region_grid", ft["region_grid"]}, {"halo", ft["halo"]},
+                                   {"near_halo", ft.value("near_halo", nlohmann::json())}};
     MergeOutcome out;
     out.dir = dir;
     out.tiles = int(tiles.size());

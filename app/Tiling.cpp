@@ -65,7 +65,11 @@ Halo haloFor(const DemGrid& region, const std::optional<double>& metres) {
     return h;
 }
 
-TileWindow tileWindow(const DemGrid& region, const TileSpec& t) {
+double nearHaloFor(const Halo& halo, double overviewCell, const std::optional<double>& metres) {
+    return std::min(halo.metres, metres ? *metres : overviewCell / kHaloShare);
+}
+
+TileWindow tileWindow(const DemGrid& region, const TileSpec& t, double overviewCell) {
     const int cellsX = region.width - 1, cellsZ = region.depth - 1;
     if (cellsX < 2 * t.nx || cellsZ < 2 * t.nz)
         throw std::invalid_argument("--tiles " + std::to_string(t.nx) + "," + std::to_string(t.nz) + ": the " +
@@ -81,12 +85,20 @@ TileWindow tileWindow(const DemGrid& region, const TileSpec& t) {
     w.regionCols = region.width;
     w.regionRows = region.depth;
     w.halo = haloFor(region, t.haloMetres);
-    const double hx = std::ceil(w.halo.metres / region.cellX), hz = std::ceil(w.halo.metres / region.cellZ);
-    const int gx = int(std::min(hx, double(cellsX))), gz = int(std::min(hz, double(cellsZ)));
-    w.tracedCol0 = std::max(0, w.col0 - gx);
-    w.tracedRow0 = std::max(0, w.row0 - gz);
-    w.tracedCols = std::min(cellsX, c1 + gx) - w.tracedCol0 + 1;
-    w.tracedRows = std::min(cellsZ, r1 + gz) - w.tracedRow0 + 1;
+    w.nearMetres = overviewCell > 0.0 || t.nearHaloMetres ? nearHaloFor(w.halo, overviewCell, t.nearHaloMetres)
+                                                          : w.halo.metres;
+    // The core grown by `metres` on each side, in whole cells, clipped to the region.
+    auto grow = [&](double metres, int& col0, int& row0, int& cols, int& rows) {
+        const double hx = std::ceil(metres / region.cellX), hz = std::ceil(metres / region.cellZ);
+        const int gx = int(std::min(hx, double(cellsX))), gz = int(std::min(hz, double(cellsZ)));
+        col0 = std::max(0, w.col0 - gx);
+        row0 = std::max(0, w.row0 - gz);
+        cols = std::min(cellsX, c1 + gx) - col0 + 1;
+        rows = std::min(cellsZ, r1 + gz) - row0 + 1;
+    };
+    grow(w.halo.metres, w.haloCol0, w.haloRow0, w.haloCols, w.haloRows);
+    grow(w.nearMetres, w.tracedCol0, w.tracedRow0, w.tracedCols, w.tracedRows);
+    w.far = w.tracedCols < w.haloCols || w.tracedRows < w.haloRows;
     return w;
 }
 
@@ -110,8 +122,11 @@ nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const DemGrid&
             {"region_grid", {region.width, region.depth}},
             {"core", {{"col0", w.col0}, {"row0", w.row0}, {"cols", w.cols}, {"rows", w.rows}}},
             {"traced", {{"col0", w.tracedCol0}, {"row0", w.tracedRow0}, {"cols", w.tracedCols}, {"rows", w.tracedRows}}},
+            {"halo_window", {{"col0", w.haloCol0}, {"row0", w.haloRow0}, {"cols", w.haloCols}, {"rows", w.haloRows}}},
             {"bounds_m", {{"min", {x0, z0}}, {"max", {x1, z1}}}},
             {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()},
+            {"near_halo_setting_m", t.nearHaloMetres ? nlohmann::json(*t.nearHaloMetres) : nlohmann::json()},
+            {"near_halo", {{"metres", w.nearMetres}, {"derived", !t.nearHaloMetres}, {"far_from_overview", w.far}}},
             {"halo",
              {{"metres", w.halo.metres},
               {"derived", w.halo.derived},

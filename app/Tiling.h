@@ -23,6 +23,8 @@ struct TileSpec {
     int nx = 1, nz = 1;
     int ix = 0, iz = 0;
     std::optional<double> haloMetres;  // unset: haloFor() derives it from the relief
+    // How much of the halo is read at the DEM's resolution; unset: nearHaloFor() derives it.
+    std::optional<double> nearHaloMetres;
     int index() const { return iz * nx + ix; }
     int count() const { return nx * nz; }
 };
@@ -48,6 +50,16 @@ struct Halo {
 };
 Halo haloFor(const DemGrid& region, const std::optional<double>& metres);
 
+// How much of the halo a tile reads at the DEM's resolution; beyond it the halo is traced on the
+// region's overview (RegionSummary), whose cells are `overviewCell` metres (the larger side). A
+// height error e at distance d moves a receiver's horizon by at most e / d radians, and the
+// cosine-weighted share of the hemisphere below elevation θ, sin²θ, moves by at most that (its
+// derivative, sin 2θ, is at most 1). The overview's area-averaged surface lies within about a
+// cell of the DEM's where the slopes across a cell are under 45°, so from d = overviewCell /
+// kHaloShare (a hundred overview cells) on, it changes a receiver's light by at most kHaloShare.
+// Never wider than the halo; `metres` overrides the rule.
+double nearHaloFor(const Halo& halo, double overviewCell, const std::optional<double>& metres);
+
 // The grid of a heightfield already in memory, as demGrid describes a DEM's.
 inline DemGrid gridOf(const Heightfield& hf) {
     return {hf.width(), hf.depth(), hf.cellSizeX(), hf.cellSizeZ(), hf.minHeight(), hf.maxHeight(), false};
@@ -55,15 +67,22 @@ inline DemGrid gridOf(const Heightfield& hf) {
 
 // A tile's vertex windows in the region's grid. The core: columns [col0, col0 + cols); tiles
 // share their border column and row, so their meshes and probe grids meet without a gap or an
-// overlap. The traced window: the core grown by the halo, clipped to the region.
+// overlap. The traced window: the core grown by the near halo, clipped to the region, read at the
+// DEM's resolution. The halo window: the core grown by the whole halo; where it is wider than the
+// traced window (`far`), the ring between them is traced on the region's overview.
 struct TileWindow {
     int col0 = 0, row0 = 0, cols = 0, rows = 0;
     int tracedCol0 = 0, tracedRow0 = 0, tracedCols = 0, tracedRows = 0;
+    int haloCol0 = 0, haloRow0 = 0, haloCols = 0, haloRows = 0;
     int regionCols = 0, regionRows = 0;  // the region's vertex grid
     Halo halo;
+    double nearMetres = 0.0;
+    bool far = false;
 };
-// Throws std::invalid_argument when the region has fewer than 2 cells a tile along an axis.
-TileWindow tileWindow(const DemGrid& region, const TileSpec& tile);
+// `overviewCell`: the region overview's cell (the larger side), for nearHaloFor; 0 reads the whole
+// halo at the DEM's resolution. Throws std::invalid_argument when the region has fewer than 2
+// cells a tile along an axis.
+TileWindow tileWindow(const DemGrid& region, const TileSpec& tile, double overviewCell = 0.0);
 
 // "tile_003_001": sorts as the seed's merge lists grids (by file name), west to east in a row.
 std::string tileName(const TileSpec& tile);

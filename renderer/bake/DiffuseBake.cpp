@@ -180,8 +180,8 @@ bool hitsWater(const BakeLighting& L, const glm::vec3& o, const glm::vec3& d, fl
     const float t = (L.water->level - o.y) / d.y;
     if (!(t < tMax)) return false;
     at = glm::vec3(o.x + t * d.x, L.water->level, o.z + t * d.z);
-    // Without the skirt nothing continues beyond the footprint, the water neither.
-    return L.tracer->options().skirt || L.tracer->heightfield().contains(at.x, at.z);
+    // Without the skirt nothing continues beyond the ground, the water neither.
+    return L.tracer->reaches(at.x, at.z);
 }
 
 // A direction about `n` with density cos θ / π, from two fresh random numbers.

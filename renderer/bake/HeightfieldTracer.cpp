@@ -183,6 +183,8 @@ const char* HeightfieldTracer::autoKernelName() {
 }
 
 HeightfieldTracer::HeightfieldTracer(const Heightfield& hf, Options opt) : hf_(&hf), opt_(opt) {
+    if (opt.beyond && opt.skirt)
+        throw std::invalid_argument("HeightfieldTracer: terrain beyond the footprint needs the skirt off");
     kernel_ = opt.kernel == Kernel::kAuto ? autoKernel()
               : opt.kernel == Kernel::kX86_64_v3 && cpuHasX86_64_v3() ? Kernel::kX86_64_v3
                                                                       : Kernel::kBaseline;
@@ -528,6 +530,87 @@ void HeightfieldTracer::batchX86_64_v3(const TraceRay* rays, size_t n, RayHit* h
     traceBatch<AnyHit>(rays, n, hits, found);
 }
 
+bool HeightfieldTracer::footprintSpan(const glm::vec3& o, const glm::vec3& dir, double& ta, double& tb) const {
+    if (!std::isfinite(double(o.x) + o.y + o.z + dir.x + dir.y + dir.z))
+        return false;
+    ta = -kInf;
+    tb = kInf;
+    // In grid space, as start() clips a ray without the skirt, so the walk over the footprint
+    // and the segments beyond it meet at the same t.
+    auto clip = [&](double p0, double dp, double hi) {
+        if (dp == 0) {
+            if (p0 < 0 || p0 > hi)
+                tb = -kInf;
+            return;
+        }
+        double a = (0 - p0) / dp, b = (hi - p0) / dp;
+        if (a > b)
+            std::swap(a, b);
+        ta = std::max(ta, a);
+        tb = std::min(tb, b);
+    };
+    clip(hf_->colOf(o.x), double(dir.x) * invCellX_, hf_->width() - 1);
+    clip(hf_->rowOf(o.z), double(dir.z) * invCellZ_, hf_->depth() - 1);
+    return ta <= tb;
+}
+
+template <bool AnyHit>
+bool HeightfieldTracer::traceHere(const glm::vec3& o, const glm::vec3& dir, float tMax, RayHit* hit) const {
+    return kernel_ == Kernel::kX86_64_v3 ? traceX86_64_v3<AnyHit>(o, dir, tMax, hit)
+                                         : traceBaseline<AnyHit>(o, dir, tMax, hit);
+}
+
+template <bool AnyHit>
+bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, double t0, float t1,
+                                    RayHit* hit) const {
+    if (!(t0 < double(t1)))
+        return false;
+    if (t0 <= 0) {
+        if (AnyHit)
+            return opt_.beyond->occluded(o, dir, t1);
+        if (!opt_.beyond->intersect(o, dir, t1, *hit))
+            return false;
+        hit->onTerrain = false;
+        return true;
+    }
+    // From the point where the ray leaves the footprint: `beyond` holds the footprint too, at
+    // its own resolution, and must not see it. Its coarser surface stands above or below this
+    // grid's at the seam, so the ray goes on at the height over the ground it had there: a ray
+    // just over this grid would otherwise start under the coarser ground and end at the seam.
+    glm::vec3 p = o + float(t0) * dir;
+    const float lift = opt_.beyond->heightfield().surfaceHeight(p.x, p.z) - hf_->surfaceHeight(p.x, p.z);
+    p.y += lift;
+    const float tMax = std::isinf(t1) ? t1 : float(double(t1) - t0);
+    if (AnyHit)
+        return opt_.beyond->occluded(p, dir, tMax);
+    if (!opt_.beyond->intersect(p, dir, tMax, *hit))
+        return false;
+    hit->t = float(t0 + double(hit->t));
+    hit->position.y -= lift;
+    hit->onTerrain = false;
+    return true;
+}
+
+template <bool AnyHit>
+bool HeightfieldTracer::throughBeyond(const glm::vec3& o, const glm::vec3& dir, float tMax, bool hereFound,
+                                      RayHit* hit) const {
+    double ta = 0, tb = 0;
+    if (!footprintSpan(o, dir, ta, tb))
+        return traceBeyond<AnyHit>(o, dir, 0.0, tMax, hit);
+    // Before the footprint: nearer than any hit over it.
+    if (ta > 0) {
+        RayHit before;
+        if (traceBeyond<AnyHit>(o, dir, 0.0, float(std::min(ta, double(tMax))), AnyHit ? nullptr : &before)) {
+            if (!AnyHit)
+                *hit = before;
+            return true;
+        }
+    }
+    if (hereFound)
+        return true;
+    return tb < double(tMax) && traceBeyond<AnyHit>(o, dir, std::max(tb, 0.0), tMax, hit);
+}
+
 void HeightfieldTracer::intersect(std::span<const TraceRay> rays, std::span<RayHit> hits,
                                   std::span<uint8_t> found) const {
     if (hits.size() < rays.size() || found.size() < rays.size())
@@ -537,6 +620,9 @@ void HeightfieldTracer::intersect(std::span<const TraceRay> rays, std::span<RayH
         batchX86_64_v3<false>(rays.data(), rays.size(), hits.data(), found.data());
     else
         batchBaseline<false>(rays.data(), rays.size(), hits.data(), found.data());
+    if (opt_.beyond)
+        for (size_t i = 0; i < rays.size(); ++i)
+            found[i] = throughBeyond<false>(rays[i].origin, rays[i].dir, rays[i].tMax, found[i], &hits[i]);
 }
 
 void HeightfieldTracer::occluded(std::span<const TraceRay> rays, std::span<uint8_t> blocked) const {
@@ -547,17 +633,22 @@ void HeightfieldTracer::occluded(std::span<const TraceRay> rays, std::span<uint8
         batchX86_64_v3<true>(rays.data(), rays.size(), nullptr, blocked.data());
     else
         batchBaseline<true>(rays.data(), rays.size(), nullptr, blocked.data());
+    if (opt_.beyond)
+        for (size_t i = 0; i < rays.size(); ++i)
+            blocked[i] = throughBeyond<true>(rays[i].origin, rays[i].dir, rays[i].tMax, blocked[i], nullptr);
 }
 
 bool HeightfieldTracer::intersect(const glm::vec3& origin, const glm::vec3& dir, float tMax,
                                   RayHit& hit) const {
-    return kernel_ == Kernel::kX86_64_v3 ? traceX86_64_v3<false>(origin, dir, tMax, &hit)
-                                         : traceBaseline<false>(origin, dir, tMax, &hit);
+    const bool here = traceHere<false>(origin, dir, tMax, &hit);
+    return opt_.beyond ? throughBeyond<false>(origin, dir, tMax, here, &hit) : here;
 }
 
 bool HeightfieldTracer::occluded(const glm::vec3& origin, const glm::vec3& dir, float tMax) const {
-    return kernel_ == Kernel::kX86_64_v3 ? traceX86_64_v3<true>(origin, dir, tMax, nullptr)
-                                         : traceBaseline<true>(origin, dir, tMax, nullptr);
+    if (!opt_.beyond)
+        return traceHere<true>(origin, dir, tMax, nullptr);
+    // The footprint first: most blocked rays of a tile end there.
+    return throughBeyond<true>(origin, dir, tMax, traceHere<true>(origin, dir, tMax, nullptr), nullptr);
 }
 
 bool intersectBruteForce(const Heightfield& hf, bool skirt, const glm::vec3& origin,

@@ -51,6 +51,12 @@ public:
     struct Options {
         bool skirt = true;
         Kernel kernel = Kernel::kAuto;  // kX86_64_v3 on a CPU without it falls back to baseline
+        // The terrain around this grid at a coarser resolution (a tile's far halo, docs/farm.md),
+        // or null. A ray traces `beyond` over the part of it outside this grid's footprint (before
+        // it enters and after it leaves) and this grid over the footprint, so the nearest hit of
+        // either is the hit; beyond's hits count as the skirt's (onTerrain false). Needs the skirt
+        // off (beyond has its own); must outlive this tracer.
+        const HeightfieldTracer* beyond = nullptr;
     };
     // Whether this CPU (and OS) can run the x86-64-v3 kernel.
     static bool cpuHasX86_64_v3();
@@ -81,6 +87,10 @@ public:
     const Options& options() const { return opt_; }
     // The kernel this tracer runs (never kAuto).
     Kernel kernel() const { return kernel_; }
+    // Whether the ground reaches (x, z): inside the footprint, on the skirt, or over `beyond`.
+    bool reaches(float x, float z) const {
+        return opt_.skirt || hf_->contains(x, z) || (opt_.beyond && opt_.beyond->reaches(x, z));
+    }
     // Number of quadtree levels (level 0 holds one node per cell).
     int levelCount() const { return int(levels_.size()); }
 
@@ -106,6 +116,18 @@ private:
     void prefetch(const Walk& w) const;
     template <bool AnyHit>
     bool trace(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit* hit) const;
+    // The ray's t over this grid's footprint, [ta, tb]; false when it never crosses it.
+    bool footprintSpan(const glm::vec3& origin, const glm::vec3& dir, double& ta, double& tb) const;
+    // The walk over this grid alone, in this tracer's kernel.
+    template <bool AnyHit>
+    bool traceHere(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit* hit) const;
+    // `beyond` along t in (t0, t1] (t0 0: from the origin), the hit's t counted from the origin.
+    template <bool AnyHit>
+    bool traceBeyond(const glm::vec3& origin, const glm::vec3& dir, double t0, float t1, RayHit* hit) const;
+    // With `beyond`: the ray's segments before and after the footprint, given whether (and
+    // where) the footprint's walk hit.
+    template <bool AnyHit>
+    bool throughBeyond(const glm::vec3& origin, const glm::vec3& dir, float tMax, bool hereFound, RayHit* hit) const;
     template <bool AnyHit>
     void traceBatch(const TraceRay* rays, size_t n, RayHit* hits, uint8_t* found) const;
     template <bool AnyHit>

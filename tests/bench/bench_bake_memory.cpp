@@ -230,8 +230,10 @@ fs::path syntheticLidar() {
 }
 
 // One tile of a 4 x 4 cut of the 20 000² DEM, its halo state.range(0) metres (0: derived from the
-// relief, about 10 km here, so the traced window is the whole DEM). Peak memory against the
-// raster the tile traces (rss_per_traced) and against the whole DEM's 1.6 GB.
+// relief, about 10 km here, so the halo window is the whole DEM) and its near halo, read at the DEM's
+// resolution, state.range(1) metres (0: derived from the overview's cells, about 2 km here; beyond
+// it the halo is traced on the overview). Peak memory against the raster the tile reads
+// (rss_per_traced) and against the whole DEM's 1.6 GB.
 void BM_TilePeakMemory(benchmark::State& state) {
     fs::path dem;
     try {
@@ -241,6 +243,7 @@ void BM_TilePeakMemory(benchmark::State& state) {
         return;
     }
     TileSpec tile = parseTiles("4,4", "5/16", state.range(0) > 0 ? std::optional<double>(double(state.range(0))) : std::nullopt);
+    if (state.range(1) > 0) tile.nearHaloMetres = double(state.range(1));
     Measured m;
     for (auto _ : state)
         if (!inChild(state, m, [&] { return measureBake(dem, false, tile); })) return;
@@ -248,7 +251,8 @@ void BM_TilePeakMemory(benchmark::State& state) {
         state.SkipWithError(m.error);
         return;
     }
-    state.SetLabel(state.range(0) ? "halo " + std::to_string(state.range(0)) + " m" : "derived halo");
+    state.SetLabel((state.range(0) ? "halo " + std::to_string(state.range(0)) + " m" : std::string("derived halo")) +
+                   (state.range(1) ? ", near halo " + std::to_string(state.range(1)) + " m" : std::string(", derived near halo")));
     state.counters["traced_MB"] = megabytes(m.raster);
     state.counters["whole_MB"] = megabytes(4.0 * 20000.0 * 20000.0);
     state.counters["heap_MB"] = megabytes(m.heapPeak);
@@ -256,7 +260,14 @@ void BM_TilePeakMemory(benchmark::State& state) {
     state.counters["rss_MB"] = megabytes(m.maxRss);
     state.counters["rss_per_traced"] = m.maxRss / m.raster;
 }
-BENCHMARK(BM_TilePeakMemory)->Arg(500)->Arg(2000)->Arg(0)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_TilePeakMemory)
+    ->Args({500, 0})
+    ->Args({2000, 0})
+    ->Args({0, 0})
+    ->Args({0, 5000})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 }  // namespace
 

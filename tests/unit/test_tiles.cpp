@@ -410,6 +410,8 @@ TEST(Tiles, TheDerivedHaloHoldsEveryProbeOfAMountainTileWithinItsShare) {
         r.project.scene.probeVolumes[0].gridDims = {13, 1, 13};
         r.project.scene.bake.quality = QualityPreset::Draft;
         r.tile = parseTiles("3,3", "0/9", whole ? std::optional<double>(1.0e7) : std::nullopt);
+        // The whole halo at the DEM's resolution: the near halo's rule is the next test's.
+        r.tile->nearHaloMetres = 1.0e7;
         r.project.scene.exportSettings.outDir = (dir / (whole ? "whole" : "derived") / kTilesFolder / "tile_000_000").string();
         const BakeOutcome o = runBake(r, {}, nullptr);
         const nlohmann::json& halo = o.report["tile"]["halo"];
@@ -441,6 +443,63 @@ TEST(Tiles, TheDerivedHaloHoldsEveryProbeOfAMountainTileWithinItsShare) {
               << 100.0 * mean << " %, max " << 100.0 * worst << " %\n";
     EXPECT_GT(relief, 2000.0);
     EXPECT_NEAR(derivedHalo, relief * std::sqrt(99.0), 1.0);
+    EXPECT_LE(worst, kHaloShare);
+    fs::remove_all(dir);
+}
+
+TEST(Tiles, TheHaloBeyondTheNearHaloTracedOnTheOverviewHoldsEveryProbeWithinItsShare) {
+    // The corner tile of N42E001 at the DEM's resolution cut 3 x 3: the derived near halo (a
+    // hundred cells of the region's 1 024-sample overview) is read at the DEM's resolution and the
+    // rest of the halo traced on the overview. Baked again with the whole halo at the DEM's
+    // resolution, the same probes' upward irradiance may differ by what nearHaloFor's rule allows.
+    const fs::path dem = fs::path(TERRALUX_SHARED_DATA) / "dem" / "N42E001.hgt";
+    if (!fs::exists(dem)) GTEST_SKIP() << "shared DEM N42E001.hgt not present";
+    const fs::path dir = freshDir("near_halo");
+    std::map<bool, std::vector<Probe>> probes;
+    std::map<bool, nlohmann::json> tile;
+    for (const bool full : {false, true}) {
+        BakeRequest r{Project{}, 2, false};
+        r.project.scene.terrain.dem = dem.string();
+        r.project.scene.probeVolumes[0].gridDims = {13, 1, 13};
+        r.project.scene.bake.quality = QualityPreset::Draft;
+        r.tile = parseTiles("3,3", "0/9", std::nullopt);
+        if (full) r.tile->nearHaloMetres = 1.0e7;
+        r.project.scene.exportSettings.outDir = (dir / (full ? "full" : "near") / kTilesFolder / "tile_000_000").string();
+        const BakeOutcome o = runBake(r, {}, nullptr);
+        tile[full] = o.report["tile"];
+        probes[full] = probesIn(r.project.scene.exportSettings.outDir);
+    }
+    const nlohmann::json& near = tile[false];
+    const double cell = std::max(near["far_window"]["cell_m"][0].get<double>(), near["far_window"]["cell_m"][1].get<double>());
+    // The overview is coarser than the DEM, and the near halo a hundred of its cells.
+    EXPECT_GT(near["region_grid"][1].get<int>(), kRegionOverview);
+    EXPECT_TRUE(near["near_halo"]["far_from_overview"].get<bool>());
+    EXPECT_NEAR(near["near_halo"]["metres"].get<double>(), cell / kHaloShare, 1e-6);
+    EXPECT_LT(near["near_halo"]["metres"].get<double>(), near["halo"]["metres"].get<double>());
+    // It reads less of the DEM; the other reads the whole halo and traces no overview.
+    const auto cells = [](const nlohmann::json& w) { return w["cols"].get<double>() * w["rows"].get<double>(); };
+    EXPECT_LT(cells(near["traced"]), 0.6 * cells(tile[true]["traced"]));
+    EXPECT_EQ(tile[true]["traced"], tile[true]["halo_window"]);
+    EXPECT_FALSE(tile[true].contains("far_window"));
+    EXPECT_EQ(near["halo_window"], tile[true]["halo_window"]);
+    ASSERT_FALSE(probes[false].empty());
+    ASSERT_EQ(probes[false].size(), probes[true].size());
+    double worst = 0.0, mean = 0.0, changed = 0.0;
+    for (size_t i = 0; i < probes[false].size(); ++i) {
+        ASSERT_LT(glm::distance(probes[false][i].position, probes[true][i].position), 0.05f);
+        const double d = std::abs(probes[false][i].irradiance - probes[true][i].irradiance) / probes[true][i].irradiance;
+        worst = std::max(worst, d);
+        mean += d / double(probes[false].size());
+        changed += d > 0.0;
+    }
+    std::cout << "N42E001 corner tile of 3 x 3 at " << near["region_grid"].dump() << ": halo "
+              << near["halo"]["metres"].get<double>() << " m, near halo " << near["near_halo"]["metres"].get<double>()
+              << " m (overview cell " << cell << " m); DEM cells read " << cells(near["traced"]) << " against "
+              << cells(tile[true]["traced"]) << "; " << probes[false].size() << " probes, " << changed
+              << " changed; upward irradiance against the whole halo at the DEM's resolution: mean " << 100.0 * mean
+              << " %, max " << 100.0 * worst << " %\n";
+    // The far ring is traced: some probe sees it.
+    EXPECT_GT(changed, 0.0);
     EXPECT_LE(worst, kHaloShare);
     fs::remove_all(dir);
 }

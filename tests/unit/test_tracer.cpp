@@ -422,6 +422,89 @@ TEST(HeightfieldTracer, BatchesAgreeWithSingleRays) {
         }
 }
 
+// A tile traces its own window at full resolution and the terrain around it from a coarser grid
+// (Options::beyond). Where that grid is the whole grid the window was cut from, every ray, from
+// inside the window or outside it, single or batched, meets what a tracer of the whole grid meets.
+TEST(HeightfieldTracer, AWindowTracesTheTerrainBeyondItInTheGridAroundIt) {
+    const Heightfield whole = makeRoughDem(161, 133, 20.0, 25.0, 900.0f, 41);
+    const Heightfield window = whole.window(50, 40, 45, 38);
+    const HeightfieldTracer reference(whole);
+    const HeightfieldTracer around(whole);
+    EXPECT_THROW(HeightfieldTracer(window, {true, Kernel::kAuto, &around}), std::invalid_argument);
+    const HeightfieldTracer alone(window, {false});
+    for (Kernel kernel : kernelsHere()) {
+        const HeightfieldTracer tile(window, {false, kernel, &around});
+        std::mt19937 rng(43);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        std::vector<TraceRay> rays;
+        for (int i = 0; i < 4000; ++i) {
+            // Two in three from over the window (a tile's probes), the rest from anywhere.
+            const Heightfield& over = i % 3 ? window : whole;
+            const float x = over.minX() + u01(rng) * (over.maxX() - over.minX());
+            const float z = over.minZ() + u01(rng) * (over.maxZ() - over.minZ());
+            const glm::vec3 o(x, whole.surfaceHeight(x, z) + std::pow(10.0f, 5.0f * u01(rng) - 1.0f), z);
+            rays.push_back({o, randomDir(rng), i % 4 == 0 ? 4000.0f * u01(rng) : kInf});
+        }
+        std::vector<RayHit> hits(rays.size());
+        std::vector<uint8_t> found(rays.size()), blocked(rays.size());
+        tile.intersect(rays, hits, found);
+        tile.occluded(rays, blocked);
+        int hitMiss = 0, tOff = 0, batchDiffers = 0, beyondHits = 0, escapeAlone = 0, hitCount = 0;
+        for (size_t i = 0; i < rays.size(); ++i) {
+            const TraceRay& r = rays[i];
+            RayHit a, b, c;
+            const bool ha = tile.intersect(r.origin, r.dir, r.tMax, a);
+            const bool hb = reference.intersect(r.origin, r.dir, r.tMax, b);
+            hitCount += hb;
+            hitMiss += ha != hb;
+            if (ha && hb && !tAgrees(a.t, b.t)) ++tOff;
+            batchDiffers += found[i] != uint8_t(ha) || blocked[i] != uint8_t(tile.occluded(r.origin, r.dir, r.tMax)) ||
+                            (ha && (hits[i].t != a.t || hits[i].onTerrain != a.onTerrain));
+            if (ha && !a.onTerrain) {
+                ++beyondHits;
+                // The grid around it answers outside the window only.
+                EXPECT_FALSE(a.position.x > window.minX() + 1.0f && a.position.x < window.maxX() - 1.0f &&
+                             a.position.z > window.minZ() + 1.0f && a.position.z < window.maxZ() - 1.0f);
+            }
+            escapeAlone += hb && !alone.intersect(r.origin, r.dir, r.tMax, c);
+        }
+        EXPECT_EQ(hitMiss, 0) << kernelName(kernel);
+        EXPECT_EQ(tOff, 0) << kernelName(kernel);
+        EXPECT_EQ(batchDiffers, 0) << kernelName(kernel);
+        // The rays exercise both sides: hits beyond the window that the window alone would miss.
+        EXPECT_GT(hitCount, 1000);
+        EXPECT_GT(beyondHits, 200);
+        EXPECT_GT(escapeAlone, 200);
+        EXPECT_TRUE(tile.reaches(whole.maxX(), whole.maxZ() + 1e6f));
+        EXPECT_FALSE(alone.reaches(whole.maxX(), whole.maxZ()));
+    }
+}
+
+// Where the grid around a window stands above (or below) the window's own surface at the seam, a
+// ray goes on over it at the height above the ground it had when it left the window: a level window
+// at 0 m inside a level grid at 3 m, a ray leaving the window 1 m up and descending meets the ground
+// where it would have met the window's plane continued, and a rising one escapes.
+TEST(HeightfieldTracer, ARayLeavingAWindowKeepsItsHeightOverTheGroundAroundIt) {
+    const Heightfield aroundHf(41, 41, 50.0, 50.0, std::vector<float>(41 * 41, 3.0f));
+    const Heightfield inner(21, 21, 10.0, 10.0, std::vector<float>(21 * 21, 0.0f));
+    const HeightfieldTracer around(aroundHf);
+    const HeightfieldTracer tile(inner, {false, Kernel::kAuto, &around});
+    const glm::vec3 o(90.0f, 1.0f, 20.0f);  // 10 m inside the window's east edge (x = 100 m)
+    for (const float slope : {0.002f, 0.01f, 0.05f}) {
+        const glm::vec3 down = glm::normalize(glm::vec3(1.0f, -slope, 0.0f));
+        RayHit hit;
+        ASSERT_TRUE(tile.intersect(o, down, kInf, hit)) << slope;
+        // Beyond the window: 1 m of descent at that slope.
+        EXPECT_NEAR(hit.t, 1.0f / -down.y, 1e-3f * hit.t) << slope;
+        EXPECT_NEAR(hit.position.y, 0.0f, 1e-3f) << slope;
+        EXPECT_FALSE(hit.onTerrain);
+        EXPECT_TRUE(tile.occluded(o, down, kInf));
+        const glm::vec3 up = glm::normalize(glm::vec3(1.0f, slope, 0.0f));
+        EXPECT_FALSE(tile.intersect(o, up, kInf, hit)) << slope;
+        EXPECT_FALSE(tile.occluded(o, up, kInf)) << slope;
+    }
+}
+
 // kAuto resolves to a real kernel: the CPU's best unless TERRALUX_TRACER_KERNEL pins the
 // baseline; asking for x86-64-v3 where the CPU lacks it gives the baseline.
 TEST(HeightfieldTracer, KernelChoice) {
