@@ -139,6 +139,21 @@ TLX_WALK_INLINE int startIndex(double p, int cells) {
     return int(std::clamp(std::floor(p), 0.0, double(cells - 1)));
 }
 
+// One axis of the footprint's slab test: narrows [lo, hi], a ray's t, to where its grid
+// coordinate p0 + t·dp lies in [0, extent]; hi becomes -inf where it never does.
+TLX_WALK_INLINE void clipToSlab(double p0, double dp, double extent, double& lo, double& hi) {
+    if (dp == 0) {
+        if (p0 < 0 || p0 > extent)
+            hi = -kInf;
+        return;
+    }
+    double a = (0 - p0) / dp, b = (extent - p0) / dp;
+    if (a > b)
+        std::swap(a, b);
+    lo = std::max(lo, a);
+    hi = std::min(hi, b);
+}
+
 glm::vec3 pieceNormal(const Piece& p, double cellX, double cellZ) {
     const double nx = -p.gu / cellX, nz = -p.gv / cellZ;
     const double inv = 1.0 / std::sqrt(nx * nx + 1.0 + nz * nz);
@@ -312,20 +327,8 @@ TLX_WALK_INLINE bool HeightfieldTracer::start(Walk& w, const glm::vec3& o, const
     if (!opt_.skirt) {
         if (!hasTriangles_)
             return false;
-        auto clip = [&](double p0, double dp, double hi) {
-            if (dp == 0) {
-                if (p0 < 0 || p0 > hi)
-                    tEnd = -1;
-                return;
-            }
-            double ta = (0 - p0) / dp, tb = (hi - p0) / dp;
-            if (ta > tb)
-                std::swap(ta, tb);
-            t = std::max(t, ta);
-            tEnd = std::min(tEnd, tb);
-        };
-        clip(ray.u0, ray.du, hf.width() - 1);
-        clip(ray.v0, ray.dv, hf.depth() - 1);
+        clipToSlab(ray.u0, ray.du, hf.width() - 1, t, tEnd);
+        clipToSlab(ray.v0, ray.dv, hf.depth() - 1, t, tEnd);
         if (!(t <= tEnd))
             return false;
     }
@@ -537,20 +540,8 @@ bool HeightfieldTracer::footprintSpan(const glm::vec3& o, const glm::vec3& dir, 
     tb = kInf;
     // In grid space, as start() clips a ray without the skirt, so the walk over the footprint
     // and the segments beyond it meet at the same t.
-    auto clip = [&](double p0, double dp, double hi) {
-        if (dp == 0) {
-            if (p0 < 0 || p0 > hi)
-                tb = -kInf;
-            return;
-        }
-        double a = (0 - p0) / dp, b = (hi - p0) / dp;
-        if (a > b)
-            std::swap(a, b);
-        ta = std::max(ta, a);
-        tb = std::min(tb, b);
-    };
-    clip(hf_->colOf(o.x), double(dir.x) * invCellX_, hf_->width() - 1);
-    clip(hf_->rowOf(o.z), double(dir.z) * invCellZ_, hf_->depth() - 1);
+    clipToSlab(hf_->colOf(o.x), double(dir.x) * invCellX_, hf_->width() - 1, ta, tb);
+    clipToSlab(hf_->rowOf(o.z), double(dir.z) * invCellZ_, hf_->depth() - 1, ta, tb);
     return ta <= tb;
 }
 
