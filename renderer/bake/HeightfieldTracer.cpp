@@ -552,11 +552,11 @@ bool HeightfieldTracer::traceHere(const glm::vec3& o, const glm::vec3& dir, floa
 }
 
 template <bool AnyHit>
-bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, double t0, float t1,
+bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, double t0, float t1, bool leaving,
                                     RayHit* hit) const {
     if (!(t0 < double(t1)))
         return false;
-    if (t0 <= 0) {
+    if (!leaving) {
         if (AnyHit)
             return opt_.beyond->occluded(o, dir, t1);
         if (!opt_.beyond->intersect(o, dir, t1, *hit))
@@ -568,6 +568,7 @@ bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, do
     // its own resolution, and must not see it. Its coarser surface stands above or below this
     // grid's at the seam, so the ray goes on at the height over the ground it had there: a ray
     // just over this grid would otherwise start under the coarser ground and end at the seam.
+    // (A ray from the footprint's very edge leaves it at t0 = 0.)
     glm::vec3 p = o + float(t0) * dir;
     const float lift = opt_.beyond->heightfield().surfaceHeight(p.x, p.z) - hf_->surfaceHeight(p.x, p.z);
     p.y += lift;
@@ -586,12 +587,16 @@ template <bool AnyHit>
 bool HeightfieldTracer::throughBeyond(const glm::vec3& o, const glm::vec3& dir, float tMax, bool hereFound,
                                       RayHit* hit) const {
     double ta = 0, tb = 0;
-    if (!footprintSpan(o, dir, ta, tb))
-        return traceBeyond<AnyHit>(o, dir, 0.0, tMax, hit);
+    // An origin on the footprint's edge (a probe on a region's border) is on it whichever side
+    // rounding puts it: within the distance the walk ignores for a ray's own surface.
+    const double edge = minDistance(o);
+    // A ray that never crosses the footprint ahead of its origin is beyond's alone.
+    if (!footprintSpan(o, dir, ta, tb) || tb < -edge)
+        return traceBeyond<AnyHit>(o, dir, 0.0, tMax, false, hit);
     // Before the footprint: nearer than any hit over it.
-    if (ta > 0) {
+    if (ta > edge) {
         RayHit before;
-        if (traceBeyond<AnyHit>(o, dir, 0.0, float(std::min(ta, double(tMax))), AnyHit ? nullptr : &before)) {
+        if (traceBeyond<AnyHit>(o, dir, 0.0, float(std::min(ta, double(tMax))), false, AnyHit ? nullptr : &before)) {
             if (!AnyHit)
                 *hit = before;
             return true;
@@ -599,7 +604,7 @@ bool HeightfieldTracer::throughBeyond(const glm::vec3& o, const glm::vec3& dir, 
     }
     if (hereFound)
         return true;
-    return tb < double(tMax) && traceBeyond<AnyHit>(o, dir, std::max(tb, 0.0), tMax, hit);
+    return tb < double(tMax) && traceBeyond<AnyHit>(o, dir, std::max(tb, 0.0), tMax, true, hit);
 }
 
 void HeightfieldTracer::intersect(std::span<const TraceRay> rays, std::span<RayHit> hits,

@@ -121,9 +121,11 @@ private:
     // The walk over this grid alone, in this tracer's kernel.
     template <bool AnyHit>
     bool traceHere(const glm::vec3& origin, const glm::vec3& dir, float tMax, RayHit* hit) const;
-    // `beyond` along t in (t0, t1] (t0 0: from the origin), the hit's t counted from the origin.
+    // `beyond` along t in (t0, t1], the hit's t counted from the origin; `leaving`: t0 is where
+    // the ray leaves the footprint, and it goes on at its height over the ground there.
     template <bool AnyHit>
-    bool traceBeyond(const glm::vec3& origin, const glm::vec3& dir, double t0, float t1, RayHit* hit) const;
+    bool traceBeyond(const glm::vec3& origin, const glm::vec3& dir, double t0, float t1, bool leaving,
+                     RayHit* hit) const;
     // With `beyond`: the ray's segments before and after the footprint, given whether (and
     // where) the footprint's walk hit.
     template <bool AnyHit>

@@ -489,19 +489,21 @@ TEST(HeightfieldTracer, ARayLeavingAWindowKeepsItsHeightOverTheGroundAroundIt) {
     const Heightfield inner(21, 21, 10.0, 10.0, std::vector<float>(21 * 21, 0.0f));
     const HeightfieldTracer around(aroundHf);
     const HeightfieldTracer tile(inner, {false, Kernel::kAuto, &around});
-    const glm::vec3 o(90.0f, 1.0f, 20.0f);  // 10 m inside the window's east edge (x = 100 m)
-    for (const float slope : {0.002f, 0.01f, 0.05f}) {
-        const glm::vec3 down = glm::normalize(glm::vec3(1.0f, -slope, 0.0f));
-        RayHit hit;
-        ASSERT_TRUE(tile.intersect(o, down, kInf, hit)) << slope;
-        // Beyond the window: 1 m of descent at that slope.
-        EXPECT_NEAR(hit.t, 1.0f / -down.y, 1e-3f * hit.t) << slope;
-        EXPECT_NEAR(hit.position.y, 0.0f, 1e-3f) << slope;
-        EXPECT_FALSE(hit.onTerrain);
-        EXPECT_TRUE(tile.occluded(o, down, kInf));
-        const glm::vec3 up = glm::normalize(glm::vec3(1.0f, slope, 0.0f));
-        EXPECT_FALSE(tile.intersect(o, up, kInf, hit)) << slope;
-        EXPECT_FALSE(tile.occluded(o, up, kInf)) << slope;
+    // 10 m inside the window's east edge (x = 100 m), and on it (a probe on a region's border).
+    for (const glm::vec3 o : {glm::vec3(90.0f, 1.0f, 20.0f), glm::vec3(100.0f, 1.0f, 20.0f)}) {
+        for (const float slope : {0.002f, 0.01f, 0.05f}) {
+            const glm::vec3 down = glm::normalize(glm::vec3(1.0f, -slope, 0.0f));
+            RayHit hit;
+            ASSERT_TRUE(tile.intersect(o, down, kInf, hit)) << slope;
+            // Beyond the window: 1 m of descent at that slope.
+            EXPECT_NEAR(hit.t, 1.0f / -down.y, 1e-3f * hit.t) << slope;
+            EXPECT_NEAR(hit.position.y, 0.0f, 1e-3f) << slope;
+            EXPECT_FALSE(hit.onTerrain);
+            EXPECT_TRUE(tile.occluded(o, down, kInf));
+            const glm::vec3 up = glm::normalize(glm::vec3(1.0f, slope, 0.0f));
+            EXPECT_FALSE(tile.intersect(o, up, kInf, hit)) << slope;
+            EXPECT_FALSE(tile.occluded(o, up, kInf)) << slope;
+        }
     }
 }
 
