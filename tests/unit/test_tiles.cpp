@@ -504,6 +504,56 @@ TEST(Tiles, TheHaloBeyondTheNearHaloTracedOnTheOverviewHoldsEveryProbeWithinItsS
     fs::remove_all(dir);
 }
 
+TEST(Tiles, ANearHaloReadsLessOfTheDemAndTracesTheRestOnTheOverview) {
+    // The committed crop is smaller than the overview's 1 024 samples, so the overview is the grid
+    // itself and the ring beyond the near halo keeps its geometry: a near halo of 150 m (5 cells)
+    // reads about a third of the halo's cells, traces the rest on the overview, and its probes
+    // match the whole halo read at the DEM's resolution within the sampling noise of the difference.
+    const fs::path dir = freshDir("near_halo_crop");
+    std::map<bool, std::vector<Probe>> probes;
+    std::map<bool, nlohmann::json> tile;
+    for (const bool full : {false, true}) {
+        BakeRequest r{regionProject(dir / (full ? "full" : "near")), 2, false};
+        r.tile = parseTiles("2,2", "3/4", std::nullopt);
+        r.tile->nearHaloMetres = full ? 1.0e7 : 150.0;
+        r.project.scene.exportSettings.outDir = (dir / (full ? "full" : "near") / kTilesFolder / tileName(*r.tile)).string();
+        const BakeOutcome o = runBake(r, {}, nullptr);
+        tile[full] = o.report["tile"];
+        probes[full] = probesIn(r.project.scene.exportSettings.outDir);
+    }
+    const nlohmann::json& near = tile[false];
+    EXPECT_TRUE(near["near_halo"]["far_from_overview"].get<bool>());
+    EXPECT_FALSE(near["near_halo"]["derived"].get<bool>());
+    EXPECT_DOUBLE_EQ(near["near_halo"]["metres"].get<double>(), 150.0);
+    EXPECT_FALSE(tile[true]["near_halo"]["far_from_overview"].get<bool>());
+    EXPECT_FALSE(tile[true].contains("far_window"));
+    // The overview over the whole halo: here the region, at the grid's own cells.
+    EXPECT_EQ(near["far_window"]["cols"], near["region_grid"][0]);
+    EXPECT_EQ(near["far_window"]["rows"], near["region_grid"][1]);
+    const auto cells = [](const nlohmann::json& w) { return w["cols"].get<double>() * w["rows"].get<double>(); };
+    EXPECT_LT(cells(near["traced"]), 0.6 * cells(tile[true]["traced"]));
+    ASSERT_FALSE(probes[false].empty());
+    ASSERT_EQ(probes[false].size(), probes[true].size());
+    double mean = 0.0, worst = 0.0, changed = 0.0;
+    for (size_t i = 0; i < probes[false].size(); ++i) {
+        const Probe& a = probes[false][i];
+        const Probe& b = probes[true][i];
+        ASSERT_LT(glm::distance(a.position, b.position), 0.05f);
+        // The standard error of the difference of two independent estimates.
+        const double se = std::hypot(double(a.se) * a.irradiance, double(b.se) * b.irradiance);
+        const double ratio = std::abs(double(a.irradiance) - b.irradiance) / se;
+        mean += ratio / double(probes[false].size());
+        worst = std::max(worst, ratio);
+        changed += a.irradiance != b.irradiance;
+    }
+    std::cout << "near halo 150 m against the whole halo: " << probes[false].size() << " probes, " << changed
+              << " changed; |difference| / its standard error mean " << mean << ", max " << worst << "\n";
+    EXPECT_GT(changed, 0.0);
+    EXPECT_LT(mean, 0.5);
+    EXPECT_LT(worst, 2.0);
+    fs::remove_all(dir);
+}
+
 TEST(Tiles, TheMergeListsEachLightingScenarioInTheOrderOfTheGrids) {
     // Two tiles of the crop with a dusk scenario beside the default: the merged scene's
     // TERRALUX_lighting.scenarios lists, per scenario, every tile's file in the order of the
