@@ -19,7 +19,8 @@ std::optional<nlohmann::json> readJson(const std::filesystem::path& file) {
 // What makes two bakes of a tile the same tile: the cut, its place and the halos asked for.
 nlohmann::json tileKey(const nlohmann::json& tile) {
     return {tile.value("tiles", nlohmann::json()), tile.value("ix", -1), tile.value("iz", -1),
-            tile.value("halo_setting_m", nlohmann::json()), tile.value("near_halo_setting_m", nlohmann::json())};
+            tile.value("halo_setting_m", nlohmann::json()), tile.value("near_halo_setting_m", nlohmann::json()),
+            tile.value("contract", 1)};
 }
 
 }  // namespace
@@ -33,7 +34,8 @@ std::optional<std::string> unchangedTile(const BakeRequest& request) {
     const TileSpec& t = *request.tile;
     const nlohmann::json now = {{"tiles", {t.nx, t.nz}}, {"ix", t.ix}, {"iz", t.iz},
                                 {"halo_setting_m", t.haloMetres ? nlohmann::json(*t.haloMetres) : nlohmann::json()},
-                                {"near_halo_setting_m", t.nearHaloMetres ? nlohmann::json(*t.nearHaloMetres) : nlohmann::json()}};
+                                {"near_halo_setting_m", t.nearHaloMetres ? nlohmann::json(*t.nearHaloMetres) : nlohmann::json()},
+                                {"contract", kTileContract}};
     if (tileKey((*report)["tile"]) != tileKey(now)) return std::nullopt;
     if (!bakeInputDifferences((*report)["inputs"], bakeInputs(request.project)).empty()) return std::nullopt;
     std::error_code ec;
@@ -376,6 +378,9 @@ MergeOutcome mergeTiles(const fs::path& dirIn) {
         const nlohmann::json& tile = t.report["tile"];
         std::string why;
         if (tile["tiles"] != first["tile"]["tiles"]) why = "cut " + tile["tiles"].dump() + ", not " + first["tile"]["tiles"].dump();
+        else if (tile.value("contract", 1) != first["tile"].value("contract", 1))
+            why = "tile contract " + std::to_string(tile.value("contract", 1)) + ", not " +
+                  std::to_string(first["tile"].value("contract", 1));
         else if (tile.value("halo_setting_m", nlohmann::json()) != first["tile"].value("halo_setting_m", nlohmann::json()))
             why = "halo " + tile.value("halo_setting_m", nlohmann::json()).dump();
         else if (tile.value("near_halo_setting_m", nlohmann::json()) != first["tile"].value("near_halo_setting_m", nlohmann::json()))

@@ -115,6 +115,7 @@ nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const DemGrid&
     const float x0 = xOf(w.col0), x1 = xOf(w.col0 + w.cols - 1);
     const float z0 = zOf(w.row0), z1 = zOf(w.row0 + w.rows - 1);
     return {{"name", tileName(t)},
+            {"contract", kTileContract},
             {"tiles", {t.nx, t.nz}},
             {"index", t.index()},
             {"ix", t.ix},

@@ -87,7 +87,13 @@ TileWindow tileWindow(const DemGrid& region, const TileSpec& tile, double overvi
 // "tile_003_001": sorts as the seed's merge lists grids (by file name), west to east in a row.
 std::string tileName(const TileSpec& tile);
 
-// What a tile's bake_report.json records under "tile": the cut, the windows and the halo rule.
+// What a tile's bake reads and traces, beyond its settings: 2 since the halo past the near halo
+// is traced on the region's overview. A tile baked under another contract is baked again, and a
+// merge refuses to mix them.
+inline constexpr int kTileContract = 2;
+
+// What a tile's bake_report.json records under "tile": the cut, the windows, the halo rules and
+// the contract.
 nlohmann::json tileReport(const TileSpec& tile, const TileWindow& w, const DemGrid& region);
 
 }  // namespace terralux

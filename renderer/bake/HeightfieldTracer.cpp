@@ -570,6 +570,8 @@ bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, do
     // just over this grid would otherwise start under the coarser ground and end at the seam.
     // (A ray from the footprint's very edge leaves it at t0 = 0.)
     glm::vec3 p = o + float(t0) * dir;
+    if (!std::isfinite(p.x + p.y + p.z))
+        return false;
     const float lift = opt_.beyond->heightfield().surfaceHeight(p.x, p.z) - hf_->surfaceHeight(p.x, p.z);
     p.y += lift;
     const float tMax = std::isinf(t1) ? t1 : float(double(t1) - t0);
@@ -586,15 +588,25 @@ bool HeightfieldTracer::traceBeyond(const glm::vec3& o, const glm::vec3& dir, do
 template <bool AnyHit>
 bool HeightfieldTracer::throughBeyond(const glm::vec3& o, const glm::vec3& dir, float tMax, bool hereFound,
                                       RayHit* hit) const {
-    double ta = 0, tb = 0;
-    // An origin on the footprint's edge (a probe on a region's border) is on it whichever side
-    // rounding puts it: within the distance the walk ignores for a ray's own surface.
+    if (!(tMax > 0.0f))
+        return hereFound;
+    // An origin on the footprint's edge (a probe on a region's border, a cache point lifted off
+    // the ground there) counts as on it whichever side rounding or the lift puts it: within
+    // twice what a secondary ray's origin is lifted by (1e-5 of its largest coordinate + 1 cm).
+    const float m = std::max({std::fabs(o.x), std::fabs(o.y), std::fabs(o.z)});
+    const double tolerance = 2.0 * (1e-5 * double(m) + 1e-2);
+    const double outside = std::max({double(hf_->minX()) - o.x, double(o.x) - hf_->maxX(),
+                                     double(hf_->minZ()) - o.z, double(o.z) - hf_->maxZ(), 0.0});
+    const bool onEdge = outside <= tolerance;
     const double edge = minDistance(o);
-    // A ray that never crosses the footprint ahead of its origin is beyond's alone.
+    double ta = 0, tb = 0;
+    // A ray that never crosses the footprint ahead of its origin is beyond's alone; from the
+    // edge, it leaves at once.
     if (!footprintSpan(o, dir, ta, tb) || tb < -edge)
-        return traceBeyond<AnyHit>(o, dir, 0.0, tMax, false, hit);
-    // Before the footprint: nearer than any hit over it.
-    if (ta > edge) {
+        return traceBeyond<AnyHit>(o, dir, 0.0, tMax, onEdge, hit);
+    // Before the footprint: nearer than any hit over it. (From the edge there is none: the ray
+    // is already over the footprint's ground.)
+    if (ta > edge && !onEdge) {
         RayHit before;
         if (traceBeyond<AnyHit>(o, dir, 0.0, float(std::min(ta, double(tMax))), false, AnyHit ? nullptr : &before)) {
             if (!AnyHit)
@@ -604,7 +616,9 @@ bool HeightfieldTracer::throughBeyond(const glm::vec3& o, const glm::vec3& dir, 
     }
     if (hereFound)
         return true;
-    return tb < double(tMax) && traceBeyond<AnyHit>(o, dir, std::max(tb, 0.0), tMax, true, hit);
+    // Past FLT_MAX no hit can be reported (hit.t is a float).
+    return tb < double(tMax) && tb < double(FLT_MAX) &&
+           traceBeyond<AnyHit>(o, dir, std::max(tb, 0.0), tMax, true, hit);
 }
 
 void HeightfieldTracer::intersect(std::span<const TraceRay> rays, std::span<RayHit> hits,

@@ -520,6 +520,19 @@ TEST(Tiles, ANearHaloReadsLessOfTheDemAndTracesTheRestOnTheOverview) {
         const BakeOutcome o = runBake(r, {}, nullptr);
         tile[full] = o.report["tile"];
         probes[full] = probesIn(r.project.scene.exportSettings.outDir);
+        if (!full) {
+            // Baked again only for another near halo, or when baked under an earlier contract
+            // (which read the whole halo at the DEM's resolution).
+            EXPECT_NE(unchangedTile(r), std::nullopt);
+            BakeRequest other = r;
+            other.tile->nearHaloMetres = 200.0;
+            EXPECT_EQ(unchangedTile(other), std::nullopt);
+            const fs::path report = fs::path(r.project.scene.exportSettings.outDir) / "bake_report.json";
+            nlohmann::json j = nlohmann::json::parse(std::ifstream(report));
+            j["tile"].erase("contract");
+            std::ofstream(report) << j.dump();
+            EXPECT_EQ(unchangedTile(r), std::nullopt);
+        }
     }
     const nlohmann::json& near = tile[false];
     EXPECT_TRUE(near["near_halo"]["far_from_overview"].get<bool>());

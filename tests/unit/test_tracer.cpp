@@ -489,11 +489,20 @@ TEST(HeightfieldTracer, ARayLeavingAWindowKeepsItsHeightOverTheGroundAroundIt) {
     const Heightfield inner(21, 21, 10.0, 10.0, std::vector<float>(21 * 21, 0.0f));
     const HeightfieldTracer around(aroundHf);
     const HeightfieldTracer tile(inner, {false, Kernel::kAuto, &around});
-    // 10 m inside the window's east edge (x = 100 m), and on it (a probe on a region's border).
-    for (const glm::vec3 o : {glm::vec3(90.0f, 1.0f, 20.0f), glm::vec3(100.0f, 1.0f, 20.0f)}) {
+    // 10 m inside the window's east edge (x = 100 m), on it (a probe on a region's border), and
+    // 1.5 cm past it (a cache point there, lifted off the ground along its normal).
+    const glm::vec3 origins[] = {{90.0f, 1.0f, 20.0f}, {100.0f, 1.0f, 20.0f}, {100.015f, 1.0f, 20.0f}};
+    for (const glm::vec3 o : origins) {
+        // Straight down and straight up: no crossing of the window ahead, yet the ray starts over it.
+        RayHit hit;
+        ASSERT_TRUE(tile.intersect(o, glm::vec3(0.0f, -1.0f, 0.0f), kInf, hit));
+        EXPECT_NEAR(hit.t, 1.0f, 1e-3f);
+        EXPECT_FALSE(tile.occluded(o, glm::vec3(0.0f, 1.0f, 0.0f), kInf));
+        // Nearly parallel to the edge: the window is left only past FLT_MAX.
+        EXPECT_FALSE(tile.intersect(o, glm::vec3(0.0f, 1.0f, 1e-36f), kInf, hit));
+        EXPECT_FALSE(tile.intersect(o, glm::vec3(1.0f, 0.0f, 0.0f), std::nanf(""), hit));
         for (const float slope : {0.002f, 0.01f, 0.05f}) {
             const glm::vec3 down = glm::normalize(glm::vec3(1.0f, -slope, 0.0f));
-            RayHit hit;
             ASSERT_TRUE(tile.intersect(o, down, kInf, hit)) << slope;
             // Beyond the window: 1 m of descent at that slope.
             EXPECT_NEAR(hit.t, 1.0f / -down.y, 1e-3f * hit.t) << slope;
