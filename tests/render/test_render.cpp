@@ -986,6 +986,12 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     auto sweepOf = [&](double azimuth) {
         return sunHorizonVisibility(r.heightfield(), sunDirection(azimuth, 5.0), float(0.27 * std::numbers::pi / 180.0), true);
     };
+    // An edit of the sun's azimuth, then one viewport frame (which starts its map's sweep).
+    auto sunTo = [&](double azimuth) {
+        p.scene.sun.azimuthDeg = azimuth;
+        r.setProject(p);
+        return r.render(viewport);
+    };
     auto waitForSweep = [&] {
         for (int i = 0; i < 20000 && !t.sunHorizonSwept(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
         return t.sunHorizonSwept();
@@ -996,9 +1002,7 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     const std::vector<float> first = t.sunHorizonMap();
     ASSERT_EQ(first, sweepOf(135.0));
 
-    p.scene.sun.azimuthDeg = 150.0;
-    r.setProject(p);
-    const RenderedImage held = r.render(viewport);
+    const RenderedImage held = sunTo(150.0);
     EXPECT_TRUE(t.sunHorizonSweeping());
     EXPECT_EQ(t.sunHorizonSweeps(), 1u);
     EXPECT_EQ(t.sunHorizonMap(), first);
@@ -1014,9 +1018,7 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     EXPECT_EQ(test::compareImages(r.render(waits).rgba, swept.rgba, kW, kH).maxAbs, 0.0);
 
     // Two edits while a sweep runs: the frames converge on the last sun.
-    p.scene.sun.azimuthDeg = 165.0;
-    r.setProject(p);
-    r.render(viewport);
+    sunTo(165.0);
     p.scene.sun.azimuthDeg = 180.0;
     r.setProject(p);
     for (int frame = 0; frame < 4 && t.sunHorizonSweeping(); ++frame) {
@@ -1026,17 +1028,13 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     EXPECT_FALSE(t.sunHorizonSweeping());
     EXPECT_EQ(t.sunHorizonMap(), sweepOf(180.0));
     // A frame that waits, with a sweep under way: its own sun's map at once.
-    p.scene.sun.azimuthDeg = 200.0;
-    r.setProject(p);
-    r.render(viewport);
+    sunTo(200.0);
     EXPECT_TRUE(t.sunHorizonSweeping());
     r.render(waits);
     EXPECT_FALSE(t.sunHorizonSweeping());
     EXPECT_EQ(t.sunHorizonMap(), sweepOf(200.0));
     // The sun back where the map held was swept while another sweep ran: the map held stays.
-    p.scene.sun.azimuthDeg = 215.0;
-    r.setProject(p);
-    r.render(viewport);
+    sunTo(215.0);
     p.scene.sun.azimuthDeg = 200.0;
     r.setProject(p);
     ASSERT_TRUE(waitForSweep());
@@ -1044,9 +1042,7 @@ TEST_F(RenderTest, AViewportFrameDrawsTheHorizonMapHeldWhileTheNextIsSwept) {
     EXPECT_FALSE(t.sunHorizonSweeping());
     EXPECT_EQ(t.sunHorizonMap(), sweepOf(200.0));
     // A view that reads no horizon map lets a finished sweep go, so the viewport stops waiting.
-    p.scene.sun.azimuthDeg = 230.0;
-    r.setProject(p);
-    r.render(viewport);
+    sunTo(230.0);
     ASSERT_TRUE(waitForSweep());
     RenderRequest albedo = viewport;
     albedo.debugView = kViewAlbedo;
