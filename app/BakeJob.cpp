@@ -141,18 +141,11 @@ void prepare(const Project& project, BakeSetup& b, const std::function<void(cons
         b.terrain.heightfield =
             b.tracedTerrain->window(w.col0 - w.tracedCol0, w.row0 - w.tracedRow0, w.cols, w.rows);
         if (w.far) {
-            // The overview's cells over the halo window, rounded outward: both are in the region's
-            // engine space, so they need no transform.
-            auto xOf = [&](int c) { return (c - 0.5 * (grid.width - 1)) * grid.cellX; };
-            auto zOf = [&](int r) { return (r - 0.5 * (grid.depth - 1)) * grid.cellZ; };
-            const int oc0 = std::clamp(int(std::floor(overview.colOf(xOf(w.haloCol0)))), 0, overview.width() - 2);
-            const int or0 = std::clamp(int(std::floor(overview.rowOf(zOf(w.haloRow0)))), 0, overview.depth() - 2);
-            const int oc1 = std::clamp(int(std::ceil(overview.colOf(xOf(w.haloCol0 + w.haloCols - 1)))), oc0 + 1, overview.width() - 1);
-            const int or1 = std::clamp(int(std::ceil(overview.rowOf(zOf(w.haloRow0 + w.haloRows - 1)))), or0 + 1, overview.depth() - 1);
-            b.farTerrain = std::make_unique<Heightfield>(overview.window(oc0, or0, oc1 - oc0 + 1, or1 - or0 + 1));
+            const GridWindow o = overviewWindow(w, grid, overview);
+            b.farTerrain = std::make_unique<Heightfield>(overview.window(o.col0, o.row0, o.cols, o.rows));
             b.farTracer = std::make_unique<HeightfieldTracer>(*b.farTerrain,
                                                               HeightfieldTracer::Options{project.scene.terrain.skirt});
-            b.tileReport["far_window"] = {{"col0", oc0}, {"row0", or0}, {"cols", oc1 - oc0 + 1}, {"rows", or1 - or0 + 1},
+            b.tileReport["far_window"] = {{"col0", o.col0}, {"row0", o.row0}, {"cols", o.cols}, {"rows", o.rows},
                                           {"cell_m", {overview.cellSizeX(), overview.cellSizeZ()}}};
         }
         b.tileReport["region_summary"] = region.cached ? "read" : "computed";

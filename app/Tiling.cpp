@@ -102,6 +102,16 @@ TileWindow tileWindow(const DemGrid& region, const TileSpec& t, double overviewC
     return w;
 }
 
+GridWindow overviewWindow(const TileWindow& w, const DemGrid& region, const Heightfield& overview) {
+    const int c0 = std::clamp(int(std::floor(overview.colOf(regionX(region, w.haloCol0)))), 0, overview.width() - 2);
+    const int r0 = std::clamp(int(std::floor(overview.rowOf(regionZ(region, w.haloRow0)))), 0, overview.depth() - 2);
+    const int c1 =
+        std::clamp(int(std::ceil(overview.colOf(regionX(region, w.haloCol0 + w.haloCols - 1)))), c0 + 1, overview.width() - 1);
+    const int r1 =
+        std::clamp(int(std::ceil(overview.rowOf(regionZ(region, w.haloRow0 + w.haloRows - 1)))), r0 + 1, overview.depth() - 1);
+    return {c0, r0, c1 - c0 + 1, r1 - r0 + 1};
+}
+
 std::string tileName(const TileSpec& t) {
     char name[32];
     std::snprintf(name, sizeof name, "tile_%03d_%03d", t.iz, t.ix);
@@ -109,9 +119,8 @@ std::string tileName(const TileSpec& t) {
 }
 
 nlohmann::json tileReport(const TileSpec& t, const TileWindow& w, const DemGrid& region) {
-    // As Heightfield::xOf places the region's vertices.
-    auto xOf = [&](int c) { return float((c - 0.5 * (region.width - 1)) * region.cellX); };
-    auto zOf = [&](int r) { return float((r - 0.5 * (region.depth - 1)) * region.cellZ); };
+    auto xOf = [&](int c) { return float(regionX(region, c)); };
+    auto zOf = [&](int r) { return float(regionZ(region, r)); };
     const float x0 = xOf(w.col0), x1 = xOf(w.col0 + w.cols - 1);
     const float z0 = zOf(w.row0), z1 = zOf(w.row0 + w.rows - 1);
     return {{"name", tileName(t)},

@@ -84,6 +84,15 @@ struct TileWindow {
 // cells a tile along an axis.
 TileWindow tileWindow(const DemGrid& region, const TileSpec& tile, double overviewCell = 0.0);
 
+// The engine-space x of the region grid's column `col` and z of its row `row`, as
+// Heightfield::xOf and zOf place a whole DEM's vertices.
+inline double regionX(const DemGrid& region, double col) { return (col - 0.5 * (region.width - 1)) * region.cellX; }
+inline double regionZ(const DemGrid& region, double row) { return (row - 0.5 * (region.depth - 1)) * region.cellZ; }
+
+// The region overview's vertices over a tile's halo window, rounded outward (at least 2 a side):
+// the overview and the region share the engine space, so the window needs no transform.
+GridWindow overviewWindow(const TileWindow& w, const DemGrid& region, const Heightfield& overview);
+
 // "tile_003_001": sorts as the seed's merge lists grids (by file name), west to east in a row.
 std::string tileName(const TileSpec& tile);
 
