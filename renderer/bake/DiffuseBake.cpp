@@ -60,12 +60,13 @@ struct Replicates {
     std::array<std::array<double, sh::kCoeffCount>, kReplicates> lum{};
     std::array<int, kReplicates> count{};
 
-    void add(int k, const glm::vec3& radiance, const glm::vec3& d) {
+    // `counted`: a ray of the replicate's lattice (a glow ray adds to its sum, already scaled).
+    void add(int k, const glm::vec3& radiance, const glm::vec3& d, bool counted = true) {
         float y[sh::kCoeffCount];
         sh::evalBasis(d, y);
         const double l = double(luminance(radiance));
         for (int j = 0; j < sh::kCoeffCount; ++j) lum[size_t(k)][size_t(j)] += l * double(y[j]);
-        ++count[size_t(k)];
+        count[size_t(k)] += counted;
     }
     // With fewer than two replicates traced the variance is unknown and reads 0.
     CoefficientMoments moments() const {
@@ -199,6 +200,32 @@ glm::vec3 sunAtHit(const BakeLighting& L, const RayHit& hit, Rng& rng) {
                          : L.sun.illuminance * std::max(0.0f, L.sun.direction.y);
 }
 
+// The irradiance the sky's glow (Sky::hasGlow) puts on a surface at o with normal n, by one ray
+// drawn from the glow's luminance (next-event estimation, as the sun's shadow ray): the glow over
+// its density, times the cosine, where the terrain does not hide it. 0 without glow, drawing no
+// numbers, so a sky without one bakes as before.
+glm::vec3 glowIrradiance(const BakeLighting& L, const glm::vec3& o, const glm::vec3& n, int samples, Rng& rng) {
+    if (!L.sky.hasGlow() || samples <= 0) return glm::vec3(0.0f);
+    glm::vec3 sum(0.0f);
+    for (int m = 0; m < samples; ++m) {
+        glm::vec3 d;
+        const float u0 = (float(m) + rng.next()) / float(samples);
+        const float u1 = rng.next(), u2 = rng.next();
+        const glm::vec3 overPdf = L.sky.sampleGlow(u0, u1, u2, d);
+        const float c = glm::dot(n, d);
+        if (c > 0.0f && !L.tracer->occluded(o, d, INFINITY)) sum += overPdf * c;
+    }
+    return sum / float(samples);
+}
+
+// The direct light at a hit: the sun's and, on the terrain, the glow's (a skirt hit's open sky
+// holds its glow).
+glm::vec3 directAtHit(const BakeLighting& L, const RayHit& hit, Rng& rng) {
+    glm::vec3 e = sunAtHit(L, hit, rng);
+    if (hit.onTerrain) e += glowIrradiance(L, liftOff(hit.position, hit.normal), hit.normal, 1, rng);
+    return e;
+}
+
 // What a terrain hit reflects toward the ray: albedo/π × (its indirect light + the sun at the
 // hit). With one bounce the indirect light is the cache's, read at the hit. With more (a cache
 // with a gather), it is gathered by one cosine-weighted ray from the hit itself, with the hit's
@@ -211,15 +238,17 @@ glm::vec3 terrainRadiance(const BakeLighting& L, const IrradianceCache* cache, i
                           Rng& rng) {
     if (!(bounces > 0 && cache)) return glm::vec3(0.0f);
     const glm::vec3 albedo = L.albedoAt(hit) / kPi;
-    if (!hit.onTerrain || !cache->gathersAtHits()) return albedo * (cache->indirectAt(hit) + sunAtHit(L, hit, rng));
+    if (!hit.onTerrain || !cache->gathersAtHits()) return albedo * (cache->indirectAt(hit) + directAtHit(L, hit, rng));
     const glm::vec3 d = randomCosineDirection(hit.normal, rng);
+    const glm::vec3 o = liftOff(hit.position, hit.normal);
     RayHit next;
     glm::vec3 gathered;  // radiance along d: the irradiance is π × it under cosine sampling
-    if (!L.tracer->intersect(liftOff(hit.position, hit.normal), d, INFINITY, next))
-        gathered = L.sky.radiance(d, 0.0f);
+    // The sky's glow comes by a ray of its own; the cosine ray reads the rest.
+    if (!L.tracer->intersect(o, d, INFINITY, next))
+        gathered = L.sky.smoothRadiance(d, 0.0f);
     else
-        gathered = L.albedoAt(next) / kPi * (cache->earlierIndirectAt(next) + sunAtHit(L, next, rng));
-    return albedo * (kPi * gathered + sunAtHit(L, hit, rng));
+        gathered = L.albedoAt(next) / kPi * (cache->earlierIndirectAt(next) + directAtHit(L, next, rng));
+    return albedo * (kPi * gathered + directAtHit(L, hit, rng));
 }
 
 // The irradiance on the level water surface at `at`: the open sky's (as on the skirt: what the
@@ -441,12 +470,12 @@ IrradianceCache::IrradianceCache(const BakeLighting& L, int resolution, int rays
                 hits[2 * r + 1] = hit.position.z;
                 if (!hit.onTerrain && varying) skirtAlbedo += L.albedoAt(hit);
             } else {
-                sky += L.sky.radiance(d, solidAngle);
+                sky += L.sky.smoothRadiance(d, solidAngle);
                 hits[2 * r] = NAN;
                 hits[2 * r + 1] = INFINITY;  // escaped: contributes sky only
             }
         }
-        sunDirect_[i] = sunIrradiance(L, p, n, sunSamples, rng);
+        sunDirect_[i] = sunIrradiance(L, p, n, sunSamples, rng) + glowIrradiance(L, o, n, std::max(1, rays / 4), rng);
         direct[i] = sky * (kPi / float(rays)) + sunDirect_[i];
         if (varying) skirtAlbedoSum[i] = skirtAlbedo;
     });
@@ -534,14 +563,48 @@ std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uin
 // along direction d, weight the solid angle one ray of the round stands for. Returns the rays.
 // With `base`, the rays estimate what the probe differs from it: the probe is `base` plus their
 // projection, and ray(d, weight) is the radiance less base's own along d.
-template <typename Ray>
+// With `glow` (a sky with a glow, Sky::sampleGlow), each round also draws a quarter as many rays
+// from the glow's luminance, split evenly between the replicates, and ray(d, weight) leaves the
+// glow out; sees(d) says whether the probe sees the sky along d. The glow the probe sees, V, is
+// estimated one of two ways, each exact at one end: as the glow's whole projection less what the
+// rays find hidden (exact for a glow in full view), or as what the rays find seen (exact for a
+// glow hidden whole, where the first way would leave the spread of the glow's texels as noise
+// many times the probe's own light). Sixteen rays drawn before the rounds choose, so the choice
+// does not depend on the rays it weighs. A ray's value is projected at the centre of its glow
+// texel, as Sky::sh() projects the texel. With `base` (whose sky holds the glow) the rays add
+// V less the glow's projection; without, V.
+template <typename Ray, typename Sees>
 int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t i, const sh::ShRgb* base,
-                     Ray&& ray) {
+                     Ray&& ray, const Sky* glow, Sees&& sees) {
     std::array<double, sh::kCoeffCount> baseLuminance{};
     if (base)
         for (int j = 0; j < sh::kCoeffCount; ++j) baseLuminance[size_t(j)] = double(luminance(base->c[size_t(j)]));
     Rounds rounds;
     sh::ShRgb total;
+    int glowRays = 0;
+    // The glow's constant part of each round and whether its rays count what they find hidden.
+    sh::ShRgb glowConstant;
+    bool countHidden = false;
+    if (glow) {
+        constexpr int kPilot = 16;
+        int hidden = 0;
+        for (int m = 0; m < kPilot; ++m) {
+            glm::vec3 d;
+            const float u0 = (float(m) + rng.next()) / float(kPilot);
+            const float u1 = rng.next(), u2 = rng.next();
+            glow->sampleGlow(u0, u1, u2, d);
+            hidden += !sees(d);
+        }
+        glowRays += kPilot;
+        countHidden = 2 * hidden <= kPilot;
+        // V = glow − hidden (rays count hidden) or V = seen; with base, less the glow.
+        if (countHidden != bool(base)) {
+            glowConstant = glow->glowSh();
+            if (base) glowConstant *= -1.0f;
+        }
+    }
+    std::array<double, sh::kCoeffCount> constantLuminance{};
+    for (int j = 0; j < sh::kCoeffCount; ++j) constantLuminance[size_t(j)] = double(luminance(glowConstant.c[size_t(j)]));
     auto round = [&](int n) {
         const ReplicateLattices lattices(n, rng);
         const float weight = 4.0f * kPi / float(n);
@@ -553,13 +616,35 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
             sh::accumulate(acc, d, radiance, weight);
             replicates.add(lattices.replicateOf(r), radiance, d);
         }
+        if (glow) {
+            // Each replicate's glow rays are stratified over the glow's distribution by their
+            // first number; in the replicate's estimate a ray's value is scaled from its
+            // lattice's weight (4π over its rays) to 1 over its glow rays.
+            const int perReplicate = std::max(1, n / (4 * kReplicates));
+            for (int k = 0; k < kReplicates; ++k) {
+                const int latticeRays = n / kReplicates + (k < n % kReplicates);
+                const float toLattice = float(latticeRays) / (4.0f * kPi * float(perReplicate));
+                for (int m = 0; m < perReplicate; ++m) {
+                    glm::vec3 d, centre;
+                    const float u0 = (float(m) + rng.next()) / float(perReplicate);
+                    const float u1 = rng.next(), u2 = rng.next();
+                    const glm::vec3 overPdf = glow->sampleGlow(u0, u1, u2, d, &centre);
+                    ++glowRays;
+                    if (sees(d) == countHidden) continue;
+                    const glm::vec3 value = countHidden ? -overPdf : overPdf;
+                    sh::accumulate(acc, centre, value, 1.0f / float(perReplicate * kReplicates));
+                    replicates.add(k, value * toLattice, centre, false);
+                }
+            }
+            for (int j = 0; j < sh::kCoeffCount; ++j) acc.c[size_t(j)] += glowConstant.c[size_t(j)];
+        }
         // Earlier rounds' share shrinks as this one adds its rays.
         const float share = float(n) / float(rounds.rays + n);
         total *= 1.0f - share;
         acc *= share;
         total += acc;
         CoefficientMoments m = replicates.moments();
-        for (size_t j = 0; j < m.mean.size(); ++j) m.mean[j] += baseLuminance[j];
+        for (size_t j = 0; j < m.mean.size(); ++j) m.mean[j] += baseLuminance[j] + constantLuminance[j];
         rounds.add(n, m);
     };
     if (!schedule.adaptive()) {
@@ -577,8 +662,8 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
     out.standardError[i] = rounds.relativeError();
     if (base) total += *base;  // the rounds' shares add up to one
     out.sh[i] = total;
-    out.raysPerProbe[i] = uint32_t(rounds.rays);
-    return rounds.rays;
+    out.raysPerProbe[i] = uint32_t(rounds.rays + glowRays);
+    return rounds.rays + glowRays;
 }
 
 ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
@@ -602,15 +687,26 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
         // the probe's light differs from the open sky's. A ray that escapes adds nothing, and the
         // sky's bright spots (an HDR's sun glow, the physical sky's circumsolar light) add noise
         // only where the terrain hides them.
-        const int rays = traceProbeRounds(schedule, rng, out, i, &L.sky.sh(), [&](const glm::vec3& d, float weight) {
-            RayHit hit;
-            const bool terrain = L.tracer->intersect(positions[i], d, INFINITY, hit);
-            if (terrain) fromBelow += glm::dot(d, hit.normal) > 0.0f;
-            if (!terrain && !L.water) return glm::vec3(0.0f);
-            return rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng) -
-                   L.sky.radiance(d, weight);
-        });
-        out.fromBelowShare[i] = float(fromBelow) / float(rays);
+        // Where the sky has a glow (Sky::hasGlow) the lattice's rays take only the smooth part
+        // as their control variate and the glow the terrain hides is estimated by rays of its own,
+        // so a glow a few pixels wide does not ride on the few lattice rays that fall on it.
+        // Water reflects the sky, so there every ray would need the glow: it keeps the whole sky.
+        const Sky* glow = L.sky.hasGlow() && !L.water ? &L.sky : nullptr;
+        int latticeRays = 0;
+        traceProbeRounds(
+            schedule, rng, out, i, &L.sky.sh(),
+            [&](const glm::vec3& d, float weight) {
+                ++latticeRays;
+                RayHit hit;
+                const bool terrain = L.tracer->intersect(positions[i], d, INFINITY, hit);
+                if (terrain) fromBelow += glm::dot(d, hit.normal) > 0.0f;
+                if (!terrain && !L.water) return glm::vec3(0.0f);
+                return rayRadiance(L, cache, bounces, positions[i], d, terrain ? &hit : nullptr, weight, rng) -
+                       (glow ? L.sky.smoothRadiance(d, weight) : L.sky.radiance(d, weight));
+            },
+            glow, [&](const glm::vec3& d) { return !L.tracer->occluded(positions[i], d, INFINITY); });
+        const int rays = int(out.raysPerProbe[i]);
+        out.fromBelowShare[i] = float(fromBelow) / float(latticeRays);
         traced.fetch_add(uint64_t(rays), std::memory_order_relaxed);
     });
     out.rays = traced.load();
@@ -668,7 +764,12 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
         uint64_t count = 0;
         int fromBelow = 0;
         // The light a path from terrain hit `hit` brings back: at each terrain vertex, sun by a
-        // shadow ray plus one cosine-weighted continuation; throughput albedo per bounce.
+        // shadow ray plus one cosine-weighted continuation; throughput albedo per bounce. A sky
+        // with a glow (and no water, as for the bake) gives the glow by a ray of its own at each
+        // vertex, as the sun, and the continuation reads the rest of the sky: a sun in an HDR
+        // found only by the paths that happen to escape toward it would leave the reference
+        // itself noisier than the bake it checks.
+        const bool glow = L.sky.hasGlow() && !L.water;
         auto path = [&](RayHit hit) {
             glm::vec3 radiance(0.0f);
             glm::vec3 throughput = L.albedoAt(hit) / kPi;
@@ -681,11 +782,15 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                 radiance += throughput * sunIrradiance(L, hit.position, n, 1, rng);
                 const glm::vec3 dir = randomCosineDirection(n, rng);
                 const glm::vec3 o = liftOff(hit.position, n);
+                if (glow) {
+                    radiance += throughput * glowIrradiance(L, o, n, 1, rng);
+                    ++count;
+                }
                 ++count;
                 RayHit next;
                 // E = π × mean radiance under cosine sampling: the π cancels albedo's 1/π.
                 if (!L.tracer->intersect(o, dir, INFINITY, next)) {
-                    radiance += throughput * kPi * L.sky.radiance(dir, 0.0f);
+                    radiance += throughput * kPi * (glow ? L.sky.smoothRadiance(dir, 0.0f) : L.sky.radiance(dir, 0.0f));
                     break;
                 }
                 if (b + 1 == depth) break;
@@ -694,9 +799,11 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
             }
             return radiance;
         };
-        const int rays = traceProbeRounds(schedule, rng, out, i, nullptr, [&](const glm::vec3& d0, float weight) {
+        int latticeRays = 0;
+        traceProbeRounds(schedule, rng, out, i, nullptr, [&](const glm::vec3& d0, float weight) {
             RayHit hit;
             ++count;
+            ++latticeRays;
             glm::vec3 radiance(0.0f);
             const bool hitSomething = L.tracer->intersect(positions[i], d0, INFINITY, hit);
             if (hitSomething) fromBelow += glm::dot(d0, hit.normal) > 0.0f;
@@ -710,13 +817,16 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
                         return L.tracer->intersect(ro, rd, INFINITY, h) ? path(h) : L.sky.radiance(rd, weight);
                     });
             } else if (!hitSomething) {
-                radiance = L.sky.radiance(d0, weight);
+                radiance = glow ? L.sky.smoothRadiance(d0, weight) : L.sky.radiance(d0, weight);
             } else if (depth > 0) {
                 radiance = path(hit);
             }
             return radiance;
+        }, glow ? &L.sky : nullptr, [&](const glm::vec3& d) {
+            ++count;
+            return !L.tracer->occluded(positions[i], d, INFINITY);
         });
-        out.fromBelowShare[i] = float(fromBelow) / float(rays);
+        out.fromBelowShare[i] = float(fromBelow) / float(latticeRays);
         traced.fetch_add(count, std::memory_order_relaxed);
     });
     out.rays = traced.load();

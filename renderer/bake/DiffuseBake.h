@@ -157,7 +157,7 @@ private:
     glm::vec3 skirt_{0.0f};
     std::vector<glm::vec3> irradiance_;
     std::vector<glm::vec3> earlier_;  // the irradiance before the last gather; empty with none
-    std::vector<glm::vec3> sunDirect_;
+    std::vector<glm::vec3> sunDirect_;  // the direct light of the sun and of the sky's glow (Sky::hasGlow)
     glm::vec3 skirtSun_{0.0f};
 };
 

@@ -16,6 +16,8 @@ namespace terralux {
 
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
+// Rec. 709 luminance, as the bake's metrics weigh colour.
+double lum(const glm::vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 }
 
 glm::vec3 sunDirection(double azimuthDeg, double elevationDeg) {
@@ -53,6 +55,15 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
         base.texels[i] = t * intensity;
     }
     levels.push_back(std::move(base));
+    buildPyramid(levels);
+    s.levels_ = std::make_shared<const std::vector<Level>>(std::move(levels));
+    s.rotation_ = float(rotationDeg / 360.0 - std::floor(rotationDeg / 360.0));
+    s.computeSh();
+    s.splitGlow();
+    return s;
+}
+
+void Sky::buildPyramid(std::vector<Level>& levels) {
     // Box-filtered pyramid, each texel weighted by its solid angle (∝ sin θ) so the poles do not
     // dominate the average.
     while (levels.back().width > 1 || levels.back().height > 1) {
@@ -75,9 +86,98 @@ Sky Sky::equirect(std::vector<float> rgb, int width, int height, float intensity
             }
         levels.push_back(std::move(c));
     }
-    s.levels_ = std::make_shared<const std::vector<Level>>(std::move(levels));
-    s.rotation_ = float(rotationDeg / 360.0 - std::floor(rotationDeg / 360.0));
-    s.computeSh();
+}
+
+void Sky::splitGlow() {
+    const Level& l = levels_->front();
+    const double dphi = 2.0 * std::numbers::pi / l.width;
+    std::vector<double> solidAngle(size_t(l.height));
+    double skyFlux = 0.0;
+    for (int y = 0; y < l.height; ++y) {
+        solidAngle[size_t(y)] =
+            dphi * (std::cos(std::numbers::pi * y / l.height) - std::cos(std::numbers::pi * (y + 1) / l.height));
+        for (int x = 0; x < l.width; ++x) skyFlux += lum(l.texels[size_t(y) * l.width + x]) * solidAngle[size_t(y)];
+    }
+    // The threshold is kGlowThreshold times the mean of the smooth part it leaves, not of the
+    // whole sky: a sun holding most of the light would otherwise set it so high that the smooth
+    // part kept a disc many times brighter than the rest. T ← k · mean(min(Y, T)) from T = k · mean(Y)
+    // falls to the largest fixed point; a few steps reach it within a percent.
+    double threshold = double(kGlowThreshold) * skyFlux / (4.0 * std::numbers::pi);
+    for (int step = 0; step < 32 && threshold > 0.0; ++step) {
+        double clamped = 0.0;
+        for (int y = 0; y < l.height; ++y)
+            for (int x = 0; x < l.width; ++x)
+                clamped += std::min(lum(l.texels[size_t(y) * l.width + x]), threshold) * solidAngle[size_t(y)];
+        const double next = double(kGlowThreshold) * clamped / (4.0 * std::numbers::pi);
+        const bool settled = next > 0.99 * threshold;
+        threshold = next;
+        if (settled) break;
+    }
+    auto glow = std::make_shared<Glow>();
+    glow->width = l.width;
+    glow->height = l.height;
+    glow->skyFlux = skyFlux;
+    Level smooth{l.width, l.height, l.texels};
+    for (int y = 0; y < l.height; ++y)
+        for (int x = 0; x < l.width; ++x) {
+            const size_t i = size_t(y) * l.width + x;
+            const double y0 = lum(l.texels[i]);
+            if (!(threshold > 0.0) || y0 <= threshold) continue;
+            smooth.texels[i] = l.texels[i] * float(threshold / y0);
+            const glm::vec3 g = l.texels[i] - smooth.texels[i];
+            const double gy = lum(g);
+            if (!(gy > 0.0)) continue;
+            glow->texel.push_back(uint32_t(i));
+            {
+                const float theta = float(std::numbers::pi * (y + 0.5) / l.height);
+                const float phi = ((x + 0.5f) / float(l.width) - 0.5f + rotation_) * 2.0f * kPi;
+                sh::accumulate(glow->sh,
+                               glm::vec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)),
+                               g, float(solidAngle[size_t(y)]));
+            }
+            glow->colour.push_back(g / float(gy));
+            glow->flux += gy * solidAngle[size_t(y)];
+            glow->cdf.push_back(glow->flux);
+        }
+    if (glow->texel.empty()) {
+        smooth_ = levels_;
+        glow_ = nullptr;
+        return;
+    }
+    for (double& c : glow->cdf) c /= glow->flux;
+    std::vector<Level> levels;
+    levels.push_back(std::move(smooth));
+    buildPyramid(levels);
+    smooth_ = std::make_shared<const std::vector<Level>>(std::move(levels));
+    glow_ = std::move(glow);
+}
+
+glm::vec3 Sky::sampleGlow(float u0, float u1, float u2, glm::vec3& dir, glm::vec3* centre) const {
+    if (!glow_) return glm::vec3(0.0f);
+    const Glow& g = *glow_;
+    const size_t k = std::min(size_t(std::upper_bound(g.cdf.begin(), g.cdf.end(), double(u0)) - g.cdf.begin()),
+                              g.texel.size() - 1);
+    const int x = int(g.texel[k] % uint32_t(g.width)), y = int(g.texel[k] / uint32_t(g.width));
+    // Uniform over the texel's solid angle: its azimuths, and cos θ between its rows' edges.
+    const double c0 = std::cos(std::numbers::pi * y / g.height), c1 = std::cos(std::numbers::pi * (y + 1) / g.height);
+    const double ct = c0 + (c1 - c0) * double(u2), st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
+    const double phi = ((x + double(u1)) / g.width - 0.5 + double(rotation_)) * 2.0 * std::numbers::pi;
+    dir = glm::vec3(float(st * std::sin(phi)), float(ct), float(-st * std::cos(phi)));
+    if (centre) {
+        // As computeSh() takes it: the mean of the rows' polar angles, the column's middle.
+        const float theta = float(std::numbers::pi * (y + 0.5) / g.height);
+        const float cphi = ((x + 0.5f) / float(g.width) - 0.5f + rotation_) * 2.0f * kPi;
+        *centre = glm::vec3(std::sin(theta) * std::sin(cphi), std::cos(theta), -std::sin(theta) * std::cos(cphi));
+    }
+    return scale_ * g.colour[k] * float(g.flux);
+}
+
+float Sky::glowShare() const { return glow_ ? float(glow_->flux / glow_->skyFlux) : 0.0f; }
+
+sh::ShRgb Sky::glowSh() const {
+    if (!glow_) return {};
+    sh::ShRgb s = glow_->sh;
+    for (auto& c : s.c) c *= scale_;
     return s;
 }
 
@@ -166,19 +266,28 @@ glm::vec3 Sky::sample(const Level& level, float u, float v) const {
 
 glm::vec3 Sky::radiance(const glm::vec3& dir, float solidAngle) const {
     if (!levels_) return uniform_;
+    return lookup(*levels_, dir, solidAngle);
+}
+
+glm::vec3 Sky::smoothRadiance(const glm::vec3& dir, float solidAngle) const {
+    if (!levels_) return uniform_;
+    return lookup(*smooth_, dir, solidAngle);
+}
+
+glm::vec3 Sky::lookup(const std::vector<Level>& levels, const glm::vec3& dir, float solidAngle) const {
     solidAngle = std::min(solidAngle, kMaxFilterSolidAngle);
     const float u = glsl::equirectU(dir.x, dir.z, rotation_), v = glsl::equirectV(dir.y);
-    const Level& base = levels_->front();
+    const Level& base = levels.front();
     // Level whose texel (at the equator) covers about `solidAngle`; blend the two nearest.
     const float texel0 = 2.0f * kPi * kPi / float(base.width * base.height);
     float lod = solidAngle > texel0 ? 0.5f * std::log2(solidAngle / texel0) : 0.0f;
-    lod = std::min(lod, float(levels_->size() - 1));
+    lod = std::min(lod, float(levels.size() - 1));
     const int l0 = int(lod);
-    const int l1 = std::min(l0 + 1, int(levels_->size()) - 1);
+    const int l1 = std::min(l0 + 1, int(levels.size()) - 1);
     const float t = lod - l0;
-    const glm::vec3 a = sample((*levels_)[size_t(l0)], u, v);
+    const glm::vec3 a = sample(levels[size_t(l0)], u, v);
     if (t <= 0.0f || l1 == l0) return scale_ * a;
-    return scale_ * glm::mix(a, sample((*levels_)[size_t(l1)], u, v), t);
+    return scale_ * glm::mix(a, sample(levels[size_t(l1)], u, v), t);
 }
 
 std::vector<glm::vec3> blendedEquirect(const Sky& a, const Sky& b, float t, int width, int height) {

@@ -61,6 +61,28 @@ public:
     // band-l factor is exp(−l(l+1)·Ω/12)), 0.6 % here. Draft's 96 rays (0.13 sr each) took 6 %
     // off, a bias under the physical sky larger than draft's noise.
     static constexpr float kMaxFilterSolidAngle = 4.0f * std::numbers::pi_v<float> / 1024.0f;
+    // The sky split in two where it is peaky (an HDR's sun and its glow, the physical sky's
+    // circumsolar light): each texel brighter than kGlowThreshold times the smooth part's mean
+    // luminance keeps that luminance in the smooth part, in its own colour, and gives the rest to
+    // the glow.
+    // A probe estimates the terrain's occlusion of the smooth part with its lattice rays and that
+    // of the glow with rays drawn from the glow's own luminance (docs/lighting.md, "The sky's
+    // glow"). Without texels over the threshold (a uniform sky) the smooth part is the sky.
+    static constexpr float kGlowThreshold = 8.0f;
+    bool hasGlow() const { return glow_ != nullptr; }
+    // radiance() of the smooth part.
+    glm::vec3 smoothRadiance(const glm::vec3& dir, float solidAngle = 0.0f) const;
+    // A direction `dir` drawn with density p(ω) proportional to the glow's luminance (a texel by
+    // u0, then uniformly over its solid angle by u1, u2, each in [0, 1)), and the glow's radiance
+    // there over p(ω): its colour times the glow's luminous flux ∫ Y(glow) dω. Zero without glow.
+    // `centre`, when given, receives the texel's centre: sh() takes each texel's SH there, so a
+    // projection that weighs the ray by the SH at the centre takes nothing of the glow's extent
+    // as noise (a sun hidden whole then costs nothing).
+    glm::vec3 sampleGlow(float u0, float u1, float u2, glm::vec3& dir, glm::vec3* centre = nullptr) const;
+    // The glow's share of the sky's luminous flux over the whole sphere (0 without glow).
+    float glowShare() const;
+    // The glow's exact SH projection, as sh() projects the sky (zero without glow).
+    sh::ShRgb glowSh() const;
     // Exact projection of the whole sky onto SH L2 (texel solid angles, no sampling).
     const sh::ShRgb& sh() const { return sh_; }
     // Irradiance on an unoccluded level surface (normal +Y), integrated exactly over the texels.
@@ -71,12 +93,26 @@ private:
         int width = 0, height = 0;
         std::vector<glm::vec3> texels;
     };
+    struct Glow {
+        int width = 0, height = 0;
+        std::vector<uint32_t> texel;    // the glow's texels of level 0
+        std::vector<double> cdf;        // their luminous flux, accumulated and normalised
+        std::vector<glm::vec3> colour;  // their glow radiance over its luminance
+        double flux = 0.0;              // ∫ Y(glow) dω over the sphere
+        sh::ShRgb sh;                   // its projection, texel centres as computeSh()
+        double skyFlux = 0.0;           // ∫ Y(sky) dω
+    };
     glm::vec3 sample(const Level& level, float u, float v) const;
+    glm::vec3 lookup(const std::vector<Level>& levels, const glm::vec3& dir, float solidAngle) const;
+    static void buildPyramid(std::vector<Level>& levels);
     void computeSh();
+    void splitGlow();
 
     glm::vec3 uniform_{0.0f};
     // Immutable once built and shared between copies: a Sky is cheap to copy into every bake.
     std::shared_ptr<const std::vector<Level>> levels_;
+    std::shared_ptr<const std::vector<Level>> smooth_;  // levels_ where there is no glow
+    std::shared_ptr<const Glow> glow_;
     float rotation_ = 0.0f;  // in u units [0, 1)
     glm::vec3 scale_{1.0f};  // applied to the shared levels on lookup
     sh::ShRgb sh_;
