@@ -907,7 +907,9 @@ BakePlan planBake(const SceneDescription& scene, const BakeSetup& setup) {
         p.totalWork += layout.positions.size() + p.mapPoints.back();
     }
     if (scene.reflectionProbes.enabled) {
-        p.reflections = placeReflectionProbes(scene.reflectionProbes, hf);
+        p.reflections = placeReflectionProbes(
+            setup.tileWindow ? tileReflectionGrid(scene.reflectionProbes, *setup.tileWindow, hf) : scene.reflectionProbes,
+            hf);
         simvxProbes(scene.reflectionProbes.simvxSubset, p.reflections->count());
     }
     p.plannedRays = plannedProbeRays(setup, p.layouts, p.mapPoints);

@@ -164,6 +164,27 @@ int tileProbes(int n, double share) { return n <= 1 ? n : std::max(2, int(std::l
 
 }  // namespace
 
+ReflectionProbeSettings tileReflectionGrid(const ReflectionProbeSettings& share, const TileWindow& w,
+                                           const Heightfield& tile) {
+    ReflectionProbeSettings r = share;
+    const bool eastShared = w.col0 + w.cols < w.regionCols, southShared = w.row0 + w.rows < w.regionRows;
+    int& nx = r.gridDims[0];
+    int& nz = r.gridDims[1];
+    if (!((eastShared && nx > 1) || (southShared && nz > 1))) return r;
+    const float spanX = tile.maxX() - tile.minX(), spanZ = tile.maxZ() - tile.minZ();
+    // The grid before the cut, as placeReflectionProbes spans the footprint; a spacing must be
+    // positive, and an axis of one probe ignores it.
+    glm::vec2 spacing(nx > 1 ? spanX / float(nx - 1) : std::max(spanX, 1.0f),
+                      nz > 1 ? spanZ / float(nz - 1) : std::max(spanZ, 1.0f));
+    const glm::vec2 origin(nx > 1 ? tile.minX() : 0.5f * (tile.minX() + tile.maxX()),
+                           nz > 1 ? tile.minZ() : 0.5f * (tile.minZ() + tile.maxZ()));
+    if (eastShared && nx > 1) --nx;
+    if (southShared && nz > 1) --nz;
+    r.spacing = spacing;
+    r.origin = origin;
+    return r;
+}
+
 std::array<int, 2> regionTerrainGridDims(const std::array<int, 2>& tileDims, const TileWindow& w) {
     const std::array<double, 2> share = tileShares(w);
     std::array<int, 2> out{};

@@ -97,9 +97,10 @@ GridWindow overviewWindow(const TileWindow& w, const DemGrid& region, const Heig
 std::string tileName(const TileSpec& tile);
 
 // What a tile's bake reads and traces, beyond its settings: 2 since the halo past the near halo
-// is traced on the region's overview. A tile baked under another contract is baked again, and a
-// merge refuses to mix them.
-inline constexpr int kTileContract = 2;
+// is traced on the region's overview, 3 since a tile leaves the reflection probes of a border it
+// shares to its neighbour. A tile baked under another contract is baked again, and a merge
+// refuses to mix them.
+inline constexpr int kTileContract = 3;
 
 // What a tile's bake_report.json records under "tile": the cut, the windows, the halo rules and
 // the contract.
@@ -109,12 +110,20 @@ nlohmann::json tileReport(const TileSpec& tile, const TileWindow& w, const DemGr
 
 namespace terralux {
 struct SceneDescription;
+struct ReflectionProbeSettings;
 // The scene a tile bakes: each terrain and box volume's grid_dims, and the reflection grid's,
 // scaled to the tile's share of the region's cells (a terrain grid over auto-span keeps the
 // region's spacing when the tile's cells are a whole number of it), so the tiles together place
 // what the region would. Throws ProjectError for what cannot be cut: an explicit origin, or an
 // adaptive volume's explicit size (each tile places over its own footprint).
 void scaleSceneToTile(SceneDescription& scene, const TileWindow& w);
+// A tile's reflection grid as it places it: scaleSceneToTile's share, its end probes on the
+// tile's edges, less the column on its east edge and the row on its south edge where another tile
+// shares that border (that tile holds them), so the merged sets hold every probe once. The
+// spacing and origin become explicit (those of the grid before the cut); an axis of one probe,
+// centred on the tile, keeps it.
+ReflectionProbeSettings tileReflectionGrid(const ReflectionProbeSettings& share, const TileWindow& w,
+                                           const Heightfield& tile);
 // The terrain grid_dims of the region whose tile share (scaleSceneToTile's rule) is `tileDims`
 // [x, z]: what a suggestion measured on one tile asks of the project.
 std::array<int, 2> regionTerrainGridDims(const std::array<int, 2>& tileDims, const TileWindow& w);

@@ -615,7 +615,9 @@ TEST(Tiles, TheMergeListsEveryTilesReflectionProbes) {
     // Two tiles with a 6 x 3 reflection grid for the region: each tile bakes its share over its own
     // footprint, and the merged scene's TERRALUX_lighting.reflection_probes lists both sets (their
     // files through the tile's folder, each set's probes inside its tile), sums the probes and
-    // keeps what the tiles share; tiles.json hashes the files; the report sums the probes.
+    // keeps what the tiles share; tiles.json hashes the files; the report sums the probes. The
+    // west tile leaves the probes on the border the two share to the east one, so the sets hold
+    // every probe once and span the region from edge to edge.
     const fs::path tiled = freshDir("reflections");
     size_t baked = 0;
     for (int i = 0; i < 2; ++i) {
@@ -663,6 +665,23 @@ TEST(Tiles, TheMergeListsEveryTilesReflectionProbes) {
         EXPECT_TRUE(hashed) << t.dump();
     }
     EXPECT_EQ(m.report["reflection_probes"]["probes"].get<size_t>(), baked);
+    {
+        std::vector<glm::vec3> all;
+        std::vector<size_t> counts;
+        for (size_t k = 0; k < 2; ++k) {
+            const ReflectionProbeSet set = readReflectionProbeFile(tiled / rp["sets"][k]["uri"].get<std::string>());
+            counts.push_back(set.probes.size());
+            for (const ReflectionProbe& p : set.probes) all.push_back(p.position);
+        }
+        EXPECT_EQ(counts[0] + 3, counts[1]) << "the west tile keeps one column fewer";
+        for (size_t a = 0; a < all.size(); ++a)
+            for (size_t b = a + 1; b < all.size(); ++b)
+                EXPECT_GT(glm::length(glm::vec2(all[a].x - all[b].x, all[a].z - all[b].z)), 1.0f) << a << " " << b;
+        float lo = INFINITY, hi = -INFINITY;
+        for (const glm::vec3& p : all) lo = std::min(lo, p.x), hi = std::max(hi, p.x);
+        EXPECT_NEAR(lo, index["tiles"][0]["bounds_m"]["min"][0].get<float>(), 1e-2f);
+        EXPECT_NEAR(hi, index["tiles"][1]["bounds_m"]["max"][0].get<float>(), 1e-2f);
+    }
     // A tile baked without them cannot join: the merge names how many lack them.
     {
         const fs::path gltf = tiled / kTilesFolder / "tile_000_001" / "scene.gltf";
