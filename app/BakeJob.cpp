@@ -756,10 +756,14 @@ ProbeRays raysOf(const BakeSetup& b, const ProbeVolumeSettings& v) { return volu
 uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& layouts,
                           const std::vector<size_t>& mapPoints) {
     uint64_t rays = 0;
+    // A sky whose glow the probes sample adds a quarter of a probe's rays and the sixteen that
+    // choose how to count them (docs/lighting.md, "The sky's glow").
+    const bool glow = b.lighting.sky.hasGlow() && !b.lighting.water;
+    auto withGlow = [&](uint64_t n) { return glow ? n + n / 4 + 16 : n; };
     for (size_t vi = 0; vi < b.volumes.size(); ++vi) {
         const ProbeRays r = raysOf(b, *b.volumes[vi]);
         const uint64_t probes = layouts[vi].validCount() + (layouts[vi].octree ? kInterpolationPoints : 0);
-        rays += probes * uint64_t(r.planned()) + mapPoints[vi] * uint64_t(r.rays);
+        rays += probes * withGlow(uint64_t(r.planned())) + mapPoints[vi] * withGlow(uint64_t(r.rays));
     }
     return rays;
 }

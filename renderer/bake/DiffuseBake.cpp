@@ -571,8 +571,8 @@ std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uin
 // glow hidden whole, where the first way would leave the spread of the glow's texels as noise
 // many times the probe's own light). Sixteen rays drawn before the rounds choose, so the choice
 // does not depend on the rays it weighs. A ray's value is projected at the centre of its glow
-// texel, as Sky::sh() projects the texel. With `base` (whose sky holds the glow) the rays add
-// V less the glow's projection; without, V.
+// texel, as Sky::sh() projects the texel. The rays add V to `base`, which holds none of the glow
+// (the bake's base is the smooth part's projection, Sky::smoothSh).
 template <typename Ray, typename Sees>
 int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t i, const sh::ShRgb* base,
                      Ray&& ray, const Sky* glow, Sees&& sees) {
@@ -597,11 +597,8 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
         }
         glowRays += kPilot;
         countHidden = 2 * hidden <= kPilot;
-        // V = glow − hidden (rays count hidden) or V = seen; with base, less the glow.
-        if (countHidden != bool(base)) {
-            glowConstant = glow->glowSh();
-            if (base) glowConstant *= -1.0f;
-        }
+        // V = glow − hidden (rays count hidden) or V = seen.
+        if (countHidden) glowConstant = glow->glowSh();
     }
     std::array<double, sh::kCoeffCount> constantLuminance{};
     for (int j = 0; j < sh::kCoeffCount; ++j) constantLuminance[size_t(j)] = double(luminance(glowConstant.c[size_t(j)]));
@@ -688,13 +685,13 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
         // sky's bright spots (an HDR's sun glow, the physical sky's circumsolar light) add noise
         // only where the terrain hides them.
         // Where the sky has a glow (Sky::hasGlow) the lattice's rays take only the smooth part
-        // as their control variate and the glow the terrain hides is estimated by rays of its own,
+        // as their control variate and the glow the probe sees is estimated by rays of its own,
         // so a glow a few pixels wide does not ride on the few lattice rays that fall on it.
         // Water reflects the sky, so there every ray would need the glow: it keeps the whole sky.
         const Sky* glow = L.sky.hasGlow() && !L.water ? &L.sky : nullptr;
         int latticeRays = 0;
         traceProbeRounds(
-            schedule, rng, out, i, &L.sky.sh(),
+            schedule, rng, out, i, glow ? &L.sky.smoothSh() : &L.sky.sh(),
             [&](const glm::vec3& d, float weight) {
                 ++latticeRays;
                 RayHit hit;

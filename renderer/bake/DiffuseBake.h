@@ -35,7 +35,7 @@ namespace terralux {
 struct ProbeRays {
     int rays = 256;        // all of them when fixed; the least a probe traces with a target
     float target = 0.0f;   // relative standard error a probe's rays are chosen for; 0: fixed
-    int maxRays = 0;       // no probe traces more
+    int maxRays = 0;       // no probe's lattice traces more (a sky's glow adds rays of its own, Sky::hasGlow)
 
     ProbeRays() = default;
     ProbeRays(int fixed) : rays(fixed) {}  // NOLINT(google-explicit-constructor): a count is a fixed schedule

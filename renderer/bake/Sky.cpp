@@ -1,6 +1,7 @@
 #include "bake/Sky.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -31,6 +32,7 @@ Sky Sky::uniform(const glm::vec3& radiance) {
     Sky s;
     s.uniform_ = radiance;
     s.sh_ = sh::projectConstant(radiance);
+    s.smoothSh_ = s.sh_;
     s.openUp_ = std::numbers::pi_v<float> * radiance;
     return s;
 }
@@ -90,6 +92,9 @@ void Sky::buildPyramid(std::vector<Level>& levels) {
 
 void Sky::splitGlow() {
     const Level& l = levels_->front();
+    smoothSh_ = sh_;
+    smooth_ = levels_;
+    glow_ = nullptr;
     const double dphi = 2.0 * std::numbers::pi / l.width;
     std::vector<double> solidAngle(size_t(l.height));
     double skyFlux = 0.0;
@@ -100,8 +105,9 @@ void Sky::splitGlow() {
     }
     // The threshold is kGlowThreshold times the mean of the smooth part it leaves, not of the
     // whole sky: a sun holding most of the light would otherwise set it so high that the smooth
-    // part kept a disc many times brighter than the rest. T ← k · mean(min(Y, T)) from T = k · mean(Y)
-    // falls to the largest fixed point; a few steps reach it within a percent.
+    // part kept a disc many times brighter than the rest. T <- k mean(min(Y, T)) from
+    // T = k mean(Y) falls toward the largest fixed point; it stops once a step moves it by under
+    // 1 % (one to three steps on the shared HDRs).
     double threshold = double(kGlowThreshold) * skyFlux / (4.0 * std::numbers::pi);
     for (int step = 0; step < 32 && threshold > 0.0; ++step) {
         double clamped = 0.0;
@@ -113,38 +119,71 @@ void Sky::splitGlow() {
         threshold = next;
         if (settled) break;
     }
+    // A glow is a bright spot: never more than kMaxGlowSolidAngle of the sphere. An image mostly
+    // black has no positive fixed point (the threshold would fall until nearly all of it glowed),
+    // so the threshold is at least the luminance above which that much of the sphere lies.
+    {
+        std::vector<std::pair<double, double>> byLuminance;  // (Y, solid angle)
+        byLuminance.reserve(l.texels.size());
+        for (int y = 0; y < l.height; ++y)
+            for (int x = 0; x < l.width; ++x)
+                byLuminance.emplace_back(lum(l.texels[size_t(y) * l.width + x]), solidAngle[size_t(y)]);
+        std::sort(byLuminance.begin(), byLuminance.end(), std::greater<>());
+        double covered = 0.0;
+        for (const auto& [y, omega] : byLuminance) {
+            covered += omega;
+            if (covered > kMaxGlowSolidAngle) {
+                threshold = std::max(threshold, y);
+                break;
+            }
+        }
+    }
+    if (!(threshold > 0.0)) return;
+    bool any = false;
+    for (const glm::vec3& t : l.texels) any |= lum(t) > threshold;
+    if (!any) return;
+
     auto glow = std::make_shared<Glow>();
     glow->width = l.width;
     glow->height = l.height;
     glow->skyFlux = skyFlux;
     Level smooth{l.width, l.height, l.texels};
-    for (int y = 0; y < l.height; ++y)
+    // Both parts' projections in double: the bake's probes take the smooth part's as their base,
+    // and a sun many thousand times the rest would leave float's rounding of the whole sky's sum
+    // as a bias of a percent or more on probes that do not see it.
+    std::array<glm::dvec3, sh::kCoeffCount> smoothSh{}, glowSh{};
+    for (int y = 0; y < l.height; ++y) {
+        const float theta = float(std::numbers::pi * (y + 0.5) / l.height);
         for (int x = 0; x < l.width; ++x) {
             const size_t i = size_t(y) * l.width + x;
+            const float phi = ((x + 0.5f) / float(l.width) - 0.5f + rotation_) * 2.0f * kPi;
+            const glm::vec3 dir(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
             const double y0 = lum(l.texels[i]);
-            if (!(threshold > 0.0) || y0 <= threshold) continue;
-            smooth.texels[i] = l.texels[i] * float(threshold / y0);
-            const glm::vec3 g = l.texels[i] - smooth.texels[i];
+            glm::vec3 g(0.0f);
+            if (y0 > threshold) {
+                smooth.texels[i] = l.texels[i] * float(threshold / y0);
+                g = l.texels[i] - smooth.texels[i];
+            }
+            float basis[sh::kCoeffCount];
+            sh::evalBasis(dir, basis);
+            for (int k = 0; k < sh::kCoeffCount; ++k) {
+                smoothSh[size_t(k)] += glm::dvec3(smooth.texels[i]) * (double(basis[k]) * solidAngle[size_t(y)]);
+                glowSh[size_t(k)] += glm::dvec3(g) * (double(basis[k]) * solidAngle[size_t(y)]);
+            }
             const double gy = lum(g);
             if (!(gy > 0.0)) continue;
             glow->texel.push_back(uint32_t(i));
-            {
-                const float theta = float(std::numbers::pi * (y + 0.5) / l.height);
-                const float phi = ((x + 0.5f) / float(l.width) - 0.5f + rotation_) * 2.0f * kPi;
-                sh::accumulate(glow->sh,
-                               glm::vec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi)),
-                               g, float(solidAngle[size_t(y)]));
-            }
             glow->colour.push_back(g / float(gy));
             glow->flux += gy * solidAngle[size_t(y)];
             glow->cdf.push_back(glow->flux);
         }
-    if (glow->texel.empty()) {
-        smooth_ = levels_;
-        glow_ = nullptr;
-        return;
     }
+    if (glow->texel.empty()) return;
     for (double& c : glow->cdf) c /= glow->flux;
+    for (int k = 0; k < sh::kCoeffCount; ++k) {
+        smoothSh_.c[size_t(k)] = glm::vec3(smoothSh[size_t(k)]);
+        glow->sh.c[size_t(k)] = glm::vec3(glowSh[size_t(k)]);
+    }
     std::vector<Level> levels;
     levels.push_back(std::move(smooth));
     buildPyramid(levels);
@@ -224,6 +263,7 @@ Sky Sky::scaled(const glm::vec3& factor) const {
     Sky s = *this;
     s.scale_ *= factor;
     for (auto& c : s.sh_.c) c *= factor;
+    for (auto& c : s.smoothSh_.c) c *= factor;
     s.openUp_ *= factor;
     return s;
 }

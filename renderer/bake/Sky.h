@@ -69,6 +69,8 @@ public:
     // of the glow with rays drawn from the glow's own luminance (docs/lighting.md, "The sky's
     // glow"). Without texels over the threshold (a uniform sky) the smooth part is the sky.
     static constexpr float kGlowThreshold = 8.0f;
+    // The most of the sphere a glow covers, steradians (1/16 of it).
+    static constexpr double kMaxGlowSolidAngle = 4.0 * std::numbers::pi / 16.0;
     bool hasGlow() const { return glow_ != nullptr; }
     // radiance() of the smooth part.
     glm::vec3 smoothRadiance(const glm::vec3& dir, float solidAngle = 0.0f) const;
@@ -83,6 +85,9 @@ public:
     float glowShare() const;
     // The glow's exact SH projection, as sh() projects the sky (zero without glow).
     sh::ShRgb glowSh() const;
+    // The smooth part's exact SH projection (sh() without glow), summed in double: what a
+    // probe's rays take as their control variate.
+    const sh::ShRgb& smoothSh() const { return smoothSh_; }
     // Exact projection of the whole sky onto SH L2 (texel solid angles, no sampling).
     const sh::ShRgb& sh() const { return sh_; }
     // Irradiance on an unoccluded level surface (normal +Y), integrated exactly over the texels.
@@ -116,6 +121,7 @@ private:
     float rotation_ = 0.0f;  // in u units [0, 1)
     glm::vec3 scale_{1.0f};  // applied to the shared levels on lookup
     sh::ShRgb sh_;
+    sh::ShRgb smoothSh_;
     glm::vec3 openUp_{0.0f};
 };
 
