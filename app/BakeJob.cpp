@@ -756,10 +756,8 @@ ProbeRays raysOf(const BakeSetup& b, const ProbeVolumeSettings& v) { return volu
 uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& layouts,
                           const std::vector<size_t>& mapPoints) {
     uint64_t rays = 0;
-    // A sky whose glow the probes sample adds a quarter of a probe's rays and the sixteen that
-    // choose how to count them (docs/lighting.md, "The sky's glow").
-    const bool glow = b.lighting.sky.hasGlow() && !b.lighting.water;
-    auto withGlow = [&](uint64_t n) { return glow ? n + n / 4 + 16 : n; };
+    const bool glow = probesSampleGlow(b.lighting);
+    auto withGlow = [&](uint64_t n) { return uint64_t(std::llround(probeRaysWithGlow(double(n), glow))); };
     for (size_t vi = 0; vi < b.volumes.size(); ++vi) {
         const ProbeRays r = raysOf(b, *b.volumes[vi]);
         const uint64_t probes = layouts[vi].validCount() + (layouts[vi].octree ? kInterpolationPoints : 0);
@@ -1499,7 +1497,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         {"inputs", bakeInputs(original.project)},
         {"threads", threads},
         {"tracer_kernel", HeightfieldTracer::autoKernelName()},
-        {"sky_glow", {{"share", lighting.sky.glowShare()}, {"probes_sample_it", lighting.sky.hasGlow() && !lighting.water}}},
+        {"sky_glow", {{"share", lighting.sky.glowShare()}, {"probes_sample_it", probesSampleGlow(lighting)}}},
         {"rays", totalRays + cacheRays + referenceRays},
         {"probe_rays", totalRays},
         {"cache_rays", cacheRays},

@@ -369,10 +369,12 @@ void Study::bakeReference() {
 // Rays a probe is expected to trace under `r`, for the estimates: a fixed count, or a target's
 // first round times the growth the current bake measured on this terrain (1 before any bake).
 double Study::expectedRays(const ProbeRays& r) const {
-    if (!r.adaptive()) return double(r.rays);
+    // The traced rays count a sampled glow's (probeRaysWithGlow), and so does meanRays.
+    const bool glow = probesSampleGlow(lighting);
+    if (!r.adaptive()) return probeRaysWithGlow(double(r.rays), glow);
     const double growth =
         current && current->rays.adaptive() && current->meanRays > 0 ? current->meanRays / current->rays.rays : 1.0;
-    return std::min(double(r.maxRays), double(r.rays) * growth);
+    return std::min(probeRaysWithGlow(double(r.maxRays), glow), double(r.rays) * growth);
 }
 
 std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {

@@ -36,6 +36,8 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // mean and 95th percentile over probes, on every shared DEM), and more replicates make each
 // lattice smaller and the bake noisier.
 constexpr int kReplicates = 2;
+// The rays that choose how a probe counts the glow's (traceProbeRounds).
+constexpr int kGlowPilotRays = 16;
 
 // Per luminance SH coefficient, an estimate and the variance of that estimate.
 struct CoefficientMoments {
@@ -586,7 +588,7 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
     sh::ShRgb glowConstant;
     bool countHidden = false;
     if (glow) {
-        constexpr int kPilot = 16;
+        constexpr int kPilot = kGlowPilotRays;
         int hidden = 0;
         for (int m = 0; m < kPilot; ++m) {
             glm::vec3 d;
@@ -663,6 +665,12 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
     return rounds.rays + glowRays;
 }
 
+bool probesSampleGlow(const BakeLighting& L) { return L.sky.hasGlow() && !L.water; }
+
+double probeRaysWithGlow(double latticeRays, bool glow) {
+    return glow ? latticeRays + latticeRays / 4.0 + double(kGlowPilotRays) : latticeRays;
+}
+
 ProbeBake bakeProbes(const BakeLighting& L, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      const ProbeRays& rays, uint64_t seed, const BakeControl& control) {
@@ -688,7 +696,7 @@ ProbeBake bakeProbesSeeded(const BakeLighting& L, const IrradianceCache* cache, 
         // as their control variate and the glow the probe sees is estimated by rays of its own,
         // so a glow a few pixels wide does not ride on the few lattice rays that fall on it.
         // Water reflects the sky, so there every ray would need the glow: it keeps the whole sky.
-        const Sky* glow = L.sky.hasGlow() && !L.water ? &L.sky : nullptr;
+        const Sky* glow = probesSampleGlow(L) ? &L.sky : nullptr;
         int latticeRays = 0;
         traceProbeRounds(
             schedule, rng, out, i, glow ? &L.sky.smoothSh() : &L.sky.sh(),
@@ -766,7 +774,7 @@ ProbeBake referenceProbesSeeded(const BakeLighting& L, int bounces,
         // vertex, as the sun, and the continuation reads the rest of the sky: a sun in an HDR
         // found only by the paths that happen to escape toward it would leave the reference
         // itself noisier than the bake it checks.
-        const bool glow = L.sky.hasGlow() && !L.water;
+        const bool glow = probesSampleGlow(L);
         auto path = [&](RayHit hit) {
             glm::vec3 radiance(0.0f);
             glm::vec3 throughput = L.albedoAt(hit) / kPi;

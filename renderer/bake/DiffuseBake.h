@@ -190,6 +190,13 @@ std::vector<uint64_t> positionSeeds(const std::vector<glm::vec3>& positions, uin
 // Bakes the probes at `positions` (skipping those with valid[i] == 0). Deterministic: each probe's
 // directions and rounds depend only on its position and `seed` (positionSeeds), so a probe at the
 // same place in two bakes (a tile's border probe and the untiled bake's) traces the same rays.
+// Whether a probe samples the sky's glow by rays of its own (docs/lighting.md, "The sky's glow"):
+// an image sky with a glow, and no water (water reflects the sky into every ray).
+bool probesSampleGlow(const BakeLighting& lighting);
+// About the rays a probe traces for `latticeRays` of its lattice: with the glow sampled, a
+// quarter more and the sixteen that choose how to count them.
+double probeRaysWithGlow(double latticeRays, bool glow);
+
 ProbeBake bakeProbes(const BakeLighting& lighting, const IrradianceCache* cache, int bounces,
                      const std::vector<glm::vec3>& positions, const std::vector<uint8_t>& valid,
                      const ProbeRays& rays, uint64_t seed, const BakeControl& control);
