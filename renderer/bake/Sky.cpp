@@ -19,6 +19,14 @@ namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 // Rec. 709 luminance, as the bake's metrics weigh colour.
 double lum(const glm::vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+// The direction of texel (x, y)'s centre in a width x height image turned by `rotation` (u units):
+// the middle of its rows' polar angles and of its column, where the glow's projection and its
+// samples' projection take the texel.
+glm::vec3 texelCentre(int x, int y, int width, int height, float rotation) {
+    const float theta = float(std::numbers::pi * (y + 0.5) / height);
+    const float phi = ((x + 0.5f) / float(width) - 0.5f + rotation) * 2.0f * kPi;
+    return glm::vec3(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+}
 }
 
 glm::vec3 sunDirection(double azimuthDeg, double elevationDeg) {
@@ -153,11 +161,9 @@ void Sky::splitGlow() {
     // as a bias of a percent or more on probes that do not see it.
     std::array<glm::dvec3, sh::kCoeffCount> smoothSh{}, glowSh{};
     for (int y = 0; y < l.height; ++y) {
-        const float theta = float(std::numbers::pi * (y + 0.5) / l.height);
         for (int x = 0; x < l.width; ++x) {
             const size_t i = size_t(y) * l.width + x;
-            const float phi = ((x + 0.5f) / float(l.width) - 0.5f + rotation_) * 2.0f * kPi;
-            const glm::vec3 dir(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            const glm::vec3 dir = texelCentre(x, y, l.width, l.height, rotation_);
             const double y0 = lum(l.texels[i]);
             glm::vec3 g(0.0f);
             if (y0 > threshold) {
@@ -202,12 +208,7 @@ glm::vec3 Sky::sampleGlow(float u0, float u1, float u2, glm::vec3& dir, glm::vec
     const double ct = c0 + (c1 - c0) * double(u2), st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
     const double phi = ((x + double(u1)) / g.width - 0.5 + double(rotation_)) * 2.0 * std::numbers::pi;
     dir = glm::vec3(float(st * std::sin(phi)), float(ct), float(-st * std::cos(phi)));
-    if (centre) {
-        // As computeSh() takes it: the mean of the rows' polar angles, the column's middle.
-        const float theta = float(std::numbers::pi * (y + 0.5) / g.height);
-        const float cphi = ((x + 0.5f) / float(g.width) - 0.5f + rotation_) * 2.0f * kPi;
-        *centre = glm::vec3(std::sin(theta) * std::sin(cphi), std::cos(theta), -std::sin(theta) * std::cos(cphi));
-    }
+    if (centre) *centre = texelCentre(x, y, g.width, g.height, rotation_);
     return scale_ * g.colour[k] * float(g.flux);
 }
 

@@ -61,8 +61,8 @@ public:
     // band-l factor is exp(−l(l+1)·Ω/12)), 0.6 % here. Draft's 96 rays (0.13 sr each) took 6 %
     // off, a bias under the physical sky larger than draft's noise.
     static constexpr float kMaxFilterSolidAngle = 4.0f * std::numbers::pi_v<float> / 1024.0f;
-    // The sky split in two where it is peaky (an HDR's sun and its glow, the physical sky's
-    // circumsolar light): each texel brighter than kGlowThreshold times the smooth part's mean
+    // The sky split in two where it is peaky (an HDR's sun and its glow; the physical sky has
+    // no texel over the threshold): each texel brighter than kGlowThreshold times the smooth part's mean
     // luminance keeps that luminance in the smooth part, in its own colour, and gives the rest to
     // the glow.
     // A probe estimates the terrain's occlusion of the smooth part with its lattice rays and that
