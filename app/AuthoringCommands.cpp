@@ -205,7 +205,16 @@ int commandRender(const Args& a) {
     const TerrainRenderer& terrain = renderer.renderer();
     std::cout << "terrain: " << terrain.lastLod().triangles << " of " << terrain.triangleCount()
               << " triangles at the level of detail, within " << fixed(terrain.lastLod().screenErrorPixels, 2)
-              << " px of the DEM\n";
+              << " px of the DEM";
+    if (terrain.meshStride() > 1) {
+        const auto& detail = terrain.lastLod().detail;
+        const auto own = std::count_if(detail.begin(), detail.end(), [](int8_t d) { return d >= 0; });
+        const int k = terrain.meshStride();
+        const char* suffix = k % 100 / 10 == 1 ? "th" : k % 10 == 1 ? "st" : k % 10 == 2 ? "nd" : k % 10 == 3 ? "rd" : "th";
+        std::cout << " (drawn from every " << k << suffix << " row and column; " << own
+                  << " patch(es) from the DEM's own vertices, " << terrain.lastLod().detailVertices << " of them)";
+    }
+    std::cout << "\n";
     // An msaa count the device lacks is drawn with the largest it has below (or fxaa): say so.
     const Antialiasing asked = project.scene.camera.antialiasing, drawn = renderer.renderer().drawnAntialiasing();
     if (msaaSamples(asked) > 1 && drawn != Antialiasing::Off && drawn != asked)

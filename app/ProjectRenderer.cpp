@@ -41,9 +41,9 @@ ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project)
     : ProjectRenderer(ctx, project, loadProjectTerrain(project)) {}
 
 ProjectRenderer::ProjectRenderer(vk::VulkanContext& ctx, const Project& project,
-                                 DemImportResult terrain, bool computeAo)
+                                 DemImportResult terrain, bool computeAo, size_t meshVertexBudget)
     : project_(project), terrain_(std::move(terrain)), computeAo_(computeAo) {
-    renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield);
+    renderer_ = std::make_unique<TerrainRenderer>(ctx, terrain_.heightfield, meshVertexBudget);
     setProject(project);
 }
 

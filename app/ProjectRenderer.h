@@ -109,8 +109,9 @@ public:
     // With a terrain already imported (the UI holds one). `computeAo` false: the horizon AO of
     // the project is not computed here but handed in with setAmbientOcclusion (the UI computes
     // it off its thread); until then the terrain is drawn without AO.
+    // `meshVertexBudget`: the drawn grid's vertices at most (TerrainRenderer's vertexBudget).
     ProjectRenderer(vk::VulkanContext& ctx, const Project& project, DemImportResult terrain,
-                    bool computeAo = true);
+                    bool computeAo = true, size_t meshVertexBudget = TerrainRenderer::kMeshVertexBudget);
     ~ProjectRenderer();
 
     // Reads sh_coeffs/<volume>.shprobe of every enabled volume from the output folder, with its

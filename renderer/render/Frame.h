@@ -48,6 +48,8 @@ inline constexpr const char* kReadback = "readback";
 inline constexpr const char* kSwapchain = "swapchain";
 inline constexpr const char* kVertices = "terrain-vertices";
 inline constexpr const char* kIndices = "terrain-indices";
+inline constexpr const char* kDetailVertices = "terrain-detail-vertices";  // the detail patches' (MeshLod.h)
+inline constexpr const char* kDetailLight = "probe-detail-light";          // the probe light at them
 inline constexpr const char* kMarkers = "markers";
 inline constexpr const char* kLeaves = "leaves";
 inline constexpr const char* kProbeCoefficients = "probe-coefficients";
@@ -179,6 +181,11 @@ struct SurfaceTextures {
 // Pipelines are built on first use (lavapipe compiles a pipeline when it is created).
 struct RendererGpu {
     vk::Buffer vertices, markers, leaves;
+    // The detail patches' vertices (position and normal, as `vertices`), and which set of them
+    // (TerrainRenderer's detail serial).
+    vk::Buffer detailVertices;
+    uint32_t detailVertexCount = 0;
+    uint64_t detailSerial = 0;
     SurfaceTextures surface;
     vk::Sampler trilinear;
     vk::UniqueSetLayout viewLayout;
@@ -271,6 +278,9 @@ struct Frame {
     // The terrain mesh and the overlays' instances.
     uint32_t vertexCount = 0, indexCount = 0, markerCount = 0, leafCount = 0, gizmoCount = 0;
     uint32_t skirtIndexCount = 0;  // drawn after indexCount by the shadow pass alone (terrain.skirt)
+    // The detail patches' triangles, from detailFirstIndex in indexBuffer, over g.detailVertices,
+    // then their skirt's (the shadow pass alone, as skirtIndexCount).
+    uint32_t detailIndexCount = 0, detailFirstIndex = 0, detailSkirtIndexCount = 0;
     VkBuffer indexBuffer = VK_NULL_HANDLE;  // the level of detail's triangles, then its skirt's
     uint64_t lodSerial = 0;                 // which levels those are (TerrainRenderer::updateLod)
     // The cascades' depth range this frame (with shadows), and the light projections of the

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -236,7 +237,21 @@ TerrainRenderer::TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, 
             const std::vector<uint32_t> pc(cols.begin() + patches_.cols[i], cols.begin() + patches_.cols[i + 1] + 1);
             const std::vector<uint32_t> pr(rows.begin() + patches_.rows[j], rows.begin() + patches_.rows[j + 1] + 1);
             decimation_[k] = lod::gridError(hf.heights(), uint32_t(w), pc, pr);
+            // The DEM's samples there lie within that of the drawn surface: the patch's bounds
+            // (its distance from the camera) hold them.
+            patches_.lo[k].y -= float(decimation_[k]);
+            patches_.hi[k].y += float(decimation_[k]);
         }
+    if (stride_ > 1) {
+        source_.nc = uint32_t(w);
+        source_.nr = uint32_t(d);
+        source_.col = cols;
+        source_.row = rows;
+        for (int c = 0; c < hf.width(); ++c) source_.x.push_back(hf.vertex(c, 0).x);
+        for (int r = 0; r < hf.depth(); ++r) source_.z.push_back(hf.vertex(0, r).z);
+        while (lod::stepOf(detailLevels_) < uint32_t(stride_)) ++detailLevels_;
+        detailLevelErrors_.resize(patches_.count());
+    }
     skirt_ = appendSkirtVertices(vertices, nc, nr);
     indexCount_ = size_t(nc - 1) * (nr - 1) * 6;
     {
@@ -752,11 +767,12 @@ void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm:
     ++sunHorizonSweeps_;
 }
 
-void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool picture, bool shadowed,
+void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool picture, bool sourceDetail, bool shadowed,
                                 const WaterResources* water) {
     double worst = 0.0;
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
     double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
+    lodPicture_ = picture;
     // A caster's height error moves the edge of its shadow 1 / tan(sun elevation) times as far
     // across the ground: with shadows, the levels keep that within the pixel (5x finer at a 11°
     // sun, 1.4x at 35°).
@@ -768,6 +784,19 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     const glm::vec3 eye = s.camera.position();
     const double fovY = glm::radians(double(s.camera.fovDeg));
     std::vector<uint8_t> levels = lod::chooseLevels(patches_, eye, fovY, rows, maxPixels);
+    // Where the drawn grid is decimated and its patches may come from the DEM's samples, a level
+    // is held to the pixel against the DEM: its error against the drawn grid plus what the grid
+    // leaves out (a bound: each of the grid's triangles lies within one of the level's), finer
+    // until it is; at level 0 the detail patches below take over.
+    const bool detailAllowed = sourceDetail && sourceDetail_ && detailLevels_ > 0 && maxPixels > 0.0;
+    if (detailAllowed)
+        for (uint32_t k = 0; k < patches_.count(); ++k) {
+            const double distance = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
+            while (levels[k] > 0 &&
+                   lod::screenPixels(patches_.error[size_t(k) * patches_.levels + levels[k]] + decimation_[k], distance,
+                                     fovY, rows) > maxPixels)
+                --levels[k];
+        }
     // Where the water meets the land, a height error moves the shore by the error over the
     // ground's slope, many pixels on a flat shore: patches the water's surface can cross (its
     // level, give or take the crests) draw every vertex.
@@ -779,22 +808,191 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     // come finer until every patch's drawn surface is within the pixel, and the figure reported
     // is what each patch's surface leaves out of the drawn grid (plus what the grid leaves out of
     // the DEM), seen from its nearest point.
-    const std::vector<double> surface =
-        lod::settleRings(patches_, levels, std::span<const float>(meshVertices_).subspan(1), 6, eye, fovY, rows,
-                         maxPixels, &lodSurfaceCache_);
-    for (uint32_t k = 0; k < patches_.count(); ++k)
-        worst = std::max(worst, lod::screenPixels(surface[k] + decimation_[k],
-                                                  lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
+    std::vector<double> surface, error(patches_.count());
+    std::vector<int8_t> detail(patches_.count(), -1);
+    for (;;) {
+        surface = lod::settleRings(patches_, levels, std::span<const float>(meshVertices_).subspan(1), 6, eye, fovY,
+                                   rows, maxPixels, &lodSurfaceCache_);
+        // Source resolution: the patches at level 0 whose drawn grid still leaves more than the
+        // pixel out of the DEM, nearest first, drawn from the DEM's vertices while they fit.
+        detail.assign(patches_.count(), -1);
+        if (detailAllowed) {
+            std::vector<std::pair<double, uint32_t>> wanted;
+            for (uint32_t k = 0; k < patches_.count(); ++k) {
+                if (levels[k] != 0) continue;
+                const double distance = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
+                if (lod::screenPixels(surface[k] + decimation_[k], distance, fovY, rows) > maxPixels)
+                    wanted.push_back({distance, k});
+            }
+            std::sort(wanted.begin(), wanted.end());
+            size_t vertices = 0;
+            for (const auto& [distance, k] : wanted) {
+                // The coarsest detail level with every finer one within the pixel (chooseLevels' rule).
+                int8_t chosen = 0;
+                for (uint8_t dl = 1; dl < detailLevels_; ++dl) {
+                    if (lod::screenPixels(detailLevelError(k, dl), distance, fovY, rows) > maxPixels) break;
+                    chosen = int8_t(dl);
+                }
+                const size_t n = lod::detailVertexCount(patches_, source_, k, uint8_t(chosen)) +
+                                 lod::detailSkirtTwins(patches_, source_, k, uint8_t(chosen)).size();
+                if (vertices + n > kDetailVertexBudget) break;
+                vertices += n;
+                detail[k] = chosen;
+            }
+        }
+        // A detail patch's surface, its zipped ring included, against the DEM: measured once per
+        // state of the patch and its four sides.
+        const uint32_t px = patches_.patchesX(), pz = patches_.patchesZ();
+        auto inside = [&](int64_t a, int64_t b) { return a >= 0 && b >= 0 && a < int64_t(px) && b < int64_t(pz); };
+        std::vector<uint32_t> measure;
+        for (uint32_t k = 0; k < patches_.count(); ++k) {
+            error[k] = surface[k] + decimation_[k];
+            if (detail[k] < 0) continue;
+            const uint32_t i = k % px, j = k / px;
+            auto side = [&](int64_t a, int64_t b) -> uint64_t {
+                if (!inside(a, b)) return 0xFF;
+                const size_t n = size_t(b) * px + size_t(a);
+                return detail[n] >= 0 ? 0x80u | uint64_t(detail[n]) : levels[n];
+            };
+            const uint64_t key = side(i, j) | side(int64_t(i) - 1, j) << 8 | side(i + 1, j) << 16 |
+                                 side(i, int64_t(j) - 1) << 24 | side(i, j + 1) << 32;
+            auto& cached = detailSurfaceCache_[k];
+            if (cached.first != key || std::isnan(cached.second)) {
+                cached = {key, std::numeric_limits<double>::quiet_NaN()};
+                measure.push_back(k);
+            }
+        }
+        std::vector<double> measured(measure.size());
+        tbb::parallel_for(size_t(0), measure.size(), [&](size_t m) {
+            measured[m] = lod::detailSurfaceError(patches_, source_, levels, detail, measure[m], hf_.heights());
+        });
+        for (size_t m = 0; m < measure.size(); ++m) detailSurfaceCache_[measure[m]].second = measured[m];
+        // A detail patch's ring zipped to a coarser drawn side can stray past the pixel, as a
+        // drawn patch's can: that side comes a level finer (settleRings' rule), and the choice
+        // is made again.
+        bool finer = false;
+        // And a drawn patch whose surface, rings included, with what the grid leaves out, is past
+        // the pixel comes finer itself, or where its ring strays, its coarser sides do.
+        if (detailAllowed)
+            for (uint32_t k = 0; k < patches_.count(); ++k) {
+                if (detail[k] >= 0 || levels[k] == 0) continue;
+                const double distance = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
+                if (lod::screenPixels(surface[k] + decimation_[k], distance, fovY, rows) <= maxPixels) continue;
+                bool sides = false;
+                if (surface[k] > patches_.error[size_t(k) * patches_.levels + levels[k]]) {
+                    const uint32_t i = k % px, j = k / px;
+                    for (const auto& [a, b] :
+                         {std::pair<int64_t, int64_t>{int64_t(i) - 1, j}, {i + 1, j}, {i, int64_t(j) - 1}, {i, j + 1}}) {
+                        if (!inside(a, b)) continue;
+                        const size_t n = size_t(b) * px + size_t(a);
+                        if (detail[n] < 0 && levels[n] > levels[k]) --levels[n], sides = true;
+                    }
+                }
+                if (!sides) --levels[k];
+                finer = true;
+            }
+        for (uint32_t k = 0; k < patches_.count(); ++k) {
+            if (detail[k] < 0) continue;
+            error[k] = detailSurfaceCache_.at(k).second;
+            if (error[k] <= detailLevelError(k, uint8_t(detail[k])) ||
+                lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows) <= maxPixels)
+                continue;
+            const uint32_t i = k % px, j = k / px;
+            for (const auto& [a, b] : {std::pair<int64_t, int64_t>{int64_t(i) - 1, j}, {i + 1, j}, {i, int64_t(j) - 1}, {i, j + 1}}) {
+                if (!inside(a, b)) continue;
+                const size_t n = size_t(b) * px + size_t(a);
+                if (detail[n] < 0 && levels[n] > 0) --levels[n], finer = true;
+            }
+        }
+        if (!finer) break;
+    }
+    for (uint32_t k = 0; k < patches_.count(); ++k) {
+        worst = std::max(worst, lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
+    }
     lastLod_.screenErrorPixels = worst;
-    if (levels == lastLod_.levels && lodSerial_ > 0) return;
+    if (levels == lastLod_.levels && detail == lastLod_.detail && lodSerial_ > 0) return;
     lastLod_.levels = std::move(levels);
+    lastLod_.detail = std::move(detail);
     lodIndices_.clear();
     std::vector<uint32_t> border;
-    lod::appendPatchTriangles(lodIndices_, patches_, lastLod_.levels, &border);
+    lod::appendPatchTriangles(lodIndices_, patches_, lastLod_.levels, &border, lastLod_.detail);
     lodMeshIndices_ = lodIndices_.size();
     lod::appendSkirt(lodIndices_, skirt_, border);
-    lastLod_.triangles = lodMeshIndices_ / 3;
+    lodSkirtEnd_ = lodIndices_.size();
+    // The detail buffer holds what this frame draws; while it does, it stays as it is.
+    bool resident = true;
+    for (uint32_t k = 0; k < patches_.count(); ++k)
+        if (lastLod_.detail[k] >= 0 && (!detailHeld_.count(k) || detailHeld_.at(k) != lastLod_.detail[k])) resident = false;
+    if (!resident) {
+        std::map<uint32_t, std::vector<float>> kept;
+        std::vector<uint32_t> added;
+        for (uint32_t k = 0; k < patches_.count(); ++k) {
+            if (lastLod_.detail[k] < 0) continue;
+            auto old = detailVertices_.find(k);
+            if (old != detailVertices_.end() && detailHeld_.at(k) == lastLod_.detail[k]) kept[k] = std::move(old->second);
+            else kept[k], added.push_back(k);
+        }
+        // The DEM's own positions and normals, as the drawn grid's vertices are made, so the
+        // vertices the two share are the same.
+        // Then, on the DEM's border, the skirt's twins of its border vertices (appendSkirtVertices'
+        // reach).
+        const float reach = 100.0f * std::max({hf_.maxX() - hf_.minX(), hf_.maxZ() - hf_.minZ(), 1.0f});
+        tbb::parallel_for(size_t(0), added.size(), [&](size_t a) {
+            const uint32_t k = added[a];
+            const uint8_t d = uint8_t(lastLod_.detail[k]);
+            const lod::SourceSpan sp = lod::sourceSpan(patches_, source_, k);
+            const std::vector<uint32_t> held = lod::detailVertices(patches_, source_, k, d);
+            const std::vector<lod::DetailTwin> twins = lod::detailSkirtTwins(patches_, source_, k, d);
+            std::vector<float>& v = kept.at(k);
+            v.reserve((held.size() + twins.size()) * 6);
+            for (uint32_t h : held) {
+                const int c = int(sp.c0 + h % sp.nc()), r = int(sp.r0 + h / sp.nc());
+                const glm::vec3 p = hf_.vertex(c, r), n = hf_.vertexNormal(c, r);
+                v.insert(v.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+            }
+            for (const lod::DetailTwin& t : twins) {
+                const glm::vec3 p = hf_.vertex(int(t.c), int(t.r)) + glm::vec3(float(t.dx), 0.0f, float(t.dz)) * reach;
+                v.insert(v.end(), {p.x, p.y, p.z, 0.0f, 1.0f, 0.0f});
+            }
+        });
+        detailVertices_ = std::move(kept);
+        detailHeld_.clear();
+        for (const auto& [k, v] : detailVertices_) detailHeld_[k] = lastLod_.detail[k];
+        detailBase_.clear();
+        uint32_t base = 0;
+        for (const auto& [k, v] : detailVertices_) detailBase_[k] = base, base += uint32_t(v.size() / 6);
+        ++detailSerial_;
+    }
+    lastLod_.detailVertices = 0;
+    for (const auto& [k, v] : detailVertices_)
+        if (lastLod_.detail[k] >= 0) lastLod_.detailVertices += v.size() / 6;
+    {
+        // Each detail patch's triangles and skirt, patch by patch in parallel.
+        std::vector<uint32_t> drawn;
+        for (uint32_t k = 0; k < patches_.count(); ++k)
+            if (lastLod_.detail[k] >= 0) drawn.push_back(k);
+        std::vector<std::vector<uint32_t>> tris(drawn.size()), skirts(drawn.size());
+        tbb::parallel_for(size_t(0), drawn.size(), [&](size_t m) {
+            const uint32_t k = drawn[m];
+            lod::appendDetailPatch(tris[m], patches_, source_, lastLod_.levels, lastLod_.detail, k, detailBase_.at(k));
+            lod::appendDetailSkirt(skirts[m], patches_, source_, lastLod_.detail, k, detailBase_.at(k));
+        });
+        for (const auto& t : tris) lodIndices_.insert(lodIndices_.end(), t.begin(), t.end());
+        lodDetailEnd_ = lodIndices_.size();
+        for (const auto& t : skirts) lodIndices_.insert(lodIndices_.end(), t.begin(), t.end());
+    }
+    lastLod_.triangles = (lodMeshIndices_ + lodDetailEnd_ - lodSkirtEnd_) / 3;
     ++lodSerial_;
+}
+
+double TerrainRenderer::detailLevelError(uint32_t k, uint8_t d) {
+    std::vector<double>& e = detailLevelErrors_[k];
+    if (e.empty()) {
+        e.assign(detailLevels_, std::numeric_limits<double>::quiet_NaN());
+        e[0] = 0.0;
+    }
+    if (std::isnan(e[d])) e[d] = lod::detailLevelError(patches_, source_, k, d, hf_.heights());
+    return e[d];
 }
 
 void TerrainRenderer::releaseRetired(bool idle) {
@@ -816,7 +1014,7 @@ const std::vector<PassInfo>& TerrainRenderer::lastFramePasses() const { return g
 
 void TerrainRenderer::setProbeVolumes(const std::vector<GpuProbeVolume>& volumes) {
     RendererGpu& g = *gpu_;
-    for (const char* name : {kProbeCoefficients, kProbeCells, kProbeVolumes, kProbeErrorMaps, kProbeLight})
+    for (const char* name : {kProbeCoefficients, kProbeCells, kProbeVolumes, kProbeErrorMaps, kProbeLight, kDetailLight})
         g.graph.forget(name);
     if (g.probes) retire(std::move(g.probes));
     volumeCount_ = 0;
@@ -1245,13 +1443,39 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const bool redrawsShadows =
         !f.lightMatrices.empty() && (f.shadows->drawn != f.lightMatrices || f.shadows->drawnSkirt != s.skirt);
     const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0;
-    const bool keepLevels = yields && view.needs.sky && !f.lightMatrices.empty() && !redrawsShadows &&
+    const bool keepLevels = yields && view.needs.sky && lodPicture_ && !f.lightMatrices.empty() && !redrawsShadows &&
                             lodSerial_ > 0 && f.shadows->drawnLod == lodSerial_;
     // The output's rows, not the supersampled target's.
     const uint32_t outputRows = s.height / std::max<uint32_t>(uint32_t(out.antialiasing.scale), 1u);
     const bool ownRows = s.levelOfDetailRows == 0 || (yields && (redrawsShadows || f.lightMatrices.empty()));
     const double rows = double(ownRows ? outputRows : s.levelOfDetailRows);
-    if (!keepLevels) updateLod(s, rows, view.needs.sky, !f.lightMatrices.empty(), f.water);
+    // Detail patches where the per-vertex attribute is none or the probe light (the probe pass
+    // lights their vertices too), not the traced sun visibility.
+    const bool sourceDetail = !f.sunVisibility;
+    const bool anyDetail = std::any_of(lastLod_.detail.begin(), lastLod_.detail.end(), [](int8_t d) { return d >= 0; });
+    if (!keepLevels || (!sourceDetail && anyDetail))
+        updateLod(s, rows, view.needs.sky, sourceDetail, !f.lightMatrices.empty(), f.water);
+    if (g.detailSerial != detailSerial_) {
+        g.graph.forget(kDetailVertices);
+        if (g.detailVertices) retire(std::move(g.detailVertices));
+        g.detailVertices = {};
+        g.detailVertexCount = 0;
+        for (const auto& [k, v] : detailVertices_) g.detailVertexCount += uint32_t(v.size() / 6);
+        if (g.detailVertexCount > 0) {
+            std::vector<float> all;
+            all.reserve(size_t(g.detailVertexCount) * 6);
+            for (const auto& [k, v] : detailVertices_) all.insert(all.end(), v.begin(), v.end());
+            g.detailVertices = vk::Buffer::deviceLocal(ctx_, all.data(), all.size() * sizeof(float),
+                                                       VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+            g.graph.importBuffer(kDetailVertices, g.detailVertices.handle(), true);
+        }
+        g.detailSerial = detailSerial_;
+    }
+    if (g.probes && g.detailVertexCount > 0 && (!g.probes->detail || g.probes->detail->serial != g.detailSerial)) {
+        g.graph.forget(kDetailLight);
+        if (g.probes->detail) retire(std::move(g.probes->detail));
+        g.probes->detail = features::buildDetailLight(ctx_, g, *g.probes);
+    }
     if (f.slot.terrainIndicesSerial != lodSerial_) {
         const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
         if (f.slot.terrainIndices.size() < bytes) {
@@ -1268,7 +1492,10 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.indexBuffer = f.slot.terrainIndices.handle();
     f.lodSerial = lodSerial_;
     f.indexCount = uint32_t(lodMeshIndices_);
-    f.skirtIndexCount = s.skirt ? uint32_t(lodIndices_.size() - lodMeshIndices_) : 0;
+    f.skirtIndexCount = s.skirt ? uint32_t(lodSkirtEnd_ - lodMeshIndices_) : 0;
+    f.detailFirstIndex = uint32_t(lodSkirtEnd_);
+    f.detailIndexCount = uint32_t(lodDetailEnd_ - lodSkirtEnd_);
+    f.detailSkirtIndexCount = s.skirt ? uint32_t(lodIndices_.size() - lodDetailEnd_) : 0;
     f.markerCount = markerCount_;
     f.leafCount = leafCount_;
     f.width = s.width;
@@ -1334,7 +1561,10 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     }
     slot.timedPasses.clear();
     for (const PassInfo& p : g.graph.lastFrame()) slot.timedPasses.push_back(p.name);
-    if (f.probes) f.probes->lightStale = false;
+    if (f.probes) {
+        f.probes->lightStale = false;
+        if (f.probes->detail) f.probes->detail->stale = false;
+    }
     slot.recordMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - recordStart).count();
 }

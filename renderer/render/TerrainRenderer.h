@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdint>
 #include <future>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -89,8 +90,10 @@ class TerrainRenderer {
 public:
     // Large DEMs are drawn from every k-th row and column (always including the last), the
     // smallest k that keeps the mesh within `vertexBudget`: a uniform grid, so no cracks.
-    TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf,
-                    size_t vertexBudget = size_t(1) << 22);
+    // (Where it is, the level of detail draws the patches near the camera from the DEM's own
+    // vertices: kDetailVertexBudget.)
+    static constexpr size_t kMeshVertexBudget = size_t(1) << 22;
+    TerrainRenderer(vk::VulkanContext& ctx, const Heightfield& hf, size_t vertexBudget = kMeshVertexBudget);
     ~TerrainRenderer();
 
     // Binds the volumes (none: the probe subsystem and its buffers go away); the next frame that
@@ -228,8 +231,19 @@ public:
         return decimation_.empty() ? 0.0 : *std::max_element(decimation_.begin(), decimation_.end());
     }
     void setLodPixelError(double pixels) { lodPixelError_ = pixels; }
+    // Source resolution: where the drawn grid is decimated (meshStride() > 1), a picture frame draws
+    // each patch whose drawn vertices leave more than the pixel out of the DEM from the DEM's own
+    // vertices instead (MeshLod.h, detail patches), at the coarsest detail level within the
+    // pixel, nearest the camera first while their vertices fit kDetailVertexBudget. Their
+    // vertices live in a buffer of their own, built when the set of such patches changes; the
+    // probe pass lights them as it lights the drawn grid's.
+    // setSourceDetail(false) draws the drawn grid alone (the benchmarks and tests compare).
+    static constexpr size_t kDetailVertexBudget = size_t(1) << 22;
+    void setSourceDetail(bool on) { sourceDetail_ = on; }
     struct LodChoice {
         std::vector<uint8_t> levels;     // per patch
+        std::vector<int8_t> detail;      // per patch: its detail level, or -1 where drawn from the drawn grid
+        size_t detailVertices = 0;       // the detail buffer's vertices
         size_t triangles = 0;            // the terrain's, skirt aside
         double screenErrorPixels = 0.0;  // the largest of a patch's drawn surface against the DEM, as the
                                          // camera sees it at the patch's nearest point
@@ -288,15 +302,33 @@ private:
     uint64_t framesBegun_ = 0;  // swapchain frames begun: each waited for its slot's frame before
     // Chooses the frame's levels for `rows` of output; builds their triangles when they changed
     // (++lodSerial_).
-    void updateLod(const RenderSettings& s, double rows, bool picture, bool shadowed, const WaterResources* water);
+    // `sourceDetail`: the frame may draw detail patches (its per-vertex attribute, if any, is the
+    // probe light, which the probe pass evaluates at their vertices too).
+    void updateLod(const RenderSettings& s, double rows, bool picture, bool sourceDetail, bool shadowed,
+                   const WaterResources* water);
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
     std::vector<double> decimation_;  // per patch
     lod::SurfaceErrorCache lodSurfaceCache_;  // what each patch's drawn surface leaves out, by its levels
     double lodPixelError_ = 1.0;
+    bool sourceDetail_ = true;
+    bool lodPicture_ = false;  // the last levels were chosen for a picture frame (not every vertex)
     LodChoice lastLod_;
-    std::vector<uint32_t> lodIndices_;  // the levels' triangles, then their skirt's
-    size_t lodMeshIndices_ = 0;
+    // The levels' triangles, then their skirt's, then the detail patches' and their skirt's.
+    std::vector<uint32_t> lodIndices_;
+    size_t lodMeshIndices_ = 0, lodSkirtEnd_ = 0, lodDetailEnd_ = 0;
+    // Source resolution (kDetailVertexBudget): the source grid, the detail levels a patch has
+    // (steps 2^d below the stride), each patch's levels' errors once measured, the patches the
+    // detail buffer holds (their vertices, and where each starts) and its serial.
+    lod::SourceGrid source_;
+    uint8_t detailLevels_ = 0;
+    std::vector<std::vector<double>> detailLevelErrors_;
+    std::map<uint32_t, std::vector<float>> detailVertices_;
+    std::map<uint32_t, int8_t> detailHeld_;  // the detail level each held patch's vertices are for
+    std::map<uint32_t, uint32_t> detailBase_;
+    uint64_t detailSerial_ = 0;
+    std::map<uint32_t, std::pair<uint64_t, double>> detailSurfaceCache_;  // per patch: its sides' key, its error
+    double detailLevelError(uint32_t k, uint8_t d);
     uint64_t lodSerial_ = 0;            // counts the index lists built
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;

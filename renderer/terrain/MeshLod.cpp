@@ -223,15 +223,55 @@ void zip(std::vector<uint32_t>& out, uint32_t nc, const std::vector<GridPoint>& 
     }
 }
 
+// Appends the grid through columns kc and rows kr of an nc-wide vertex grid, its edges drawn
+// through the runs north (along row kr.front()), south (kr.back()), west (column kc.front()) and
+// east (kc.back()), each from corner to corner; where a run is not the kept lines the ring of
+// cells along that edge is zipped to it. Returns whether any edge is zipped.
+bool appendZippedGrid(std::vector<uint32_t>& indices, uint32_t nc, const std::vector<uint32_t>& kc,
+                      const std::vector<uint32_t>& kr, const std::vector<uint32_t>& north,
+                      const std::vector<uint32_t>& south, const std::vector<uint32_t>& west,
+                      const std::vector<uint32_t>& east) {
+    // (A grid one cell across has no ring; its neighbours along its row or column are one cell
+    // across too, so they all stand at the same step and nothing is zipped.)
+    if ((north == kc && south == kc && west == kr && east == kr) || kc.size() < 3 || kr.size() < 3) {
+        appendTriangles(indices, nc, kc, kr);
+        return false;
+    }
+    // The ring of cells along the edges zipped to the edges' vertices, the inside as a
+    // plain grid. Its inner runs are the second and second-last kept lines.
+    const std::vector<uint32_t> ic(kc.begin() + 1, kc.end() - 1), ir(kr.begin() + 1, kr.end() - 1);
+    appendTriangles(indices, nc, ic, ir);
+    auto row = [](const std::vector<uint32_t>& cs, uint32_t r) {
+        std::vector<GridPoint> g;
+        for (uint32_t c : cs) g.push_back({c, r});
+        return g;
+    };
+    auto column = [](const std::vector<uint32_t>& rs, uint32_t c) {
+        std::vector<GridPoint> g;
+        for (uint32_t r : rs) g.push_back({c, r});
+        return g;
+    };
+    // The plain grid's diagonal (c, r)-(c+1, r+1) runs from the outer vertex to the next
+    // inner one on the north and west edges, and from the inner vertex to the next outer
+    // one on the south and east edges.
+    zip(indices, nc, row(north, kr.front()), row(ic, ir.front()), true, true);
+    zip(indices, nc, row(south, kr.back()), row(ic, ir.back()), true, false);
+    zip(indices, nc, column(west, kc.front()), column(ir, ic.front()), false, true);
+    zip(indices, nc, column(east, kc.back()), column(ir, ic.back()), false, false);
+    return true;
+}
+
 // Appends patch (i, j)'s triangles at its level, zipped to coarser neighbours; returns whether
-// any edge is zipped.
+// any edge is zipped. A patch drawn from the source grid (detail[k] >= 0) gives neither
+// triangles nor border segments (its own skirt hangs from its own border edges).
 bool appendPatch(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels, uint32_t i,
-                 uint32_t j, std::vector<uint32_t>* borderSegments) {
+                 uint32_t j, std::vector<uint32_t>* borderSegments, std::span<const int8_t> detail = {}) {
     const uint32_t px = p.patchesX(), pz = p.patchesZ(), nc = p.nc;
     auto level = [&](int64_t a, int64_t b) -> int {
         if (a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz)) return -1;  // outside: the border
         return levels[size_t(b) * px + size_t(a)];
     };
+    if (!detail.empty() && detail[size_t(j) * px + i] >= 0) return false;
     const int own = level(i, j);
     const uint32_t step = stepOf(uint8_t(own));
     const uint32_t c0 = p.cols[i], c1 = p.cols[i + 1], r0 = p.rows[j], r1 = p.rows[j + 1];
@@ -253,43 +293,175 @@ bool appendPatch(std::vector<uint32_t>& indices, const Patches& p, std::span<con
         if (i == 0) segments(keptRange(r0, r1, sW), false, c0);
         if (i + 1 == px) segments(keptRange(r0, r1, sE), false, c1);
     }
-    // (A patch one cell across has no ring; its neighbours along its row or column are one
-    // cell across too, so they all stand at level 0 and nothing is zipped.)
-    if ((sN == step && sS == step && sW == step && sE == step) || kc.size() < 3 || kr.size() < 3) {
-        appendTriangles(indices, nc, kc, kr);
-        return false;
+    return appendZippedGrid(indices, nc, kc, kr, keptRange(c0, c1, sN), keptRange(c0, c1, sS), keptRange(r0, r1, sW),
+                            keptRange(r0, r1, sE));
+}
+
+// The largest |h - s| over the grid vertices under each of `tris` (indices r * nc + c, less
+// `base`), s the triangle's plane through its corners, in world (x(c), z(r)).
+template <class H, class X, class Z>
+double trianglesError(const std::vector<uint32_t>& tris, uint32_t nc, uint32_t base, H h, X x, Z z) {
+    double worst = 0.0;
+    for (size_t t = 0; t + 2 < tris.size(); t += 3) {
+        uint32_t c[3], r[3];
+        for (int v = 0; v < 3; ++v) c[v] = (tris[t + v] - base) % nc, r[v] = (tris[t + v] - base) / nc;
+        const double x0 = x(c[0]), z0 = z(r[0]);
+        const double ax = x(c[1]) - x0, az = z(r[1]) - z0, bx = x(c[2]) - x0, bz = z(r[2]) - z0;
+        const double det = ax * bz - az * bx;
+        if (det == 0.0) continue;
+        const double h0 = h(c[0], r[0]), h1 = h(c[1], r[1]), h2 = h(c[2], r[2]);
+        const double eps = 1e-9;
+        for (uint32_t rr = std::min({r[0], r[1], r[2]}); rr <= std::max({r[0], r[1], r[2]}); ++rr)
+            for (uint32_t cc = std::min({c[0], c[1], c[2]}); cc <= std::max({c[0], c[1], c[2]}); ++cc) {
+                const double dx = x(cc) - x0, dz = z(rr) - z0;
+                const double u = (dx * bz - dz * bx) / det, v = (ax * dz - az * dx) / det;
+                if (u < -eps || v < -eps || u + v > 1.0 + eps) continue;
+                worst = std::max(worst, std::abs(h(cc, rr) - (h0 + u * (h1 - h0) + v * (h2 - h0))));
+            }
     }
-    // The ring of cells along the edges zipped to the edges' vertices, the inside as a
-    // plain grid. Its inner runs are the second and second-last kept lines.
-    const std::vector<uint32_t> ic(kc.begin() + 1, kc.end() - 1), ir(kr.begin() + 1, kr.end() - 1);
-    appendTriangles(indices, nc, ic, ir);
-    auto row = [](const std::vector<uint32_t>& cs, uint32_t r) {
-        std::vector<GridPoint> g;
-        for (uint32_t c : cs) g.push_back({c, r});
-        return g;
-    };
-    auto column = [](const std::vector<uint32_t>& rs, uint32_t c) {
-        std::vector<GridPoint> g;
-        for (uint32_t r : rs) g.push_back({c, r});
-        return g;
-    };
-    // The plain grid's diagonal (c, r)-(c+1, r+1) runs from the outer vertex to the next
-    // inner one on the north and west edges, and from the inner vertex to the next outer
-    // one on the south and east edges.
-    zip(indices, nc, row(keptRange(c0, c1, sN), r0), row(ic, ir.front()), true, true);
-    zip(indices, nc, row(keptRange(c0, c1, sS), r1), row(ic, ir.back()), true, false);
-    zip(indices, nc, column(keptRange(r0, r1, sW), c0), column(ir, ic.front()), false, true);
-    zip(indices, nc, column(keptRange(r0, r1, sE), c1), column(ir, ic.back()), false, false);
-    return true;
+    return worst;
 }
 
 }  // namespace
 
 void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
-                          std::vector<uint32_t>* borderSegments) {
+                          std::vector<uint32_t>* borderSegments, std::span<const int8_t> detail) {
     if (p.cols.size() < 2 || p.rows.size() < 2) return;
     for (uint32_t j = 0; j < p.patchesZ(); ++j)
-        for (uint32_t i = 0; i < p.patchesX(); ++i) appendPatch(indices, p, levels, i, j, borderSegments);
+        for (uint32_t i = 0; i < p.patchesX(); ++i) appendPatch(indices, p, levels, i, j, borderSegments, detail);
+}
+
+SourceSpan sourceSpan(const Patches& p, const SourceGrid& g, uint32_t k) {
+    const uint32_t i = k % p.patchesX(), j = k / p.patchesX();
+    return {g.col[p.cols[i]], g.col[p.cols[i + 1]], g.row[p.rows[j]], g.row[p.rows[j + 1]]};
+}
+
+std::vector<uint32_t> detailVertices(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d) {
+    const SourceSpan s = sourceSpan(p, g, k);
+    const std::vector<uint32_t> kc = keptRange(0, s.nc() - 1, stepOf(d)), kr = keptRange(0, s.nr() - 1, stepOf(d));
+    std::vector<uint32_t> v;
+    size_t next = 0;  // the next kept row
+    for (uint32_t r = 0; r < s.nr(); ++r) {
+        const bool keptRow = next < kr.size() && kr[next] == r;
+        if (keptRow) ++next;
+        if (r == 0 || r + 1 == s.nr()) {
+            for (uint32_t c = 0; c < s.nc(); ++c) v.push_back(r * s.nc() + c);
+        } else if (keptRow) {
+            for (uint32_t c : kc) v.push_back(r * s.nc() + c);
+        } else {
+            v.push_back(r * s.nc());
+            v.push_back(r * s.nc() + s.nc() - 1);
+        }
+    }
+    return v;
+}
+
+size_t detailVertexCount(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d) {
+    const SourceSpan s = sourceSpan(p, g, k);
+    const size_t kc = keptRange(0, s.nc() - 1, stepOf(d)).size(), kr = keptRange(0, s.nr() - 1, stepOf(d)).size();
+    return 2 * size_t(s.nc()) + (kr - 2) * kc + (size_t(s.nr()) - kr) * 2;
+}
+
+namespace {
+
+// Detail patch k's triangles in its span's own indices.
+std::vector<uint32_t> detailTriangles(const Patches& p, const SourceGrid& g, std::span<const uint8_t> levels,
+                                      std::span<const int8_t> detail, uint32_t k) {
+    const uint32_t px = p.patchesX(), pz = p.patchesZ(), i = k % px, j = k / px;
+    const SourceSpan s = sourceSpan(p, g, k);
+    const int own = detail[k];
+    const std::vector<uint32_t> kc = keptRange(0, s.nc() - 1, stepOf(uint8_t(own)));
+    const std::vector<uint32_t> kr = keptRange(0, s.nr() - 1, stepOf(uint8_t(own)));
+    // One edge's run in the span's own coordinates, along columns (north, south) or rows.
+    auto run = [&](int64_t a, int64_t b, bool alongColumns) {
+        const uint32_t n = alongColumns ? s.nc() : s.nr();
+        const bool outside = a < 0 || b < 0 || a >= int64_t(px) || b >= int64_t(pz);
+        if (outside) return keptRange(0, n - 1, stepOf(uint8_t(own)));
+        const size_t nk = size_t(b) * px + size_t(a);
+        if (detail[nk] >= 0) return keptRange(0, n - 1, stepOf(uint8_t(std::max(own, int(detail[nk])))));
+        // A drawn neighbour's vertices at its level.
+        const uint32_t drawnStep = stepOf(levels[nk]);
+        const std::vector<uint32_t>& bounds = alongColumns ? p.cols : p.rows;
+        const std::vector<uint32_t>& source = alongColumns ? g.col : g.row;
+        const uint32_t first = alongColumns ? bounds[i] : bounds[j], last = alongColumns ? bounds[i + 1] : bounds[j + 1];
+        std::vector<uint32_t> r = keptRange(first, last, drawnStep);
+        for (uint32_t& v : r) v = source[v] - source[first];
+        return r;
+    };
+    std::vector<uint32_t> tris;
+    appendZippedGrid(tris, s.nc(), kc, kr, run(i, int64_t(j) - 1, true), run(i, int64_t(j) + 1, true),
+                     run(int64_t(i) - 1, j, false), run(int64_t(i) + 1, j, false));
+    return tris;
+}
+
+// A span's own index to its place in `held` (detailVertices, ascending).
+uint32_t heldIndex(const std::vector<uint32_t>& held, uint32_t v) {
+    return uint32_t(std::lower_bound(held.begin(), held.end(), v) - held.begin());
+}
+
+}  // namespace
+
+void appendDetailPatch(std::vector<uint32_t>& indices, const Patches& p, const SourceGrid& g,
+                       std::span<const uint8_t> levels, std::span<const int8_t> detail, uint32_t k, uint32_t base) {
+    const std::vector<uint32_t> held = detailVertices(p, g, k, uint8_t(detail[k]));
+    std::vector<uint32_t> place(sourceSpan(p, g, k).vertices(), 0);
+    for (size_t m = 0; m < held.size(); ++m) place[held[m]] = base + uint32_t(m);
+    const std::vector<uint32_t> tris = detailTriangles(p, g, levels, detail, k);
+    indices.reserve(indices.size() + tris.size());
+    for (uint32_t v : tris) indices.push_back(place[v]);
+}
+
+std::vector<DetailTwin> detailSkirtTwins(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d) {
+    const uint32_t px = p.patchesX(), pz = p.patchesZ(), i = k % px, j = k / px;
+    const SourceSpan s = sourceSpan(p, g, k);
+    std::vector<DetailTwin> t;
+    if (j == 0)
+        for (uint32_t c : keptRange(s.c0, s.c1, stepOf(d))) t.push_back({c, s.r0, 0, -1});
+    if (j + 1 == pz)
+        for (uint32_t c : keptRange(s.c0, s.c1, stepOf(d))) t.push_back({c, s.r1, 0, 1});
+    if (i == 0)
+        for (uint32_t r : keptRange(s.r0, s.r1, stepOf(d))) t.push_back({s.c0, r, -1, 0});
+    if (i + 1 == px)
+        for (uint32_t r : keptRange(s.r0, s.r1, stepOf(d))) t.push_back({s.c1, r, 1, 0});
+    return t;
+}
+
+void appendDetailSkirt(std::vector<uint32_t>& indices, const Patches& p, const SourceGrid& g,
+                       std::span<const int8_t> detail, uint32_t k, uint32_t base) {
+    const uint32_t px = p.patchesX(), pz = p.patchesZ(), i = k % px, j = k / px;
+    const SourceSpan s = sourceSpan(p, g, k);
+    const uint8_t d = uint8_t(detail[k]);
+    const std::vector<uint32_t> held = detailVertices(p, g, k, d);
+    uint32_t twin = base + uint32_t(held.size());
+    // One border edge: its vertices at the patch's step and their twins, from `twin` on.
+    auto edge = [&](bool alongColumns, uint32_t fixed) {
+        const std::vector<uint32_t> run = keptRange(0, (alongColumns ? s.nc() : s.nr()) - 1, stepOf(d));
+        auto vertex = [&](uint32_t t) { return base + heldIndex(held, alongColumns ? fixed * s.nc() + t : t * s.nc() + fixed); };
+        for (size_t m = 0; m + 1 < run.size(); ++m) {
+            const uint32_t a = vertex(run[m]), b = vertex(run[m + 1]), ta = twin + uint32_t(m), tb = ta + 1;
+            indices.insert(indices.end(), {a, b, tb, a, tb, ta});
+        }
+        twin += uint32_t(run.size());
+    };
+    if (j == 0) edge(true, 0);
+    if (j + 1 == pz) edge(true, s.nr() - 1);
+    if (i == 0) edge(false, 0);
+    if (i + 1 == px) edge(false, s.nc() - 1);
+}
+
+double detailSurfaceError(const Patches& p, const SourceGrid& g, std::span<const uint8_t> levels,
+                          std::span<const int8_t> detail, uint32_t k, std::span<const float> heights) {
+    const std::vector<uint32_t> tris = detailTriangles(p, g, levels, detail, k);
+    const SourceSpan s = sourceSpan(p, g, k);
+    return trianglesError(
+        tris, s.nc(), 0, [&](uint32_t c, uint32_t r) { return double(heights[size_t(s.r0 + r) * g.nc + s.c0 + c]); },
+        [&](uint32_t c) { return double(g.x[s.c0 + c]); }, [&](uint32_t r) { return double(g.z[s.r0 + r]); });
+}
+
+double detailLevelError(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d, std::span<const float> heights) {
+    if (d == 0) return 0.0;
+    const SourceSpan s = sourceSpan(p, g, k);
+    return gridError(heights, g.nc, keptRange(s.c0, s.c1, stepOf(d)), keptRange(s.r0, s.r1, stepOf(d)), g.x, g.z);
 }
 
 std::vector<double> surfaceErrors(const Patches& p, std::span<const uint8_t> levels, std::span<const float> heights,
@@ -317,25 +489,8 @@ std::vector<double> surfaceErrors(const Patches& p, std::span<const uint8_t> lev
         if (!appendPatch(tris, p, levels, i, j, nullptr)) return p.error[size_t(k) * p.levels + levels[k]];
         // Zipped: each grid vertex under each triangle against the triangle's plane, in world
         // (x, z).
-        double worst = 0.0;
-        for (size_t t = 0; t + 2 < tris.size(); t += 3) {
-            uint32_t c[3], r[3];
-            for (int v = 0; v < 3; ++v) c[v] = tris[t + v] % p.nc, r[v] = tris[t + v] / p.nc;
-            const double x0 = p.x[c[0]], z0 = p.z[r[0]];
-            const double ax = p.x[c[1]] - x0, az = p.z[r[1]] - z0, bx = p.x[c[2]] - x0, bz = p.z[r[2]] - z0;
-            const double det = ax * bz - az * bx;
-            if (det == 0.0) continue;
-            const double h0 = h(c[0], r[0]), h1 = h(c[1], r[1]), h2 = h(c[2], r[2]);
-            const double eps = 1e-9;
-            for (uint32_t rr = std::min({r[0], r[1], r[2]}); rr <= std::max({r[0], r[1], r[2]}); ++rr)
-                for (uint32_t cc = std::min({c[0], c[1], c[2]}); cc <= std::max({c[0], c[1], c[2]}); ++cc) {
-                    const double dx = p.x[cc] - x0, dz = p.z[rr] - z0;
-                    const double u = (dx * bz - dz * bx) / det, v = (ax * dz - az * dx) / det;
-                    if (u < -eps || v < -eps || u + v > 1.0 + eps) continue;
-                    worst = std::max(worst, std::abs(h(cc, rr) - (h0 + u * (h1 - h0) + v * (h2 - h0))));
-                }
-        }
-        return worst;
+        return trianglesError(tris, p.nc, 0, h, [&](uint32_t c) { return double(p.x[c]); },
+                              [&](uint32_t r) { return double(p.z[r]); });
     };
     tbb::parallel_for(uint32_t(0), p.count(), [&](uint32_t k) {
         const uint32_t i = k % px, j = k / px;

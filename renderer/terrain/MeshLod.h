@@ -77,8 +77,66 @@ inline uint32_t stepOf(uint8_t level) { return 1u << level; }
 // patch (as appendTriangles winds and, where no edge is zipped, splits them), and returns the
 // mesh's border segments at the border patches' steps: pairs of vertex indices, in order along
 // the border, for the skirt.
+// Patches with detail[k] >= 0 (detail patches, below) give neither triangles nor border segments.
 void appendPatchTriangles(std::vector<uint32_t>& indices, const Patches& p, std::span<const uint8_t> levels,
-                          std::vector<uint32_t>* borderSegments = nullptr);
+                          std::vector<uint32_t>* borderSegments = nullptr, std::span<const int8_t> detail = {});
+
+// Source resolution under a decimated drawn grid: the drawn grid's column c is the source grid's
+// column col[c] (its row r, row[r]). A patch whose drawn vertices leave too much of the source
+// out may be drawn from the source grid instead, a detail patch at detail level d: every 2^d-th
+// source vertex of its span along each axis (its last row and column always). It holds its own
+// vertices (detailVertices); those it shares with the drawn grid have the same positions, so it
+// meets its drawn neighbours without cracks.
+struct SourceGrid {
+    uint32_t nc = 0, nr = 0;         // the source grid's vertices along each axis
+    std::vector<uint32_t> col, row;  // per drawn column / row: its source column / row
+    std::vector<float> x, z;         // the source columns' and rows' world coordinates
+};
+// Patch k's span of the source grid: columns c0..c1, rows r0..r1.
+struct SourceSpan {
+    uint32_t c0 = 0, c1 = 0, r0 = 0, r1 = 0;
+    uint32_t nc() const { return c1 - c0 + 1; }
+    uint32_t nr() const { return r1 - r0 + 1; }
+    size_t vertices() const { return size_t(nc()) * nr(); }
+};
+SourceSpan sourceSpan(const Patches& p, const SourceGrid& g, uint32_t k);
+
+// The vertices detail patch k at level d holds, as its span's own indices (r - r0) * nc() +
+// (c - c0), ascending: its level's grid and every source vertex of its four edges, so whatever
+// its sides, each edge's vertices are among them.
+// (A patch spans two cells a side at least.) detailVertexCount is their number, without listing them.
+std::vector<uint32_t> detailVertices(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d);
+size_t detailVertexCount(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d);
+
+// Appends detail patch k's triangles at its level detail[k], vertex detailVertices()[m] being
+// index base + m. Each edge is drawn at the coarser of the two sides: with a detail neighbour,
+// the coarser detail step; with a drawn neighbour, the drawn vertices that neighbour's level
+// keeps on it (as appendPatchTriangles draws it); at the border, its own step (appendDetailSkirt
+// closes it). The ring along an edge coarser than the patch is zipped.
+void appendDetailPatch(std::vector<uint32_t>& indices, const Patches& p, const SourceGrid& g,
+                       std::span<const uint8_t> levels, std::span<const int8_t> detail, uint32_t k, uint32_t base);
+
+// The skirt under a detail patch's border edges: after the vertices detailVertices lists, the
+// patch holds a twin pushed out across the border for each vertex of each border edge at its
+// step, edge by edge in the order north (row r0), south, west (column c0), east, each along the
+// edge. `detailSkirtTwins` lists them (the source vertex and the outward direction in (x, z));
+// appendDetailSkirt appends each segment of those edges and its twins as two triangles, wound
+// as appendSkirt winds them. (The DEM's corners are drawn vertices: the drawn skirt's corner
+// squares serve.)
+struct DetailTwin {
+    uint32_t c, r;
+    int dx, dz;
+};
+std::vector<DetailTwin> detailSkirtTwins(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d);
+void appendDetailSkirt(std::vector<uint32_t>& indices, const Patches& p, const SourceGrid& g,
+                       std::span<const int8_t> detail, uint32_t k, uint32_t base);
+
+// The largest |h - s| over the source vertices of detail patch k's span, s the surface its
+// triangles (appendDetailPatch) draw there; `heights` is the source grid, row-major.
+double detailSurfaceError(const Patches& p, const SourceGrid& g, std::span<const uint8_t> levels,
+                          std::span<const int8_t> detail, uint32_t k, std::span<const float> heights);
+// What detail level d of patch k leaves out of the source grid, without zipping.
+double detailLevelError(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d, std::span<const float> heights);
 
 // Per patch, the largest |h - s| over its vertices of the drawn grid, s the surface its triangles
 // at `levels` draw there (appendPatchTriangles's): its level's error where no edge is zipped, and

@@ -306,6 +306,55 @@ void BM_DynamicResolution(benchmark::State& state) {
 }
 BENCHMARK(BM_DynamicResolution)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
 
+// Source resolution (docs/ARCHITECTURE.md, "Source resolution"): N42E001 given the mesh budget of
+// 2^20 vertices (stride 2), 1280 x 720, seen from 2 km over the ground (azimuth 210°, 15°), with
+// the detail patches (arg 1) and without (arg 0): the frame's cost, its triangles, the detail
+// patches' vertices and the screen error. The camera's target moves 6 km (a patch) back and forth
+// between frames (arg 2 with the detail patches), so every frame draws a new set of them: what
+// building and uploading them costs a moving camera.
+void BM_SourceResolution(benchmark::State& state) {
+    Fixture& f = fixture();
+    if (!f.renderer) {
+        state.SkipWithError(f.error.c_str());
+        return;
+    }
+    static std::unique_ptr<ProjectRenderer> decimated;
+    if (!decimated) {
+        const Project p = fixtureProject();
+        decimated = std::make_unique<ProjectRenderer>(*f.ctx, p, loadProjectTerrain(p), true, size_t(1) << 20);
+        decimated->loadProbes(true);
+    }
+    TerrainRenderer& t = decimated->renderer();
+    t.setSourceDetail(state.range(0) != 0);
+    OrbitCamera camera = decimated->defaultCamera();
+    camera.azimuthDeg = 210.0f;
+    camera.elevationDeg = 15.0f;
+    camera.radius = 2000.0f;
+    RenderRequest q;
+    q.width = 1280;
+    q.height = 720;
+    const glm::vec3 target = camera.target;
+    decimated->render(q, camera);  // pipelines, maps and the first set of detail patches
+    double ms = 0;
+    FrameCost cost;
+    int frame = 0;
+    for (auto _ : state) {
+        if (state.range(0) == 2) camera.target.x = target.x + 6000.0f * float(++frame % 2);
+        const RenderedImage img = decimated->render(q, camera);
+        ms += img.milliseconds;
+        cost.add(t);
+        benchmark::DoNotOptimize(img.rgba.data());
+    }
+    state.SetLabel(std::string(state.range(0) == 0 ? "drawn grid alone" : state.range(0) == 1 ? "detail patches, still camera"
+                                                                                               : "detail patches, moving camera") +
+                   " on " + f.ctx->deviceName());
+    state.counters["frame_ms"] = ms / double(state.iterations());
+    state.counters["stride"] = t.meshStride();
+    cost.report(state);
+    t.setSourceDetail(true);
+}
+BENCHMARK(BM_SourceResolution)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Iterations(4)->UseRealTime();
+
 // Beauty at 1280 x 720 with the terrain surface's parts each on or off: horizon AO, the
 // normal-variance specular and the micro-detail (shadows and fog off, so only these differ).
 void BM_BeautySurface(benchmark::State& state) {

@@ -3144,6 +3144,61 @@ TEST_F(RenderTest, AFrameBelowFullResolutionKeepsTheShadowMapsUntilTheCascadesMo
     EXPECT_EQ(t.lastLod().levels, supersampled.levels);
 }
 
+// Source resolution (TerrainRenderer::kDetailVertexBudget): a DEM past the mesh's vertex budget
+// is drawn from every k-th vertex, and where that leaves more than the pixel out, near the camera,
+// patches are drawn from the DEM's own vertices, lit by the probes at those vertices and casting
+// shadows as drawn. The sample with a budget that halves it, seen close to the ground: the frame is
+// the undecimated mesh's up to the pixel (no cracks: the sky would show through), and without
+// the detail patches it is not.
+TEST_F(RenderTest, CloseToTheGroundADecimatedDemIsDrawnAtItsSourceResolution) {
+    Project p = sampleProject("detail", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    const size_t vertices = [&] {
+        const DemImportResult t = loadProjectTerrain(p);
+        return size_t(t.heightfield.width()) * size_t(t.heightfield.depth());
+    }();
+    ProjectRenderer whole(*ctx_, p, loadProjectTerrain(p));
+    ProjectRenderer decimated(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    ASSERT_EQ(whole.renderer().meshStride(), 1);
+    ASSERT_EQ(decimated.renderer().meshStride(), 2);
+    ASSERT_EQ(whole.loadProbes(true), 1u);
+    ASSERT_EQ(decimated.loadProbes(true), 1u);
+    ASSERT_TRUE(whole.renderer().hasProbeResources());
+    OrbitCamera close = OrbitCamera::fromSettings(p.scene.camera, whole.heightfield());
+    close.radius = 150.0f;
+    close.elevationDeg = 10.0f;
+    RenderRequest q = unprobed(kViewBeauty, false);
+    q.probes = true;
+    const RenderedImage reference = whole.render(q, close);
+    const RenderedImage detailed = decimated.render(q, close);
+    const TerrainRenderer::LodChoice chosen = decimated.renderer().lastLod();
+    const size_t detailPatches = size_t(std::count_if(chosen.detail.begin(), chosen.detail.end(), [](int8_t d) { return d >= 0; }));
+    decimated.renderer().setSourceDetail(false);
+    const RenderedImage coarse = decimated.render(q, close);
+    const double coarsePixels = decimated.renderer().lastLod().screenErrorPixels;
+    const test::ImageDiff d = test::compareImages(detailed.rgba, reference.rgba, kW, kH);
+    const test::ImageDiff c = test::compareImages(coarse.rgba, reference.rgba, kW, kH);
+    std::printf("detail patches %zu (%zu vertices), %.3f px (without: %.3f px); against the whole mesh: "
+                "mean %.5f max %.4f ssim %.5f, without %.5f %.4f %.5f\n",
+                detailPatches, chosen.detailVertices, chosen.screenErrorPixels, coarsePixels, d.meanAbs, d.maxAbs, d.ssim,
+                c.meanAbs, c.maxAbs, c.ssim);
+    EXPECT_GE(detailPatches, 1u);
+    EXPECT_LE(chosen.screenErrorPixels, 1.0);
+    EXPECT_GT(coarsePixels, 1.0);
+    // Near the camera both draw every DEM sample; further out, the same levels' vertices.
+    EXPECT_LT(d.meanAbs, 2e-4);
+    EXPECT_LT(d.maxAbs, 0.05);
+    EXPECT_GT(c.meanAbs, 5e-4);
+    EXPECT_LT(d.meanAbs, 0.1 * c.meanAbs);
+    EXPECT_GT(d.ssim, c.ssim);
+    // The frames are lit by the probes (the probe pass's light at the detail patches' vertices
+    // among them): without them the same frame differs.
+    decimated.renderer().setSourceDetail(true);
+    RenderRequest unlit = q;
+    unlit.probes = false;
+    EXPECT_GT(test::compareImages(decimated.render(unlit, close).rgba, detailed.rgba, kW, kH).meanAbs, 5e-4);
+}
+
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
     Project p = sampleProject("lod", 4, 4);
     ProjectRenderer r(*ctx_, p);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <numbers>
+#include <set>
 #include <utility>
 #include <vector>
 
@@ -176,6 +177,143 @@ TEST(MeshLod, PatchesAtAnyLevelsMeetWithoutCracks) {
             }
             EXPECT_DOUBLE_EQ(length, 2.0 * (nc - 1) + 2.0 * (nr - 1));
         }
+    }
+}
+
+// Source resolution under a decimated grid: a source grid drawn from every s-th vertex (s = 3,
+// whose detail steps 1 and 2 do not divide it, and 4), patches at random levels, and a random
+// choice of patches drawn from the source grid at random detail levels. The drawn patches'
+// triangles and the detail patches', each in the source grid's vertices, are one watertight mesh
+// of the whole source rectangle: a detail patch meets a drawn neighbour at that neighbour's
+// vertices and another detail patch at the coarser of their steps.
+TEST(MeshLod, DetailPatchesMeetTheDrawnGridAndEachOtherWithoutCracks) {
+    for (const uint32_t stride : {3u, 4u}) {
+        const Terrain src(97, 61, 8);
+        lod::SourceGrid g;
+        g.nc = src.nc;
+        g.nr = src.nr;
+        g.col = lod::kept(src.nc, stride);
+        g.row = lod::kept(src.nr, stride);
+        g.x = src.x;
+        g.z = src.z;
+        const uint32_t nc = uint32_t(g.col.size()), nr = uint32_t(g.row.size());
+        std::vector<float> drawn, cx, rz;
+        for (uint32_t r : g.row)
+            for (uint32_t c : g.col) drawn.push_back(src.h[size_t(r) * src.nc + c]);
+        for (uint32_t c : g.col) cx.push_back(src.x[c]);
+        for (uint32_t r : g.row) rz.push_back(src.z[r]);
+        const lod::Patches p = lod::buildPatches(drawn, nc, nr, cx, rz, 4);
+        ASSERT_GE(p.count(), 12u);
+        uint32_t seed = 777;
+        auto next = [&] { return seed = seed * 1664525u + 1013904223u, seed >> 16; };
+        size_t detailed = 0, zipped = 0;
+        double detailBorder = 0.0;  // the detail skirts' length, in source cells
+        for (int trial = 0; trial < 40; ++trial) {
+            std::vector<uint8_t> levels(p.count());
+            std::vector<int8_t> detail(p.count(), -1);
+            for (uint32_t k = 0; k < p.count(); ++k) {
+                levels[k] = uint8_t(next() % (p.coarsest[k] + 1u));
+                if (levels[k] == 0 && next() % 3 != 0) detail[k] = int8_t(next() % 2), ++detailed;
+            }
+            std::vector<uint32_t> main, border;
+            lod::appendPatchTriangles(main, p, levels, &border, detail);
+            // In the source grid's vertices.
+            std::vector<uint32_t> all;
+            for (uint32_t v : main) all.push_back(g.row[v / nc] * g.nc + g.col[v % nc]);
+            for (uint32_t k = 0; k < p.count(); ++k) {
+                if (detail[k] < 0) continue;
+                const lod::SourceSpan sp = lod::sourceSpan(p, g, k);
+                std::vector<uint32_t> tris;
+                lod::appendDetailPatch(tris, p, g, levels, detail, k, 1000);
+                // Its vertices: its level's grid and its edges, ascending, counted as listed.
+                const std::vector<uint32_t> held = lod::detailVertices(p, g, k, uint8_t(detail[k]));
+                ASSERT_EQ(held.size(), lod::detailVertexCount(p, g, k, uint8_t(detail[k])));
+                ASSERT_TRUE(std::is_sorted(held.begin(), held.end()));
+                for (uint32_t v : tris) {
+                    ASSERT_LT(v - 1000, held.size());
+                    all.push_back((sp.r0 + held[v - 1000] / sp.nc()) * g.nc + sp.c0 + held[v - 1000] % sp.nc());
+                }
+                // Its skirt hangs from exactly its edges on the DEM's border: each segment's top
+                // edge is one of its triangles' border edges, and every such edge has one; its
+                // twins are the ones detailSkirtTwins lists, pushed out across that border.
+                std::set<std::pair<uint32_t, uint32_t>> edges, hung;
+                for (size_t t = 0; t < tris.size(); t += 3)
+                    for (int e = 0; e < 3; ++e) {
+                        const uint32_t a = tris[t + e] - 1000, b = tris[t + (e + 1) % 3] - 1000;
+                        const uint32_t ca = sp.c0 + held[a] % sp.nc(), ra = sp.r0 + held[a] / sp.nc();
+                        const uint32_t cb = sp.c0 + held[b] % sp.nc(), rb = sp.r0 + held[b] / sp.nc();
+                        if ((ra == rb && (ra == 0 || ra == g.nr - 1)) || (ca == cb && (ca == 0 || ca == g.nc - 1)))
+                            edges.insert({std::min(a, b), std::max(a, b)});
+                    }
+                std::vector<uint32_t> skirt;
+                lod::appendDetailSkirt(skirt, p, g, detail, k, 1000);
+                const std::vector<lod::DetailTwin> twins = lod::detailSkirtTwins(p, g, k, uint8_t(detail[k]));
+                ASSERT_EQ(skirt.size() % 6, 0u);
+                for (size_t t = 0; t < skirt.size(); t += 6) {
+                    const uint32_t a = skirt[t] - 1000, b = skirt[t + 1] - 1000;
+                    ASSERT_LT(a, held.size());
+                    ASSERT_LT(b, held.size());
+                    hung.insert({std::min(a, b), std::max(a, b)});
+                    detailBorder += std::abs(double(held[a] % sp.nc()) - double(held[b] % sp.nc())) +
+                                    std::abs(double(held[a] / sp.nc()) - double(held[b] / sp.nc()));
+                    for (const uint32_t tw : {skirt[t + 2] - 1000, skirt[t + 5] - 1000}) {
+                        ASSERT_GE(tw, held.size());
+                        ASSERT_LT(tw - held.size(), twins.size());
+                    }
+                    const lod::DetailTwin& ta = twins[skirt[t + 5] - 1000 - held.size()];
+                    EXPECT_EQ(ta.c, sp.c0 + held[a] % sp.nc());
+                    EXPECT_EQ(ta.r, sp.r0 + held[a] / sp.nc());
+                    EXPECT_TRUE((ta.dx != 0 && (ta.c == 0 || ta.c == g.nc - 1)) || (ta.dz != 0 && (ta.r == 0 || ta.r == g.nr - 1)));
+                }
+                EXPECT_EQ(hung, edges) << "patch " << k;
+                // A ring zipped to a coarser side draws a surface the level alone does not.
+                const double e = lod::detailSurfaceError(p, g, levels, detail, k, src.h);
+                if (std::abs(e - lod::detailLevelError(p, g, k, uint8_t(detail[k]), src.h)) > 1e-9) ++zipped;
+            }
+            ASSERT_TRUE(watertight(all, g.nc, g.nr)) << "stride " << stride << " trial " << trial;
+            // The drawn skirt's segments and the detail skirts run the whole border once, in
+            // source cells.
+            double length = detailBorder;
+            for (size_t i = 0; i + 1 < border.size(); i += 2) {
+                const uint32_t a = border[i], b = border[i + 1];
+                length += std::abs(double(g.col[a % nc]) - double(g.col[b % nc])) +
+                          std::abs(double(g.row[a / nc]) - double(g.row[b / nc]));
+            }
+            EXPECT_DOUBLE_EQ(length, 2.0 * (g.nc - 1) + 2.0 * (g.nr - 1)) << "stride " << stride << " trial " << trial;
+            detailBorder = 0.0;
+        }
+        EXPECT_GT(detailed, 100u);
+        EXPECT_GT(zipped, 10u);
+    }
+}
+
+// Detail patches at detail level 0 everywhere are the source grid itself: no error. One alone
+// among drawn patches zips its rings to their vertices, and its coarser detail levels leave out
+// what their grid leaves out.
+TEST(MeshLod, ADetailPatchAtLevelZeroIsTheSourceGrid) {
+    const Terrain src(97, 97, 8);
+    lod::SourceGrid g;
+    g.nc = g.nr = src.nc;
+    g.col = g.row = lod::kept(src.nc, 4);
+    g.x = src.x;
+    g.z = src.z;
+    const uint32_t n = uint32_t(g.col.size());
+    std::vector<float> drawn, cx;
+    for (uint32_t r : g.row)
+        for (uint32_t c : g.col) drawn.push_back(src.h[size_t(r) * src.nc + c]);
+    for (uint32_t c : g.col) cx.push_back(src.x[c]);
+    const lod::Patches p = lod::buildPatches(drawn, n, n, cx, cx, 4);
+    const std::vector<uint8_t> levels(p.count(), 0);
+    const std::vector<int8_t> detail(p.count(), 0);
+    for (uint32_t k = 0; k < p.count(); ++k) {
+        EXPECT_EQ(lod::detailLevelError(p, g, k, 0, src.h), 0.0);
+        // Every side a detail patch at level 0 or the border (drawn at the patch's own step).
+        EXPECT_EQ(lod::detailSurfaceError(p, g, levels, detail, k, src.h), 0.0) << k;
+        // With a drawn side its ring is zipped to that side's vertices: what they leave out shows.
+        std::vector<int8_t> alone(p.count(), -1);
+        alone[k] = 0;
+        EXPECT_GT(lod::detailSurfaceError(p, g, levels, alone, k, src.h), 0.0) << k;
+        EXPECT_GT(lod::detailLevelError(p, g, k, 1, src.h), 0.0);
     }
 }
 

@@ -1,5 +1,6 @@
 #include "render/features/Probes.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "ShaderBinaries.h"
@@ -86,9 +87,41 @@ std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu&
     return p;
 }
 
+std::unique_ptr<ProbeResources::Detail> buildDetailLight(vk::VulkanContext& ctx, RendererGpu& g, const ProbeResources& p) {
+    auto d = std::make_unique<ProbeResources::Detail>();
+    d->serial = g.detailSerial;
+    d->vertexCount = g.detailVertexCount;
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    d->light = vk::Buffer(ctx, std::max<size_t>(d->vertexCount, 1) * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage,
+                          VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    blocks::ProbesBlock block;
+    block.volumeCount = p.volumeCount;
+    block.vertexCount = int32_t(d->vertexCount);
+    block.anyErrorMap = p.anyErrorMap ? 1 : 0;
+    d->block = vk::Buffer::hostVisible(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    d->block.write(&block, sizeof block);
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    d->set = vk::DescriptorSetBuilder()
+                 .uniform(blocks::ProbesBlock::kBinding, "probes", d->block, compute)
+                 .storage(1, kProbeCoefficients, p.coeffs, compute)
+                 .storage(2, kProbeCells, p.cells, compute)
+                 .storage(3, kProbeVolumes, p.volumes, compute)
+                 .storage(4, kProbeErrorMaps, p.errors, compute)
+                 .storage(5, kDetailVertices, g.detailVertices, compute)
+                 .storage(6, kDetailLight, d->light, compute)
+                 .build(ctx);
+    g.graph.importBuffer(kDetailLight, d->light.handle());
+    return d;
+}
+
 void addProbePass(Frame& f) {
     ProbeResources* probes = f.probes;
-    if (!probes || !probes->lightStale) return;
+    if (!probes) return;
+    ProbeResources::Detail* detail = probes->detail && probes->detail->vertexCount > 0 &&
+                                             (probes->lightStale || probes->detail->stale)
+                                         ? probes->detail.get()
+                                         : nullptr;
+    if (!probes->lightStale && !detail) return;
     RendererGpu& g = f.g;
     if (!g.probePass) {
         const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), probes->set.layout()};
@@ -103,13 +136,28 @@ void addProbePass(Frame& f) {
                    {kVertices, Access::ComputeStorageRead},
                    {kProbeLight, Access::ComputeStorageWrite}},
                   probes->set.bindingNames()};
-    const uint32_t n = f.vertexCount;
-    g.graph.addPass(std::move(info), [&g, probes, n](VkCommandBuffer c) {
+    const uint32_t n = probes->lightStale ? f.vertexCount : 0, nd = detail ? detail->vertexCount : 0;
+    if (n == 0) {
+        info.uses.erase(std::remove_if(info.uses.begin(), info.uses.end(),
+                                       [](const ResourceUse& u) { return u.resource == kVertices || u.resource == kProbeLight; }),
+                        info.uses.end());
+        info.bindings = {};
+    }
+    if (detail) {
+        info.uses.push_back({kDetailVertices, Access::ComputeStorageRead});
+        info.uses.push_back({kDetailLight, Access::ComputeStorageWrite});
+        info.bindings = concat(info.bindings, detail->set.bindingNames());
+    }
+    const VkDescriptorSet sets[2] = {probes->set.handle(), detail ? detail->set.handle() : VK_NULL_HANDLE};
+    g.graph.addPass(std::move(info), [&g, sets, n, nd](VkCommandBuffer c) {
         vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probePass.get());
-        VkDescriptorSet set = probes->set.handle();
-        vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probeLayout.handle(),
-                                TLX_SET_SUBSYSTEM, 1, &set, 0, nullptr);
-        vkCmdDispatch(c, (n + 63) / 64, 1, 1);
+        for (int k = 0; k < 2; ++k) {
+            const uint32_t count = k == 0 ? n : nd;
+            if (count == 0) continue;
+            vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probeLayout.handle(), TLX_SET_SUBSYSTEM, 1,
+                                    &sets[k], 0, nullptr);
+            vkCmdDispatch(c, (count + 63) / 64, 1, 1);
+        }
     });
 }
 

@@ -15,6 +15,16 @@ struct ProbeResources {
     vk::Buffer block, coeffs, cells, volumes, errors, light;
     vk::DescriptorSet set;
     bool lightStale = true;  // the probe pass has not run since the volumes changed
+    // The same light at the detail patches' vertices (RendererGpu::detailVertices), for the set of
+    // them `serial` names.
+    struct Detail {
+        vk::Buffer block, light;
+        vk::DescriptorSet set;
+        uint64_t serial = 0;
+        uint32_t vertexCount = 0;
+        bool stale = true;
+    };
+    std::unique_ptr<Detail> detail;
     int volumeCount = 0;
     bool anyErrorMap = false;  // some volume carries an interpolation-error map
     size_t bytes = 0;          // coefficients and cells on the GPU
@@ -27,7 +37,10 @@ namespace features {
 // imported.
 std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu& g, uint32_t vertexCount,
                                             const std::vector<GpuProbeVolume>& volumes);
-// Evaluates the volumes at the vertices, once after they changed.
+// The probe light's buffer and set for the detail patches' vertices g.detailVertices holds now.
+std::unique_ptr<ProbeResources::Detail> buildDetailLight(vk::VulkanContext& ctx, RendererGpu& g, const ProbeResources& p);
+// Evaluates the volumes at the vertices, once after they changed, and at the detail patches'
+// vertices, once after either changed.
 void addProbePass(Frame& f);
 
 }  // namespace features

@@ -75,10 +75,16 @@ void addShadowPass(Frame& f) {
                    {kVertices, Access::VertexAttributeRead},
                    {kIndices, Access::IndexRead}},
                   {std::string("vertex:") + kVertices, std::string("index:") + kIndices}};
+    // The detail patches cast as they are drawn.
+    if (f.detailIndexCount > 0) {
+        info.uses.push_back({kDetailVertices, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + kDetailVertices);
+    }
     const uint32_t indexCount = f.indexCount + f.skirtIndexCount, res = uint32_t(shadows->resolution);
-    const VkBuffer indices = f.indexBuffer;
-    g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, indices,
-                                      res](VkCommandBuffer c) {
+    const uint32_t detailCount = f.detailIndexCount + f.detailSkirtIndexCount, detailFirst = f.detailFirstIndex;
+    const VkBuffer indices = f.indexBuffer, detailVertices = g.detailVertices.handle();
+    g.graph.addPass(std::move(info), [&g, shadows, lightMatrices = f.lightMatrices, indexCount, indices, res,
+                                      detailCount, detailFirst, detailVertices](VkCommandBuffer c) {
         for (size_t i = 0; i < lightMatrices.size(); ++i) {
             VkClearValue clear{};
             clear.depthStencil = {1.0f, 0};
@@ -89,7 +95,7 @@ void addShadowPass(Frame& f) {
             rbi.clearValueCount = 1;
             rbi.pClearValues = &clear;
             vkCmdBeginRenderPass(c, &rbi, VK_SUBPASS_CONTENTS_INLINE);
-            if (indexCount > 0) {
+            if (indexCount > 0 || detailCount > 0) {
                 setViewport(c, res, res);
                 vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, g.shadowDepth.get());
                 vkCmdPushConstants(c, g.shadowDepthLayout.handle(), VK_SHADER_STAGE_VERTEX_BIT, 0,
@@ -98,7 +104,11 @@ void addShadowPass(Frame& f) {
                 const VkDeviceSize offset = 0;
                 vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
                 vkCmdBindIndexBuffer(c, indices, 0, VK_INDEX_TYPE_UINT32);
-                vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+                if (indexCount > 0) vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+                if (detailCount > 0) {
+                    vkCmdBindVertexBuffers(c, 0, 1, &detailVertices, &offset);
+                    vkCmdDrawIndexed(c, detailCount, 1, detailFirst, 0, 0);
+                }
             }
             vkCmdEndRenderPass(c);
         }

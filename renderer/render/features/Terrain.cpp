@@ -124,9 +124,14 @@ TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
     const VkDescriptorSet lpvSet = f.lpvSet ? f.slot.lpvSet.handle() : VK_NULL_HANDLE;
     const VkBuffer vertices = g.vertices.handle(), indices = f.indexBuffer;
     const uint32_t indexCount = f.indexCount;
-    return [handle, layout, lights, lpvSet, vertices, indices, attribute, attributeOffset,
-            indexCount](VkCommandBuffer c, VkDescriptorSet viewSet) {
-        if (indexCount == 0) return;
+    // The detail patches: the same pipeline over their own vertices and, with probes, the probe
+    // light the probe pass wrote at them (a frame with detail patches has no other attribute).
+    const uint32_t detailCount = f.detailIndexCount, detailFirst = f.detailFirstIndex;
+    const VkBuffer detailVertices = g.detailVertices.handle();
+    const VkBuffer detailAttribute = f.probes && f.probes->detail ? f.probes->detail->light.handle() : VK_NULL_HANDLE;
+    return [handle, layout, lights, lpvSet, vertices, indices, attribute, attributeOffset, indexCount, detailCount,
+            detailFirst, detailVertices, detailAttribute](VkCommandBuffer c, VkDescriptorSet viewSet) {
+        if (indexCount == 0 && detailCount == 0) return;
         vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, handle);
         const VkDescriptorSet sets[] = {viewSet, lights, lpvSet};
         vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, TLX_SET_VIEW,
@@ -135,7 +140,12 @@ TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
         const VkDeviceSize offsets[2] = {0, attributeOffset};
         vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, vb, offsets);
         vkCmdBindIndexBuffer(c, indices, 0, VK_INDEX_TYPE_UINT32);
-        vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+        if (indexCount > 0) vkCmdDrawIndexed(c, indexCount, 1, 0, 0, 0);
+        if (detailCount > 0) {
+            const VkBuffer dvb[2] = {detailVertices, detailAttribute};
+            vkCmdBindVertexBuffers(c, 0, attribute ? 2 : 1, dvb, offsets);
+            vkCmdDrawIndexed(c, detailCount, 1, detailFirst, 0, 0);
+        }
     };
 }
 
@@ -157,6 +167,14 @@ PassInfo terrainPassInfo(const Frame& f, const char* name, std::vector<ResourceU
     if (attribute) {
         info.uses.push_back({attribute, Access::VertexAttributeRead});
         info.bindings.push_back(std::string("vertex:") + attribute);
+    }
+    if (f.detailIndexCount > 0) {
+        info.uses.push_back({kDetailVertices, Access::VertexAttributeRead});
+        info.bindings.push_back(std::string("vertex:") + kDetailVertices);
+        if (attribute) {
+            info.uses.push_back({kDetailLight, Access::VertexAttributeRead});
+            info.bindings.push_back(std::string("vertex:") + kDetailLight);
+        }
     }
     if (f.fog) info.bindings.push_back("fog");
     return info;
