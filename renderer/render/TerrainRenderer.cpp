@@ -773,6 +773,7 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
     double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
     lodPicture_ = picture;
+    lodInputs_ = lodInputsOf(water);
     // A caster's height error moves the edge of its shadow 1 / tan(sun elevation) times as far
     // across the ground: with shadows, the levels keep that within the pixel (5x finer at a 11°
     // sun, 1.4x at 35°).
@@ -983,6 +984,15 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     }
     lastLod_.triangles = (lodMeshIndices_ + lodDetailEnd_ - lodSkirtEnd_) / 3;
     ++lodSerial_;
+}
+
+TerrainRenderer::LodInputs TerrainRenderer::lodInputsOf(const WaterResources* water) const {
+    LodInputs in;
+    in.pixelError = lodPixelError_;
+    in.sourceDetail = sourceDetail_;
+    in.water = water != nullptr;
+    if (water) in.waterLevel = water->level, in.waterMargin = water->margin;
+    return in;
 }
 
 double TerrainRenderer::detailLevelError(uint32_t k, uint8_t d) {
@@ -1443,8 +1453,9 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const bool redrawsShadows =
         !f.lightMatrices.empty() && (f.shadows->drawn != f.lightMatrices || f.shadows->drawnSkirt != s.skirt);
     const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0;
-    const bool keepLevels = yields && view.needs.sky && lodPicture_ && !f.lightMatrices.empty() && !redrawsShadows &&
-                            lodSerial_ > 0 && f.shadows->drawnLod == lodSerial_;
+    const bool keepLevels = yields && view.needs.sky && lodPicture_ && lodInputs_ == lodInputsOf(f.water) &&
+                            !f.lightMatrices.empty() && !redrawsShadows && lodSerial_ > 0 &&
+                            f.shadows->drawnLod == lodSerial_;
     // The output's rows, not the supersampled target's.
     const uint32_t outputRows = s.height / std::max<uint32_t>(uint32_t(out.antialiasing.scale), 1u);
     const bool ownRows = s.levelOfDetailRows == 0 || (yields && (redrawsShadows || f.lightMatrices.empty()));

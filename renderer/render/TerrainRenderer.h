@@ -313,6 +313,16 @@ private:
     double lodPixelError_ = 1.0;
     bool sourceDetail_ = true;
     bool lodPicture_ = false;  // the last levels were chosen for a picture frame (not every vertex)
+    // What the levels are chosen by besides the camera, the sun and the frame's rows: a frame
+    // that keeps the shadow maps' levels keeps them only while these stand.
+    struct LodInputs {
+        double pixelError = 0.0;
+        bool sourceDetail = false, water = false;
+        float waterLevel = 0.0f, waterMargin = 0.0f;
+        bool operator==(const LodInputs&) const = default;
+    };
+    LodInputs lodInputs_;
+    LodInputs lodInputsOf(const WaterResources* water) const;
     LodChoice lastLod_;
     // The levels' triangles, then their skirt's, then the detail patches' and their skirt's.
     std::vector<uint32_t> lodIndices_;

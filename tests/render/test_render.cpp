@@ -3124,6 +3124,27 @@ TEST_F(RenderTest, AFrameBelowFullResolutionKeepsTheShadowMapsUntilTheCascadesMo
     r.render(full);
     EXPECT_TRUE(hasShadowPass());
     EXPECT_GT(t.lastLod().triangles, smallLevels.triangles);
+    // A change of what the levels are chosen by (the pixel asked for; the water's level, whose
+    // shore draws every vertex) is no frame to keep levels through: the small frame takes levels
+    // of its own and draws the maps for them.
+    const TerrainRenderer::LodChoice fullAgain = t.lastLod();
+    t.setLodPixelError(4.0);
+    r.render(small);
+    EXPECT_TRUE(hasShadowPass());
+    EXPECT_LT(t.lastLod().triangles, fullAgain.triangles);
+    t.setLodPixelError(1.0);
+    r.render(full);
+    p = withWater(p, r, 20.0);
+    r.setProject(p);
+    r.render(full);
+    const TerrainRenderer::LodChoice wet = t.lastLod();
+    p.scene.water.level = 0.5 * (double(r.heightfield().minHeight()) + double(r.heightfield().maxHeight()));
+    r.setProject(p);
+    r.render(small);
+    EXPECT_TRUE(hasShadowPass());
+    EXPECT_NE(t.lastLod().levels, wet.levels);
+    p.scene.water.enabled = false;
+    r.setProject(p);
 
     // The viewport names its own height for a full-resolution frame too: with supersampling (the
     // target twice the rows) that frame still takes the levels of its output, not a small frame's.
