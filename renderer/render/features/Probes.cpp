@@ -10,6 +10,37 @@ namespace terralux::features {
 
 using namespace frame;
 
+namespace {
+
+// The probe pass's light at `vertexCount` vertices of `vertices` (position and normal): the
+// light buffer it writes (per vertex two vec4, read as a vertex attribute), its block and its
+// set, over the volumes p holds.
+void lightAt(vk::VulkanContext& ctx, const ProbeResources& p, uint32_t vertexCount, const char* verticesName,
+             const vk::Buffer& vertices, const char* lightName, vk::Buffer& blockBuffer, vk::Buffer& light,
+             vk::DescriptorSet& set) {
+    light = vk::Buffer(ctx, std::max<size_t>(vertexCount, 1) * 32,
+                       VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                       VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    blocks::ProbesBlock block;
+    block.volumeCount = p.volumeCount;
+    block.vertexCount = int32_t(vertexCount);
+    block.anyErrorMap = p.anyErrorMap ? 1 : 0;
+    blockBuffer = vk::Buffer::hostVisible(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    blockBuffer.write(&block, sizeof block);
+    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
+    set = vk::DescriptorSetBuilder()
+              .uniform(blocks::ProbesBlock::kBinding, "probes", blockBuffer, compute)
+              .storage(1, kProbeCoefficients, p.coeffs, compute)
+              .storage(2, kProbeCells, p.cells, compute)
+              .storage(3, kProbeVolumes, p.volumes, compute)
+              .storage(4, kProbeErrorMaps, p.errors, compute)
+              .storage(5, verticesName, vertices, compute)
+              .storage(6, lightName, light, compute)
+              .build(ctx);
+}
+
+}  // namespace
+
 std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu& g, uint32_t vertexCount,
                                             const std::vector<GpuProbeVolume>& volumes) {
     auto p = std::make_unique<ProbeResources>();
@@ -61,24 +92,7 @@ std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu&
     p->cells = vk::Buffer::deviceLocal(ctx, cells.data(), cells.size() * 4, storage);
     p->volumes = vk::Buffer::deviceLocal(ctx, records.data(), records.size() * sizeof(records[0]), storage);
     p->errors = vk::Buffer::deviceLocal(ctx, errors.data(), errors.size() * 4, storage);
-    p->light = vk::Buffer(ctx, std::max<size_t>(vertexCount, 1) * 32,
-                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    blocks::ProbesBlock block;
-    block.volumeCount = p->volumeCount;
-    block.vertexCount = int32_t(vertexCount);
-    block.anyErrorMap = p->anyErrorMap ? 1 : 0;
-    p->block = vk::Buffer::hostVisible(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    p->block.write(&block, sizeof block);
-    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
-    p->set = vk::DescriptorSetBuilder()
-                 .uniform(blocks::ProbesBlock::kBinding, "probes", p->block, compute)
-                 .storage(1, kProbeCoefficients, p->coeffs, compute)
-                 .storage(2, kProbeCells, p->cells, compute)
-                 .storage(3, kProbeVolumes, p->volumes, compute)
-                 .storage(4, kProbeErrorMaps, p->errors, compute)
-                 .storage(5, kVertices, g.vertices, compute)
-                 .storage(6, kProbeLight, p->light, compute)
-                 .build(ctx);
+    lightAt(ctx, *p, vertexCount, kVertices, g.vertices, kProbeLight, p->block, p->light, p->set);
     g.graph.importBuffer(kProbeCoefficients, p->coeffs.handle(), true);
     g.graph.importBuffer(kProbeCells, p->cells.handle(), true);
     g.graph.importBuffer(kProbeVolumes, p->volumes.handle(), true);
@@ -91,25 +105,7 @@ std::unique_ptr<ProbeResources::Detail> buildDetailLight(vk::VulkanContext& ctx,
     auto d = std::make_unique<ProbeResources::Detail>();
     d->serial = g.detailSerial;
     d->vertexCount = g.detailVertexCount;
-    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    d->light = vk::Buffer(ctx, std::max<size_t>(d->vertexCount, 1) * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | storage,
-                          VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    blocks::ProbesBlock block;
-    block.volumeCount = p.volumeCount;
-    block.vertexCount = int32_t(d->vertexCount);
-    block.anyErrorMap = p.anyErrorMap ? 1 : 0;
-    d->block = vk::Buffer::hostVisible(ctx, sizeof block, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    d->block.write(&block, sizeof block);
-    constexpr VkShaderStageFlags compute = VK_SHADER_STAGE_COMPUTE_BIT;
-    d->set = vk::DescriptorSetBuilder()
-                 .uniform(blocks::ProbesBlock::kBinding, "probes", d->block, compute)
-                 .storage(1, kProbeCoefficients, p.coeffs, compute)
-                 .storage(2, kProbeCells, p.cells, compute)
-                 .storage(3, kProbeVolumes, p.volumes, compute)
-                 .storage(4, kProbeErrorMaps, p.errors, compute)
-                 .storage(5, kDetailVertices, g.detailVertices, compute)
-                 .storage(6, kDetailLight, d->light, compute)
-                 .build(ctx);
+    lightAt(ctx, p, d->vertexCount, kDetailVertices, g.detailVertices, kDetailLight, d->block, d->light, d->set);
     g.graph.importBuffer(kDetailLight, d->light.handle());
     return d;
 }
