@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <queue>
 
 #include <glm/gtc/packing.hpp>
 #include <glm/packing.hpp>
@@ -811,36 +812,16 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     // the DEM), seen from its nearest point.
     std::vector<double> surface, error(patches_.count());
     std::vector<int8_t> detail(patches_.count(), -1);
+    // Per patch: the coarsest detail level a detail neighbour's ring asks of it (-1: none asked).
+    std::vector<int8_t> finestDetail(patches_.count(), -1);
+    std::vector<double> asked(patches_.count(), 0.0);
     for (;;) {
         surface = lod::settleRings(patches_, levels, std::span<const float>(meshVertices_).subspan(1), 6, eye, fovY,
                                    rows, maxPixels, &lodSurfaceCache_);
         // Source resolution: the patches at level 0 whose drawn grid still leaves more than the
-        // pixel out of the DEM, nearest first, drawn from the DEM's vertices while they fit.
+        // pixel out of the DEM are drawn from the DEM's vertices, within the detail budget.
         detail.assign(patches_.count(), -1);
-        if (detailAllowed) {
-            std::vector<std::pair<double, uint32_t>> wanted;
-            for (uint32_t k = 0; k < patches_.count(); ++k) {
-                if (levels[k] != 0) continue;
-                const double distance = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
-                if (lod::screenPixels(surface[k] + decimation_[k], distance, fovY, rows) > maxPixels)
-                    wanted.push_back({distance, k});
-            }
-            std::sort(wanted.begin(), wanted.end());
-            size_t vertices = 0;
-            for (const auto& [distance, k] : wanted) {
-                // The coarsest detail level with every finer one within the pixel (chooseLevels' rule).
-                int8_t chosen = 0;
-                for (uint8_t dl = 1; dl < detailLevels_; ++dl) {
-                    if (lod::screenPixels(detailLevelError(k, dl), distance, fovY, rows) > maxPixels) break;
-                    chosen = int8_t(dl);
-                }
-                const size_t n = lod::detailVertexCount(patches_, source_, k, uint8_t(chosen)) +
-                                 lod::detailSkirtTwins(patches_, source_, k, uint8_t(chosen)).size();
-                if (vertices + n > kDetailVertexBudget) break;
-                vertices += n;
-                detail[k] = chosen;
-            }
-        }
+        if (detailAllowed) chooseDetail(detail, levels, surface, finestDetail, asked, eye, fovY, rows, maxPixels);
         // A detail patch's surface, its zipped ring included, against the DEM: measured once per
         // state of the patch and its four sides.
         const uint32_t px = patches_.patchesX(), pz = patches_.patchesZ();
@@ -895,14 +876,21 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         for (uint32_t k = 0; k < patches_.count(); ++k) {
             if (detail[k] < 0) continue;
             error[k] = detailSurfaceCache_.at(k).second;
-            if (error[k] <= detailLevelError(k, uint8_t(detail[k])) ||
-                lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows) <= maxPixels)
-                continue;
+            const double pixels = lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows);
+            if (error[k] <= detailLevelError(k, uint8_t(detail[k])) || pixels <= maxPixels) continue;
             const uint32_t i = k % px, j = k / px;
             for (const auto& [a, b] : {std::pair<int64_t, int64_t>{int64_t(i) - 1, j}, {i + 1, j}, {i, int64_t(j) - 1}, {i, j + 1}}) {
                 if (!inside(a, b)) continue;
                 const size_t n = size_t(b) * px + size_t(a);
-                if (detail[n] < 0 && levels[n] > 0) --levels[n], finer = true;
+                // A drawn side comes a level finer; at level 0 it is drawn from the DEM; a coarser
+                // detail side comes a detail level finer.
+                const int8_t cap = detail[n] < 0 ? int8_t(detailLevels_ - 1) : int8_t(detail[n] - 1);
+                if (detail[n] < 0 && levels[n] > 0) {
+                    --levels[n], finer = true;
+                } else if (detail[n] < 0 || detail[n] > detail[k]) {
+                    asked[n] = std::max(asked[n], pixels);
+                    if (finestDetail[n] < 0 || finestDetail[n] > cap) finestDetail[n] = cap, finer = true;
+                }
             }
         }
         if (!finer) break;
@@ -911,6 +899,7 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         worst = std::max(worst, lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
     }
     lastLod_.screenErrorPixels = worst;
+    lastLod_.error = error;
     if (levels == lastLod_.levels && detail == lastLod_.detail && lodSerial_ > 0) return;
     lastLod_.levels = std::move(levels);
     lastLod_.detail = std::move(detail);
@@ -986,9 +975,60 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     ++lodSerial_;
 }
 
+void TerrainRenderer::chooseDetail(std::vector<int8_t>& detail, std::span<const uint8_t> levels,
+                                   std::span<const double> surface, std::span<const int8_t> finest,
+                                   std::span<const double> asked, const glm::vec3& eye, double fovY, double rows,
+                                   double maxPixels) {
+    // The candidates: patches at level 0 whose drawn grid still leaves more than the pixel out of
+    // the DEM, or whose detail neighbour's ring asks a detail level of them (`finest`, with that
+    // neighbour's error on screen, `asked`).
+    std::vector<uint32_t> wanted;
+    std::vector<double> distance;
+    for (uint32_t k = 0; k < patches_.count(); ++k) {
+        if (levels[k] != 0) continue;
+        const double d = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
+        if (finest[k] >= 0 || lod::screenPixels(surface[k] + decimation_[k], d, fovY, rows) > maxPixels)
+            wanted.push_back(k), distance.push_back(d);
+    }
+    if (wanted.empty()) return;
+    // Every level's error of every candidate, measured once per patch, in parallel.
+    tbb::parallel_for(size_t(0), wanted.size(), [&](size_t m) {
+        for (uint8_t dl = 1; dl < detailLevels_; ++dl) detailLevelError(wanted[m], dl);
+    });
+    // A candidate's states: drawn, then detail levels from the coarsest to 0.
+    std::vector<lod::DetailCandidate> candidates(wanted.size());
+    tbb::parallel_for(size_t(0), wanted.size(), [&](size_t m) {
+        const uint32_t k = wanted[m];
+        lod::DetailCandidate& c = candidates[m];
+        for (int s = -1; s < int(detailLevels_); ++s) {
+            const int8_t d = s < 0 ? int8_t(-1) : int8_t(detailLevels_ - 1 - s);
+            double px = lod::screenPixels(d < 0 ? surface[k] + decimation_[k] : detailLevelError(k, uint8_t(d)),
+                                          distance[m], fovY, rows);
+            if (finest[k] >= 0 && (d < 0 || d > finest[k])) px = std::max(px, asked[k]);
+            c.pixels.push_back(px);
+            c.vertices.push_back(d < 0 ? 0
+                                       : lod::detailVertexCount(patches_, source_, k, uint8_t(d)) +
+                                             lod::detailSkirtTwins(patches_, source_, k, uint8_t(d)).size());
+        }
+        // The coarsest detail level with every finer one within the pixel (chooseLevels' rule),
+        // no coarser than a neighbour's ring asks.
+        int8_t target = 0;
+        for (uint8_t dl = 1; dl < detailLevels_; ++dl) {
+            if (lod::screenPixels(detailLevelError(k, dl), distance[m], fovY, rows) > maxPixels) break;
+            target = int8_t(dl);
+        }
+        if (finest[k] >= 0) target = std::min(target, finest[k]);
+        c.target = size_t(detailLevels_ - target);
+    });
+    const std::vector<size_t> state = lod::allocateDetail(candidates, detailVertexBudget_, maxPixels);
+    for (size_t m = 0; m < wanted.size(); ++m)
+        detail[wanted[m]] = state[m] == 0 ? int8_t(-1) : int8_t(detailLevels_ - state[m]);
+}
+
 TerrainRenderer::LodInputs TerrainRenderer::lodInputsOf(const WaterResources* water) const {
     LodInputs in;
     in.pixelError = lodPixelError_;
+    in.detailBudget = detailVertexBudget_;
     in.sourceDetail = sourceDetail_;
     in.water = water != nullptr;
     if (water) in.waterLevel = water->level, in.waterMargin = water->margin;

@@ -234,17 +234,25 @@ public:
     // Source resolution: where the drawn grid is decimated (meshStride() > 1), a picture frame draws
     // each patch whose drawn vertices leave more than the pixel out of the DEM from the DEM's own
     // vertices instead (MeshLod.h, detail patches), at the coarsest detail level within the
-    // pixel, nearest the camera first while their vertices fit kDetailVertexBudget. Their
-    // vertices live in a buffer of their own, built when the set of such patches changes; the
-    // probe pass lights them as it lights the drawn grid's.
+    // pixel, while their vertices fit the detail budget (kDetailVertexBudget unless set). Past
+    // the budget, the largest error on screen is made as small as the budget allows: the patch
+    // furthest off on screen is refined a detail level at a time until the next one does not fit.
+    // Their vertices live in a buffer of their own, built when the set of such patches changes;
+    // the probe pass lights them as it lights the drawn grid's.
     // setSourceDetail(false) draws the drawn grid alone (the benchmarks and tests compare).
     static constexpr size_t kDetailVertexBudget = size_t(1) << 22;
     void setSourceDetail(bool on) { sourceDetail_ = on; }
+    void setDetailVertexBudget(size_t vertices) { detailVertexBudget_ = vertices; }
+    // Detail levels a patch has (steps 2^d below the stride; 0 where the DEM is drawn whole), and
+    // what level d of patch k leaves out of the DEM (metres), measured once.
+    uint8_t detailLevels() const { return detailLevels_; }
+    double detailLevelError(uint32_t k, uint8_t d);
     struct LodChoice {
         std::vector<uint8_t> levels;     // per patch
         std::vector<int8_t> detail;      // per patch: its detail level, or -1 where drawn from the drawn grid
         size_t detailVertices = 0;       // the detail buffer's vertices
         size_t triangles = 0;            // the terrain's, skirt aside
+        std::vector<double> error;       // per patch: what its drawn surface leaves out of the DEM (m)
         double screenErrorPixels = 0.0;  // the largest of a patch's drawn surface against the DEM, as the
                                          // camera sees it at the patch's nearest point
     };
@@ -317,6 +325,7 @@ private:
     // that keeps the shadow maps' levels keeps them only while these stand.
     struct LodInputs {
         double pixelError = 0.0;
+        size_t detailBudget = 0;
         bool sourceDetail = false, water = false;
         float waterLevel = 0.0f, waterMargin = 0.0f;
         bool operator==(const LodInputs&) const = default;
@@ -338,7 +347,10 @@ private:
     std::map<uint32_t, uint32_t> detailBase_;
     uint64_t detailSerial_ = 0;
     std::map<uint32_t, std::pair<uint64_t, double>> detailSurfaceCache_;  // per patch: its sides' key, its error
-    double detailLevelError(uint32_t k, uint8_t d);
+    size_t detailVertexBudget_ = kDetailVertexBudget;
+    void chooseDetail(std::vector<int8_t>& detail, std::span<const uint8_t> levels, std::span<const double> surface,
+                      std::span<const int8_t> finest, std::span<const double> asked, const glm::vec3& eye, double fovY,
+                      double rows, double maxPixels);
     uint64_t lodSerial_ = 0;            // counts the index lists built
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;

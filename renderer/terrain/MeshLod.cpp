@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <queue>
 
 #include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
@@ -456,6 +457,35 @@ double detailSurfaceError(const Patches& p, const SourceGrid& g, std::span<const
     return trianglesError(
         tris, s.nc(), 0, [&](uint32_t c, uint32_t r) { return double(heights[size_t(s.r0 + r) * g.nc + s.c0 + c]); },
         [&](uint32_t c) { return double(g.x[s.c0 + c]); }, [&](uint32_t r) { return double(g.z[s.r0 + r]); });
+}
+
+std::vector<size_t> allocateDetail(std::span<const DetailCandidate> candidates, size_t budget, double maxPixels) {
+    std::vector<size_t> state(candidates.size(), 0);
+    size_t need = 0;
+    for (const DetailCandidate& c : candidates) need += c.vertices[c.target];
+    if (need <= budget) {
+        for (size_t m = 0; m < candidates.size(); ++m) state[m] = candidates[m].target;
+        return state;
+    }
+    std::priority_queue<std::pair<double, size_t>> worst;
+    for (size_t m = 0; m < candidates.size(); ++m) worst.push({candidates[m].pixels[0], m});
+    size_t used = 0;
+    while (!worst.empty() && worst.top().first > maxPixels) {
+        const size_t m = worst.top().second;
+        const DetailCandidate& c = candidates[m];
+        // Its cheapest finer state that is nearer (a state no nearer is skipped: it would spend
+        // vertices and lower nothing).
+        size_t next = state[m] + 1;
+        while (next < c.pixels.size() && c.pixels[next] >= c.pixels[state[m]]) ++next;
+        if (next >= c.pixels.size()) break;
+        const size_t more = c.vertices[next] - c.vertices[state[m]];
+        if (used + more > budget) break;
+        used += more;
+        state[m] = next;
+        worst.pop();
+        worst.push({c.pixels[state[m]], m});
+    }
+    return state;
 }
 
 double detailLevelError(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d, std::span<const float> heights) {

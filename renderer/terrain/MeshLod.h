@@ -138,6 +138,22 @@ double detailSurfaceError(const Patches& p, const SourceGrid& g, std::span<const
 // What detail level d of patch k leaves out of the source grid, without zipping.
 double detailLevelError(const Patches& p, const SourceGrid& g, uint32_t k, uint8_t d, std::span<const float> heights);
 
+// Spending a vertex budget over the patches that want detail. Each candidate has a sequence of
+// states, coarsest first (state 0: drawn from the drawn grid, at no cost), each with its error on
+// screen (pixels) and its vertices (rising along the sequence), and a target state (within the
+// pixel). Within the budget every candidate takes its target. Past it the largest error is made as
+// small as the budget allows: the candidate furthest off moves to its cheapest finer state that is
+// nearer, until the furthest is within maxPixels or its move does not fit. (Optimal for the
+// largest error: the largest never grows, so every state passed by was at least the final
+// largest, and a smaller largest would need more than each candidate holds and more than the
+// budget.) Returns each candidate's state.
+struct DetailCandidate {
+    std::vector<double> pixels;
+    std::vector<size_t> vertices;
+    size_t target = 0;
+};
+std::vector<size_t> allocateDetail(std::span<const DetailCandidate> candidates, size_t budget, double maxPixels);
+
 // Per patch, the largest |h - s| over its vertices of the drawn grid, s the surface its triangles
 // at `levels` draw there (appendPatchTriangles's): its level's error where no edge is zipped, and
 // where one is, measured under every triangle of the patch, so a ring zipped to a coarser

@@ -3220,6 +3220,70 @@ TEST_F(RenderTest, CloseToTheGroundADecimatedDemIsDrawnAtItsSourceResolution) {
     EXPECT_GT(test::compareImages(decimated.render(unlit, close).rgba, detailed.rgba, kW, kH).meanAbs, 5e-4);
 }
 
+TEST_F(RenderTest, DetailPatchesMeetTheirPixelWhereverTheCameraIsAndKeepToTheirBudget) {
+    Project p = sampleProject("detail_budget", 4, 4);
+    // The sample at four times its resolution (bilinear, with a metre of deterministic roughness),
+    // drawn at stride 4: 64 patches with two detail levels each.
+    DemImportResult fine = loadProjectTerrain(p);
+    {
+        const Heightfield& h = fine.heightfield;
+        const int w = (h.width() - 1) * 4 + 1, d = (h.depth() - 1) * 4 + 1;
+        std::vector<float> heights(size_t(w) * size_t(d));
+        for (int r = 0; r < d; ++r)
+            for (int c = 0; c < w; ++c) {
+                const int c0 = std::min(c / 4, h.width() - 2), r0 = std::min(r / 4, h.depth() - 2);
+                const float u = float(c - 4 * c0) / 4.0f, v = float(r - 4 * r0) / 4.0f;
+                const float z = (1 - v) * ((1 - u) * h.at(c0, r0) + u * h.at(c0 + 1, r0)) +
+                                v * ((1 - u) * h.at(c0, r0 + 1) + u * h.at(c0 + 1, r0 + 1));
+                const uint32_t hash = (uint32_t(c) * 73856093u) ^ (uint32_t(r) * 19349663u);
+                heights[size_t(r) * size_t(w) + size_t(c)] = z + float(hash % 1000u) / 1000.0f;
+            }
+        fine.heightfield = Heightfield(w, d, h.cellSizeX() / 4.0, h.cellSizeZ() / 4.0, std::move(heights));
+    }
+    const size_t vertices = size_t(fine.heightfield.width()) * size_t(fine.heightfield.depth());
+    ProjectRenderer r(*ctx_, p, std::move(fine), true, vertices / 12);
+    TerrainRenderer& t = r.renderer();
+    ASSERT_GE(t.meshStride(), 4);
+    ASSERT_GE(t.detailLevels(), 2);
+    const RenderRequest q = unprobed(kViewBeauty, false);
+    auto detailPatches = [](const TerrainRenderer::LodChoice& c) {
+        return size_t(std::count_if(c.detail.begin(), c.detail.end(), [](int8_t d) { return d >= 0; }));
+    };
+    // Near the ground and further out, low and higher: a detail patch's ring zipped to a drawn
+    // neighbour leaves what that neighbour's grid leaves out, seen nearer; the neighbour is drawn
+    // from the DEM too, so every patch keeps to the pixel.
+    OrbitCamera close = OrbitCamera::fromSettings(p.scene.camera, r.heightfield());
+    for (const float radius : {150.0f, 600.0f, 1500.0f})
+        for (const float elevation : {10.0f, 25.0f}) {
+            close.radius = radius;
+            close.elevationDeg = elevation;
+            r.render(q, close);
+            std::printf("%.0f m at %.0f deg: %zu detail patches, %.3f px\n", radius, elevation,
+                        detailPatches(t.lastLod()), t.lastLod().screenErrorPixels);
+            EXPECT_GE(detailPatches(t.lastLod()), 1u);
+            EXPECT_LE(t.lastLod().screenErrorPixels, 1.0) << radius << " m at " << elevation << " deg";
+        }
+    close.radius = 600.0f;
+    close.elevationDeg = 25.0f;
+    r.render(q, close);
+    const TerrainRenderer::LodChoice free = t.lastLod();
+    t.setSourceDetail(false);
+    r.render(q, close);
+    const double drawnPixels = t.lastLod().screenErrorPixels;
+    t.setSourceDetail(true);
+    t.setDetailVertexBudget(free.detailVertices / 3);
+    r.render(q, close);
+    const TerrainRenderer::LodChoice bound = t.lastLod();
+    std::printf("free: %zu patches, %zu vertices, %.3f px; a third of the budget: %zu patches, %zu vertices, "
+                "%.3f px; without detail %.3f px\n",
+                detailPatches(free), free.detailVertices, free.screenErrorPixels, detailPatches(bound),
+                bound.detailVertices, bound.screenErrorPixels, drawnPixels);
+    EXPECT_LE(free.screenErrorPixels, 1.0);
+    EXPECT_LE(bound.detailVertices, free.detailVertices / 3);
+    EXPECT_GT(bound.screenErrorPixels, 1.0);  // the budget binds
+    EXPECT_LT(bound.screenErrorPixels, 0.5 * drawnPixels);
+}
+
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
     Project p = sampleProject("lod", 4, 4);
     ProjectRenderer r(*ctx_, p);

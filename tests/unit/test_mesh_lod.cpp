@@ -5,8 +5,10 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <numbers>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
@@ -318,6 +320,60 @@ TEST(MeshLod, ADetailPatchAtLevelZeroIsTheSourceGrid) {
 }
 
 // At level 0 everywhere the patches draw exactly the whole grid's triangles (the bake's surface).
+TEST(MeshLod, PastTheBudgetTheDetailGoesWhereItLowersTheLargestError) {
+    // Random candidates (errors along the states not always falling), against every assignment
+    // within the budget: the largest error on screen is the least any assignment reaches.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> px(0.2, 40.0);
+    const double maxPixels = 1.0;
+    size_t bound = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        std::vector<lod::DetailCandidate> cs(1 + rng() % 5);
+        size_t need = 0;
+        for (lod::DetailCandidate& c : cs) {
+            const size_t states = 2 + rng() % 3;
+            size_t v = 0;
+            for (size_t s = 0; s < states; ++s) {
+                c.pixels.push_back(s + 1 == states ? 0.0 : px(rng));
+                c.vertices.push_back(v);
+                v += 1 + rng() % 50;
+            }
+            c.target = states - 1;
+            for (size_t s = states - 1; s-- > 1 && c.pixels[s] <= maxPixels;) c.target = s;
+            need += c.vertices[c.target];
+        }
+        const size_t budget = rng() % (need + 20);
+        const std::vector<size_t> got = lod::allocateDetail(cs, budget, maxPixels);
+        ASSERT_EQ(got.size(), cs.size());
+        size_t used = 0;
+        double largest = 0.0;
+        for (size_t m = 0; m < cs.size(); ++m) {
+            used += cs[m].vertices[got[m]];
+            largest = std::max(largest, cs[m].pixels[got[m]]);
+        }
+        ASSERT_LE(used, budget) << "trial " << trial;
+        if (need <= budget) {
+            for (size_t m = 0; m < cs.size(); ++m) EXPECT_EQ(got[m], cs[m].target) << "trial " << trial;
+            continue;
+        }
+        ++bound;
+        // Every assignment within the budget, by brute force.
+        double best = std::numeric_limits<double>::infinity();
+        std::vector<size_t> a(cs.size(), 0);
+        for (;;) {
+            size_t v = 0;
+            double worst = 0.0;
+            for (size_t m = 0; m < cs.size(); ++m) v += cs[m].vertices[a[m]], worst = std::max(worst, cs[m].pixels[a[m]]);
+            if (v <= budget) best = std::min(best, worst);
+            size_t m = 0;
+            while (m < cs.size() && ++a[m] == cs[m].pixels.size()) a[m++] = 0;
+            if (m == cs.size()) break;
+        }
+        EXPECT_EQ(std::max(largest, maxPixels), std::max(best, maxPixels)) << "trial " << trial;
+    }
+    EXPECT_GT(bound, 1000u);
+}
+
 TEST(MeshLod, LevelZeroEverywhereIsTheWholeGrid) {
     const Terrain t(70, 45, 16);
     std::vector<uint32_t> idx, whole;
