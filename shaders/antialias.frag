@@ -9,6 +9,9 @@
 //   kMode 1, ssaa: the source holds 2x2 samples a pixel; their mean.
 // kLinear 1: the source holds scene-linear values (EXR), whose luminance is compressed as a
 // display would before edges are judged.
+#extension GL_GOOGLE_include_directive : require
+#include "display_math.glsl"
+
 layout(constant_id = 0) const int kMode = 0;
 layout(constant_id = 1) const int kLinear = 0;
 
@@ -25,7 +28,7 @@ const float kSubpixel = 0.75;   // how much of the 3x3 average a one-pixel featu
 const int kSearchSteps = 12;
 
 float luma(vec3 c) {
-    float l = dot(max(c, vec3(0.0)), vec3(0.2126, 0.7152, 0.0722));
+    float l = rec709Luminance(max(c.r, 0.0), max(c.g, 0.0), max(c.b, 0.0));
     if (kLinear == 1) l = sqrt(l / (1.0 + l));  // Reinhard, then roughly the display's gamma
     return l;
 }

@@ -1,5 +1,5 @@
 // The display encoding, in the common subset of GLSL and C++ (shaders/ShaderMath.h includes it
-// for C++): the viewport's tone curve and the sRGB transfer curve, written once. tonemap.glsl
+// for C++): the viewport's tone curve, the sRGB transfer curve and Rec. 709 luminance, written once. tonemap.glsl
 // applies them per channel; the renderer's background colour, the reflection panel's cube cross
 // and the tests call the same functions.
 #ifndef TLX_DISPLAY_MATH_GLSL
@@ -21,6 +21,10 @@ TLX_SHARED float acesFitInverse(float y) {
     float a = 2.43f * y - 2.51f, b = 0.59f * y - 0.03f, k = 0.14f * y;
     return (-b - sqrt(max(b * b - 4.0f * a * k, 0.0f))) / (2.0f * a);
 }
+
+// Relative luminance of linear RGB with the Rec. 709 primaries (ITU-R BT.709-6, item 3.3): what the
+// exposure meter, the sky's glow threshold, the bake's and the LPV's measures of light weigh.
+TLX_SHARED float rec709Luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 // sRGB transfer curve (IEC 61966-2-1:1999, §5.2): linear [0, 1] to the encoded value, and back.
 TLX_SHARED float srgbEncode(float c) {

@@ -6,6 +6,7 @@
 // constants, so each compiles out what the frame does not use.
 #ifndef TLX_LPV_GLSL
 #define TLX_LPV_GLSL
+#include "display_math.glsl"
 
 struct LpvSample {
     vec3 irradiance;  // × indirect_intensity
@@ -42,7 +43,7 @@ float lpvShEvaluate(vec4 sh, vec3 d) { return sh.x * kShY00 + kShY1 * (sh.y * d.
 float lpvIrradianceLinear(vec4 l, vec3 n) {
     return PI * kShY00 * l.x + (2.0 * PI / 3.0) * kShY1 * (l.y * n.y + l.z * n.z + l.w * n.x);
 }
-float lpvLuminance(vec3 c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+float lpvLuminance(vec3 c) { return rec709Luminance(c.r, c.g, c.b); }
 
 // A cascade's fade weight at p: 1 inside, falling to 0 over the fade range (cells) at its faces.
 float lpvFade(int c, vec3 p) {
@@ -161,7 +162,8 @@ vec4 lpvGeometryAt(vec3 p, int last) {
 // ZH3 hallucinated from L1 with the luminance's axis shared by the channels (Roughton et al.,
 // "ZH3: Quadratic Zonal Harmonics", I3D 2024, Section 3.4.3; Lpv.cpp irradianceZh3Hallucinated()).
 vec3 lpvIrradianceZh3(vec4 l[3], vec3 n) {
-    vec3 lum = 0.2126 * l[0].wyz + 0.7152 * l[1].wyz + 0.0722 * l[2].wyz;
+    vec3 lum = vec3(rec709Luminance(l[0].w, l[1].w, l[2].w), rec709Luminance(l[0].y, l[1].y, l[2].y),
+                    rec709Luminance(l[0].z, l[1].z, l[2].z));
     float len = length(lum);
     vec3 e;
     for (int c = 0; c < 3; ++c) {

@@ -136,7 +136,7 @@ vec3 viewNormalVariance(ShadingPoint s) {
 // Filled voids: the final image with filled cells tinted magenta.
 vec3 viewFilled(ShadingPoint s) {
     vec3 c = display(s.linear);
-    float luma = dot(c, vec3(0.2126, 0.7152, 0.0722));
+    float luma = rec709Luminance(c.r, c.g, c.b);
     return mix(c, vec3(1.0, 0.1, 0.9) * (0.35 + 0.65 * luma), 0.75 * clamp(s.filled, 0.0, 1.0));
 }
 

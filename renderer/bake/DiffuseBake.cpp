@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "ShaderMath.h"
 #include "bake/SphereSampling.h"
 #include "water/Water.h"
 
@@ -347,7 +348,7 @@ glm::vec3 sunFirstBounce(const BakeLighting& lighting, const glm::vec3& p, const
     return rays ? sum / float(rays) : sum;
 }
 
-float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(const glm::vec3& c) { return glsl::rec709Luminance(c.x, c.y, c.z); }
 
 const char* qualityName(QualityPreset preset) {
     switch (preset) {

@@ -18,7 +18,7 @@ namespace terralux {
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
 // Rec. 709 luminance, as the bake's metrics weigh colour.
-double lum(const glm::vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+double lum(const glm::vec3& c) { return glsl::rec709Luminance(c.x, c.y, c.z); }
 // The direction of texel (x, y)'s centre in a width x height image turned by `rotation` (u units):
 // the middle of its rows' polar angles and of its column, where the glow's projection and its
 // samples' projection take the texel.

@@ -28,7 +28,7 @@ constexpr float kFarFace = 0.4006696846f;
 constexpr float kSideFace = 0.4234413544f;
 constexpr int kHalf = kGrid / 2;
 
-float luminanceOf(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+float luminanceOf(const glm::vec3& c) { return glsl::rec709Luminance(c.r, c.g, c.b); }
 
 using Face = PropagationFace;
 using Neighbour = PropagationNeighbour;
@@ -124,9 +124,9 @@ float hallucinatedZonal(const Sh4& l, const glm::vec3& axis) {
 }
 
 glm::vec3 irradianceZh3Hallucinated(const std::array<Sh4, 3>& rgb, const glm::vec3& n) {
-    glm::vec3 lum(0.0f);
-    const glm::vec3 w(0.2126f, 0.7152f, 0.0722f);
-    for (int c = 0; c < 3; ++c) lum += w[c] * glm::vec3(rgb[c][3], rgb[c][1], rgb[c][2]);
+    const glm::vec3 lum(glsl::rec709Luminance(rgb[0][3], rgb[1][3], rgb[2][3]),
+                        glsl::rec709Luminance(rgb[0][1], rgb[1][1], rgb[2][1]),
+                        glsl::rec709Luminance(rgb[0][2], rgb[1][2], rgb[2][2]));
     const float len = glm::length(lum);
     glm::vec3 out;
     for (int c = 0; c < 3; ++c) {
@@ -244,8 +244,8 @@ double lightRange(const LightVolume& injected, double cellSize, double indirectI
     std::vector<double> radiance;
     const double kY00 = kShY00;
     for (size_t cell = 0; cell < size_t(kCells); ++cell) {
-        const double y = 0.2126 * injected[lightOffset(0, cell, 0)] + 0.7152 * injected[lightOffset(1, cell, 0)] +
-                         0.0722 * injected[lightOffset(2, cell, 0)];
+        const double y = glsl::rec709Luminance(injected[lightOffset(0, cell, 0)], injected[lightOffset(1, cell, 0)],
+                                               injected[lightOffset(2, cell, 0)]);
         if (y > 0.0) radiance.push_back(y * kY00 / (cellSize * cellSize) * indirectIntensity);
     }
     if (radiance.empty()) return 0.0;

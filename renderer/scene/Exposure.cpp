@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "ShaderMath.h"
 #include "bake/PhysicalSky.h"
 
 namespace terralux {
@@ -31,7 +32,7 @@ double meterEv100(const std::vector<float>& rgba, uint32_t width, uint32_t heigh
     std::vector<double> logs(n);
     for (size_t i = 0; i < n; ++i) {
         const float* p = &rgba[i * 4];
-        const double y = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];  // Rec. 709 luminance
+        const double y = glsl::rec709Luminance(p[0], p[1], p[2]);
         const double cd = y / double(kSceneUnitsPerLux);
         logs[i] = std::isfinite(cd) && cd > 0.0 ? std::clamp(std::log2(cd), kMinLog2, kMaxLog2) : kMinLog2;
     }

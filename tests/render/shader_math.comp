@@ -16,7 +16,7 @@ layout(std430, set = 0, binding = 0) readonly buffer Inputs { vec4 inputs[]; };
 layout(std430, set = 0, binding = 1) writeonly buffer Outputs { float outputs[]; };
 layout(push_constant) uniform Push { ivec4 count; } push;
 
-const int kOutputs = 21;
+const int kOutputs = 22;
 
 void main() {
     int i = int(gl_GlobalInvocationID.x);
@@ -36,4 +36,5 @@ void main() {
     outputs[o + 18] = equirectV(b.y);
     outputs[o + 19] = shadowShortestDrawn(0.01 * b.w, 2.0 * a.y);
     outputs[o + 20] = shadowTakesHorizon(0.01 * b.w, 2.0 * a.y, 60.0) ? 1.0 : 0.0;
+    outputs[o + 21] = rec709Luminance(a.x, a.y, abs(b.x));
 }

@@ -1,4 +1,4 @@
-// The rules C++ and GLSL share (shaders/ShaderMath.h: display encoding, SH basis, fog optics)
+// The rules C++ and GLSL share (shaders/ShaderMath.h: display encoding and luminance, SH basis, fog optics)
 // evaluated by a compute shader built from the same headers, against their C++ evaluation, at
 // samples spread over each function's domain; and the SH basis against the CPU bake's own
 // double-precision closed forms.
@@ -32,7 +32,7 @@ using namespace terralux;
 
 namespace {
 
-constexpr int kOutputs = 21;
+constexpr int kOutputs = 22;
 
 struct Sample {
     glm::vec4 a, b;
@@ -73,13 +73,14 @@ std::array<float, kOutputs> onCpu(const Sample& s) {
     // A cascade texel of 0..200 m, a sun 0..63° high (tan 0..2), DEM cells of 60 m.
     o[19] = glsl::shadowShortestDrawn(0.01f * s.b.w, 2.0f * s.a.y);
     o[20] = glsl::shadowTakesHorizon(0.01f * s.b.w, 2.0f * s.a.y, 60.0f) ? 1.0f : 0.0f;
+    o[21] = glsl::rec709Luminance(s.a.x, s.a.y, std::abs(s.b.x));
     return o;
 }
 
 const char* kNames[kOutputs] = {"acesFit", "srgbEncode", "srgbDecode", "acesFitInverse", "Y0", "Y1", "Y2",
                                 "Y3", "Y4", "Y5", "Y6", "Y7", "Y8", "fogOpticalDepth", "henyeyGreenstein",
                                 "display", "fogSkyOpticalDepth", "equirectU", "equirectV",
-                                "shadowShortestDrawn", "shadowTakesHorizon"};
+                                "shadowShortestDrawn", "shadowTakesHorizon", "rec709Luminance"};
 
 // A device with validation, or none (the test skips).
 std::unique_ptr<vk::VulkanContext> device(std::string& why) {
@@ -144,7 +145,7 @@ TEST(ShaderMath, TheShadersEvaluateEachSharedRuleAsCppDoes) {
     // the zenith, a fortieth of a texel of a 2k sky (5e-4). A division may be 2.5 ulps off (1e-6).
     const double bound[kOutputs] = {2.5e-7, 2e-6, 2e-6, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7,
                                     2.5e-7, 2.5e-7, 2.5e-7, 2.5e-7, 5e-5, 2.5e-7, 2e-6, 5e-5, 5e-4, 5e-4,
-                                    1e-6, 1e-6};
+                                    1e-6, 1e-6, 2.5e-7};
     for (int f = 0; f < kOutputs; ++f) {
         double worst = 0.0;
         for (size_t i = 0; i < in.size(); ++i) {

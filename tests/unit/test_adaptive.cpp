@@ -706,8 +706,8 @@ Project orkhonProject(const fs::path& out) {
 
 TEST(AdaptiveBake, SameBytesWithOneAndTwoThreadsAndAReportThatSaysWhatHappened) {
     const fs::path dir = tempDir("threads");
-    BakeRequest one{orkhonProject(dir / "one"), 1, false};
-    BakeRequest two{orkhonProject(dir / "two"), 2, false};
+    BakeRequest one{orkhonProject(dir / "one"), 1, false, {}};
+    BakeRequest two{orkhonProject(dir / "two"), 2, false, {}};
     const BakeOutcome a = runBake(one, {}, nullptr);
     runBake(two, {}, nullptr);
     for (const char* f : {"sh_coeffs/valley.shprobe", "sh_coeffs/grid.shprobe",
@@ -752,7 +752,7 @@ TEST(AdaptiveBake, TerrainGridFileMapsEveryCellAboveTheGroundToItsColumn) {
     p.scene.exportSettings.outDir = dir.string();
     p.scene.probeVolumes[0].gridDims = {12, 1, 9};
     p.scene.probeVolumes[0].heightOffset = 50.0;  // clear of the triangle surface everywhere
-    runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     const ShProbeGrid g = readShProbeFile(dir / "sh_coeffs/probes.shprobe");
     const DemImportResult dem = importDem(p.scene.terrain.dem);
     const Heightfield& hf = dem.heightfield;
@@ -792,7 +792,7 @@ TEST(AdaptiveBake, TerrainGridFileMapsEveryCellAboveTheGroundToItsColumn) {
 
 TEST(AdaptiveBake, DryRunEstimatesWithoutWriting) {
     const fs::path dir = tempDir("dry") / "out";
-    BakeRequest request{orkhonProject(dir), 0, false};
+    BakeRequest request{orkhonProject(dir), 0, false, {}};
     const BakeEstimate e = estimateBake(request);
     EXPECT_FALSE(fs::exists(dir));
     ASSERT_EQ(e.volumes.size(), 2u);

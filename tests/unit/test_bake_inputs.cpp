@@ -151,7 +151,7 @@ std::map<std::string, std::string> bakeOutputs(Project p, const fs::path& out) {
     p.scene.exportSettings.outDir = out.string();
     std::map<std::string, std::string> files;
     try {
-        runBake(BakeRequest{p, 1, false}, {}, nullptr);
+        runBake(BakeRequest{p, 1, false, {}}, {}, nullptr);
     } catch (const std::exception& e) {
         return {{"refused", e.what()}};  // an edit the bake refuses is one it reads
     }
@@ -274,8 +274,8 @@ TEST(BakeInputs, ABakeWithEveryIgnoredRowChangedWritesTheSameProbes) {
     q.scene = changed;
     p.scene.exportSettings.outDir = (dir / "a").string();
     q.scene.exportSettings.outDir = (dir / "b").string();
-    const BakeOutcome a = runBake(BakeRequest{p, 1, false}, {}, nullptr);
-    const BakeOutcome b = runBake(BakeRequest{q, 1, false}, {}, nullptr);
+    const BakeOutcome a = runBake(BakeRequest{p, 1, false, {}}, {}, nullptr);
+    const BakeOutcome b = runBake(BakeRequest{q, 1, false, {}}, {}, nullptr);
     int probeFiles = 0;
     for (const fs::path& f : a.files) {
         const fs::path rel = fs::relative(f, dir / "a");

@@ -67,7 +67,7 @@ TEST(BakeDefaults, NoExportedProbeHasNegativeIrradiance) {
     Project p = cropProject(dir / "on", 16);
     p.scene.sky.color = glm::vec3(0.0f);
     p.scene.sun.elevationDeg = 0.0;
-    const BakeOutcome on = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome on = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     const ShProbeGrid g = readShProbeFile(dir / "on" / "sh_coeffs/probes.shprobe");
     ASSERT_GT(g.probes.size(), 200u);
     EXPECT_GE(minIrradianceOf(g), 0.0f);
@@ -75,7 +75,7 @@ TEST(BakeDefaults, NoExportedProbeHasNegativeIrradiance) {
     // Without the window the same bake has negative irradiance: the case is a real one.
     p.scene.bake.deringing = false;
     p.scene.exportSettings.outDir = (dir / "off").string();
-    runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     EXPECT_LT(minIrradianceOf(readShProbeFile(dir / "off" / "sh_coeffs/probes.shprobe")), 0.0f);
     fs::remove_all(dir);
 }
@@ -230,7 +230,7 @@ TEST(PresetRounds, EachPresetReachesItsErrorAgainstTheReference) {
             p.scene.sky.mode = c.sky;
             const std::string what = std::string(name) + " " + qualityName(c.preset) +
                                      (c.sky == SkyMode::Physical ? ", physical sky" : "");
-            const nlohmann::json r = runBake(BakeRequest{p, 0, true}, {}, nullptr).report;
+            const nlohmann::json r = runBake(BakeRequest{p, 0, true, {}}, {}, nullptr).report;
             // Draft's one bounce reads the cache at the hit; two bounces and more gather there.
             EXPECT_EQ(r["quality"]["final_gather"].get<bool>(), c.preset != QualityPreset::Draft) << what;
             const nlohmann::json& v = r["volumes"][0];
@@ -252,7 +252,7 @@ TEST(BakeTargetError, ChosenRaysAndBouncesMeetItAgainstAFineBake) {
     const fs::path dir = tempDir("sampling_target");
     Project p = cropProject(dir, 8);
     p.scene.bake.targetError = 0.01;
-    const nlohmann::json r = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+    const nlohmann::json r = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr).report;
     ASSERT_TRUE(r.contains("sampling_target")) << r.dump(1);
     const nlohmann::json& t = r["sampling_target"];
     const int rays = t["rays"].get<int>(), bounces = t["bounces"].get<int>();
@@ -330,7 +330,7 @@ TEST(BakeEstimate, CountsLoadingWritingAndTheSuggestionAHighMapTriggers) {
     const fs::path dir = tempDir("estimate_parts");
     Project p = cropProject(dir, 8);
     p.scene.bake.errorMapResolution = 32;
-    BakeEstimate e = estimateBake(BakeRequest{p, 0, false});
+    BakeEstimate e = estimateBake(BakeRequest{p, 0, false, {}});
     EXPECT_GT(e.loadSeconds, 0.0);
     EXPECT_EQ(e.writeSeconds, 0.0) << "export.gltf is off";
     ASSERT_EQ(e.volumes.size(), 1u);
@@ -342,18 +342,18 @@ TEST(BakeEstimate, CountsLoadingWritingAndTheSuggestionAHighMapTriggers) {
     EXPECT_GT(coarse.secondsMax, coarse.seconds);
     EXPECT_LE(coarse.secondsMax - coarse.seconds, coarse.suggestionSecondsMax);
     EXPECT_NEAR(e.seconds, e.cacheSeconds + e.loadSeconds + e.writeSeconds + coarse.seconds, 1e-9);
-    BakeRequest bake{p, 0, false};
+    BakeRequest bake{p, 0, false, {}};
     const BakeOutcome o = runBake(bake, {}, nullptr);
     EXPECT_FALSE(o.report["volumes"][0]["suggestions"].empty()) << "the coarse map's prediction holds";
 
     // A grid dense enough that the map is low: no suggestion counted, but still its bound.
     p.scene.probeVolumes[0].gridDims = {64, 1, 43};
     p.scene.exportSettings.gltf = true;
-    e = estimateBake(BakeRequest{p, 0, false});
+    e = estimateBake(BakeRequest{p, 0, false, {}});
     EXPECT_GT(e.writeSeconds, 0.0);
     EXPECT_FALSE(e.volumes[0].suggestionLikely);
     EXPECT_NEAR(e.volumes[0].secondsMax - e.volumes[0].seconds, e.volumes[0].suggestionSecondsMax, 1e-9);
-    const BakeOutcome dense = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome dense = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     EXPECT_TRUE(!dense.report["volumes"][0].contains("suggestions") || dense.report["volumes"][0]["suggestions"].empty());
     fs::remove_all(dir);
 }
@@ -366,7 +366,7 @@ TEST(BakeTargetError, TighterTargetsTraceMoreAndTheReferencePresetRefusesIt) {
     int last = 0;
     for (double target : {0.04, 0.01, 0.0025}) {
         p.scene.bake.targetError = target;
-        const BakeEstimate e = estimateBake(BakeRequest{p, 0, false});
+        const BakeEstimate e = estimateBake(BakeRequest{p, 0, false, {}});
         ASSERT_TRUE(e.sampling);
         EXPECT_EQ(e.rays, e.sampling->rays);
         EXPECT_EQ(e.volumes[0].raysPerProbe, e.sampling->rays) << "the target replaces the volume's ray_count";
@@ -382,7 +382,7 @@ TEST(BakeTargetError, TighterTargetsTraceMoreAndTheReferencePresetRefusesIt) {
     }
     p.scene.bake.quality = QualityPreset::Reference;
     try {
-        estimateBake(BakeRequest{p, 0, false});
+        estimateBake(BakeRequest{p, 0, false, {}});
         ADD_FAILURE() << "the reference preset took a target";
     } catch (const ProjectError& e) {
         EXPECT_NE(std::string(e.what()).find("bake.target_error = 0.0025: the reference preset"), std::string::npos)
@@ -397,7 +397,7 @@ TEST(BakeJob, ASceneBuiltInCodeMeetsTheTableRules) {
     const fs::path dir = tempDir("table_rules");
     const Project p = cropProject(dir, 65);
     try {
-        runBake(BakeRequest{p, 0, false}, {}, nullptr);
+        runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
         ADD_FAILURE() << "a 65 x 65 terrain grid was baked";
     } catch (const ProjectError& e) {
         const std::string m = e.what();
@@ -407,7 +407,7 @@ TEST(BakeJob, ASceneBuiltInCodeMeetsTheTableRules) {
     EXPECT_FALSE(fs::exists(dir));
     // At the limit it bakes.
     const Project atLimit = cropProject(dir, 64);
-    EXPECT_NO_THROW(estimateBake(BakeRequest{atLimit, 0, false}));
+    EXPECT_NO_THROW(estimateBake(BakeRequest{atLimit, 0, false, {}}));
 }
 
 // The report counts every ray: the irradiance cache's as well as the probes'.
@@ -415,7 +415,7 @@ TEST(BakeReport, RaysCountTheCacheAndTheProbes) {
     const fs::path dir = tempDir("rays");
     Project p = cropProject(dir, 8);
     p.scene.bake.quality = QualityPreset::Draft;
-    const nlohmann::json r = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+    const nlohmann::json r = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr).report;
     const nlohmann::json& v = r["volumes"][0];
     // Each probe's rounds: the volume's rays are the sum over probes of what each traced.
     EXPECT_EQ(r["probe_rays"].get<uint64_t>(),
@@ -438,7 +438,7 @@ TEST(BakeReport, ReferenceQualityComparedWithTheReferenceSaysWhyThereIsNoError) 
     Project p = cropProject(dir, 2);
     p.scene.bake.quality = QualityPreset::Reference;
     p.scene.bake.rays = 256;
-    const nlohmann::json r = runBake(BakeRequest{p, 0, true}, {}, nullptr).report;
+    const nlohmann::json r = runBake(BakeRequest{p, 0, true, {}}, {}, nullptr).report;
     const nlohmann::json& e = r["volumes"][0]["reference_error"];
     ASSERT_TRUE(e.is_object());
     EXPECT_TRUE(e["mean"].is_null());
@@ -460,7 +460,7 @@ TEST(BakeCost, PresetsAreOrderedByRaysTracedOnSmallAndLargeGrids) {
                                      QualityPreset::Reference}) {
             Project p = cropProject(dir, grid);
             p.scene.bake.quality = preset;
-            const nlohmann::json r = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+            const nlohmann::json r = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr).report;
             const uint64_t rays = r["rays"].get<uint64_t>();
             std::printf("%d x %d %s: %llu rays (cache %llu)\n", grid, grid, qualityName(preset),
                         (unsigned long long)rays, (unsigned long long)r["cache_rays"].get<uint64_t>());
@@ -586,7 +586,7 @@ TEST(BakeJob, AutoWaterOnADryDemIsNoneAndSaysSo) {
     p.scene.bake.quality = QualityPreset::Draft;
     p.scene.water.enabled = true;
     p.scene.exportSettings.gltf = true;
-    const BakeOutcome out = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome out = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     ASSERT_EQ(out.warnings.size(), 1u);
     EXPECT_EQ(out.warnings[0].rfind("water.level auto: the DEM shows no water surface", 0), 0u) << out.warnings[0];
     std::ifstream gltf(dir / "scene.gltf");
@@ -608,8 +608,8 @@ TEST(BakeJob, ProbesOverALakeSeeTheWater) {
     wet.scene.water.level = 900.0;  // the crop spans 569 to 1589 m
     wet.scene.probeVolumes[0].heightOffset = 400.0;  // every probe above the water
     dry.scene.probeVolumes[0].heightOffset = 400.0;
-    const BakeOutcome a = runBake(BakeRequest{dry, 0, false}, {}, nullptr);
-    const BakeOutcome b = runBake(BakeRequest{wet, 0, false}, {}, nullptr);
+    const BakeOutcome a = runBake(BakeRequest{dry, 0, false, {}}, {}, nullptr);
+    const BakeOutcome b = runBake(BakeRequest{wet, 0, false, {}}, {}, nullptr);
     EXPECT_FALSE(a.report["volumes"][0].contains("probes_under_water"));
     EXPECT_EQ(b.report["volumes"][0]["probes_under_water"], 0);
     EXPECT_EQ(b.report["inputs"]["settings"]["water"]["level"], 900.0);
@@ -633,7 +633,7 @@ TEST(BakeJob, ProbesOverALakeSeeTheWater) {
     Project deep = wet;
     deep.scene.exportSettings.outDir = (dir / "deep").string();
     deep.scene.probeVolumes[0].heightOffset = 5.0;
-    const BakeOutcome c = runBake(BakeRequest{deep, 0, false}, {}, nullptr);
+    const BakeOutcome c = runBake(BakeRequest{deep, 0, false, {}}, {}, nullptr);
     EXPECT_GT(c.report["volumes"][0]["probes_under_water"].get<int>(), 0);
     fs::remove_all(dir);
 }
@@ -651,7 +651,7 @@ TEST(BakeSuggestions, TheSuggestedGridDeliversThePredictedError) {
         p.scene.bake.quality = QualityPreset::Draft;
         p.scene.bake.errorMapResolution = 32;
         p.scene.probeVolumes[0].gridDims = {4, 1, 4};
-        const nlohmann::json first = runBake(BakeRequest{p, 0, false}, {}, nullptr).report;
+        const nlohmann::json first = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr).report;
         const nlohmann::json& v = first["volumes"][0];
         const double mean = v["error_map"]["mean"].get<double>(), p95 = v["error_map"]["p95"].get<double>();
         ASSERT_TRUE(mean > kSuggestAboveMeanError || p95 > kSuggestAboveP95Error) << crop << ": " << v["error_map"].dump();
@@ -667,7 +667,7 @@ TEST(BakeSuggestions, TheSuggestedGridDeliversThePredictedError) {
         Project suggested = p;
         suggested.scene = sceneFromJson(doc, "suggestion", nullptr);
         suggested.scene.exportSettings.outDir = (dir / "suggested").string();
-        const nlohmann::json second = runBake(BakeRequest{suggested, 0, false}, {}, nullptr).report;
+        const nlohmann::json second = runBake(BakeRequest{suggested, 0, false, {}}, {}, nullptr).report;
         const nlohmann::json& m = second["volumes"][0]["error_map"];
         std::printf("%s: 4 x 4 mean %.2f %% / p95 %.2f %%; %s predicted %.2f / %.2f %%, baked %.2f / %.2f %%\n", crop,
                     100 * mean, 100 * p95, s["set"][0].get<std::string>().c_str(), 100 * predictedMean,
@@ -694,7 +694,7 @@ TEST(BakeValidity, ProbesOnSlopesTooSteepForTheTracerAreLiftedClear) {
     p.scene.bake.quality = QualityPreset::Draft;
     p.scene.bake.errorMapResolution = 0;
     p.scene.terrain.verticalScale = 100.0;
-    const BakeOutcome steep = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome steep = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     const nlohmann::json& validity = steep.report["volumes"][0]["validity"];
     EXPECT_EQ(validity["probes_with_rays_from_below"].get<size_t>(), 0u) << validity.dump();
     const size_t lifted = validity["lifted_clear_of_surface"].get<size_t>();
@@ -709,13 +709,13 @@ TEST(BakeValidity, ProbesOnSlopesTooSteepForTheTracerAreLiftedClear) {
     }
     EXPECT_TRUE(said) << nlohmann::json(steep.warnings).dump();
     p.scene.probeVolumes[0].heightOffset = 50.0;
-    const BakeOutcome higher = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome higher = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     EXPECT_EQ(higher.report["volumes"][0]["validity"]["probes_with_rays_from_below"].get<size_t>(), 0u);
     EXPECT_LT(higher.report["volumes"][0]["validity"]["lifted_clear_of_surface"].get<size_t>(), lifted);
     // At the real scale nothing moves.
     p.scene.terrain.verticalScale = 1.0;
     p.scene.probeVolumes[0].heightOffset = 5.0;
-    const BakeOutcome real = runBake(BakeRequest{p, 0, false}, {}, nullptr);
+    const BakeOutcome real = runBake(BakeRequest{p, 0, false, {}}, {}, nullptr);
     EXPECT_EQ(real.report["volumes"][0]["validity"]["lifted_clear_of_surface"].get<size_t>(), 0u);
     fs::remove_all(dir);
 }

@@ -131,14 +131,14 @@ TEST(Scenarios, AScenariosProbesAreABakeOfItsLighting) {
     doc["scenarios"] = json::array({kDusk});
     Project p;
     p.scene = sceneFromJson(doc, "p.json", nullptr);
-    const BakeOutcome out = runBake(BakeRequest{p, 2, false}, {}, nullptr);
+    const BakeOutcome out = runBake(BakeRequest{p, 2, false, {}}, {}, nullptr);
 
     json lit = cropDocument(dir / "lit");
     lit["sun"] = kDusk["sun"];
     lit["sky"] = kDusk["sky"];
     Project q;
     q.scene = sceneFromJson(lit, "lit.json", nullptr);
-    (void)runBake(BakeRequest{q, 1, false}, {}, nullptr);
+    (void)runBake(BakeRequest{q, 1, false, {}}, {}, nullptr);
 
     const fs::path scenarioFile = dir / "with" / "scenarios" / "probes.dusk.shprobe";
     ASSERT_TRUE(fs::exists(scenarioFile));
@@ -183,7 +183,7 @@ TEST(Scenarios, AScenariosProbesAreABakeOfItsLighting) {
     // A bake without the scenario removes its file with the rest of the earlier bake.
     doc["scenarios"] = json::array();
     p.scene = sceneFromJson(doc, "p.json", nullptr);
-    (void)runBake(BakeRequest{p, 2, false}, {}, nullptr);
+    (void)runBake(BakeRequest{p, 2, false, {}}, {}, nullptr);
     EXPECT_FALSE(fs::exists(scenarioFile));
     std::ifstream again(dir / "with" / "scene.gltf");
     EXPECT_FALSE(json::parse(again)["scenes"][0]["extensions"]["TERRALUX_lighting"].contains("scenarios"));

@@ -225,7 +225,7 @@ TEST(Tiles, CoresCoverTheRegionSharingTheirBordersAndTheHaloFollowsTheRelief) {
 
 TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
     const fs::path whole = freshDir("whole"), tiled = freshDir("tiled");
-    const BakeOutcome w = runBake(BakeRequest{regionProject(whole), 2, false}, {}, nullptr);
+    const BakeOutcome w = runBake(BakeRequest{regionProject(whole), 2, false, {}}, {}, nullptr);
     const std::vector<Probe> reference = probesIn(whole);
     ASSERT_EQ(reference.size(), 63u);
 
@@ -234,7 +234,7 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
     for (const std::optional<double> halo : {std::optional<double>(), std::optional<double>(300.0)}) {
         fs::remove_all(tiled);
         for (int i = 0; i < 4; ++i) {
-            BakeRequest r{regionProject(tiled), 2, false};
+            BakeRequest r{regionProject(tiled), 2, false, {}};
             r.tile = parseTiles("2,2", std::to_string(i) + "/4", halo);
             r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
             const BakeOutcome o = runBake(r, {}, nullptr);
@@ -338,7 +338,7 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
         const std::string read = bytesOf(folder / "sh_coeffs" / "probes.shprobe");
         fs::remove(tiled / kTilesFolder / "region.json");
         fs::remove_all(folder);
-        BakeRequest r{regionProject(tiled), 1, false};
+        BakeRequest r{regionProject(tiled), 1, false, {}};
         r.tile = parseTiles("2,2", "2/4", std::optional<double>(300.0));
         r.project.scene.exportSettings.outDir = folder.string();
         const BakeOutcome o = runBake(r, {}, nullptr);
@@ -378,7 +378,7 @@ TEST(Tiles, TheirBakesMatchTheUntiledBakeAlongTheBordersAndMergeIntoOneScene) {
     } catch (const ProjectError& e) {
         EXPECT_NE(std::string(e.what()).find("1 of 4 tiles missing: tile_001_000"), std::string::npos) << e.what();
     }
-    BakeRequest other{regionProject(tiled), 2, false};
+    BakeRequest other{regionProject(tiled), 2, false, {}};
     other.project.scene.sun.elevationDeg = 20.0;
     other.tile = parseTiles("2,2", "2/4", std::optional<double>(300.0));
     other.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*other.tile)).string();
@@ -404,7 +404,7 @@ TEST(Tiles, TheDerivedHaloHoldsEveryProbeOfAMountainTileWithinItsShare) {
     std::map<bool, std::vector<Probe>> probes;
     double derivedHalo = 0.0, relief = 0.0;
     for (const bool whole : {false, true}) {
-        BakeRequest r{Project{}, 2, false};
+        BakeRequest r{Project{}, 2, false, {}};
         r.project.scene.terrain.dem = dem.string();
         r.project.scene.terrain.maxResolution = 301;
         r.project.scene.probeVolumes[0].gridDims = {13, 1, 13};
@@ -458,7 +458,7 @@ TEST(Tiles, TheHaloBeyondTheNearHaloTracedOnTheOverviewHoldsEveryProbeWithinItsS
     std::map<bool, std::vector<Probe>> probes;
     std::map<bool, nlohmann::json> tile;
     for (const bool full : {false, true}) {
-        BakeRequest r{Project{}, 2, false};
+        BakeRequest r{Project{}, 2, false, {}};
         r.project.scene.terrain.dem = dem.string();
         r.project.scene.probeVolumes[0].gridDims = {13, 1, 13};
         r.project.scene.bake.quality = QualityPreset::Draft;
@@ -513,7 +513,7 @@ TEST(Tiles, ANearHaloReadsLessOfTheDemAndTracesTheRestOnTheOverview) {
     std::map<bool, std::vector<Probe>> probes;
     std::map<bool, nlohmann::json> tile;
     for (const bool full : {false, true}) {
-        BakeRequest r{regionProject(dir / (full ? "full" : "near")), 2, false};
+        BakeRequest r{regionProject(dir / (full ? "full" : "near")), 2, false, {}};
         r.tile = parseTiles("2,2", "3/4", std::nullopt);
         r.tile->nearHaloMetres = full ? 1.0e7 : 150.0;
         r.project.scene.exportSettings.outDir = (dir / (full ? "full" : "near") / kTilesFolder / tileName(*r.tile)).string();
@@ -573,7 +573,7 @@ TEST(Tiles, TheMergeListsEachLightingScenarioInTheOrderOfTheGrids) {
     // sorted shProbeGrids (the default's are the grids themselves), and tiles.json hashes them.
     const fs::path tiled = freshDir("scenarios");
     for (int i = 0; i < 2; ++i) {
-        BakeRequest r{regionProject(tiled), 2, false};
+        BakeRequest r{regionProject(tiled), 2, false, {}};
         LightingScenario dusk;
         dusk.name = "dusk";
         dusk.sun = r.project.scene.sun;
@@ -621,7 +621,7 @@ TEST(Tiles, TheMergeListsEveryTilesReflectionProbes) {
     const fs::path tiled = freshDir("reflections");
     size_t baked = 0;
     for (int i = 0; i < 2; ++i) {
-        BakeRequest r{regionProject(tiled), 2, false};
+        BakeRequest r{regionProject(tiled), 2, false, {}};
         ReflectionProbeSettings& rp = r.project.scene.reflectionProbes;
         rp.enabled = true;
         rp.gridDims = {6, 3};
@@ -715,7 +715,7 @@ TEST(Tiles, ASuggestionMeasuredOnATileNamesTheRegionsGrid) {
     // prints asks the project for the region's grid_dims whose share is exactly the grid the tile
     // measured (it named the tile's own, 71 x 57, which the region would hold four times).
     const fs::path tiled = freshDir("suggestion");
-    BakeRequest r{regionProject(tiled), 2, false};
+    BakeRequest r{regionProject(tiled), 2, false, {}};
     r.tile = parseTiles("2,2", "0/4", std::optional<double>(300.0));
     r.project.scene.exportSettings.outDir = (tiled / kTilesFolder / tileName(*r.tile)).string();
     const BakeOutcome o = runBake(r, {}, nullptr);
