@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# glow_checks.sh TERRALUX WORKDIR
+# An image sky with a sun in it (docs/lighting.md, "The sky's glow"): the bake's report states the
+# glow's share of the sky's light as the rule splits it (computed here again from the image), says
+# the probes sample it by rays of their own (their rays then pass the schedule's cap), and that
+# with water they keep the whole sky instead; a uniform sky has no glow.
+set -u
+terralux=$1 work=$2
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+
+# A 64 x 32 Radiance HDR: a sky of 1.0 and a 2 x 2-texel sun of 12 800, about 20 degrees up
+# (flat RGBE scanlines).
+python3 - "$work/sun.hdr" <<'PY'
+import sys
+w, h = 64, 32
+with open(sys.argv[1], "wb") as f:
+    f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (h, w))
+    for y in range(h):
+        for x in range(w):
+            f.write(bytes([200, 200, 200, 142]) if y in (12, 13) and x in (20, 21) else bytes([128, 128, 128, 129]))
+PY
+
+# The split, as Sky::splitGlow makes it: T <- 8 mean(min(Y, T)) from T = 8 mean(Y) until a step
+# moves it by under 1 %, at least the luminance above which 1/16 of the sphere lies; the glow is
+# what each texel has over T, its share over the whole sky's light (texels weighed by solid angle).
+expected=$(python3 - <<'PY'
+import math
+def rgbe(m, e): return m * math.ldexp(1.0, e - 136)
+w, h = 64, 32
+Y = [[rgbe(200, 142) if y in (12, 13) and x in (20, 21) else rgbe(128, 129) for x in range(w)] for y in range(h)]
+om = [2 * math.pi / w * (math.cos(math.pi * y / h) - math.cos(math.pi * (y + 1) / h)) for y in range(h)]
+texels = [(Y[y][x], om[y]) for y in range(h) for x in range(w)]
+flux = sum(v * o for v, o in texels)
+T = 8 * flux / (4 * math.pi)
+for _ in range(32):
+    n = 8 * sum(min(v, T) * o for v, o in texels) / (4 * math.pi)
+    settled, T = n > 0.99 * T, n
+    if settled:
+        break
+covered = 0.0
+for v, o in sorted(texels, reverse=True):
+    covered += o
+    if covered > 4 * math.pi / 16:
+        T = max(T, v)
+        break
+print(sum(max(v - T, 0.0) * o for v, o in texels) / flux)
+PY
+)
+
+# report DIR SHARE SAMPLED: the report's sky_glow, and the rays that follow from it.
+report() {
+  python3 - "$1/bake_report.json" "$2" "$3" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+share, sampled = float(sys.argv[2]), sys.argv[3] == "true"
+g = r["sky_glow"]
+errors = []
+if abs(g["share"] - share) > 1e-5 * max(1.0, share):
+    errors.append(f"sky_glow.share {g['share']} != {share}")
+if g["probes_sample_it"] != sampled:
+    errors.append(f"sky_glow.probes_sample_it {g['probes_sample_it']} != {sampled}")
+v = r["volumes"][0]
+most, cap = v["rays_per_probe"]["max"], v["ray_schedule"]["max"]
+# The glow's own rays come on top of the lattice's, which the schedule caps.
+if sampled and not most > cap:
+    errors.append(f"rays_per_probe.max {most} is not past ray_schedule.max {cap} with the glow sampled")
+if not sampled and most > cap:
+    errors.append(f"rays_per_probe.max {most} is past ray_schedule.max {cap} without the glow sampled")
+if errors:
+    print("FAIL: " + "; ".join(errors))
+    sys.exit(1)
+PY
+}
+
+common=(--bake --quiet --set probe_volumes[0].grid_dims=4,4 --set bake.quality=draft)
+"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --out "$work/sun" ||
+  fail "the bake under the sun sky exited $?"
+report "$work/sun" "$expected" true || fail "under the sun sky"
+python3 -c "import sys; sys.exit(0 if 0.9 < float(sys.argv[1]) < 1.0 else 1)" "$expected" ||
+  fail "the sky's glow share $expected: the sun should hold nearly all of its light"
+
+"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --set water.enabled=true --set water.level=700 \
+  --out "$work/wet" || fail "the bake with water exited $?"
+report "$work/wet" "$expected" false || fail "with water"
+
+"$terralux" "${common[@]}" --set sky.mode=uniform --out "$work/uniform" || fail "the uniform bake exited $?"
+report "$work/uniform" 0 false || fail "under a uniform sky"
+echo "sky glow share $expected as reported; sampled without water, not with it; none under a uniform sky"
