@@ -203,9 +203,13 @@ int commandRender(const Args& a) {
               << ctx->deviceName() << ", " << fixed(img.milliseconds, 1) << " ms)\n";
     // The level of detail the image drew (docs/ARCHITECTURE.md, "Level of detail").
     const TerrainRenderer& terrain = renderer.renderer();
-    std::cout << "terrain: " << terrain.lastLod().triangles << " of " << terrain.triangleCount()
+    // Out of the DEM's own triangles (two a cell), which a decimated drawn grid has fewer of than
+    // the detail patches near the camera can add.
+    const Heightfield& dem = renderer.heightfield();
+    const size_t demTriangles = 2 * size_t(std::max(dem.width() - 1, 0)) * size_t(std::max(dem.depth() - 1, 0));
+    std::cout << "terrain: " << terrain.lastLod().triangles << " of the DEM's " << demTriangles
               << " triangles at the level of detail, within " << fixed(terrain.lastLod().screenErrorPixels, 2)
-              << " px of the DEM";
+              << " px of it";
     if (terrain.meshStride() > 1) {
         const auto& detail = terrain.lastLod().detail;
         const auto own = std::count_if(detail.begin(), detail.end(), [](int8_t d) { return d >= 0; });

@@ -7,7 +7,6 @@
 #include <limits>
 #include <map>
 #include <numbers>
-#include <queue>
 
 #include <glm/gtc/packing.hpp>
 #include <glm/packing.hpp>
@@ -899,7 +898,6 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         worst = std::max(worst, lod::screenPixels(error[k], lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]), fovY, rows));
     }
     lastLod_.screenErrorPixels = worst;
-    lastLod_.error = error;
     if (levels == lastLod_.levels && detail == lastLod_.detail && lodSerial_ > 0) return;
     lastLod_.levels = std::move(levels);
     lastLod_.detail = std::move(detail);

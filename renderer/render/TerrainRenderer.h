@@ -236,7 +236,8 @@ public:
     // vertices instead (MeshLod.h, detail patches), at the coarsest detail level within the
     // pixel, while their vertices fit the detail budget (kDetailVertexBudget unless set). Past
     // the budget, the largest error on screen is made as small as the budget allows: the patch
-    // furthest off on screen is refined a detail level at a time until the next one does not fit.
+    // furthest off on screen moves to its cheapest finer state that is nearer (lod::allocateDetail),
+    // while such a move fits.
     // Their vertices live in a buffer of their own, built when the set of such patches changes;
     // the probe pass lights them as it lights the drawn grid's.
     // setSourceDetail(false) draws the drawn grid alone (the benchmarks and tests compare).
@@ -252,7 +253,6 @@ public:
         std::vector<int8_t> detail;      // per patch: its detail level, or -1 where drawn from the drawn grid
         size_t detailVertices = 0;       // the detail buffer's vertices
         size_t triangles = 0;            // the terrain's, skirt aside
-        std::vector<double> error;       // per patch: what its drawn surface leaves out of the DEM (m)
         double screenErrorPixels = 0.0;  // the largest of a patch's drawn surface against the DEM, as the
                                          // camera sees it at the patch's nearest point
     };

@@ -477,12 +477,14 @@ std::vector<size_t> allocateDetail(std::span<const DetailCandidate> candidates, 
         // vertices and lower nothing).
         size_t next = state[m] + 1;
         while (next < c.pixels.size() && c.pixels[next] >= c.pixels[state[m]]) ++next;
-        if (next >= c.pixels.size()) break;
+        worst.pop();
+        // Where it has none, or it does not fit, the largest stays what it is; the budget left
+        // still brings the others nearer.
+        if (next >= c.pixels.size()) continue;
         const size_t more = c.vertices[next] - c.vertices[state[m]];
-        if (used + more > budget) break;
+        if (used + more > budget) continue;
         used += more;
         state[m] = next;
-        worst.pop();
         worst.push({c.pixels[state[m]], m});
     }
     return state;

@@ -143,10 +143,11 @@ double detailLevelError(const Patches& p, const SourceGrid& g, uint32_t k, uint8
 // screen (pixels) and its vertices (rising along the sequence), and a target state (within the
 // pixel). Within the budget every candidate takes its target. Past it the largest error is made as
 // small as the budget allows: the candidate furthest off moves to its cheapest finer state that is
-// nearer, until the furthest is within maxPixels or its move does not fit. (Optimal for the
-// largest error: the largest never grows, so every state passed by was at least the final
-// largest, and a smaller largest would need more than each candidate holds and more than the
-// budget.) Returns each candidate's state.
+// nearer, until every candidate is within maxPixels or has no such move that fits (a candidate
+// whose move does not fit keeps its state, and the budget left brings the others nearer).
+// (Optimal for the largest error: the largest never grows, so every state passed by was at
+// least the largest when the first move did not fit, and a smaller largest would need more than
+// each candidate holds and more than the budget.) Returns each candidate's state.
 struct DetailCandidate {
     std::vector<double> pixels;
     std::vector<size_t> vertices;

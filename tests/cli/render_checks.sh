@@ -50,5 +50,24 @@ grep -q "^terralux: --overlay probes,grid: 'grid' is not one of probes, leaves$"
   || fail "view 56 without a map exited $?"
 grep -q "^terralux: note: this bake measured no interpolation-error map (bake.error_map_resolution = 0" stderr \
   || fail "no note for a bake without a map: $(cat stderr)"
+# A DEM past the mesh's vertex budget (a committed crop resampled to 2400 x 2400, over the budget
+# of 2^22 vertices): the line says the drawn grid keeps every 2nd row and column, and from near
+# the ground the patches that need it are drawn from the DEM's own vertices, within the pixel.
+dems=$(cd "$(dirname "$0")/../data/dem" && pwd)
+gdal_translate -q -outsize 2400 2400 -r cubic "$dems/rainier_crop.tif" big.tif || fail "gdal_translate"
+"$terralux" --render --dem big.tif --out big.png --size 640x360 --no-probes --set ao.enabled=false \
+  --camera 210,10,600 --quiet >stdout 2>stderr || fail "render of the large DEM exited $?: $(cat stderr)"
+python3 - stdout <<'PY' || fail "large DEM: $(cat stdout)"
+import re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r"^terrain: (\d+) of the DEM's (\d+) triangles at the level of detail, within ([0-9.]+) px of it "
+              r"\(drawn from every 2nd row and column; (\d+) patch\(es\) from the DEM's own vertices, (\d+) of them\)$",
+              text, re.M)
+if not m:
+    sys.exit("no terrain line with the stride and the detail patches")
+drawn, whole, px, patches, vertices = int(m[1]), int(m[2]), float(m[3]), int(m[4]), int(m[5])
+if not (0 < drawn <= whole and px <= 1.0 and patches >= 1 and vertices >= patches * 9):
+    sys.exit(f"drawn {drawn} of {whole}, {px} px, {patches} patches of {vertices} vertices")
+PY
 ls -a | grep -q "\.tmp-" && fail "temporary files left behind"
 echo "ok: rendered"

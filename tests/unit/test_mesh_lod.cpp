@@ -319,7 +319,6 @@ TEST(MeshLod, ADetailPatchAtLevelZeroIsTheSourceGrid) {
     }
 }
 
-// At level 0 everywhere the patches draw exactly the whole grid's triangles (the bake's surface).
 TEST(MeshLod, PastTheBudgetTheDetailGoesWhereItLowersTheLargestError) {
     // Random candidates (errors along the states not always falling), against every assignment
     // within the budget: the largest error on screen is the least any assignment reaches.
@@ -370,10 +369,20 @@ TEST(MeshLod, PastTheBudgetTheDetailGoesWhereItLowersTheLargestError) {
             if (m == cs.size()) break;
         }
         EXPECT_EQ(std::max(largest, maxPixels), std::max(best, maxPixels)) << "trial " << trial;
+        // And no budget is left that would bring a candidate still past the pixel nearer.
+        for (size_t m = 0; m < cs.size(); ++m) {
+            if (cs[m].pixels[got[m]] <= maxPixels) continue;
+            for (size_t s = got[m] + 1; s < cs[m].pixels.size(); ++s)
+                if (cs[m].pixels[s] < cs[m].pixels[got[m]]) {
+                    EXPECT_GT(cs[m].vertices[s] - cs[m].vertices[got[m]], budget - used) << "trial " << trial;
+                    break;
+                }
+        }
     }
     EXPECT_GT(bound, 1000u);
 }
 
+// At level 0 everywhere the patches draw exactly the whole grid's triangles (the bake's surface).
 TEST(MeshLod, LevelZeroEverywhereIsTheWholeGrid) {
     const Terrain t(70, 45, 16);
     std::vector<uint32_t> idx, whole;
