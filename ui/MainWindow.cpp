@@ -66,6 +66,7 @@
 #include "bake/DiffuseBake.h"
 #include "bake/ProbeDiagnostics.h"
 #include "bake/ProbePlacement.h"
+#include "render/TerrainRenderer.h"
 #include "scene/DebugViews.h"
 
 namespace terralux {
@@ -152,6 +153,16 @@ QString formatBytes(double bytes) {
     if (bytes < 1024) return QString::number(bytes) + " B";
     if (bytes < 1024 * 1024) return QString::number(bytes / 1024.0, 'f', 1) + " KiB";
     return QString::number(bytes / (1024.0 * 1024.0), 'f', 1) + " MiB";
+}
+
+// The terrain's level of detail as the status bar shows it: its triangles and the most its
+// surface strays from the DEM on screen (TerrainRenderer::LodChoice).
+QString terrainLodText(const TerrainRenderer::LodChoice& lod) {
+    const double t = double(lod.triangles);
+    const QString tris = t >= 1e6 ? QString("%1 M").arg(t / 1e6, 0, 'f', 1)
+                         : t >= 1e3 ? QString("%1 k").arg(t / 1e3, 0, 'f', 0)
+                                    : QString::number(lod.triangles);
+    return QString("terrain %1 tris, %2 px").arg(tris).arg(lod.screenErrorPixels, 0, 'f', 2);
 }
 
 // A status line of a dock: plain text that wraps, found by `name` in tests.
@@ -274,6 +285,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             const FrameTimings& t = viewport_->renderer()->renderer().lastFrameTimings();
             if (t.gpuTimed()) text += QString(" · GPU %1 ms").arg(t.gpuMilliseconds, 0, 'f', 2);
             if (t.recordMilliseconds > 0.0) text += QString(" · host %1 ms").arg(t.recordMilliseconds, 0, 'f', 1);
+            text += " · " + terrainLodText(viewport_->renderer()->renderer().lastLod());
             // A metered exposure is shown as it adapts: what the camera is at now.
             const double ev = viewport_->renderer()->shownEv100();
             if (std::isfinite(ev)) text += QString(" · EV100 %1").arg(ev, 0, 'f', 2);
@@ -284,6 +296,8 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         frameLabel_->setToolTip("Wall time of the last frame; % res: the share of the window's pixels it was drawn "
                                 "at while the view changes (View > Dynamic resolution); GPU: its passes' time from "
                                 "timestamps; host: recording it (the per-pass times: terralux --render --profile); "
+                                "terrain: its triangles at the level of detail and the most its surface strays "
+                                "from the DEM on screen (over 1 px only where the detail budget binds); "
                                 "EV100: the camera's exposure (metered in modes average and histogram)");
     });
     connect(viewport_, &ViewportWindow::lpvUpdated, this, [this](double ms) {

@@ -1061,6 +1061,15 @@ private slots:
             w_->findChild<QLabel*>("status.frame")->text().contains(QString("EV100 %1").arg(r->shownEv100(), 0, 'f', 2)), 5000);
         // Adapted: no frame without a change, and a redraw of the same view does not meter again.
         QVERIFY(settlesQuiet(w_->viewport()));
+        // The status bar also says what the terrain's level of detail drew, and how close to the DEM.
+        const TerrainRenderer::LodChoice& lod = r->renderer().lastLod();
+        QVERIFY(lod.triangles > 0);
+        QTRY_VERIFY_WITH_TIMEOUT(w_->findChild<QLabel*>("status.frame")->text().contains(
+                                     QString(" tris, %1 px").arg(lod.screenErrorPixels, 0, 'f', 2)),
+                                 5000);
+        QVERIFY2(w_->findChild<QLabel*>("status.frame")->text().contains(
+                     QString("terrain %1 k tris").arg(double(lod.triangles) / 1e3, 0, 'f', 0)),
+                 qPrintable(w_->findChild<QLabel*>("status.frame")->text()));
         const size_t settled = r->meterings();
         for (int i = 0; i < 3; ++i) w_->viewport()->renderNow();
         QCOMPARE(r->meterings(), settled);
