@@ -14,6 +14,7 @@
 #include <iomanip>
 #include <thread>
 
+#include <glm/trigonometric.hpp>
 #include <glm/vector_relational.hpp>
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -28,6 +29,7 @@
 #include "ReflectionProbeFile.h"
 #include "SceneLighting.h"
 #include "ShProbeFile.h"
+#include "ShaderMath.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
@@ -1525,7 +1527,16 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     }
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
     // A date and a time: where they put the sun the bake lit with.
-    if (const SunAngles sun = sunAnglesOf(scene, hf); sun.place)
+    if (sunFromSkyImage(scene)) {
+        // The image's glow, lit as the sun: where it stands, how bright and how large.
+        const ImageSun sun = imageSunOf(lighting);
+        out.report["sun"] = {{"from_sky_image", true},
+                             {"azimuth_deg", sun.azimuthDeg},
+                             {"elevation_deg", sun.elevationDeg},
+                             {"illuminance_lux", sun.illuminanceLux},
+                             {"angular_radius_deg", sun.angularRadiusDeg},
+                             {"share_of_sky", sun.shareOfSky}};
+    } else if (const SunAngles sun = sunAnglesOf(scene, hf); sun.place)
         out.report["sun"] = {{"date", scene.sun.date},
                              {"time_h", scene.sun.timeH},
                              {"utc_offset_h", sun.place->utcOffsetH},
@@ -1534,6 +1545,33 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                              {"azimuth_deg", sun.azimuthDeg},
                              {"true_azimuth_deg", sun.place->position.azimuthDeg},
                              {"elevation_deg", sun.elevationDeg}};
+    if (scene.sky.mode == SkyMode::Hdr && !scene.sun.followSky && lighting.sky.glowIsSun()) {
+        // A sun in the image that gives level ground more light than the rest of the sky: baked
+        // into the probes, its shadows are as wide as their spacing.
+        const SunLight glow = lighting.sky.glowSun();
+        const glm::vec3 fromSun = glow.illuminance * std::max(0.0f, glow.direction.y);
+        const glm::vec3 fromSky = lighting.sky.withoutGlow().openIrradianceUp();
+        if (glsl::rec709Luminance(fromSun.x, fromSun.y, fromSun.z) > glsl::rec709Luminance(fromSky.x, fromSky.y, fromSky.z)) {
+            BakeLighting asSun = lighting;
+            asSun.sun = glow;
+            asSun.sky = lighting.sky.withoutGlow();
+            const ImageSun read = imageSunOf(asSun);
+            char where[96];
+            std::snprintf(where, sizeof where, "azimuth %.1f°, %.1f° up, %.0f %% of its light", read.azimuthDeg, read.elevationDeg,
+                          100.0 * read.shareOfSky);
+            out.warnings.push_back(std::string("sun.follow_sky: false under sky.hdr, whose image has a sun (") + where +
+                                   "): the probes hold its light and its shadows, blurred over their spacing, and the authored sun lights "
+                                   "besides it; set sun.follow_sky=true to light with the image's sun, shadowed at the pixel");
+        }
+    }
+    if (sunFromSkyImage(scene) && lighting.sky.hasGlow()) {
+        // Followed, but too wide to be a sun: the probes keep it (lightingOf).
+        char why[160];
+        std::snprintf(why, sizeof why, "the image's glow spreads %.1f° about its centre, wider than a sun's %.0f°",
+                      glm::degrees(double(lighting.sky.glowSun().angularRadius)), Sky::kMaxSunRadiusDeg);
+        out.warnings.push_back(std::string("sun.follow_sky under sky.hdr: ") + why +
+                               ": it stays in the sky the probes see, and no sun lights besides it");
+    }
     if (scene.water.enabled && !lighting.water)
         out.warnings.push_back("water.level auto: " + water::autoLevel(hf).summary +
                                "; no water is baked or exported; set water.level to place it");

@@ -267,7 +267,18 @@ int commandBake(const Args& a) {
     const int bounces = quality["bounces"].get<int>();
     std::cout << ", " << bounces << (bounces == 1 ? " bounce, " : " bounces, ") << r["threads"].get<int>()
               << " threads)\n";
-    if (r.contains("sun")) {
+    if (r.contains("sun") && r["sun"].contains("from_sky_image")) {
+        const auto& sun = r["sun"];
+        if (sun["illuminance_lux"].get<double>() > 0.0)
+            std::cout << "  sun: the sky image's own (sun.follow_sky) at azimuth " << fixed(sun["azimuth_deg"].get<double>(), 1)
+                      << "°, elevation " << fixed(sun["elevation_deg"].get<double>(), 1) << "°, "
+                      << fixed(sun["illuminance_lux"].get<double>(), 0) << " lx, radius "
+                      << fixed(sun["angular_radius_deg"].get<double>(), 2) << "°: "
+                      << fixed(100.0 * sun["share_of_sky"].get<double>(), 1)
+                      << " % of the image's light, shadowed by the renderer, the probes keeping the rest\n";
+        else
+            std::cout << "  sun: the sky image has none (sun.follow_sky): it lights alone\n";
+    } else if (r.contains("sun")) {
         const auto& sun = r["sun"];
         const double lat = sun["latitude_deg"].get<double>(), lon = sun["longitude_deg"].get<double>();
         const double hours = sun["time_h"].get<double>();

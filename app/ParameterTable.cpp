@@ -299,22 +299,25 @@ std::vector<ParameterSpec> buildTable() {
     // Sun.
     const auto physical = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Physical; };
     const auto sunFromSky = [](const SceneDescription& s, size_t) {
-        return s.sky.mode == SkyMode::Physical && s.sun.followSky;
+        return (s.sky.mode == SkyMode::Physical || s.sky.mode == SkyMode::Hdr) && s.sun.followSky;
     };
-    const auto manualSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::Manual; };
-    const auto datedSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::DateTime; };
+    // The image's glow is the sun: where it stands, how bright and how large are the image's.
+    static constexpr const char* kNotUnderImageSun = "; not read while the sun follows an image sky (sun.follow_sky)";
+    const auto placedSun = [](const SceneDescription& s, size_t) { return !sunFromSkyImage(s); };
+    const auto manualSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::Manual && !sunFromSkyImage(s); };
+    const auto datedSun = [](const SceneDescription& s, size_t) { return s.sun.mode == SunMode::DateTime && !sunFromSkyImage(s); };
     add(Row("sun.mode", T::Choice)).choices({"manual", "date_time"}).label("Sun position")
-        .about("manual: sun.azimuth_deg and sun.elevation_deg; date_time: where the sun stands over the terrain at sun.date and sun.time_h (NOAA's solar position, refracted, turned from true to the DEM grid's north)")
-        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::mode);
+        .about("manual: sun.azimuth_deg and sun.elevation_deg; date_time: where the sun stands over the terrain at sun.date and sun.time_h (NOAA's solar position, refracted, turned from true to the DEM grid's north)" + std::string(kNotUnderImageSun))
+        .redoes(kUpload | kRebake).onlyWhen(placedSun).field(&SceneDescription::sun, &SunSettings::mode);
     add(Row("sun.azimuth_deg", T::Number)).range(-360.0, 360.0).unit("°").decimals(1).slider()
-        .label("Sun azimuth").about("Direction of the sun, clockwise from north (-Z) toward east (+X)")
+        .label("Sun azimuth").about(std::string("Direction of the sun, clockwise from north (-Z) toward east (+X)") + kNotUnderImageSun)
         .redoes(kUpload | kRebake).onlyWhen(manualSun).field(&SceneDescription::sun, &SunSettings::azimuthDeg);
     add(Row("sun.elevation_deg", T::Number)).range(-90.0, 90.0).unit("°").decimals(1).slider()
-        .label("Sun elevation").about("Angle of the sun above the horizon")
+        .label("Sun elevation").about(std::string("Angle of the sun above the horizon") + kNotUnderImageSun)
         .redoes(kUpload | kRebake).onlyWhen(manualSun).field(&SceneDescription::sun, &SunSettings::elevationDeg);
     const std::string dateRule = "must be " + civilDateRule();
     add(Row("sun.date", T::String)).pattern("[0-9]{4}-[0-9]{2}-[0-9]{2}", dateRule).label("Date")
-        .about("Day of the sun's position, Gregorian, on the local clock")
+        .about(std::string("Day of the sun's position, Gregorian, on the local clock") + kNotUnderImageSun)
         .redoes(kUpload | kRebake).onlyWhen(datedSun)
         .custom([](const SceneDescription& s, size_t) { return json(s.sun.date); },
                 [dateRule](SceneDescription& s, size_t, const json& v) {
@@ -323,7 +326,7 @@ std::vector<ParameterSpec> buildTable() {
                     s.sun.date = text;
                 });
     add(Row("sun.time_h", T::Number)).range(0.0, 24.0).unit("h").decimals(2).slider().label("Local time")
-        .about("Hours after local midnight on the clock sun.utc_offset_h gives (13.5 is 13:30; 24 is the next midnight)")
+        .about(std::string("Hours after local midnight on the clock sun.utc_offset_h gives (13.5 is 13:30; 24 is the next midnight)") + kNotUnderImageSun)
         .redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, &SunSettings::timeH);
     // The place the sun is computed for, as sunAnglesOf resolves it.
     const auto placeOf = [](const SceneDescription& s, const Heightfield& hf) -> std::optional<std::array<double, 2>> {
@@ -337,7 +340,7 @@ std::vector<ParameterSpec> buildTable() {
             const auto place = placeOf(s, hf);
             return place ? json(nominalUtcOffsetHours((*place)[1])) : json(nullptr);
         })
-        .about("How far the local clock is ahead of UTC, daylight saving included (Central European Summer Time: 2)")
+        .about(std::string("How far the local clock is ahead of UTC, daylight saving included (Central European Summer Time: 2)") + kNotUnderImageSun)
         .redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, &SunSettings::utcOffsetH);
     // Latitude (axis 0) and longitude (axis 1) of the place, alike but for their range and words.
     const auto placeRow = [&](const char* path, int axis, double limit, const char* label, const char* about,
@@ -348,27 +351,32 @@ std::vector<ParameterSpec> buildTable() {
                 const auto place = placeOf(s, hf);
                 return place ? json((*place)[size_t(axis)]) : json(nullptr);
             })
-            .about(about).redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, member);
+            .about(std::string(about) + kNotUnderImageSun).redoes(kUpload | kRebake).onlyWhen(datedSun).field(&SceneDescription::sun, member);
     };
     placeRow("sun.latitude_deg", 0, 90.0, "Latitude",
              "Where the sun is computed for, north positive; set it (with sun.longitude_deg) for a DEM without a CRS",
              &SunSettings::latitudeDeg);
     placeRow("sun.longitude_deg", 1, 180.0, "Longitude", "Where the sun is computed for, east positive",
              &SunSettings::longitudeDeg);
-    add(Row("sun.follow_sky", T::Boolean)).label("Sun from sky model")
-        .about("Sky mode physical: the sun's colour and illuminance come from the sky model (sun.color and sun.illuminance are not read)")
-        .redoes(kUpload | kRebake).onlyWhen(physical).field(&SceneDescription::sun, &SunSettings::followSky);
+    const auto skyWithSun = [](const SceneDescription& s, size_t) {
+        return s.sky.mode == SkyMode::Physical || s.sky.mode == SkyMode::Hdr;
+    };
+    add(Row("sun.follow_sky", T::Boolean)).label("Sun from sky")
+        .about("Sky mode physical: the sun's colour and illuminance come from the sky model (sun.color and sun.illuminance are not read). "
+               "Sky mode hdr: the image's sun is the sun, its glow taken out of the sky the probes see and lit as the directional light: "
+               "direction, illuminance, colour and radius from the image (no other sun.* is read; docs/lighting.md, \"The image's sun\"); off, the image lights whole and the authored sun adds to it")
+        .redoes(kUpload | kRebake).onlyWhen(skyWithSun).field(&SceneDescription::sun, &SunSettings::followSky);
     add(Row("sun.illuminance", T::Number)).range(0.0, 1.0e7).unit("lx").decimals(0).label("Sun illuminance")
         .about("Illuminance on a surface facing the sun: a clear day's sun is about 100 000 lx, an overcast one 0; "
-               "the bake lights with 3e-5 scene units per lux, the unit of the sky's radiance; not read while the sun follows the physical sky")
+               "the bake lights with 3e-5 scene units per lux, the unit of the sky's radiance; not read while the sun follows the sky")
         .redoes(kUpload | kRebake).onlyWhen(std::not_fn(sunFromSky))
         .field(&SceneDescription::sun, &SunSettings::illuminance);
     add(Row("sun.color", T::Color)).range(0.0, kUnbounded).label("Sun colour")
-        .about("Linear RGB tint of the sun's illuminance; not read while the sun follows the physical sky").redoes(kUpload | kRebake)
+        .about("Linear RGB tint of the sun's illuminance; not read while the sun follows the sky").redoes(kUpload | kRebake)
         .onlyWhen(std::not_fn(sunFromSky)).field(&SceneDescription::sun, &SunSettings::color);
-    add(Row("sun.angular_radius_deg", T::Number)).range(0.0, 45.0).unit("°").label("Sun radius")
-        .about("Angular radius of the sun's disc (0.27° for the real sun): soft shadow size")
-        .redoes(kUpload | kRebake).field(&SceneDescription::sun, &SunSettings::angularRadiusDeg);
+    add(Row("sun.angular_radius_deg", T::Number)).range(0.0, Sky::kMaxSunRadiusDeg).unit("°").label("Sun radius")
+        .about("Angular radius of the sun's disc (0.27° for the real sun): soft shadow size" + std::string(kNotUnderImageSun))
+        .redoes(kUpload | kRebake).onlyWhen(placedSun).field(&SceneDescription::sun, &SunSettings::angularRadiusDeg);
 
     // Sky.
     const auto hdr = [](const SceneDescription& s, size_t) { return s.sky.mode == SkyMode::Hdr; };

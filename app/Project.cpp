@@ -400,6 +400,21 @@ const std::vector<ProjectMigration>& projectMigrations() {
          [](json& doc, std::vector<std::string>& notes) {
              if (json* fog = objectIn(doc, "fog")) radianceToLuminance(*fog, "fog", "", notes);
          }},
+        {7,
+         "sun.follow_sky now takes an image sky's sun as the sun: a version-7 image sky lit whole, the authored "
+         "sun beside it, so it gets sun.follow_sky false; so do the scenarios' image skies",
+         [](json& doc, std::vector<std::string>& notes) {
+             forEachLighting(doc, [&](json& section, const std::string& where) {
+                 const json* sky = objectIn(section, "sky");
+                 if (!sky || !sky->contains("mode") || (*sky)["mode"] != "hdr") return;
+                 if (!section.contains("sun")) section["sun"] = json::object();
+                 // Anything but an object under "sun" is left for the check to name.
+                 if (json* sun = objectIn(section, "sun")) {
+                     (*sun)["follow_sky"] = false;
+                     notes.push_back(where + "sun.follow_sky set to false: version 7 lit the image whole with the authored sun");
+                 }
+             });
+         }},
     };
     return steps;
 }

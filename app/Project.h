@@ -22,7 +22,7 @@ public:
 
 // The project file's version (docs/formats.md, "Project file"): older files are migrated step
 // by step on reading, newer ones refused.
-inline constexpr int kProjectVersion = 7;
+inline constexpr int kProjectVersion = 8;
 inline constexpr int kMaxBoxGridProbes = kMaxVolumeProbes;  // cells; docs/lighting.md, "Probe limits"
 inline constexpr int kMaxBounces = 16;
 inline constexpr int kMaxRampStops = 8;              // terrain.ramp_heights

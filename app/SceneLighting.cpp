@@ -1,5 +1,6 @@
 #include "SceneLighting.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <numbers>
 
 #include <glm/common.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "EnvironmentImage.h"
 #include "ImageFile.h"
@@ -17,6 +19,7 @@
 #include "lpv/Lpv.h"
 #include "bake/PhysicalSky.h"
 #include "ParameterTable.h"
+#include "ShaderMath.h"
 #include "scene/ShadowCascades.h"
 #include "scene/SolarPosition.h"
 #include "terrain/SurfaceMaps.h"
@@ -81,10 +84,11 @@ size_t hdrSkyReads() { return skyReads.load(); }
 size_t physicalSkyBuilds() { return physicalBuilds.load(); }
 
 void checkSunPlaces(const SceneDescription& scene, const Heightfield& hf) {
-    (void)sunAnglesOf(scene, hf);
+    if (!sunFromSkyImage(scene)) (void)sunAnglesOf(scene, hf);
     for (const LightingScenario& l : scene.scenarios) {
         try {
-            (void)sunAnglesOf(scenarioScene(scene, l.name), hf);
+            const SceneDescription lit = scenarioScene(scene, l.name);
+            if (!sunFromSkyImage(lit)) (void)sunAnglesOf(lit, hf);
         } catch (const ProjectError& e) {
             throw ProjectError("scenario '" + l.name + "': " + e.what());
         }
@@ -171,10 +175,35 @@ SunLight sunOf(const SunSettings& s) {
     return sun;
 }
 
+bool sunFromSkyImage(const SceneDescription& scene) {
+    return scene.sky.mode == SkyMode::Hdr && scene.sun.followSky;
+}
+
+ImageSun imageSunOf(const BakeLighting& l) {
+    const glm::dvec3 d(l.sun.direction);
+    const glm::vec3& e = l.sun.illuminance;
+    return {glm::degrees(std::atan2(d.x, -d.z)), glm::degrees(std::asin(std::clamp(d.y, -1.0, 1.0))),
+            double(glsl::rec709Luminance(e.x, e.y, e.z)) / kSceneUnitsPerLux, glm::degrees(double(l.sun.angularRadius)),
+            double(l.sky.takenGlowShare())};
+}
+
 BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
     const SceneDescription& scene = p.scene;
     BakeLighting l;
     l.sky = skyOf(p, hf);
+    l.albedo = scene.terrain.albedo;
+    if (sunFromSkyImage(scene)) {
+        // The image's glow lights as the sun, shadowed by the renderer's maps at the pixel, and
+        // the probes keep the rest: a sun baked into probes a kilometre apart smears its shadows.
+        // A glow too wide to be a sun, or none, stays in the sky: no sun lights besides it.
+        if (l.sky.glowIsSun()) {
+            l.sun = l.sky.glowSun();
+            l.sky = l.sky.withoutGlow();
+        } else {
+            l.sun = SunLight{};
+        }
+        return l;
+    }
     l.sun.direction = sunDirectionOf(scene, hf);
     if (scene.sky.mode == SkyMode::Physical && scene.sun.followSky)
         l.sun.illuminance = PhysicalSky(l.sun.direction, scene.sky.turbidity).sunIlluminance() *
@@ -182,7 +211,6 @@ BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
     else
         l.sun.illuminance = sunOf(scene.sun).illuminance;
     l.sun.angularRadius = float(scene.sun.angularRadiusDeg * std::numbers::pi / 180.0);
-    l.albedo = scene.terrain.albedo;
     return l;
 }
 
@@ -250,8 +278,10 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
     nlohmann::json& sun = ext["sun"] = authored.at("sun");
     const SunLight asAuthored = sunOf(scene.sun);
     sun["direction"] = shortest(l.sun.direction);
-    // A date and a time: where they put the sun, so an engine need not repeat the ephemeris.
-    if (const SunAngles a = sunAnglesOf(scene, hf); a.place) {
+    // A date and a time: where they put the sun, so an engine need not repeat the ephemeris (not
+    // read while the sun is the image's).
+    const bool imageSun = sunFromSkyImage(scene);
+    if (const SunAngles a = imageSun ? SunAngles{} : sunAnglesOf(scene, hf); a.place) {
         sun["resolved_azimuth_deg"] = a.azimuthDeg;
         sun["resolved_elevation_deg"] = a.elevationDeg;
         sun["resolved_true_azimuth_deg"] = a.place->position.azimuthDeg;
@@ -259,7 +289,12 @@ nlohmann::json lightingExtension(const Project& p, const Heightfield& hf, const 
         sun["resolved_longitude_deg"] = a.place->longitudeDeg;
         sun["resolved_utc_offset_h"] = a.place->utcOffsetH;
     }
-    if (l.sun.illuminance != asAuthored.illuminance) {
+    if (imageSun) {
+        // The image's sun in lux (its luminance), its colour normalised to that; none: 0 lx.
+        const double lux = imageSunOf(l).illuminanceLux;
+        sun["illuminance"] = lux;
+        if (lux > 0.0) sun["color"] = shortest(l.sun.illuminance / sceneUnitsOfLux(lux));
+    } else if (l.sun.illuminance != asAuthored.illuminance) {
         // The authored scalar (lux) where there is one; the colour carries the rest.
         const double e = scene.sun.illuminance > 0.0 ? scene.sun.illuminance : 1.0;
         sun["illuminance"] = e;

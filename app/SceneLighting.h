@@ -20,8 +20,19 @@ size_t hdrSkyReads();
 // How many times a physical sky was sampled and filtered since start.
 size_t physicalSkyBuilds();
 // Sun, sky and albedo; the caller sets the tracer. In sky mode physical with sun.follow_sky the
-// sun's colour and illuminance are the model's, × sky.intensity.
+// sun's colour and illuminance are the model's, × sky.intensity; in sky mode hdr with
+// sun.follow_sky the sun is the image's glow (Sky::glowSun) and the sky the image without it.
 BakeLighting lightingOf(const Project& project, const Heightfield& hf);
+// Sky mode hdr with sun.follow_sky: the sun is the image's own (its position, illuminance, colour
+// and size are not read).
+bool sunFromSkyImage(const SceneDescription& scene);
+// The image's sun of lightingOf() under sunFromSkyImage, as a TD reads it: azimuth (engine
+// space, clockwise from -Z) and elevation, the illuminance in lux (the Rec. 709 luminance of the
+// per-channel illuminance), the angular radius, and the share of the image's luminous flux it took.
+struct ImageSun {
+    double azimuthDeg = 0.0, elevationDeg = 0.0, illuminanceLux = 0.0, angularRadiusDeg = 0.0, shareOfSky = 0.0;
+};
+ImageSun imageSunOf(const BakeLighting& lighting);
 
 // The lighting of scenario `name` (scenarioScene): its sun and sky, with the tracer, albedo and
 // water of `shared` (the default's), so every scenario lights the same terrain.

@@ -492,13 +492,19 @@ std::vector<Candidate> Study::candidates(const ProbeLayout& cur) {
         add("reflection_encoding", "reflection " + other, {"reflection_probes.encoding=" + other}, StudyMetric::Reflection);
     }
     // The renderer draws no shadow maps once the sun is more than about 3° below the horizon.
-    const double sunElevation = sunAnglesOf(s, hf()).elevationDeg;
-    const bool sunUp = std::sin(glm::radians(sunElevation)) > -0.05;
-    if (s.shadows.enabled && !sunUp)
+    const bool imageSun = sunFromSkyImage(s);
+    const std::optional<ImageSun> fromImage = imageSun ? std::optional(imageSunOf(lightingOf(project, hf()))) : std::nullopt;
+    const double sunElevation = fromImage ? fromImage->elevationDeg : sunAnglesOf(s, hf()).elevationDeg;
+    const bool sunlit = !fromImage || fromImage->illuminanceLux > 0.0;
+    const bool sunUp = sunlit && std::sin(glm::radians(sunElevation)) > -0.05;
+    if (s.shadows.enabled && !sunlit)
+        result.notStudied.push_back("shadows: the sky image has no sun to cast them (sun.follow_sky)");
+    else if (s.shadows.enabled && !sunUp)
         result.notStudied.push_back(
             "shadows: the sun is below the horizon (" +
-            (s.sun.mode == SunMode::Manual ? "sun.elevation_deg = " + fmt("%g", sunElevation)
-                                           : "sun.date and sun.time_h put it at " + fmt("%.1f", sunElevation) + "°") +
+            (imageSun ? "the sky image's sun stands at " + fmt("%.1f", sunElevation) + "°"
+             : s.sun.mode == SunMode::Manual ? "sun.elevation_deg = " + fmt("%g", sunElevation)
+                                             : "sun.date and sun.time_h put it at " + fmt("%.1f", sunElevation) + "°") +
             "), so no shadow maps are drawn");
     if (s.shadows.enabled && sunUp) {
         const ShadowSettings& sh = s.shadows;

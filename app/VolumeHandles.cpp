@@ -231,6 +231,8 @@ std::vector<VolumeBounds> lpvBounds(const SceneDescription& scene, const Heightf
 
 std::optional<VolumeBounds> sunBounds(const SceneDescription& scene, const Heightfield& hf, const OrbitCamera& camera,
                                       float distance) {
+    // The image's sun stands where the image has it: no handle moves it.
+    if (sunFromSkyImage(scene)) return std::nullopt;
     try {
         const SunAngles a = sunAnglesOf(scene, hf);
         VolumeBounds b{BoundsKind::Sun, 0, "sun"};
@@ -244,7 +246,7 @@ std::optional<VolumeBounds> sunBounds(const SceneDescription& scene, const Heigh
 std::vector<glm::vec3> sunPath(const SceneDescription& scene, const Heightfield& hf, const OrbitCamera& camera,
                                float distance) {
     std::vector<glm::vec3> path;
-    if (scene.sun.mode != SunMode::DateTime) return path;
+    if (scene.sun.mode != SunMode::DateTime || sunFromSkyImage(scene)) return path;
     SceneDescription at = scene;
     try {
         for (int q = 0; q <= 96; ++q) {

@@ -430,7 +430,26 @@ QDockWidget* MainWindow::buildSunSkyDock() {
     sky->addWidget("", position);
     auto showPosition = [this, position] {
         const SceneDescription& scene = doc_->project().scene;
-        position->setVisible(scene.sun.mode == SunMode::DateTime);
+        const bool image = sunFromSkyImage(scene);
+        position->setVisible(image || scene.sun.mode == SunMode::DateTime);
+        if (image) {
+            // The image's sun: no slider places it, so the dock says where it stands.
+            try {
+                const ImageSun sun = imageSunOf(lightingOf(doc_->project(), doc_->terrain().heightfield));
+                position->setText(sun.illuminanceLux > 0.0
+                                      ? QString("Sun from the image at azimuth %1°, %2° above the horizon, %3 lx, radius %4° "
+                                                "(%5 % of the image's light)")
+                                            .arg(sun.azimuthDeg, 0, 'f', 1)
+                                            .arg(sun.elevationDeg, 0, 'f', 1)
+                                            .arg(sun.illuminanceLux, 0, 'f', 0)
+                                            .arg(sun.angularRadiusDeg, 0, 'f', 2)
+                                            .arg(100.0 * sun.shareOfSky, 0, 'f', 1)
+                                      : QString("The image has no sun: it lights alone"));
+            } catch (const std::exception& e) {
+                position->setText(QString::fromStdString(e.what()));
+            }
+            return;
+        }
         if (scene.sun.mode != SunMode::DateTime) return;
         try {
             const SunAngles a = sunAnglesOf(scene, doc_->terrain().heightfield);

@@ -42,6 +42,7 @@ Sky Sky::uniform(const glm::vec3& radiance) {
     s.sh_ = sh::projectConstant(radiance);
     s.smoothSh_ = s.sh_;
     s.openUp_ = std::numbers::pi_v<float> * radiance;
+    s.smoothOpenUp_ = s.openUp_;
     return s;
 }
 
@@ -101,6 +102,7 @@ void Sky::buildPyramid(std::vector<Level>& levels) {
 void Sky::splitGlow() {
     const Level& l = levels_->front();
     smoothSh_ = sh_;
+    smoothOpenUp_ = openUp_;
     smooth_ = levels_;
     glow_ = nullptr;
     const double dphi = 2.0 * std::numbers::pi / l.width;
@@ -160,6 +162,7 @@ void Sky::splitGlow() {
     // and a sun many thousand times the rest would leave float's rounding of the whole sky's sum
     // as a bias of a percent or more on probes that do not see it.
     std::array<glm::dvec3, sh::kCoeffCount> smoothSh{}, glowSh{};
+    glm::dvec3 smoothUp(0.0), glowMean(0.0);
     for (int y = 0; y < l.height; ++y) {
         for (int x = 0; x < l.width; ++x) {
             const size_t i = size_t(y) * l.width + x;
@@ -176,15 +179,34 @@ void Sky::splitGlow() {
                 smoothSh[size_t(k)] += glm::dvec3(smooth.texels[i]) * (double(basis[k]) * solidAngle[size_t(y)]);
                 glowSh[size_t(k)] += glm::dvec3(g) * (double(basis[k]) * solidAngle[size_t(y)]);
             }
+            if (dir.y > 0.0f) smoothUp += glm::dvec3(smooth.texels[i]) * (double(dir.y) * solidAngle[size_t(y)]);
             const double gy = lum(g);
             if (!(gy > 0.0)) continue;
             glow->texel.push_back(uint32_t(i));
             glow->colour.push_back(g / float(gy));
             glow->flux += gy * solidAngle[size_t(y)];
+            glowMean += glm::dvec3(dir) * (gy * solidAngle[size_t(y)]);
             glow->cdf.push_back(glow->flux);
         }
     }
     if (glow->texel.empty()) return;
+    // The glow as a sun: its spread about its mean direction, in a second pass over its texels.
+    const glm::dvec3 toSun = glm::length(glowMean) > 0.0 ? glm::normalize(glowMean) : glm::dvec3(0.0, 1.0, 0.0);
+    glm::dvec3 illuminance(0.0);
+    double spread = 0.0;
+    for (size_t k = 0; k < glow->texel.size(); ++k) {
+        const int x = int(glow->texel[k] % uint32_t(l.width)), y = int(glow->texel[k] / uint32_t(l.width));
+        const glm::dvec3 dir(texelCentre(x, y, l.width, l.height, rotation_));
+        const double omega = solidAngle[size_t(y)];
+        const double flux = (glow->cdf[k] - (k ? glow->cdf[k - 1] : 0.0));  // Y·ω of this texel
+        const double angle = std::acos(std::clamp(glm::dot(dir, toSun), -1.0, 1.0));
+        spread += flux * (angle * angle + omega / 6.0);
+        illuminance += glm::dvec3(glow->colour[k]) * (flux * std::max(0.0, glm::dot(dir, toSun)));
+    }
+    glow->sun.direction = glm::vec3(toSun);
+    glow->sun.illuminance = glm::vec3(illuminance);
+    glow->sun.angularRadius = float(std::sqrt(2.0 * spread / glow->flux));
+    smoothOpenUp_ = glm::vec3(smoothUp);
     for (double& c : glow->cdf) c /= glow->flux;
     for (int k = 0; k < sh::kCoeffCount; ++k) {
         smoothSh_.c[size_t(k)] = glm::vec3(smoothSh[size_t(k)]);
@@ -210,6 +232,28 @@ glm::vec3 Sky::sampleGlow(float u0, float u1, float u2, glm::vec3& dir, glm::vec
     dir = glm::vec3(float(st * std::sin(phi)), float(ct), float(-st * std::cos(phi)));
     if (centre) *centre = texelCentre(x, y, g.width, g.height, rotation_);
     return scale_ * g.colour[k] * float(g.flux);
+}
+
+SunLight Sky::glowSun() const {
+    if (!glow_) return SunLight{};
+    SunLight sun = glow_->sun;
+    sun.illuminance *= scale_;
+    return sun;
+}
+
+bool Sky::glowIsSun() const {
+    return glow_ && double(glow_->sun.angularRadius) <= kMaxSunRadiusDeg * std::numbers::pi / 180.0;
+}
+
+Sky Sky::withoutGlow() const {
+    if (!glow_) return *this;
+    Sky s = *this;
+    s.levels_ = smooth_;
+    s.glow_ = nullptr;
+    s.sh_ = smoothSh_;
+    s.openUp_ = s.smoothOpenUp_ = smoothOpenUp_;
+    s.takenGlowShare_ = glowShare();
+    return s;
 }
 
 float Sky::glowShare() const { return glow_ ? float(glow_->flux / glow_->skyFlux) : 0.0f; }
@@ -266,6 +310,7 @@ Sky Sky::scaled(const glm::vec3& factor) const {
     for (auto& c : s.sh_.c) c *= factor;
     for (auto& c : s.smoothSh_.c) c *= factor;
     s.openUp_ *= factor;
+    s.smoothOpenUp_ *= factor;
     return s;
 }
 

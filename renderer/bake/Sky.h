@@ -85,6 +85,23 @@ public:
     float glowShare() const;
     // The glow's exact SH projection, as sh() projects the sky (zero without glow).
     sh::ShRgb glowSh() const;
+    // The glow as a sun (sun.follow_sky under an image sky), so the terrain's shadow of it is drawn
+    // sharp rather than left to probes a kilometre apart: the direction is the glow's mean
+    // direction weighted by its luminous flux; the illuminance, per channel, what the glow gives a
+    // surface facing that way; the angular radius that of a uniform disc with the glow's spread
+    // about that direction (a disc of radius r has mean squared angle r²/2; each texel adds its own,
+    // a²/6 for a square of side a). Zero illuminance, straight up, without a glow.
+    SunLight glowSun() const;
+    // The widest sun a glow may be taken for, and sun.angular_radius_deg's upper bound: past it a
+    // glow is light from a wide part of the sky (two suns, a bright cloud bank), not a sun.
+    static constexpr double kMaxSunRadiusDeg = 45.0;
+    // A glow that is a sun: one whose glowSun() radius is at most kMaxSunRadiusDeg.
+    bool glowIsSun() const;
+    // The sky less its glow: the smooth part alone (image, projection, open irradiance), the sky
+    // that lights with glowSun() as the sun. The sky itself when it has no glow.
+    Sky withoutGlow() const;
+    // The glowShare() of the sky withoutGlow() took the glow from (0 for any other sky).
+    float takenGlowShare() const { return takenGlowShare_; }
     // The smooth part's exact SH projection (sh() without glow), summed in double: what a
     // probe's rays take as their control variate.
     const sh::ShRgb& smoothSh() const { return smoothSh_; }
@@ -106,6 +123,7 @@ private:
         double flux = 0.0;              // ∫ Y(glow) dω over the sphere
         sh::ShRgb sh;                   // its projection, texel centres as computeSh()
         double skyFlux = 0.0;           // ∫ Y(sky) dω
+        SunLight sun;                   // glowSun() before scale()
     };
     glm::vec3 sample(const Level& level, float u, float v) const;
     glm::vec3 lookup(const std::vector<Level>& levels, const glm::vec3& dir, float solidAngle) const;
@@ -123,6 +141,8 @@ private:
     sh::ShRgb sh_;
     sh::ShRgb smoothSh_;
     glm::vec3 openUp_{0.0f};
+    glm::vec3 smoothOpenUp_{0.0f};  // openIrradianceUp() of the smooth part
+    float takenGlowShare_ = 0.0f;
 };
 
 // The equirectangular image (rotation 0, row 0 at the zenith, scale 1) of two skies mixed,

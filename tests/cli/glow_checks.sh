@@ -3,7 +3,9 @@
 # An image sky with a sun in it (docs/lighting.md, "The sky's glow"): the bake's report states the
 # glow's share of the sky's light as the rule splits it (computed here again from the image), says
 # the probes sample it by rays of their own (their rays then pass the schedule's cap), and that
-# with water they keep the whole sky instead; a uniform sky has no glow.
+# with water they keep the whole sky instead; a uniform sky has no glow. With sun.follow_sky (the
+# default) the glow is the sun instead (docs/lighting.md, "The image's sun"): the report states
+# where it stands, its illuminance and its share, and the probes' sky has no glow left.
 set -u
 terralux=$1 work=$2
 rm -rf "$work" && mkdir -p "$work"
@@ -44,9 +46,21 @@ for v, o in sorted(texels, reverse=True):
     if covered > 4 * math.pi / 16:
         T = max(T, v)
         break
-print(sum(max(v - T, 0.0) * o for v, o in texels) / flux)
+# The glow as a sun (Sky::glowSun): its flux-weighted mean direction, and the radius of a disc of
+# its spread about it, r = sqrt(2 E[angle^2 + texel solid angle / 6]).
+def centre(x, y):
+    t, p = math.pi * (y + 0.5) / h, ((x + 0.5) / w - 0.5) * 2 * math.pi
+    return (math.sin(t) * math.sin(p), math.cos(t), -math.sin(t) * math.cos(p))
+glow = [((Y[y][x] - T) * om[y], centre(x, y), om[y]) for y in range(h) for x in range(w) if Y[y][x] > T]
+m = [sum(g * d[i] for g, d, _ in glow) for i in range(3)]
+n = math.sqrt(sum(c * c for c in m))
+s = [c / n for c in m]
+spread = sum(g * (math.acos(min(1.0, sum(a * b for a, b in zip(d, s)))) ** 2 + o / 6) for g, d, o in glow)
+radius = math.degrees(math.sqrt(2 * spread / sum(g for g, _, _ in glow)))
+print(sum(max(v - T, 0.0) * o for v, o in texels) / flux, flux, radius)
 PY
 )
+read -r expected flux radius <<<"$expected"
 
 # report DIR SHARE SAMPLED: the report's sky_glow, and the rays that follow from it.
 report() {
@@ -74,16 +88,45 @@ PY
 }
 
 common=(--bake --quiet --set probe_volumes[0].grid_dims=4,4 --set bake.quality=draft)
-"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --out "$work/sun" ||
+"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --set sun.follow_sky=false --out "$work/sun" ||
   fail "the bake under the sun sky exited $?"
 report "$work/sun" "$expected" true || fail "under the sun sky"
+# Not followed, a sun that outshines the rest of the image is worth a warning that names the setting.
+grep -q "sun.follow_sky: false under sky.hdr, whose image has a sun (azimuth -61.9°" "$work/sun/bake_report.json" ||
+  fail "no warning that the image's sun is baked into the probes"
+
 python3 -c "import sys; sys.exit(0 if 0.9 < float(sys.argv[1]) < 1.0 else 1)" "$expected" ||
   fail "the sky's glow share $expected: the sun should hold nearly all of its light"
 
-"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --set water.enabled=true --set water.level=700 \
+"$terralux" "${common[@]}" --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" --set sun.follow_sky=false --set water.enabled=true --set water.level=700 \
   --out "$work/wet" || fail "the bake with water exited $?"
 report "$work/wet" "$expected" false || fail "with water"
 
 "$terralux" "${common[@]}" --set sky.mode=uniform --out "$work/uniform" || fail "the uniform bake exited $?"
 report "$work/uniform" 0 false || fail "under a uniform sky"
-echo "sky glow share $expected as reported; sampled without water, not with it; none under a uniform sky"
+# The glow as the sun: the 2 x 2 texels' centres stand at azimuth -61.9 degrees (u = 21/64) and
+# 16.9 degrees up (v = 13/32); its illuminance is the glow's flux (their cosines to the mean
+# direction are over 0.997), at 3e-5 scene units per lux.
+"$terralux" --bake --set probe_volumes[0].grid_dims=4,4 --set bake.quality=draft --set sky.mode=hdr --set sky.hdr="$work/sun.hdr" \
+  --out "$work/lit" > "$work/lit.txt" || fail "the bake with the image's sun exited $?"
+report "$work/lit" 0 false || fail "with the image's sun"
+! grep -q "sun.follow_sky: false" "$work/lit/bake_report.json" || fail "the followed image's sun is warned about"
+python3 - "$work/lit/bake_report.json" "$expected" "$flux" "$radius" <<'PY' || fail "the image's sun in the report"
+import json, sys
+sun = json.load(open(sys.argv[1]))["sun"]
+share, flux, radius = float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
+errors = []
+if abs(sun["angular_radius_deg"] - radius) > 1e-3: errors.append(f"angular_radius_deg {sun['angular_radius_deg']} != {radius}")
+if sun.get("from_sky_image") is not True: errors.append("from_sky_image is not true")
+if abs(sun["share_of_sky"] - share) > 1e-5: errors.append(f"share_of_sky {sun['share_of_sky']} != {share}")
+if abs(sun["azimuth_deg"] + 61.875) > 0.5: errors.append(f"azimuth_deg {sun['azimuth_deg']} is not -61.9")
+if abs(sun["elevation_deg"] - 16.875) > 0.5: errors.append(f"elevation_deg {sun['elevation_deg']} is not 16.9")
+lux = share * flux / 3e-5
+if not 0.997 * lux < sun["illuminance_lux"] <= 1.0001 * lux: errors.append(f"illuminance_lux {sun['illuminance_lux']} is not {lux}")
+if errors:
+    print("FAIL: " + "; ".join(errors)); sys.exit(1)
+PY
+grep -q "sun: the sky image's own (sun.follow_sky) at azimuth -61.9°, elevation 16.[89]°" "$work/lit.txt" ||
+  fail "the summary does not say where the image's sun stands: $(grep 'sun:' "$work/lit.txt")"
+echo "sky glow share $expected as reported; sampled without water, not with it; none under a uniform sky; lit as the sun with sun.follow_sky"
+

@@ -169,7 +169,8 @@ sets=(--set shadows.cascades=3 --set fog.enabled=true --set fog.density=0.0001 -
 check "$work/sample.json" "$work/sample/scene.gltf" 3 0.09,0.11,0.15 || fail "sample: TERRALUX_lighting disagrees with --print-project"
 validate "$work/sample/scene.gltf"
 
-# A project file with a relative HDR sky: an 8 x 4 Radiance image of one radiance everywhere.
+# A project file with a relative HDR sky: an 8 x 4 Radiance image of one radiance everywhere, and
+# the authored sun beside it (an image without a sun of its own would otherwise light alone).
 mkdir -p "$work/project/skies"
 python3 - "$work/project/skies/even.hdr" <<'EOF' || fail "cannot write the test sky"
 import sys
@@ -180,6 +181,7 @@ EOF
 cat >"$work/project/lit.terralux.json" <<'EOF'
 {
   "sky": {"mode": "hdr", "hdr": "skies/even.hdr", "color": [1, 1, 1], "intensity": 0.5},
+  "sun": {"follow_sky": false},
   "shadows": {"cascades": 2, "split_mode": "manual", "splits": [9000]},
   "fog": {"enabled": true, "base_height": 800, "color": null},
   "camera": {"exposure_ev": 1.5},

@@ -42,6 +42,7 @@
 
 #include "CascadeSplitChart.h"
 #include "ImageCompare.h"
+#include "ImageFile.h"
 #include "LpvConsoleVariables.h"
 #include "LpvPanel.h"
 #include "MainWindow.h"
@@ -1443,6 +1444,32 @@ private slots:
             QVERIFY(!w_->document()->project().scene.sun.followSky);
             rowsMatchTheTable();
             QVERIFY(rowOf(w_->findChild<QWidget*>("param.sun.illuminance"))->isVisibleTo(dock));
+            // An image sky with a sun in it, followed: no authored sun row shows, and the dock says
+            // where the image's sun stands (a 2 x 2-texel sun at azimuth -61.9 degrees, 16.9 up).
+            follow->setChecked(true);
+            const fs::path sunHdr = kOut / "sun.exr";
+            std::vector<float> rgba(size_t(64) * 32 * 4, 1.0f);
+            for (int y : {12, 13})
+                for (int x : {20, 21})
+                    for (int c = 0; c < 3; ++c) rgba[(size_t(y) * 64 + size_t(x)) * 4 + size_t(c)] = 12800.0f;
+            writeImage(sunHdr, 64, 32, rgba);
+            QString error;
+            QVERIFY2(w_->document()->setParameter("sky.hdr", sunHdr.string(), &error), qPrintable(error));
+            mode->setCurrentText("hdr");
+            QCOMPARE(w_->document()->project().scene.sky.mode, SkyMode::Hdr);
+            rowsMatchTheTable();
+            for (const char* row : {"param.sun.azimuth_deg", "param.sun.illuminance", "param.sun.angular_radius_deg", "param.sun.mode"})
+                QVERIFY2(!rowOf(w_->findChild<QWidget*>(row))->isVisibleTo(dock), row);
+            QVERIFY(rowOf(follow)->isVisibleTo(dock));
+            auto* position = w_->findChild<QLabel*>("sun.position");
+            QVERIFY(position && position->isVisibleTo(dock));
+            QVERIFY2(position->text().startsWith(QString("Sun from the image at azimuth %1°, 16.").arg(-61.9, 0, 'f', 1)) &&
+                         position->text().contains("° above the horizon"),
+                     qPrintable(position->text()));
+            follow->setChecked(false);
+            rowsMatchTheTable();
+            QVERIFY(rowOf(w_->findChild<QWidget*>("param.sun.azimuth_deg"))->isVisibleTo(dock));
+            QVERIFY(!position->isVisibleTo(dock));
             mode->setCurrentText("uniform");
             rowsMatchTheTable();
             QVERIFY(!rowOf(w_->findChild<QWidget*>("param.sky.turbidity"))->isVisibleTo(dock));

@@ -8,6 +8,7 @@
 #include <set>
 
 #include <gtest/gtest.h>
+#include <glm/trigonometric.hpp>
 #include <tbb/global_control.h>
 
 #include "bake/DiffuseBake.h"
@@ -230,6 +231,83 @@ TEST(SkyGlow, ASunGoesToTheGlowAndItsSamplesProjectToItsExactSh) {
                 1e-3f * sh::evalIrradiance(exact, centre).z);
     const glm::vec3 g1 = sky.sampleGlow(0.3f, 0.5f, 0.5f, d), g2 = dim.sampleGlow(0.3f, 0.5f, 0.5f, d);
     EXPECT_FLOAT_EQ(g2.x, 0.5f * g1.x);
+}
+
+// The glow taken as the sun (sun.follow_sky under an image sky): a disc of 2 degrees' radius at a
+// known place in a 512 x 256 image (texels of 0.7 degrees) lights as a sun at its centre, with its
+// illuminance and its radius, and the sky left is the smooth part alone; together they give a
+// level surface what the whole image gives it.
+TEST(Bake, TheSkyImagesGlowTakenAsTheSunStandsWhereTheDiscIsWithItsLightAndSize) {
+    const int w = 512, h = 256;
+    const float radius = glm::radians(2.0f);
+    const glm::vec3 toDisc = sunDirection(60.0, 30.0);
+    const float rotationDeg = 25.0f;
+    std::vector<float> rgb(size_t(w) * h * 3);
+    double discSolidAngle = 0.0;  // of the texels drawn
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double omega = 2.0 * std::numbers::pi / w *
+                                 (std::cos(std::numbers::pi * y / h) - std::cos(std::numbers::pi * (y + 1) / h));
+            const float theta = kPi * (float(y) + 0.5f) / float(h);
+            const float phi = ((float(x) + 0.5f) / float(w) - 0.5f + rotationDeg / 360.0f) * 2.0f * kPi;
+            const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+            const bool disc = std::acos(std::clamp(glm::dot(d, toDisc), -1.0f, 1.0f)) < radius;
+            if (disc) discSolidAngle += omega;
+            const glm::vec3 v = disc ? glm::vec3(30000.0f, 27000.0f, 24000.0f) : glm::vec3(0.6f, 0.8f, 1.0f);
+            for (int c = 0; c < 3; ++c) rgb[(size_t(y) * w + x) * 3 + c] = v[c];
+        }
+    const Sky sky = Sky::equirect(rgb, w, h, 1.0f, rotationDeg);
+    ASSERT_TRUE(sky.hasGlow());
+    const SunLight sun = sky.glowSun();
+    EXPECT_GT(glm::dot(sun.direction, toDisc), std::cos(glm::radians(0.1f)));
+    // The disc's radius, within a texel's worth.
+    EXPECT_NEAR(glm::degrees(sun.angularRadius), 2.0f, 0.15f);
+    // Its illuminance: the disc's radiance over its texels' solid angle (less the threshold the
+    // smooth part keeps, under 0.1 %), in the disc's colour.
+    const float discIlluminance = float(30000.0 * discSolidAngle);
+    EXPECT_NEAR(sun.illuminance.x, discIlluminance, 0.002f * discIlluminance);
+    EXPECT_NEAR(sun.illuminance.z / sun.illuminance.x, 0.8f, 0.001f);
+    // The sky left: no glow, the smooth part's image and projection, and the share it took.
+    const Sky rest = sky.withoutGlow();
+    EXPECT_FALSE(rest.hasGlow());
+    EXPECT_FLOAT_EQ(rest.takenGlowShare(), sky.glowShare());
+    EXPECT_EQ(sky.takenGlowShare(), 0.0f);
+    EXPECT_LT(rest.radiance(toDisc, 0.0f).x, 20.0f);
+    EXPECT_EQ(rest.radiance(-toDisc, 0.0f), sky.radiance(-toDisc, 0.0f));
+    for (size_t k = 0; k < rest.sh().c.size(); ++k) EXPECT_EQ(rest.sh().c[k], sky.smoothSh().c[k]);
+    const glm::vec3 whole = sky.openIrradianceUp(), split = rest.openIrradianceUp() + sun.illuminance * sun.direction.y;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(split[c], whole[c], 0.005f * whole[c]);
+    EXPECT_LT(rest.openIrradianceUp().x, 0.2f * whole.x);
+    // Scaled, the sun's light scales with the sky; where it stands and its size do not.
+    const Sky tinted = sky.scaled(glm::vec3(0.5f, 1.0f, 2.0f));
+    EXPECT_FLOAT_EQ(tinted.glowSun().illuminance.x, 0.5f * sun.illuminance.x);
+    EXPECT_FLOAT_EQ(tinted.glowSun().illuminance.z, 2.0f * sun.illuminance.z);
+    EXPECT_EQ(tinted.glowSun().direction, sun.direction);
+    EXPECT_FLOAT_EQ(tinted.withoutGlow().openIrradianceUp().z, 2.0f * rest.openIrradianceUp().z);
+    // The sun where Sky itself reads the image: its radiance there is the disc's.
+    EXPECT_GT(sky.radiance(sun.direction, 0.0f).x, 10000.0f);
+    // A sun of one texel is no point: its radius is the texel's own spread, √(2 · ω/6).
+    std::vector<float> one(size_t(w) * h * 3, 0.5f);
+    const int sx = 100, sy = 100;
+    for (int c = 0; c < 3; ++c) one[(size_t(sy) * w + sx) * 3 + c] = 1.0e6f;
+    const double texel = 2.0 * std::numbers::pi / w * (std::cos(std::numbers::pi * sy / h) - std::cos(std::numbers::pi * (sy + 1) / h));
+    const Sky point = Sky::equirect(one, w, h, 1.0f, 0.0f);
+    ASSERT_TRUE(point.glowIsSun());
+    EXPECT_NEAR(point.glowSun().angularRadius, std::sqrt(texel / 3.0), 0.01 * std::sqrt(texel / 3.0));
+    // Two equal suns half the sky apart are no sun: the glow's spread is past 45 degrees.
+    std::vector<float> two(size_t(w) * h * 3, 0.5f);
+    for (int x : {100, 100 + w / 2})
+        for (int c = 0; c < 3; ++c) two[(size_t(sy) * w + size_t(x)) * 3 + c] = 1.0e6f;
+    const Sky pair = Sky::equirect(two, w, h, 1.0f, 0.0f);
+    ASSERT_TRUE(pair.hasGlow());
+    EXPECT_FALSE(pair.glowIsSun());
+    EXPECT_GT(glm::degrees(pair.glowSun().angularRadius), float(Sky::kMaxSunRadiusDeg));
+    EXPECT_TRUE(sky.glowIsSun());
+    // No glow, no sun: a plain sky stays whole.
+    const Sky plain = Sky::uniform(glm::vec3(1.0f));
+    EXPECT_EQ(plain.glowSun().illuminance, glm::vec3(0.0f));
+    EXPECT_EQ(plain.withoutGlow().openIrradianceUp(), plain.openIrradianceUp());
+    EXPECT_FALSE(plain.glowIsSun());
 }
 
 // Under a sky image with a sun, flat ground sees the whole sky: it is lit by the sky's open

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "GltfExport.h"
+#include "ImageFile.h"
 #include "ParameterTable.h"
 #include "Project.h"
 #include "SceneLighting.h"
@@ -131,6 +132,67 @@ TEST(LightingExtension, TheSunIsTheOneTheBakeLightsWith) {
     const json dark = lightingExtension(projectWith({"sun.illuminance=0"}), hf, l)["sun"];
     EXPECT_EQ(dark["illuminance"].get<double>(), 1.0);
     EXPECT_EQ(vec3Of(dark["color"]), l.sun.illuminance / sceneUnitsOfLux(1.0));
+}
+
+// An image sky with a sun in it, with sun.follow_sky: the sun the bake and the renderer light
+// with is the image's glow, the sky they keep is the image less it, and the extension writes that
+// sun; off, the image lights whole beside the authored sun.
+TEST(LightingExtension, UnderAnImageSkyTheSunFollowsTheImagesGlow) {
+    // A 64 x 32 EXR sky of 1.0 with a 2 x 2-texel sun of 12 800,
+    // the texels' centres at azimuth -61.9 degrees (u = 21/64) and 16.9 degrees up (v = 13/32).
+    const fs::path hdr = fs::temp_directory_path() / ("terralux_image_sun_" + std::to_string(getpid()) + ".exr");
+    std::vector<float> rgba(size_t(64) * 32 * 4, 1.0f);
+    for (int y : {12, 13})
+        for (int x : {20, 21})
+            for (int c = 0; c < 3; ++c) rgba[(size_t(y) * 64 + size_t(x)) * 4 + size_t(c)] = 12800.0f;
+    writeImage(hdr, 64, 32, rgba);
+    // The terrain has no CRS: a date_time sun could not be placed, and is not read.
+    const Heightfield hf = makeTerrain();
+    const std::vector<std::string> sets = {"sky.mode=hdr", "sky.hdr=" + hdr.string(), "sun.azimuth_deg=100",
+                                           "sun.elevation_deg=50", "sun.mode=date_time", "sun.illuminance=3000",
+                                           "sun.angular_radius_deg=2"};
+    const Project p = projectWith(sets);
+    const BakeLighting l = lightingOf(p, hf);
+    EXPECT_GT(glm::dot(l.sun.direction, sunDirection(-61.875, 16.875)), std::cos(0.5 * std::numbers::pi / 180.0));
+    EXPECT_FALSE(l.sky.hasGlow());
+    EXPECT_GT(l.sky.takenGlowShare(), 0.9f);
+    // The glow's light: the 2 x 2 texels' 12 800 less the threshold the sky keeps (a few times
+    // 1.0), over their solid angle (rows 12 and 13 of 32, 2 of 64 columns), all within 4 degrees of
+    // the sun's direction (cosines over 0.997).
+    double omega = 0.0;
+    for (int y : {12, 13})
+        omega += 2.0 * (2.0 * std::numbers::pi / 64.0) * (std::cos(std::numbers::pi * y / 32.0) - std::cos(std::numbers::pi * (y + 1) / 32.0));
+    EXPECT_GT(l.sun.illuminance.x, 0.997 * (12800.0 - 12.0) * omega);
+    EXPECT_LT(l.sun.illuminance.x, 12800.0 * omega);
+    const ImageSun read = imageSunOf(l);
+    EXPECT_NEAR(read.azimuthDeg, -61.875, 0.5);
+    EXPECT_NEAR(read.elevationDeg, 16.875, 0.5);
+    // sky.intensity scales the image, and so its sun.
+    const BakeLighting bright = lightingOf(projectWith({"sky.mode=hdr", "sky.hdr=" + hdr.string(), "sky.intensity=2"}), hf);
+    EXPECT_FLOAT_EQ(bright.sun.illuminance.x, 2.0f * l.sun.illuminance.x);
+    EXPECT_EQ(bright.sun.direction, l.sun.direction);
+
+    // Exported as lit: the image's sun in lux, its colour normalised to it, its size; no date's
+    // resolution (the authored date_time is not read), and no error for the place it lacks.
+    const json sun = lightingExtension(p, hf)["sun"];
+    EXPECT_EQ(vec3Of(sun["direction"]), l.sun.direction);
+    EXPECT_NEAR(sun["illuminance"].get<double>(), read.illuminanceLux, 1e-6 * read.illuminanceLux);
+    const glm::vec3 exported = vec3Of(sun["color"]) * sceneUnitsOfLux(sun["illuminance"].get<double>());
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(exported[c], l.sun.illuminance[c], 1e-5f * l.sun.illuminance[c]);
+    EXPECT_NEAR(sun["angular_radius_deg"].get<double>(), double(l.sun.angularRadius) * 180.0 / std::numbers::pi, 1e-5);
+    EXPECT_GT(sun["angular_radius_deg"].get<double>(), 3.0);  // the 2 x 2 texels' 6.4, not the authored 2
+    EXPECT_EQ(sun["follow_sky"], true);
+    for (auto it = sun.begin(); it != sun.end(); ++it) EXPECT_FALSE(it.key().starts_with("resolved_")) << it.key();
+    EXPECT_NO_THROW(checkSunPlaces(p.scene, hf));
+
+    // Off: the authored sun, and the image whole with its glow.
+    const BakeLighting whole = lightingOf(projectWith({"sky.mode=hdr", "sky.hdr=" + hdr.string(), "sun.azimuth_deg=100",
+                                                       "sun.elevation_deg=50", "sun.follow_sky=false"}),
+                                          hf);
+    EXPECT_EQ(whole.sun.direction, sunDirection(100.0, 50.0));
+    EXPECT_TRUE(whole.sky.hasGlow());
+    EXPECT_EQ(whole.sky.takenGlowShare(), 0.0f);
+    fs::remove(hdr);
 }
 
 TEST(LightingExtension, ComputedSplitsAreTheProjectCamerasCascades) {

@@ -225,11 +225,32 @@ TEST(ParameterTable, SunAndSkyRowsAreReadByTheirSkyMode) {
         EXPECT_TRUE(read(s, path)) << path;
     for (const char* path : {"sky.turbidity", "sun.follow_sky", "sky.hdr", "sky.rotation_deg"})
         EXPECT_FALSE(read(s, path)) << path;
-    s.sky.mode = SkyMode::Hdr;
-    for (const char* path : {"sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
-        EXPECT_TRUE(read(s, path)) << path;
-    for (const char* path : {"sky.turbidity", "sun.follow_sky", "sky.color"}) EXPECT_FALSE(read(s, path)) << path;
+    s.sky.mode = SkyMode::Hdr;  // the sun follows the image: nothing of the authored sun is read
+    const std::vector<const char*> placed = {"sun.mode", "sun.illuminance", "sun.color", "sun.angular_radius_deg"};
+    const std::vector<const char*> manual = {"sun.azimuth_deg", "sun.elevation_deg"};
+    const std::vector<const char*> dated = {"sun.date", "sun.time_h", "sun.utc_offset_h", "sun.latitude_deg", "sun.longitude_deg"};
+    for (SunMode mode : {SunMode::Manual, SunMode::DateTime}) {
+        s.sun.mode = mode;
+        for (const char* path : {"sky.hdr", "sky.rotation_deg", "sun.follow_sky"}) EXPECT_TRUE(read(s, path)) << path;
+        for (const auto* rows : {&placed, &manual, &dated})
+            for (const char* path : *rows) EXPECT_FALSE(read(s, path)) << path;
+        for (const char* path : {"sky.turbidity", "sky.color"}) EXPECT_FALSE(read(s, path)) << path;
+        s.sun.followSky = false;  // the image whole, and the authored sun
+        for (const char* path : placed) EXPECT_TRUE(read(s, path)) << path;
+        for (const char* path : mode == SunMode::Manual ? manual : dated) EXPECT_TRUE(read(s, path)) << path;
+        s.sun.followSky = true;
+    }
+    s.sun.mode = SunMode::Manual;
+    // A scenario's image sky hides its own sun's rows alike.
+    SceneDescription withScenario;
+    withScenario.scenarios.push_back(LightingScenario{});
+    withScenario.scenarios[0].name = "noon";
+    withScenario.scenarios[0].sky.mode = SkyMode::Hdr;
+    EXPECT_FALSE(findParameter("scenarios[].sun.azimuth_deg")->isRead(withScenario, 0));
+    EXPECT_TRUE(findParameter("sun.azimuth_deg")->isRead(withScenario, 0));
     s.sky.mode = SkyMode::Physical;
+    // The physical sky's sun stands where it is placed, at its authored size.
+    for (const char* path : {"sun.mode", "sun.azimuth_deg", "sun.angular_radius_deg"}) EXPECT_TRUE(read(s, path)) << path;
     for (const char* path : {"sky.turbidity", "sky.intensity", "sun.follow_sky"}) EXPECT_TRUE(read(s, path)) << path;
     for (const char* path : {"sky.color", "sky.hdr", "sky.rotation_deg", "sun.illuminance", "sun.color"})
         EXPECT_FALSE(read(s, path)) << path;

@@ -142,7 +142,7 @@ INSTANTIATE_TEST_SUITE_P(
         Rule{"camera.fov_deg=0.5", "p.json: camera.fov_deg = 0.5: must be in [1, 150]"},
         Rule{"camera.radius=0", "p.json: camera.radius = 0: must be in (0, 100000000] or null"},
         Rule{"camera.target=[1,2]", "p.json: camera.target = [1,2]: must be an array of 3 numbers or null"},
-        Rule{"version=8", "p.json: version = 8: is newer than this Terralux reads (7); open it with a newer Terralux"},
+        Rule{"version=9", "p.json: version = 9: is newer than this Terralux reads (8); open it with a newer Terralux"},
         Rule{"version=0", "p.json: version = 0: must be an integer >= 1"}));
 
 TEST(Project, BoxVolumesValidateThreeDims) {
@@ -482,6 +482,31 @@ TEST(ProjectVersions, EveryOlderVersionHasOneMigrationStep) {
     const auto& steps = projectMigrations();
     ASSERT_EQ(steps.size(), size_t(kProjectVersion - 1));
     for (int v = 1; v < kProjectVersion; ++v) EXPECT_EQ(steps[size_t(v - 1)].from, v);
+}
+
+TEST(ProjectVersions, VersionSevenImageSkiesKeepTheAuthoredSunBesideTheWholeImage) {
+    // Version 7 lit an image sky whole with the authored sun; version 8's sun.follow_sky (default
+    // true) would take the image's sun instead, so a version-7 image sky gets it false.
+    const json v7 = {{"version", 7},
+                     {"sky", {{"mode", "hdr"}, {"hdr", "noon.hdr"}}},
+                     {"scenarios", json::array({json{{"name", "dusk"}, {"sky", {{"mode", "hdr"}, {"hdr", "dusk.hdr"}}}},
+                                                json{{"name", "grey"}, {"sky", {{"mode", "uniform"}}}}})}};
+    std::vector<std::string> notes;
+    const json migrated = migrateProjectJson(v7, "old.json", &notes);
+    EXPECT_EQ(migrated["sun"]["follow_sky"], false);
+    EXPECT_EQ(migrated["scenarios"][0]["sun"]["follow_sky"], false);
+    EXPECT_FALSE(migrated["scenarios"][1].contains("sun"));
+    ASSERT_EQ(notes.size(), 2u);
+    EXPECT_EQ(notes[1], "old.json: version 7 migrated to 8: scenarios[0].sun.follow_sky set to false: version 7 lit the image "
+                        "whole with the authored sun");
+    // A version-7 uniform or physical sky, and a current image sky, keep the default.
+    EXPECT_TRUE(sceneFromJson(json{{"version", 7}, {"sky", {{"mode", "physical"}}}}, "old.json", nullptr).sun.followSky);
+    EXPECT_TRUE(sceneFromJson(json{{"version", kProjectVersion}, {"sky", {{"mode", "hdr"}, {"hdr", "a.hdr"}}}}, "new.json", nullptr)
+                    .sun.followSky);
+    // A sun that is not an object is left for the check to name.
+    json bad = v7;
+    bad["sun"] = "east";
+    EXPECT_EQ(migrateProjectJson(bad, "old.json", nullptr)["sun"], "east");
 }
 
 TEST(ProjectVersions, VersionOneWithoutAnAlbedoModeKeepsItsConstantAlbedo) {

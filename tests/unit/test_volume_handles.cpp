@@ -239,6 +239,14 @@ TEST(VolumeHandles, ReflectionGridWaterAndSun) {
     const SceneDescription dated = sceneWith({"sun.mode=date_time", "sun.date=2026-06-21", "sun.time_h=9.5"});
     const std::vector<glm::vec3> path = sunPath(dated, sample(), camera, 500.0f);
     ASSERT_EQ(path.size(), 97u);
+    // Under an image sky the image's sun stands where the image has it: no handle, no path.
+    const SceneDescription imaged = sceneWith({"sun.mode=date_time", "sky.mode=hdr", "sky.hdr=noon.hdr"});
+    EXPECT_FALSE(sunBounds(imaged, sample(), camera, 500.0f));
+    EXPECT_TRUE(sunPath(imaged, sample(), camera, 500.0f).empty());
+    SceneDescription placed = imaged;
+    placed.sun.followSky = false;
+    EXPECT_TRUE(sunBounds(placed, sample(), camera, 500.0f));
+    EXPECT_EQ(sunPath(placed, sample(), camera, 500.0f).size(), 97u);
     const std::optional<VolumeBounds> datedSun = sunBounds(dated, sample(), camera, 500.0f);
     ASSERT_TRUE(datedSun);
     EXPECT_LT(glm::distance(path[38], datedSun->min), 0.05f);  // 09:30 is the 38th quarter hour
