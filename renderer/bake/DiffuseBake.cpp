@@ -372,9 +372,9 @@ BakeQuality qualityOf(const BakeSettings& bake) {
 
 BakeQuality qualityPreset(QualityPreset preset) {
     switch (preset) {
-        case QualityPreset::Draft: return {96, 1, 64, 32, 2, 0.016f, 1536};
-        case QualityPreset::Standard: return {256, 2, 128, 64, 4, 0.004f, 4096};
-        case QualityPreset::High: return {1024, 3, 256, 128, 8, 0.002f, 16384};
+        case QualityPreset::Draft: return {96, 1, 64, 32, 2, 0.016f, 6144};
+        case QualityPreset::Standard: return {256, 2, 128, 64, 4, 0.004f, 16384};
+        case QualityPreset::High: return {1024, 3, 256, 128, 8, 0.002f, 65536};
         case QualityPreset::Reference: return {4096, 16, 0, 0, 1, 0.001f, 65536};
     }
     return {};

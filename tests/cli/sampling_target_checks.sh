@@ -35,7 +35,7 @@ PY
       --set bake.target_error=0.01 >"$work/stdout" 2>"$work/stderr" || fail "dry run exited $?"
     grep -Eq "^dry run: nothing baked, nothing written \(standard, [0-9]+ rays, [0-9]+ bounces" "$work/stdout" \
       || fail "no dry-run header"
-    grep -Eq "$line on 64 probes \(replaces the standard preset's 0\.40 % standard error per probe \(256 to 4096 rays\) and 2 bounces; meets it; [0-9]+ trials" \
+    grep -Eq "$line on 64 probes \(replaces the standard preset's 0\.40 % standard error per probe \(256 to 16384 rays\) and 2 bounces; meets it; [0-9]+ trials" \
       "$work/stdout" || fail "no choice in the dry run: $(cat "$work/stdout")"
     [ -e "$work/out" ] && fail "the dry run created $work/out"
     [ -s "$work/stderr" ] && fail "stderr not empty"

@@ -85,7 +85,9 @@ TEST(BakeDefaults, NoExportedProbeHasNegativeIrradiance) {
 // measured with the metric the estimate stands for (relative RMS over normals). Compared as root
 // mean squares over the probes (a standard error is the RMS of the error), on two committed
 // mountain crops under three lightings: the project's defaults (physical sky and sun, the height
-// ramp's albedo), a sky and sun of constant colours, and a bright uniform sky alone.
+// ramp's albedo), a sky and sun of constant colours, and a bright uniform sky alone. High's
+// rounds may trace past 16384 rays (its cap is 65536): the 16384 rays' own noise then counts in
+// the measured error, which only makes the comparison stricter.
 TEST(StandardError, MatchesTheMeasuredSamplingErrorOfEachPreset) {
     const fs::path crops[] = {kCrop, fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif"};
     for (const fs::path& crop : crops) {
@@ -261,7 +263,7 @@ TEST(BakeTargetError, ChosenRaysAndBouncesMeetItAgainstAFineBake) {
     EXPECT_TRUE(t["met"].get<bool>()) << t.dump(1);
     EXPECT_LE(t["baked_standard_error_p95"].get<double>(), 0.01);
     EXPECT_EQ(t["replaced"].get<std::string>(),
-              "the standard preset's 0.40 % standard error per probe (256 to 4096 rays) and 2 bounces");
+              "the standard preset's 0.40 % standard error per probe (256 to 16384 rays) and 2 bounces");
 
     const DemImportResult dem = importDem(kCrop.string());
     const HeightfieldTracer tracer(dem.heightfield);
