@@ -1551,7 +1551,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         const SunLight glow = lighting.sky.glowSun();
         const glm::vec3 fromSun = glow.illuminance * std::max(0.0f, glow.direction.y);
         const glm::vec3 fromSky = lighting.sky.withoutGlow().openIrradianceUp();
-        if (glsl::rec709Luminance(fromSun.x, fromSun.y, fromSun.z) > glsl::rec709Luminance(fromSky.x, fromSky.y, fromSky.z)) {
+        if (glsl::rec709Luminance(fromSun) > glsl::rec709Luminance(fromSky)) {
             BakeLighting asSun = lighting;
             asSun.sun = glow;
             asSun.sky = lighting.sky.withoutGlow();

@@ -183,7 +183,7 @@ ImageSun imageSunOf(const BakeLighting& l) {
     const glm::dvec3 d(l.sun.direction);
     const glm::vec3& e = l.sun.illuminance;
     return {glm::degrees(std::atan2(d.x, -d.z)), glm::degrees(std::asin(std::clamp(d.y, -1.0, 1.0))),
-            double(glsl::rec709Luminance(e.x, e.y, e.z)) / kSceneUnitsPerLux, glm::degrees(double(l.sun.angularRadius)),
+            double(glsl::rec709Luminance(e)) / kSceneUnitsPerLux, glm::degrees(double(l.sun.angularRadius)),
             double(l.sky.takenGlowShare())};
 }
 

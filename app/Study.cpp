@@ -21,6 +21,7 @@
 #include "ReflectionProbeFile.h"
 #include "ProjectRenderer.h"
 #include "SceneLighting.h"
+#include "ShaderMath.h"
 #include "TerrainLoading.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
@@ -744,7 +745,7 @@ StudyPoint Study::measureLpv(const Candidate& c) {
         }
         lpvTruth.resize(lpvP.size());
         tbb::parallel_for(size_t(0), lpvP.size(), [&](size_t i) {
-            lpvTruth[i] = luminance(sunFirstBounce(lighting, lpvP[i], lpvN[i], kLpvRays, kStudySeed + 7919u * i));
+            lpvTruth[i] = glsl::rec709Luminance(sunFirstBounce(lighting, lpvP[i], lpvN[i], kLpvRays, kStudySeed + 7919u * i));
         });
         double mean = 0.0;
         for (float t : lpvTruth) mean += t;
@@ -761,7 +762,7 @@ StudyPoint Study::measureLpv(const Candidate& c) {
     std::vector<float> err;
     for (size_t i = 0; i < lpvP.size(); ++i) {
         const glm::vec3 toEye = glm::normalize(glm::vec3(eye) - lpvP[i]);
-        const float value = luminance(volumes.evaluate(lpvP[i], lpvN[i], toEye).irradiance);
+        const float value = glsl::rec709Luminance(volumes.evaluate(lpvP[i], lpvN[i], toEye).irradiance);
         err.push_back(std::abs(value - lpvTruth[i]) / std::max(lpvTruth[i], std::max(lpvFloor, 1e-12f)));
     }
     setErrors(p, std::move(err));

@@ -37,6 +37,9 @@ inline float atan(float y, float x) { return std::atan2(y, x); }  // GLSL's two-
 #include "shadow_math.glsl"
 #undef TLX_SHARED
 
+// C++ only: the same luminance of a colour, as the bake's and the meter's code holds it.
+inline float rec709Luminance(const glm::vec3& c) { return rec709Luminance(c.x, c.y, c.z); }
+
 }  // namespace terralux::glsl
 
 namespace terralux::glsl::dbl {

@@ -67,7 +67,7 @@ struct Replicates {
     void add(int k, const glm::vec3& radiance, const glm::vec3& d, bool counted = true) {
         float y[sh::kCoeffCount];
         sh::evalBasis(d, y);
-        const double l = double(luminance(radiance));
+        const double l = double(glsl::rec709Luminance(radiance));
         for (int j = 0; j < sh::kCoeffCount; ++j) lum[size_t(k)][size_t(j)] += l * double(y[j]);
         count[size_t(k)] += counted;
     }
@@ -348,8 +348,6 @@ glm::vec3 sunFirstBounce(const BakeLighting& lighting, const glm::vec3& p, const
     return rays ? sum / float(rays) : sum;
 }
 
-float luminance(const glm::vec3& c) { return glsl::rec709Luminance(c.x, c.y, c.z); }
-
 const char* qualityName(QualityPreset preset) {
     switch (preset) {
         case QualityPreset::Draft: return "draft";
@@ -581,7 +579,7 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
                      Ray&& ray, const Sky* glow, Sees&& sees) {
     std::array<double, sh::kCoeffCount> baseLuminance{};
     if (base)
-        for (int j = 0; j < sh::kCoeffCount; ++j) baseLuminance[size_t(j)] = double(luminance(base->c[size_t(j)]));
+        for (int j = 0; j < sh::kCoeffCount; ++j) baseLuminance[size_t(j)] = double(glsl::rec709Luminance(base->c[size_t(j)]));
     Rounds rounds;
     sh::ShRgb total;
     int glowRays = 0;
@@ -604,7 +602,7 @@ int traceProbeRounds(const ProbeRays& schedule, Rng& rng, ProbeBake& out, size_t
         if (countHidden) glowConstant = glow->glowSh();
     }
     std::array<double, sh::kCoeffCount> constantLuminance{};
-    for (int j = 0; j < sh::kCoeffCount; ++j) constantLuminance[size_t(j)] = double(luminance(glowConstant.c[size_t(j)]));
+    for (int j = 0; j < sh::kCoeffCount; ++j) constantLuminance[size_t(j)] = double(glsl::rec709Luminance(glowConstant.c[size_t(j)]));
     auto round = [&](int n) {
         const ReplicateLattices lattices(n, rng);
         const float weight = 4.0f * kPi / float(n);
@@ -854,8 +852,8 @@ float relativeIrradianceError(const sh::ShRgb& value, const sh::ShRgb& reference
     const auto& normals = metricNormals();
     double num = 0, den = 0;
     for (const auto& n : normals) {
-        const double e = luminance(sh::evalIrradiance(value, n));
-        const double r = luminance(sh::evalIrradiance(reference, n));
+        const double e = glsl::rec709Luminance(sh::evalIrradiance(value, n));
+        const double r = glsl::rec709Luminance(sh::evalIrradiance(reference, n));
         num += (e - r) * (e - r);
         den += r * r;
     }
@@ -867,7 +865,7 @@ double rmsIrradiance(const sh::ShRgb& sh) {
     const auto& normals = metricNormals();
     double sq = 0;
     for (const auto& n : normals) {
-        const double r = luminance(sh::evalIrradiance(sh, n));
+        const double r = glsl::rec709Luminance(sh::evalIrradiance(sh, n));
         sq += r * r;
     }
     return std::sqrt(sq / double(normals.size()));

@@ -235,7 +235,6 @@ struct ErrorStats {
 ErrorStats compareToReference(const std::vector<sh::ShRgb>& bake,
                               const std::vector<sh::ShRgb>& reference,
                               const std::vector<uint8_t>& valid);
-float luminance(const glm::vec3& c);
 
 class Rng;
 // Schlick's approximation of the Fresnel reflectance of water (F0 = 0.02) for light arriving at

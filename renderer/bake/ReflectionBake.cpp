@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "ShaderMath.h"
 #include "bake/SphereSampling.h"
 
 namespace terralux {
@@ -419,7 +420,7 @@ void toEncoding(ReflectionProbeSet& set, ReflectionEncoding encoding) {
 std::vector<double> referenceLuminance(const RadianceCube& reference, float roughness) {
     const CubeGeometry g(reference.size);
     std::vector<double> out;
-    for (const glm::vec3& d : errorDirections()) out.push_back(luminance(ggxIntegral(reference.texels, g, d, roughness)));
+    for (const glm::vec3& d : errorDirections()) out.push_back(glsl::rec709Luminance(ggxIntegral(reference.texels, g, d, roughness)));
     return out;
 }
 
@@ -438,7 +439,7 @@ float reflectionProbeError(const ReflectionProbeSet& set, size_t probe, Reflecti
     double num = 0, den = 0;
     const auto& dirs = errorDirections();
     for (size_t k = 0; k < dirs.size(); ++k) {
-        const double e = luminance(s->evaluate(probe, dirs[k], roughness));
+        const double e = glsl::rec709Luminance(s->evaluate(probe, dirs[k], roughness));
         num += (e - reference[k]) * (e - reference[k]);
         den += reference[k] * reference[k];
     }

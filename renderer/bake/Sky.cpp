@@ -17,8 +17,6 @@ namespace terralux {
 
 namespace {
 constexpr float kPi = std::numbers::pi_v<float>;
-// Rec. 709 luminance, as the bake's metrics weigh colour.
-double lum(const glm::vec3& c) { return glsl::rec709Luminance(c.x, c.y, c.z); }
 // The direction of texel (x, y)'s centre in a width x height image turned by `rotation` (u units):
 // the middle of its rows' polar angles and of its column, where the glow's projection and its
 // samples' projection take the texel.
@@ -111,7 +109,7 @@ void Sky::splitGlow() {
     for (int y = 0; y < l.height; ++y) {
         solidAngle[size_t(y)] =
             dphi * (std::cos(std::numbers::pi * y / l.height) - std::cos(std::numbers::pi * (y + 1) / l.height));
-        for (int x = 0; x < l.width; ++x) skyFlux += lum(l.texels[size_t(y) * l.width + x]) * solidAngle[size_t(y)];
+        for (int x = 0; x < l.width; ++x) skyFlux += glsl::rec709Luminance(l.texels[size_t(y) * l.width + x]) * solidAngle[size_t(y)];
     }
     // The threshold is kGlowThreshold times the mean of the smooth part it leaves, not of the
     // whole sky: a sun holding most of the light would otherwise set it so high that the smooth
@@ -123,7 +121,7 @@ void Sky::splitGlow() {
         double clamped = 0.0;
         for (int y = 0; y < l.height; ++y)
             for (int x = 0; x < l.width; ++x)
-                clamped += std::min(lum(l.texels[size_t(y) * l.width + x]), threshold) * solidAngle[size_t(y)];
+                clamped += std::min(double(glsl::rec709Luminance(l.texels[size_t(y) * l.width + x])), threshold) * solidAngle[size_t(y)];
         const double next = double(kGlowThreshold) * clamped / (4.0 * std::numbers::pi);
         const bool settled = next > 0.99 * threshold;
         threshold = next;
@@ -137,7 +135,7 @@ void Sky::splitGlow() {
         byLuminance.reserve(l.texels.size());
         for (int y = 0; y < l.height; ++y)
             for (int x = 0; x < l.width; ++x)
-                byLuminance.emplace_back(lum(l.texels[size_t(y) * l.width + x]), solidAngle[size_t(y)]);
+                byLuminance.emplace_back(glsl::rec709Luminance(l.texels[size_t(y) * l.width + x]), solidAngle[size_t(y)]);
         std::sort(byLuminance.begin(), byLuminance.end(), std::greater<>());
         double covered = 0.0;
         for (const auto& [y, omega] : byLuminance) {
@@ -150,7 +148,7 @@ void Sky::splitGlow() {
     }
     if (!(threshold > 0.0)) return;
     bool any = false;
-    for (const glm::vec3& t : l.texels) any |= lum(t) > threshold;
+    for (const glm::vec3& t : l.texels) any |= glsl::rec709Luminance(t) > threshold;
     if (!any) return;
 
     auto glow = std::make_shared<Glow>();
@@ -167,7 +165,7 @@ void Sky::splitGlow() {
         for (int x = 0; x < l.width; ++x) {
             const size_t i = size_t(y) * l.width + x;
             const glm::vec3 dir = texelCentre(x, y, l.width, l.height, rotation_);
-            const double y0 = lum(l.texels[i]);
+            const double y0 = glsl::rec709Luminance(l.texels[i]);
             glm::vec3 g(0.0f);
             if (y0 > threshold) {
                 smooth.texels[i] = l.texels[i] * float(threshold / y0);
@@ -180,7 +178,7 @@ void Sky::splitGlow() {
                 glowSh[size_t(k)] += glm::dvec3(g) * (double(basis[k]) * solidAngle[size_t(y)]);
             }
             if (dir.y > 0.0f) smoothUp += glm::dvec3(smooth.texels[i]) * (double(dir.y) * solidAngle[size_t(y)]);
-            const double gy = lum(g);
+            const double gy = glsl::rec709Luminance(g);
             if (!(gy > 0.0)) continue;
             glow->texel.push_back(uint32_t(i));
             glow->colour.push_back(g / float(gy));

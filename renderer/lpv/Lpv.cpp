@@ -28,8 +28,6 @@ constexpr float kFarFace = 0.4006696846f;
 constexpr float kSideFace = 0.4234413544f;
 constexpr int kHalf = kGrid / 2;
 
-float luminanceOf(const glm::vec3& c) { return glsl::rec709Luminance(c.r, c.g, c.b); }
-
 using Face = PropagationFace;
 using Neighbour = PropagationNeighbour;
 const std::array<Neighbour, 6>& neighbours() { return propagationNeighbours(); }
@@ -739,9 +737,9 @@ Sample Volumes::evaluate(const glm::vec3& p, const glm::vec3& n, const glm::vec3
         // Leak dampening by the directional derivative along the normal: where the irradiance
         // grows into the surface, the light came through it from behind (a coarse cell straddling
         // a ridge); damp it by how much: × clamp(1 + min(0, E(q + h/2·n) − E(q − h/2·n)) / E(q), 0, 1).
-        const float front = luminanceOf(irradianceAt(q + half * n, n, quality));
-        const float back = luminanceOf(irradianceAt(q - half * n, n, quality));
-        const float centre = luminanceOf(e);
+        const float front = glsl::rec709Luminance(irradianceAt(q + half * n, n, quality));
+        const float back = glsl::rec709Luminance(irradianceAt(q - half * n, n, quality));
+        const float centre = glsl::rec709Luminance(e);
         if (centre > 0.0f) e *= std::clamp(1.0f + std::min(0.0f, front - back) / centre, 0.0f, 1.0f);
     }
     if (quality >= 2) {
@@ -822,7 +820,7 @@ GroundComparison compareWithOneBounce(const Volumes& volumes, const BakeLighting
         out.normals.push_back(n);
         out.lpv.push_back(volumes.evaluate(p, n, n).irradiance);
         out.reference.push_back(cache.indirectAt(hit));
-        const double a = luminanceOf(out.lpv.back()), b = luminanceOf(out.reference.back());
+        const double a = glsl::rec709Luminance(out.lpv.back()), b = glsl::rec709Luminance(out.reference.back());
         out.meanLpv += a;
         out.meanReference += b;
         sq += (a - b) * (a - b);

@@ -27,6 +27,7 @@
 
 #include "DemImport.h"
 #include "SampleTerrain.h"
+#include "ShaderMath.h"
 #include "TestScenes.h"
 #include "bake/AdaptivePlacement.h"
 #include "bake/DiffuseBake.h"
@@ -94,7 +95,7 @@ std::unique_ptr<Terrain> load(int which) {
     const auto start = std::chrono::steady_clock::now();
     t->reference.resize(kPoints);
     tbb::parallel_for(0, kPoints, [&](int i) {
-        t->reference[size_t(i)] = luminance(sunFirstBounce(t->lighting, t->p[size_t(i)], t->n[size_t(i)], kReferenceRays, uint64_t(i) * 7919u + 17u));
+        t->reference[size_t(i)] = glsl::rec709Luminance(sunFirstBounce(t->lighting, t->p[size_t(i)], t->n[size_t(i)], kReferenceRays, uint64_t(i) * 7919u + 17u));
     });
     t->referenceSeconds = secondsSince(start);
     for (float r : t->reference) t->meanReference += r;
@@ -158,7 +159,7 @@ void BM_Lpv(benchmark::State& state) {
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < kPoints; ++i) {
         const glm::vec3 toEye = glm::normalize(glm::vec3(t->camera) - t->p[size_t(i)]);
-        values[size_t(i)] = luminance(v->evaluate(t->p[size_t(i)], t->n[size_t(i)], toEye).irradiance);
+        values[size_t(i)] = glsl::rec709Luminance(v->evaluate(t->p[size_t(i)], t->n[size_t(i)], toEye).irradiance);
     }
     state.counters["apply_us_per_point"] = 1e6 * secondsSince(start) / kPoints;
     char label[96];
@@ -271,7 +272,7 @@ void BM_Probes(benchmark::State& state) {
             ++uncovered;
             continue;
         }
-        values[size_t(i)] = luminance(sh::evalIrradiance(sh, t->n[size_t(i)]));
+        values[size_t(i)] = glsl::rec709Luminance(sh::evalIrradiance(sh, t->n[size_t(i)]));
     }
     char label[96];
     std::snprintf(label, sizeof label, "%s probes %dx%d, %.0f m apart", t->name.c_str(), kProbesPerSide,

@@ -22,6 +22,7 @@
 #include "BakeJob.h"
 #include "DemImport.h"
 #include "Project.h"
+#include "ShaderMath.h"
 #include "TerrainLoading.h"
 #include "TestScenes.h"
 #include "bake/DiffuseBake.h"
@@ -466,7 +467,7 @@ struct BounceScene {
 };
 
 // Irradiance on a surface facing down: the light the ground below sends up.
-float fromBelow(const sh::ShRgb& s) { return luminance(sh::evalIrradiance(s, glm::vec3(0.0f, -1.0f, 0.0f))); }
+float fromBelow(const sh::ShRgb& s) { return glsl::rec709Luminance(sh::evalIrradiance(s, glm::vec3(0.0f, -1.0f, 0.0f))); }
 
 }  // namespace
 

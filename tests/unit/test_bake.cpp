@@ -11,6 +11,7 @@
 #include <glm/trigonometric.hpp>
 #include <tbb/global_control.h>
 
+#include "ShaderMath.h"
 #include "bake/DiffuseBake.h"
 #include "bake/ProbePlacement.h"
 #include "bake/SphereSampling.h"
@@ -501,7 +502,7 @@ TEST(Bake, ReferenceAgreesWithAnalyticFlatPlane) {
 TEST(Bake, InterpolationErrorIsRelativeToAtLeastAShareOfTheMeanLight) {
     const sh::ShRgb bright = sh::projectConstant(glm::vec3(1.0f));
     const sh::ShRgb dim = sh::projectConstant(glm::vec3(1e-4f));
-    EXPECT_NEAR(rmsIrradiance(bright), luminance(sh::evalIrradiance(bright, kUp)), 1e-4);
+    EXPECT_NEAR(rmsIrradiance(bright), glsl::rec709Luminance(sh::evalIrradiance(bright, kUp)), 1e-4);
     const double floor = interpolationErrorFloor({bright, dim});
     EXPECT_NEAR(floor, 0.05 * (rmsIrradiance(bright) + rmsIrradiance(dim)) / 2.0, 1e-9);
     // A dim truth with a brighter interpolation: 500x its own light, 2x against the floor.
