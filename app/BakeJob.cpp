@@ -90,6 +90,39 @@ ShProbeGrid toGrid(const ProbeLayout& layout, const std::vector<sh::ShRgb>& coef
     return g;
 }
 
+// What an image sky's sun asks of the author, for the project's lighting or a scenario's (`where`
+// "" or "scenarios[i]."): followed but too wide to be a sun (the probes keep it, lightingOf), or
+// not followed though it gives level ground more light than the rest of the image (baked into the
+// probes, its shadows are as wide as their spacing).
+void imageSunWarnings(const SceneDescription& scene, const BakeLighting& lighting, const std::string& where,
+                      std::vector<std::string>& warnings) {
+    if (scene.sky.mode != SkyMode::Hdr) return;
+    if (scene.sun.followSky) {
+        if (!lighting.sky.hasGlow()) return;
+        char why[160];
+        std::snprintf(why, sizeof why, "the image's glow spreads %.1f° about its centre, wider than a sun's %.0f°",
+                      glm::degrees(double(lighting.sky.glowSun().angularRadius)), Sky::kMaxSunRadiusDeg);
+        warnings.push_back(where + "sun.follow_sky under " + where + "sky.hdr: " + why +
+                           ": it stays in the sky the probes see, and no sun lights besides it");
+        return;
+    }
+    if (!lighting.sky.glowIsSun()) return;
+    const SunLight glow = lighting.sky.glowSun();
+    const glm::vec3 fromSun = glow.illuminance * std::max(0.0f, glow.direction.y);
+    const glm::vec3 fromSky = lighting.sky.withoutGlow().openIrradianceUp();
+    if (glsl::rec709Luminance(fromSun) <= glsl::rec709Luminance(fromSky)) return;
+    BakeLighting asSun = lighting;
+    asSun.sun = glow;
+    asSun.sky = lighting.sky.withoutGlow();
+    const ImageSun read = imageSunOf(asSun);
+    char at[96];
+    std::snprintf(at, sizeof at, "azimuth %.1f°, %.1f° up, %.0f %% of its light", read.azimuthDeg, read.elevationDeg,
+                  100.0 * read.shareOfSky);
+    warnings.push_back(where + "sun.follow_sky: false under " + where + "sky.hdr, whose image has a sun (" + at +
+                       "): the probes hold its light and its shadows, blurred over their spacing, and the authored sun lights "
+                       "besides it; set " + where + "sun.follow_sky=true to light with the image's sun, shadowed at the pixel");
+}
+
 // What a bake needs before it places a probe: terrain, lighting, tracer, quality, volumes.
 struct BakeSetup {
     DemImportResult terrain;  // a tile's core when tiled
@@ -1384,6 +1417,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
     // irradiance cache of its own; written as the default's are (deringing, encoding).
     std::vector<GltfScenario> scenarioGrids;
     nlohmann::json scenarioReports = nlohmann::json::array();
+    std::vector<std::string> scenarioWarnings;
     const double scenarioBase = 0.02 + (cacheShare + probeShare) + refShare;
     for (size_t si = 0; si < scene.scenarios.size(); ++si) {
         const std::string& name = scene.scenarios[si].name;
@@ -1395,6 +1429,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         Project litProject = project;
         litProject.scene = scenarioScene(scene, name);
         const BakeLighting lit = scenarioLightingOf(project, name, hf, lighting);
+        imageSunWarnings(litProject.scene, lit, "scenarios[" + std::to_string(si) + "].", scenarioWarnings);
         std::unique_ptr<IrradianceCache> litCache;
         if (!referenceMode && q.bounces > 0)
             litCache = std::make_unique<IrradianceCache>(
@@ -1545,33 +1580,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
                              {"azimuth_deg", sun.azimuthDeg},
                              {"true_azimuth_deg", sun.place->position.azimuthDeg},
                              {"elevation_deg", sun.elevationDeg}};
-    if (scene.sky.mode == SkyMode::Hdr && !scene.sun.followSky && lighting.sky.glowIsSun()) {
-        // A sun in the image that gives level ground more light than the rest of the sky: baked
-        // into the probes, its shadows are as wide as their spacing.
-        const SunLight glow = lighting.sky.glowSun();
-        const glm::vec3 fromSun = glow.illuminance * std::max(0.0f, glow.direction.y);
-        const glm::vec3 fromSky = lighting.sky.withoutGlow().openIrradianceUp();
-        if (glsl::rec709Luminance(fromSun) > glsl::rec709Luminance(fromSky)) {
-            BakeLighting asSun = lighting;
-            asSun.sun = glow;
-            asSun.sky = lighting.sky.withoutGlow();
-            const ImageSun read = imageSunOf(asSun);
-            char where[96];
-            std::snprintf(where, sizeof where, "azimuth %.1f°, %.1f° up, %.0f %% of its light", read.azimuthDeg, read.elevationDeg,
-                          100.0 * read.shareOfSky);
-            out.warnings.push_back(std::string("sun.follow_sky: false under sky.hdr, whose image has a sun (") + where +
-                                   "): the probes hold its light and its shadows, blurred over their spacing, and the authored sun lights "
-                                   "besides it; set sun.follow_sky=true to light with the image's sun, shadowed at the pixel");
-        }
-    }
-    if (sunFromSkyImage(scene) && lighting.sky.hasGlow()) {
-        // Followed, but too wide to be a sun: the probes keep it (lightingOf).
-        char why[160];
-        std::snprintf(why, sizeof why, "the image's glow spreads %.1f° about its centre, wider than a sun's %.0f°",
-                      glm::degrees(double(lighting.sky.glowSun().angularRadius)), Sky::kMaxSunRadiusDeg);
-        out.warnings.push_back(std::string("sun.follow_sky under sky.hdr: ") + why +
-                               ": it stays in the sky the probes see, and no sun lights besides it");
-    }
+    imageSunWarnings(scene, lighting, "", out.warnings);
+    out.warnings.insert(out.warnings.end(), scenarioWarnings.begin(), scenarioWarnings.end());
     if (scene.water.enabled && !lighting.water)
         out.warnings.push_back("water.level auto: " + water::autoLevel(hf).summary +
                                "; no water is baked or exported; set water.level to place it");

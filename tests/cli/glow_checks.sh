@@ -128,5 +128,17 @@ if errors:
 PY
 grep -q "sun: the sky image's own (sun.follow_sky) at azimuth -61.9°, elevation 16.[89]°" "$work/lit.txt" ||
   fail "the summary does not say where the image's sun stands: $(grep 'sun:' "$work/lit.txt")"
+# A scenario's image sky is held to the same rule, named by its path: not followed, it is warned
+# about; followed, it is not.
+cat > "$work/scenarios.terralux.json" <<JSON
+{"probe_volumes": [{"grid_dims": [4, 4]}], "bake": {"quality": "draft", "error_map_resolution": 0},
+ "scenarios": [{"name": "whole", "sky": {"mode": "hdr", "hdr": "$work/sun.hdr"}, "sun": {"follow_sky": false}},
+               {"name": "lit", "sky": {"mode": "hdr", "hdr": "$work/sun.hdr"}}]}
+JSON
+"$terralux" --bake --quiet "$work/scenarios.terralux.json" --out "$work/scenarios" 2>/dev/null ||
+  fail "the bake with scenarios exited $?"
+grep -q "scenarios\[0\].sun.follow_sky: false under scenarios\[0\].sky.hdr, whose image has a sun" "$work/scenarios/bake_report.json" ||
+  fail "no warning that scenario 'whole' bakes the image's sun into its probes"
+! grep -q "scenarios\[1\].sun.follow_sky" "$work/scenarios/bake_report.json" || fail "the followed scenario is warned about"
 echo "sky glow share $expected as reported; sampled without water, not with it; none under a uniform sky; lit as the sun with sun.follow_sky"
 
