@@ -111,10 +111,7 @@ void imageSunWarnings(const SceneDescription& scene, const BakeLighting& lightin
     const glm::vec3 fromSun = glow.illuminance * std::max(0.0f, glow.direction.y);
     const glm::vec3 fromSky = lighting.sky.withoutGlow().openIrradianceUp();
     if (glsl::rec709Luminance(fromSun) <= glsl::rec709Luminance(fromSky)) return;
-    BakeLighting asSun = lighting;
-    asSun.sun = glow;
-    asSun.sky = lighting.sky.withoutGlow();
-    const ImageSun read = imageSunOf(asSun);
+    const ImageSun read = imageSunOf(glow, double(lighting.sky.glowShare()));
     char at[96];
     std::snprintf(at, sizeof at, "azimuth %.1f°, %.1f° up, %.0f %% of its light", read.azimuthDeg, read.elevationDeg,
                   100.0 * read.shareOfSky);

@@ -179,13 +179,14 @@ bool sunFromSkyImage(const SceneDescription& scene) {
     return scene.sky.mode == SkyMode::Hdr && scene.sun.followSky;
 }
 
-ImageSun imageSunOf(const BakeLighting& l) {
-    const glm::dvec3 d(l.sun.direction);
-    const glm::vec3& e = l.sun.illuminance;
+ImageSun imageSunOf(const SunLight& sun, double shareOfSky) {
+    const glm::dvec3 d(sun.direction);
     return {glm::degrees(std::atan2(d.x, -d.z)), glm::degrees(std::asin(std::clamp(d.y, -1.0, 1.0))),
-            double(glsl::rec709Luminance(e)) / kSceneUnitsPerLux, glm::degrees(double(l.sun.angularRadius)),
-            double(l.sky.takenGlowShare())};
+            double(glsl::rec709Luminance(sun.illuminance)) / kSceneUnitsPerLux, glm::degrees(double(sun.angularRadius)),
+            shareOfSky};
 }
+
+ImageSun imageSunOf(const BakeLighting& l) { return imageSunOf(l.sun, double(l.sky.takenGlowShare())); }
 
 BakeLighting lightingOf(const Project& p, const Heightfield& hf) {
     const SceneDescription& scene = p.scene;

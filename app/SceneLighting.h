@@ -33,6 +33,8 @@ struct ImageSun {
     double azimuthDeg = 0.0, elevationDeg = 0.0, illuminanceLux = 0.0, angularRadiusDeg = 0.0, shareOfSky = 0.0;
 };
 ImageSun imageSunOf(const BakeLighting& lighting);
+// The same for any sun, with the share of the image's flux it stands for.
+ImageSun imageSunOf(const SunLight& sun, double shareOfSky);
 
 // The lighting of scenario `name` (scenarioScene): its sun and sky, with the tracer, albedo and
 // water of `shared` (the default's), so every scenario lights the same terrain.
