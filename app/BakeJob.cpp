@@ -800,6 +800,30 @@ uint64_t plannedProbeRays(const BakeSetup& b, const std::vector<ProbeLayout>& la
 
 uint64_t reflectionSeed() { return splitmix64(0x2EF1EC7ull); }
 
+// The report's `sun`: the image's glow lit as the sun, or where a date and a time put the sun;
+// null for a sun set by its angles, which the project states already.
+nlohmann::json sunReport(const SceneDescription& scene, const Heightfield& hf, const BakeLighting& lighting) {
+    if (sunFromSkyImage(scene)) {
+        const ImageSun sun = imageSunOf(lighting);
+        return {{"from_sky_image", true},
+                {"azimuth_deg", sun.azimuthDeg},
+                {"elevation_deg", sun.elevationDeg},
+                {"illuminance_lux", sun.illuminanceLux},
+                {"angular_radius_deg", sun.angularRadiusDeg},
+                {"share_of_sky", sun.shareOfSky}};
+    }
+    const SunAngles sun = sunAnglesOf(scene, hf);
+    if (!sun.place) return nullptr;
+    return {{"date", scene.sun.date},
+            {"time_h", scene.sun.timeH},
+            {"utc_offset_h", sun.place->utcOffsetH},
+            {"latitude_deg", sun.place->latitudeDeg},
+            {"longitude_deg", sun.place->longitudeDeg},
+            {"azimuth_deg", sun.azimuthDeg},
+            {"true_azimuth_deg", sun.place->position.azimuthDeg},
+            {"elevation_deg", sun.elevationDeg}};
+}
+
 // The reflection probes of a bake, baked and encoded for export.
 struct ReflectionOutput {
     nlohmann::json report;
@@ -1435,6 +1459,7 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         const nlohmann::json ext = lightingExtension(litProject, hf, lit);
         GltfScenario out{name, {}, {{"sun", ext.at("sun")}, {"sky", ext.at("sky")}}};
         nlohmann::json sr = {{"name", name}, {"cache_rays", litCache ? litCache->rays() : 0}};
+        if (nlohmann::json sun = sunReport(litProject.scene, hf, lit); !sun.is_null()) sr["sun"] = std::move(sun);
         uint64_t rays = 0;
         for (size_t vi = 0; vi < volumes.size(); ++vi) {
             const ProbeVolumeSettings& v = *volumes[vi];
@@ -1558,25 +1583,8 @@ BakeOutcome runBake(const BakeRequest& original, const BakeProgress& progress,
         out.warnings = reflections->warnings;
     }
     if (scene.lpv.enabled) out.report["lpv"] = lpvReport(scene, hf, lighting, out.warnings);
-    // A date and a time: where they put the sun the bake lit with.
-    if (sunFromSkyImage(scene)) {
-        // The image's glow, lit as the sun: where it stands, how bright and how large.
-        const ImageSun sun = imageSunOf(lighting);
-        out.report["sun"] = {{"from_sky_image", true},
-                             {"azimuth_deg", sun.azimuthDeg},
-                             {"elevation_deg", sun.elevationDeg},
-                             {"illuminance_lux", sun.illuminanceLux},
-                             {"angular_radius_deg", sun.angularRadiusDeg},
-                             {"share_of_sky", sun.shareOfSky}};
-    } else if (const SunAngles sun = sunAnglesOf(scene, hf); sun.place)
-        out.report["sun"] = {{"date", scene.sun.date},
-                             {"time_h", scene.sun.timeH},
-                             {"utc_offset_h", sun.place->utcOffsetH},
-                             {"latitude_deg", sun.place->latitudeDeg},
-                             {"longitude_deg", sun.place->longitudeDeg},
-                             {"azimuth_deg", sun.azimuthDeg},
-                             {"true_azimuth_deg", sun.place->position.azimuthDeg},
-                             {"elevation_deg", sun.elevationDeg}};
+    // Where the sun the bake lit with stands, when the project does not say it in angles.
+    if (nlohmann::json sun = sunReport(scene, hf, lighting); !sun.is_null()) out.report["sun"] = std::move(sun);
     imageSunWarnings(scene, lighting, "", out.warnings);
     out.warnings.insert(out.warnings.end(), scenarioWarnings.begin(), scenarioWarnings.end());
     if (scene.water.enabled && !lighting.water)

@@ -386,6 +386,15 @@ int commandBake(const Args& a) {
             for (const auto& v : sc["volumes"])
                 std::cout << ", '" << v["name"].get<std::string>() << "' standard error mean "
                           << fixed(100.0 * v["standard_error"]["mean"].get<double>(), 2) << " %";
+            if (sc.contains("sun") && sc["sun"].contains("from_sky_image")) {
+                const auto& sun = sc["sun"];
+                if (sun["illuminance_lux"].get<double>() > 0.0)
+                    std::cout << ", the sky image's sun at azimuth " << fixed(sun["azimuth_deg"].get<double>(), 1)
+                              << "°, elevation " << fixed(sun["elevation_deg"].get<double>(), 1) << "°, "
+                              << fixed(sun["illuminance_lux"].get<double>(), 0) << " lx";
+                else
+                    std::cout << ", no sun in the sky image";
+            }
             std::cout << "\n";
         }
     if (r.contains("lpv")) {

@@ -135,10 +135,27 @@ cat > "$work/scenarios.terralux.json" <<JSON
  "scenarios": [{"name": "whole", "sky": {"mode": "hdr", "hdr": "$work/sun.hdr"}, "sun": {"follow_sky": false}},
                {"name": "lit", "sky": {"mode": "hdr", "hdr": "$work/sun.hdr"}}]}
 JSON
-"$terralux" --bake --quiet "$work/scenarios.terralux.json" --out "$work/scenarios" 2>/dev/null ||
+"$terralux" --bake "$work/scenarios.terralux.json" --out "$work/scenarios" > "$work/scenarios.txt" 2>/dev/null ||
   fail "the bake with scenarios exited $?"
 grep -q "scenarios\[0\].sun.follow_sky: false under scenarios\[0\].sky.hdr, whose image has a sun" "$work/scenarios/bake_report.json" ||
   fail "no warning that scenario 'whole' bakes the image's sun into its probes"
 ! grep -q "scenarios\[1\].sun.follow_sky" "$work/scenarios/bake_report.json" || fail "the followed scenario is warned about"
+# Each scenario reports the sun it lit with: the followed image's sun, as the default's would be.
+python3 - "$work/scenarios/bake_report.json" <<'PY' || fail "the scenarios' suns in the report"
+import json, sys
+r = json.load(open(sys.argv[1]))
+errors = []
+if "sun" in r: errors.append("the default scenario, a uniform sky with a sun set by its angles, reports a sun")
+whole, lit = r["scenarios"]
+if "sun" in whole: errors.append("scenario 'whole' (not following its image) reports an image's sun")
+sun = lit.get("sun", {})
+if sun.get("from_sky_image") is not True: errors.append("scenario 'lit' reports no sun from its sky image")
+elif abs(sun["azimuth_deg"] + 61.875) > 0.5 or abs(sun["elevation_deg"] - 16.875) > 0.5 or sun["illuminance_lux"] <= 0:
+    errors.append(f"scenario 'lit' reports its sun at {sun['azimuth_deg']}, {sun['elevation_deg']}, {sun['illuminance_lux']} lx")
+if errors:
+    print("FAIL: " + "; ".join(errors)); sys.exit(1)
+PY
+grep -q "scenario 'lit': .*, the sky image's sun at azimuth -61.9°, elevation 16.[89]°, [0-9]* lx" "$work/scenarios.txt" ||
+  fail "the summary does not say where scenario 'lit's image sun stands: $(grep "scenario 'lit'" "$work/scenarios.txt")"
 echo "sky glow share $expected as reported; sampled without water, not with it; none under a uniform sky; lit as the sun with sun.follow_sky"
 
