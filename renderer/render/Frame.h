@@ -264,7 +264,7 @@ struct Frame {
     ProbeResources* probes = nullptr;            // volumes bound, probes on, the view reads them
     ReflectionResources* reflections = nullptr;  // a set bound, probes on, the view reads specular
     LpvResources* lpvVolumes = nullptr;          // volumes bound, lit by them or shown
-    ShadowResources* shadows = nullptr;          // shadows on, the sun up, the view draws them
+    ShadowResources* shadows = nullptr;          // shadows on, the sun up (and lit), the view draws them
     WaterResources* water = nullptr;             // water on and the view draws it
     bool localLights = false;     // the scene has point or spot lights and the view lights with them
     bool lpvSet = false;          // lpvVolumes or localLights: the terrain binds its LPV set

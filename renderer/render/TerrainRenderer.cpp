@@ -1456,9 +1456,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.sunVisibility = view.needs.sunVisibility;
     f.sky = view.needs.sky;
     if (f.sunVisibility) updateSunVisibility(s.sun, s.skirt);
-    // Shadows: the scene has them on, the sun is up and the view draws them. A scene without
-    // shadows holds no maps.
-    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f;
+    // Shadows: the scene has them on, the sun is up and the view draws them: a lit view only for a
+    // sun that gives light (an image sky without a glow, a sun at 0 lx), the shadow views for any.
+    // A scene without shadows holds no maps.
+    const bool sunLights = std::max({s.sun.illuminance.x, s.sun.illuminance.y, s.sun.illuminance.z}) > 0.0f;
+    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f &&
+                          (sunLights || view.needs.showsShadows);
     if (!s.shadows.enabled) ensureShadowMaps(0, 0);
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     f.shadows = shadowed ? g.shadows.get() : nullptr;

@@ -13,7 +13,7 @@ const std::vector<int>& shaderViewNumbers() {
 
 const std::vector<DebugView>& debugViews() {
     constexpr ViewNeeds none{}, diagnostics{false, true, false}, diagnosticsAndMarkers{false, true, true},
-        shadows{false, false, false, true}, visibility{false, false, false, false, true},
+        shadows{.shadows = true, .showsShadows = true}, visibility{false, false, false, false, true},
         lit{true, false, false, true, false, true, true, true, true, true}, light{true, false, false},
         lpvOnly{false, false, false, false, false, false, false, false, false, false, true},
         waterOnly{false, false, false, false, false, false, true, false},
@@ -131,7 +131,10 @@ std::string debugViewsMarkdown() {
         if (v.needs.probeDiagnostics) passes = "probe-vertices (diagnostics), the bake's sidecar";
         if (v.needs.probeMarkers) passes += ", overlays (probe markers)";
         if (v.needs.reflectionProbes) passes += (passes.empty() ? "" : ", ") + std::string("reflection probes (when bound)");
-        if (v.needs.shadows) passes = "shadow (when shadows are on)" + (passes.empty() ? "" : ", " + passes);
+        if (v.needs.shadows)
+            passes = std::string(v.needs.showsShadows ? "shadow (when shadows are on)"
+                                                      : "shadow (when shadows are on and the sun gives light)") +
+                     (passes.empty() ? "" : ", " + passes);
         if (v.needs.sunVisibility) passes = "CPU sun tracing at the vertices (cached per sun)";
         if (v.needs.sceneLights) passes += ", LPV (when lighting.indirect uses it) and local lights";
         if (v.needs.lpvVolumes) passes = "LPV volumes (computed on the CPU for the camera)";

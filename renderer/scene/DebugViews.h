@@ -37,6 +37,9 @@ struct ViewNeeds {
     // The scene's LPV light (when lighting.indirect uses it) and its point and spot lights.
     bool sceneLights = false;
     bool lpvVolumes = false;        // the LPV's volumes whatever lighting.indirect says
+    // The view shows the shadow maps themselves, so they are drawn for a sun that gives no light;
+    // a lit view draws none for it (nothing it lights to shadow).
+    bool showsShadows = false;
 };
 
 struct DebugView {

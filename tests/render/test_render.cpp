@@ -1342,6 +1342,46 @@ TEST_F(RenderTest, ShadowsOffDrawsNoShadowPassAndHoldsNoMaps) {
     }
 }
 
+// A sun that gives no light (0 lx, or an image sky without a glow) has nothing to shadow: a lit
+// view draws no maps for it and looks as it does with shadows off; the shadow view still shows them.
+TEST_F(RenderTest, ASunWithoutLightDrawsNoShadowMapsInALitView) {
+    Project p = sampleProject("dark_sun", 8, 8);
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    p.scene.sky.mode = SkyMode::Uniform;
+    p.scene.sun.followSky = false;
+    p.scene.sun.illuminance = 0.0;
+    ProjectRenderer r(*ctx_, p);
+    const RenderedImage dark = draw(r, kViewBeauty, false, true);
+    for (const auto& pass : r.renderer().lastFramePasses()) {
+        EXPECT_NE(pass.name, "shadow");
+        for (const auto& b : pass.bindings) EXPECT_EQ(b.find("shadow"), std::string::npos) << pass.name;
+    }
+    EXPECT_FALSE(r.renderer().sunHorizonSweeping());
+    draw(r, kViewShadow, false, true);
+    const auto shown = passNames(r.renderer().lastFramePasses());
+    EXPECT_NE(std::find(shown.begin(), shown.end(), "shadow"), shown.end()) << "the shadow view draws no maps";
+
+    p.scene.shadows.enabled = false;
+    r.setProject(p);
+    const RenderedImage off = draw(r, kViewBeauty, false, true);
+    ASSERT_EQ(dark.rgba.size(), off.rgba.size());
+    double most = 0.0, sum = 0.0;
+    for (size_t i = 0; i < off.rgba.size(); ++i) {
+        most = std::max(most, double(std::abs(dark.rgba[i] - off.rgba[i])));
+        sum += double(off.rgba[i]);
+    }
+    EXPECT_GT(sum, 0.0) << "the sky alone lights the terrain";
+    EXPECT_LE(most, 1e-6) << "a dark sun's frame differs from the frame with shadows off";
+
+    // The same scene with the sun lit draws its maps in the beauty view.
+    p.scene.shadows.enabled = true;
+    p.scene.sun.illuminance = 100000.0;
+    r.setProject(p);
+    draw(r, kViewBeauty, false, true);
+    const auto lit = passNames(r.renderer().lastFramePasses());
+    EXPECT_NE(std::find(lit.begin(), lit.end(), "shadow"), lit.end()) << "a lit sun's beauty frame draws no maps";
+}
+
 namespace {
 
 // A projected GeoTIFF of n x n heights h(column, row) with `cell` metre cells; NaN heights are
