@@ -601,6 +601,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     s.levelOfDetailRows = r.levelOfDetailRows;
     s.levelOfDetailYields = r.levelOfDetailRows > r.height;  // a frame below full resolution
     s.waitForHorizon = r.waitForHorizon;
+    s.waitForLevelOfDetail = r.waitForLevelOfDetail;
     return s;
 }
 

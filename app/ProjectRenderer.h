@@ -45,6 +45,9 @@ struct RenderRequest {
     // Off for the viewport: a sun edit's horizon map is swept on a worker while the frames draw
     // the one held (RenderSettings::waitForHorizon).
     bool waitForHorizon = true;
+    // Off for the viewport: a new camera's levels of detail are chosen on a worker while the frames
+    // draw the set held (RenderSettings::waitForLevelOfDetail).
+    bool waitForLevelOfDetail = true;
 };
 
 class ProjectRenderer;

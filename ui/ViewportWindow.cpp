@@ -31,15 +31,17 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
     });
     presentPoll_.setInterval(2);
     connect(&presentPoll_, &QTimer::timeout, this, &ViewportWindow::pollPresent);
-    // A sun edit's horizon map is swept on a worker: once it has finished, a frame takes it. The
-    // full-resolution frame due after the change does; with none due, the frame that takes it is
-    // one (the view holds still), not another frame of the change.
-    sweepPoll_.setInterval(10);
-    connect(&sweepPoll_, &QTimer::timeout, this, [this] {
-        if (!renderer_ || !renderer_->renderer().sunHorizonSweeping()) {
-            sweepPoll_.stop();
-        } else if (renderer_->renderer().sunHorizonSwept()) {
-            sweepPoll_.stop();
+    // A sun edit's horizon map is swept, and a new camera's levels of detail chosen, on a worker:
+    // once either has finished, a frame takes it. The full-resolution frame due after the change
+    // does; with none due, the frame that takes it is one (the view holds still), not another
+    // frame of the change.
+    workerPoll_.setInterval(10);
+    connect(&workerPoll_, &QTimer::timeout, this, [this] {
+        const TerrainRenderer* t = renderer_ ? &renderer_->renderer() : nullptr;
+        if (!t || (!t->sunHorizonSweeping() && !t->levelOfDetailBuilding())) {
+            workerPoll_.stop();
+        } else if (t->sunHorizonSwept() || t->levelOfDetailBuilt()) {
+            workerPoll_.stop();
             if (refineTimer_.isActive()) return;
             refining_ = true;
             requestUpdate();
@@ -194,10 +196,11 @@ void ViewportWindow::draw(bool now) {
     drawn.height = size.height;
     drawn.levelOfDetailRows = request_.height;
     drawn.waitForHorizon = false;
+    drawn.waitForLevelOfDetail = false;
     // Below full resolution the refine timer below brings the full-resolution frame, which meters.
     drawn.interactive = size.width < request_.width || size.height < request_.height;
     if (!renderer_->present(drawn, camera_, *swapchain_)) return;
-    if (renderer_->renderer().sunHorizonSweeping()) sweepPoll_.start();
+    if (renderer_->renderer().sunHorizonSweeping() || renderer_->renderer().levelOfDetailBuilding()) workerPoll_.start();
     drawnScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
     if (drawnScale_ < 1.0) refineTimer_.start();
     else refineTimer_.stop();

@@ -128,10 +128,6 @@ inline constexpr uint32_t kRenderSlots = vk::kFramesInFlight + 1;
 // water (the planar reflection pass).
 struct FrameSlot {
     vk::Buffer camera, surface, sunSky, atmosphere, shadow, overlay, reflectionCamera;
-    // The terrain's triangles at the level of detail this slot drew last (host-visible, written
-    // when the levels change), and which levels those are.
-    vk::Buffer terrainIndices;
-    uint64_t terrainIndicesSerial = 0;
     // The terrain's horizon map (TLX_SUN_HORIZON_BINDING), host-visible, and the sweep it holds.
     vk::Buffer sunHorizon;
     uint64_t sunHorizonSerial = 0;
@@ -186,6 +182,11 @@ struct RendererGpu {
     vk::Buffer detailVertices;
     uint32_t detailVertexCount = 0;
     uint64_t detailSerial = 0;
+    // The terrain's triangles at the level of detail drawn (host-visible, written once per choice
+    // of levels, where it was made), and which choice that is: a new one retires the old, which
+    // frames in flight may still read.
+    vk::Buffer terrainIndices;
+    uint64_t terrainIndicesSerial = 0;
     SurfaceTextures surface;
     vk::Sampler trilinear;
     vk::UniqueSetLayout viewLayout;

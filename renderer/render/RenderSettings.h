@@ -77,6 +77,10 @@ struct RenderSettings {
     // worker and the frames draw the map held until it lands (TerrainRenderer::sunHorizonSweeping);
     // on, the frame waits for it.
     bool waitForHorizon = true;
+    // Off (the viewport's frames): a picture's levels of detail for a new camera are chosen and
+    // built on a worker, and the frames draw the set held until it lands
+    // (TerrainRenderer::levelOfDetailBuilding); on, the frame chooses its own.
+    bool waitForLevelOfDetail = true;
 };
 
 }  // namespace terralux

@@ -768,12 +768,12 @@ void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm:
 }
 
 void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool picture, bool sourceDetail, bool shadowed,
-                                const WaterResources* water) {
+                                const LodInputs& inputs) {
     double worst = 0.0;
     // The data views are measured against the bake vertex by vertex: they draw every vertex.
-    double maxPixels = picture ? std::max(lodPixelError_, 0.0) : 0.0;
+    double maxPixels = picture ? std::max(inputs.pixelError, 0.0) : 0.0;
     lodPicture_ = picture;
-    lodInputs_ = lodInputsOf(water);
+    lodInputs_ = inputs;
     // A caster's height error moves the edge of its shadow 1 / tan(sun elevation) times as far
     // across the ground: with shadows, the levels keep that within the pixel (5x finer at a 11°
     // sun, 1.4x at 35°).
@@ -789,7 +789,7 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     // is held to the pixel against the DEM: its error against the drawn grid plus what the grid
     // leaves out (a bound: each of the grid's triangles lies within one of the level's), finer
     // until it is; at level 0 the detail patches below take over.
-    const bool detailAllowed = sourceDetail && sourceDetail_ && detailLevels_ > 0 && maxPixels > 0.0;
+    const bool detailAllowed = sourceDetail && inputs.sourceDetail && detailLevels_ > 0 && maxPixels > 0.0;
     if (detailAllowed)
         for (uint32_t k = 0; k < patches_.count(); ++k) {
             const double distance = lod::distanceToBox(eye, patches_.lo[k], patches_.hi[k]);
@@ -801,9 +801,10 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     // Where the water meets the land, a height error moves the shore by the error over the
     // ground's slope, many pixels on a flat shore: patches the water's surface can cross (its
     // level, give or take the crests) draw every vertex.
-    if (water)
+    if (inputs.water)
         for (uint32_t k = 0; k < patches_.count(); ++k)
-            if (patches_.lo[k].y <= water->level + water->margin && patches_.hi[k].y >= water->level - water->margin)
+            if (patches_.lo[k].y <= inputs.waterLevel + inputs.waterMargin &&
+                patches_.hi[k].y >= inputs.waterLevel - inputs.waterMargin)
                 levels[k] = 0;
     // A ring zipped to a coarser neighbour can stray further than either level: such neighbours
     // come finer until every patch's drawn surface is within the pixel, and the figure reported
@@ -820,7 +821,8 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         // Source resolution: the patches at level 0 whose drawn grid still leaves more than the
         // pixel out of the DEM are drawn from the DEM's vertices, within the detail budget.
         detail.assign(patches_.count(), -1);
-        if (detailAllowed) chooseDetail(detail, levels, surface, finestDetail, asked, eye, fovY, rows, maxPixels);
+        if (detailAllowed)
+            chooseDetail(detail, levels, surface, finestDetail, asked, eye, fovY, rows, maxPixels, inputs.detailBudget);
         // A detail patch's surface, its zipped ring included, against the DEM: measured once per
         // state of the patch and its four sides.
         const uint32_t px = patches_.patchesX(), pz = patches_.patchesZ();
@@ -971,12 +973,50 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
     }
     lastLod_.triangles = (lodMeshIndices_ + lodDetailEnd_ - lodSkirtEnd_) / 3;
     ++lodSerial_;
+    buildLodBuffers(!resident);
+}
+
+void TerrainRenderer::buildLodBuffers(bool detailChanged) {
+    lodIndexCount_ = lodIndices_.size();
+    const VkDeviceSize indexBytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
+    lodIndexBuffer_ = vk::Buffer::hostVisible(ctx_, indexBytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    if (!lodIndices_.empty()) lodIndexBuffer_.write(lodIndices_.data(), lodIndices_.size() * sizeof(uint32_t));
+    lodIndices_ = {};  // the buffer holds them (16 384²: 150 MB)
+    if (!detailChanged) return;
+    detailBuffer_ = {};
+    detailUpload_.clear();
+    size_t floats = 0;
+    for (const auto& [k, v] : detailVertices_) floats += v.size();
+    if (floats == 0) return;
+    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    // Where the device shares the host's memory its local memory is host-visible: written here,
+    // the frame only binds it (vk::Buffer::deviceLocal's rule; elsewhere the copy needs the queue,
+    // which is the frame's).
+    const VkPhysicalDeviceType type = ctx_.deviceType();
+    if (type == VK_PHYSICAL_DEVICE_TYPE_CPU || type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
+        try {
+            vk::Buffer b(ctx_, floats * sizeof(float), usage,
+                         VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                             VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+            VkDeviceSize offset = 0;
+            for (const auto& [k, v] : detailVertices_) {
+                b.write(v.data(), v.size() * sizeof(float), offset);
+                offset += v.size() * sizeof(float);
+            }
+            detailBuffer_ = std::move(b);
+            return;
+        } catch (const vk::VulkanError&) {
+            // No such memory type: the frame uploads them.
+        }
+    }
+    detailUpload_.reserve(floats);
+    for (const auto& [k, v] : detailVertices_) detailUpload_.insert(detailUpload_.end(), v.begin(), v.end());
 }
 
 void TerrainRenderer::chooseDetail(std::vector<int8_t>& detail, std::span<const uint8_t> levels,
                                    std::span<const double> surface, std::span<const int8_t> finest,
                                    std::span<const double> asked, const glm::vec3& eye, double fovY, double rows,
-                                   double maxPixels) {
+                                   double maxPixels, size_t budget) {
     // The candidates: patches at level 0 whose drawn grid still leaves more than the pixel out of
     // the DEM, or whose detail neighbour's ring asks a detail level of them (`finest`, with that
     // neighbour's error on screen, `asked`).
@@ -1018,7 +1058,7 @@ void TerrainRenderer::chooseDetail(std::vector<int8_t>& detail, std::span<const 
         if (finest[k] >= 0) target = std::min(target, finest[k]);
         c.target = size_t(detailLevels_ - target);
     });
-    const std::vector<size_t> state = lod::allocateDetail(candidates, detailVertexBudget_, maxPixels);
+    const std::vector<size_t> state = lod::allocateDetail(candidates, budget, maxPixels);
     for (size_t m = 0; m < wanted.size(); ++m)
         detail[wanted[m]] = state[m] == 0 ? int8_t(-1) : int8_t(detailLevels_ - state[m]);
 }
@@ -1031,6 +1071,33 @@ TerrainRenderer::LodInputs TerrainRenderer::lodInputsOf(const WaterResources* wa
     in.water = water != nullptr;
     if (water) in.waterLevel = water->level, in.waterMargin = water->margin;
     return in;
+}
+
+void TerrainRenderer::publishLod() {
+    DrawnLod& d = drawnLod_;
+    d.choice = lastLod_;
+    d.picture = lodPicture_;
+    d.inputs = lodInputs_;
+    if (d.serial != lodSerial_) {
+        d.indexBuffer = std::move(lodIndexBuffer_);
+        d.indexCount = lodIndexCount_;
+        d.meshIndices = lodMeshIndices_;
+        d.skirtEnd = lodSkirtEnd_;
+        d.detailEnd = lodDetailEnd_;
+        d.serial = lodSerial_;
+    }
+    if (d.detailSerial != detailSerial_) {
+        d.detailBuffer = std::move(detailBuffer_);
+        d.detailVertices = std::move(detailUpload_);
+        detailUpload_.clear();
+        d.detailVertexCount = 0;
+        for (const auto& [k, v] : detailVertices_) d.detailVertexCount += uint32_t(v.size() / 6);
+        d.detailSerial = detailSerial_;
+    }
+}
+
+bool TerrainRenderer::levelOfDetailBuilt() const {
+    return pendingLod_.valid() && pendingLod_.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
 }
 
 double TerrainRenderer::detailLevelError(uint32_t k, uint8_t d) {
@@ -1050,8 +1117,9 @@ void TerrainRenderer::releaseRetired(bool idle) {
 }
 
 TerrainRenderer::~TerrainRenderer() {
-    // A sweep under way reads the heightfield.
+    // A sweep or a choice of levels under way reads the heightfield.
     if (pendingHorizon_) pendingHorizon_->perVertex.wait();
+    if (pendingLod_.valid()) pendingLod_.wait();
     // Frames in flight may still read what is about to be destroyed.
     if (gpu_) ctx_.waitIdle();
 }
@@ -1494,9 +1562,10 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     const bool redrawsShadows =
         !f.lightMatrices.empty() && (f.shadows->drawn != f.lightMatrices || f.shadows->drawnSkirt != s.skirt);
     const bool yields = s.levelOfDetailYields && s.levelOfDetailRows > 0;
-    const bool keepLevels = yields && view.needs.sky && lodPicture_ && lodInputs_ == lodInputsOf(f.water) &&
-                            !f.lightMatrices.empty() && !redrawsShadows && lodSerial_ > 0 &&
-                            f.shadows->drawnLod == lodSerial_;
+    const LodInputs lodInputs = lodInputsOf(f.water);
+    const bool keepLevels = yields && view.needs.sky && drawnLod_.picture && drawnLod_.inputs == lodInputs &&
+                            !f.lightMatrices.empty() && !redrawsShadows && drawnLod_.serial > 0 &&
+                            f.shadows->drawnLod == drawnLod_.serial;
     // The output's rows, not the supersampled target's.
     const uint32_t outputRows = s.height / std::max<uint32_t>(uint32_t(out.antialiasing.scale), 1u);
     const bool ownRows = s.levelOfDetailRows == 0 || (yields && (redrawsShadows || f.lightMatrices.empty()));
@@ -1504,50 +1573,69 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     // Detail patches where the per-vertex attribute is none or the probe light (the probe pass
     // lights their vertices too), not the traced sun visibility.
     const bool sourceDetail = !f.sunVisibility;
-    const bool anyDetail = std::any_of(lastLod_.detail.begin(), lastLod_.detail.end(), [](int8_t d) { return d >= 0; });
-    if (!keepLevels || (!sourceDetail && anyDetail))
-        updateLod(s, rows, view.needs.sky, sourceDetail, !f.lightMatrices.empty(), f.water);
-    if (g.detailSerial != detailSerial_) {
+    const bool anyDetail =
+        std::any_of(drawnLod_.choice.detail.begin(), drawnLod_.choice.detail.end(), [](int8_t d) { return d >= 0; });
+    if (!keepLevels || (!sourceDetail && anyDetail)) {
+        const bool picture = view.needs.sky, shadowed = !f.lightMatrices.empty();
+        const LodKey key{s.camera.position(), double(s.camera.fovDeg), rows, double(s.sun.direction.y),
+                         picture, sourceDetail, shadowed, lodInputs};
+        // A viewport picture chooses its levels on a worker once a set is held (the first close
+        // view of a 16 384² DEM takes 0.6 s to choose and build) and draws the held set until the
+        // new one lands; every other frame waits for one under way and chooses its own here.
+        const bool onWorker = !s.waitForLevelOfDetail && picture && sourceDetail && drawnLod_.serial > 0;
+        if (pendingLod_.valid() && (!onWorker || levelOfDetailBuilt())) {
+            pendingLod_.get();
+            publishLod();
+        }
+        if (!onWorker) {
+            updateLod(s, rows, picture, sourceDetail, shadowed, lodInputs);
+            publishLod();
+            lodAsked_ = key;
+        } else if (!pendingLod_.valid() && lodAsked_ != key) {
+            lodAsked_ = key;
+            // Isolated: its parallel loops must not take up the UI thread's tasks, nor it theirs.
+            pendingLod_ = std::async(std::launch::async, [this, settings = s, rows, picture, sourceDetail, shadowed,
+                                                          lodInputs] {
+                tbb::this_task_arena::isolate(
+                    [&] { updateLod(settings, rows, picture, sourceDetail, shadowed, lodInputs); });
+            });
+        }
+    }
+    if (g.detailSerial != drawnLod_.detailSerial) {
         g.graph.forget(kDetailVertices);
         if (g.detailVertices) retire(std::move(g.detailVertices));
         g.detailVertices = {};
-        g.detailVertexCount = 0;
-        for (const auto& [k, v] : detailVertices_) g.detailVertexCount += uint32_t(v.size() / 6);
-        if (g.detailVertexCount > 0) {
-            std::vector<float> all;
-            all.reserve(size_t(g.detailVertexCount) * 6);
-            for (const auto& [k, v] : detailVertices_) all.insert(all.end(), v.begin(), v.end());
-            g.detailVertices = vk::Buffer::deviceLocal(ctx_, all.data(), all.size() * sizeof(float),
+        g.detailVertexCount = drawnLod_.detailVertexCount;
+        if (drawnLod_.detailBuffer)
+            g.detailVertices = std::move(drawnLod_.detailBuffer);
+        else if (!drawnLod_.detailVertices.empty())
+            g.detailVertices = vk::Buffer::deviceLocal(ctx_, drawnLod_.detailVertices.data(),
+                                                       drawnLod_.detailVertices.size() * sizeof(float),
                                                        VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-            g.graph.importBuffer(kDetailVertices, g.detailVertices.handle(), true);
-        }
-        g.detailSerial = detailSerial_;
+        if (g.detailVertices) g.graph.importBuffer(kDetailVertices, g.detailVertices.handle(), true);
+        drawnLod_.detailVertices = {};
+        g.detailSerial = drawnLod_.detailSerial;
     }
     if (g.probes && g.detailVertexCount > 0 && (!g.probes->detail || g.probes->detail->serial != g.detailSerial)) {
         g.graph.forget(kDetailLight);
         if (g.probes->detail) retire(std::move(g.probes->detail));
         g.probes->detail = features::buildDetailLight(ctx_, g, *g.probes);
     }
-    if (f.slot.terrainIndicesSerial != lodSerial_) {
-        const VkDeviceSize bytes = std::max<VkDeviceSize>(lodIndices_.size(), 1) * sizeof(uint32_t);
-        if (f.slot.terrainIndices.size() < bytes) {
-            g.graph.forget(kIndices);
-            if (f.slot.terrainIndices) retire(std::move(f.slot.terrainIndices));
-            // A quarter more, so that a camera move does not grow it frame after frame.
-            f.slot.terrainIndices = vk::Buffer::hostVisible(ctx_, bytes + bytes / 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-        }
-        if (!lodIndices_.empty()) f.slot.terrainIndices.write(lodIndices_.data(), lodIndices_.size() * sizeof(uint32_t));
-        f.slot.terrainIndicesSerial = lodSerial_;
+    if (g.terrainIndicesSerial != drawnLod_.serial) {
+        g.graph.forget(kIndices);
+        if (g.terrainIndices) retire(std::move(g.terrainIndices));
+        g.terrainIndices = std::move(drawnLod_.indexBuffer);
+        g.terrainIndicesSerial = drawnLod_.serial;
     }
     g.graph.park(kIndices);
-    g.graph.importBuffer(kIndices, f.slot.terrainIndices.handle());
-    f.indexBuffer = f.slot.terrainIndices.handle();
-    f.lodSerial = lodSerial_;
-    f.indexCount = uint32_t(lodMeshIndices_);
-    f.skirtIndexCount = s.skirt ? uint32_t(lodSkirtEnd_ - lodMeshIndices_) : 0;
-    f.detailFirstIndex = uint32_t(lodSkirtEnd_);
-    f.detailIndexCount = uint32_t(lodDetailEnd_ - lodSkirtEnd_);
-    f.detailSkirtIndexCount = s.skirt ? uint32_t(lodIndices_.size() - lodDetailEnd_) : 0;
+    g.graph.importBuffer(kIndices, g.terrainIndices.handle());
+    f.indexBuffer = g.terrainIndices.handle();
+    f.lodSerial = drawnLod_.serial;
+    f.indexCount = uint32_t(drawnLod_.meshIndices);
+    f.skirtIndexCount = s.skirt ? uint32_t(drawnLod_.skirtEnd - drawnLod_.meshIndices) : 0;
+    f.detailFirstIndex = uint32_t(drawnLod_.skirtEnd);
+    f.detailIndexCount = uint32_t(drawnLod_.detailEnd - drawnLod_.skirtEnd);
+    f.detailSkirtIndexCount = s.skirt ? uint32_t(drawnLod_.indexCount - drawnLod_.detailEnd) : 0;
     f.markerCount = markerCount_;
     f.leafCount = leafCount_;
     f.width = s.width;

@@ -30,6 +30,7 @@
 #include "scene/SceneDescription.h"
 #include "terrain/Heightfield.h"
 #include "terrain/MeshLod.h"
+#include "vk/Buffer.h"
 #include "vk/Swapchain.h"
 #include "water/Water.h"
 #include "vk/VulkanContext.h"
@@ -257,7 +258,14 @@ public:
                                          // camera sees it at the patch's nearest point
     };
     // The levels the last frame drew.
-    const LodChoice& lastLod() const { return lastLod_; }
+    const LodChoice& lastLod() const { return drawnLod_.choice; }
+    // Counts the triangle lists the frames have drawn (each new choice of levels is one).
+    uint64_t levelOfDetailSerial() const { return drawnLod_.serial; }
+    // A frame that does not wait for its levels (RenderSettings::waitForLevelOfDetail off) chooses
+    // and builds them on a worker and draws the set held: whether one is under way, and whether it
+    // has finished (the next frame draws it).
+    bool levelOfDetailBuilding() const { return pendingLod_.valid(); }
+    bool levelOfDetailBuilt() const;
     size_t vertexCount() const { return vertexCount_; }
     size_t triangleCount() const { return indexCount_ / 3; }
     size_t probeBytes() const { return probeBytes_; }
@@ -312,8 +320,12 @@ private:
     // (++lodSerial_).
     // `sourceDetail`: the frame may draw detail patches (its per-vertex attribute, if any, is the
     // probe light, which the probe pass evaluates at their vertices too).
+    // Runs on a worker for a frame that does not wait (RenderSettings::waitForLevelOfDetail): it
+    // reads the immutable mesh and DEM, its own caches and `inputs`, and writes only the working
+    // state below, which publishLod hands to the frames.
+    struct LodInputs;
     void updateLod(const RenderSettings& s, double rows, bool picture, bool sourceDetail, bool shadowed,
-                   const WaterResources* water);
+                   const LodInputs& inputs);
     lod::Patches patches_;
     lod::SkirtVertices skirt_;
     std::vector<double> decimation_;  // per patch
@@ -332,6 +344,8 @@ private:
     };
     LodInputs lodInputs_;
     LodInputs lodInputsOf(const WaterResources* water) const;
+    // The working state (updateLod's): the last choice, its triangle list and, when the detail
+    // patches changed, their vertices packed for the upload.
     LodChoice lastLod_;
     // The levels' triangles, then their skirt's, then the detail patches' and their skirt's.
     std::vector<uint32_t> lodIndices_;
@@ -346,12 +360,43 @@ private:
     std::map<uint32_t, int8_t> detailHeld_;  // the detail level each held patch's vertices are for
     std::map<uint32_t, uint32_t> detailBase_;
     uint64_t detailSerial_ = 0;
+    // Made where the levels are chosen (a worker's device memory is as good as the frame's): the
+    // triangle list's index buffer, and where the device shares the host's memory, the detail
+    // buffer; elsewhere every held patch's vertices in detailBase_ order, for the frame to upload.
+    vk::Buffer lodIndexBuffer_, detailBuffer_;
+    size_t lodIndexCount_ = 0;
+    std::vector<float> detailUpload_;
+    void buildLodBuffers(bool detailChanged);
     std::map<uint32_t, std::pair<uint64_t, double>> detailSurfaceCache_;  // per patch: its sides' key, its error
     size_t detailVertexBudget_ = kDetailVertexBudget;
     void chooseDetail(std::vector<int8_t>& detail, std::span<const uint8_t> levels, std::span<const double> surface,
                       std::span<const int8_t> finest, std::span<const double> asked, const glm::vec3& eye, double fovY,
-                      double rows, double maxPixels);
+                      double rows, double maxPixels, size_t budget);
     uint64_t lodSerial_ = 0;            // counts the index lists built
+    // What the frames draw: the working state as last published, read by the frame's thread only.
+    struct DrawnLod {
+        LodChoice choice;
+        size_t indexCount = 0, meshIndices = 0, skirtEnd = 0, detailEnd = 0;
+        uint64_t serial = 0, detailSerial = 0;
+        vk::Buffer indexBuffer, detailBuffer;  // until the frame takes them
+        std::vector<float> detailVertices;     // until uploaded (no detailBuffer)
+        uint32_t detailVertexCount = 0;
+        bool picture = false;
+        LodInputs inputs;
+    };
+    DrawnLod drawnLod_;
+    void publishLod();
+    // A choice under way on a worker, and what it was asked for: the camera, the rows, the view
+    // and the inputs (a frame asking the same again starts nothing).
+    struct LodKey {
+        glm::vec3 eye{0.0f};
+        double fovY = 0.0, rows = 0.0, sunUp = 0.0;
+        bool picture = false, sourceDetail = false, shadowed = false;
+        LodInputs inputs;
+        bool operator==(const LodKey&) const = default;
+    };
+    std::future<void> pendingLod_;
+    std::optional<LodKey> lodAsked_;
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<RendererGpu> gpu_;

@@ -3260,6 +3260,62 @@ TEST_F(RenderTest, CloseToTheGroundADecimatedDemIsDrawnAtItsSourceResolution) {
     EXPECT_GT(test::compareImages(decimated.render(unlit, close).rgba, detailed.rgba, kW, kH).meanAbs, 5e-4);
 }
 
+// The viewport's frames (waitForLevelOfDetail off) choose a new camera's levels on a worker: the
+// frame that asks draws the set held, the first frame after the worker has finished draws the new
+// one, and that frame is the one a frame that waits draws.
+TEST_F(RenderTest, AViewportFrameChoosesItsLevelsOnAWorkerAndDrawsTheHeldSetMeanwhile) {
+    Project p = sampleProject("lod_worker", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    const size_t vertices = [&] {
+        const DemImportResult t = loadProjectTerrain(p);
+        return size_t(t.heightfield.width()) * size_t(t.heightfield.depth());
+    }();
+    ProjectRenderer waits(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    ProjectRenderer viewport(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    const OrbitCamera far = OrbitCamera::fromSettings(p.scene.camera, waits.heightfield());
+    OrbitCamera close = far;
+    close.radius = 150.0f;
+    close.elevationDeg = 10.0f;
+    RenderRequest q = unprobed(kViewBeauty, false);
+    q.waitForLevelOfDetail = false;
+    TerrainRenderer& t = viewport.renderer();
+    // The first frame holds no set: it chooses its own.
+    viewport.render(q, far);
+    const uint64_t first = t.levelOfDetailSerial();
+    const TerrainRenderer::LodChoice farLevels = t.lastLod();
+    EXPECT_GT(first, 0u);
+    EXPECT_FALSE(t.levelOfDetailBuilding());
+    // The same camera again asks for nothing.
+    viewport.render(q, far);
+    EXPECT_FALSE(t.levelOfDetailBuilding());
+    EXPECT_EQ(t.levelOfDetailSerial(), first);
+    // The close camera: this frame draws the far set while the worker chooses.
+    const RenderedImage held = viewport.render(q, close);
+    EXPECT_TRUE(t.levelOfDetailBuilding());
+    EXPECT_EQ(t.levelOfDetailSerial(), first);
+    EXPECT_EQ(t.lastLod().levels, farLevels.levels);
+    const auto start = std::chrono::steady_clock::now();
+    while (!t.levelOfDetailBuilt() && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ASSERT_TRUE(t.levelOfDetailBuilt());
+    const RenderedImage landed = viewport.render(q, close);
+    EXPECT_GT(t.levelOfDetailSerial(), first);
+    EXPECT_FALSE(t.levelOfDetailBuilding()) << "the same camera again started another choice";
+
+    const RenderedImage reference = waits.render(unprobed(kViewBeauty, false), close);
+    const TerrainRenderer::LodChoice& chosen = waits.renderer().lastLod();
+    EXPECT_GE(std::count_if(chosen.detail.begin(), chosen.detail.end(), [](int8_t d) { return d >= 0; }), 1);
+    EXPECT_EQ(t.lastLod().levels, chosen.levels);
+    EXPECT_EQ(t.lastLod().detail, chosen.detail);
+    EXPECT_EQ(t.lastLod().triangles, chosen.triangles);
+    const test::ImageDiff same = test::compareImages(landed.rgba, reference.rgba, kW, kH);
+    const test::ImageDiff before = test::compareImages(held.rgba, reference.rgba, kW, kH);
+    std::printf("held set against the close camera's own: mean %.5f; landed: mean %.6f max %.6f\n", before.meanAbs,
+                same.meanAbs, same.maxAbs);
+    EXPECT_LE(same.maxAbs, 1e-6);
+    EXPECT_GT(before.meanAbs, 5e-4);
+}
+
 TEST_F(RenderTest, DetailPatchesMeetTheirPixelWhereverTheCameraIsAndKeepToTheirBudget) {
     Project p = sampleProject("detail_budget", 4, 4);
     // The sample at four times its resolution (bilinear, with a metre of deterministic roughness),
