@@ -3211,13 +3211,16 @@ TEST_F(RenderTest, AFrameBelowFullResolutionKeepsTheShadowMapsUntilTheCascadesMo
 // shadows as drawn. The sample with a budget that halves it, seen close to the ground: the frame is
 // the undecimated mesh's up to the pixel (no cracks: the sky would show through), and without
 // the detail patches it is not.
+// The vertices of the project's DEM as imported.
+size_t demVertices(const Project& p) {
+    const DemImportResult t = loadProjectTerrain(p);
+    return size_t(t.heightfield.width()) * size_t(t.heightfield.depth());
+}
+
 TEST_F(RenderTest, CloseToTheGroundADecimatedDemIsDrawnAtItsSourceResolution) {
     Project p = sampleProject("detail", 4, 4);
     p.scene.camera.exposureMode = ExposureMode::Manual;
-    const size_t vertices = [&] {
-        const DemImportResult t = loadProjectTerrain(p);
-        return size_t(t.heightfield.width()) * size_t(t.heightfield.depth());
-    }();
+    const size_t vertices = demVertices(p);
     ProjectRenderer whole(*ctx_, p, loadProjectTerrain(p));
     ProjectRenderer decimated(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
     ASSERT_EQ(whole.renderer().meshStride(), 1);
@@ -3266,10 +3269,7 @@ TEST_F(RenderTest, CloseToTheGroundADecimatedDemIsDrawnAtItsSourceResolution) {
 TEST_F(RenderTest, AViewportFrameChoosesItsLevelsOnAWorkerAndDrawsTheHeldSetMeanwhile) {
     Project p = sampleProject("lod_worker", 4, 4);
     p.scene.camera.exposureMode = ExposureMode::Manual;
-    const size_t vertices = [&] {
-        const DemImportResult t = loadProjectTerrain(p);
-        return size_t(t.heightfield.width()) * size_t(t.heightfield.depth());
-    }();
+    const size_t vertices = demVertices(p);
     ProjectRenderer waits(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
     ProjectRenderer viewport(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
     const OrbitCamera far = OrbitCamera::fromSettings(p.scene.camera, waits.heightfield());
