@@ -951,7 +951,6 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         detailBase_.clear();
         uint32_t base = 0;
         for (const auto& [k, v] : detailVertices_) detailBase_[k] = base, base += uint32_t(v.size() / 6);
-        ++detailSerial_;
     }
     lastLod_.detailVertices = 0;
     for (const auto& [k, v] : detailVertices_)
@@ -972,8 +971,17 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         for (const auto& t : skirts) lodIndices_.insert(lodIndices_.end(), t.begin(), t.end());
     }
     lastLod_.triangles = (lodMeshIndices_ + lodDetailEnd_ - lodSkirtEnd_) / 3;
+    try {
+        buildLodBuffers(!resident);
+    } catch (...) {
+        // Nothing half made is drawn: the next choice, even of the same levels, builds it all again.
+        lastLod_.levels.clear();
+        lastLod_.detail.clear();
+        detailHeld_.clear();
+        throw;
+    }
+    if (!resident) ++detailSerial_;
     ++lodSerial_;
-    buildLodBuffers(!resident);
 }
 
 void TerrainRenderer::buildLodBuffers(bool detailChanged) {
@@ -1584,7 +1592,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         // new one lands; every other frame waits for one under way and chooses its own here.
         const bool onWorker = !s.waitForLevelOfDetail && picture && sourceDetail && drawnLod_.serial > 0;
         if (pendingLod_.valid() && (!onWorker || levelOfDetailBuilt())) {
-            pendingLod_.get();
+            try {
+                pendingLod_.get();
+            } catch (...) {
+                lodAsked_.reset();  // the same camera asks again
+                throw;
+            }
             publishLod();
         }
         if (!onWorker) {

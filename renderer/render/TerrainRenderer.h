@@ -245,10 +245,8 @@ public:
     static constexpr size_t kDetailVertexBudget = size_t(1) << 22;
     void setSourceDetail(bool on) { sourceDetail_ = on; }
     void setDetailVertexBudget(size_t vertices) { detailVertexBudget_ = vertices; }
-    // Detail levels a patch has (steps 2^d below the stride; 0 where the DEM is drawn whole), and
-    // what level d of patch k leaves out of the DEM (metres), measured once.
+    // Detail levels a patch has (steps 2^d below the stride; 0 where the DEM is drawn whole).
     uint8_t detailLevels() const { return detailLevels_; }
-    double detailLevelError(uint32_t k, uint8_t d);
     struct LodChoice {
         std::vector<uint8_t> levels;     // per patch
         std::vector<int8_t> detail;      // per patch: its detail level, or -1 where drawn from the drawn grid
@@ -356,6 +354,8 @@ private:
     lod::SourceGrid source_;
     uint8_t detailLevels_ = 0;
     std::vector<std::vector<double>> detailLevelErrors_;
+    // What level d of patch k leaves out of the DEM (metres), measured once (updateLod's cache).
+    double detailLevelError(uint32_t k, uint8_t d);
     std::map<uint32_t, std::vector<float>> detailVertices_;
     std::map<uint32_t, int8_t> detailHeld_;  // the detail level each held patch's vertices are for
     std::map<uint32_t, uint32_t> detailBase_;

@@ -18,6 +18,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
                                                    void* user) {
     if (severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) {
         auto* self = static_cast<VulkanContext*>(user);
+        const std::lock_guard lock(self->messagesMutex_);
         self->messages_.push_back(data && data->pMessage ? data->pMessage : "(no message)");
     }
     return VK_FALSE;

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -90,8 +91,15 @@ public:
     bool validationEnabled() const { return messenger_ != VK_NULL_HANDLE; }
 
     // Validation messages seen so far (warnings and errors), for tests that must see none.
-    size_t validationMessageCount() const { return messages_.size(); }
-    const std::vector<std::string>& validationMessages() const { return messages_; }
+    // A copy: the layers may report from a worker making buffers (TerrainRenderer's levels).
+    size_t validationMessageCount() const {
+        const std::lock_guard lock(messagesMutex_);
+        return messages_.size();
+    }
+    std::vector<std::string> validationMessages() const {
+        const std::lock_guard lock(messagesMutex_);
+        return messages_;
+    }
 
     uint32_t memoryType(uint32_t typeBits, VkMemoryPropertyFlags required) const;
 
@@ -134,6 +142,7 @@ private:
     VkPhysicalDeviceType deviceType_ = VK_PHYSICAL_DEVICE_TYPE_OTHER;
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;
+    mutable std::mutex messagesMutex_;
 
     friend VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(
         VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
