@@ -2743,7 +2743,9 @@ private slots:
 
     void screenshot() {
         w_->viewport()->renderNow();
-        QTest::qWait(500);
+        // The frame at full resolution, not one drawn small while the view changes.
+        QVERIFY(settlesQuiet(w_->viewport()));
+        QCOMPARE(w_->viewport()->presentedScale(), 1.0);
         const QPixmap shot = w_->screen()->grabWindow(0, w_->x(), w_->y(), w_->frameGeometry().width(), w_->frameGeometry().height());
         QVERIFY(shot.save(QString::fromStdString((kOut / "main_window.png").string())));
         // The Bake & Export dock after a (quick) bake: output folder and report table.
