@@ -74,11 +74,12 @@ std::string fileBytes(const fs::path& p) {
     return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
-// Whether the viewport, within ten tries, goes 300 ms without presenting a frame and with none
-// submitted, asked for or due: a frame asked for before may still land (slow under load), but a
-// viewport that keeps drawing never goes quiet.
+// Whether the viewport, within twenty tries, goes 300 ms without presenting a frame and with none
+// submitted, asked for or due: frames asked for before may still land (slow under load; a worker's
+// result, a horizon map or the terrain's levels, asks for one more), but a viewport that keeps
+// drawing never goes quiet.
 bool settlesQuiet(ViewportWindow* viewport) {
-    for (int attempt = 0; attempt < 10; ++attempt) {
+    for (int attempt = 0; attempt < 20; ++attempt) {
         QSignalSpy frames(viewport, &ViewportWindow::frameRendered);
         QTest::qWait(300);
         if (frames.count() == 0 && !viewport->drawing()) return true;
