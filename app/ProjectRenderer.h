@@ -38,6 +38,10 @@ struct RenderRequest {
     // unless the view is the one the frame before it showed; the full-resolution frame meters.
     // Only present() reads it.
     bool interactive = false;
+    // The window's size, where a viewport frame is drawn below it (0: width and height): the meter
+    // reads the view at one size from that shape whatever the frame's scale, as a size rounded
+    // from each scale's own shape differs by a row at some scales and would meter the view again.
+    uint32_t windowWidth = 0, windowHeight = 0;
     // The rows the terrain's level of detail is chosen for (0: height): a viewport frame drawn
     // below full resolution keeps the full frame's levels and the shadow maps drawn for them,
     // unless its cascades moved (RenderSettings::levelOfDetailYields).

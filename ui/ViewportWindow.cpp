@@ -195,6 +195,8 @@ void ViewportWindow::draw(bool now) {
     drawn.width = size.width;
     drawn.height = size.height;
     drawn.levelOfDetailRows = request_.height;
+    drawn.windowWidth = request_.width;
+    drawn.windowHeight = request_.height;
     drawn.waitForHorizon = false;
     drawn.waitForLevelOfDetail = false;
     // Below full resolution the refine timer below brings the full-resolution frame, which meters.
