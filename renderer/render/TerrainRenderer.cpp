@@ -996,26 +996,17 @@ void TerrainRenderer::buildLodBuffers(bool detailChanged) {
     size_t floats = 0;
     for (const auto& [k, v] : detailVertices_) floats += v.size();
     if (floats == 0) return;
-    const VkBufferUsageFlags usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    // Where the device shares the host's memory its local memory is host-visible: written here,
-    // the frame only binds it (vk::Buffer::deviceLocal's rule; elsewhere the copy needs the queue,
-    // which is the frame's).
-    const VkPhysicalDeviceType type = ctx_.deviceType();
-    if (type == VK_PHYSICAL_DEVICE_TYPE_CPU || type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
-        try {
-            vk::Buffer b(ctx_, floats * sizeof(float), usage,
-                         VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                             VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-            VkDeviceSize offset = 0;
-            for (const auto& [k, v] : detailVertices_) {
-                b.write(v.data(), v.size() * sizeof(float), offset);
-                offset += v.size() * sizeof(float);
-            }
-            detailBuffer_ = std::move(b);
-            return;
-        } catch (const vk::VulkanError&) {
-            // No such memory type: the frame uploads them.
+    // Written here where the device shares the host's memory, so the frame only binds it;
+    // elsewhere the copy needs the queue, which is the frame's.
+    detailBuffer_ = vk::Buffer::sharedDeviceLocal(
+        ctx_, floats * sizeof(float), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (detailBuffer_) {
+        VkDeviceSize offset = 0;
+        for (const auto& [k, v] : detailVertices_) {
+            detailBuffer_.write(v.data(), v.size() * sizeof(float), offset);
+            offset += v.size() * sizeof(float);
         }
+        return;
     }
     detailUpload_.reserve(floats);
     for (const auto& [k, v] : detailVertices_) detailUpload_.insert(detailUpload_.end(), v.begin(), v.end());

@@ -33,6 +33,19 @@ void Buffer::write(const void* bytes, VkDeviceSize size, VkDeviceSize offset) {
     std::memcpy(static_cast<char*>(map()) + offset, bytes, size_t(size));
 }
 
+Buffer Buffer::sharedDeviceLocal(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage) {
+    // Where the device shares the host's memory, its local memory is host-visible too.
+    const VkPhysicalDeviceType type = ctx.deviceType();
+    if (type != VK_PHYSICAL_DEVICE_TYPE_CPU && type != VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) return {};
+    try {
+        return Buffer(ctx, size, usage,
+                      VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                          VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    } catch (const VulkanError&) {
+        return {};  // no such memory type: through a staging copy, as on a discrete GPU
+    }
+}
+
 Buffer Buffer::hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage) {
     return Buffer(ctx, size, usage,
                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
@@ -50,20 +63,11 @@ Buffer Buffer::hostReadable(const VulkanContext& ctx, VkDeviceSize size, VkBuffe
 
 Buffer Buffer::deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                            VkBufferUsageFlags usage, VkDeviceSize capacity) {
-    // Where the device shares the host's memory (a CPU device, an integrated GPU), its local
-    // memory is host-visible too: written in place, the buffer needs no copy on the queue, which
-    // would wait behind every frame already queued there.
-    const VkPhysicalDeviceType type = ctx.deviceType();
-    if (type == VK_PHYSICAL_DEVICE_TYPE_CPU || type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU) {
-        try {
-            Buffer b(ctx, std::max(size, capacity), usage,
-                     VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                         VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-            if (size > 0) b.write(bytes, size);
-            return b;
-        } catch (const VulkanError&) {
-            // No such memory type: through a staging copy, as on a discrete GPU.
-        }
+    // Written in place where it can be: a copy on the queue would wait behind every frame already
+    // queued there.
+    if (Buffer b = sharedDeviceLocal(ctx, std::max(size, capacity), usage)) {
+        if (size > 0) b.write(bytes, size);
+        return b;
     }
     Buffer staging = hostVisible(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     if (size > 0) staging.write(bytes, size);

@@ -33,6 +33,10 @@ public:
     // is more (the rest undefined until written).
     static Buffer deviceLocal(const VulkanContext& ctx, const void* bytes, VkDeviceSize size,
                               VkBufferUsageFlags usage, VkDeviceSize capacity = 0);
+    // A device-local buffer the host writes in place, where the device shares the host's memory
+    // (a CPU device, an integrated GPU); empty elsewhere. It needs no queue, so any thread may
+    // make and fill it.
+    static Buffer sharedDeviceLocal(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
     // A host-visible, coherent buffer (uniforms, staging).
     static Buffer hostVisible(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage);
     // A host-visible, coherent buffer the host reads: host-cached memory where the device has it.
