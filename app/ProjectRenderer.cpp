@@ -445,18 +445,13 @@ bool ProjectRenderer::meters(const RenderRequest& r) const {
     return view && view->background != ViewBackground::Black;
 }
 
-namespace {
-
-// The size the meter draws a request at: `maxWidth` wide at most, the request's shape. The
-// viewport's dynamic resolution draws the same view at several sizes, all of one meter size.
+// The viewport's dynamic resolution draws the same view at several sizes, all of one meter size.
 std::pair<uint32_t, uint32_t> meterSize(const RenderRequest& r, uint32_t maxWidth) {
     const bool window = r.windowWidth > 0 && r.windowHeight > 0;
     const uint32_t width = window ? r.windowWidth : r.width, height = window ? r.windowHeight : r.height;
     const uint32_t w = std::min(width, maxWidth);
     return {w, std::max(1u, uint32_t(std::lround(double(height) * w / std::max(1u, width))))};
 }
-
-}  // namespace
 
 std::string ProjectRenderer::meterKey(const RenderRequest& r, const OrbitCamera& camera) const {
     std::ostringstream key;

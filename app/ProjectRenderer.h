@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "DemImport.h"
 #include "bake/DiffuseBake.h"
@@ -53,6 +54,10 @@ struct RenderRequest {
     // draw the set held (RenderSettings::waitForLevelOfDetail).
     bool waitForLevelOfDetail = true;
 };
+
+// The size the exposure meter draws a request at: `maxWidth` wide at most, the shape of the
+// request's window (RenderRequest::windowWidth/Height) or, without one, of the request.
+std::pair<uint32_t, uint32_t> meterSize(const RenderRequest& r, uint32_t maxWidth);
 
 class ProjectRenderer;
 
@@ -213,6 +218,9 @@ public:
         std::vector<glm::vec4> markers, leaves;
     };
 
+    // The widest the exposure meter draws a frame (meterSize).
+    static constexpr uint32_t kMeterWidth = 128;
+
 private:
     // Per volume, the overlays follow the bound probes where they carry diagnostics and were
     // baked from the current probe-volume settings; otherwise the placement of those settings.
@@ -225,7 +233,6 @@ private:
     RenderSettings meterSettings(const RenderRequest& request, const OrbitCamera& camera) const;
     // What a metering depends on: the bound inputs' revision, the view and the camera.
     std::string meterKey(const RenderRequest& request, const OrbitCamera& camera) const;
-    static constexpr uint32_t kMeterWidth = 128;
     static constexpr double kAdaptedEv = 0.02;  // closer than this to the meter is adapted
 
     Project project_;

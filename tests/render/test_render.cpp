@@ -11,6 +11,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include <gdal_priv.h>
@@ -30,6 +31,7 @@
 #include "lpv/Lpv.h"
 #include "scene/Exposure.h"
 #include "scene/DebugViews.h"
+#include "scene/DynamicResolution.h"
 #include "terrain/HorizonAO.h"
 #include "render/FrameGraph.h"
 #include "render/features/Antialiasing.h"
@@ -1340,6 +1342,27 @@ TEST_F(RenderTest, ShadowsOffDrawsNoShadowPassAndHoldsNoMaps) {
         EXPECT_NE(pass.name, "shadow");
         for (const auto& b : pass.bindings) EXPECT_EQ(b.find("shadow"), std::string::npos) << pass.name;
     }
+}
+
+// The exposure meter reads a view at one size whatever scale the viewport draws it at: a size
+// rounded from each scale's own shape gives a 710 x 725 window 131 rows at four scales and 130 at
+// a quarter, so a still view drawn small would be metered again.
+TEST(MeterSize, OneSizeForAViewAtEveryScaleOfItsWindow) {
+    const uint32_t windowWidth = 710, windowHeight = 725;
+    std::set<std::pair<uint32_t, uint32_t>> own, window;
+    for (double scale : DynamicResolution::kScales) {
+        const ScaledSize size = scaledSize(windowWidth, windowHeight, scale);
+        RenderRequest r;
+        r.width = size.width;
+        r.height = size.height;
+        own.insert(meterSize(r, ProjectRenderer::kMeterWidth));
+        r.windowWidth = windowWidth;
+        r.windowHeight = windowHeight;
+        window.insert(meterSize(r, ProjectRenderer::kMeterWidth));
+    }
+    EXPECT_EQ(own.size(), 2u) << "the scales' own shapes no longer round apart: pick another window";
+    ASSERT_EQ(window.size(), 1u);
+    EXPECT_EQ(*window.begin(), std::make_pair(128u, 131u));
 }
 
 // A sun that gives no light (0 lx, or an image sky without a glow) has nothing to shadow: a lit
