@@ -60,7 +60,11 @@ void scrollsPastUnlessFocused(QWidget* w) {
 ParameterForm::ParameterForm(ProjectDocument* doc, QWidget* parent)
     : QWidget(parent), doc_(doc), form_(new QFormLayout(this)) {
     form_->setFieldGrowthPolicy(QFormLayout::AllNonFixedFieldsGrow);
-    connect(doc_, &ProjectDocument::parametersChanged, this, [this] { refresh(); });
+    // A form out of sight (a dock behind another's tab) catches up when shown (showEvent): its
+    // rows' resolved "auto" values cost the UI thread milliseconds an edit need not spend.
+    connect(doc_, &ProjectDocument::parametersChanged, this, [this] {
+        if (isVisible()) refresh();
+    });
 }
 
 void ParameterForm::setElement(int index) {
