@@ -12,12 +12,33 @@ void LatestJob::Context::post(std::function<void()> f) const {
 
 void LatestJob::start(std::function<void(const Context&)> work) {
     stop();
+    launch(std::move(work));
+}
+
+void LatestJob::startBeside(std::function<void(const Context&)> work) {
+    cancel();
+    ++generation_;  // what it queued or still posts must not land
+    // Those that have ended are joined now, which does not wait.
+    std::erase_if(retiring_, [](Retiring& r) {
+        if (!r.ended->load()) return false;
+        r.thread.join();
+        return true;
+    });
+    if (thread_.joinable()) retiring_.push_back({std::move(thread_), ended_});
+    launch(std::move(work));
+}
+
+void LatestJob::launch(std::function<void(const Context&)> work) {
     cancel_ = std::make_shared<std::atomic<bool>>(false);
+    ended_ = std::make_shared<std::atomic<bool>>(false);
     Context c;
     c.job_ = this;
     c.generation_ = generation_;
     c.cancel_ = cancel_;
-    thread_ = std::thread([work = std::move(work), c] { work(c); });
+    thread_ = std::thread([work = std::move(work), c, ended = ended_] {
+        work(c);
+        *ended = true;
+    });
 }
 
 void LatestJob::cancel() { *cancel_ = true; }
@@ -30,6 +51,8 @@ void LatestJob::stop() {
 
 void LatestJob::wait() {
     if (thread_.joinable()) thread_.join();
+    for (Retiring& r : retiring_) r.thread.join();
+    retiring_.clear();
 }
 
 }  // namespace terralux

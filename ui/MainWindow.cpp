@@ -1378,7 +1378,7 @@ void MainWindow::startPreview() {
     const Project project = doc_->project();
     auto terrain = doc_->terrainShared();
     const ScenarioView shown = renderer_ ? renderer_->shownView() : ScenarioView{};
-    previewJob_.start([this, project, terrain, shown](const LatestJob::Context& job) {
+    previewJob_.startBeside([this, project, terrain, shown](const LatestJob::Context& job) {
         try {
             // The scenario shown, and the one it blends toward: a draft of each, mixed.
             Project lit = project;

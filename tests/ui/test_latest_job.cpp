@@ -91,3 +91,43 @@ TEST(LatestJob, CancelLetsTheJobReportItself) {
     pump([&] { return !landed.empty(); });
     EXPECT_EQ(landed, std::vector<int>{7});
 }
+
+// startBeside does not wait for the cancelled job: a job that notices its cancellation only after
+// 300 ms winds down beside the new one, and of the two only the new one's posts land; wait()
+// waits for both.
+TEST(LatestJob, StartBesideLeavesTheCancelledJobToWindDown) {
+    app();
+    QObject owner;
+    std::vector<int> landed;
+    std::atomic<bool> oldEnded{false}, oldSawCancel{false};
+    LatestJob job(&owner);
+    job.start([&](const LatestJob::Context& c) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a stretch that polls nothing
+        oldSawCancel = c.cancelled();
+        c.post([&] { landed.push_back(1); });
+        oldEnded = true;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const auto before = std::chrono::steady_clock::now();
+    job.startBeside([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(2); }); });
+    const auto took = std::chrono::steady_clock::now() - before;
+    EXPECT_LT(took, std::chrono::milliseconds(100));
+    EXPECT_FALSE(oldEnded.load());  // still running when the new job started
+    pump([&] { return !landed.empty(); });
+    EXPECT_EQ(landed, std::vector<int>{2});
+    job.wait();
+    EXPECT_TRUE(oldEnded.load());
+    EXPECT_TRUE(oldSawCancel.load());
+    pump([] { return false; }, std::chrono::milliseconds(100));  // the old job's post would run here
+    EXPECT_EQ(landed, std::vector<int>{2});
+    // start() still waits: it returns only once the job beside has ended.
+    job.startBeside([&](const LatestJob::Context& c) {
+        while (!c.cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        oldEnded = false;
+    });
+    job.start([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(3); }); });
+    EXPECT_FALSE(oldEnded.load());
+    pump([&] { return landed.size() == 2; });
+    EXPECT_EQ(landed, (std::vector<int>{2, 3}));
+}
