@@ -18,9 +18,10 @@ inline int displayByteFormula(float linear) {
     return std::clamp(int(std::lround(255.0f * c)), 0, 255);
 }
 
-// The light at which each code 1..255 begins: the least non-negative float whose formula code
-// reaches it. The code never falls as the light grows, so each is found by bisection over the
-// floats' bit patterns, which order non-negative floats as their values.
+// The light at which each code 1..255 begins: a float where the formula's code reaches it and
+// the float below does not, found by bisection over the floats' bit patterns (which order
+// non-negative floats as their values). The code rises with the light but for the float rounding
+// of the curves, which steps it back by one at a few floats near a step.
 inline std::array<float, 255> displayByteSteps() {
     std::array<float, 255> steps{};
     const uint32_t top = std::bit_cast<uint32_t>(1.0e6f);  // well past white (code 255)
@@ -37,8 +38,8 @@ inline std::array<float, 255> displayByteSteps() {
 
 // The same code by lookup: the number of steps at or below the light, a binary search instead of
 // a power per channel, so a dock's picture of 16 000 pixels costs a fraction of a millisecond
-// rather than several on the UI thread. A NaN light is black, as in the formula; above 10^6 the
-// formula's ratio overflows to NaN, and the lookup says white.
+// rather than several on the UI thread. A NaN light is black, as in the formula; above about
+// 10^19 the formula's ratio overflows to NaN (black), and the lookup says white.
 inline int displayByte(float linear) {
     static const std::array<float, 255> steps = displayByteSteps();
     if (!(linear >= steps[0])) return 0;

@@ -24,6 +24,12 @@ void LatestJob::startBeside(std::function<void(const Context&)> work) {
         r.thread.join();
         return true;
     });
+    // At most two wind down beside the new job: edits faster than a cancellation is noticed
+    // wait for the oldest rather than pile up bakes and their memory.
+    while (retiring_.size() >= 2) {
+        retiring_.front().thread.join();
+        retiring_.erase(retiring_.begin());
+    }
     if (thread_.joinable()) retiring_.push_back({std::move(thread_), ended_});
     launch(std::move(work));
 }
@@ -35,8 +41,11 @@ void LatestJob::launch(std::function<void(const Context&)> work) {
     c.job_ = this;
     c.generation_ = generation_;
     c.cancel_ = cancel_;
-    thread_ = std::thread([work = std::move(work), c, ended = ended_] {
-        work(c);
+    thread_ = std::thread([work = std::move(work), c, ended = ended_]() mutable {
+        {
+            auto run = std::move(work);  // what the job holds goes before it says it has ended
+            run(c);
+        }
         *ended = true;
     });
 }

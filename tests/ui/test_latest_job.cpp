@@ -120,14 +120,41 @@ TEST(LatestJob, StartBesideLeavesTheCancelledJobToWindDown) {
     EXPECT_TRUE(oldSawCancel.load());
     pump([] { return false; }, std::chrono::milliseconds(100));  // the old job's post would run here
     EXPECT_EQ(landed, std::vector<int>{2});
-    // start() still waits: it returns only once the job beside has ended.
+    // start() still waits, for a job winding down beside the current one too: the slow job is
+    // set beside by a quick one, and start() returns only once it has ended.
+    std::atomic<bool> slowEnded{false};
     job.startBeside([&](const LatestJob::Context& c) {
         while (!c.cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        oldEnded = false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        slowEnded = true;
     });
+    job.startBeside([](const LatestJob::Context&) {});
+    EXPECT_FALSE(slowEnded.load());  // beside, cancelled, still winding down
     job.start([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(3); }); });
-    EXPECT_FALSE(oldEnded.load());
+    EXPECT_TRUE(slowEnded.load());
     pump([&] { return landed.size() == 2; });
     EXPECT_EQ(landed, (std::vector<int>{2, 3}));
+}
+
+// Edits faster than a cancellation is noticed do not pile up jobs: with two winding down, the
+// next startBeside waits for the oldest.
+TEST(LatestJob, AtMostTwoJobsWindDownBesideTheCurrentOne) {
+    app();
+    QObject owner;
+    std::atomic<int> ended{0};
+    LatestJob job(&owner);
+    const auto deaf = [&](const LatestJob::Context&) {  // notices nothing for 300 ms
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        ++ended;
+    };
+    const auto start = std::chrono::steady_clock::now();
+    job.startBeside(deaf);
+    job.startBeside(deaf);
+    job.startBeside(deaf);  // two beside, one current: none waited
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
+    EXPECT_EQ(ended.load(), 0);
+    job.startBeside(deaf);  // a third would be beside: the first is joined
+    EXPECT_GE(ended.load(), 1);
+    job.wait();
+    EXPECT_EQ(ended.load(), 4);
 }
