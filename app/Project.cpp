@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <regex>
 #include <set>
 #include <cstdio>
@@ -16,6 +18,18 @@
 
 namespace terralux {
 namespace {
+
+// A pattern compiles once: every edit reads the whole project back, and compiling the names'
+// patterns each time was a tenth of an edit's milliseconds on the UI thread. A compiled regex
+// is only read after, from any thread.
+const std::regex& compiledPattern(const std::string& pattern) {
+    static std::mutex mutex;
+    static std::map<std::string, std::regex> compiled;
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto it = compiled.find(pattern);
+    if (it == compiled.end()) it = compiled.emplace(pattern, std::regex(pattern)).first;
+    return it->second;
+}
 
 using nlohmann::json;
 
@@ -108,7 +122,7 @@ void checkValue(const ParameterSpec& spec, const json& v, const std::string& pat
             return;
         case ParamType::String:
             if (!v.is_string()) reject(source, path, v, "must be a string");
-            if (!spec.pattern.empty() && !std::regex_match(v.get<std::string>(), std::regex(spec.pattern)))
+            if (!spec.pattern.empty() && !std::regex_match(v.get<std::string>(), compiledPattern(spec.pattern)))
                 reject(source, path, v, spec.patternRule);
             return;
         case ParamType::Choice:

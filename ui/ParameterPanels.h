@@ -28,6 +28,7 @@ public:
     // Per-volume rows edit probe_volumes[volume], per-light rows lights[index].
     void setVolume(int volume) { setElement(volume); }
     void setElement(int index);
+    int element() const { return element_; }
 
     // The editor of one row of the parameter table (app/ParameterTable.h): its widget, limits,
     // unit, "auto" text and tooltip all come from the row. `path` is the table's path

@@ -1030,6 +1030,76 @@ private slots:
         QVERIFY(w_->findChild<QPushButton*>("param.terrain.ramp_colors.1")->toolTip() == "1, 0, 0");
     }
 
+    // Every edit refreshes every open form, so a row whose value did not change must cost
+    // nothing: a sun edit re-polishes no ramp swatch and repaints no surface row, and a closed
+    // dock's form skips the edit until it is shown. The probe volume list keeps its items.
+    void formsLeaveUnchangedRowsAlone() {
+        class Counter : public QObject {
+        public:
+            std::map<QEvent::Type, int> seen;
+            bool eventFilter(QObject*, QEvent* e) override {
+                ++seen[e->type()];
+                return false;
+            }
+        };
+        ProjectDocument* doc = w_->document();
+        const int undoIndex = doc->undoStack()->index();
+        QString error;
+        QVERIFY(doc->setParameter("terrain.albedo_mode", "ramp", &error));
+        auto* surfaceDock = w_->findChild<QDockWidget*>("dock.surface");
+        surfaceDock->raise();
+        w_->findChild<QDockWidget*>("dock.probeVolumes")->raise();
+        auto* swatch = surfaceDock->findChild<QPushButton*>("param.terrain.ramp_colors.0");
+        auto* roughness = surfaceDock->findChild<QDoubleSpinBox*>("param.terrain.roughness");
+        auto* volumes = w_->findChild<QListWidget*>("volumes.list");
+        QVERIFY(swatch && roughness && volumes && volumes->count() > 0);
+        QTRY_VERIFY(swatch->isVisible() && roughness->isVisible() && volumes->isVisible());
+        // In view, or the rows would draw nothing either way.
+        auto* scroll = qobject_cast<QScrollArea*>(surfaceDock->widget());
+        if (!scroll) scroll = surfaceDock->findChild<QScrollArea*>();
+        QVERIFY(scroll);
+        scroll->ensureWidgetVisible(roughness);
+        QVERIFY(!roughness->visibleRegion().isEmpty());
+        QTest::qWait(200);  // the raise's own repaints land first
+        Counter swatchEvents, roughnessEvents;
+        swatch->installEventFilter(&swatchEvents);
+        roughness->installEventFilter(&roughnessEvents);
+        const QListWidgetItem* firstVolume = volumes->item(0);
+        const double elevation = doc->project().scene.sun.elevationDeg;
+        QVERIFY(doc->setParameter("sun.elevation_deg", elevation + 3.0, &error));
+        QTest::qWait(200);
+        QCOMPARE(swatchEvents.seen[QEvent::StyleChange], 0);
+        QCOMPARE(swatchEvents.seen[QEvent::ToolTipChange], 0);
+        QCOMPARE(roughnessEvents.seen[QEvent::Paint], 0);
+        QCOMPARE(volumes->item(0), firstVolume);
+        // The counters see a change: the edited row repaints, the edited swatch re-polishes.
+        const double before = doc->project().scene.terrain.roughness;
+        QVERIFY(doc->setParameter("terrain.roughness", before > 0.5 ? 0.3 : 0.7, &error));
+        QTRY_VERIFY(roughnessEvents.seen[QEvent::Paint] > 0);
+        nlohmann::json colors = doc->value("terrain.ramp_colors");
+        colors[0] = colors[0].get<double>() > 0.5 ? 0.25 : 0.75;
+        QVERIFY(doc->setParameter("terrain.ramp_colors", colors, &error));
+        QCOMPARE(swatchEvents.seen[QEvent::StyleChange], 1);
+        swatch->removeEventFilter(&swatchEvents);
+        roughness->removeEventFilter(&roughnessEvents);
+
+        // A closed dock's form keeps what it showed, and catches up when opened. (Behind another
+        // dock's tab a form still refreshes: Qt moves the dock out of the window, not hides it,
+        // and with its unchanged rows left alone a refresh costs little.)
+        surfaceDock->close();
+        QTRY_VERIFY(!roughness->isVisible());
+        const double shown = roughness->value();
+        QVERIFY(doc->setParameter("terrain.roughness", shown > 0.5 ? 0.35 : 0.65, &error));
+        QCOMPARE(roughness->value(), shown);
+        surfaceDock->show();
+        surfaceDock->raise();
+        QTRY_VERIFY(roughness->isVisible());
+        QCOMPARE(roughness->value(), doc->project().scene.terrain.roughness);
+        doc->undoStack()->setIndex(undoIndex);
+        QCOMPARE(doc->project().scene.terrain.roughness, before);
+        QCOMPARE(doc->project().scene.sun.elevationDeg, elevation);
+    }
+
     // A metered exposure: an edit that darkens the frame meters again, and the viewport's shown
     // exposure follows the meter over frames with the authored time constant, then stops drawing;
     // the status bar shows the EV100 as it moves.
