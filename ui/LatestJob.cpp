@@ -16,6 +16,11 @@ void LatestJob::start(std::function<void(const Context&)> work) {
 }
 
 void LatestJob::startBeside(std::function<void(const Context&)> work) {
+    dismiss();
+    launch(std::move(work));
+}
+
+void LatestJob::dismiss() {
     cancel();
     ++generation_;  // what it queued or still posts must not land
     // Those that have ended are joined now, which does not wait.
@@ -24,14 +29,13 @@ void LatestJob::startBeside(std::function<void(const Context&)> work) {
         r.thread.join();
         return true;
     });
-    // At most two wind down beside the new job: edits faster than a cancellation is noticed
+    // At most two wind down beside the next job: edits faster than a cancellation is noticed
     // wait for the oldest rather than pile up bakes and their memory.
     while (retiring_.size() >= 2) {
         retiring_.front().thread.join();
         retiring_.erase(retiring_.begin());
     }
     if (thread_.joinable()) retiring_.push_back({std::move(thread_), ended_});
-    launch(std::move(work));
 }
 
 void LatestJob::launch(std::function<void(const Context&)> work) {

@@ -3,7 +3,8 @@
 // preview bake, the horizon AO, the LPV update, a terrain import, the study, the bake). start()
 // cancels the job running, waits for it and starts the new one; what a job posts back runs on the
 // owner's thread, and only while no newer job has started and stop() has not run, so the result
-// of a superseded job that is already queued never lands. startBeside() cancels without waiting.
+// of a superseded job that is already queued never lands. startBeside() and dismiss() cancel
+// without waiting.
 
 #include <atomic>
 #include <functional>
@@ -44,6 +45,10 @@ public:
     // winds down beside it and nothing it posts lands. For jobs whose runs share no output (the
     // draft preview), so an edit never waits for the last one's cancellation to be noticed.
     void startBeside(std::function<void(const Context&)> work);
+    // Cancels the running job and drops whatever it posted or still posts, without waiting: it
+    // winds down beside the next job as one startBeside cancelled does. For results that must
+    // not land (an edit undone back to a current bake) where nothing else waits on the job.
+    void dismiss();
     // Asks the running job to stop (Context::cancelled); what it still posts lands.
     void cancel();
     // Cancels, waits, and drops whatever the job posted that has not landed.
@@ -62,7 +67,7 @@ private:
     QObject* owner_;
     std::thread thread_;
     std::shared_ptr<std::atomic<bool>> ended_ = std::make_shared<std::atomic<bool>>(true);
-    std::vector<Retiring> retiring_;  // cancelled by startBeside, not yet joined
+    std::vector<Retiring> retiring_;  // cancelled by startBeside or dismiss, not yet joined
     std::shared_ptr<std::atomic<bool>> cancel_ = std::make_shared<std::atomic<bool>>(false);
     unsigned generation_ = 0;  // the owner's thread only
 };

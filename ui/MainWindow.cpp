@@ -1255,7 +1255,7 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 
 void MainWindow::rebuildRenderer() {
     // A preview that finished for the terrain before may still be queued: it must not land.
-    previewJob_.stop();
+    previewJob_.dismiss();
     viewport_->setRenderer(nullptr);
     stopAmbientOcclusion();
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
@@ -1294,7 +1294,7 @@ void MainWindow::refreshLighting() {
 }
 
 void MainWindow::stopAmbientOcclusion() {
-    aoJob_.stop();  // a result already queued must not land
+    aoJob_.dismiss();  // a result already queued must not land; the UI thread does not wait
     aoRunning_.reset();
     if (aoProgress_) aoProgress_->setVisible(false);
 }
@@ -1321,7 +1321,7 @@ void MainWindow::updateAmbientOcclusion() {
                            .arg(wanted->directions)
                            .arg(QLocale().toString(qulonglong(renderer_->heightfield().heights().size()))));
     auto terrain = doc_->terrainShared();
-    aoJob_.start([this, terrain, settings = *wanted](const LatestJob::Context& job) {
+    aoJob_.startBeside([this, terrain, settings = *wanted](const LatestJob::Context& job) {
         const auto start = std::chrono::steady_clock::now();
         std::atomic<int> shown{-1};  // the progress may come from any of the AO's threads
         std::vector<float> field;
@@ -1363,7 +1363,7 @@ void MainWindow::startPreview() {
     // show it (again, after an edit that was undone) and bake no preview.
     const auto folder = bakeFolder();
     if (renderer_ && folder && bakeStaleness(doc_->project(), *folder).empty()) {
-        previewJob_.stop();  // a preview started for an edit since undone must not land
+        previewJob_.dismiss();  // a preview started for an edit since undone must not land
         if (probeSource_ != "last bake") {
             renderer_->setProject(doc_->project());
             renderer_->loadProbes(false, nullptr, nullptr, *folder);
@@ -1620,7 +1620,7 @@ void MainWindow::startBake(const QString& outDir) {
     // due, would land after it and put a draft in its place (a cancelled or failed bake asks for
     // the preview again). One asked for by a later edit lands.
     previewTimer_.stop();
-    previewJob_.stop();
+    previewJob_.dismiss();
     bake_->start(p);
 }
 

@@ -158,3 +158,34 @@ TEST(LatestJob, AtMostTwoJobsWindDownBesideTheCurrentOne) {
     job.wait();
     EXPECT_EQ(ended.load(), 4);
 }
+
+// dismiss() is stop() without the wait: the job's posts never land, and the owner's thread goes
+// on while the job notices its cancellation; wait() joins it.
+TEST(LatestJob, DismissDropsTheJobWithoutWaitingForIt) {
+    app();
+    QObject owner;
+    std::vector<int> landed;
+    std::atomic<bool> ended{false}, sawCancel{false};
+    LatestJob job(&owner);
+    job.start([&](const LatestJob::Context& c) {
+        c.post([&] { landed.push_back(1); });  // queued before the dismissal
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        sawCancel = c.cancelled();
+        c.post([&] { landed.push_back(2); });  // posted after it
+        ended = true;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const auto before = std::chrono::steady_clock::now();
+    job.dismiss();
+    EXPECT_LT(std::chrono::steady_clock::now() - before, std::chrono::milliseconds(100));
+    EXPECT_FALSE(ended.load());
+    job.wait();
+    EXPECT_TRUE(ended.load());
+    EXPECT_TRUE(sawCancel.load());
+    pump([] { return false; }, std::chrono::milliseconds(100));  // both posts would run here
+    EXPECT_TRUE(landed.empty());
+    // A job started after a dismissal posts as any other.
+    job.startBeside([&](const LatestJob::Context& c) { c.post([&] { landed.push_back(3); }); });
+    pump([&] { return !landed.empty(); });
+    EXPECT_EQ(landed, std::vector<int>{3});
+}
