@@ -539,6 +539,13 @@ void ProjectRenderer::setLpv(std::shared_ptr<const lpv::Volumes> volumes, const 
 bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera, vk::Swapchain& swapchain) {
     if (!drawsLpv(r)) setLpv(nullptr, "");  // volumes no frame draws hold no memory
     RenderSettings s = settingsOf(r, camera);
+    // Nothing is drawn, and nothing metered, until the frame's pipelines and its meter's are
+    // built: the window keeps the frame it shows meanwhile.
+    if (!r.waitForPipelines) {
+        bool ready = renderer_->pipelinesReady(s);
+        if (meters(r)) ready = renderer_->pipelinesReady(meterSettings(r, camera)) && ready;
+        if (!ready) return false;
+    }
     if (!meters(r)) adapting_ = false;
     else {
         // Metered again only when what the frame shows changed; the shown exposure follows the

@@ -53,6 +53,9 @@ struct RenderRequest {
     // Off for the viewport: a new camera's levels of detail are chosen on a worker while the frames
     // draw the set held (RenderSettings::waitForLevelOfDetail).
     bool waitForLevelOfDetail = true;
+    // Off for the viewport: a frame whose pipelines are not built yet starts their builds on a
+    // worker and is not drawn (present() returns false; TerrainRenderer::pipelinesReady).
+    bool waitForPipelines = true;
 };
 
 // The size the exposure meter draws a request at: `maxWidth` wide at most, the shape of the
@@ -166,6 +169,8 @@ public:
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
+    // False when nothing was drawn: no swapchain image, or (waitForPipelines off) pipelines still
+    // building (TerrainRenderer::pipelinesBuilding).
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
     // The exposure the last frame showed, EV100: camera.ev100 in mode manual; in the metered modes
     // what the meter read (render) or the viewport's adaptation toward it (present); NaN before a

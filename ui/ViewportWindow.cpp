@@ -35,6 +35,12 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
     // once either has finished, a frame takes it. The full-resolution frame due after the change
     // does; with none due, the frame that takes it is one (the view holds still), not another
     // frame of the change.
+    pipelinePoll_.setInterval(10);
+    connect(&pipelinePoll_, &QTimer::timeout, this, [this] {
+        if (renderer_ && renderer_->renderer().pipelinesBuilding()) return;
+        pipelinePoll_.stop();
+        requestUpdate();
+    });
     workerPoll_.setInterval(10);
     connect(&workerPoll_, &QTimer::timeout, this, [this] {
         const TerrainRenderer* t = renderer_ ? &renderer_->renderer() : nullptr;
@@ -189,6 +195,7 @@ void ViewportWindow::draw(bool now) {
     // A frame of a change draws at the scale that holds the budget; the full-resolution frame
     // follows when the changes stop.
     const double scale = dynamicResolution_ && !refining_ ? resolution_.interactiveScale() : 1.0;
+    const bool refining = refining_;
     refining_ = false;
     RenderRequest drawn = request_;
     const ScaledSize size = scaledSize(request_.width, request_.height, scale);
@@ -199,9 +206,18 @@ void ViewportWindow::draw(bool now) {
     drawn.windowHeight = request_.height;
     drawn.waitForHorizon = false;
     drawn.waitForLevelOfDetail = false;
+    drawn.waitForPipelines = false;
     // Below full resolution the refine timer below brings the full-resolution frame, which meters.
     drawn.interactive = size.width < request_.width || size.height < request_.height;
-    if (!renderer_->present(drawn, camera_, *swapchain_)) return;
+    if (!renderer_->present(drawn, camera_, *swapchain_)) {
+        // Its pipelines are compiling on a worker: the frame is drawn, as it was asked for, when
+        // they land.
+        if (renderer_->renderer().pipelinesBuilding()) {
+            refining_ = refining;
+            pipelinePoll_.start();
+        }
+        return;
+    }
     if (renderer_->renderer().sunHorizonSweeping() || renderer_->renderer().levelOfDetailBuilding()) workerPoll_.start();
     drawnScale_ = std::sqrt(double(drawn.width) * drawn.height / (double(request_.width) * request_.height));
     if (drawnScale_ < 1.0) refineTimer_.start();

@@ -94,7 +94,8 @@ public:
     // frame after a change, the frame that takes a horizon map swept on a worker): the viewport
     // has more to show.
     bool drawing() const {
-        return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive() || workerPoll_.isActive();
+        return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive() || workerPoll_.isActive() ||
+               pipelinePoll_.isActive();
     }
 
 signals:
@@ -149,6 +150,7 @@ private:
     // The UI thread never waits for the device: a submitted frame is presented once it has
     // finished (polled every few milliseconds), and a frame asked for meanwhile is drawn then.
     QTimer presentPoll_;
+    QTimer pipelinePoll_;  // while a frame's pipelines compile on a worker
     QTimer workerPoll_;  // while the renderer sweeps a horizon map or chooses levels on a worker
     std::optional<std::chrono::steady_clock::time_point> frameStart_;
     bool frameWanted_ = false;

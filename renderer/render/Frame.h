@@ -19,6 +19,7 @@
 #include <glm/vec4.hpp>
 
 #include "render/FrameGraph.h"
+#include "render/PipelineSet.h"
 #include "render/RenderSettings.h"
 #include "render/UniformBlocks.h"
 #include "scene/DebugViews.h"
@@ -174,7 +175,8 @@ struct SurfaceTextures {
 
 // What the renderer holds on the GPU for its lifetime: the terrain mesh, the frame slots and
 // targets, the render passes and layouts every feature shares, and each feature's resources.
-// Pipelines are built on first use (lavapipe compiles a pipeline when it is created).
+// Pipelines are built on first use (lavapipe compiles a pipeline when it is created); the
+// terrain's and the water's may be built on a worker ahead of the frame (PipelineSet.h).
 struct RendererGpu {
     vk::Buffer vertices, markers, leaves;
     // The detail patches' vertices (position and normal, as `vertices`), and which set of them
@@ -196,8 +198,6 @@ struct RendererGpu {
     vk::Sampler linear;
     vk::UniqueSetLayout waterLayout;
     std::array<vk::PipelineLayout, 4> waterLayouts;  // by lights variant
-    // By variant: kShadowVariant | kFogVariant | kReflectionVariant.
-    std::map<int, vk::UniquePipeline> waterPipelines;
     // The sun-visibility view's per-vertex attribute (stride 32, like the probe light), and the
     // sun and surface it was traced for.
     vk::Buffer sunVisibility;
@@ -237,8 +237,12 @@ struct RendererGpu {
     // Terrain pipelines by variant: kProbeLightVariant | kShadowVariant | kFogVariant |
     // kReflectionVariant | kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV
     // shaders and layout).
-    // Keyed also by the samples a pixel of the pass they draw in (kSamplesKey).
-    std::map<int, vk::UniquePipeline> terrain;
+    // Keyed also by the samples a pixel of the pass they draw in (kSamplesKey). These two sets
+    // may build on a worker (PipelineSet.h): declared after the passes and layouts their builds
+    // read, they wait for them before those go.
+    PipelineSet terrain;
+    // The water surface's, by kShadowVariant | kFogVariant | kReflectionVariant and samples.
+    PipelineSet waterPipelines;
     std::map<int, vk::UniquePipeline> sky, markerPipelines, leafPipelines, gizmoPipelines;
     vk::UniquePipeline shadowDepth, probePass;
     // The anti-aliasing pass: its colour-only render pass, layout and pipelines by

@@ -1189,6 +1189,17 @@ void importTarget(FrameGraph& graph, const RenderTarget& t) {
 
 }  // namespace
 
+void TerrainRenderer::ensureMultisampledPasses(uint32_t samples) {
+    RendererGpu& g = *gpu_;
+    if (samples <= 1 || g.multisampledPasses.count(samples)) return;
+    const VkFormat colorFormats[] = {vk::kColorFormat};
+    vk::RenderPassDesc clear{colorFormats, vk::kDepthFormat, true, true};
+    clear.samples = samples;
+    vk::RenderPassDesc draw = clear;
+    draw.clear = false;
+    g.multisampledPasses.emplace(samples, std::make_pair(vk::RenderPass(ctx_, clear), vk::RenderPass(ctx_, draw)));
+}
+
 void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const features::AntialiasingPlan& plan) {
     RendererGpu& g = *gpu_;
     if (serves(g.target.get(), width, height, plan)) return;
@@ -1212,14 +1223,7 @@ void TerrainRenderer::ensureTarget(uint32_t width, uint32_t height, const featur
     ++g.targetAllocations;
     const uint32_t drawnWidth = width * plan.scale, drawnHeight = height * plan.scale;
     const uint32_t samples = plan.samples;
-    if (samples > 1 && !g.multisampledPasses.count(samples)) {
-        const VkFormat colorFormats[] = {vk::kColorFormat};
-        vk::RenderPassDesc clear{colorFormats, vk::kDepthFormat, true, true};
-        clear.samples = samples;
-        vk::RenderPassDesc draw = clear;
-        draw.clear = false;
-        g.multisampledPasses.emplace(samples, std::make_pair(vk::RenderPass(ctx_, clear), vk::RenderPass(ctx_, draw)));
-    }
+    ensureMultisampledPasses(samples);
     auto t = std::make_unique<RenderTarget>(RenderTarget{
         samples > 1 ? vk::Image::multisampledTarget(ctx_, drawnWidth, drawnHeight, samples, vk::kColorFormat)
                     : vk::Image::colorTarget(ctx_, drawnWidth, drawnHeight),
@@ -1496,6 +1500,62 @@ void TerrainRenderer::writeBlocks(Frame& f) {
     }
 }
 
+TerrainRenderer::Parts TerrainRenderer::partsOf(const RenderSettings& s, const DebugView& view) const {
+    const RendererGpu& g = *gpu_;
+    Parts p;
+    // Probes: volumes bound, probes on and the view reads their light. Reflection probes: a set
+    // bound, probes on and the view reads the environment's specular (the strength does not decide
+    // it: it is a live uniform, and a weight of 0 leaves the sky's specular as it is). The LPV:
+    // volumes bound and either the view lights with them and lighting.indirect asks for them, or
+    // the view shows them; the local lights in the lit views whenever the scene has some; either
+    // binds the terrain's LPV set.
+    p.probes = g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics);
+    p.reflections = g.reflections && s.probes && view.needs.reflectionProbes;
+    p.lpvVolumes = g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes);
+    p.localLights = !s.lights.empty() && view.needs.sceneLights;
+    p.sunVisibility = view.needs.sunVisibility;
+    // Shadows: the scene has them on, the sun is up and the view draws them: a lit view only for a
+    // sun that gives light (an image sky without a glow, a sun at 0 lx), the shadow views for any.
+    const bool sunLights = std::max({s.sun.illuminance.x, s.sun.illuminance.y, s.sun.illuminance.z}) > 0.0f;
+    p.shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f &&
+                 (sunLights || view.needs.showsShadows);
+    // Water: the scene has it and the view draws it; the reflection and the copy of the frame
+    // under it only where the view shades it, the reflection only when planar.
+    p.water = s.water.enabled && view.needs.water && g.water;
+    p.waterShading = p.water && view.needs.waterShading;
+    p.planarReflection = p.waterShading && s.water.reflection == WaterReflection::Planar;
+    return p;
+}
+
+bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
+    RendererGpu& g = *gpu_;
+    const Parts p = partsOf(s, findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)));
+    const uint32_t samples = antialiasingOf(s).samples;
+    ensureMultisampledPasses(samples);
+    const int terrain = features::terrainVariant(p.probes || p.sunVisibility, p.shadowed, s.fog.enabled,
+                                                 p.reflections, p.lpvVolumes, p.localLights);
+    // Each missing one starts now, beside the others.
+    bool ready = g.terrain.ready(terrain | kSamplesKey(samples), features::terrainPipelineBuild(ctx_, g, terrain, samples));
+    if (p.planarReflection)
+        ready = g.terrain.ready(terrain | kSamplesKey(1), features::terrainPipelineBuild(ctx_, g, terrain, 1)) && ready;
+    if (p.water) {
+        const int water = features::waterVariant(p.shadowed, s.fog.enabled, p.reflections);
+        ready = g.waterPipelines.ready(water | kSamplesKey(samples),
+                                       features::waterPipelineBuild(ctx_, g, water, samples)) && ready;
+    }
+    return ready;
+}
+
+bool TerrainRenderer::pipelinesBuilding() const { return gpu_->terrain.building() || gpu_->waterPipelines.building(); }
+
+size_t TerrainRenderer::pipelinesBuiltInline() const {
+    return gpu_->terrain.builtHere() + gpu_->waterPipelines.builtHere();
+}
+
+size_t TerrainRenderer::pipelinesBuiltOnWorkers() const {
+    return gpu_->terrain.builtOnWorkers() + gpu_->waterPipelines.builtOnWorkers();
+}
+
 void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
                                   const Output& out) {
     const auto recordStart = std::chrono::steady_clock::now();
@@ -1503,16 +1563,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     Frame f{ctx_, g, g.slots[slotIndex], slotIndex, s,
             findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty))};
     const DebugView& view = f.view;
-    // Who takes part. Probes: volumes bound, probes on and the view reads their light. Reflection
-    // probes: a set bound, probes on and the view reads the environment's specular (the strength
-    // does not decide it: it is a live uniform, and a weight of 0 leaves the sky's specular as it
-    // is). The LPV: volumes bound and either the view lights with them and lighting.indirect asks
-    // for them, or the view shows them; the local lights in the lit views whenever the scene has
-    // some; either binds the terrain's LPV set.
-    f.probes = g.probes && s.probes && (view.needs.probeLight || view.needs.probeDiagnostics) ? g.probes.get() : nullptr;
-    f.reflections = g.reflections && s.probes && view.needs.reflectionProbes ? g.reflections.get() : nullptr;
-    f.lpvVolumes = g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes) ? g.lpv.get() : nullptr;
-    f.localLights = !s.lights.empty() && view.needs.sceneLights;
+    // Who takes part (partsOf).
+    const Parts parts = partsOf(s, view);
+    f.probes = parts.probes ? g.probes.get() : nullptr;
+    f.reflections = parts.reflections ? g.reflections.get() : nullptr;
+    f.lpvVolumes = parts.lpvVolumes ? g.lpv.get() : nullptr;
+    f.localLights = parts.localLights;
     f.lpvSet = f.lpvVolumes || f.localLights;
     f.drawMarkers = (s.showProbePositions || view.needs.probeMarkers) && markerCount_ > 0;
     f.drawReflectionMarkers = s.showProbePositions && g.reflections && g.reflections->markerCount > 0;
@@ -1520,25 +1576,19 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.drawGizmos = !s.gizmos.empty();
     f.gizmoCount = uint32_t(s.gizmos.size());
     f.fog = s.fog.enabled;
-    f.sunVisibility = view.needs.sunVisibility;
+    f.sunVisibility = parts.sunVisibility;
     f.sky = view.needs.sky;
     if (f.sunVisibility) updateSunVisibility(s.sun, s.skirt);
-    // Shadows: the scene has them on, the sun is up and the view draws them: a lit view only for a
-    // sun that gives light (an image sky without a glow, a sun at 0 lx), the shadow views for any.
     // A scene without shadows holds no maps.
-    const bool sunLights = std::max({s.sun.illuminance.x, s.sun.illuminance.y, s.sun.illuminance.z}) > 0.0f;
-    const bool shadowed = s.shadows.enabled && view.needs.shadows && s.sun.direction.y > -0.05f &&
-                          (sunLights || view.needs.showsShadows);
+    const bool shadowed = parts.shadowed;
     if (!s.shadows.enabled) ensureShadowMaps(0, 0);
     if (shadowed) ensureShadowMaps(s.shadows.mapResolution, std::clamp(s.shadows.cascades, 1, 4));
     f.shadows = shadowed ? g.shadows.get() : nullptr;
     if (shadowed && s.shadows.heightfield) updateSunHorizon(s.sun, s.skirt, s.waitForHorizon);
     else dropSweptHorizon();
-    // Water: the scene has it and the view draws it; the reflection and the copy of the frame
-    // under it only where the view shades it, the reflection only when planar.
-    f.water = s.water.enabled && view.needs.water ? g.water.get() : nullptr;
-    f.waterShading = f.water && view.needs.waterShading;
-    f.planarReflection = f.waterShading && s.water.reflection == WaterReflection::Planar;
+    f.water = parts.water ? g.water.get() : nullptr;
+    f.waterShading = parts.waterShading;
+    f.planarReflection = parts.planarReflection;
     if (f.water) ensureWaterTargets(s.width, s.height, float(s.water.reflectionScale));
     f.vertexCount = uint32_t(vertexCount_);
     // The cascades, fitted to this frame's view. The ones the horizon map stands in for are read

@@ -25,6 +25,7 @@
 #include "bake/SphericalHarmonics.h"
 #include "render/FrameGraph.h"
 #include "render/RenderSettings.h"
+#include "scene/DebugViews.h"
 #include "scene/OrbitCamera.h"
 #include "scene/ShadowCascades.h"
 #include "scene/SceneDescription.h"
@@ -178,6 +179,15 @@ public:
     // readback) and submits it without waiting for the GPU; the swapchain presents it once it
     // has finished (vk::Swapchain::presentIfDone). False when nothing could be shown.
     bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
+    // Whether a frame of `settings` finds the terrain's and the water's pipelines for it built (a
+    // CPU device compiles the terrain's in 120-170 ms); those missing start building on a worker.
+    // A viewport that must not wait draws such a frame once this holds, polling
+    // pipelinesBuilding(); any other frame builds what it lacks where it is recorded.
+    bool pipelinesReady(const RenderSettings& settings);
+    bool pipelinesBuilding() const;
+    // Pipelines of those two kinds built where a frame was recorded, and on workers.
+    size_t pipelinesBuiltInline() const;
+    size_t pipelinesBuiltOnWorkers() const;
     // The passes of the last frame, in order, with what each used and bound.
     const std::vector<PassInfo>& lastFramePasses() const;
     // The cost of the last frame whose GPU work is known to have finished: after render(), that
@@ -270,6 +280,14 @@ public:
 
 private:
     struct Output;
+    // Who takes part in a frame, from its settings, its view and what is bound (recordFrame and
+    // pipelinesReady decide alike).
+    struct Parts {
+        bool probes = false, reflections = false, lpvVolumes = false, localLights = false;
+        bool sunVisibility = false, shadowed = false, water = false, waterShading = false, planarReflection = false;
+    };
+    Parts partsOf(const RenderSettings& s, const DebugView& view) const;
+    void ensureMultisampledPasses(uint32_t samples);
     void recordFrame(VkCommandBuffer cb, uint32_t slot, const RenderSettings& s, const Output& out);
     void writeBlocks(Frame& f);
     void ensureTarget(uint32_t width, uint32_t height, const features::AntialiasingPlan& plan);

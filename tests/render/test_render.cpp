@@ -3339,6 +3339,65 @@ TEST_F(RenderTest, AViewportFrameChoosesItsLevelsOnAWorkerAndDrawsTheHeldSetMean
     EXPECT_GT(before.meanAbs, 5e-4);
 }
 
+// A viewport's frame (waitForPipelines off) whose pipelines are not built has them built on a
+// worker and is not drawn meanwhile (lavapipe compiles the terrain's in 120-170 ms): the terrain's
+// at the frame's samples and at the water reflection's one, and the water's. Once they have
+// landed the frame records without building any, and it is the frame a renderer that built them
+// where it recorded draws. A feature turned on asks for its variant the same way.
+TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
+    Project p = sampleProject("pipelines_worker", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    p.scene.fog.enabled = false;
+    ProjectRenderer here(*ctx_, p, loadProjectTerrain(p), true);
+    addLake(p, here);
+    p.scene.water.reflection = WaterReflection::Planar;
+    const bool msaa = (ctx_->framebufferSampleCounts() & 4u) != 0;
+    if (msaa) p.scene.camera.antialiasing = Antialiasing::Msaa4;
+    here.setProject(p);
+    ProjectRenderer worker(*ctx_, p, loadProjectTerrain(p), true);
+    const OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, worker.heightfield());
+    RenderRequest q = unprobed(kViewBeauty, false);
+    TerrainRenderer& t = worker.renderer();
+    auto landed = [&] {
+        const auto start = std::chrono::steady_clock::now();
+        while (t.pipelinesBuilding() && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        return !t.pipelinesBuilding();
+    };
+    const RenderSettings s = worker.settingsOf(q, camera);
+    EXPECT_FALSE(t.pipelinesReady(s));
+    EXPECT_TRUE(t.pipelinesBuilding());
+    EXPECT_FALSE(t.pipelinesReady(s)) << "asked again while building";
+    ASSERT_TRUE(landed());
+    EXPECT_TRUE(t.pipelinesReady(s));
+    // The terrain at the frame's samples and, with 4, at the reflection's 1; the water's.
+    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 3u : 2u);
+    const RenderedImage drawn = worker.render(q, camera);
+    EXPECT_EQ(t.pipelinesBuiltInline(), 0u) << "the frame built a pipeline where it recorded";
+    const std::vector<std::string> names = passNames(t.lastFramePasses());
+    for (const char* pass : {"terrain", "water-reflection", "water"})
+        EXPECT_NE(std::find(names.begin(), names.end(), pass), names.end()) << pass;
+    const RenderedImage reference = here.render(q, camera);
+    EXPECT_GT(here.renderer().pipelinesBuiltInline(), 0u);
+    EXPECT_EQ(here.renderer().pipelinesBuiltOnWorkers(), 0u);
+    EXPECT_EQ(drawn.rgba, reference.rgba);
+
+    // Fog on: a new variant of both, built on a worker again.
+    p.scene.fog.enabled = true;
+    worker.setProject(p);
+    const RenderSettings fogged = worker.settingsOf(q, camera);
+    EXPECT_FALSE(t.pipelinesReady(fogged));
+    ASSERT_TRUE(landed());
+    EXPECT_TRUE(t.pipelinesReady(fogged));
+    worker.render(q, camera);
+    EXPECT_EQ(t.pipelinesBuiltInline(), 0u);
+    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 6u : 4u);
+    // Back to no fog: the first variants are still there.
+    p.scene.fog.enabled = false;
+    worker.setProject(p);
+    EXPECT_TRUE(t.pipelinesReady(worker.settingsOf(q, camera)));
+}
+
 TEST_F(RenderTest, DetailPatchesMeetTheirPixelWhereverTheCameraIsAndKeepToTheirBudget) {
     Project p = sampleProject("detail_budget", 4, 4);
     // The sample at four times its resolution (bilinear, with a metre of deterministic roughness),

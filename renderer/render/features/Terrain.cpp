@@ -78,39 +78,62 @@ blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& i
     return surface;
 }
 
+int terrainVariant(bool vertexAttribute, bool shadows, bool fog, bool reflections, bool lpvVolumes, bool localLights) {
+    return (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0) |
+           (reflections ? kReflectionVariant : 0) | (lpvVolumes ? kLpvVariant : 0) |
+           (localLights ? kLocalLightsVariant : 0);
+}
+
+namespace {
+
+// The terrain pass binds the LPV set with either the volumes or the local lights.
+bool bindsLpvSet(int variant) { return (variant & (kLpvVariant | kLocalLightsVariant)) != 0; }
+
+VkPipelineLayout terrainLayoutOf(const RendererGpu& g, int variant) {
+    const size_t lights = size_t(((variant & kShadowVariant) ? kShadowedLights : 0) |
+                                 ((variant & kReflectionVariant) ? kReflectedLights : 0));
+    return bindsLpvSet(variant) ? g.terrainLpvLayouts[lights].handle() : g.terrainLayouts[lights].handle();
+}
+
+}  // namespace
+
+PipelineSet::Build terrainPipelineBuild(const vk::VulkanContext& ctx, const RendererGpu& g, int variant,
+                                        uint32_t samples) {
+    const bool vertexAttribute = variant & kProbeLightVariant, shadows = variant & kShadowVariant,
+               reflections = variant & kReflectionVariant, lpvSet = bindsLpvSet(variant);
+    vk::GraphicsPipelineDesc d;
+    d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
+    if (lpvSet)
+        d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionLpvFrag() : shaders::terrainReflectionLpvFrag())
+                             : (shadows ? shaders::terrainShadowLpvFrag() : shaders::terrainLpvFrag());
+    else
+        d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
+                             : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
+    d.fragConstants = {(variant & kFogVariant) ? 1u : 0u};
+    if (lpvSet)
+        d.fragConstants.insert(d.fragConstants.end(),
+                               {(variant & kLpvVariant) ? 1u : 0u, (variant & kLocalLightsVariant) ? 1u : 0u});
+    d.bindings = {kMeshBinding};
+    d.attributes = {kMeshPosition, kMeshNormal};
+    if (vertexAttribute) {
+        d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
+        d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
+    }
+    d.samples = samples;
+    const VkRenderPass pass = g.clearPassFor(samples).handle();
+    const VkPipelineLayout layout = terrainLayoutOf(g, variant);
+    return [&ctx, pass, layout, d = std::move(d)] { return vk::createGraphicsPipeline(ctx, pass, layout, d); };
+}
+
 TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
     RendererGpu& g = f.g;
     // The per-vertex attribute: probe light (or diagnostics) from the probe pass, or the traced
     // sun visibility; one of two vec4 per vertex (stride 32; bound at offset 16 for the diagnostics).
-    const bool vertexAttribute = f.probes || f.sunVisibility;
-    const bool shadows = f.shadows, reflections = f.reflections;
-    const int variant = (vertexAttribute ? kProbeLightVariant : 0) | (shadows ? kShadowVariant : 0) |
-                        (f.fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0) |
-                        (f.lpvVolumes ? kLpvVariant : 0) | (f.localLights ? kLocalLightsVariant : 0);
-    const size_t lightsVariant = size_t(f.lightsVariant());
-    const VkPipelineLayout layout =
-        f.lpvSet ? g.terrainLpvLayouts[lightsVariant].handle() : g.terrainLayouts[lightsVariant].handle();
-    vk::UniquePipeline& pipeline = g.terrain[variant | kSamplesKey(samples)];
-    if (!pipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = vertexAttribute ? shaders::terrainProbeLightVert() : shaders::terrainVert();
-        if (f.lpvSet)
-            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionLpvFrag() : shaders::terrainReflectionLpvFrag())
-                                 : (shadows ? shaders::terrainShadowLpvFrag() : shaders::terrainLpvFrag());
-        else
-            d.frag = reflections ? (shadows ? shaders::terrainShadowReflectionFrag() : shaders::terrainReflectionFrag())
-                                 : (shadows ? shaders::terrainShadowFrag() : shaders::terrainFrag());
-        d.fragConstants = {f.fog ? 1u : 0u};
-        if (f.lpvSet) d.fragConstants.insert(d.fragConstants.end(), {f.lpvVolumes ? 1u : 0u, f.localLights ? 1u : 0u});
-        d.bindings = {kMeshBinding};
-        d.attributes = {kMeshPosition, kMeshNormal};
-        if (vertexAttribute) {
-            d.bindings.push_back({1, 32, VK_VERTEX_INPUT_RATE_VERTEX});
-            d.attributes.push_back({2, 1, VK_FORMAT_R32G32B32A32_SFLOAT, 0});
-        }
-        d.samples = samples;
-        pipeline = vk::createGraphicsPipeline(f.ctx, g.clearPassFor(samples).handle(), layout, d);
-    }
+    const int variant = terrainVariant(f.probes || f.sunVisibility, f.shadows, f.fog, f.reflections, f.lpvVolumes,
+                                       f.localLights);
+    const VkPipelineLayout layout = terrainLayoutOf(g, variant);
+    const VkPipeline handle =
+        g.terrain.get(variant | kSamplesKey(samples), terrainPipelineBuild(f.ctx, g, variant, samples));
     VkBuffer attribute = VK_NULL_HANDLE;
     if (f.probes)
         attribute = f.probes->light.handle();
@@ -119,7 +142,6 @@ TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
     // The diagnostics views read the probe pass's second vec4 in place of the first: one
     // attribute and one varying either way, so no view pays for the other.
     const VkDeviceSize attributeOffset = f.probes && f.view.needs.probeDiagnostics ? 16 : 0;
-    const VkPipeline handle = pipeline.get();
     const VkDescriptorSet lights = f.lights().handle();
     const VkDescriptorSet lpvSet = f.lpvSet ? f.slot.lpvSet.handle() : VK_NULL_HANDLE;
     const VkBuffer vertices = g.vertices.handle(), indices = f.indexBuffer;

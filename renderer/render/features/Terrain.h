@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 
 #include "render/Frame.h"
+#include "render/PipelineSet.h"
 
 namespace terralux::features {
 
@@ -39,6 +40,13 @@ blocks::CameraBlock packMirroredCamera(const RenderSettings& s, const blocks::Ca
 // Terrain surface and material: albedo, GGX roughness, exposure, AO use, micro-detail.
 blocks::SurfaceBlock packSurface(const RenderSettings& s, const SurfaceInputs& in);
 
+// The terrain pipeline's variant (Frame.h's bits) for a frame with these parts: the per-vertex
+// attribute (probe light or sun visibility), shadows, fog, reflection probes, LPV volumes, local lights.
+int terrainVariant(bool vertexAttribute, bool shadows, bool fog, bool reflections, bool lpvVolumes, bool localLights);
+// Builds the terrain pipeline of `variant` for a pass of `samples` a pixel; reads only handles
+// that outlive it, so it may run on a worker (PipelineSet).
+PipelineSet::Build terrainPipelineBuild(const vk::VulkanContext& ctx, const RendererGpu& g, int variant,
+                                        uint32_t samples);
 // Records the terrain mesh with the frame's pipeline variant, with `viewSet` (the frame's view or
 // the mirrored camera's), in a pass of `samples` a pixel (the frame's, or the reflection's 1).
 using TerrainDraw = std::function<void(VkCommandBuffer, VkDescriptorSet viewSet)>;

@@ -167,25 +167,32 @@ std::unique_ptr<WaterTargets> buildWaterTargets(vk::VulkanContext& ctx, const Re
     return t;
 }
 
+int waterVariant(bool shadows, bool fog, bool reflections) {
+    return (shadows ? kShadowVariant : 0) | (fog ? kFogVariant : 0) | (reflections ? kReflectionVariant : 0);
+}
+
+PipelineSet::Build waterPipelineBuild(const vk::VulkanContext& ctx, const RendererGpu& g, int variant,
+                                      uint32_t samples) {
+    const bool shadows = variant & kShadowVariant, reflections = variant & kReflectionVariant;
+    vk::GraphicsPipelineDesc d;
+    d.vert = shaders::waterVert();
+    d.frag = reflections ? (shadows ? shaders::waterShadowReflectionFrag() : shaders::waterReflectionFrag())
+                         : (shadows ? shaders::waterShadowFrag() : shaders::waterFrag());
+    d.fragConstants = {(variant & kFogVariant) ? 1u : 0u};
+    d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
+    d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
+    d.samples = samples;
+    const size_t lights = size_t((shadows ? kShadowedLights : 0) | (reflections ? kReflectedLights : 0));
+    const VkRenderPass pass = g.drawPassFor(samples).handle();
+    const VkPipelineLayout layout = g.waterLayouts[lights].handle();
+    return [&ctx, pass, layout, d = std::move(d)] { return vk::createGraphicsPipeline(ctx, pass, layout, d); };
+}
+
 namespace {
 
 VkPipeline waterPipeline(Frame& f) {
-    const int variant = (f.shadows ? kShadowVariant : 0) | (f.fog ? kFogVariant : 0) |
-                        (f.reflections ? kReflectionVariant : 0);
-    vk::UniquePipeline& pipeline = f.g.waterPipelines[variant | kSamplesKey(f.samples)];
-    if (!pipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::waterVert();
-        d.frag = f.reflections ? (f.shadows ? shaders::waterShadowReflectionFrag() : shaders::waterReflectionFrag())
-                               : (f.shadows ? shaders::waterShadowFrag() : shaders::waterFrag());
-        d.fragConstants = {f.fog ? 1u : 0u};
-        d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
-        d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
-        d.samples = f.samples;
-        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(f.samples).handle(),
-                                              f.g.waterLayouts[size_t(f.lightsVariant())].handle(), d);
-    }
-    return pipeline.get();
+    const int variant = waterVariant(f.shadows, f.fog, f.reflections);
+    return f.g.waterPipelines.get(variant | kSamplesKey(f.samples), waterPipelineBuild(f.ctx, f.g, variant, f.samples));
 }
 
 // The terrain and the sky seen from the mirrored camera, scene-linear, with everything below the

@@ -8,6 +8,7 @@
 #include <glm/vec2.hpp>
 
 #include "render/Frame.h"
+#include "render/PipelineSet.h"
 #include "terrain/Heightfield.h"
 
 namespace terralux {
@@ -59,6 +60,11 @@ std::unique_ptr<WaterTargets> buildWaterTargets(vk::VulkanContext& ctx, const Re
 // mesh too). Null views: the layout alone.
 vk::DescriptorSetBuilder waterSetBuilder(const vk::Buffer& block, VkImageView reflection, VkImageView scene,
                                          VkImageView field, VkSampler sampler);
+// The water surface's pipeline variant (Frame.h's bits: shadows, fog, reflection probes), and
+// its build for a pass of `samples` a pixel, which may run on a worker (PipelineSet).
+int waterVariant(bool shadows, bool fog, bool reflections);
+PipelineSet::Build waterPipelineBuild(const vk::VulkanContext& ctx, const RendererGpu& g, int variant,
+                                      uint32_t samples);
 // The planar reflection (terrain and sky from the mirrored camera), the copy of the frame the
 // water refracts, and the water surface; each only where the frame needs it.
 void addWaterPasses(Frame& f);
