@@ -541,10 +541,14 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
     RenderSettings s = settingsOf(r, camera);
     // Nothing is drawn, and nothing metered, until the frame's pipelines and its meter's are
     // built: the window keeps the frame it shows meanwhile.
-    if (!r.waitForPipelines) {
+    deferredFrame_ = false;
+    if (!r.waitUntilDrawable) {
         bool ready = renderer_->pipelinesReady(s);
         if (meters(r)) ready = renderer_->pipelinesReady(meterSettings(r, camera)) && ready;
-        if (!ready) return false;
+        if (!ready) {
+            deferredFrame_ = true;
+            return false;
+        }
     }
     if (!meters(r)) adapting_ = false;
     else {
@@ -566,9 +570,20 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
         }
         if (key != meterKey_ && (!r.interactive || still || std::isnan(meteredEv100_))) {
             if (std::isnan(meteredEv100_)) {
-                // The first frame has no reading to show: it waits for its own.
-                meteredEv100_ = meter(r, camera);
-                meterKey_ = key;
+                // The first frame has no reading to show: it waits for its own (the viewport's
+                // behind the frames in flight, without holding the UI thread; 180 ms on lavapipe).
+                if (r.waitUntilDrawable) {
+                    meteredEv100_ = meter(r, camera);
+                    meterKey_ = key;
+                } else {
+                    if (!renderer_->offscreenPending()) {
+                        renderer_->beginOffscreen(meterSettings(r, camera));
+                        pendingMeterKey_ = key;
+                    }
+                    deferredFrame_ = true;
+                    adapting_ = true;  // the eye has a reading to come
+                    return false;
+                }
             } else if (!renderer_->offscreenPending()) {
                 renderer_->beginOffscreen(meterSettings(r, camera));
                 pendingMeterKey_ = key;
@@ -585,6 +600,11 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
         s.exposure = float(exposureScale(shownEv100_, project_.scene.camera.exposureEv));
     }
     return renderer_->present(s, swapchain);
+}
+
+bool ProjectRenderer::waitingToDraw() const {
+    return renderer_->pipelinesBuilding() || (std::isnan(meteredEv100_) && renderer_->offscreenPending() &&
+                                              !renderer_->offscreenFinished());
 }
 
 RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCamera& camera) const {

@@ -54,8 +54,10 @@ struct RenderRequest {
     // draw the set held (RenderSettings::waitForLevelOfDetail).
     bool waitForLevelOfDetail = true;
     // Off for the viewport: a frame whose pipelines are not built yet starts their builds on a
-    // worker and is not drawn (present() returns false; TerrainRenderer::pipelinesReady).
-    bool waitForPipelines = true;
+    // worker (TerrainRenderer::pipelinesReady), and a renderer's first metered frame draws its
+    // meter behind the frames in flight; either is not drawn until that is done (present()
+    // returns false, waitingToDraw() holds meanwhile). On, the frame waits for them.
+    bool waitUntilDrawable = true;
 };
 
 // The size the exposure meter draws a request at: `maxWidth` wide at most, the shape of the
@@ -169,9 +171,14 @@ public:
     // The same render with an explicit camera (the viewport's).
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
-    // False when nothing was drawn: no swapchain image, or (waitForPipelines off) pipelines still
-    // building (TerrainRenderer::pipelinesBuilding).
+    // False when nothing was drawn: no swapchain image, or (waitUntilDrawable off) the frame's
+    // pipelines or its first meter reading are still to come (waitingToDraw).
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
+    // Whether the last present() put its frame off (waitUntilDrawable off), and whether what it
+    // waits for, pipelines building on a worker or the first meter reading, is still to come:
+    // the viewport asks for the frame again once it is not.
+    bool deferredFrame() const { return deferredFrame_; }
+    bool waitingToDraw() const;
     // The exposure the last frame showed, EV100: camera.ev100 in mode manual; in the metered modes
     // what the meter read (render) or the viewport's adaptation toward it (present); NaN before a
     // metered frame.
@@ -227,6 +234,7 @@ public:
     static constexpr uint32_t kMeterWidth = 128;
 
 private:
+    bool deferredFrame_ = false;
     // Per volume, the overlays follow the bound probes where they carry diagnostics and were
     // baked from the current probe-volume settings; otherwise the placement of those settings.
     void updateOverlays();

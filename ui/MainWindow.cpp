@@ -357,6 +357,18 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         showError("Bake", m);
     });
 
+    drainPoll_.setInterval(10);
+    connect(&drainPoll_, &QTimer::timeout, this, [this] {
+        // The old renderer goes at one tick and the new one is made at the next: each takes
+        // 5-35 ms on the sample, and together they held the UI thread too long.
+        if (retiredRenderer_) {
+            if (!drain_.done()) return;
+            drain_ = vk::Submission();
+            retiredRenderer_.reset();
+            return;
+        }
+        buildRenderer();
+    });
     rebuildRenderer();
     updateEstimate();
     updateTitle();
@@ -375,6 +387,8 @@ MainWindow::~MainWindow() {
     delete viewport_;  // before the device it presents with
     viewport_ = nullptr;
     renderer_.reset();
+    retiredRenderer_.reset();
+    drain_ = vk::Submission();
 }
 
 QString MainWindow::autosaveDir() {
@@ -1258,6 +1272,23 @@ void MainWindow::rebuildRenderer() {
     previewJob_.dismiss();
     viewport_->setRenderer(nullptr);
     stopAmbientOcclusion();
+    if (renderer_) {
+        retiredRenderer_ = std::move(renderer_);
+        drain_ = ctx_->submit([](VkCommandBuffer) {});
+    }
+    // Built in a later turn of the event loop than the change (and than the old renderer's
+    // going), once the device is done; a terrain that changes again meanwhile is built then.
+    if (retiredRenderer_) {
+        drainPoll_.start();
+        return;
+    }
+    buildRenderer();
+}
+
+void MainWindow::buildRenderer() {
+    drainPoll_.stop();
+    drain_ = vk::Submission();
+    retiredRenderer_.reset();  // its frames are done: it goes without waiting
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
     renderer_->setScenarioView(scenarioView_);
     viewport_->setCamera(renderer_->defaultCamera());
@@ -1279,7 +1310,8 @@ void MainWindow::rebuildRenderer() {
                                  .arg(QString::fromStdString(hf.geo.crsName.empty() ? "no CRS" : hf.geo.crsName))
                                  .arg(filledShare, 0, 'f', filledShare > 0.0 && filledShare < 0.1 ? 3 : 1));
     updateAmbientOcclusion();
-    if (!baked) schedulePreview();
+    if (!baked || previewPutOff_) schedulePreview();
+    previewPutOff_ = false;
     updateStatus();
 }
 
@@ -1359,6 +1391,11 @@ void MainWindow::updateAmbientOcclusion() {
 void MainWindow::schedulePreview() { previewTimer_.start(); }
 
 void MainWindow::startPreview() {
+    // A new terrain's renderer is still to be made: it starts this preview once made.
+    if (!renderer_) {
+        previewPutOff_ = true;
+        return;
+    }
     // The project's own bake, when current, holds what a draft preview would only approximate:
     // show it (again, after an edit that was undone) and bake no preview.
     const auto folder = bakeFolder();

@@ -131,7 +131,11 @@ private:
     QString askExportFolder();
     void showReport(const nlohmann::json& report);
     void updateOutputPath();
+    // A new terrain's renderer. The one it replaces is kept until the device has finished its
+    // frames (a CPU device takes hundreds of milliseconds over one): the new renderer's uploads
+    // share the queue and would wait behind them on the UI thread.
     void rebuildRenderer();
+    void buildRenderer();
     void refreshLighting();
     // Starts the horizon AO the project asks for on a worker, unless the renderer has it or it
     // is under way; the result lands in the renderer on the UI thread.
@@ -160,6 +164,12 @@ private:
     ProjectDocument* doc_;
     QVulkanInstance vulkan_;
     std::unique_ptr<vk::VulkanContext> ctx_;
+    // The renderer a new terrain replaced, until drain_ (an empty submission behind its frames)
+    // has passed; drainPoll_ asks meanwhile.
+    std::unique_ptr<ProjectRenderer> retiredRenderer_;
+    vk::Submission drain_;
+    QTimer drainPoll_;
+    bool previewPutOff_ = false;  // a preview asked for while no renderer was there
     std::unique_ptr<ProjectRenderer> renderer_;
     ViewportWindow* viewport_ = nullptr;
     BakeController* bake_;

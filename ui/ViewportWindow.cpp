@@ -35,12 +35,6 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
     // once either has finished, a frame takes it. The full-resolution frame due after the change
     // does; with none due, the frame that takes it is one (the view holds still), not another
     // frame of the change.
-    pipelinePoll_.setInterval(10);
-    connect(&pipelinePoll_, &QTimer::timeout, this, [this] {
-        if (renderer_ && renderer_->renderer().pipelinesBuilding()) return;
-        pipelinePoll_.stop();
-        requestUpdate();
-    });
     workerPoll_.setInterval(10);
     connect(&workerPoll_, &QTimer::timeout, this, [this] {
         const TerrainRenderer* t = renderer_ ? &renderer_->renderer() : nullptr;
@@ -52,6 +46,14 @@ ViewportWindow::ViewportWindow(vk::VulkanContext& ctx, QVulkanInstance* instance
             refining_ = true;
             requestUpdate();
         }
+    });
+    // A frame put off for its pipelines or its first meter reading is asked for again once they
+    // are there.
+    deferredPoll_.setInterval(10);
+    connect(&deferredPoll_, &QTimer::timeout, this, [this] {
+        if (renderer_ && renderer_->waitingToDraw()) return;
+        deferredPoll_.stop();
+        requestUpdate();
     });
 }
 
@@ -206,15 +208,15 @@ void ViewportWindow::draw(bool now) {
     drawn.windowHeight = request_.height;
     drawn.waitForHorizon = false;
     drawn.waitForLevelOfDetail = false;
-    drawn.waitForPipelines = false;
+    drawn.waitUntilDrawable = false;
     // Below full resolution the refine timer below brings the full-resolution frame, which meters.
     drawn.interactive = size.width < request_.width || size.height < request_.height;
     if (!renderer_->present(drawn, camera_, *swapchain_)) {
-        // Its pipelines are compiling on a worker: the frame is drawn, as it was asked for, when
-        // they land.
-        if (renderer_->renderer().pipelinesBuilding()) {
+        // Its pipelines are compiling on a worker, or its first meter is being drawn: the frame
+        // is drawn, as it was asked for, once they are done.
+        if (renderer_->deferredFrame()) {
             refining_ = refining;
-            pipelinePoll_.start();
+            deferredPoll_.start();
         }
         return;
     }

@@ -95,7 +95,7 @@ public:
     // has more to show.
     bool drawing() const {
         return presentPoll_.isActive() || frameWanted_ || refineTimer_.isActive() || workerPoll_.isActive() ||
-               pipelinePoll_.isActive();
+               deferredPoll_.isActive();
     }
 
 signals:
@@ -150,7 +150,7 @@ private:
     // The UI thread never waits for the device: a submitted frame is presented once it has
     // finished (polled every few milliseconds), and a frame asked for meanwhile is drawn then.
     QTimer presentPoll_;
-    QTimer pipelinePoll_;  // while a frame's pipelines compile on a worker
+    QTimer deferredPoll_;  // while a frame waits for its pipelines or its first meter (ProjectRenderer::waitingToDraw)
     QTimer workerPoll_;  // while the renderer sweeps a horizon map or chooses levels on a worker
     std::optional<std::chrono::steady_clock::time_point> frameStart_;
     bool frameWanted_ = false;

@@ -243,7 +243,9 @@ struct RendererGpu {
     PipelineSet terrain;
     // The water surface's, by kShadowVariant | kFogVariant | kReflectionVariant and samples.
     PipelineSet waterPipelines;
-    std::map<int, vk::UniquePipeline> sky, markerPipelines, leafPipelines, gizmoPipelines;
+    // The sky behind the terrain's, by fog and samples.
+    PipelineSet sky;
+    std::map<int, vk::UniquePipeline> markerPipelines, leafPipelines, gizmoPipelines;
     vk::UniquePipeline shadowDepth, probePass;
     // The anti-aliasing pass: its colour-only render pass, layout and pipelines by
     // (ssaa ? 2 : 0) + (scene-linear output ? 1 : 0).

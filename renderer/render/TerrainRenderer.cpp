@@ -1514,6 +1514,7 @@ TerrainRenderer::Parts TerrainRenderer::partsOf(const RenderSettings& s, const D
     p.lpvVolumes = g.lpv && ((s.lpvLight && view.needs.sceneLights) || view.needs.lpvVolumes);
     p.localLights = !s.lights.empty() && view.needs.sceneLights;
     p.sunVisibility = view.needs.sunVisibility;
+    p.sky = view.needs.sky;
     // Shadows: the scene has them on, the sun is up and the view draws them: a lit view only for a
     // sun that gives light (an image sky without a glow, a sun at 0 lx), the shadow views for any.
     const bool sunLights = std::max({s.sun.illuminance.x, s.sun.illuminance.y, s.sun.illuminance.z}) > 0.0f;
@@ -1538,6 +1539,11 @@ bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
     bool ready = g.terrain.ready(terrain | kSamplesKey(samples), features::terrainPipelineBuild(ctx_, g, terrain, samples));
     if (p.planarReflection)
         ready = g.terrain.ready(terrain | kSamplesKey(1), features::terrainPipelineBuild(ctx_, g, terrain, 1)) && ready;
+    // The sky behind the frame and in the water's reflection.
+    const int sky = features::skyVariant(s.fog.enabled);
+    if (p.sky)
+        ready = g.sky.ready(sky | kSamplesKey(samples), features::skyPipelineBuild(ctx_, g, sky, samples)) && ready;
+    if (p.planarReflection) ready = g.sky.ready(sky | kSamplesKey(1), features::skyPipelineBuild(ctx_, g, sky, 1)) && ready;
     if (p.water) {
         const int water = features::waterVariant(p.shadowed, s.fog.enabled, p.reflections);
         ready = g.waterPipelines.ready(water | kSamplesKey(samples),
@@ -1546,14 +1552,16 @@ bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
     return ready;
 }
 
-bool TerrainRenderer::pipelinesBuilding() const { return gpu_->terrain.building() || gpu_->waterPipelines.building(); }
+bool TerrainRenderer::pipelinesBuilding() const {
+    return gpu_->terrain.building() || gpu_->waterPipelines.building() || gpu_->sky.building();
+}
 
 size_t TerrainRenderer::pipelinesBuiltInline() const {
-    return gpu_->terrain.builtHere() + gpu_->waterPipelines.builtHere();
+    return gpu_->terrain.builtHere() + gpu_->waterPipelines.builtHere() + gpu_->sky.builtHere();
 }
 
 size_t TerrainRenderer::pipelinesBuiltOnWorkers() const {
-    return gpu_->terrain.builtOnWorkers() + gpu_->waterPipelines.builtOnWorkers();
+    return gpu_->terrain.builtOnWorkers() + gpu_->waterPipelines.builtOnWorkers() + gpu_->sky.builtOnWorkers();
 }
 
 void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
@@ -1577,7 +1585,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
     f.gizmoCount = uint32_t(s.gizmos.size());
     f.fog = s.fog.enabled;
     f.sunVisibility = parts.sunVisibility;
-    f.sky = view.needs.sky;
+    f.sky = parts.sky;
     if (f.sunVisibility) updateSunVisibility(s.sun, s.skirt);
     // A scene without shadows holds no maps.
     const bool shadowed = parts.shadowed;

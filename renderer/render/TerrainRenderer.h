@@ -172,6 +172,8 @@ public:
     // the image once the GPU has drawn it. False, drawing nothing, while one is still untaken.
     bool beginOffscreen(const RenderSettings& settings);
     bool offscreenPending() const { return offscreen_.has_value(); }
+    // Whether the device has finished it (takeOffscreen() then gives it).
+    bool offscreenFinished() const { return offscreen_ && (offscreen_->read || offscreen_->submission.done()); }
     // The image beginOffscreen() drew, once the GPU has finished it (never waits); nullopt before
     // then and when none was begun.
     std::optional<RenderedImage> takeOffscreen();
@@ -179,13 +181,14 @@ public:
     // readback) and submits it without waiting for the GPU; the swapchain presents it once it
     // has finished (vk::Swapchain::presentIfDone). False when nothing could be shown.
     bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
-    // Whether a frame of `settings` finds the terrain's and the water's pipelines for it built (a
-    // CPU device compiles the terrain's in 120-170 ms); those missing start building on a worker.
+    // Whether a frame of `settings` finds the terrain's, the sky's and the water's pipelines for it
+    // built (a CPU device compiles the terrain's in 120-170 ms, the sky's in 10-16 ms); those
+    // missing start building on a worker.
     // A viewport that must not wait draws such a frame once this holds, polling
     // pipelinesBuilding(); any other frame builds what it lacks where it is recorded.
     bool pipelinesReady(const RenderSettings& settings);
     bool pipelinesBuilding() const;
-    // Pipelines of those two kinds built where a frame was recorded, and on workers.
+    // Pipelines of those kinds built where a frame was recorded, and on workers.
     size_t pipelinesBuiltInline() const;
     size_t pipelinesBuiltOnWorkers() const;
     // The passes of the last frame, in order, with what each used and bound.
@@ -284,7 +287,8 @@ private:
     // pipelinesReady decide alike).
     struct Parts {
         bool probes = false, reflections = false, lpvVolumes = false, localLights = false;
-        bool sunVisibility = false, shadowed = false, water = false, waterShading = false, planarReflection = false;
+        bool sunVisibility = false, sky = false, shadowed = false, water = false, waterShading = false;
+        bool planarReflection = false;
     };
     Parts partsOf(const RenderSettings& s, const DebugView& view) const;
     void ensureMultisampledPasses(uint32_t samples);

@@ -3339,9 +3339,9 @@ TEST_F(RenderTest, AViewportFrameChoosesItsLevelsOnAWorkerAndDrawsTheHeldSetMean
     EXPECT_GT(before.meanAbs, 5e-4);
 }
 
-// A viewport's frame (waitForPipelines off) whose pipelines are not built has them built on a
+// A viewport's frame (waitUntilDrawable off) whose pipelines are not built has them built on a
 // worker and is not drawn meanwhile (lavapipe compiles the terrain's in 120-170 ms): the terrain's
-// at the frame's samples and at the water reflection's one, and the water's. Once they have
+// and the sky's at the frame's samples and at the water reflection's one, and the water's. Once they have
 // landed the frame records without building any, and it is the frame a renderer that built them
 // where it recorded draws. A feature turned on asks for its variant the same way.
 TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
@@ -3370,8 +3370,8 @@ TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
     EXPECT_FALSE(t.pipelinesReady(s)) << "asked again while building";
     ASSERT_TRUE(landed());
     EXPECT_TRUE(t.pipelinesReady(s));
-    // The terrain at the frame's samples and, with 4, at the reflection's 1; the water's.
-    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 3u : 2u);
+    // The terrain and the sky at the frame's samples and, with 4, at the reflection's 1; the water's.
+    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 5u : 3u);
     const RenderedImage drawn = worker.render(q, camera);
     EXPECT_EQ(t.pipelinesBuiltInline(), 0u) << "the frame built a pipeline where it recorded";
     const std::vector<std::string> names = passNames(t.lastFramePasses());
@@ -3382,7 +3382,7 @@ TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
     EXPECT_EQ(here.renderer().pipelinesBuiltOnWorkers(), 0u);
     EXPECT_EQ(drawn.rgba, reference.rgba);
 
-    // Fog on: a new variant of both, built on a worker again.
+    // Fog on: a new variant of each, built on a worker again.
     p.scene.fog.enabled = true;
     worker.setProject(p);
     const RenderSettings fogged = worker.settingsOf(q, camera);
@@ -3391,7 +3391,7 @@ TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
     EXPECT_TRUE(t.pipelinesReady(fogged));
     worker.render(q, camera);
     EXPECT_EQ(t.pipelinesBuiltInline(), 0u);
-    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 6u : 4u);
+    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), msaa ? 10u : 6u);
     // Back to no fog: the first variants are still there.
     p.scene.fog.enabled = false;
     worker.setProject(p);

@@ -26,18 +26,23 @@ blocks::AtmosphereBlock packAtmosphere(const FogSettings& fog) {
     return atmosphere;
 }
 
+int skyVariant(bool fog) { return fog ? 1 : 0; }
+
+PipelineSet::Build skyPipelineBuild(const vk::VulkanContext& ctx, const RendererGpu& g, int variant, uint32_t samples) {
+    vk::GraphicsPipelineDesc d;
+    d.vert = shaders::fullscreenVert();
+    d.frag = shaders::skyBackgroundFrag();
+    d.fragConstants = {uint32_t(variant & 1)};
+    d.depthWrite = false;
+    d.samples = samples;
+    const VkRenderPass pass = g.drawPassFor(samples).handle();
+    const VkPipelineLayout layout = g.terrainLayouts[0].handle();
+    return [&ctx, pass, layout, d = std::move(d)] { return vk::createGraphicsPipeline(ctx, pass, layout, d); };
+}
+
 VkPipeline skyPipeline(Frame& f, uint32_t samples) {
-    vk::UniquePipeline& pipeline = f.g.sky[(f.fog ? 1 : 0) | kSamplesKey(samples)];
-    if (!pipeline) {
-        vk::GraphicsPipelineDesc d;
-        d.vert = shaders::fullscreenVert();
-        d.frag = shaders::skyBackgroundFrag();
-        d.fragConstants = {f.fog ? 1u : 0u};
-        d.depthWrite = false;
-        d.samples = samples;
-        pipeline = vk::createGraphicsPipeline(f.ctx, f.g.drawPassFor(samples).handle(), f.g.terrainLayouts[0].handle(), d);
-    }
-    return pipeline.get();
+    const int variant = skyVariant(f.fog);
+    return f.g.sky.get(variant | kSamplesKey(samples), skyPipelineBuild(f.ctx, f.g, variant, samples));
 }
 
 void addSkyPass(Frame& f) {
