@@ -360,9 +360,10 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
     drainPoll_.setInterval(10);
     connect(&drainPoll_, &QTimer::timeout, this, [this] {
         // The old renderer goes at one tick and the new one is made at the next: each takes
-        // 5-35 ms on the sample, and together they held the UI thread too long.
+        // 5-30 ms on the sample, and together they held the UI thread too long. It goes once its
+        // workers have finished too, so that its destruction waits for nothing.
         if (retiredRenderer_) {
-            if (!drain_.done()) return;
+            if (!drain_.done() || !retiredRenderer_->renderer().workersFinished()) return;
             drain_ = vk::Submission();
             retiredRenderer_.reset();
             return;
@@ -1278,6 +1279,7 @@ void MainWindow::rebuildRenderer() {
     }
     // Built in a later turn of the event loop than the change (and than the old renderer's
     // going), once the device is done; a terrain that changes again meanwhile is built then.
+    // With no renderer to retire (the first, or one retired a tick ago) it is built now.
     if (retiredRenderer_) {
         drainPoll_.start();
         return;
@@ -1287,8 +1289,6 @@ void MainWindow::rebuildRenderer() {
 
 void MainWindow::buildRenderer() {
     drainPoll_.stop();
-    drain_ = vk::Submission();
-    retiredRenderer_.reset();  // its frames are done: it goes without waiting
     renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
     renderer_->setScenarioView(scenarioView_);
     viewport_->setCamera(renderer_->defaultCamera());

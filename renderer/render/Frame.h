@@ -176,7 +176,7 @@ struct SurfaceTextures {
 // What the renderer holds on the GPU for its lifetime: the terrain mesh, the frame slots and
 // targets, the render passes and layouts every feature shares, and each feature's resources.
 // Pipelines are built on first use (lavapipe compiles a pipeline when it is created); the
-// terrain's and the water's may be built on a worker ahead of the frame (PipelineSet.h).
+// terrain's, the water's and the sky's may be built on a worker ahead of the frame (PipelineSet.h).
 struct RendererGpu {
     vk::Buffer vertices, markers, leaves;
     // The detail patches' vertices (position and normal, as `vertices`), and which set of them
@@ -237,9 +237,9 @@ struct RendererGpu {
     // Terrain pipelines by variant: kProbeLightVariant | kShadowVariant | kFogVariant |
     // kReflectionVariant | kLpvVariant | kLocalLightsVariant (either of the last two: the TLX_LPV
     // shaders and layout).
-    // Keyed also by the samples a pixel of the pass they draw in (kSamplesKey). These two sets
-    // may build on a worker (PipelineSet.h): declared after the passes and layouts their builds
-    // read, they wait for them before those go.
+    // Keyed also by the samples a pixel of the pass they draw in (kSamplesKey). This set and the
+    // two below may build on a worker (PipelineSet.h): declared after the passes and layouts
+    // their builds read, they wait for them before those go.
     PipelineSet terrain;
     // The water surface's, by kShadowVariant | kFogVariant | kReflectionVariant and samples.
     PipelineSet waterPipelines;

@@ -1552,6 +1552,11 @@ bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
     return ready;
 }
 
+bool TerrainRenderer::workersFinished() const {
+    return !pipelinesBuilding() && (!sunHorizonSweeping() || sunHorizonSwept()) &&
+           (!levelOfDetailBuilding() || levelOfDetailBuilt());
+}
+
 bool TerrainRenderer::pipelinesBuilding() const {
     return gpu_->terrain.building() || gpu_->waterPipelines.building() || gpu_->sky.building();
 }

@@ -183,11 +183,15 @@ public:
     bool present(const RenderSettings& settings, vk::Swapchain& swapchain);
     // Whether a frame of `settings` finds the terrain's, the sky's and the water's pipelines for it
     // built (a CPU device compiles the terrain's in 120-170 ms, the sky's in 10-16 ms); those
-    // missing start building on a worker.
-    // A viewport that must not wait draws such a frame once this holds, polling
-    // pipelinesBuilding(); any other frame builds what it lacks where it is recorded.
+    // missing start building on a worker. A viewport that must not wait draws such a frame once
+    // this holds (ProjectRenderer::waitingToDraw polls pipelinesBuilding()); any other frame
+    // builds what it lacks where it is recorded. The shadow-depth, overlay and anti-aliasing
+    // pipelines (0.5-6 ms each on lavapipe) are still built where the frame is recorded.
     bool pipelinesReady(const RenderSettings& settings);
     bool pipelinesBuilding() const;
+    // No work of this renderer's is still running on a worker (pipeline builds, a horizon sweep,
+    // a choice of levels): destroying it then waits for none.
+    bool workersFinished() const;
     // Pipelines of those kinds built where a frame was recorded, and on workers.
     size_t pipelinesBuiltInline() const;
     size_t pipelinesBuiltOnWorkers() const;
