@@ -49,7 +49,8 @@ void memoryBarrier(VkCommandBuffer cb, VkPipelineStageFlags srcStages, VkAccessF
 RendererGpu::~RendererGpu() = default;
 
 int Frame::lightsVariant() const {
-    return (shadows ? frame::kShadowedLights : 0) | (reflections ? frame::kReflectedLights : 0);
+    return frame::lightsOfVariant((shadows ? frame::kShadowVariant : 0) |
+                                  (reflections ? frame::kReflectionVariant : 0));
 }
 
 const vk::DescriptorSet& Frame::lights() const {

@@ -87,6 +87,10 @@ inline constexpr int kProbeLightVariant = 1, kShadowVariant = 2, kFogVariant = 4
 inline int kSamplesKey(uint32_t samples) { return int(samples) << 8; }
 // The lights set's variants, an index into the layouts: the shadow cascades, the reflection probes.
 inline constexpr int kShadowedLights = 1, kReflectedLights = 2;
+// The lights set a pipeline variant (or a frame with its shadows and reflections) binds.
+inline constexpr int lightsOfVariant(int variant) {
+    return ((variant & kShadowVariant) ? kShadowedLights : 0) | ((variant & kReflectionVariant) ? kReflectedLights : 0);
+}
 
 // The terrain mesh's vertices as the terrain and shadow pipelines read them: position and normal.
 inline constexpr VkVertexInputBindingDescription kMeshBinding{0, 24, VK_VERTEX_INPUT_RATE_VERTEX};

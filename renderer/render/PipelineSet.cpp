@@ -19,8 +19,7 @@ bool PipelineSet::land(int key) {
     return true;
 }
 
-VkPipeline PipelineSet::get(int key, const Build& build) {
-    if (auto it = built_.find(key); it != built_.end()) return it->second.get();
+VkPipeline PipelineSet::buildHere(int key, const Build& build) {
     if (!land(key)) {
         built_[key] = build();
         ++builtHere_;
@@ -28,13 +27,12 @@ VkPipeline PipelineSet::get(int key, const Build& build) {
     return built_[key].get();
 }
 
-bool PipelineSet::ready(int key, Build build) {
-    if (built_.count(key)) return true;
+void PipelineSet::start(int key, Build build) {
+    building_.emplace(key, std::async(std::launch::async, std::move(build)));
+}
+
+bool PipelineSet::poll(int key) {
     auto it = building_.find(key);
-    if (it == building_.end()) {
-        building_.emplace(key, std::async(std::launch::async, std::move(build)));
-        return false;
-    }
     if (it->second.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
     land(key);
     return true;

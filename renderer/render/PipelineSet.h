@@ -24,10 +24,24 @@ public:
     PipelineSet& operator=(const PipelineSet&) = delete;
     ~PipelineSet();  // waits for the builds under way: they read handles the owner frees next
 
-    // key's pipeline, built here when missing (after the build under way, if one is).
-    VkPipeline get(int key, const Build& build);
+    // key's pipeline, built here when missing (after the build under way, if one is). `make`
+    // returns the Build; it is called only when one is needed, so a frame that finds its
+    // pipelines built assembles no pipeline description.
+    template <class Make>
+    VkPipeline get(int key, Make&& make) {
+        if (auto it = built_.find(key); it != built_.end()) return it->second.get();
+        return buildHere(key, make());
+    }
     // Whether key's pipeline is built; when not, its build starts on a worker (once).
-    bool ready(int key, Build build);
+    template <class Make>
+    bool ready(int key, Make&& make) {
+        if (built_.count(key)) return true;
+        if (!building_.count(key)) {
+            start(key, make());
+            return false;
+        }
+        return poll(key);
+    }
     // Some build under way has not finished.
     bool building() const;
     // Pipelines built on the recording thread, and on workers, since the set was made.
@@ -36,6 +50,9 @@ public:
 
 private:
     bool land(int key);  // a finished build's pipeline taken in (its error thrown here)
+    VkPipeline buildHere(int key, const Build& build);  // lands the build under way, else builds
+    void start(int key, Build build);                   // on a worker
+    bool poll(int key);                                 // whether the build under way landed
 
     std::map<int, vk::UniquePipeline> built_;
     std::map<int, std::future<vk::UniquePipeline>> building_;

@@ -1536,18 +1536,24 @@ bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
     const int terrain = features::terrainVariant(p.probes || p.sunVisibility, p.shadowed, s.fog.enabled,
                                                  p.reflections, p.lpvVolumes, p.localLights);
     // Each missing one starts now, beside the others.
-    bool ready = g.terrain.ready(terrain | kSamplesKey(samples), features::terrainPipelineBuild(ctx_, g, terrain, samples));
-    if (p.planarReflection)
-        ready = g.terrain.ready(terrain | kSamplesKey(1), features::terrainPipelineBuild(ctx_, g, terrain, 1)) && ready;
+    auto terrainAt = [&](uint32_t n) {
+        return g.terrain.ready(terrain | kSamplesKey(n),
+                               [&] { return features::terrainPipelineBuild(ctx_, g, terrain, n); });
+    };
+    bool ready = terrainAt(samples);
+    if (p.planarReflection) ready = terrainAt(1) && ready;
     // The sky behind the frame and in the water's reflection.
     const int sky = features::skyVariant(s.fog.enabled);
-    if (p.sky)
-        ready = g.sky.ready(sky | kSamplesKey(samples), features::skyPipelineBuild(ctx_, g, sky, samples)) && ready;
-    if (p.planarReflection) ready = g.sky.ready(sky | kSamplesKey(1), features::skyPipelineBuild(ctx_, g, sky, 1)) && ready;
+    auto skyAt = [&](uint32_t n) {
+        return g.sky.ready(sky | kSamplesKey(n), [&] { return features::skyPipelineBuild(ctx_, g, sky, n); });
+    };
+    if (p.sky) ready = skyAt(samples) && ready;
+    if (p.planarReflection) ready = skyAt(1) && ready;
     if (p.water) {
         const int water = features::waterVariant(p.shadowed, s.fog.enabled, p.reflections);
         ready = g.waterPipelines.ready(water | kSamplesKey(samples),
-                                       features::waterPipelineBuild(ctx_, g, water, samples)) && ready;
+                                       [&] { return features::waterPipelineBuild(ctx_, g, water, samples); }) &&
+                ready;
     }
     return ready;
 }

@@ -42,7 +42,7 @@ PipelineSet::Build skyPipelineBuild(const vk::VulkanContext& ctx, const Renderer
 
 VkPipeline skyPipeline(Frame& f, uint32_t samples) {
     const int variant = skyVariant(f.fog);
-    return f.g.sky.get(variant | kSamplesKey(samples), skyPipelineBuild(f.ctx, f.g, variant, samples));
+    return f.g.sky.get(variant | kSamplesKey(samples), [&] { return skyPipelineBuild(f.ctx, f.g, variant, samples); });
 }
 
 void addSkyPass(Frame& f) {

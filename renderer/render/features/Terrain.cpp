@@ -90,8 +90,7 @@ namespace {
 bool bindsLpvSet(int variant) { return (variant & (kLpvVariant | kLocalLightsVariant)) != 0; }
 
 VkPipelineLayout terrainLayoutOf(const RendererGpu& g, int variant) {
-    const size_t lights = size_t(((variant & kShadowVariant) ? kShadowedLights : 0) |
-                                 ((variant & kReflectionVariant) ? kReflectedLights : 0));
+    const size_t lights = size_t(lightsOfVariant(variant));
     return bindsLpvSet(variant) ? g.terrainLpvLayouts[lights].handle() : g.terrainLayouts[lights].handle();
 }
 
@@ -133,7 +132,7 @@ TerrainDraw terrainDraw(Frame& f, uint32_t samples) {
                                        f.localLights);
     const VkPipelineLayout layout = terrainLayoutOf(g, variant);
     const VkPipeline handle =
-        g.terrain.get(variant | kSamplesKey(samples), terrainPipelineBuild(f.ctx, g, variant, samples));
+        g.terrain.get(variant | kSamplesKey(samples), [&] { return terrainPipelineBuild(f.ctx, g, variant, samples); });
     VkBuffer attribute = VK_NULL_HANDLE;
     if (f.probes)
         attribute = f.probes->light.handle();

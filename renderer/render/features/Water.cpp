@@ -182,7 +182,7 @@ PipelineSet::Build waterPipelineBuild(const vk::VulkanContext& ctx, const Render
     d.bindings = {{0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX}};
     d.attributes = {{0, 0, VK_FORMAT_R32G32_SFLOAT, 0}};
     d.samples = samples;
-    const size_t lights = size_t((shadows ? kShadowedLights : 0) | (reflections ? kReflectedLights : 0));
+    const size_t lights = size_t(lightsOfVariant(variant));
     const VkRenderPass pass = g.drawPassFor(samples).handle();
     const VkPipelineLayout layout = g.waterLayouts[lights].handle();
     return [&ctx, pass, layout, d = std::move(d)] { return vk::createGraphicsPipeline(ctx, pass, layout, d); };
@@ -192,7 +192,8 @@ namespace {
 
 VkPipeline waterPipeline(Frame& f) {
     const int variant = waterVariant(f.shadows, f.fog, f.reflections);
-    return f.g.waterPipelines.get(variant | kSamplesKey(f.samples), waterPipelineBuild(f.ctx, f.g, variant, f.samples));
+    return f.g.waterPipelines.get(variant | kSamplesKey(f.samples),
+                                  [&] { return waterPipelineBuild(f.ctx, f.g, variant, f.samples); });
 }
 
 // The terrain and the sky seen from the mirrored camera, scene-linear, with everything below the
