@@ -822,7 +822,8 @@ void TerrainRenderer::updateLod(const RenderSettings& s, double rows, bool pictu
         // pixel out of the DEM are drawn from the DEM's vertices, within the detail budget.
         detail.assign(patches_.count(), -1);
         if (detailAllowed)
-            chooseDetail(detail, levels, surface, finestDetail, asked, eye, fovY, rows, maxPixels, inputs.detailBudget);
+            chooseDetail(detail, levels, surface, finestDetail, asked, eye, fovY, rows, maxPixels,
+                         detailBudgetFor(inputs.detailBudget, rows, s.height > 0 ? double(s.width) / s.height : 1.0));
         // A detail patch's surface, its zipped ring included, against the DEM: measured once per
         // state of the patch and its four sides.
         const uint32_t px = patches_.patchesX(), pz = patches_.patchesZ();
@@ -1060,6 +1061,11 @@ void TerrainRenderer::chooseDetail(std::vector<int8_t>& detail, std::span<const 
     const std::vector<size_t> state = lod::allocateDetail(candidates, budget, maxPixels);
     for (size_t m = 0; m < wanted.size(); ++m)
         detail[wanted[m]] = state[m] == 0 ? int8_t(-1) : int8_t(detailLevels_ - state[m]);
+}
+
+size_t TerrainRenderer::detailBudgetFor(size_t budget, double rows, double aspect) {
+    const double scale = std::clamp(rows * rows * aspect / kDetailBudgetPixels, 1.0, kDetailBudgetMaxScale);
+    return size_t(double(budget) * scale);
 }
 
 TerrainRenderer::LodInputs TerrainRenderer::lodInputsOf(const WaterResources* water) const {

@@ -259,7 +259,14 @@ public:
     // Their vertices live in a buffer of their own, built when the set of such patches changes;
     // the probe pass lights them as it lights the drawn grid's.
     // setSourceDetail(false) draws the drawn grid alone (the benchmarks and tests compare).
+    // The budget is for a frame of up to kDetailBudgetPixels (1280 x 720); a larger frame gets
+    // it in proportion to its pixels, up to kDetailBudgetMaxScale times: a pixel's error needs
+    // about as many vertices wherever it is, so a 1920 x 1080 frame keeps the pixel where a
+    // 1280 x 720 one does (detailBudgetFor).
     static constexpr size_t kDetailVertexBudget = size_t(1) << 22;
+    static constexpr double kDetailBudgetPixels = 1280.0 * 720.0;
+    static constexpr double kDetailBudgetMaxScale = 4.0;
+    static size_t detailBudgetFor(size_t budget, double rows, double aspect);
     void setSourceDetail(bool on) { sourceDetail_ = on; }
     void setDetailVertexBudget(size_t vertices) { detailVertexBudget_ = vertices; }
     // Detail levels a patch has (steps 2^d below the stride; 0 where the DEM is drawn whole).

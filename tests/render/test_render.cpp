@@ -3460,6 +3460,22 @@ TEST_F(RenderTest, DetailPatchesMeetTheirPixelWhereverTheCameraIsAndKeepToTheirB
     EXPECT_LE(bound.detailVertices, free.detailVertices / 3);
     EXPECT_GT(bound.screenErrorPixels, 1.0);  // the budget binds
     EXPECT_LT(bound.screenErrorPixels, 0.5 * drawnPixels);
+    // A frame of more pixels than kDetailBudgetPixels gets the budget in proportion (1920 x 1080:
+    // 2.25 times), so its pixel costs no more of the DEM than a 1280 x 720 frame's does.
+    const size_t budget = free.detailVertices / 3;
+    EXPECT_NEAR(double(TerrainRenderer::detailBudgetFor(budget, 720.0, 16.0 / 9.0)), double(budget), 1.0);
+    const size_t scaled = TerrainRenderer::detailBudgetFor(budget, 1080.0, 16.0 / 9.0);
+    EXPECT_NEAR(double(scaled), 2.25 * double(budget), 1.0);
+    EXPECT_NEAR(double(TerrainRenderer::detailBudgetFor(budget, 4320.0, 16.0 / 9.0)),
+                TerrainRenderer::kDetailBudgetMaxScale * double(budget), 1.0);
+    RenderRequest large = q;
+    large.width = 1920;
+    large.height = 1080;
+    r.render(large, close);
+    std::printf("1920 x 1080 at a third of the budget: %zu vertices (budget %zu), %.3f px\n",
+                t.lastLod().detailVertices, scaled, t.lastLod().screenErrorPixels);
+    EXPECT_GT(t.lastLod().detailVertices, budget);
+    EXPECT_LE(t.lastLod().detailVertices, scaled);
 }
 
 TEST_F(RenderTest, TheLevelOfDetailDrawnStraysAtMostAPixelFromTheWholeMesh) {
