@@ -190,8 +190,13 @@ int commandRender(const Args& a) {
         std::cerr << programName() << ": note: this bake measured no interpolation-error map "
                      "(bake.error_map_resolution = 0, or no volume over the terrain): view "
                   << kViewInterpolationError << " is grey\n";
+    // A PNG is read back as its 8-bit codes: no float frame is made to be rounded again.
+    request.bytes = encodingFor(image) == ImageEncoding::Display8;
     const RenderedImage img = renderer.render(request);
-    writeImage(image, img.width, img.height, img.rgba);
+    if (request.bytes)
+        writeImage(image, img.width, img.height, img.bytes);
+    else
+        writeImage(image, img.width, img.height, img.rgba);
     // The first frame builds pipelines, maps and volumes; the profile is of the same frame warm,
     // drawn again for at least a second (a GPU's clocks ramp up under load) and at least three
     // times, the median of each figure reported: one warm frame on an idle GPU read up to 5x high.

@@ -468,6 +468,7 @@ RenderSettings ProjectRenderer::meterSettings(const RenderRequest& r, const Orbi
     RenderRequest q = r;
     std::tie(q.width, q.height) = meterSize(r, kMeterWidth);
     q.linearOutput = true;
+    q.bytes = false;
     q.probePositions = q.leaves = false;
     q.gizmos.clear();
     RenderSettings s = settingsOf(q, camera);
@@ -618,6 +619,7 @@ RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCa
     const IndirectLighting indirect = project_.scene.lighting.indirect;
     s.probes = r.probes && (indirect == IndirectLighting::Probes || indirect == IndirectLighting::Both);
     s.linearOutput = r.linearOutput;
+    s.readbackBytes = r.bytes && !r.linearOutput;
     s.showProbePositions = r.probePositions;
     s.showLeaves = r.leaves;
     s.gizmos = r.gizmos;

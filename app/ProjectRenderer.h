@@ -28,6 +28,8 @@ struct RenderRequest {
     int debugView = 0;
     bool probes = true;
     bool linearOutput = false;
+    // The pixels as 8-bit codes (RenderedImage::bytes) rather than floats: a PNG's read-back.
+    bool bytes = false;
     bool bakeIfMissing = true;
     bool probePositions = false;  // overlay of the enabled volumes' probe positions
     bool leaves = false;          // overlay of the adaptive volumes' octree leaves

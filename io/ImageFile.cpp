@@ -8,6 +8,7 @@
 
 #include "AtomicFile.h"
 #include "EnvironmentImage.h"
+#include "scene/ImageCodes.h"
 
 namespace terralux {
 
@@ -17,9 +18,12 @@ ImageEncoding encodingFor(const std::filesystem::path& path) {
     return ext == ".exr" ? ImageEncoding::LinearFloat : ImageEncoding::Display8;
 }
 
-void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
-                const std::vector<float>& rgba) {
-    if (rgba.size() != size_t(width) * height * 4)
+namespace {
+
+// `data`: width * height * 4 samples of `type` (FLOAT or UINT8), written as that type.
+void writeSamples(const std::filesystem::path& path, uint32_t width, uint32_t height, size_t count,
+                  OIIO::TypeDesc type, const void* data) {
+    if (count != size_t(width) * height * 4)
         throw ImageError(path.string() + ": image data does not match " + std::to_string(width) +
                          "x" + std::to_string(height));
     // The temporary keeps the extension so OpenImageIO picks the format from it.
@@ -29,22 +33,11 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
     if (!out)
         throw ImageError(path.string() + ": no image writer for this extension (" +
                          OIIO::geterror() + "); use .png or .exr");
-    const bool linear = encodingFor(path) == ImageEncoding::LinearFloat;
-    OIIO::ImageSpec spec(int(width), int(height), 4, linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    OIIO::ImageSpec spec(int(width), int(height), 4, type);
     // OpenImageIO stamps an EXR with the time of writing unless DateTime is given; an empty one
     // keeps the file the same bytes on every run, like every other output.
-    if (linear) spec.attribute("DateTime", "");
-    std::vector<uint8_t> bytes;
-    const void* data = rgba.data();
-    if (!linear) {
-        bytes.resize(rgba.size());
-        for (size_t i = 0; i < rgba.size(); ++i)
-            bytes[i] = uint8_t(std::lround(std::clamp(std::isfinite(rgba[i]) ? rgba[i] : 0.0f, 0.0f, 1.0f) * 255.0f));
-        data = bytes.data();
-    }
-    if (!out->open(tmp.string(), spec) ||
-        !out->write_image(linear ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8, data) ||
-        !out->close()) {
+    if (type == OIIO::TypeDesc::FLOAT) spec.attribute("DateTime", "");
+    if (!out->open(tmp.string(), spec) || !out->write_image(type, data) || !out->close()) {
         std::string why = out->geterror();
         std::replace(why.begin(), why.end(), '\n', ' ');
         std::error_code ec;
@@ -58,6 +51,27 @@ void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t heig
         std::filesystem::remove(tmp, ec);
         throw FileWriteError(path.string() + ": cannot replace (" + reason + ")");
     }
+}
+
+}  // namespace
+
+void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                const std::vector<float>& rgba) {
+    if (encodingFor(path) == ImageEncoding::LinearFloat) {
+        writeSamples(path, width, height, rgba.size(), OIIO::TypeDesc::FLOAT, rgba.data());
+        return;
+    }
+    std::vector<uint8_t> bytes(rgba.size());
+    for (size_t i = 0; i < rgba.size(); ++i) bytes[i] = unitToByte(rgba[i]);
+    writeSamples(path, width, height, bytes.size(), OIIO::TypeDesc::UINT8, bytes.data());
+}
+
+void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                const std::vector<uint8_t>& bytes) {
+    if (encodingFor(path) == ImageEncoding::LinearFloat)
+        throw ImageError(path.string() + ": 8-bit samples cannot be written as EXR, which holds scene-linear "
+                                         "floats; use .png");
+    writeSamples(path, width, height, bytes.size(), OIIO::TypeDesc::UINT8, bytes.data());
 }
 
 std::vector<uint8_t> encodePng(uint32_t width, uint32_t height, int channels,

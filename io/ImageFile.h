@@ -16,6 +16,10 @@ enum class ImageEncoding { Display8, LinearFloat };
 // FileWriteError (AtomicFile.h) when the file cannot be written; both name the file and the reason.
 void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
                 const std::vector<float>& rgba);
+// bytes: width * height * 4 8-bit codes (unitToByte, scene/ImageCodes.h), row 0 at the top,
+// written as they are; an .exr path is refused (ImageError).
+void writeImage(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                const std::vector<uint8_t>& bytes);
 ImageEncoding encodingFor(const std::filesystem::path& path);
 
 // Encodes 8-bit samples (width * height * channels, row 0 at the top) as a PNG file's bytes, in

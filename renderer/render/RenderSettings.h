@@ -27,6 +27,9 @@ struct RenderSettings {
     bool probes = true;           // false: exactly the image without probes, diffuse or reflection
                                   // (no probe pass, no reflection probes bound)
     bool linearOutput = false;    // scene-linear values for EXR instead of the display encoding
+    // render(): the pixels read back as 8-bit codes (RenderedImage::bytes, what a PNG holds)
+    // rather than floats (RenderedImage::rgba).
+    bool readbackBytes = false;
     OrbitCamera camera;
     glm::vec3 albedo{0.3f};       // the constant albedo (when no albedo map is set)
     // The scene's own sections, read as they are (docs/lighting.md): the terrain's roughness and

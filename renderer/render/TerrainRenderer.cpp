@@ -1294,7 +1294,10 @@ RenderedImage TerrainRenderer::render(const RenderSettings& s) {
     img.width = s.width;
     img.height = s.height;
     const auto readback = std::chrono::steady_clock::now();
-    img.rgba = gpu_->target->readback.pixels();
+    if (s.readbackBytes)
+        img.bytes = gpu_->target->readback.bytes();
+    else
+        img.rgba = gpu_->target->readback.pixels();
     const auto end = std::chrono::steady_clock::now();
     timings_.readbackMilliseconds = std::chrono::duration<double, std::milli>(end - readback).count();
     img.milliseconds = std::chrono::duration<double, std::milli>(end - start).count();

@@ -70,6 +70,7 @@ struct GpuProbeVolume {
 struct RenderedImage {
     uint32_t width = 0, height = 0;
     std::vector<float> rgba;      // row 0 at the top
+    std::vector<uint8_t> bytes;   // instead, with RenderSettings::readbackBytes: unitToByte of each
     double milliseconds = 0.0;    // draw + readback, wall clock
 };
 

@@ -1,5 +1,7 @@
 #include "vk/Readback.h"
 
+#include "scene/ImageCodes.h"
+
 #include <cstring>
 
 #include <tbb/blocked_range.h>
@@ -43,6 +45,16 @@ const std::vector<float>& halfTable() {
     }();
     return table;
 }
+
+// Every half's 8-bit code (64 KiB), by the rule of the floats it stands for.
+const std::vector<uint8_t>& byteTable() {
+    static const std::vector<uint8_t> table = [] {
+        std::vector<uint8_t> t(65536);
+        for (uint32_t h = 0; h < 65536; ++h) t[h] = unitToByte(halfTable()[h]);
+        return t;
+    }();
+    return table;
+}
 }  // namespace
 
 Readback::Readback(const VulkanContext& ctx, uint32_t width, uint32_t height)
@@ -60,6 +72,16 @@ std::vector<float> Readback::pixels() {
     const auto* half = static_cast<const uint16_t*>(buffer_.map());
     const float* table = halfTable().data();
     std::vector<float> out(size_t(width_) * height_ * 4);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
+    });
+    return out;
+}
+
+std::vector<uint8_t> Readback::bytes() {
+    const auto* half = static_cast<const uint16_t*>(buffer_.map());
+    const uint8_t* table = byteTable().data();
+    std::vector<uint8_t> out(size_t(width_) * height_ * 4);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
     });

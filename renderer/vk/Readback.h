@@ -20,6 +20,9 @@ public:
     void recordCopy(VkCommandBuffer cb, VkImage image) const;
     // RGBA float pixels, row 0 at the top, once the copy has finished and is visible to the host.
     std::vector<float> pixels();
+    // The same as 8-bit codes (unitToByte of each float), what a PNG holds: one table lookup a
+    // sample and a quarter of the memory.
+    std::vector<uint8_t> bytes();
 
 private:
     uint32_t width_, height_;

@@ -32,6 +32,7 @@
 #include "scene/Exposure.h"
 #include "scene/DebugViews.h"
 #include "scene/DynamicResolution.h"
+#include "scene/ImageCodes.h"
 #include "terrain/HorizonAO.h"
 #include "render/FrameGraph.h"
 #include "render/features/Antialiasing.h"
@@ -804,6 +805,35 @@ TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
             const size_t least = size_t(kW) * kH / (v.needs.water && !v.needs.waterShading ? 50 : 8);
             EXPECT_GT(differing, least) << v.name << (linear ? " (linear)" : "") << " is blank";
         }
+}
+
+// `terralux --render` to a PNG reads the frame back as its 8-bit codes: the same codes the float
+// frame rounds to, sample for sample, with no float frame made (RenderRequest::bytes).
+TEST_F(RenderTest, AFrameReadBackAsCodesIsTheFloatFrameRounded) {
+    Project p = sampleProject("codes", 4, 4);
+    ProjectRenderer r(*ctx_, p);
+    ASSERT_EQ(r.loadProbes(true), 1u);
+    RenderRequest q = unprobed(kViewBeauty, false);
+    q.probes = true;
+    const RenderedImage floats = r.render(q);
+    q.bytes = true;
+    const RenderedImage codes = r.render(q);
+    EXPECT_TRUE(codes.rgba.empty());
+    ASSERT_EQ(floats.rgba.size(), size_t(kW) * kH * 4);
+    ASSERT_EQ(codes.bytes.size(), floats.rgba.size());
+    size_t differing = 0, distinct = 0;
+    std::vector<bool> seen(256, false);
+    for (size_t i = 0; i < codes.bytes.size(); ++i) {
+        differing += codes.bytes[i] != unitToByte(floats.rgba[i]);
+        if (!seen[codes.bytes[i]]) seen[codes.bytes[i]] = true, ++distinct;
+    }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_GT(distinct, 64u);  // a picture, not a flat frame
+    // Scene-linear output stays float whatever is asked.
+    q.linearOutput = true;
+    const RenderedImage linear = r.render(q);
+    EXPECT_TRUE(linear.bytes.empty());
+    EXPECT_EQ(linear.rgba.size(), floats.rgba.size());
 }
 
 // The device layer's target kinds, samplers and image bindings, through the frame graph: a depth

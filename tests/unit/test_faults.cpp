@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <thread>
@@ -27,6 +28,7 @@
 #include "OutputFolder.h"
 #include "Project.h"
 #include "ShProbeFile.h"
+#include "scene/ImageCodes.h"
 
 namespace fs = std::filesystem;
 using namespace terralux;
@@ -272,6 +274,30 @@ TEST_F(Faults, AnExrIsTheSameBytesWhenWrittenAgain) {
     EXPECT_EQ(readText(dir / "a.exr"), readText(dir / "b.exr"));
     uint32_t w = 0, h = 0;
     EXPECT_EQ(readImageRgba(dir / "b.exr", w, h), rgba);
+}
+
+// A PNG written from a frame's 8-bit codes is the file written from its floats; the codes are
+// refused as an EXR, which holds scene-linear floats.
+TEST_F(Faults, APngFromCodesIsThePngFromFloatsAndAnExrRefusesCodes) {
+    std::vector<float> rgba(8 * 4 * 4);
+    for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = float(i) / 100.0f - 0.1f;  // below 0 to above 1
+    rgba[5] = std::numeric_limits<float>::quiet_NaN();
+    rgba[6] = std::numeric_limits<float>::infinity();
+    rgba[7] = 0.5f;
+    std::vector<uint8_t> codes(rgba.size());
+    for (size_t i = 0; i < rgba.size(); ++i) codes[i] = unitToByte(rgba[i]);
+    EXPECT_EQ(codes[0], 0);
+    EXPECT_EQ(codes[5], 0);
+    EXPECT_EQ(codes[6], 0);
+    EXPECT_EQ(codes[7], 128);  // 0.5 * 255 = 127.5, rounded away from zero
+    EXPECT_EQ(codes.back(), 255);
+    writeImage(dir / "floats.png", 8, 4, rgba);
+    writeImage(dir / "codes.png", 8, 4, codes);
+    EXPECT_EQ(readText(dir / "floats.png"), readText(dir / "codes.png"));
+    EXPECT_EQ(errorOf([&] { writeImage(dir / "codes.exr", 8, 4, codes); }),
+              (dir / "codes.exr").string() +
+                  ": 8-bit samples cannot be written as EXR, which holds scene-linear floats; use .png");
+    EXPECT_FALSE(fs::exists(dir / "codes.exr"));
 }
 
 // The lock file an earlier version's killed bake left is removed; a locked one is kept.
