@@ -153,7 +153,10 @@ void Swapchain::submit(const SwapchainFrame& f) {
     si.pSignalSemaphores = &presentable;
     VkFence fence = slot.done.get();
     check(vkResetFences(ctx_.device(), 1, &fence), "vkResetFences");
-    check(vkQueueSubmit(ctx_.queue(), 1, &si, fence), "vkQueueSubmit (frame)");
+    {
+        const auto lock = ctx_.lockQueue();
+        check(vkQueueSubmit(ctx_.queue(), 1, &si, fence), "vkQueueSubmit (frame)");
+    }
     if (holdsFrames_) pending_ = Held{f.slot, f.imageIndex};
     else present(f.imageIndex);
 }
@@ -178,7 +181,11 @@ void Swapchain::present(uint32_t imageIndex) {
     pi.swapchainCount = 1;
     pi.pSwapchains = &sc;
     pi.pImageIndices = &imageIndex;
-    const VkResult r = vkQueuePresentKHR(ctx_.queue(), &pi);
+    VkResult r;
+    {
+        const auto lock = ctx_.lockQueue();
+        r = vkQueuePresentKHR(ctx_.queue(), &pi);
+    }
     // The next begin() recreates it for the new size.
     if (r == VK_ERROR_OUT_OF_DATE_KHR || r == VK_SUBOPTIMAL_KHR) extent_ = {0, 0};
     else check(r, "vkQueuePresentKHR");

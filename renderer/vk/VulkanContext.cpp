@@ -26,6 +26,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
 
 namespace {
 
+// The WorkerCommands of this thread, if it holds one.
+thread_local WorkerCommands* threadCommands = nullptr;
+
 bool layerAvailable(const char* name) {
     uint32_t n = 0;
     vkEnumerateInstanceLayerProperties(&n, nullptr);
@@ -218,25 +221,46 @@ UniqueMemory VulkanContext::allocateMemory(const VkMemoryRequirements& requireme
 }
 
 UniqueCommandBuffer VulkanContext::allocateCommandBuffer() const {
+    const VkCommandPool pool = threadCommands && &threadCommands->ctx_ == this ? threadCommands->pool_ : pool_;
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = pool_;
+    ai.commandPool = pool;
     ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     ai.commandBufferCount = 1;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     check(vkAllocateCommandBuffers(device_, &ai, &cb), "vkAllocateCommandBuffers");
-    return UniqueCommandBuffer(device_, pool_, cb);
+    return UniqueCommandBuffer(device_, pool, cb);
 }
 
 void VulkanContext::waitIdle() const {
     hostWaits_.fetch_add(1, std::memory_order_relaxed);
+    const auto lock = lockQueue();
     check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle");
+}
+
+WorkerCommands::WorkerCommands(const VulkanContext& ctx) : ctx_(ctx), outer_(threadCommands) {
+    VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pci.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+    pci.queueFamilyIndex = ctx.queueFamily_;
+    check(vkCreateCommandPool(ctx.device_, &pci, nullptr, &pool_), "vkCreateCommandPool (worker)");
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    if (const VkResult r = vkCreateFence(ctx.device_, &fci, nullptr, &fence_); r != VK_SUCCESS) {
+        vkDestroyCommandPool(ctx.device_, pool_, nullptr);
+        check(r, "vkCreateFence (worker)");
+    }
+    threadCommands = this;
+}
+
+WorkerCommands::~WorkerCommands() {
+    threadCommands = outer_;
+    vkDestroyFence(ctx_.device_, fence_, nullptr);
+    vkDestroyCommandPool(ctx_.device_, pool_, nullptr);
 }
 
 namespace {
 
-// Records `record` into `cb` as a one-time command buffer and submits it to `queue`, signalling
-// `fence` (unsignalled) when the device has finished it.
-void recordAndSubmit(VkQueue queue, VkCommandBuffer cb, VkFence fence,
+// Records `record` into `cb` as a one-time command buffer and submits it to `ctx`'s queue,
+// signalling `fence` (unsignalled) when the device has finished it.
+void recordAndSubmit(const VulkanContext& ctx, VkCommandBuffer cb, VkFence fence,
                      const std::function<void(VkCommandBuffer)>& record) {
     VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -246,17 +270,19 @@ void recordAndSubmit(VkQueue queue, VkCommandBuffer cb, VkFence fence,
     VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     si.commandBufferCount = 1;
     si.pCommandBuffers = &cb;
-    check(vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
+    const auto lock = ctx.lockQueue();
+    check(vkQueueSubmit(ctx.queue(), 1, &si, fence), "vkQueueSubmit");
 }
 
 }  // namespace
 
 void VulkanContext::submitAndWait(const std::function<void(VkCommandBuffer)>& record) const {
     const UniqueCommandBuffer owned = allocateCommandBuffer();
-    check(vkResetFences(device_, 1, &fence_), "vkResetFences");
-    recordAndSubmit(queue_, owned.get(), fence_, record);
+    const VkFence fence = threadCommands && &threadCommands->ctx_ == this ? threadCommands->fence_ : fence_;
+    check(vkResetFences(device_, 1, &fence), "vkResetFences");
+    recordAndSubmit(*this, owned.get(), fence, record);
     hostWaits_.fetch_add(1, std::memory_order_relaxed);
-    check(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    check(vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
 
 Submission VulkanContext::submit(const std::function<void(VkCommandBuffer)>& record) const {
@@ -267,7 +293,7 @@ Submission VulkanContext::submit(const std::function<void(VkCommandBuffer)>& rec
     VkFence fence = VK_NULL_HANDLE;
     check(vkCreateFence(device_, &fi, nullptr, &fence), "vkCreateFence");
     UniqueFence ownedFence(device_, fence);
-    recordAndSubmit(queue_, sub.cb_.get(), fence, record);
+    recordAndSubmit(*this, sub.cb_.get(), fence, record);
     sub.fence_ = std::move(ownedFence);  // only submitted work has a fence to wait for
     return sub;
 }

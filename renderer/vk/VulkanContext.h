@@ -60,6 +60,8 @@ private:
     UniqueFence fence_;
 };
 
+class WorkerCommands;
+
 class VulkanContext {
 public:
     explicit VulkanContext(const ContextOptions& options = {});
@@ -109,7 +111,8 @@ public:
     UniqueMemory allocateMemory(const VkMemoryRequirements& requirements, VkMemoryPropertyFlags properties,
                                 const char* what) const;
     // Records commands into a one-time command buffer, submits it and waits. The command buffer
-    // is freed on every path, a throw from `record` included.
+    // is freed on every path, a throw from `record` included. On a thread holding WorkerCommands
+    // the buffer and the fence are that thread's own.
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record) const;
     // Records and submits as submitAndWait does, without waiting: the submission says when the
     // device has finished it, and must outlive the work (wait for it, or for the queue, first).
@@ -119,8 +122,13 @@ public:
     // How often the host has waited for the device here (waitIdle, submitAndWait): what a path
     // that must not wait is checked against.
     size_t hostWaits() const { return hostWaits_.load(std::memory_order_relaxed); }
+    // The queue is externally synchronised (Vulkan): every submission, present and wait on it
+    // holds this lock, for the moment of the call only, so a worker's uploads and the UI
+    // thread's frames may reach it from two threads.
+    std::unique_lock<std::mutex> lockQueue() const { return std::unique_lock(queueMutex_); }
 
 private:
+    friend class WorkerCommands;
     // Destroys whatever exists, in reverse order of creation; safe on a half-built context.
     void create(const ContextOptions& options);
     void destroy();
@@ -143,10 +151,31 @@ private:
     VkPhysicalDeviceMemoryProperties memory_{};
     std::vector<std::string> messages_;
     mutable std::mutex messagesMutex_;
+    mutable std::mutex queueMutex_;
 
     friend VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(
         VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
         const VkDebugUtilsMessengerCallbackDataEXT*, void*);
+};
+
+// A command pool and a fence of the calling thread's own, for as long as it lives: a worker
+// that makes a renderer (its uploads go through submitAndWait) records beside the UI thread,
+// whose frames use the context's pool (a pool, like the queue, is externally synchronised). Made
+// and destroyed on the worker; every command buffer the thread allocates meanwhile comes from
+// it, so none may outlive it (submit(), whose buffer does, is not for such a thread).
+class WorkerCommands {
+public:
+    explicit WorkerCommands(const VulkanContext& ctx);
+    ~WorkerCommands();
+    WorkerCommands(const WorkerCommands&) = delete;
+    WorkerCommands& operator=(const WorkerCommands&) = delete;
+
+private:
+    friend class VulkanContext;
+    const VulkanContext& ctx_;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+    WorkerCommands* outer_ = nullptr;
 };
 
 }  // namespace terralux::vk
