@@ -233,6 +233,12 @@ void ProjectRenderer::setAmbientOcclusion(const HorizonAoSettings& settings, con
     ++revision_;
 }
 
+void ProjectRenderer::setAmbientOcclusion(const HorizonAoSettings& settings, TerrainRenderer::SurfaceMapTextures maps) {
+    renderer_->setSurfaceMaps(std::move(maps));
+    boundAo_ = settings;
+    ++revision_;
+}
+
 void ProjectRenderer::setProbes(const std::vector<GpuProbeVolume>& volumes) {
     renderer_->setProbeVolumes(volumes);
     ++revision_;
@@ -546,6 +552,7 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
     if (!r.waitUntilDrawable) {
         bool ready = renderer_->pipelinesReady(s);
         if (meters(r)) ready = renderer_->pipelinesReady(meterSettings(r, camera)) && ready;
+        ready = renderer_->sunHorizonReady(s) && ready;  // the meter reads the same sun's map
         if (!ready) {
             deferredFrame_ = true;
             return false;
@@ -604,8 +611,8 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
 }
 
 bool ProjectRenderer::waitingToDraw() const {
-    return renderer_->pipelinesBuilding() || (std::isnan(meteredEv100_) && renderer_->offscreenPending() &&
-                                              !renderer_->offscreenFinished());
+    return renderer_->pipelinesBuilding() || renderer_->sunHorizonAwaited() ||
+           (std::isnan(meteredEv100_) && renderer_->offscreenPending() && !renderer_->offscreenFinished());
 }
 
 RenderSettings ProjectRenderer::settingsOf(const RenderRequest& r, const OrbitCamera& camera) const {

@@ -56,8 +56,9 @@ struct RenderRequest {
     // draw the set held (RenderSettings::waitForLevelOfDetail).
     bool waitForLevelOfDetail = true;
     // Off for the viewport: a frame whose pipelines are not built yet starts their builds on a
-    // worker (TerrainRenderer::pipelinesReady), and a renderer's first metered frame draws its
-    // meter behind the frames in flight; either is not drawn until that is done (present()
+    // worker (TerrainRenderer::pipelinesReady), a renderer's first frame that reads the horizon
+    // map sweeps it on a worker (sunHorizonReady), and its first metered frame draws its meter
+    // behind the frames in flight; none is drawn until that is done (present()
     // returns false, waitingToDraw() holds meanwhile). On, the frame waits for them.
     bool waitUntilDrawable = true;
 };
@@ -174,10 +175,12 @@ public:
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
     // False when nothing was drawn: no swapchain image, or (waitUntilDrawable off) the frame's
-    // pipelines or its first meter reading are still to come (waitingToDraw).
+    // pipelines, its first horizon map or its first meter reading are still to come
+    // (waitingToDraw).
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
     // Whether the last present() put its frame off (waitUntilDrawable off), and whether what it
-    // waits for, pipelines building on a worker or the first meter reading, is still to come:
+    // waits for, pipelines building or the first horizon map sweeping on a worker, or the first
+    // meter reading, is still to come:
     // the viewport asks for the frame again once it is not.
     bool deferredFrame() const { return deferredFrame_; }
     bool waitingToDraw() const;
@@ -225,6 +228,8 @@ public:
     // Binds a horizon AO field computed for `settings` over this renderer's terrain
     // (horizonSkyVisibility, one value per vertex).
     void setAmbientOcclusion(const HorizonAoSettings& settings, const std::vector<float>& field);
+    // The same with its maps already made (TerrainRenderer::prepareSurfaceMaps, on a worker).
+    void setAmbientOcclusion(const HorizonAoSettings& settings, TerrainRenderer::SurfaceMapTextures maps);
     TerrainRenderer& renderer() { return *renderer_; }
 
     // One volume's overlay records: probe markers and octree leaves.

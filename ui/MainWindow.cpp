@@ -359,9 +359,35 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
 
     drainPoll_.setInterval(10);
     connect(&drainPoll_, &QTimer::timeout, this, [this] {
-        // The old renderer goes at one tick and the new one is made at the next: each takes
-        // 5-30 ms on the sample, and together they held the UI thread too long. It goes once its
-        // workers have finished too, so that its destruction waits for nothing.
+        // A renderer being made on a worker is installed once made. The old renderer goes at one
+        // tick, once its frames and its workers have finished (its destruction waits for
+        // nothing), and the new one is started at the next.
+        if (makingRenderer_.valid()) {
+            if (makingRenderer_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+            std::unique_ptr<ProjectRenderer> made;
+            try {
+                made = makingRenderer_.get();
+            } catch (const std::exception& e) {
+                if (remakeRenderer_) {  // it was for a terrain since replaced: make the new one
+                    remakeRenderer_ = false;
+                    buildRenderer();
+                    return;
+                }
+                drainPoll_.stop();
+                showError("Viewport", QString("cannot draw this terrain: %1").arg(e.what()));
+                return;
+            }
+            ++renderersMadeOnWorkers_;
+            if (remakeRenderer_) {
+                // Made for a terrain since replaced: it drew nothing; it goes as a retired one does.
+                remakeRenderer_ = false;
+                retiredRenderer_ = std::move(made);
+                return;
+            }
+            drainPoll_.stop();
+            installRenderer(std::move(made));
+            return;
+        }
         if (retiredRenderer_) {
             if (!drain_.done() || !retiredRenderer_->renderer().workersFinished()) return;
             drain_ = vk::Submission();
@@ -370,7 +396,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         }
         buildRenderer();
     });
-    rebuildRenderer();
+    buildRenderer(true);
     updateEstimate();
     updateTitle();
     updateOutputPath();
@@ -390,6 +416,12 @@ MainWindow::~MainWindow() {
     renderer_.reset();
     retiredRenderer_.reset();
     drain_ = vk::Submission();
+    if (makingRenderer_.valid()) {
+        try {
+            makingRenderer_.get();  // made, it goes now, before the device
+        } catch (const std::exception&) {
+        }
+    }
 }
 
 QString MainWindow::autosaveDir() {
@@ -1273,6 +1305,11 @@ void MainWindow::rebuildRenderer() {
     previewJob_.dismiss();
     viewport_->setRenderer(nullptr);
     stopAmbientOcclusion();
+    if (makingRenderer_.valid()) {
+        // The renderer being made is for the terrain before: it is retired once made.
+        remakeRenderer_ = true;
+        return;
+    }
     if (renderer_) {
         retiredRenderer_ = std::move(renderer_);
         drain_ = ctx_->submit([](VkCommandBuffer) {});
@@ -1287,9 +1324,29 @@ void MainWindow::rebuildRenderer() {
     buildRenderer();
 }
 
-void MainWindow::buildRenderer() {
-    drainPoll_.stop();
-    renderer_ = std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false);
+void MainWindow::buildRenderer(bool now) {
+    if (now) {
+        drainPoll_.stop();
+        installRenderer(std::make_unique<ProjectRenderer>(*ctx_, doc_->project(), doc_->terrain(), false));
+        return;
+    }
+    // The UI thread does no other device work meanwhile (there is no renderer to draw); the
+    // worker records its uploads with a command pool of its own and shares the queue under its
+    // lock (vk::WorkerCommands).
+    projectChangedWhileMaking_ = false;
+    remakeRenderer_ = false;
+    makingRenderer_ = std::async(std::launch::async, [ctx = ctx_.get(), project = doc_->project(),
+                                                      terrain = doc_->terrainShared()] {
+        const vk::WorkerCommands commands(*ctx);
+        return std::make_unique<ProjectRenderer>(*ctx, project, *terrain, false);
+    });
+    drainPoll_.start();
+}
+
+void MainWindow::installRenderer(std::unique_ptr<ProjectRenderer> made) {
+    renderer_ = std::move(made);
+    if (projectChangedWhileMaking_) renderer_->setProject(doc_->project());
+    projectChangedWhileMaking_ = false;
     renderer_->setScenarioView(scenarioView_);
     viewport_->setCamera(renderer_->defaultCamera());
     // An untitled project with a relative output folder has no bake of its own yet.
@@ -1316,7 +1373,10 @@ void MainWindow::buildRenderer() {
 }
 
 void MainWindow::refreshLighting() {
-    if (!renderer_) return;
+    if (!renderer_) {
+        projectChangedWhileMaking_ = true;
+        return;
+    }
     renderer_->setProject(doc_->project());
     albedoStatus_->setText(renderer_->albedoError().empty()
                                ? QString()
@@ -1353,7 +1413,7 @@ void MainWindow::updateAmbientOcclusion() {
                            .arg(wanted->directions)
                            .arg(QLocale().toString(qulonglong(renderer_->heightfield().heights().size()))));
     auto terrain = doc_->terrainShared();
-    aoJob_.startBeside([this, terrain, settings = *wanted](const LatestJob::Context& job) {
+    aoJob_.startBeside([this, terrain, settings = *wanted, ctx = ctx_.get()](const LatestJob::Context& job) {
         const auto start = std::chrono::steady_clock::now();
         std::atomic<int> shown{-1};  // the progress may come from any of the AO's threads
         std::vector<float> field;
@@ -1373,15 +1433,28 @@ void MainWindow::updateAmbientOcclusion() {
         }
         if (field.empty()) return;  // cancelled
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        auto result = std::make_shared<std::vector<float>>(std::move(field));
-        job.post([this, result, settings, seconds] {
+        // Its maps are built and uploaded here too: the UI thread only swaps them in.
+        std::shared_ptr<TerrainRenderer::SurfaceMapTextures> maps;
+        try {
+            const vk::WorkerCommands commands(*ctx);
+            maps = std::make_shared<TerrainRenderer::SurfaceMapTextures>(
+                TerrainRenderer::prepareSurfaceMaps(*ctx, terrain->heightfield, field));
+        } catch (const std::exception& e) {
+            job.post([this, message = QString::fromStdString(e.what())] {
+                aoRunning_.reset();
+                aoProgress_->setVisible(false);
+                aoStatus_->setText("Not computed: " + message);
+            });
+            return;
+        }
+        job.post([this, maps, settings, seconds, vertices = field.size()] {
             if (!renderer_) return;
-            renderer_->setAmbientOcclusion(settings, *result);
+            renderer_->setAmbientOcclusion(settings, std::move(*maps));
             aoRunning_.reset();
             aoProgress_->setVisible(false);
             aoStatus_->setText(QString("%1 directions over %2 vertices in %3 s")
                                    .arg(settings.directions)
-                                   .arg(QLocale().toString(qulonglong(result->size())))
+                                   .arg(QLocale().toString(qulonglong(vertices)))
                                    .arg(seconds, 0, 'f', 2));
             viewport_->requestUpdate();
         });

@@ -2,6 +2,7 @@
 // The authoring window: menus, the parameter docks, the live Vulkan viewport, background bakes.
 
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <optional>
 
@@ -76,6 +77,8 @@ public:
     size_t boundProbeCount() const;
     // Draft previews started so far: edits that change no probes start none.
     unsigned previewsStarted() const { return previewsStarted_; }
+    // Renderers made on a worker (every one after the window's first).
+    unsigned renderersMadeOnWorkers() const { return renderersMadeOnWorkers_; }
     // The absolute folder Bake writes: export.out_dir, relative to the project file. None for an
     // untitled project with a relative out_dir (Bake asks to save it or for a folder).
     std::optional<std::filesystem::path> bakeFolder() const;
@@ -135,7 +138,11 @@ private:
     // frames (a CPU device takes hundreds of milliseconds over one): the new renderer's uploads
     // share the queue and would wait behind them on the UI thread.
     void rebuildRenderer();
-    void buildRenderer();
+    // Makes the document's renderer: on a worker (N42E001's took the UI thread 350 ms to make),
+    // installed by drainPoll_ once made; `now`: here (the window's first, before it is shown).
+    void buildRenderer(bool now = false);
+    // What follows making a renderer: the bake it draws, the camera, the viewport, the summary.
+    void installRenderer(std::unique_ptr<ProjectRenderer> made);
     void refreshLighting();
     // Starts the horizon AO the project asks for on a worker, unless the renderer has it or it
     // is under way; the result lands in the renderer on the UI thread.
@@ -169,6 +176,12 @@ private:
     std::unique_ptr<ProjectRenderer> retiredRenderer_;
     vk::Submission drain_;
     QTimer drainPoll_;
+    // The renderer being made on a worker (buildRenderer), for a terrain that a newer one may
+    // have replaced meanwhile (remakeRenderer_: it is retired unshown and made again).
+    std::future<std::unique_ptr<ProjectRenderer>> makingRenderer_;
+    bool remakeRenderer_ = false;
+    bool projectChangedWhileMaking_ = false;  // an edit the renderer being made has not seen
+    unsigned renderersMadeOnWorkers_ = 0;
     bool previewPutOff_ = false;  // a preview asked for while no renderer was there
     std::unique_ptr<ProjectRenderer> renderer_;
     ViewportWindow* viewport_ = nullptr;

@@ -392,9 +392,12 @@ void TerrainRenderer::redrawShadowMaps() {
     if (gpu_->shadows) gpu_->shadows->drawn.clear();
 }
 
-void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
-    RendererGpu& g = *gpu_;
-    const SurfaceMaps maps = buildSurfaceMaps(hf_, ao);
+TerrainRenderer::SurfaceMapTextures TerrainRenderer::prepareSurfaceMaps(const vk::VulkanContext& ctx,
+                                                                         const Heightfield& hf,
+                                                                         const std::vector<float>& ao) {
+    if (!ao.empty() && ao.size() != hf.heights().size())
+        throw std::invalid_argument("ambient occlusion needs one value per DEM vertex");
+    const SurfaceMaps maps = buildSurfaceMaps(hf, ao);
     std::vector<vk::MipLevel> levels;
     int w = maps.width, h = maps.height;
     for (const auto& level : maps.normalAo) {
@@ -402,17 +405,38 @@ void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) {
         w = std::max(w / 2, 1);
         h = std::max(h / 2, 1);
     }
-    SurfaceTextures next;
-    next.normalAo = vk::Image::texture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
-    next.filled = vk::Image::texture(ctx_, VK_FORMAT_R8_UNORM,
-                                     {vk::MipLevel{uint32_t(maps.width), uint32_t(maps.height), maps.filled}});
-    ctx_.waitIdle();  // no frame may still read the old maps
-    g.surface.normalAo = std::move(next.normalAo);
-    g.surface.filled = std::move(next.filled);
-    surfaceMapSize_ = {maps.width, maps.height};
-    hasAo_ = !ao.empty();
-    if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
+    SurfaceMapTextures t;
+    t.normalAo = vk::Image::texture(ctx, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
+    t.filled = vk::Image::texture(ctx, VK_FORMAT_R8_UNORM,
+                                  {vk::MipLevel{uint32_t(maps.width), uint32_t(maps.height), maps.filled}});
+    t.size = {maps.width, maps.height};
+    t.vertices = hf.heights().size();
+    t.ao = !ao.empty();
+    return t;
 }
+
+void TerrainRenderer::setSurfaceMaps(SurfaceMapTextures maps) {
+    if (maps.vertices != hf_.heights().size())
+        throw std::invalid_argument("surface maps made for another terrain");
+    RendererGpu& g = *gpu_;
+    // Frames in flight may still read the old maps, and the view sets that name them: retired,
+    // not waited for.
+    retire(std::move(g.surface.normalAo));
+    retire(std::move(g.surface.filled));
+    g.surface.normalAo = std::move(maps.normalAo);
+    g.surface.filled = std::move(maps.filled);
+    surfaceMapSize_ = maps.size;
+    hasAo_ = maps.ao;
+    if (g.surface.albedo.handle() != VK_NULL_HANDLE) {
+        for (FrameSlot& f : g.slots) {
+            retire(std::move(f.view));
+            retire(std::move(f.reflectionView));
+        }
+        buildViewSets();
+    }
+}
+
+void TerrainRenderer::uploadSurfaceMaps(const std::vector<float>& ao) { setSurfaceMaps(prepareSurfaceMaps(ctx_, hf_, ao)); }
 
 void TerrainRenderer::setSkyImage(int width, int height, const std::vector<glm::vec3>& radiance) {
     RendererGpu& g = *gpu_;
@@ -430,11 +454,7 @@ void TerrainRenderer::setSkyImage(int width, int height, const std::vector<glm::
     if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
 }
 
-void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) {
-    if (!perVertex.empty() && perVertex.size() != hf_.heights().size())
-        throw std::invalid_argument("ambient occlusion needs one value per DEM vertex");
-    uploadSurfaceMaps(perVertex);
-}
+void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) { uploadSurfaceMaps(perVertex); }
 
 void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb) {
     RendererGpu& g = *gpu_;
@@ -704,15 +724,37 @@ bool TerrainRenderer::sunHorizonSwept() const {
     return pendingHorizon_ && pendingHorizon_->perVertex.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
 }
 
-void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wait) {
-    const glm::vec4 key(sun.direction, sun.angularRadius);
+std::function<std::vector<float>()> TerrainRenderer::sunHorizonSweep(const SunLight& sun, bool skirt) const {
     // Isolated: a thread waiting for its sweep's tasks may otherwise take up any task of the
     // shared pool meanwhile, such as a chunk of the preview bake's, on the UI thread.
-    auto sweep = [this, direction = sun.direction, radius = sun.angularRadius, skirt] {
+    return [this, direction = sun.direction, radius = sun.angularRadius, skirt] {
         std::vector<float> perVertex;
         tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, direction, radius, skirt); });
         return perVertex;
     };
+}
+
+void TerrainRenderer::startSunHorizonSweep(const SunLight& sun, bool skirt) {
+    auto pending = std::make_unique<PendingHorizon>();
+    pending->key = glm::vec4(sun.direction, sun.angularRadius);
+    pending->skirt = skirt;
+    pending->perVertex = std::async(std::launch::async, sunHorizonSweep(sun, skirt));
+    pendingHorizon_ = std::move(pending);
+}
+
+bool TerrainRenderer::sunHorizonReady(const RenderSettings& s) {
+    const Parts p = partsOf(s, findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)));
+    if (!p.shadowed || !s.shadows.heightfield || sunHorizonSerial_ > 0) return true;
+    if (!pendingHorizon_) startSunHorizonSweep(s.sun, s.skirt);
+    return sunHorizonSwept();
+}
+
+bool TerrainRenderer::sunHorizonAwaited() const {
+    return sunHorizonSerial_ == 0 && pendingHorizon_ && !sunHorizonSwept();
+}
+
+void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wait) {
+    const glm::vec4 key(sun.direction, sun.angularRadius);
     auto held = [&] { return sunHorizonSerial_ > 0 && key == sunHorizonKey_ && sunHorizonSkirt_ == int(skirt); };
     // A finished sweep lands first, unless the map held is the one asked for (the sun went back):
     // its sun is newer than the held one's. Then the one asked for starts if it is another.
@@ -723,17 +765,14 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wai
     }
     if (held()) return;
     if (pendingHorizon_) return;  // one at a time: the frames draw the map held until it lands
-    // The first map, and every map of a frame that waits, is swept here; the viewport's frames
-    // sweep on a worker (a 12 M-vertex map takes 275 ms) and draw the map held meanwhile.
+    // Every map of a frame that waits, and the first of any other that was not put off for it
+    // (sunHorizonReady), is swept here; the viewport's frames sweep on a worker (a 12 M-vertex
+    // map takes 275 ms) and draw the map held meanwhile.
     if (wait || sunHorizonSerial_ == 0) {
-        installSunHorizon(sweep(), key, skirt);
+        installSunHorizon(sunHorizonSweep(sun, skirt)(), key, skirt);
         return;
     }
-    auto pending = std::make_unique<PendingHorizon>();
-    pending->key = key;
-    pending->skirt = skirt;
-    pending->perVertex = std::async(std::launch::async, sweep);
-    pendingHorizon_ = std::move(pending);
+    startSunHorizonSweep(sun, skirt);
 }
 
 void TerrainRenderer::dropSweptHorizon() {

@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <future>
 #include <map>
 #include <memory>
@@ -32,6 +33,7 @@
 #include "terrain/Heightfield.h"
 #include "terrain/MeshLod.h"
 #include "vk/Buffer.h"
+#include "vk/Image.h"
 #include "vk/Swapchain.h"
 #include "water/Water.h"
 #include "vk/VulkanContext.h"
@@ -149,6 +151,18 @@ public:
     // The sky visibility per DEM vertex (horizonSkyVisibility's layout), or empty for none: the
     // surface maps are built and uploaded again.
     void setAmbientOcclusion(const std::vector<float>& perVertex);
+    // The same in two steps: the maps built and uploaded where prepareSurfaceMaps is called (the
+    // UI's AO worker, holding vk::WorkerCommands: over N42E001 this took the UI thread 100-500 ms
+    // on lavapipe), then swapped in, the old ones retired rather than waited for.
+    struct SurfaceMapTextures {
+        vk::Image normalAo, filled;
+        glm::ivec2 size{1, 1};
+        size_t vertices = 0;  // the terrain's, which they were made for
+        bool ao = false;
+    };
+    static SurfaceMapTextures prepareSurfaceMaps(const vk::VulkanContext& ctx, const Heightfield& hf,
+                                                 const std::vector<float>& ao);
+    void setSurfaceMaps(SurfaceMapTextures maps);
     // An albedo map over the footprint (texel centres corner to corner, row 0 north, 8-bit sRGB,
     // 3 bytes a texel: SurfaceAlbedo::srgb), or width 0 for the constant albedo of RenderSettings.
     void setAlbedoMap(int width, int height, const std::vector<uint8_t>& srgb);
@@ -226,6 +240,13 @@ public:
     // next frame takes its map).
     bool sunHorizonSweeping() const { return pendingHorizon_ != nullptr; }
     bool sunHorizonSwept() const;
+    // Whether a frame of `settings` finds the horizon map it reads: a renderer's first is swept
+    // on a worker (N42E001's takes 90 ms on the 2-core machine), and a viewport that must not
+    // wait draws that frame once it has landed (ProjectRenderer::waitingToDraw polls
+    // sunHorizonAwaited()), as for pipelines. Later maps are swept while the frames draw the
+    // one held.
+    bool sunHorizonReady(const RenderSettings& settings);
+    bool sunHorizonAwaited() const;
     const std::vector<float>& sunHorizonMap() const { return sunHorizonMap_; }
     HorizonMapInfo horizonMapInfo() const { return horizonMap_; }
     // The device memory the map takes: a byte a vertex in each frame slot.
@@ -313,6 +334,8 @@ private:
     void ensureShadowMaps(int resolution, int cascades);
     void updateSunVisibility(const SunLight& sun, bool skirt);
     void updateSunHorizon(const SunLight& sun, bool skirt, bool wait);
+    std::function<std::vector<float>()> sunHorizonSweep(const SunLight& sun, bool skirt) const;
+    void startSunHorizonSweep(const SunLight& sun, bool skirt);  // on a worker (pendingHorizon_)
     void installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt);
     void dropSweptHorizon();
     void uploadSurfaceMaps(const std::vector<float>& ao);

@@ -807,6 +807,39 @@ TEST_F(RenderTest, EveryViewRendersFiniteAndNonBlank) {
         }
 }
 
+// The AO's surface maps made on another thread (the UI's AO worker, with a command pool of its
+// own: vk::WorkerCommands) and swapped in without waiting draw the frame the maps made inline do,
+// bit for bit, with no validation message (TearDown).
+TEST_F(RenderTest, SurfaceMapsMadeOnAWorkerDrawTheSameFrame) {
+    Project p = sampleProject("aoworker", 4, 4);
+    ProjectRenderer r(*ctx_, p);
+    TerrainRenderer& t = r.renderer();
+    const HorizonAoSettings settings = *r.wantedAo();
+    const std::vector<float> field = horizonSkyVisibility(r.heightfield(), settings);
+    t.setAmbientOcclusion(field);
+    const RenderedImage inline_ = draw(r, kViewBeauty, false, true);
+    t.setAmbientOcclusion({});
+    const RenderedImage without = draw(r, kViewBeauty, false, true);
+    // Made while this thread draws frames: the queue is shared under its lock, the pools are not.
+    TerrainRenderer::SurfaceMapTextures maps;
+    std::thread worker([&] {
+        const vk::WorkerCommands commands(*ctx_);
+        for (int i = 0; i < 3; ++i) maps = TerrainRenderer::prepareSurfaceMaps(*ctx_, r.heightfield(), field);
+    });
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(draw(r, kViewBeauty, false, true).rgba, without.rgba);
+    worker.join();
+    EXPECT_TRUE(maps.ao);
+    t.setSurfaceMaps(std::move(maps));
+    EXPECT_TRUE(t.hasAmbientOcclusion());
+    const RenderedImage made = draw(r, kViewBeauty, false, true);
+    EXPECT_EQ(made.rgba, inline_.rgba);
+    EXPECT_NE(without.rgba, inline_.rgba);  // the AO shows
+    // Maps made for another terrain are refused.
+    const Heightfield small(4, 4, 30.0, 30.0, std::vector<float>(16, 0.0f));
+    TerrainRenderer::SurfaceMapTextures other = TerrainRenderer::prepareSurfaceMaps(*ctx_, small, {});
+    EXPECT_THROW(t.setSurfaceMaps(std::move(other)), std::invalid_argument);
+}
+
 // `terralux --render` to a PNG reads the frame back as its 8-bit codes: the same codes the float
 // frame rounds to, sample for sample, with no float frame made (RenderRequest::bytes).
 TEST_F(RenderTest, AFrameReadBackAsCodesIsTheFloatFrameRounded) {
@@ -1121,6 +1154,38 @@ TEST_F(RenderTest, TheHorizonMapIsSweptOncePerSunAndIsTheSweep) {
     const RenderedImage withMap = draw(r, kViewShadow, false, true);
     EXPECT_EQ(t.sunHorizonSweeps(), 3u);
     EXPECT_GT(test::compareImages(mapsOnly.rgba, withMap.rgba, kW, kH).meanAbs, 1e-3) << "the setting changes the frame";
+}
+
+// A renderer's first frame that reads the horizon map, in a viewport that must not wait, finds
+// it not ready: its sweep starts on a worker, and once it has landed the frame draws with that
+// map (no second sweep) the frame a renderer that swept where it recorded draws.
+TEST_F(RenderTest, TheFirstHorizonMapIsSweptOnAWorkerBeforeTheFirstFrame) {
+    Project p = sampleProject("horizon_first", 4, 4);
+    p.scene.sun.elevationDeg = 5.0;
+    p.scene.sun.azimuthDeg = 135.0;
+    ProjectRenderer inlineRenderer(*ctx_, p);
+    const RenderedImage swept = draw(inlineRenderer, kViewShadow, false, true);
+    ASSERT_EQ(inlineRenderer.renderer().sunHorizonSweeps(), 1u);
+    ProjectRenderer r(*ctx_, p);
+    TerrainRenderer& t = r.renderer();
+    RenderRequest q = unprobed(kViewShadow, true);
+    const RenderSettings s = r.settingsOf(q, r.defaultCamera());
+    EXPECT_FALSE(t.sunHorizonReady(s));
+    EXPECT_TRUE(t.sunHorizonSweeping());
+    EXPECT_EQ(t.sunHorizonSweeps(), 0u);
+    for (int i = 0; i < 2000 && !t.sunHorizonSwept(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_FALSE(t.sunHorizonAwaited());
+    EXPECT_TRUE(t.sunHorizonReady(s));
+    q.waitForHorizon = false;
+    const RenderedImage drawn = r.render(q);
+    EXPECT_EQ(t.sunHorizonSweeps(), 1u);
+    EXPECT_FALSE(t.sunHorizonSweeping());
+    EXPECT_EQ(drawn.rgba, swept.rgba);
+    // A view without shadows reads no map: ready at once, nothing swept.
+    ProjectRenderer albedoOnly(*ctx_, p);
+    EXPECT_TRUE(albedoOnly.renderer().sunHorizonReady(albedoOnly.settingsOf(unprobed(kViewAlbedo, true),
+                                                                               albedoOnly.defaultCamera())));
+    EXPECT_FALSE(albedoOnly.renderer().sunHorizonSweeping());
 }
 
 // Shadow maps against the traced sun at low, middle and high suns, from the default framing
