@@ -1417,25 +1417,17 @@ void MainWindow::updateAmbientOcclusion() {
         const auto start = std::chrono::steady_clock::now();
         std::atomic<int> shown{-1};  // the progress may come from any of the AO's threads
         std::vector<float> field;
+        // Its maps are built and uploaded here too: the UI thread only swaps them in.
+        std::shared_ptr<TerrainRenderer::SurfaceMapTextures> maps;
+        double seconds = 0.0;
         try {
             field = horizonSkyVisibility(terrain->heightfield, settings, [this, &shown, &job](double f) {
                 const int percent = int(f * 100.0);
                 if (shown.exchange(percent) != percent) job.post([this, percent] { aoProgress_->setValue(percent); });
                 return !job.cancelled();
             });
-        } catch (const std::exception& e) {
-            job.post([this, message = QString::fromStdString(e.what())] {
-                aoRunning_.reset();
-                aoProgress_->setVisible(false);
-                aoStatus_->setText("Not computed: " + message);
-            });
-            return;
-        }
-        if (field.empty()) return;  // cancelled
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        // Its maps are built and uploaded here too: the UI thread only swaps them in.
-        std::shared_ptr<TerrainRenderer::SurfaceMapTextures> maps;
-        try {
+            if (field.empty()) return;  // cancelled
+            seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             const vk::WorkerCommands commands(*ctx);
             maps = std::make_shared<TerrainRenderer::SurfaceMapTextures>(
                 TerrainRenderer::prepareSurfaceMaps(*ctx, terrain->heightfield, field));

@@ -172,6 +172,44 @@ class UiTest : public QObject {
     std::unique_ptr<MainWindow> w_;
     QString skip_;
 
+    // Imports `dem` (its terrain at `latitude`), lets its first frames and `whileShown` settle,
+    // undoes back to the terrain before, and holds the longest stall of the UI thread over all of
+    // it to 100 ms; both renderers are made on workers.
+    void importThenUndoWithoutStalls(const fs::path& dem, double latitude, const char* what,
+                                     const std::function<void(ProjectRenderer&)>& whileShown = {}) {
+        ProjectDocument& doc = *w_->document();
+        ViewportWindow* v = w_->viewport();
+        v->renderNow();
+        QVERIFY(settlesQuiet(v));
+        const double before = doc.terrain().heightfield.geo.latitudeDeg;
+        const unsigned made = w_->renderersMadeOnWorkers();
+        Watchdog watchdog;
+        QVERIFY(w_->importDemFile(QString::fromStdString(dem.string())));
+        auto shows = [&](double at) {
+            return !doc.terrainLoading() && v->renderer() &&
+                   std::abs(v->renderer()->heightfield().geo.latitudeDeg - at) < 0.01;
+        };
+        QTRY_VERIFY_WITH_TIMEOUT(shows(doc.terrain().heightfield.geo.latitudeDeg) &&
+                                     std::abs(doc.terrain().heightfield.geo.latitudeDeg - latitude) < 0.5,
+                                 60000);
+        // Its first frame waited for its own meter reading (the project meters by default) and
+        // was drawn.
+        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 20000);
+        if (whileShown) whileShown(*v->renderer());
+        if (QTest::currentTestFailed()) return;
+        QVERIFY(settlesQuiet(v));
+        QVERIFY(!v->renderer()->deferredFrame());
+        doc.undoStack()->undo();
+        QTRY_VERIFY_WITH_TIMEOUT(shows(before), 30000);
+        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 10000);
+        QVERIFY(settlesQuiet(v));
+        QVERIFY(!v->renderer()->deferredFrame());
+        const qint64 worst = watchdog.worst();
+        qInfo() << what << "import and undo: longest UI stall" << worst << "ms";
+        QVERIFY2(worst <= 100, qPrintable(QString("the UI thread stalled %1 ms").arg(worst)));
+        QCOMPARE(w_->renderersMadeOnWorkers(), made + 2);
+    }
+
 private slots:
     void initTestCase() {
         if (QGuiApplication::platformName() == "offscreen" || QGuiApplication::platformName() == "minimal")
@@ -512,79 +550,25 @@ private slots:
     // device has finished its frames (the new one's uploads would wait behind them: 0.4-0.55 s on
     // lavapipe), and the first frame's pipelines and exposure meter are drawn behind the window's
     // frames. The UI thread is never held for any of it.
+    // 16-50 ms here, where the waits for the device and the first meter held it 460-600 ms.
     void newTerrainsNeverHoldTheUiThread() {
-        ProjectDocument& doc = *w_->document();
-        ViewportWindow* v = w_->viewport();
-        v->renderNow();
-        QVERIFY(settlesQuiet(v));
-        const double sampleLatitude = doc.terrain().heightfield.geo.latitudeDeg;
-        const unsigned made = w_->renderersMadeOnWorkers();
-        Watchdog watchdog;
-        const fs::path dem = fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif";
-        QVERIFY(w_->importDemFile(QString::fromStdString(dem.string())));
-        auto shows = [&](double latitude) {
-            return !doc.terrainLoading() && v->renderer() &&
-                   std::abs(v->renderer()->heightfield().geo.latitudeDeg - latitude) < 0.01;
-        };
-        const double rainier = 46.85;
-        QTRY_VERIFY_WITH_TIMEOUT(shows(doc.terrain().heightfield.geo.latitudeDeg) &&
-                                     std::abs(doc.terrain().heightfield.geo.latitudeDeg - rainier) < 0.5,
-                                 30000);
-        // Its first frame waited for its own meter reading (the project meters by default) and
-        // was drawn.
-        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 10000);
-        QVERIFY(settlesQuiet(v));
-        QVERIFY(!v->renderer()->deferredFrame());
-        doc.undoStack()->undo();
-        QTRY_VERIFY_WITH_TIMEOUT(shows(sampleLatitude), 30000);
-        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 10000);
-        QVERIFY(settlesQuiet(v));
-        QVERIFY(!v->renderer()->deferredFrame());
-        // 16-50 ms here, where the waits for the device and the first meter held it 460-600 ms.
-        const qint64 worst = watchdog.worst();
-        qInfo() << "import and undo: longest UI stall" << worst << "ms";
-        QVERIFY2(worst <= 100, qPrintable(QString("the UI thread stalled %1 ms").arg(worst)));
-        QCOMPARE(w_->renderersMadeOnWorkers(), made + 2);
+        importThenUndoWithoutStalls(fs::path(TERRALUX_TEST_DATA) / "dem" / "rainier_crop.tif", 46.85,
+                                    "Rainier crop");
     }
 
-    // An 80 km tile (N42E001, 986 × 1 348 vertices once reprojected): its renderer is made on a worker (it held the UI
-    // thread 350 ms), its first horizon map swept on one before its first frame (90 ms), and its
-    // AO's maps built and uploaded on the AO's worker (100-500 ms); import and undo held the UI
-    // thread 437 ms, now 31-46 ms.
+    // An 80 km tile (N42E001, 986 × 1 348 vertices once reprojected): its renderer is made on a
+    // worker (it held the UI thread 350 ms), its first horizon map swept on one before its first
+    // frame (90 ms), and its AO's maps built and uploaded on the AO's worker (100-500 ms); import
+    // and undo held the UI thread 437 ms, now 31-63 ms.
     void aMountainTileNeverHoldsTheUiThread() {
         const fs::path dem = fs::path(TERRALUX_SHARED_DATA) / "dem" / "N42E001.hgt";
         if (!fs::exists(dem)) QSKIP("../shared/data/dem/N42E001.hgt is absent");
-        ProjectDocument& doc = *w_->document();
-        ViewportWindow* v = w_->viewport();
-        v->renderNow();
-        QVERIFY(settlesQuiet(v));
-        const double sampleLatitude = doc.terrain().heightfield.geo.latitudeDeg;
-        const unsigned made = w_->renderersMadeOnWorkers();
-        Watchdog watchdog;
-        QVERIFY(w_->importDemFile(QString::fromStdString(dem.string())));
-        auto shows = [&](double latitude) {
-            return !doc.terrainLoading() && v->renderer() &&
-                   std::abs(v->renderer()->heightfield().geo.latitudeDeg - latitude) < 0.01;
-        };
-        QTRY_VERIFY_WITH_TIMEOUT(shows(doc.terrain().heightfield.geo.latitudeDeg) &&
-                                     std::abs(doc.terrain().heightfield.geo.latitudeDeg - 42.5) < 0.5,
-                                 60000);
-        const Heightfield& tile = v->renderer()->heightfield();
-        QVERIFY(size_t(tile.width()) * size_t(tile.depth()) > 1'000'000);  // reprojected: 986 x 1348
-        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 20000);
-        // Its AO lands (built off the UI thread) and the frames draw with it.
-        QTRY_VERIFY_WITH_TIMEOUT(v->renderer()->renderer().hasAmbientOcclusion(), 60000);
-        QVERIFY(v->renderer()->renderer().sunHorizonSweeps() >= 1);
-        QVERIFY(settlesQuiet(v));
-        QVERIFY(!v->renderer()->deferredFrame());
-        doc.undoStack()->undo();
-        QTRY_VERIFY_WITH_TIMEOUT(shows(sampleLatitude), 30000);
-        QTRY_VERIFY_WITH_TIMEOUT(!std::isnan(v->renderer()->meteredEv100()), 10000);
-        QVERIFY(settlesQuiet(v));
-        const qint64 worst = watchdog.worst();
-        qInfo() << "N42E001 import and undo: longest UI stall" << worst << "ms";
-        QVERIFY2(worst <= 100, qPrintable(QString("the UI thread stalled %1 ms").arg(worst)));
-        QCOMPARE(w_->renderersMadeOnWorkers(), made + 2);
+        importThenUndoWithoutStalls(dem, 42.5, "N42E001", [](ProjectRenderer& r) {
+            QVERIFY(size_t(r.heightfield().width()) * size_t(r.heightfield().depth()) > 1'000'000);
+            // Its AO lands (its maps made off the UI thread) and the frames draw with it.
+            QTRY_VERIFY_WITH_TIMEOUT(r.renderer().hasAmbientOcclusion(), 60000);
+            QVERIFY(r.renderer().sunHorizonSweeps() >= 1);
+        });
     }
 
     void rejectedValuesLeaveTheProject() {
