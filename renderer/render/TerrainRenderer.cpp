@@ -1,5 +1,7 @@
 #include "render/TerrainRenderer.h"
 
+#include "scene/ImageCodes.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -724,14 +726,36 @@ bool TerrainRenderer::sunHorizonSwept() const {
     return pendingHorizon_ && pendingHorizon_->perVertex.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
 }
 
-std::function<std::vector<float>()> TerrainRenderer::sunHorizonSweep(const SunLight& sun, bool skirt) const {
+std::function<TerrainRenderer::SweptHorizon()> TerrainRenderer::sunHorizonSweep(const SunLight& sun, bool skirt) const {
     // Isolated: a thread waiting for its sweep's tasks may otherwise take up any task of the
     // shared pool meanwhile, such as a chunk of the preview bake's, on the UI thread.
     return [this, direction = sun.direction, radius = sun.angularRadius, skirt] {
         std::vector<float> perVertex;
         tbb::this_task_arena::isolate([&] { perVertex = sunHorizonVisibility(hf_, direction, radius, skirt); });
-        return perVertex;
+        return sweptHorizonOf(std::move(perVertex));
     };
+}
+
+TerrainRenderer::SweptHorizon TerrainRenderer::sweptHorizonOf(std::vector<float> perVertex) const {
+    SweptHorizon s;
+    const int w = horizonMap_.width, h = horizonMap_.height;
+    const bool whole = w == hf_.width() && h == hf_.depth();
+    if (whole) {
+        s.map = std::move(perVertex);
+    } else {
+        // The nearest DEM vertex to each map vertex, both spanning the footprint corner to corner.
+        s.map.assign(size_t(w) * size_t(h), 1.0f);
+        for (int r = 0; r < h; ++r) {
+            const size_t row = size_t(std::lround(double(r) * (hf_.depth() - 1) / std::max(h - 1, 1)));
+            for (int c = 0; c < w; ++c) {
+                const size_t col = size_t(std::lround(double(c) * (hf_.width() - 1) / std::max(w - 1, 1)));
+                s.map[size_t(r) * size_t(w) + size_t(c)] = perVertex[row * size_t(hf_.width()) + col];
+            }
+        }
+    }
+    s.bytes.assign((s.map.size() + 3) / 4, 0u);
+    for (size_t i = 0; i < s.map.size(); ++i) s.bytes[i / 4] |= uint32_t(unitToByte(s.map[i])) << (8 * (i % 4));
+    return s;
 }
 
 void TerrainRenderer::startSunHorizonSweep(const SunLight& sun, bool skirt) {
@@ -760,8 +784,8 @@ void TerrainRenderer::updateSunHorizon(const SunLight& sun, bool skirt, bool wai
     // its sun is newer than the held one's. Then the one asked for starts if it is another.
     if (pendingHorizon_ && (wait || sunHorizonSwept())) {
         std::unique_ptr<PendingHorizon> done = std::move(pendingHorizon_);
-        std::vector<float> perVertex = done->perVertex.get();
-        if (!held()) installSunHorizon(std::move(perVertex), done->key, done->skirt);
+        SweptHorizon swept = done->perVertex.get();
+        if (!held()) installSunHorizon(std::move(swept), done->key, done->skirt);
     }
     if (held()) return;
     if (pendingHorizon_) return;  // one at a time: the frames draw the map held until it lands
@@ -781,25 +805,9 @@ void TerrainRenderer::dropSweptHorizon() {
     if (sunHorizonSwept()) pendingHorizon_.reset();
 }
 
-void TerrainRenderer::installSunHorizon(std::vector<float> perVertex, const glm::vec4& key, bool skirt) {
-    const int w = horizonMap_.width, h = horizonMap_.height;
-    const bool whole = w == hf_.width() && h == hf_.depth();
-    if (whole) {
-        sunHorizonMap_ = std::move(perVertex);
-    } else {
-        // The nearest DEM vertex to each map vertex, both spanning the footprint corner to corner.
-        sunHorizonMap_.assign(size_t(w) * size_t(h), 1.0f);
-        for (int r = 0; r < h; ++r) {
-            const size_t row = size_t(std::lround(double(r) * (hf_.depth() - 1) / std::max(h - 1, 1)));
-            for (int c = 0; c < w; ++c) {
-                const size_t col = size_t(std::lround(double(c) * (hf_.width() - 1) / std::max(w - 1, 1)));
-                sunHorizonMap_[size_t(r) * size_t(w) + size_t(c)] = perVertex[row * size_t(hf_.width()) + col];
-            }
-        }
-    }
-    sunHorizonBytes_.assign((sunHorizonMap_.size() + 3) / 4, 0u);
-    for (size_t i = 0; i < sunHorizonMap_.size(); ++i)
-        sunHorizonBytes_[i / 4] |= uint32_t(std::lround(std::clamp(sunHorizonMap_[i], 0.0f, 1.0f) * 255.0f)) << (8 * (i % 4));
+void TerrainRenderer::installSunHorizon(SweptHorizon swept, const glm::vec4& key, bool skirt) {
+    sunHorizonMap_ = std::move(swept.map);
+    sunHorizonBytes_ = std::move(swept.bytes);
     sunHorizonKey_ = key;
     sunHorizonSkirt_ = int(skirt);
     ++sunHorizonSerial_;

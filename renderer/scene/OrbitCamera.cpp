@@ -12,10 +12,7 @@ namespace terralux {
 
 OrbitCamera OrbitCamera::fromSettings(const CameraSettings& s, const Heightfield& hf) {
     OrbitCamera c;
-    double sum = 0;
-    for (float h : hf.heights()) sum += h;
-    const float mean = float(sum / double(hf.heights().size()));
-    c.target = s.target ? *s.target : glm::vec3(0.0f, mean, 0.0f);
+    c.target = s.target ? *s.target : glm::vec3(0.0f, hf.meanHeight(), 0.0f);
     c.fovDeg = float(s.fovDeg);
     c.azimuthDeg = float(s.azimuthDeg);
     c.elevationDeg = float(s.elevationDeg);

@@ -30,11 +30,14 @@ Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSize
                                     std::to_string(depth) + " grid");
     minHeight_ = heights_[0];
     maxHeight_ = heights_[0];
+    double sum = 0.0;
     for (float h : heights_) {
         if (!std::isfinite(h)) throw std::invalid_argument("heightfield: non-finite height");
         minHeight_ = std::min(minHeight_, h);
         maxHeight_ = std::max(maxHeight_, h);
+        sum += h;
     }
+    meanHeight_ = float(sum / double(heights_.size()));
 }
 
 float Heightfield::surfaceHeight(float x, float z) const {
@@ -112,11 +115,8 @@ void Heightfield::setNodataMask(std::vector<uint8_t> mask) {
     if (!mask.empty() && mask.size() != heights_.size())
         throw std::invalid_argument("heightfield: nodata mask size does not match the grid");
     nodataMask_ = std::move(mask);
+    nodataCount_ = size_t(std::count(nodataMask_.begin(), nodataMask_.end(), uint8_t(1)));
     serial_ = nextSerial();
-}
-
-size_t Heightfield::nodataCount() const {
-    return size_t(std::count(nodataMask_.begin(), nodataMask_.end(), uint8_t(1)));
 }
 
 }  // namespace terralux
