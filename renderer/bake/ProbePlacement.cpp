@@ -40,8 +40,13 @@ SurfaceRange surfaceRange(const Heightfield& hf, double x0, double x1, double z0
         r.lo = std::min(r.lo, h);
         r.hi = std::max(r.hi, h);
     };
-    for (int row = int(std::ceil(v0)); row <= int(std::floor(v1)); ++row)
-        for (int col = int(std::ceil(u0)); col <= int(std::floor(u1)); ++col) add(hf.at(col, row));
+    if (const int c0 = int(std::ceil(u0)), c1 = int(std::floor(u1)), r0 = int(std::ceil(v0)),
+        r1 = int(std::floor(v1));
+        c0 <= c1 && r0 <= r1) {
+        const auto [lo, hi] = hf.sampleRange(c0, c1, r0, r1);
+        add(lo);
+        add(hi);
+    }
     // Along an edge of constant v: its ends, the grid lines u = col and the diagonals of the
     // cells it runs through (u - col = v - row, Heightfield.h).
     auto alongU = [&](double v) {

@@ -412,13 +412,13 @@ TerrainRenderer::SurfaceMapTextures TerrainRenderer::prepareSurfaceMaps(const vk
     t.filled = vk::Image::texture(ctx, VK_FORMAT_R8_UNORM,
                                   {vk::MipLevel{uint32_t(maps.width), uint32_t(maps.height), maps.filled}});
     t.size = {maps.width, maps.height};
-    t.vertices = hf.heights().size();
+    t.terrain = hf.serial();
     t.ao = !ao.empty();
     return t;
 }
 
 void TerrainRenderer::setSurfaceMaps(SurfaceMapTextures maps) {
-    if (maps.vertices != hf_.heights().size())
+    if (maps.terrain != hf_.serial())
         throw std::invalid_argument("surface maps made for another terrain");
     RendererGpu& g = *gpu_;
     // Frames in flight may still read the old maps, and the view sets that name them: retired,

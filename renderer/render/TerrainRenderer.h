@@ -157,7 +157,7 @@ public:
     struct SurfaceMapTextures {
         vk::Image normalAo, filled;
         glm::ivec2 size{1, 1};
-        size_t vertices = 0;  // the terrain's, which they were made for
+        uint64_t terrain = 0;  // the serial of the heightfield they were made for
         bool ao = false;
     };
     static SurfaceMapTextures prepareSurfaceMaps(const vk::VulkanContext& ctx, const Heightfield& hf,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <glm/geometric.hpp>
@@ -38,6 +39,56 @@ Heightfield::Heightfield(int width, int depth, double cellSizeX, double cellSize
         sum += h;
     }
     meanHeight_ = float(sum / double(heights_.size()));
+
+    blocksX_ = (width_ + kRangeBlock - 1) / kRangeBlock;
+    const int blocksZ = (depth_ + kRangeBlock - 1) / kRangeBlock;
+    blockMin_.assign(size_t(blocksX_) * size_t(blocksZ), std::numeric_limits<float>::infinity());
+    blockMax_.assign(blockMin_.size(), -std::numeric_limits<float>::infinity());
+    for (int row = 0; row < depth_; ++row) {
+        float* lo = blockMin_.data() + size_t(row / kRangeBlock) * size_t(blocksX_);
+        float* hi = blockMax_.data() + size_t(row / kRangeBlock) * size_t(blocksX_);
+        const float* h = heights_.data() + size_t(row) * size_t(width_);
+        for (int col = 0; col < width_; ++col) {
+            const int b = col / kRangeBlock;
+            lo[b] = std::min(lo[b], h[col]);
+            hi[b] = std::max(hi[b], h[col]);
+        }
+    }
+}
+
+std::pair<float, float> Heightfield::sampleRange(int col0, int col1, int row0, int row1) const {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    auto scan = [&](int c0, int c1, int r0, int r1) {
+        for (int row = r0; row <= r1; ++row) {
+            const float* h = heights_.data() + size_t(row) * size_t(width_);
+            for (int col = c0; col <= c1; ++col) {
+                lo = std::min(lo, h[col]);
+                hi = std::max(hi, h[col]);
+            }
+        }
+    };
+    // The blocks wholly inside: from the first block starting at or after the first index to
+    // the last ending at or before the last (the grid's last block ends at its edge).
+    constexpr int B = kRangeBlock;
+    const int blocksZ = (depth_ + B - 1) / B;
+    const int bc0 = (col0 + B - 1) / B, bc1 = col1 == width_ - 1 ? blocksX_ - 1 : (col1 + 1) / B - 1;
+    const int br0 = (row0 + B - 1) / B, br1 = row1 == depth_ - 1 ? blocksZ - 1 : (row1 + 1) / B - 1;
+    if (bc0 > bc1 || br0 > br1) {
+        scan(col0, col1, row0, row1);
+        return {lo, hi};
+    }
+    for (int b = br0; b <= br1; ++b)
+        for (int a = bc0; a <= bc1; ++a) {
+            lo = std::min(lo, blockMin_[size_t(b) * size_t(blocksX_) + size_t(a)]);
+            hi = std::max(hi, blockMax_[size_t(b) * size_t(blocksX_) + size_t(a)]);
+        }
+    const int inCol0 = bc0 * B, inCol1 = std::min((bc1 + 1) * B, width_) - 1;
+    const int inRow0 = br0 * B, inRow1 = std::min((br1 + 1) * B, depth_) - 1;
+    scan(col0, col1, row0, inRow0 - 1);  // rows above the blocks
+    scan(col0, col1, inRow1 + 1, row1);  // rows below
+    scan(col0, inCol0 - 1, inRow0, inRow1);  // the blocks' rows, left of them
+    scan(inCol1 + 1, col1, inRow0, inRow1);  // and right
+    return {lo, hi};
 }
 
 float Heightfield::surfaceHeight(float x, float z) const {

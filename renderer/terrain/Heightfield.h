@@ -87,6 +87,12 @@ public:
     // every refresh.
     float meanHeight() const { return meanHeight_; }
     float maxHeight() const { return maxHeight_; }
+    // The lowest and highest sample in columns [col0, col1] and rows [row0, row1] (inclusive,
+    // inside the grid, col0 <= col1, row0 <= row1). Whole blocks of kRangeBlock² samples are read
+    // from their ranges, kept from construction, so a placement's cells of a 16 384² grid do not
+    // read its 268 M samples one by one on every edit.
+    std::pair<float, float> sampleRange(int col0, int col1, int row0, int row1) const;
+    static constexpr int kRangeBlock = 16;
     bool contains(float x, float z) const {
         return x >= minX() && x <= maxX() && z >= minZ() && z <= maxZ();
     }
@@ -138,6 +144,10 @@ private:
     float minHeight_ = 0.0f;
     float maxHeight_ = 0.0f;
     float meanHeight_ = 0.0f;
+    // Per block of kRangeBlock² samples (the last row and column of blocks may be cut short),
+    // row-major, blocksX_ a row: its lowest and highest sample.
+    int blocksX_ = 0;
+    std::vector<float> blockMin_, blockMax_;
     size_t nodataCount_ = 0;
 };
 

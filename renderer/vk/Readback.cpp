@@ -55,6 +55,17 @@ const std::vector<uint8_t>& byteTable() {
     }();
     return table;
 }
+
+// Each half float of the mapped frame looked up in a table of what it becomes.
+template <typename T>
+std::vector<T> lookUp(const uint16_t* half, size_t count, const T* table) {
+    std::vector<T> out(count);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
+    });
+    return out;
+}
+
 }  // namespace
 
 Readback::Readback(const VulkanContext& ctx, uint32_t width, uint32_t height)
@@ -69,23 +80,11 @@ void Readback::recordCopy(VkCommandBuffer cb, VkImage image) const {
 }
 
 std::vector<float> Readback::pixels() {
-    const auto* half = static_cast<const uint16_t*>(buffer_.map());
-    const float* table = halfTable().data();
-    std::vector<float> out(size_t(width_) * height_ * 4);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
-    });
-    return out;
+    return lookUp(static_cast<const uint16_t*>(buffer_.map()), size_t(width_) * height_ * 4, halfTable().data());
 }
 
 std::vector<uint8_t> Readback::bytes() {
-    const auto* half = static_cast<const uint16_t*>(buffer_.map());
-    const uint8_t* table = byteTable().data();
-    std::vector<uint8_t> out(size_t(width_) * height_ * 4);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) out[i] = table[half[i]];
-    });
-    return out;
+    return lookUp(static_cast<const uint16_t*>(buffer_.map()), size_t(width_) * height_ * 4, byteTable().data());
 }
 
 }  // namespace terralux::vk

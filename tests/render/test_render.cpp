@@ -838,6 +838,13 @@ TEST_F(RenderTest, SurfaceMapsMadeOnAWorkerDrawTheSameFrame) {
     const Heightfield small(4, 4, 30.0, 30.0, std::vector<float>(16, 0.0f));
     TerrainRenderer::SurfaceMapTextures other = TerrainRenderer::prepareSurfaceMaps(*ctx_, small, {});
     EXPECT_THROW(t.setSurfaceMaps(std::move(other)), std::invalid_argument);
+    // So are maps of a terrain with as many vertices (the same grid raised 1 m): a vertex count
+    // does not name a terrain, its serial does.
+    const Heightfield& hf = r.heightfield();
+    std::vector<float> raised = hf.heights();
+    for (float& h : raised) h += 1.0f;
+    const Heightfield twin(hf.width(), hf.depth(), hf.cellSizeX(), hf.cellSizeZ(), raised);
+    EXPECT_THROW(t.setSurfaceMaps(TerrainRenderer::prepareSurfaceMaps(*ctx_, twin, field)), std::invalid_argument);
 }
 
 // `terralux --render` to a PNG reads the frame back as its 8-bit codes: the same codes the float

@@ -1,6 +1,9 @@
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -79,4 +82,35 @@ TEST(Heightfield, ASerialNamesWhatTheGridHolds) {
     const Heightfield to = std::move(from);
     EXPECT_EQ(to.serial(), copy.serial());
     EXPECT_EQ(from.serial(), 0u);  // NOLINT(bugprone-use-after-move): what a move leaves
+}
+
+TEST(Heightfield, ASampleRangeIsTheRangeOfItsSamples) {
+    // 70 x 53: neither side a whole number of blocks, so the cut-short last blocks are read too.
+    const int w = 70, d = 53;
+    std::vector<float> h(size_t(w) * d);
+    uint32_t state = 12345u;
+    for (float& v : h) {
+        state = state * 1664525u + 1013904223u;
+        v = float(state >> 8) / float(1 << 24) * 1000.0f - 300.0f;
+    }
+    const Heightfield hf(w, d, 1.0, 1.0, h);
+    auto brute = [&](int c0, int c1, int r0, int r1) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (int r = r0; r <= r1; ++r)
+            for (int c = c0; c <= c1; ++c) lo = std::min(lo, hf.at(c, r)), hi = std::max(hi, hf.at(c, r));
+        return std::pair(lo, hi);
+    };
+    size_t withBlocks = 0;
+    for (int c0 = 0; c0 < w; c0 += 3)
+        for (int c1 = c0; c1 < w; c1 += 5)
+            for (int r0 = 0; r0 < d; r0 += 4)
+                for (int r1 = r0; r1 < d; r1 += 7) {
+                    ASSERT_EQ(hf.sampleRange(c0, c1, r0, r1), brute(c0, c1, r0, r1)) << c0 << ".." << c1 << " x " << r0 << ".." << r1;
+                    withBlocks += c1 - c0 >= 2 * Heightfield::kRangeBlock && r1 - r0 >= 2 * Heightfield::kRangeBlock;
+                }
+    // The whole grid and its edges, where the cut-short blocks lie.
+    EXPECT_EQ(hf.sampleRange(0, w - 1, 0, d - 1), std::pair(hf.minHeight(), hf.maxHeight()));
+    EXPECT_EQ(hf.sampleRange(w - 1, w - 1, 0, d - 1), brute(w - 1, w - 1, 0, d - 1));
+    EXPECT_EQ(hf.sampleRange(20, w - 1, 17, d - 1), brute(20, w - 1, 17, d - 1));
+    EXPECT_GT(withBlocks, 100u);
 }
