@@ -661,20 +661,14 @@ std::vector<ParameterSpec> buildTable() {
     const auto isSurface = [](const SceneDescription& s, size_t i) {
         return s.probeVolumes.at(i).placement == ProbePlacement::Surface;
     };
-    // A terrain or box grid as the bake places it, for the values "auto" resolves to. The docks
-    // show them on every edit of the project: a placement is kept until its volume or terrain
-    // changes (placing the default grid over a 1201² tile took 12 ms of every sun edit).
+    // A terrain or box grid as the bake places it, for the values "auto" resolves to.
     const auto placedGrid = [=](const SceneDescription& s, const Heightfield& hf, size_t i) -> std::optional<ProbeLayout> {
         if (isAdaptive(s, i)) return std::nullopt;
-        static DerivedCache<std::optional<ProbeLayout>> kept(8);
-        const std::string volume = sceneToJson(s).at("probe_volumes").at(i).dump();
-        return *kept.get(hf.serial(), volume, [&]() -> std::optional<ProbeLayout> {
-            try {
-                return placeProbes(s.probeVolumes.at(i), hf);
-            } catch (const std::exception&) {
-                return std::nullopt;
-            }
-        });
+        try {
+            return *keptPlacement(s, i, hf);
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
     };
     add(Row("probe_volumes[].name", T::String))
         .pattern("[A-Za-z0-9_-]{1,64}", "must be 1-64 letters, digits, '_' or '-' (it names the .shprobe file)")
@@ -1653,6 +1647,24 @@ std::string uiObjectNamesMarkdown() {
     for (size_t k = 0; k < special.size(); ++k) out << (k ? ", " : "") << special[k];
     out << ".\n";
     return out.str();
+}
+
+std::shared_ptr<const ProbeLayout> keptPlacement(const SceneDescription& scene, size_t volume, const Heightfield& hf) {
+    struct Placed {
+        std::optional<ProbeLayout> layout;
+        std::string error;
+    };
+    static DerivedCache<Placed> kept(8);
+    const std::string key = sceneToJson(scene).at("probe_volumes").at(volume).dump();
+    const auto placed = kept.get(hf.serial(), key, [&] {
+        try {
+            return Placed{placeProbes(scene.probeVolumes.at(volume), hf), {}};
+        } catch (const std::exception& e) {
+            return Placed{std::nullopt, e.what()};
+        }
+    });
+    if (!placed->layout) throw PlacementError(placed->error);
+    return std::shared_ptr<const ProbeLayout>(placed, &*placed->layout);
 }
 
 }  // namespace terralux

@@ -10,6 +10,7 @@
 
 #include "AlbedoImport.h"
 #include "BakeJob.h"
+#include "ParameterTable.h"
 #include "SceneLighting.h"
 #include "ProbeDiagnosticsFile.h"
 #include "ReflectionProbeFile.h"
@@ -204,10 +205,11 @@ void ProjectRenderer::setProject(const Project& project) {
     placedVolumes_ = volumes;
     ++placements_;
     placed_.clear();
-    for (const auto& v : scene.probeVolumes) {
+    for (size_t i = 0; i < scene.probeVolumes.size(); ++i) {
+        const auto& v = scene.probeVolumes[i];
         if (!v.enabled) continue;
         try {
-            placed_[v.name] = overlayOf(describeProbes(placeProbes(v, terrain_.heightfield)));
+            placed_[v.name] = overlayOf(describeProbes(*keptPlacement(scene, i, terrain_.heightfield)));
         } catch (const PlacementError&) {
             // Settings the bake would refuse: no markers for that volume.
         }

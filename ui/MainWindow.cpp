@@ -364,6 +364,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
         // nothing), and the new one is started at the next.
         if (makingRenderer_.valid()) {
             if (makingRenderer_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+            if (tearingDown()) return;
             std::unique_ptr<ProjectRenderer> made;
             try {
                 made = makingRenderer_.get();
@@ -389,9 +390,12 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             return;
         }
         if (retiredRenderer_) {
-            if (!drain_.done() || !retiredRenderer_->renderer().workersFinished()) return;
+            if (!drain_.done() || !retiredRenderer_->renderer().workersFinished() || tearingDown()) return;
             drain_ = vk::Submission();
-            retiredRenderer_.reset();
+            tearingDown_ = std::async(std::launch::async, [this, old = std::move(retiredRenderer_)]() mutable {
+                old.reset();
+                ++renderersTornDownOnWorkers_;
+            });
             return;
         }
         buildRenderer();
@@ -422,6 +426,11 @@ MainWindow::~MainWindow() {
         } catch (const std::exception&) {
         }
     }
+    if (tearingDown_.valid()) tearingDown_.wait();
+}
+
+bool MainWindow::tearingDown() const {
+    return tearingDown_.valid() && tearingDown_.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
 }
 
 QString MainWindow::autosaveDir() {
@@ -1532,7 +1541,8 @@ void MainWindow::updateEstimate() {
         const auto& v = p.scene.probeVolumes[i];
         if (!v.enabled) continue;
         try {
-            const ProbeLayout l = placeProbes(v, doc_->terrain().heightfield);
+            const auto placed = keptPlacement(p.scene, i, doc_->terrain().heightfield);
+            const ProbeLayout& l = *placed;
             probes += l.validCount();
             invalid += l.positions.size() - l.validCount();
             bytes += 48 + 160ull * l.validCount() + 4ull * l.cellProbe.size();

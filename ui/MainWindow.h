@@ -1,6 +1,7 @@
 #pragma once
 // The authoring window: menus, the parameter docks, the live Vulkan viewport, background bakes.
 
+#include <atomic>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -79,6 +80,8 @@ public:
     unsigned previewsStarted() const { return previewsStarted_; }
     // Renderers made on a worker (every one after the window's first).
     unsigned renderersMadeOnWorkers() const { return renderersMadeOnWorkers_; }
+    // Retired renderers torn down on a worker (all of them but the last, at close).
+    unsigned renderersTornDownOnWorkers() const { return renderersTornDownOnWorkers_.load(); }
     // The absolute folder Bake writes: export.out_dir, relative to the project file. None for an
     // untitled project with a relative out_dir (Bake asks to save it or for a folder).
     std::optional<std::filesystem::path> bakeFolder() const;
@@ -143,6 +146,7 @@ private:
     void buildRenderer(bool now = false);
     // What follows making a renderer: the bake it draws, the camera, the viewport, the summary.
     void installRenderer(std::unique_ptr<ProjectRenderer> made);
+    bool tearingDown() const;  // a retired renderer's teardown is still running on its worker
     void refreshLighting();
     // Starts the horizon AO the project asks for on a worker, unless the renderer has it or it
     // is under way; the result lands in the renderer on the UI thread.
@@ -175,6 +179,11 @@ private:
     // has passed; drainPoll_ asks meanwhile.
     std::unique_ptr<ProjectRenderer> retiredRenderer_;
     vk::Submission drain_;
+    // A drained renderer's teardown, on a worker: it frees its copies of the terrain and its
+    // buffers (a 16 384² grid's took 100 ms). Meanwhile the UI thread records nothing with the
+    // context's command pool, whose buffers the teardown may free: no renderer is installed
+    // until it has finished.
+    std::future<void> tearingDown_;
     QTimer drainPoll_;
     // The renderer being made on a worker (buildRenderer), for a terrain that a newer one may
     // have replaced meanwhile (remakeRenderer_: it is retired unshown and made again).
@@ -182,6 +191,7 @@ private:
     bool remakeRenderer_ = false;
     bool projectChangedWhileMaking_ = false;  // an edit the renderer being made has not seen
     unsigned renderersMadeOnWorkers_ = 0;
+    std::atomic<unsigned> renderersTornDownOnWorkers_{0};
     bool previewPutOff_ = false;  // a preview asked for while no renderer was there
     std::unique_ptr<ProjectRenderer> renderer_;
     ViewportWindow* viewport_ = nullptr;

@@ -182,7 +182,7 @@ class UiTest : public QObject {
         v->renderNow();
         QVERIFY(settlesQuiet(v));
         const double before = doc.terrain().heightfield.geo.latitudeDeg;
-        const unsigned made = w_->renderersMadeOnWorkers();
+        const unsigned made = w_->renderersMadeOnWorkers(), tornDown = w_->renderersTornDownOnWorkers();
         Watchdog watchdog;
         QVERIFY(w_->importDemFile(QString::fromStdString(dem.string())));
         auto shows = [&](double at) {
@@ -208,6 +208,9 @@ class UiTest : public QObject {
         qInfo() << what << "import and undo: longest UI stall" << worst << "ms";
         QVERIFY2(worst <= 100, qPrintable(QString("the UI thread stalled %1 ms").arg(worst)));
         QCOMPARE(w_->renderersMadeOnWorkers(), made + 2);
+        // The sample's renderer and the imported terrain's were torn down on workers (a
+        // 16 384² grid's held the UI thread 100 ms).
+        QTRY_COMPARE(w_->renderersTornDownOnWorkers(), tornDown + 2);
     }
 
 private slots:

@@ -435,3 +435,46 @@ TEST(ParameterTable, AutoValuesFollowTheVolumeAndTheTerrain) {
     s.probeVolumes.at(0).gridDims = {16, 1, 16};
     EXPECT_NE(spacing->resolved(s, a, 0), coarse);
 }
+
+// The docks, the window's estimate and the viewport's markers ask for a volume's placement on
+// every edit: it is placed once per volume and terrain, as placeProbes places it, and refused
+// as placeProbes refuses it.
+TEST(ParameterTable, APlacementIsKeptPerVolumeAndTerrain) {
+    auto slope = [](float rise) {
+        std::vector<float> h(size_t(33) * 33);
+        for (size_t i = 0; i < h.size(); ++i) h[i] = rise * float(i / 33);
+        return Heightfield(33, 33, 20.0, 20.0, std::move(h));
+    };
+    const Heightfield a = slope(1.0f), b = slope(3.0f);
+    SceneDescription s;
+    s.probeVolumes.at(0).gridDims = {6, 1, 5};
+    const auto first = keptPlacement(s, 0, a);
+    const ProbeLayout direct = placeProbes(s.probeVolumes.at(0), a);
+    EXPECT_EQ(first->positions, direct.positions);
+    EXPECT_EQ(first->cellProbe, direct.cellProbe);
+    EXPECT_EQ(keptPlacement(s, 0, a), first);  // kept
+    const Heightfield copy = a;                // a copy is the same terrain
+    EXPECT_EQ(keptPlacement(s, 0, copy), first);
+    const auto other = keptPlacement(s, 0, b);  // another terrain: placed on it
+    EXPECT_NE(other, first);
+    EXPECT_EQ(other->positions, placeProbes(s.probeVolumes.at(0), b).positions);
+    s.probeVolumes.at(0).gridDims = {7, 1, 5};  // another volume: placed again
+    EXPECT_EQ(keptPlacement(s, 0, a)->positions.size(), 35u);
+    // A volume the bake refuses throws placeProbes' message, kept or not.
+    s.probeVolumes.at(0).heightOffset = -1.0e6;
+    std::string refused;
+    try {
+        placeProbes(s.probeVolumes.at(0), a);
+    } catch (const PlacementError& e) {
+        refused = e.what();
+    }
+    ASSERT_FALSE(refused.empty());
+    for (int i = 0; i < 2; ++i) {
+        try {
+            keptPlacement(s, 0, a);
+            ADD_FAILURE() << "not refused";
+        } catch (const PlacementError& e) {
+            EXPECT_EQ(std::string(e.what()), refused);
+        }
+    }
+}
