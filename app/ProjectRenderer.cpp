@@ -555,6 +555,7 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
         bool ready = renderer_->pipelinesReady(s);
         if (meters(r)) ready = renderer_->pipelinesReady(meterSettings(r, camera)) && ready;
         ready = renderer_->sunHorizonReady(s) && ready;  // the meter reads the same sun's map
+        ready = renderer_->levelOfDetailReady(s) && ready;
         if (!ready) {
             deferredFrame_ = true;
             return false;
@@ -613,7 +614,7 @@ bool ProjectRenderer::present(const RenderRequest& r, const OrbitCamera& camera,
 }
 
 bool ProjectRenderer::waitingToDraw() const {
-    return renderer_->pipelinesBuilding() || renderer_->sunHorizonAwaited() ||
+    return renderer_->pipelinesBuilding() || renderer_->sunHorizonAwaited() || renderer_->levelOfDetailAwaited() ||
            (std::isnan(meteredEv100_) && renderer_->offscreenPending() && !renderer_->offscreenFinished());
 }
 

@@ -57,7 +57,8 @@ struct RenderRequest {
     bool waitForLevelOfDetail = true;
     // Off for the viewport: a frame whose pipelines are not built yet starts their builds on a
     // worker (TerrainRenderer::pipelinesReady), a renderer's first frame that reads the horizon
-    // map sweeps it on a worker (sunHorizonReady), and its first metered frame draws its meter
+    // map sweeps it on a worker (sunHorizonReady), its first picture chooses its levels of detail
+    // on a worker (levelOfDetailReady), and its first metered frame draws its meter
     // behind the frames in flight; none is drawn until that is done (present()
     // returns false, waitingToDraw() holds meanwhile). On, the frame waits for them.
     bool waitUntilDrawable = true;
@@ -175,12 +176,13 @@ public:
     RenderedImage render(const RenderRequest& request, const OrbitCamera& camera);
     // The same frame into a window's swapchain, without reading it back or waiting for the GPU.
     // False when nothing was drawn: no swapchain image, or (waitUntilDrawable off) the frame's
-    // pipelines, its first horizon map or its first meter reading are still to come
+    // pipelines, its first horizon map, its first levels of detail or its first meter reading are
+    // still to come
     // (waitingToDraw).
     bool present(const RenderRequest& request, const OrbitCamera& camera, vk::Swapchain& swapchain);
     // Whether the last present() put its frame off (waitUntilDrawable off), and whether what it
-    // waits for, pipelines building or the first horizon map sweeping on a worker, or the first
-    // meter reading, is still to come:
+    // waits for, pipelines building, the first horizon map or levels of detail on a worker, or the
+    // first meter reading, is still to come:
     // the viewport asks for the frame again once it is not.
     bool deferredFrame() const { return deferredFrame_; }
     bool waitingToDraw() const;

@@ -90,7 +90,7 @@ terralux_forbid_link(terralux_io "${_no_device}" "file formats run without a dev
 terralux_forbid_link(terralux_io "${_no_qt}" "file formats are plain C++")
 terralux_forbid_link(terralux_core "${_no_device}" "terralux-bake runs without a device")
 terralux_forbid_link(terralux_core "${_no_qt_gui}" "terralux-bake runs without a display")
-foreach(dir bake lpv scene terrain water)
+foreach(dir bake lpv scene system terrain water)
   terralux_forbid_include("${PROJECT_SOURCE_DIR}/renderer/${dir}" "vulkan/|Q[A-Za-z]+|Qt" "renderer/${dir} is the CPU bake")
 endforeach()
 terralux_forbid_include("${PROJECT_SOURCE_DIR}/io" "vulkan/|Q[A-Za-z]+|Qt" "io/ is plain C++")

@@ -2,6 +2,8 @@
 
 #include <QMetaObject>
 
+#include "system/BackgroundPriority.h"
+
 namespace terralux {
 
 void LatestJob::Context::post(std::function<void()> f) const {
@@ -46,6 +48,7 @@ void LatestJob::launch(std::function<void(const Context&)> work) {
     c.generation_ = generation_;
     c.cancel_ = cancel_;
     thread_ = std::thread([work = std::move(work), c, ended = ended_]() mutable {
+        const BackgroundThread background;
         {
             auto run = std::move(work);  // what the job holds goes before it says it has ended
             run(c);

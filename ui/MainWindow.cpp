@@ -68,6 +68,7 @@
 #include "bake/ProbePlacement.h"
 #include "render/TerrainRenderer.h"
 #include "scene/DebugViews.h"
+#include "system/BackgroundPriority.h"
 
 namespace terralux {
 
@@ -393,6 +394,7 @@ MainWindow::MainWindow(QWidget* parent) : QMainWindow(parent), doc_(new ProjectD
             if (!drain_.done() || !retiredRenderer_->renderer().workersFinished() || tearingDown()) return;
             drain_ = vk::Submission();
             tearingDown_ = std::async(std::launch::async, [this, old = std::move(retiredRenderer_)]() mutable {
+                const BackgroundThread background;
                 old.reset();
                 ++renderersTornDownOnWorkers_;
             });
@@ -1346,6 +1348,7 @@ void MainWindow::buildRenderer(bool now) {
     remakeRenderer_ = false;
     makingRenderer_ = std::async(std::launch::async, [ctx = ctx_.get(), project = doc_->project(),
                                                       terrain = doc_->terrainShared()] {
+        const BackgroundThread background;
         const vk::WorkerCommands commands(*ctx);
         return std::make_unique<ProjectRenderer>(*ctx, project, *terrain, false);
     });

@@ -249,8 +249,10 @@ struct RendererGpu {
     PipelineSet waterPipelines;
     // The sky behind the terrain's, by fog and samples.
     PipelineSet sky;
+    // The probe pass's compute pipeline (key 0), on probeLayout.
+    PipelineSet probePass;
     std::map<int, vk::UniquePipeline> markerPipelines, leafPipelines, gizmoPipelines;
-    vk::UniquePipeline shadowDepth, probePass;
+    vk::UniquePipeline shadowDepth;
     // The anti-aliasing pass: its colour-only render pass, layout and pipelines by
     // (ssaa ? 2 : 0) + (scene-linear output ? 1 : 0).
     vk::RenderPass outputPass;

@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "system/BackgroundPriority.h"
+
 namespace terralux {
 
 PipelineSet::~PipelineSet() {
@@ -28,7 +30,10 @@ VkPipeline PipelineSet::buildHere(int key, const Build& build) {
 }
 
 void PipelineSet::start(int key, Build build) {
-    building_.emplace(key, std::async(std::launch::async, std::move(build)));
+    building_.emplace(key, std::async(std::launch::async, [build = std::move(build)] {
+                          const BackgroundThread background;
+                          return build();
+                      }));
 }
 
 bool PipelineSet::poll(int key) {

@@ -35,6 +35,7 @@
 #include "render/features/Water.h"
 #include "scene/DebugViews.h"
 #include "render/UniformBlocks.h"
+#include "system/BackgroundPriority.h"
 #include "terrain/HorizonAO.h"
 #include "terrain/MeshLod.h"
 #include "terrain/SurfaceAlbedo.h"
@@ -762,7 +763,10 @@ void TerrainRenderer::startSunHorizonSweep(const SunLight& sun, bool skirt) {
     auto pending = std::make_unique<PendingHorizon>();
     pending->key = glm::vec4(sun.direction, sun.angularRadius);
     pending->skirt = skirt;
-    pending->perVertex = std::async(std::launch::async, sunHorizonSweep(sun, skirt));
+    pending->perVertex = std::async(std::launch::async, [sweep = sunHorizonSweep(sun, skirt)] {
+        const BackgroundThread background;
+        return sweep();
+    });
     pendingHorizon_ = std::move(pending);
 }
 
@@ -1146,6 +1150,38 @@ void TerrainRenderer::publishLod() {
         for (const auto& [k, v] : detailVertices_) d.detailVertexCount += uint32_t(v.size() / 6);
         d.detailSerial = detailSerial_;
     }
+}
+
+void TerrainRenderer::startLevelOfDetail(const RenderSettings& s, const LodKey& key) {
+    lodAsked_ = key;
+    // Isolated: its parallel loops must not take up the UI thread's tasks, nor it theirs.
+    pendingLod_ = std::async(std::launch::async, [this, settings = s, key] {
+        const BackgroundThread background;
+        tbb::this_task_arena::isolate([&] {
+            updateLod(settings, key.rows, key.picture, key.sourceDetail, key.shadowed, key.inputs);
+        });
+    });
+}
+
+bool TerrainRenderer::levelOfDetailReady(const RenderSettings& s) {
+    if (s.waitForLevelOfDetail || drawnLod_.serial > 0) return true;
+    const Parts p = partsOf(s, findDebugView(s.debugView).value_or(*findDebugView(kViewBeauty)));
+    if (!p.sky || p.sunVisibility) return true;  // recordFrame chooses such a frame's levels itself
+    if (!pendingLod_.valid()) {
+        // The key recordFrame's first frame asks for: no shadow map is drawn yet, so it chooses
+        // for its own output rows unless it keeps the window's, and with the shadow casters when
+        // it has shadows. Where the frame asks for another key it draws this set and starts its own.
+        const uint32_t outputRows = s.height / std::max<uint32_t>(uint32_t(antialiasingOf(s).scale), 1u);
+        const bool ownRows = s.levelOfDetailRows == 0 || s.levelOfDetailYields;
+        const double rows = double(ownRows ? outputRows : s.levelOfDetailRows);
+        startLevelOfDetail(s, LodKey{s.camera.position(), double(s.camera.fovDeg), rows, double(s.sun.direction.y),
+                                     true, true, p.shadowed, lodInputsOf(p.water ? gpu_->water.get() : nullptr)});
+    }
+    return levelOfDetailBuilt();
+}
+
+bool TerrainRenderer::levelOfDetailAwaited() const {
+    return drawnLod_.serial == 0 && pendingLod_.valid() && !levelOfDetailBuilt();
 }
 
 bool TerrainRenderer::levelOfDetailBuilt() const {
@@ -1605,6 +1641,7 @@ bool TerrainRenderer::pipelinesReady(const RenderSettings& s) {
     };
     if (p.sky) ready = skyAt(samples) && ready;
     if (p.planarReflection) ready = skyAt(1) && ready;
+    if (p.probes) ready = g.probePass.ready(0, [&] { return features::probePassBuild(ctx_, g, *g.probes); }) && ready;
     if (p.water) {
         const int water = features::waterVariant(p.shadowed, s.fog.enabled, p.reflections);
         ready = g.waterPipelines.ready(water | kSamplesKey(samples),
@@ -1620,15 +1657,18 @@ bool TerrainRenderer::workersFinished() const {
 }
 
 bool TerrainRenderer::pipelinesBuilding() const {
-    return gpu_->terrain.building() || gpu_->waterPipelines.building() || gpu_->sky.building();
+    return gpu_->terrain.building() || gpu_->waterPipelines.building() || gpu_->sky.building() ||
+           gpu_->probePass.building();
 }
 
 size_t TerrainRenderer::pipelinesBuiltInline() const {
-    return gpu_->terrain.builtHere() + gpu_->waterPipelines.builtHere() + gpu_->sky.builtHere();
+    return gpu_->terrain.builtHere() + gpu_->waterPipelines.builtHere() + gpu_->sky.builtHere() +
+           gpu_->probePass.builtHere();
 }
 
 size_t TerrainRenderer::pipelinesBuiltOnWorkers() const {
-    return gpu_->terrain.builtOnWorkers() + gpu_->waterPipelines.builtOnWorkers() + gpu_->sky.builtOnWorkers();
+    return gpu_->terrain.builtOnWorkers() + gpu_->waterPipelines.builtOnWorkers() + gpu_->sky.builtOnWorkers() +
+           gpu_->probePass.builtOnWorkers();
 }
 
 void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const RenderSettings& s,
@@ -1706,8 +1746,11 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
         // A viewport picture chooses its levels on a worker once a set is held (the first close
         // view of a 16 384² DEM takes 0.6 s to choose and build) and draws the held set until the
         // new one lands; every other frame waits for one under way and chooses its own here.
-        const bool onWorker = !s.waitForLevelOfDetail && picture && sourceDetail && drawnLod_.serial > 0;
-        if (pendingLod_.valid() && (!onWorker || levelOfDetailBuilt())) {
+        // A frame that holds none takes the first set started for it (levelOfDetailReady),
+        // waiting for it if it has not landed.
+        const bool onWorker =
+            !s.waitForLevelOfDetail && picture && sourceDetail && (drawnLod_.serial > 0 || pendingLod_.valid());
+        if (pendingLod_.valid() && (!onWorker || drawnLod_.serial == 0 || levelOfDetailBuilt())) {
             try {
                 pendingLod_.get();
             } catch (...) {
@@ -1721,13 +1764,7 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
             publishLod();
             lodAsked_ = key;
         } else if (!pendingLod_.valid() && lodAsked_ != key) {
-            lodAsked_ = key;
-            // Isolated: its parallel loops must not take up the UI thread's tasks, nor it theirs.
-            pendingLod_ = std::async(std::launch::async, [this, settings = s, rows, picture, sourceDetail, shadowed,
-                                                          lodInputs] {
-                tbb::this_task_arena::isolate(
-                    [&] { updateLod(settings, rows, picture, sourceDetail, shadowed, lodInputs); });
-            });
+            startLevelOfDetail(s, key);
         }
     }
     if (g.detailSerial != drawnLod_.detailSerial) {

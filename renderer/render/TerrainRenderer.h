@@ -310,6 +310,13 @@ public:
     // has finished (the next frame draws it).
     bool levelOfDetailBuilding() const { return pendingLod_.valid(); }
     bool levelOfDetailBuilt() const;
+    // Whether a frame of `settings` finds levels to draw: a viewport picture (waitForLevelOfDetail
+    // off) of a renderer that holds none has its first set chosen on a worker (a 16 384² DEM's
+    // takes 120-140 ms on the 2-core machine), and a viewport that must not wait draws that frame
+    // once it has landed (ProjectRenderer::waitingToDraw polls levelOfDetailAwaited()), as for
+    // the first horizon map. Any other frame is ready: it chooses its own where it records.
+    bool levelOfDetailReady(const RenderSettings& settings);
+    bool levelOfDetailAwaited() const;
     size_t vertexCount() const { return vertexCount_; }
     size_t triangleCount() const { return indexCount_ / 3; }
     size_t probeBytes() const { return probeBytes_; }
@@ -461,6 +468,7 @@ private:
     };
     std::future<void> pendingLod_;
     std::optional<LodKey> lodAsked_;
+    void startLevelOfDetail(const RenderSettings& s, const LodKey& key);
     vk::VulkanContext& ctx_;
     const Heightfield& hf_;
     std::unique_ptr<RendererGpu> gpu_;

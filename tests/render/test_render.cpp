@@ -3441,6 +3441,52 @@ TEST_F(RenderTest, AViewportFrameChoosesItsLevelsOnAWorkerAndDrawsTheHeldSetMean
     EXPECT_GT(before.meanAbs, 5e-4);
 }
 
+// A viewport's first picture of a terrain (waitForLevelOfDetail off) finds no set held: its levels
+// are chosen on a worker (levelOfDetailReady) and the frame is put off, nothing chosen where it asked;
+// once they have landed it draws them without choosing again, and they are the set, and the frame,
+// of a renderer that chose where it recorded. A view the worker does not choose for is ready at once.
+TEST_F(RenderTest, AViewportsFirstLevelsAreChosenOnAWorker) {
+    Project p = sampleProject("lod_first", 4, 4);
+    p.scene.camera.exposureMode = ExposureMode::Manual;
+    const size_t vertices = demVertices(p);
+    ProjectRenderer waits(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    ProjectRenderer viewport(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    OrbitCamera camera = OrbitCamera::fromSettings(p.scene.camera, waits.heightfield());
+    camera.radius = 150.0f;
+    camera.elevationDeg = 10.0f;
+    RenderRequest q = unprobed(kViewBeauty, false);
+    q.waitForLevelOfDetail = false;
+    TerrainRenderer& t = viewport.renderer();
+    const RenderSettings s = viewport.settingsOf(q, camera);
+    EXPECT_FALSE(t.levelOfDetailReady(s));
+    EXPECT_TRUE(t.levelOfDetailBuilding());
+    EXPECT_EQ(t.levelOfDetailSerial(), 0u);
+    const auto start = std::chrono::steady_clock::now();
+    while (!t.levelOfDetailBuilt() && std::chrono::steady_clock::now() - start < std::chrono::seconds(60))
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    EXPECT_FALSE(t.levelOfDetailAwaited());
+    EXPECT_TRUE(t.levelOfDetailReady(s));
+    EXPECT_EQ(t.levelOfDetailSerial(), 0u) << "a set was published before a frame took it";
+    const RenderedImage drawn = viewport.render(q, camera);
+    EXPECT_EQ(t.levelOfDetailSerial(), 1u);
+    EXPECT_FALSE(t.levelOfDetailBuilding()) << "the frame asked for another set than the one chosen for it";
+
+    const RenderedImage reference = waits.render(unprobed(kViewBeauty, false), camera);
+    const TerrainRenderer::LodChoice& chosen = waits.renderer().lastLod();
+    EXPECT_GE(std::count_if(chosen.detail.begin(), chosen.detail.end(), [](int8_t d) { return d >= 0; }), 1);
+    EXPECT_EQ(t.lastLod().levels, chosen.levels);
+    EXPECT_EQ(t.lastLod().detail, chosen.detail);
+    EXPECT_EQ(t.lastLod().triangles, chosen.triangles);
+    EXPECT_LE(test::compareImages(drawn.rgba, reference.rgba, kW, kH).maxAbs, 1e-6);
+    // The traced sun's view chooses its own levels where it records (its per-vertex visibility
+    // draws no detail patches).
+    ProjectRenderer traced(*ctx_, p, loadProjectTerrain(p), true, vertices / 3);
+    RenderRequest sunView = unprobed(kViewSunVisibility, false);
+    sunView.waitForLevelOfDetail = false;
+    EXPECT_TRUE(traced.renderer().levelOfDetailReady(traced.settingsOf(sunView, camera)));
+    EXPECT_FALSE(traced.renderer().levelOfDetailBuilding());
+}
+
 // A viewport's frame (waitUntilDrawable off) whose pipelines are not built has them built on a
 // worker and is not drawn meanwhile (lavapipe compiles the terrain's in 120-170 ms): the terrain's
 // and the sky's at the frame's samples and at the water reflection's one, and the water's. Once they have
@@ -3498,6 +3544,22 @@ TEST_F(RenderTest, PipelinesAFrameLacksAreBuiltOnAWorkerAndDrawTheSameFrame) {
     p.scene.fog.enabled = false;
     worker.setProject(p);
     EXPECT_TRUE(t.pipelinesReady(worker.settingsOf(q, camera)));
+    // Probes on: the terrain's probe-light variant and the probe pass's compute pipeline (40-50 ms
+    // on lavapipe) are built on workers too, and the frame that evaluates the probes builds none.
+    ASSERT_EQ(worker.loadProbes(true), 1u);
+    RenderRequest probed = q;
+    probed.probes = true;
+    const RenderSettings withProbes = worker.settingsOf(probed, camera);
+    const size_t before = t.pipelinesBuiltOnWorkers();
+    EXPECT_FALSE(t.pipelinesReady(withProbes));
+    ASSERT_TRUE(landed());
+    EXPECT_TRUE(t.pipelinesReady(withProbes));
+    // The terrain's at the frame's samples (and the reflection's 1), and the probe pass's.
+    EXPECT_EQ(t.pipelinesBuiltOnWorkers(), before + (msaa ? 3u : 2u));
+    worker.render(probed, camera);
+    const std::vector<std::string> probedPasses = passNames(t.lastFramePasses());
+    EXPECT_NE(std::find(probedPasses.begin(), probedPasses.end(), "probe-vertices"), probedPasses.end());
+    EXPECT_EQ(t.pipelinesBuiltInline(), 0u) << "the probed frame built a pipeline where it recorded";
 }
 
 TEST_F(RenderTest, DetailPatchesMeetTheirPixelWhereverTheCameraIsAndKeepToTheirBudget) {

@@ -110,6 +110,16 @@ std::unique_ptr<ProbeResources::Detail> buildDetailLight(vk::VulkanContext& ctx,
     return d;
 }
 
+PipelineSet::Build probePassBuild(const vk::VulkanContext& ctx, RendererGpu& g, const ProbeResources& p) {
+    if (!g.probeLayout.handle()) {
+        const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), p.set.layout()};
+        g.probeLayout = vk::PipelineLayout(ctx, sets);
+    }
+    return [&ctx, layout = g.probeLayout.handle()] {
+        return vk::createComputePipeline(ctx, layout, shaders::probeVerticesComp());
+    };
+}
+
 void addProbePass(Frame& f) {
     ProbeResources* probes = f.probes;
     if (!probes) return;
@@ -119,11 +129,7 @@ void addProbePass(Frame& f) {
                                          : nullptr;
     if (!probes->lightStale && !detail) return;
     RendererGpu& g = f.g;
-    if (!g.probePass) {
-        const VkDescriptorSetLayout sets[] = {g.emptySet.get(), g.emptySet.get(), probes->set.layout()};
-        g.probeLayout = vk::PipelineLayout(f.ctx, sets);
-        g.probePass = vk::createComputePipeline(f.ctx, g.probeLayout.handle(), shaders::probeVerticesComp());
-    }
+    const VkPipeline pipeline = g.probePass.get(0, [&] { return probePassBuild(f.ctx, g, *probes); });
     PassInfo info{"probe-vertices",
                   {{kProbeCoefficients, Access::ComputeStorageRead},
                    {kProbeCells, Access::ComputeStorageRead},
@@ -145,8 +151,8 @@ void addProbePass(Frame& f) {
         info.bindings = concat(info.bindings, detail->set.bindingNames());
     }
     const VkDescriptorSet sets[2] = {probes->set.handle(), detail ? detail->set.handle() : VK_NULL_HANDLE};
-    g.graph.addPass(std::move(info), [&g, sets, n, nd](VkCommandBuffer c) {
-        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, g.probePass.get());
+    g.graph.addPass(std::move(info), [&g, pipeline, sets, n, nd](VkCommandBuffer c) {
+        vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
         for (int k = 0; k < 2; ++k) {
             const uint32_t count = k == 0 ? n : nd;
             if (count == 0) continue;

@@ -39,6 +39,10 @@ std::unique_ptr<ProbeResources> buildProbes(vk::VulkanContext& ctx, RendererGpu&
                                             const std::vector<GpuProbeVolume>& volumes);
 // The probe light's buffer and set for the detail patches' vertices g.detailVertices holds now.
 std::unique_ptr<ProbeResources::Detail> buildDetailLight(vk::VulkanContext& ctx, RendererGpu& g, const ProbeResources& p);
+// The probe pass's compute pipeline, on the layout of `p`'s set (made here, on the calling thread,
+// the first time): built on a worker for a viewport frame (TerrainRenderer::pipelinesReady;
+// lavapipe compiles it in 40-50 ms), else where the frame records.
+PipelineSet::Build probePassBuild(const vk::VulkanContext& ctx, RendererGpu& g, const ProbeResources& p);
 // Evaluates the volumes at the vertices, once after they changed, and at the detail patches'
 // vertices, once after either changed.
 void addProbePass(Frame& f);
