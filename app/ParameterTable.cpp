@@ -1,4 +1,5 @@
 #include "ParameterTable.h"
+#include "KeptPlacement.h"
 
 #include <cctype>
 #include <charconv>
@@ -10,7 +11,6 @@
 #include "bake/PhysicalSky.h"
 #include "bake/ReflectionBake.h"
 #include "lpv/Lpv.h"
-#include "terrain/DerivedCache.h"
 #include "water/Water.h"
 
 #include <algorithm>
@@ -1647,24 +1647,6 @@ std::string uiObjectNamesMarkdown() {
     for (size_t k = 0; k < special.size(); ++k) out << (k ? ", " : "") << special[k];
     out << ".\n";
     return out.str();
-}
-
-std::shared_ptr<const ProbeLayout> keptPlacement(const SceneDescription& scene, size_t volume, const Heightfield& hf) {
-    struct Placed {
-        std::optional<ProbeLayout> layout;
-        std::string error;
-    };
-    static DerivedCache<Placed> kept(8);
-    const std::string key = sceneToJson(scene).at("probe_volumes").at(volume).dump();
-    const auto placed = kept.get(hf.serial(), key, [&] {
-        try {
-            return Placed{placeProbes(scene.probeVolumes.at(volume), hf), {}};
-        } catch (const std::exception& e) {
-            return Placed{std::nullopt, e.what()};
-        }
-    });
-    if (!placed->layout) throw PlacementError(placed->error);
-    return std::shared_ptr<const ProbeLayout>(placed, &*placed->layout);
 }
 
 }  // namespace terralux

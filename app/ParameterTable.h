@@ -168,12 +168,6 @@ std::string autoShort(const ParameterSpec& spec);
 // 0.30000001192092896): how the project writes its float fields, and the exporters theirs.
 double shortestDecimal(float f);
 
-// Volume `volume` of the scene as the bake places it (placeProbes), kept until that volume or
-// the terrain changes: the docks and the window's estimate ask for it on every edit of the
-// project (placing a 16 384² grid's default volume took 40 ms each). Throws what placeProbes
-// throws, as a PlacementError.
-std::shared_ptr<const ProbeLayout> keptPlacement(const SceneDescription& scene, size_t volume, const Heightfield& hf);
-
 // JSON Schema (draft 2020-12) of the project file, generated from the table.
 nlohmann::json projectSchema();
 // What a bake of `scene` reads, as JSON in the project's shape: every row whose BakeUse is Reads,

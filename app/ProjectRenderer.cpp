@@ -10,6 +10,7 @@
 
 #include "AlbedoImport.h"
 #include "BakeJob.h"
+#include "KeptPlacement.h"
 #include "ParameterTable.h"
 #include "SceneLighting.h"
 #include "ProbeDiagnosticsFile.h"

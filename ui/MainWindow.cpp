@@ -55,6 +55,7 @@
 #include "DemImport.h"
 #include "ParameterPanels.h"
 #include "WaterPanel.h"
+#include "KeptPlacement.h"
 #include "ParameterTable.h"
 #include "BakeJob.h"
 #include "PreviewBake.h"

@@ -2,11 +2,13 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "terrain/DerivedCache.h"
 #include "terrain/Heightfield.h"
 
 using namespace terralux;
@@ -82,6 +84,40 @@ TEST(Heightfield, ASerialNamesWhatTheGridHolds) {
     const Heightfield to = std::move(from);
     EXPECT_EQ(to.serial(), copy.serial());
     EXPECT_EQ(from.serial(), 0u);  // NOLINT(bugprone-use-after-move): what a move leaves
+}
+
+// A cache with a byte budget keeps the newest values within it, the newest always, and no more
+// than its count; a value it let go is computed again.
+TEST(DerivedCache, KeepsTheNewestWithinItsCountAndBytes) {
+    DerivedCache<std::string> cache(3, 10, [](const std::string& s) { return s.size(); });
+    int computed = 0;
+    auto get = [&](const std::string& key, size_t bytes) {
+        return *cache.get(7, key, [&] {
+            ++computed;
+            return std::string(bytes, 'x');
+        });
+    };
+    get("a", 4);
+    get("b", 4);
+    EXPECT_EQ(cache.size(), 2u);
+    EXPECT_EQ(cache.bytes(), 8u);
+    get("c", 4);  // 12 bytes: "a", the oldest, goes
+    EXPECT_EQ(cache.size(), 2u);
+    EXPECT_EQ(cache.bytes(), 8u);
+    get("b", 4);
+    EXPECT_EQ(computed, 3);  // "b" was kept
+    get("a", 4);
+    EXPECT_EQ(computed, 4);  // "a" was not
+    get("big", 25);          // over the budget alone: kept, alone
+    EXPECT_EQ(cache.size(), 1u);
+    EXPECT_EQ(cache.bytes(), 25u);
+    get("big", 25);
+    EXPECT_EQ(computed, 5);
+    DerivedCache<std::string> counted(2);  // no budget: its count alone
+    for (const char* k : {"a", "b", "c"}) counted.get(7, k, [] { return std::string(100, 'x'); });
+    EXPECT_EQ(counted.size(), 2u);
+    EXPECT_EQ(counted.get(0, "a", [] { return std::string(); })->size(), 0u);  // serial 0: never kept
+    EXPECT_EQ(counted.size(), 2u);
 }
 
 TEST(Heightfield, ASampleRangeIsTheRangeOfItsSamples) {

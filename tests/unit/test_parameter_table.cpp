@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "KeptPlacement.h"
 #include "ParameterTable.h"
 #include "Project.h"
 #include "ProjectErrors.h"
@@ -438,8 +439,9 @@ TEST(ParameterTable, AutoValuesFollowTheVolumeAndTheTerrain) {
 
 // The docks, the window's estimate and the viewport's markers ask for a volume's placement on
 // every edit: it is placed once per volume and terrain, as placeProbes places it, and refused
-// as placeProbes refuses it.
-TEST(ParameterTable, APlacementIsKeptPerVolumeAndTerrain) {
+// as placeProbes refuses it; any other failure is thrown as it is. What is kept stays within
+// its count and bytes.
+TEST(KeptPlacement, APlacementIsKeptPerVolumeAndTerrain) {
     auto slope = [](float rise) {
         std::vector<float> h(size_t(33) * 33);
         for (size_t i = 0; i < h.size(); ++i) h[i] = rise * float(i / 33);
@@ -477,4 +479,9 @@ TEST(ParameterTable, APlacementIsKeptPerVolumeAndTerrain) {
             EXPECT_EQ(std::string(e.what()), refused);
         }
     }
+    // No such volume: not a refusal of the bake's.
+    EXPECT_THROW(keptPlacement(s, 3, a), std::out_of_range);
+    EXPECT_GE(keptPlacements(), 1u);
+    EXPECT_LE(keptPlacements(), kKeptPlacements);
+    EXPECT_LE(keptPlacementBytes(), kKeptPlacementBytes);
 }
