@@ -450,11 +450,25 @@ void TerrainRenderer::setSkyImage(int width, int height, const std::vector<glm::
     if (image)
         for (size_t i = 0; i < level.size(); ++i) level[i] = glm::vec4(glm::min(radiance[i], glm::vec3(65000.0f)), 1.0f);
     const std::vector<vk::MipLevel> levels = boxMipChain(std::move(level), image ? width : 1, image ? height : 1, halfLevel);
-    vk::Image texture = vk::Image::texture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels);
-    ctx_.waitIdle();  // no frame may still read the old image
-    g.surface.sky = std::move(texture);
+    replaceTexture(g.surface.sky, vk::Image::stagedTexture(ctx_, VK_FORMAT_R16G16B16A16_SFLOAT, levels));
     skyImageHeight_ = image ? height : 0;
     if (g.surface.albedo.handle() != VK_NULL_HANDLE) buildViewSets();
+}
+
+void TerrainRenderer::replaceTexture(vk::Image& held, vk::StagedTexture staged) {
+    RendererGpu& g = *gpu_;
+    // Frames in flight may still read the old image and the view sets that name it: retired, not
+    // waited for. The new one's levels are copied in by the next frame, before its passes: a
+    // submission of their own would wait behind every frame queued (0.1-0.3 s a sky edit on
+    // lavapipe while the water's waves kept frames coming).
+    std::erase_if(pendingTextures_, [&](const vk::StagedTexture& t) { return t.target == held.handle(); });
+    retire(std::move(held));
+    held = std::move(staged.image);
+    pendingTextures_.push_back(std::move(staged));
+    for (FrameSlot& f : g.slots) {
+        retire(std::move(f.view));
+        retire(std::move(f.reflectionView));
+    }
 }
 
 void TerrainRenderer::setAmbientOcclusion(const std::vector<float>& perVertex) { uploadSurfaceMaps(perVertex); }
@@ -477,9 +491,7 @@ void TerrainRenderer::setAlbedoMap(int width, int height, const std::vector<uint
             }
             return l;
         });
-    vk::Image image = vk::Image::texture(ctx_, VK_FORMAT_R8G8B8A8_SRGB, levels);
-    ctx_.waitIdle();  // no frame may still read the old map
-    g.surface.albedo = std::move(image);
+    replaceTexture(g.surface.albedo, vk::Image::stagedTexture(ctx_, VK_FORMAT_R8G8B8A8_SRGB, levels));
     hasAlbedoMap_ = map;
     if (map) {
         // The ring of border texels, the albedo the skirt takes (it is clamped to the footprint).
@@ -1851,6 +1863,12 @@ void TerrainRenderer::recordFrame(VkCommandBuffer cb, uint32_t slotIndex, const 
                         });
         g.graph.addFinalUse({kSwapchain, Access::Present});
     }
+    // Textures set since the last frame: their levels go in before anything reads them.
+    for (vk::StagedTexture& t : pendingTextures_) {
+        t.record(cb);
+        retire(std::move(t.staging));
+    }
+    pendingTextures_.clear();
     FrameSlot& slot = f.slot;
     slot.timestampsWritten = g.graph.execute(cb, slot.timestamps.get(), slot.timestamps ? kFrameTimestamps : 0);
     if (slot.timestampsWritten > 0) {

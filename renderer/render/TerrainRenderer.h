@@ -384,6 +384,9 @@ private:
         std::shared_ptr<void> resource;
     };
     std::vector<Retired> retired_;
+    // Textures whose levels the next recorded frame copies in (replaceTexture).
+    std::vector<vk::StagedTexture> pendingTextures_;
+    void replaceTexture(vk::Image& held, vk::StagedTexture staged);
     uint64_t framesBegun_ = 0;  // swapchain frames begun: each waited for its slot's frame before
     // Chooses the frame's levels for `rows` of output; builds their triangles when they changed
     // (++lodSerial_).

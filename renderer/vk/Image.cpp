@@ -119,46 +119,61 @@ Image Image::cubeArrayTexture(const VulkanContext& ctx, VkFormat format, uint32_
     return upload(ctx, ImageShape::CubeArray, format, 6 * cubes, levels);
 }
 
-Image Image::upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
-                    const std::vector<MipLevel>& levels) {
+StagedTexture Image::stagedTexture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels) {
+    return stage(ctx, ImageShape::Plane, format, 1, levels);
+}
+
+StagedTexture Image::stage(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
+                           const std::vector<MipLevel>& levels) {
     if (levels.empty()) throw std::invalid_argument("a texture needs at least one level");
-    Image img(ctx, {shape, format, levels[0].width, levels[0].height, layers,
-                    VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, uint32_t(levels.size())});
+    StagedTexture t;
+    t.image = Image(ctx, {shape, format, levels[0].width, levels[0].height, layers,
+                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, uint32_t(levels.size())});
+    t.target = t.image.handle();
+    t.layers = layers;
     size_t total = 0;
     for (const MipLevel& l : levels) total += (l.bytes.size() + 15) & ~size_t(15);
-    Buffer staging(ctx, std::max<size_t>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    std::vector<VkBufferImageCopy> copies;
+    t.staging = Buffer(ctx, std::max<size_t>(total, 16), VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     size_t offset = 0;
     for (uint32_t i = 0; i < levels.size(); ++i) {
-        staging.write(levels[i].bytes.data(), levels[i].bytes.size(), offset);
+        t.staging.write(levels[i].bytes.data(), levels[i].bytes.size(), offset);
         VkBufferImageCopy c{};
         c.bufferOffset = offset;
         c.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, i, 0, layers};
         c.imageExtent = {levels[i].width, levels[i].height, 1};
-        copies.push_back(c);
+        t.copies.push_back(c);
         offset += (levels[i].bytes.size() + 15) & ~size_t(15);
     }
-    ctx.submitAndWait([&](VkCommandBuffer cb) {
-        VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.image = img.handle();
-        b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(levels.size()), 0, layers};
-        b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-        b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                             nullptr, 0, nullptr, 1, &b);
-        vkCmdCopyBufferToImage(cb, staging.handle(), img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                               uint32_t(copies.size()), copies.data());
-        b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-        b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-        b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-        b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-        vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0,
-                             nullptr, 0, nullptr, 1, &b);
-    });
-    return img;
+    return t;
+}
+
+void StagedTexture::record(VkCommandBuffer cb) const {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = target;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, uint32_t(copies.size()), 0, layers};
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+    vkCmdCopyBufferToImage(cb, staging.handle(), target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           uint32_t(copies.size()), copies.data());
+    b.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    // Every later stage: a frame's uploads are recorded before any of its passes.
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &b);
+}
+
+Image Image::upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
+                    const std::vector<MipLevel>& levels) {
+    StagedTexture t = stage(ctx, shape, format, layers, levels);
+    ctx.submitAndWait([&](VkCommandBuffer cb) { t.record(cb); });
+    return std::move(t.image);
 }
 
 }  // namespace terralux::vk

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "vk/Buffer.h"
 #include "vk/Handle.h"
 #include "vk/VulkanContext.h"
 
@@ -31,6 +32,8 @@ struct MipLevel {
     uint32_t width = 1, height = 1;
     std::vector<uint8_t> bytes;
 };
+
+struct StagedTexture;
 
 class Image {
 public:
@@ -68,6 +71,10 @@ public:
     // each level's bytes hold its layers one after another. Needs VulkanContext::cubeArrays().
     static Image cubeArrayTexture(const VulkanContext& ctx, VkFormat format, uint32_t cubes,
                                   const std::vector<MipLevel>& levels);
+    // A texture as texture() makes it, its levels still in the staging buffer: the caller records
+    // their copy into a command buffer it submits anyway (a frame's), rather than waiting for a
+    // submission of its own behind every frame already queued.
+    static StagedTexture stagedTexture(const VulkanContext& ctx, VkFormat format, const std::vector<MipLevel>& levels);
 
     VkImage handle() const { return image_.get(); }
     // The whole image as shaders see it: 2D, 2D array or cube.
@@ -83,6 +90,8 @@ public:
 private:
     static Image upload(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
                         const std::vector<MipLevel>& levels);
+    static StagedTexture stage(const VulkanContext& ctx, ImageShape shape, VkFormat format, uint32_t layers,
+                               const std::vector<MipLevel>& levels);
     ImageDesc desc_;
     VkImageAspectFlags aspect_ = VK_IMAGE_ASPECT_COLOR_BIT;
     // Declared in destruction order: views, image, then its memory.
@@ -90,6 +99,18 @@ private:
     UniqueImage image_;
     UniqueImageView view_;
     std::vector<UniqueImageView> layerViews_;
+};
+
+// A texture and the staging buffer its levels wait in (Image::stagedTexture).
+struct StagedTexture {
+    Image image;            // the caller may take it: record() needs only `target`
+    VkImage target = VK_NULL_HANDLE;
+    Buffer staging;
+    std::vector<VkBufferImageCopy> copies;
+    uint32_t layers = 1;
+    // Copies the levels in and leaves the image in the shader-read layout for every stage after
+    // it; the staging buffer must outlive the command buffer's execution.
+    void record(VkCommandBuffer cb) const;
 };
 
 bool isDepthFormat(VkFormat format);
